@@ -1,0 +1,13 @@
+/* Runs every suite; the exit status is the number of failures (0 on success). */
+#include <stdlib.h>
+#include "fsdem_tests.h"
+
+int main(void) {
+    SRunner *runner = srunner_create(core_suite());
+    int failed;
+    srunner_add_suite(runner, dem_suite());
+    srunner_run_all(runner, CK_NORMAL);
+    failed = srunner_ntests_failed(runner);
+    srunner_free(runner);
+    return failed == 0 ? EXIT_SUCCESS : EXIT_FAILURE;
+}

@@ -1,0 +1,10 @@
+/* Shared declarations of the Check suite: one suite per module, and small helpers. */
+#ifndef FSDEM_TESTS_H
+#define FSDEM_TESTS_H
+#include <check.h>
+#include "fsdem.h"
+
+Suite *core_suite(void);
+Suite *dem_suite(void);
+
+#endif
