@@ -1005,9 +1005,11 @@ static fsdem_vec3 fsdem__contact_force(const fsdem_dem *d, const fsdem__contact 
         ft_max = p->friction * fn;
         ft_len = fsdem__norm(ft);
         if (ft_len > ft_max) {
-            /* sliding: cap at Coulomb and reset the spring to match the capped force */
+            /* Sliding: cap at Coulomb and let the spring carry the capped force alone. Folding the
+               damping term into the spring (-(F_t + eta_t v_t)/S_t) would store energy along the
+               slip at first touch, where eta_t ~ d^(1/4) outgrows mu F_n ~ d^(3/2). */
             ft = fsdem__scale(ft, ft_max / ft_len);
-            xi = st > 0 ? fsdem__scale(fsdem__add(ft, fsdem__scale(vt, eta_t)), -1 / st) : fsdem__zero3();
+            xi = st > 0 ? fsdem__scale(ft, -1 / st) : fsdem__zero3();
         }
         if (commit) *history = xi;
         *fn_out = fn;
