@@ -68,6 +68,7 @@ sanitize: $(TEST_SRC) fsdem.h | $(BUILD) check-deps
 	CK_FORK=no UBSAN_OPTIONS=halt_on_error=1 $(BUILD)/check_fsdem_san
 
 $(BUILD)/examples/%: examples/%.c fsdem.h | $(BUILD)
+	@mkdir -p $(dir $@)
 	$(CC) $(STD) $(WARN) $(CFLAGS) -I. $< -o $@ $(LDLIBS)
 
 examples: $(EXAMPLES)
