@@ -194,7 +194,9 @@ typedef enum fsdem_contact_law {
 } fsdem_contact_law;
 
 typedef enum fsdem_integrator {
-    /* Velocity Verlet (kick-drift-kick), second order, one force evaluation per step. */
+    /* Velocity Verlet (kick-drift-kick), one force evaluation per step: second order for elastic
+       forces; dashpots see the half-step velocity, which makes damping first order in dt (resolve
+       a contact with >= 50 steps, or use the predictor-corrector, whose error is far smaller). */
     FSDEM_INTEGRATOR_VERLET = 0,
     /* Predictor-corrector of seed 000 Eq. 21-24, two force evaluations per step. */
     FSDEM_INTEGRATOR_PREDICTOR_CORRECTOR = 1
@@ -714,7 +716,17 @@ typedef struct fsdem__list {
     int count, capacity;
 } fsdem__list;
 
+/* One particle-wall contact of the current positions. */
+typedef struct fsdem__wall_hit {
+    int entry;         /* index into the particle-wall list */
+    fsdem_vec3 n;      /* unit normal from the wall towards the particle */
+    fsdem_real delta;  /* m, overlap > 0 */
+    int on_feature;    /* contact point on a triangle edge/vertex or a segment end */
+} fsdem__wall_hit;
+
 #define FSDEM__WALL_KEY(wall, face) ((wall) * 8 + (face))
+#define FSDEM__WALL_OF(key) ((key) / 8)
+#define FSDEM__FACE_OF(key) ((key) % 8)
 
 struct fsdem_dem {
     fsdem_dem_desc desc;
@@ -740,6 +752,8 @@ struct fsdem_dem {
     int wall_count, wall_capacity;
 
     fsdem__list pp, pp_old, pw, pw_old;
+    struct fsdem__wall_hit *hits; /* scratch: one particle's wall contacts (fsdem__wall_hits) */
+    int hit_capacity;
     fsdem_cellgrid grid;
     fsdem_real skin, r_max, max_disp2, k0_linear;
     int need_rebuild, forces_valid;
@@ -867,11 +881,11 @@ static fsdem_result fsdem__material_check(const fsdem_material *m, char *msg, si
    d0 = v0 t0. The scaling removes m, k and v0, so e depends on a alone (Tsuji et al. 1992), and the
    force is clamped at zero (no adhesion) as it is in the simulation. Integrated with RK4. */
 static double fsdem__hertz_restitution(double a) {
-    double x = 0, v = 1, h = 1e-3 / (1 + a);
+    double x = 0, v = 1, h = 4e-3 / (1 + a); /* ~800 steps per contact: e to about 1e-6 */
     int step;
     for (step = 0; step < 100000000; ++step) {
         double k1x, k1v, k2x, k2v, k3x, k3v, k4x, k4v, xs, vs, xn, vn;
-#define FSDEM__HERTZ_ACC(X, V) (-fmax(0.0, pow(fmax(X, 0.0), 1.5) + a * pow(fmax(X, 0.0), 0.25) * (V)))
+#define FSDEM__HERTZ_ACC(X, V) (-fmax(0.0, fmax(X, 0.0) * sqrt(fmax(X, 0.0)) + a * sqrt(sqrt(fmax(X, 0.0))) * (V)))
         k1x = v;
         k1v = FSDEM__HERTZ_ACC(x, v);
         xs = x + 0.5 * h * k1x;
@@ -915,7 +929,7 @@ static fsdem_real fsdem__tsuji_coefficient(fsdem_real e) {
 
 static fsdem_real fsdem__inv_or_zero(fsdem_real x) { return fsdem__finite(x) ? 1 / x : 0; }
 
-static void fsdem__pair_setup(fsdem__pair *p, const fsdem_material *a, const fsdem_material *b,
+static void fsdem__pair_setup(fsdem__pair *p, const fsdem_material *a, const fsdem_material *b, fsdem_contact_law law,
                               const fsdem__pair *known, int known_count) {
     fsdem_real ea = a->young_modulus, eb = b->young_modulus, na = a->poisson_ratio, nb = b->poisson_ratio;
     fsdem_real e = (a->restitution + b->restitution) / 2;
@@ -931,7 +945,9 @@ static void fsdem__pair_setup(fsdem__pair *p, const fsdem_material *a, const fsd
     p->friction = (a->friction + b->friction) / 2;
     p->rolling = (a->rolling_friction + b->rolling_friction) / 2;
     p->restitution = e;
-    /* The calibration costs milliseconds; reuse it for a restitution seen before. */
+    p->tsuji = 0;
+    if (law != FSDEM_CONTACT_HERTZ_MINDLIN) return;
+    /* The calibration costs a few milliseconds; reuse it for a restitution seen before. */
     for (k = 0; k < known_count; ++k)
         if (known[k].restitution == e) {
             p->tsuji = known[k].tsuji;
@@ -1138,6 +1154,7 @@ void fsdem_dem_destroy(fsdem_dem *d) {
     fsdem__list_free(d, &d->pp_old);
     fsdem__list_free(d, &d->pw);
     fsdem__list_free(d, &d->pw_old);
+    fsdem__free(&al, d->hits, sizeof(fsdem__wall_hit) * (size_t)d->hit_capacity);
     fsdem_cellgrid_free(&d->grid);
     fsdem__free(&al, d, sizeof *d);
 }
@@ -1160,7 +1177,8 @@ fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_material *mat, int
         for (b = 0; b < nm; ++b) {
             if (a < nm - 1 && b < nm - 1) pairs[a * nm + b] = d->pairs[a * (nm - 1) + b];
             else if (b < a) pairs[a * nm + b] = pairs[b * nm + a];
-            else fsdem__pair_setup(&pairs[a * nm + b], &d->materials[a], &d->materials[b], pairs, a * nm + b);
+            else fsdem__pair_setup(&pairs[a * nm + b], &d->materials[a], &d->materials[b], d->desc.law, pairs,
+                                   a * nm + b);
         }
     /* the loop reads earlier rows only, which are already in the new table */
     fsdem__free(&d->allocator, d->pairs, sizeof(fsdem__pair) * (size_t)d->pair_capacity);
@@ -1351,8 +1369,8 @@ static fsdem_vec3 fsdem__closest_on_segment(fsdem_vec3 p, fsdem_vec3 a, fsdem_ve
 }
 
 /* Closest point to p on triangle a-b-c: the projection when it falls inside, else the closest
-   point on the nearest edge. */
-static fsdem_vec3 fsdem__closest_on_triangle(fsdem_vec3 p, fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c) {
+   point on the nearest edge (then *on_edge is 1). */
+static fsdem_vec3 fsdem__closest_on_triangle(fsdem_vec3 p, fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c, int *on_edge) {
     fsdem_vec3 ab = fsdem__sub(b, a), ac = fsdem__sub(c, a), ap = fsdem__sub(p, a);
     fsdem_vec3 nrm = fsdem__cross(ab, ac), q, best;
     fsdem_real n2 = fsdem__dot(nrm, nrm), u, v, dist2, best2;
@@ -1361,6 +1379,7 @@ static fsdem_vec3 fsdem__closest_on_triangle(fsdem_vec3 p, fsdem_vec3 a, fsdem_v
     /* barycentric coordinates of the projection of p */
     v = fsdem__dot(fsdem__cross(ap, ac), nrm) / n2;
     u = fsdem__dot(fsdem__cross(ab, ap), nrm) / n2;
+    *on_edge = !(v > 0 && u > 0 && u + v < 1);
     if (v >= 0 && u >= 0 && u + v <= 1) return fsdem__add(a, fsdem__add(fsdem__scale(ab, v), fsdem__scale(ac, u)));
     edge_point[0] = fsdem__closest_on_segment(p, a, b);
     edge_point[1] = fsdem__closest_on_segment(p, b, c);
@@ -1386,10 +1405,14 @@ static fsdem_vec3 fsdem__direction(fsdem_vec3 p, fsdem_vec3 q, fsdem_vec3 fallba
     return *dist > 0 ? fsdem__scale(dv, 1 / *dist) : fallback;
 }
 
-/* Signed distance (m) from p to face `face` of a wall, with the unit normal from the wall towards p. */
-static fsdem_real fsdem__wall_distance(const fsdem__wall *w, int face, fsdem_vec3 p, int dim, fsdem_vec3 *n) {
+/* Signed distance (m) from p to face `face` of a wall, with the unit normal from the wall towards p.
+   *on_feature is set when the closest point is an edge or vertex of a triangle, or an end of a
+   segment: such points are shared by neighbouring elements of a mesh (see fsdem__wall_hits). */
+static fsdem_real fsdem__wall_distance(const fsdem__wall *w, int face, fsdem_vec3 p, int dim, fsdem_vec3 *n,
+                                      int *on_feature) {
     const fsdem_wall_desc *g = &w->d;
     fsdem_real dist;
+    *on_feature = 0;
     switch (g->type) {
     case FSDEM_WALL_PLANE:
         *n = g->b;
@@ -1426,14 +1449,18 @@ static fsdem_real fsdem__wall_distance(const fsdem__wall *w, int face, fsdem_vec
     case FSDEM_WALL_SEGMENT: {
         fsdem_vec3 ab = fsdem__sub(g->b, g->a), perp = fsdem_v3(-ab.y, ab.x, 0);
         fsdem_real len = fsdem__norm(perp);
+        fsdem_vec3 q = fsdem__closest_on_segment(p, g->a, g->b);
         perp = len > 0 ? fsdem__scale(perp, 1 / len) : fsdem_v3(0, 1, 0);
-        *n = fsdem__direction(p, fsdem__closest_on_segment(p, g->a, g->b), perp, &dist);
+        *on_feature = fsdem__dot(fsdem__sub(q, g->a), fsdem__sub(q, g->a)) == 0 ||
+                      fsdem__dot(fsdem__sub(q, g->b), fsdem__sub(q, g->b)) == 0;
+        *n = fsdem__direction(p, q, perp, &dist);
         return dist;
     }
     case FSDEM_WALL_TRIANGLE: {
         fsdem_vec3 nrm = fsdem__cross(fsdem__sub(g->b, g->a), fsdem__sub(g->c, g->a));
+        fsdem_vec3 q = fsdem__closest_on_triangle(p, g->a, g->b, g->c, on_feature);
         nrm = fsdem__scale(nrm, 1 / fsdem__norm(nrm));
-        *n = fsdem__direction(p, fsdem__closest_on_triangle(p, g->a, g->b, g->c), nrm, &dist);
+        *n = fsdem__direction(p, q, nrm, &dist);
         return dist;
     }
     case FSDEM_WALL_SDF:
@@ -1629,8 +1656,8 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
             if (!w->active) continue;
             for (face = 0; face < faces; ++face) {
                 fsdem_vec3 nrm;
-                int key = FSDEM__WALL_KEY(k, face);
-                if (fsdem__wall_distance(w, face, xi, dim, &nrm) >= ri + off + skin) continue;
+                int key = FSDEM__WALL_KEY(k, face), on_feature;
+                if (fsdem__wall_distance(w, face, xi, dim, &nrm, &on_feature) >= ri + off + skin) continue;
                 res = fsdem__list_append(d, &d->pw, key, fsdem__old_history(&d->pw_old, oi, key));
                 if (res != FSDEM_OK) break;
             }
@@ -1644,6 +1671,10 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
     d->pp.start[d->n] = d->pp.count;
     d->pw.start[d->n] = d->pw.count;
     d->pp.rows = d->pw.rows = d->n;
+    for (i = 0, k = 0; i < d->n; ++i)
+        if (d->pw.start[i + 1] - d->pw.start[i] > k) k = d->pw.start[i + 1] - d->pw.start[i];
+    if (fsdem__grow(&d->allocator, (void **)&d->hits, &d->hit_capacity, 0, k, sizeof(fsdem__wall_hit)) != FSDEM_OK)
+        return FSDEM_ERR_OUT_OF_MEMORY;
     for (i = 0; i < d->n; ++i) {
         d->x_ref[i] = d->x[i];
         d->old_of[i] = i;
@@ -1663,17 +1694,66 @@ static int fsdem__lists_stale(const fsdem_dem *d) {
     return d->need_rebuild || 2 * disp > d->skin || disp + wall_moved > d->skin;
 }
 
+/* Wall contacts (overlap > 0) of particle i into d->hits; returns their number. A mesh of
+   triangles or a polyline shares edges and vertices between elements, and a particle touching a
+   shared edge would be pushed once per element. So an edge/vertex contact is dropped when its
+   contact point lies in the plane of a face contact of the same particle (the edge belongs to that
+   face), or when an edge/vertex contact kept before has the same normal (one edge seen from two
+   elements). With `reset`, entries without a kept contact lose their tangential history. */
+static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
+    const fsdem_real off = d->desc.contact_offset, tol = (fsdem_real)1e-9 * d->r[i];
+    const fsdem_vec3 xi = d->x[i];
+    int k, a, b, count = 0, kept = 0;
+    for (k = d->pw.start[i]; k < d->pw.start[i + 1]; ++k) {
+        const int key = d->pw.entry[k].other;
+        const fsdem__wall *wall = &d->walls[FSDEM__WALL_OF(key)];
+        fsdem__wall_hit *h = &d->hits[count];
+        if (wall->active) {
+            h->delta = d->r[i] + off - fsdem__wall_distance(wall, FSDEM__FACE_OF(key), xi, d->desc.dim, &h->n, &h->on_feature);
+            if (h->delta > 0) {
+                h->entry = k;
+                count++;
+                continue;
+            }
+        }
+        if (reset) d->pw.entry[k].history = fsdem__zero3();
+    }
+    for (a = 0; a < count; ++a) {
+        fsdem__wall_hit h = d->hits[a];
+        int duplicate = 0;
+        if (h.on_feature) {
+            /* contact point q = x - (r + off - delta) n; in face b's plane when (q - x).n_b = -(r + off - delta_b) */
+            fsdem_vec3 q_rel = fsdem__scale(h.n, -(d->r[i] + off - h.delta));
+            for (b = 0; b < count && !duplicate; ++b) {
+                const fsdem__wall_hit *o = &d->hits[b];
+                if (b == a) continue;
+                if (!o->on_feature)
+                    duplicate = fsdem__dot(q_rel, o->n) + (d->r[i] + off - o->delta) <= tol &&
+                                fsdem__dot(q_rel, o->n) + (d->r[i] + off - o->delta) >= -tol;
+                else if (b < a)
+                    duplicate = fsdem__dot(h.n, o->n) >= 1 - (fsdem_real)1e-12;
+            }
+        }
+        if (duplicate) {
+            if (reset) d->pw.entry[h.entry].history = fsdem__zero3();
+            continue;
+        }
+        d->hits[kept++] = h;
+    }
+    return kept;
+}
+
 /* ---- >>dem_forces : contact force evaluation ---- */
 
 /* Contact forces and torques of all particle pairs and particle-wall contacts into f, t and the
    walls' force; `h` is the step the history and the one-step spring of seed 000 Eq. 8 use. */
 static void fsdem__compute_forces(fsdem_dem *d, fsdem_real h, int commit) {
     const fsdem_real off = d->desc.contact_offset;
-    const int nm = d->material_count, dim = d->desc.dim;
+    const int nm = d->material_count;
     fsdem_vec3 *f = d->f, *t = d->t;
     const fsdem_vec3 *x = d->x, *v = d->v, *w = d->w;
     const fsdem_real *r = d->r, *m = d->m, *inv_m = d->inv_m, *inv_i = d->inv_i;
-    int i, k, contacts = 0, wall_contacts = 0;
+    int i, k, nh, contacts = 0, wall_contacts = 0;
     fsdem_real max_overlap = 0;
     for (i = 0; i < d->n; ++i) f[i] = t[i] = fsdem__zero3();
     for (k = 0; k < d->wall_count; ++k) d->walls[k].force = fsdem__zero3();
@@ -1719,24 +1799,21 @@ static void fsdem__compute_forces(fsdem_dem *d, fsdem_real h, int commit) {
             contacts++;
             if (c.delta > max_overlap) max_overlap = c.delta;
         }
-        for (k = d->pw.start[i]; k < d->pw.start[i + 1]; ++k) {
-            fsdem__wall *wall = &d->walls[d->pw.entry[k].other / 8];
+        nh = d->pw.start[i + 1] > d->pw.start[i] && inv_m[i] > 0 ? fsdem__wall_hits(d, i, commit) : 0;
+        for (k = 0; k < nh; ++k) {
+            const fsdem__wall_hit *hit = &d->hits[k];
+            fsdem__wall *wall = &d->walls[FSDEM__WALL_OF(d->pw.entry[hit->entry].other)];
             fsdem__contact c;
-            fsdem_real dist, la, fn;
+            fsdem_real la, fn;
             fsdem_vec3 force;
-            if (!wall->active || inv_m[i] == 0) continue;
-            dist = fsdem__wall_distance(wall, d->pw.entry[k].other % 8, xi, dim, &c.n);
-            c.delta = ri + off - dist;
-            if (c.delta <= 0) {
-                if (commit) d->pw.entry[k].history = fsdem__zero3();
-                continue;
-            }
+            c.n = hit->n;
+            c.delta = hit->delta;
             la = ri - c.delta / 2;
             c.vrel = fsdem__sub(fsdem__sub(vi, fsdem__scale(fsdem__cross(wi, c.n), la)), wall->d.velocity);
             c.m_eff = c.m_mean = m[i];
             c.r_eff = ri;
             c.pair = row + wall->d.material;
-            force = fsdem__contact_force(d, &c, &d->pw.entry[k].history, commit, h, &fn);
+            force = fsdem__contact_force(d, &c, &d->pw.entry[hit->entry].history, commit, h, &fn);
             fi = fsdem__add(fi, force);
             wall->force = fsdem__sub(wall->force, force);
             ti = fsdem__madd(ti, fsdem__cross(c.n, force), -la);
@@ -1900,7 +1977,8 @@ fsdem_result fsdem_dem_advance(fsdem_dem *d, fsdem_real dt_outer, int *substeps)
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_advance: dt_outer must be > 0 (got %g s)",
                            (double)dt_outer);
     /* seed 000: K = INT(dt/dt_DEM), dt_DEM = dt/K; Eq. 25: dt_DEM = dt when dt_DEM > dt */
-    count = d->dt >= dt_outer ? 1 : (int)(dt_outer / d->dt);
+    /* the relative 1e-9 keeps an exact multiple (3e-4/1e-4 = 2.9999999999999996) from losing a step */
+    count = d->dt >= dt_outer ? 1 : (int)(dt_outer / d->dt * (1 + 1e-9));
     if (count < 1) count = 1;
     if (substeps) *substeps = count;
     for (k = 0; k < count; ++k) {
@@ -1981,8 +2059,8 @@ static fsdem_real fsdem__contact_energy(const fsdem_dem *d, const fsdem__contact
 
 fsdem_energy fsdem_dem_energy(const fsdem_dem *d) {
     fsdem_energy e;
-    const int nm = d->material_count, dim = d->desc.dim;
-    int i, k;
+    const int nm = d->material_count;
+    int i, k, nh;
     memset(&e, 0, sizeof e);
     for (i = 0; i < d->n; ++i) {
         fsdem_real iner = d->inv_i[i] > 0 ? 1 / d->inv_i[i] : 0;
@@ -2005,16 +2083,14 @@ fsdem_energy fsdem_dem_energy(const fsdem_dem *d) {
             c.pair = row + d->material[j];
             e.elastic += fsdem__contact_energy(d, &c, d->pp.entry[k].history);
         }
-        for (k = d->pw.start[i]; k < d->pw.start[i + 1]; ++k) {
-            const fsdem__wall *wall = &d->walls[d->pw.entry[k].other / 8];
-            if (!wall->active) continue;
-            c.delta = d->r[i] + d->desc.contact_offset -
-                      fsdem__wall_distance(wall, d->pw.entry[k].other % 8, d->x[i], dim, &c.n);
-            if (c.delta <= 0) continue;
+        nh = fsdem__wall_hits((fsdem_dem *)d, i, 0);
+        for (k = 0; k < nh; ++k) {
+            const fsdem__wall_hit *hit = &d->hits[k];
+            c.delta = hit->delta;
             c.m_mean = d->m[i];
             c.r_eff = d->r[i];
-            c.pair = row + wall->d.material;
-            e.elastic += fsdem__contact_energy(d, &c, d->pw.entry[k].history);
+            c.pair = row + d->walls[FSDEM__WALL_OF(d->pw.entry[hit->entry].other)].d.material;
+            e.elastic += fsdem__contact_energy(d, &c, d->pw.entry[hit->entry].history);
         }
     }
     return e;
@@ -2061,7 +2137,7 @@ static void fsdem__report_contact(fsdem_contact_info *out, int capacity, int cou
 
 int fsdem_dem_contacts(fsdem_dem *d, fsdem_contact_info *out, int capacity) {
     const fsdem_real off = d->desc.contact_offset;
-    int i, k, count = 0;
+    int i, k, nh, count = 0;
     if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     for (i = 0; i < d->n; ++i) {
         for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
@@ -2071,15 +2147,10 @@ int fsdem_dem_contacts(fsdem_dem *d, fsdem_contact_info *out, int capacity) {
             if (d->r[i] + d->r[j] + off - dist <= 0) continue;
             fsdem__report_contact(out, capacity, count++, i, j, n, d->r[i] + d->r[j] + off - dist);
         }
-        for (k = d->pw.start[i]; k < d->pw.start[i + 1]; ++k) {
-            const int wall = d->pw.entry[k].other / 8;
-            fsdem_vec3 n;
-            fsdem_real overlap;
-            if (!d->walls[wall].active) continue;
-            overlap = d->r[i] + off - fsdem__wall_distance(&d->walls[wall], d->pw.entry[k].other % 8, d->x[i], d->desc.dim, &n);
-            if (overlap <= 0) continue;
-            fsdem__report_contact(out, capacity, count++, i, -1 - wall, n, overlap);
-        }
+        nh = fsdem__wall_hits(d, i, 0);
+        for (k = 0; k < nh; ++k)
+            fsdem__report_contact(out, capacity, count++, i, -1 - FSDEM__WALL_OF(d->pw.entry[d->hits[k].entry].other),
+                                  d->hits[k].n, d->hits[k].delta);
     }
     return count;
 }
