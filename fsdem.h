@@ -14,6 +14,8 @@
      >>core     real type, vectors, results, allocator, logging
      >>grid     cell grid (uniform spatial binning) shared by DEM, MPS and the couplings
      >>dem      discrete element method: particles, materials, contact laws, walls, integration
+     >>linalg   CSR and MAC-grid stencil operators, preconditioned conjugate gradients (Jacobi,
+                IC(0), MIC(0), geometric multigrid) shared by the pressure solves
      >>io       CSV time series and particle snapshots (CSV, legacy VTK for ParaView)
      >>impl     implementation, in the same order
      >>licence  MIT
@@ -406,6 +408,168 @@ typedef struct fsdem_contact_info {
    stale). Writes up to `capacity` entries to `out` (may be NULL) and returns the total number, or
    FSDEM_ERR_OUT_OF_MEMORY (negative) when the lists cannot be rebuilt. */
 FSDEM_API int fsdem_dem_contacts(fsdem_dem *dem, fsdem_contact_info *out, int capacity);
+
+/* ===== >>linalg : sparse operators and preconditioned conjugate gradients ===== */
+
+/* One conjugate-gradient solver for every symmetric positive definite system in the library: the
+   PIC/FLIP pressure projection and implicit viscosity (MAC-grid stencils) and the MPS pressure
+   Poisson equation (general sparse matrices). Operators come in two forms:
+
+   - fsdem_csr: a general sparse matrix in compressed rows, owned by the caller.
+   - fsdem_stencil: a matrix-free 5-point (2D) / 7-point (3D) cell-centred operator on a MAC grid,
+     with one coefficient per face and a type per cell, built for pressure equations:
+
+         (A p)_c = sum over faces f of c:  w_f (p_c - p_nb(f))  +  diag_c p_c      for fluid cells c
+
+     where p_nb = 0 for an air neighbour (free surface, Dirichlet), a face next to a solid cell adds
+     nothing (Neumann), and outside the grid is a Dirichlet p = 0 wherever the boundary face's
+     coefficient is > 0 (give it 0 for a wall). A face coefficient is typically an open fraction
+     times dt/(rho dx^2): the cut-cell weight E/dx of seed 000 Eq. 5 (E: the unblocked length of the
+     cell edge), or the face volume fraction beta of seed 004 Eq. 11 and 63; any w >= 0 works. `diag` carries what the faces do not: the ghost-fluid free surface (a fluid cell
+     whose air neighbour lies a fraction theta of the way to the interface adds w (1/theta - 1)),
+     or the identity term of an implicit viscosity solve. Keep pressure equations in their
+     conservative, symmetric form: seed 004 Eq. 12 divides each row by alpha_f', which would make
+     the matrix unsymmetric; solve div(alpha_f' grad p) = alpha_f' (right-hand side of Eq. 12)
+     instead. A Neumann face whose flux is moved to the right-hand side (the push-out condition of
+     seed 004 App. B, the solid velocity of seed 000 Eq. 5) is a face with coefficient 0.
+
+   A fsdem_pcg object is set up once per operator (this is where all memory is allocated and the
+   preconditioner is built) and then solves any number of right-hand sides without allocating.
+   Preconditioners: Jacobi, incomplete Cholesky IC(0) and modified IC(0) (both on stencils and on
+   CSR), and for stencils a geometric multigrid V-cycle (MGPCG), whose iteration count stays nearly
+   constant as the grid is refined. A solve stops when ||b - A x||_2 <= tolerance ||b||_2 (checked on
+   the true residual). Not converging, a non-positive curvature p.Ap <= 0 (the operator is not
+   positive definite) and NaN are result codes with a message, never a silent wrong answer.
+
+   Stencil vectors (x, b) hold one value per cell, x fastest, then y, then z: cell (i, j, k) is at
+   (k n[1] + j) n[0] + i. Face arrays use the MAC layout of the velocity components: face[0] holds
+   (n[0]+1) n[1] n[2] x-faces, the face between cells i-1 and i at (k n[1] + j)(n[0]+1) + i; face[1]
+   n[0] (n[1]+1) n[2] y-faces at (k (n[1]+1) + j) n[0] + i; face[2] n[0] n[1] (n[2]+1) z-faces at
+   (k n[1] + j) n[0] + i. */
+
+typedef enum fsdem_stencil_cell {
+    FSDEM_STENCIL_CELL_FLUID = 0, /* an unknown */
+    FSDEM_STENCIL_CELL_AIR = 1,   /* Dirichlet p = 0 (free surface); the solution there is 0 */
+    FSDEM_STENCIL_CELL_SOLID = 2  /* excluded; faces towards it are Neumann; the solution there is 0 */
+} fsdem_stencil_cell;
+
+/* Optional symmetric positive semi-definite term added to a stencil operator, y += E x, on vectors
+   in the stencil layout (e.g. the implicit solid coupling dt J^T M^-1 J of seed 000 Eq. 6). It must
+   add only to fluid cells. Preconditioners do not see it. */
+typedef void (*fsdem_operator_fn)(void *user, const fsdem_real *x, fsdem_real *y);
+
+/* A MAC-grid stencil operator. A view of caller-owned arrays: fsdem_pcg_setup_stencil copies what
+   it needs, so the arrays may change or go away after setup (call setup again after a change).
+   Zero-initialise it and set dim and n: NULL arrays give the plain -h^2 Laplacian of the unit box
+   with Dirichlet walls (every cell fluid, every face 1). */
+typedef struct fsdem_stencil {
+    int dim;                      /* 2 or 3 */
+    int n[3];                     /* cells per axis, >= 1; n[2] is ignored (taken as 1) in 2D */
+    const unsigned char *cell;    /* n[0] n[1] n[2] fsdem_stencil_cell values; NULL: all fluid */
+    const fsdem_real *face[3];    /* face coefficients >= 0 (layout above); NULL: all 1. Only faces */
+                                  /*    with a fluid cell on a side are read. face[2] unused in 2D */
+    const fsdem_real *diag;       /* extra diagonal >= 0 per cell (fluid cells read); NULL: 0 */
+    fsdem_operator_fn extra;      /* optional extra term (see fsdem_operator_fn); NULL: none */
+    void *extra_user;             /* passed to `extra`; must stay valid while the pcg uses it */
+} fsdem_stencil;
+
+/* A square sparse matrix in compressed sparse rows, stored in full (both triangles), columns
+   strictly ascending in each row, the diagonal present. A view of caller-owned arrays, which must
+   stay valid and unchanged from fsdem_pcg_setup_csr until the next setup or destroy. */
+typedef struct fsdem_csr {
+    int rows;                 /* number of rows = columns, >= 1 */
+    const int *row_start;     /* rows + 1 offsets into col/val; row_start[0] = 0 */
+    const int *col;           /* column of each entry, 0-based */
+    const fsdem_real *val;    /* value of each entry */
+} fsdem_csr;
+
+typedef enum fsdem_precond {
+    FSDEM_PRECOND_AUTO = 0,   /* multigrid for a stencil, MIC(0) for a CSR matrix */
+    FSDEM_PRECOND_NONE = 1,   /* plain conjugate gradients */
+    FSDEM_PRECOND_JACOBI = 2, /* diagonal scaling */
+    FSDEM_PRECOND_IC0 = 3,    /* incomplete Cholesky, no fill */
+    FSDEM_PRECOND_MIC0 = 4,   /* modified incomplete Cholesky (row sums kept, times mic_tau) */
+    FSDEM_PRECOND_MG = 5      /* geometric multigrid V-cycle on the MAC grid; stencils only */
+} fsdem_precond;
+
+typedef struct fsdem_pcg_desc {
+    fsdem_precond preconditioner; /* default FSDEM_PRECOND_AUTO */
+    fsdem_real tolerance;         /* -; stop at ||r||_2 <= tolerance ||b||_2; default 1e-8 (1e-5 float) */
+    int max_iterations;           /* > 0; default 1000 */
+    fsdem_real mic_tau;           /* -; MIC(0) share of the dropped fill moved to the diagonal, */
+                                  /*    in [0, 1]; default 0.97 */
+    fsdem_real ic_safety;         /* -; IC(0)/MIC(0) pivot floor: a pivot below ic_safety times the */
+                                  /*    matrix diagonal is replaced by the diagonal; default 0.25 */
+    int mg_sweeps;                /* >= 1; red-black Gauss-Seidel sweeps before and after each */
+                                  /*    coarse-grid correction; default 2 */
+    fsdem_allocator allocator;    /* default: FSDEM_MALLOC/FSDEM_FREE */
+    fsdem_log_fn log;             /* optional; default NULL */
+    void *log_user;
+} fsdem_pcg_desc;
+
+/* What a solve did. */
+typedef struct fsdem_pcg_info {
+    int iterations;             /* CG iterations taken */
+    fsdem_real residual;        /* -; final ||b - A x||_2 / ||b||_2 (true residual, recomputed) */
+    fsdem_real rhs_norm;        /* ||b||_2 after the null-space projection below */
+    int nullspace_components;   /* stencil only: fluid regions with no Dirichlet cell, face or diag */
+                                /*    (a closed tank full of water). Their p is fixed up to a */
+                                /*    constant: b's mean there is removed and x's mean set to 0 */
+    fsdem_real incompatibility; /* -; ||removed part of b||_2 / ||b||_2 (0 without such regions) */
+    int levels;                 /* multigrid levels (1 for other preconditioners) */
+    size_t memory_bytes;        /* bytes held by the pcg object */
+} fsdem_pcg_info;
+
+typedef struct fsdem_pcg fsdem_pcg;
+
+/* Defaults (see the field comments). */
+FSDEM_API fsdem_pcg_desc fsdem_pcg_desc_default(void);
+/* Creates a solver; nothing size-dependent is allocated until a setup call. *out is NULL on
+   failure. Errors: FSDEM_ERR_INVALID_ARG (the reason goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY.
+   Destroy with fsdem_pcg_destroy. */
+FSDEM_API fsdem_result fsdem_pcg_create(const fsdem_pcg_desc *desc, fsdem_pcg **out);
+FSDEM_API void fsdem_pcg_destroy(fsdem_pcg *pcg);
+/* Message of the last failed call on this object ("" after success). Valid until the next call. */
+FSDEM_API const char *fsdem_pcg_last_error(const fsdem_pcg *pcg);
+/* Changes the stopping rule of later solves (tolerance > 0, max_iterations > 0). */
+FSDEM_API fsdem_result fsdem_pcg_set_tolerance(fsdem_pcg *pcg, fsdem_real tolerance, int max_iterations);
+
+/* Sets up for a stencil operator: validates it, copies its coefficients, (re)allocates the
+   workspace when it grew and builds the preconditioner. Call again whenever the stencil changes;
+   memory is reused when the grid does not grow. Errors: FSDEM_ERR_INVALID_ARG (dim, a size < 1, a
+   bad cell type, a negative or non-finite coefficient; the message names the cell or face; the
+   previous setup stays usable), FSDEM_ERR_OUT_OF_MEMORY (the allocator failed, or the grid has
+   more than about 2^30 cells; the previous setup stays usable). */
+FSDEM_API fsdem_result fsdem_pcg_setup_stencil(fsdem_pcg *pcg, const fsdem_stencil *stencil);
+/* Sets up for a CSR matrix (kept by reference, see fsdem_csr): validates it (sizes, indices, sorted
+   columns, finite values, a positive diagonal, symmetry to a relative 1e-10 (1e-4 in float)),
+   allocates the workspace and builds the preconditioner (FSDEM_PRECOND_MG is refused).
+   Errors: FSDEM_ERR_INVALID_ARG (message names the row and entry), FSDEM_ERR_OUT_OF_MEMORY; after
+   either the previous setup stays usable. */
+FSDEM_API fsdem_result fsdem_pcg_setup_csr(fsdem_pcg *pcg, const fsdem_csr *matrix);
+
+/* Solves A x = b for the operator of the last setup. `x` (length: rows, or cells of the stencil)
+   holds the initial guess on entry (zeros are fine) and the solution on return; for a stencil it is
+   0 in air and solid cells. `b` has the same length (its air and solid entries are ignored). `info`
+   may be NULL. Allocates nothing. Errors: FSDEM_ERR_NOT_CONVERGED (x holds the last iterate and
+   info the residual reached), FSDEM_ERR_NAN (b or x holds NaN/Inf, or the iteration produced it;
+   x is then unchanged), FSDEM_ERR_INVALID_ARG (no setup, NULL vectors, or the operator or
+   preconditioner is not positive definite: p.Ap <= 0 or r.z <= 0; x holds the last iterate). */
+FSDEM_API fsdem_result fsdem_pcg_solve(fsdem_pcg *pcg, const fsdem_real *b, fsdem_real *x,
+                                       fsdem_pcg_info *info);
+
+/* Checks a stencil without setting anything up; the reason goes to `message` (may be NULL).
+   Returns FSDEM_OK or FSDEM_ERR_INVALID_ARG. */
+FSDEM_API fsdem_result fsdem_stencil_check(const fsdem_stencil *stencil, char *message,
+                                           size_t message_size);
+/* y = A x for a stencil (including `extra`), on vectors in the stencil layout; y is 0 in air and
+   solid cells. No validation: check the stencil first. x and y must not overlap. */
+FSDEM_API void fsdem_stencil_apply(const fsdem_stencil *stencil, const fsdem_real *x, fsdem_real *y);
+/* Checks a CSR matrix as fsdem_pcg_setup_csr does; the reason goes to `message` (may be NULL).
+   Returns FSDEM_OK or FSDEM_ERR_INVALID_ARG. */
+FSDEM_API fsdem_result fsdem_csr_check(const fsdem_csr *matrix, char *message, size_t message_size);
+/* y = A x for a CSR matrix. No validation. x and y must not overlap. */
+FSDEM_API void fsdem_csr_apply(const fsdem_csr *matrix, const fsdem_real *x, fsdem_real *y);
 
 /* ===== >>io : CSV time series and particle snapshots =============================================== */
 
@@ -2153,6 +2317,1607 @@ int fsdem_dem_contacts(fsdem_dem *d, fsdem_contact_info *out, int capacity) {
                                   d->hits[k].n, d->hits[k].delta);
     }
     return count;
+}
+
+/* ===== >>impl_linalg : sparse operators and preconditioned conjugate gradients ===== */
+
+/* Layout. A stencil is solved on padded arrays: one ghost cell on each side of every axis (none
+   along z in 2D), so the kernels need no bounds tests. Cell (i, j, k) sits at
+   (i + 1) + (j + 1) sy + (k + 1) sz (2D: no z term). Each level of the operator stores
+     type[c]   fsdem_stencil_cell (ghosts: AIR where the boundary face is Dirichlet, else SOLID),
+               plus FSDEM__NEAR_SOLID on fluid cells whose coarse-grid interpolation touches a
+               solid cell;
+     d[c]      the diagonal (0 off fluid cells), inv_d[c] its inverse (0 where d = 0);
+     w[a][c]   the coupling across the face on the low side of c along axis a. While a level is
+               built it holds the physical coefficient (0 next to a solid); once the next coarser
+               level exists it is reduced to the matrix off-diagonal: kept only between two fluid
+               cells. Then y = A x is d x - sum w x_nb with no masks, since x is 0 off fluid cells.
+
+   Multigrid (>>linalg_mg). Coarse levels halve each axis longer than one cell ((n + 1) / 2; an
+   axis of one cell is not coarsened), down to one cell or to a level with no fluid left. A coarse
+   cell is AIR if any child is air (Dirichlet dominates, so the coarse problem never loses its
+   free surface), else FLUID if any child is fluid, else SOLID. A coarse face coefficient is the
+   sum of its fine sub-face coefficients divided by the coarsening ratio along its normal, and
+   the extra diagonal is summed over the children: this is the finite-volume rediscretisation
+   that matches R A P for smooth fields with P = cell-centred (bi/tri)linear interpolation and
+   R = P^T. P leaves out coarse cells that are solid and renormalises the remaining weights
+   (Neumann); air cells and Dirichlet ghosts contribute their value 0. The V-cycle smooths with
+   red-black Gauss-Seidel, red then black before the coarse correction and black then red after,
+   so the preconditioner is symmetric positive definite, as CG needs. */
+
+#define FSDEM__MG_MAX_LEVELS 40
+#define FSDEM__NEAR_SOLID 0x80
+#define FSDEM__TYPE(t) ((t) & 3)
+
+#ifdef FSDEM_USE_FLOAT
+#define FSDEM__SYM_TOL 1e-4
+#define FSDEM__DEFAULT_TOL 1e-5
+#else
+#define FSDEM__SYM_TOL 1e-10
+#define FSDEM__DEFAULT_TOL 1e-8
+#endif
+
+typedef struct fsdem__level {
+    int n[3], ratio[3];    /* interior cells per axis; coarsening ratio from the finer level */
+    fsdem_real h[3];       /* cell size per axis in units of the finest cell */
+    int sy, sz, count;     /* padded strides and cell count */
+    int fluid;             /* fluid cells */
+    unsigned char *type;
+    fsdem_real *d, *inv_d, *w[3];
+    fsdem_real *x, *b;     /* multigrid vectors (level 0 borrows the CG vectors) */
+} fsdem__level;
+
+enum { FSDEM__KIND_NONE = 0, FSDEM__KIND_STENCIL = 1, FSDEM__KIND_CSR = 2 };
+
+struct fsdem_pcg {
+    fsdem_pcg_desc desc;
+    fsdem__status status;
+    fsdem_allocator allocator;
+    int kind;               /* FSDEM__KIND_* of the last successful setup */
+    fsdem_precond precond;  /* resolved preconditioner */
+    int length;             /* internal vector length (padded cells or rows) */
+    int user_length;        /* length of the caller's vectors */
+    int dim;
+    fsdem_stencil stencil;  /* geometry and extra term of the last stencil setup */
+    fsdem_csr csr;          /* matrix of the last CSR setup */
+    void *arena;            /* every array below lives in this one block */
+    size_t arena_bytes;
+    fsdem_real *x, *r, *z, *p; /* CG vectors; z also holds A p */
+    fsdem_real *ux, *uy;    /* caller-layout copies for the stencil's extra term */
+    int levels;
+    fsdem__level level[FSDEM__MG_MAX_LEVELS];
+    fsdem_real *ic;         /* stencil IC/MIC: 1/sqrt(pivot); CSR Jacobi: 1/diagonal */
+    fsdem_real *rowbuf;     /* multigrid: two rows of the finest level */
+    int ns_components, ns_cells; /* null space: fluid regions without a Dirichlet anchor */
+    int *ns_cell;           /* their cells, each region's first cell stored as -(c + 1) */
+    unsigned char *mark;
+    int *u_start, *u_col;   /* CSR IC/MIC: upper factor U (M = U^T U), diagonal first per row */
+    fsdem_real *u_val;
+    int *u_pos;             /* CSR IC/MIC workspace: column -> position in a row of U, or -1 */
+};
+
+/* ---- >>linalg_check : validation of operators ---- */
+
+static fsdem_real fsdem__stencil_face(const fsdem_stencil *st, int axis, int i, int j, int k) {
+    const fsdem_real *f = st->face[axis];
+    int n0 = st->n[0], n1 = st->n[1];
+    if (!f) return 1;
+    if (axis == 0) return f[((size_t)k * n1 + j) * (size_t)(n0 + 1) + i];
+    if (axis == 1) return f[((size_t)k * (n1 + 1) + j) * (size_t)n0 + i];
+    return f[((size_t)k * n1 + j) * (size_t)n0 + i];
+}
+
+static int fsdem__stencil_type(const fsdem_stencil *st, int i, int j, int k) {
+    if (!st->cell) return FSDEM_STENCIL_CELL_FLUID;
+    return st->cell[((size_t)k * st->n[1] + j) * (size_t)st->n[0] + i];
+}
+
+/* Padded cell count of a stencil (as a double: it may not fit an int). */
+static double fsdem__stencil_padded(const fsdem_stencil *st) {
+    return ((double)st->n[0] + 2) * ((double)st->n[1] + 2) * (st->dim == 3 ? (double)st->n[2] + 2 : 1);
+}
+
+/* Indices are ints; the multigrid levels add up to 8/7 of the finest. */
+#define FSDEM__MAX_PADDED (2147483647.0 / 2)
+
+/* Cells per axis with n[2] = 1 in 2D. */
+static void fsdem__stencil_dims(const fsdem_stencil *st, int n[3]) {
+    n[0] = st->n[0];
+    n[1] = st->n[1];
+    n[2] = st->dim == 3 ? st->n[2] : 1;
+}
+
+fsdem_result fsdem_stencil_check(const fsdem_stencil *st, char *msg, size_t size) {
+    int n[3], i, j, k, a;
+    double padded;
+    if (!st) return fsdem__reject(msg, size, "fsdem_stencil is NULL");
+    if (st->dim != 2 && st->dim != 3)
+        return fsdem__reject(msg, size, "fsdem_stencil.dim must be 2 or 3 (got %d)", st->dim);
+    fsdem__stencil_dims(st, n);
+    for (a = 0; a < st->dim; ++a)
+        if (n[a] < 1)
+            return fsdem__reject(msg, size, "fsdem_stencil.n[%d] must be >= 1 (got %d)", a, n[a]);
+    padded = fsdem__stencil_padded(st);
+    if (padded > FSDEM__MAX_PADDED)
+        return fsdem__reject(msg, size, "fsdem_stencil: %d x %d x %d cells is too large", n[0], n[1], n[2]);
+    for (k = 0; st->cell && k < n[2]; ++k)
+        for (j = 0; j < n[1]; ++j)
+            for (i = 0; i < n[0]; ++i) {
+                int t = fsdem__stencil_type(st, i, j, k);
+                if (t > FSDEM_STENCIL_CELL_SOLID)
+                    return fsdem__reject(msg, size, "fsdem_stencil.cell of cell (%d,%d,%d) is %d, not a "
+                                                    "fsdem_stencil_cell", i, j, k, t);
+            }
+    if (!st->diag && !st->face[0] && !st->face[1] && (st->dim == 2 || !st->face[2])) return FSDEM_OK;
+    for (k = 0; k < n[2]; ++k)
+        for (j = 0; j < n[1]; ++j)
+            for (i = 0; i < n[0]; ++i) {
+                if (fsdem__stencil_type(st, i, j, k) != FSDEM_STENCIL_CELL_FLUID) continue;
+                if (st->diag) {
+                    fsdem_real dv = st->diag[((size_t)k * n[1] + j) * (size_t)n[0] + i];
+                    if (!(dv >= 0) || !fsdem__finite(dv))
+                        return fsdem__reject(msg, size, "fsdem_stencil.diag of fluid cell (%d,%d,%d) is %g; it "
+                                                        "must be finite and >= 0", i, j, k, (double)dv);
+                }
+                /* both faces of every axis of a fluid cell are read */
+                for (a = 0; a < st->dim; ++a) {
+                    int side;
+                    for (side = 0; side < 2; ++side) {
+                        int fi = i + (a == 0 ? side : 0), fj = j + (a == 1 ? side : 0), fk = k + (a == 2 ? side : 0);
+                        fsdem_real w = fsdem__stencil_face(st, a, fi, fj, fk);
+                        if (!(w >= 0) || !fsdem__finite(w))
+                            return fsdem__reject(msg, size, "fsdem_stencil.face[%d] at face (%d,%d,%d) of fluid "
+                                                            "cell (%d,%d,%d) is %g; it must be finite and >= 0",
+                                                 a, fi, fj, fk, i, j, k, (double)w);
+                    }
+                }
+            }
+    return FSDEM_OK;
+}
+
+/* Position of column `col` in row `row`, or -1. Columns are ascending. */
+static int fsdem__csr_find(const fsdem_csr *m, int row, int col) {
+    int lo = m->row_start[row], hi = m->row_start[row + 1] - 1;
+    while (lo <= hi) {
+        int mid = lo + (hi - lo) / 2;
+        if (m->col[mid] == col) return mid;
+        if (m->col[mid] < col) lo = mid + 1;
+        else hi = mid - 1;
+    }
+    return -1;
+}
+
+fsdem_result fsdem_csr_check(const fsdem_csr *m, char *msg, size_t size) {
+    int i, e;
+    if (!m) return fsdem__reject(msg, size, "fsdem_csr is NULL");
+    if (m->rows < 1) return fsdem__reject(msg, size, "fsdem_csr.rows must be >= 1 (got %d)", m->rows);
+    if (!m->row_start || !m->col || !m->val)
+        return fsdem__reject(msg, size, "fsdem_csr: row_start, col and val must not be NULL");
+    if (m->row_start[0] != 0)
+        return fsdem__reject(msg, size, "fsdem_csr.row_start[0] must be 0 (got %d)", m->row_start[0]);
+    for (i = 0; i < m->rows; ++i)
+        if (m->row_start[i + 1] < m->row_start[i])
+            return fsdem__reject(msg, size, "fsdem_csr.row_start decreases at row %d", i);
+    for (i = 0; i < m->rows; ++i) {
+        int has_diag = 0;
+        for (e = m->row_start[i]; e < m->row_start[i + 1]; ++e) {
+            int c = m->col[e];
+            if (c < 0 || c >= m->rows)
+                return fsdem__reject(msg, size, "fsdem_csr: column %d of row %d is out of range [0, %d)", c, i,
+                                     m->rows);
+            if (e > m->row_start[i] && c <= m->col[e - 1])
+                return fsdem__reject(msg, size, "fsdem_csr: columns of row %d are not strictly ascending", i);
+            if (!fsdem__finite(m->val[e]))
+                return fsdem__reject(msg, size, "fsdem_csr: entry (%d,%d) is not finite", i, c);
+            if (c == i) {
+                has_diag = 1;
+                if (!(m->val[e] > 0))
+                    return fsdem__reject(msg, size, "fsdem_csr: diagonal entry (%d,%d) = %g is not positive, so the "
+                                                    "matrix is not positive definite", i, i, (double)m->val[e]);
+            }
+        }
+        if (!has_diag) return fsdem__reject(msg, size, "fsdem_csr: row %d has no diagonal entry", i);
+    }
+    for (i = 0; i < m->rows; ++i)
+        for (e = m->row_start[i]; e < m->row_start[i + 1]; ++e) {
+            int c = m->col[e], t;
+            double a, b, scale;
+            if (c == i) continue;
+            t = fsdem__csr_find(m, c, i);
+            if (c < i && t >= 0) continue; /* the pair was compared from row c */
+            a = m->val[e];
+            b = t >= 0 ? m->val[t] : 0;
+            scale = fabs(a) > fabs(b) ? fabs(a) : fabs(b);
+            if (fabs(a - b) > FSDEM__SYM_TOL * scale)
+                return fsdem__reject(msg, size, "fsdem_csr is not symmetric: entry (%d,%d) = %g but (%d,%d) = %g%s", i,
+                                     c, a, c, i, b, t >= 0 ? "" : " (absent)");
+        }
+    return FSDEM_OK;
+}
+
+void fsdem_csr_apply(const fsdem_csr *m, const fsdem_real *x, fsdem_real *y) {
+    int i, e;
+    for (i = 0; i < m->rows; ++i) {
+        fsdem_real s = 0;
+        for (e = m->row_start[i]; e < m->row_start[i + 1]; ++e) s += m->val[e] * x[m->col[e]];
+        y[i] = s;
+    }
+}
+
+/* Reference stencil product on caller-layout vectors, written straight from the definition in
+   >>linalg (the solver's padded kernels are checked against it in the tests). */
+void fsdem_stencil_apply(const fsdem_stencil *st, const fsdem_real *x, fsdem_real *y) {
+    int n[3], i, j, k, a, side;
+    fsdem__stencil_dims(st, n);
+    for (k = 0; k < n[2]; ++k)
+        for (j = 0; j < n[1]; ++j)
+            for (i = 0; i < n[0]; ++i) {
+                size_t c = ((size_t)k * n[1] + j) * (size_t)n[0] + i;
+                fsdem_real s = 0;
+                if (fsdem__stencil_type(st, i, j, k) != FSDEM_STENCIL_CELL_FLUID) {
+                    y[c] = 0;
+                    continue;
+                }
+                for (a = 0; a < st->dim; ++a)
+                    for (side = 0; side < 2; ++side) {
+                        int nb[3];
+                        fsdem_real w;
+                        nb[0] = i;
+                        nb[1] = j;
+                        nb[2] = k;
+                        nb[a] += side ? 1 : -1;
+                        w = fsdem__stencil_face(st, a, i + (a == 0 ? side : 0), j + (a == 1 ? side : 0),
+                                                k + (a == 2 ? side : 0));
+                        if (nb[a] < 0 || nb[a] >= n[a]) {
+                            s += w * x[c]; /* Dirichlet outside when w > 0 */
+                        } else {
+                            int t = fsdem__stencil_type(st, nb[0], nb[1], nb[2]);
+                            size_t cn = ((size_t)nb[2] * n[1] + nb[1]) * (size_t)n[0] + nb[0];
+                            if (t == FSDEM_STENCIL_CELL_FLUID) s += w * (x[c] - x[cn]);
+                            else if (t == FSDEM_STENCIL_CELL_AIR) s += w * x[c];
+                        }
+                    }
+                if (st->diag) s += st->diag[c] * x[c];
+                y[c] = s;
+            }
+    if (st->extra) st->extra(st->extra_user, x, y);
+}
+
+/* ---- >>linalg_object : creation, memory ---- */
+
+fsdem_pcg_desc fsdem_pcg_desc_default(void) {
+    fsdem_pcg_desc d;
+    memset(&d, 0, sizeof d);
+    d.preconditioner = FSDEM_PRECOND_AUTO;
+    d.tolerance = (fsdem_real)FSDEM__DEFAULT_TOL;
+    d.max_iterations = 1000;
+    d.mic_tau = (fsdem_real)0.97;
+    d.ic_safety = (fsdem_real)0.25;
+    d.mg_sweeps = 2;
+    return d;
+}
+
+static fsdem_result fsdem__pcg_desc_check(const fsdem_pcg_desc *d, char *msg, size_t size) {
+    if (!d) return fsdem__reject(msg, size, "fsdem_pcg_desc is NULL");
+    if ((int)d->preconditioner < (int)FSDEM_PRECOND_AUTO || (int)d->preconditioner > (int)FSDEM_PRECOND_MG)
+        return fsdem__reject(msg, size, "fsdem_pcg_desc.preconditioner is not a fsdem_precond (%d)",
+                             (int)d->preconditioner);
+    if (!(d->tolerance > 0) || !fsdem__finite(d->tolerance))
+        return fsdem__reject(msg, size, "fsdem_pcg_desc.tolerance must be > 0 (got %g)", (double)d->tolerance);
+    if (d->max_iterations < 1)
+        return fsdem__reject(msg, size, "fsdem_pcg_desc.max_iterations must be >= 1 (got %d)", d->max_iterations);
+    if (!(d->mic_tau >= 0 && d->mic_tau <= 1))
+        return fsdem__reject(msg, size, "fsdem_pcg_desc.mic_tau must be in [0, 1] (got %g)", (double)d->mic_tau);
+    if (!(d->ic_safety >= 0 && d->ic_safety < 1))
+        return fsdem__reject(msg, size, "fsdem_pcg_desc.ic_safety must be in [0, 1) (got %g)", (double)d->ic_safety);
+    if (d->mg_sweeps < 1 || d->mg_sweeps > 64)
+        return fsdem__reject(msg, size, "fsdem_pcg_desc.mg_sweeps must be in [1, 64] (got %d)", d->mg_sweeps);
+    if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
+        return fsdem__reject(msg, size, "fsdem_pcg_desc.allocator: set both alloc and free, or neither");
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_pcg_create(const fsdem_pcg_desc *desc, fsdem_pcg **out) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_pcg *s;
+    if (out) *out = NULL;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    if (fsdem__pcg_desc_check(desc, msg, sizeof msg) != FSDEM_OK) {
+        if (desc && desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
+        return FSDEM_ERR_INVALID_ARG;
+    }
+    s = (fsdem_pcg *)fsdem__alloc(&desc->allocator, sizeof *s);
+    if (!s) return FSDEM_ERR_OUT_OF_MEMORY;
+    memset(s, 0, sizeof *s);
+    s->desc = *desc;
+    s->allocator = desc->allocator;
+    s->status.log = desc->log;
+    s->status.log_user = desc->log_user;
+    *out = s;
+    return FSDEM_OK;
+}
+
+void fsdem_pcg_destroy(fsdem_pcg *s) {
+    fsdem_allocator al;
+    if (!s) return;
+    al = s->allocator;
+    fsdem__free(&al, s->arena, s->arena_bytes);
+    fsdem__free(&al, s, sizeof *s);
+}
+
+const char *fsdem_pcg_last_error(const fsdem_pcg *s) { return s ? s->status.message : "fsdem_pcg is NULL"; }
+
+fsdem_result fsdem_pcg_set_tolerance(fsdem_pcg *s, fsdem_real tolerance, int max_iterations) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!(tolerance > 0) || !fsdem__finite(tolerance))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pcg_set_tolerance: tolerance must be > 0 (got %g)",
+                           (double)tolerance);
+    if (max_iterations < 1)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_pcg_set_tolerance: max_iterations must be >= 1 (got %d)", max_iterations);
+    s->desc.tolerance = tolerance;
+    s->desc.max_iterations = max_iterations;
+    return fsdem__ok(&s->status);
+}
+
+/* Carves arrays out of one block: a first pass with base = NULL measures, a second assigns. */
+typedef struct fsdem__carver {
+    char *base;
+    size_t used;
+    int overflow;
+} fsdem__carver;
+
+static void *fsdem__carve(fsdem__carver *cv, size_t count, size_t elem) {
+    size_t off = (cv->used + 63) & ~(size_t)63;
+    if (elem && count > ((size_t)-1 - off) / elem / 2) {
+        cv->overflow = 1;
+        return NULL;
+    }
+    cv->used = off + count * elem;
+    return cv->base ? (void *)(cv->base + off) : NULL;
+}
+
+/* Replaces the arena by one of at least `bytes` (contents are not kept). On failure the old arena
+   and everything in it stay as they were. */
+static fsdem_result fsdem__pcg_reserve(fsdem_pcg *s, size_t bytes) {
+    void *fresh;
+    if (bytes <= s->arena_bytes && s->arena) return FSDEM_OK;
+    fresh = fsdem__alloc(&s->allocator, bytes);
+    if (!fresh) return FSDEM_ERR_OUT_OF_MEMORY;
+    fsdem__free(&s->allocator, s->arena, s->arena_bytes);
+    s->arena = fresh;
+    s->arena_bytes = bytes;
+    return FSDEM_OK;
+}
+
+/* ---- >>linalg_grid : padded MAC-grid levels ---- */
+
+static void fsdem__level_geometry(fsdem__level *L, int dim, const int n[3]) {
+    L->n[0] = n[0];
+    L->n[1] = n[1];
+    L->n[2] = dim == 3 ? n[2] : 1;
+    L->sy = n[0] + 2;
+    L->sz = L->sy * (n[1] + 2);
+    L->count = dim == 3 ? L->sz * (L->n[2] + 2) : L->sz;
+}
+
+static int fsdem__level_index(const fsdem__level *L, int dim, int i, int j, int k) {
+    return (i + 1) + (j + 1) * L->sy + (dim == 3 ? (k + 1) * L->sz : 0);
+}
+
+/* Geometry of every level the multigrid may need (coarsening to one cell). Returns the count. */
+static int fsdem__mg_plan(fsdem__level *lv, int dim, const int n0[3]) {
+    int n[3], count = 0, a;
+    n[0] = n0[0];
+    n[1] = n0[1];
+    n[2] = dim == 3 ? n0[2] : 1;
+    for (a = 0; a < 3; ++a) {
+        lv[0].ratio[a] = 1;
+        lv[0].h[a] = 1;
+    }
+    for (;;) {
+        fsdem__level_geometry(&lv[count], dim, n);
+        ++count;
+        if ((n[0] == 1 && n[1] == 1 && n[2] == 1) || count == FSDEM__MG_MAX_LEVELS) break;
+        for (a = 0; a < 3; ++a) {
+            lv[count].ratio[a] = n[a] > 1 ? 2 : 1;
+            lv[count].h[a] = lv[count - 1].h[a] * (fsdem_real)lv[count].ratio[a];
+            n[a] = n[a] > 1 ? (n[a] + 1) / 2 : 1;
+        }
+    }
+    return count;
+}
+
+/* Ghost types from the boundary faces: a ghost is AIR (Dirichlet) when a boundary face between it
+   and the nearest interior cell has a positive coefficient, else SOLID. */
+static void fsdem__level_ghosts(fsdem__level *L, int dim) {
+    int i, j, k, a;
+    int lo[3], hi[3];
+    for (a = 0; a < 3; ++a) {
+        lo[a] = (a < dim) ? -1 : 0;
+        hi[a] = (a < dim) ? L->n[a] : 0;
+    }
+    for (k = lo[2]; k <= hi[2]; ++k)
+        for (j = lo[1]; j <= hi[1]; ++j)
+            for (i = lo[0]; i <= hi[0]; ++i) {
+                int g[3], c[3] = {0, 0, 0}, ghost = 0, air = 0, ci;
+                g[0] = i;
+                g[1] = j;
+                g[2] = k;
+                for (a = 0; a < dim; ++a) {
+                    c[a] = g[a] < 0 ? 0 : g[a] >= L->n[a] ? L->n[a] - 1 : g[a];
+                    if (c[a] != g[a]) ghost = 1;
+                }
+                if (!ghost) continue;
+                ci = fsdem__level_index(L, dim, c[0], c[1], c[2]);
+                for (a = 0; a < dim; ++a) {
+                    int s = a == 0 ? 1 : a == 1 ? L->sy : L->sz;
+                    if (g[a] < 0 && L->w[a][ci] > 0) air = 1;
+                    if (g[a] >= L->n[a] && L->w[a][ci + s] > 0) air = 1;
+                }
+                L->type[fsdem__level_index(L, dim, i, j, k)] =
+                    (unsigned char)(air ? FSDEM_STENCIL_CELL_AIR : FSDEM_STENCIL_CELL_SOLID);
+            }
+}
+
+/* Diagonal of a level from its physical face coefficients and the extra diagonal `extra`. */
+static void fsdem__level_diagonal(fsdem__level *L, int dim, const fsdem_real *extra) {
+    int c, a;
+    L->fluid = 0;
+    for (c = 0; c < L->count; ++c) {
+        fsdem_real d = 0;
+        if (FSDEM__TYPE(L->type[c]) != FSDEM_STENCIL_CELL_FLUID) {
+            L->d[c] = L->inv_d[c] = 0;
+            continue;
+        }
+        for (a = 0; a < dim; ++a) {
+            int s = a == 0 ? 1 : a == 1 ? L->sy : L->sz;
+            d += L->w[a][c] + L->w[a][c + s];
+        }
+        d += extra[c];
+        L->d[c] = d;
+        L->inv_d[c] = d > 0 ? 1 / d : 0;
+        L->fluid++;
+    }
+}
+
+/* Reduces the physical face coefficients of a level to matrix off-diagonals. */
+static void fsdem__level_offdiagonal(fsdem__level *L, int dim) {
+    int c, a;
+    for (a = 0; a < dim; ++a) {
+        int s = a == 0 ? 1 : a == 1 ? L->sy : L->sz;
+        fsdem_real *w = L->w[a];
+        for (c = 0; c < L->count; ++c)
+            if (FSDEM__TYPE(L->type[c]) != FSDEM_STENCIL_CELL_FLUID || c - s < 0 ||
+                FSDEM__TYPE(L->type[c - s]) != FSDEM_STENCIL_CELL_FLUID)
+                w[c] = 0;
+    }
+}
+
+/* Level 0 from the caller's stencil: types, physical coefficients, extra diagonal (to `extra`). */
+static void fsdem__level_from_stencil(fsdem__level *L, const fsdem_stencil *st, fsdem_real *extra) {
+    int dim = st->dim, i, j, k, a;
+    memset(L->type, FSDEM_STENCIL_CELL_SOLID, (size_t)L->count);
+    for (a = 0; a < 3; ++a)
+        if (a < dim) memset(L->w[a], 0, sizeof(fsdem_real) * (size_t)L->count);
+    memset(extra, 0, sizeof(fsdem_real) * (size_t)L->count);
+    for (k = 0; k < L->n[2]; ++k)
+        for (j = 0; j < L->n[1]; ++j)
+            for (i = 0; i < L->n[0]; ++i)
+                L->type[fsdem__level_index(L, dim, i, j, k)] = (unsigned char)fsdem__stencil_type(st, i, j, k);
+    /* Each face once, stored at the cell on its high side; only faces with a fluid side are read. */
+    for (a = 0; a < dim; ++a) {
+        int s = a == 0 ? 1 : a == 1 ? L->sy : L->sz;
+        int ext[3];
+        ext[0] = L->n[0];
+        ext[1] = L->n[1];
+        ext[2] = L->n[2];
+        ext[a] += 1;
+        for (k = 0; k < ext[2]; ++k)
+            for (j = 0; j < ext[1]; ++j)
+                for (i = 0; i < ext[0]; ++i) {
+                    int hi = fsdem__level_index(L, dim, i, j, k);
+                    int t_hi = (a == 0 ? i : a == 1 ? j : k) < L->n[a] ? L->type[hi] : -1;
+                    int t_lo = (a == 0 ? i : a == 1 ? j : k) > 0 ? L->type[hi - s] : -1;
+                    if (t_hi != FSDEM_STENCIL_CELL_FLUID && t_lo != FSDEM_STENCIL_CELL_FLUID) continue;
+                    if (t_hi == FSDEM_STENCIL_CELL_SOLID || t_lo == FSDEM_STENCIL_CELL_SOLID) continue;
+                    L->w[a][hi] = fsdem__stencil_face(st, a, i, j, k);
+                }
+    }
+    if (st->diag)
+        for (k = 0; k < L->n[2]; ++k)
+            for (j = 0; j < L->n[1]; ++j)
+                for (i = 0; i < L->n[0]; ++i) {
+                    int c = fsdem__level_index(L, dim, i, j, k);
+                    if (L->type[c] == FSDEM_STENCIL_CELL_FLUID)
+                        extra[c] = st->diag[((size_t)k * L->n[1] + j) * (size_t)L->n[0] + i];
+                }
+    fsdem__level_ghosts(L, dim);
+}
+
+/* Coarse level C from fine level F (physical coefficients, extra diagonal `fextra`); writes the
+   coarse extra diagonal to `cextra`. */
+static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim, const fsdem_real *fextra,
+                                 fsdem_real *cextra) {
+    int I, J, K, a, di, dj, dk;
+    int rx = C->ratio[0], ry = C->ratio[1], rz = C->ratio[2];
+    memset(C->type, FSDEM_STENCIL_CELL_SOLID, (size_t)C->count);
+    memset(cextra, 0, sizeof(fsdem_real) * (size_t)C->count);
+    for (a = 0; a < dim; ++a) memset(C->w[a], 0, sizeof(fsdem_real) * (size_t)C->count);
+    for (K = 0; K < C->n[2]; ++K)
+        for (J = 0; J < C->n[1]; ++J)
+            for (I = 0; I < C->n[0]; ++I) {
+                int any_air = 0, any_fluid = 0, c = fsdem__level_index(C, dim, I, J, K);
+                fsdem_real ex = 0;
+                for (dk = 0; dk < rz; ++dk)
+                    for (dj = 0; dj < ry; ++dj)
+                        for (di = 0; di < rx; ++di) {
+                            int i = I * rx + di, j = J * ry + dj, k = K * rz + dk, f, t;
+                            if (i >= F->n[0] || j >= F->n[1] || k >= F->n[2]) continue;
+                            f = fsdem__level_index(F, dim, i, j, k);
+                            t = FSDEM__TYPE(F->type[f]);
+                            if (t == FSDEM_STENCIL_CELL_AIR) any_air = 1;
+                            if (t == FSDEM_STENCIL_CELL_FLUID) {
+                                any_fluid = 1;
+                                ex += fextra[f];
+                            }
+                        }
+                C->type[c] = (unsigned char)(any_air ? FSDEM_STENCIL_CELL_AIR
+                                             : any_fluid ? FSDEM_STENCIL_CELL_FLUID
+                                                         : FSDEM_STENCIL_CELL_SOLID);
+                cextra[c] = C->type[c] == FSDEM_STENCIL_CELL_FLUID ? ex : 0;
+            }
+    /* faces: the sum of the fine sub-faces over the coarsening ratio along the normal */
+    for (a = 0; a < dim; ++a) {
+        int ext[3], ra = C->ratio[a];
+        ext[0] = C->n[0];
+        ext[1] = C->n[1];
+        ext[2] = C->n[2];
+        ext[a] += 1;
+        for (K = 0; K < ext[2]; ++K)
+            for (J = 0; J < ext[1]; ++J)
+                for (I = 0; I < ext[0]; ++I) {
+                    int lo[3], cnt[3], u, v, wdx;
+                    fsdem_real sum = 0;
+                    int cc[3];
+                    cc[0] = I;
+                    cc[1] = J;
+                    cc[2] = K;
+                    for (u = 0; u < 3; ++u) {
+                        if (u == a) {
+                            lo[u] = cc[u] * ra > F->n[u] ? F->n[u] : cc[u] * ra;
+                            cnt[u] = 1;
+                        } else {
+                            lo[u] = cc[u] * C->ratio[u];
+                            cnt[u] = C->ratio[u];
+                        }
+                    }
+                    for (wdx = 0; wdx < cnt[2]; ++wdx)
+                        for (v = 0; v < cnt[1]; ++v)
+                            for (u = 0; u < cnt[0]; ++u) {
+                                int i = lo[0] + u, j = lo[1] + v, k = lo[2] + wdx;
+                                if ((a != 0 && i >= F->n[0]) || (a != 1 && j >= F->n[1]) ||
+                                    (a != 2 && k >= F->n[2]))
+                                    continue;
+                                sum += F->w[a][fsdem__level_index(F, dim, i, j, k)];
+                            }
+                    /* A boundary face reaches the Dirichlet point of the finest level, half a finest
+                       cell beyond the face: scale by the ratio of the centre-to-point distances. */
+                    if (cc[a] == 0 || cc[a] == C->n[a]) sum *= (F->h[a] + 1) / (C->h[a] + 1);
+                    else sum /= (fsdem_real)ra;
+                    C->w[a][fsdem__level_index(C, dim, I, J, K)] = sum;
+                }
+    }
+    fsdem__level_ghosts(C, dim);
+}
+
+/* Marks fine fluid cells whose interpolation stencil (from level C) contains a solid cell. */
+static void fsdem__level_mark_near_solid(fsdem__level *F, const fsdem__level *C, int dim) {
+    int i, j, k;
+    for (k = 0; k < F->n[2]; ++k)
+        for (j = 0; j < F->n[1]; ++j)
+            for (i = 0; i < F->n[0]; ++i) {
+                int f = fsdem__level_index(F, dim, i, j, k), near = 0, u, v, w;
+                int pc = fsdem__level_index(C, dim, i / C->ratio[0], j / C->ratio[1], k / C->ratio[2]);
+                int o[3];
+                if (FSDEM__TYPE(F->type[f]) != FSDEM_STENCIL_CELL_FLUID) continue;
+                o[0] = C->ratio[0] == 2 ? ((i & 1) ? 1 : -1) : 0;
+                o[1] = C->ratio[1] == 2 ? ((j & 1) ? C->sy : -C->sy) : 0;
+                o[2] = C->ratio[2] == 2 ? ((k & 1) ? C->sz : -C->sz) : 0;
+                for (w = 0; w < 2; ++w)
+                    for (v = 0; v < 2; ++v)
+                        for (u = 0; u < 2; ++u)
+                            if (FSDEM__TYPE(C->type[pc + u * o[0] + v * o[1] + w * o[2]]) == FSDEM_STENCIL_CELL_SOLID)
+                                near = 1;
+                if (near) F->type[f] |= FSDEM__NEAR_SOLID;
+            }
+}
+
+/* ---- >>linalg_kernels : stencil kernels on padded levels ---- */
+
+/* y = A x on a level (interior cells; y untouched on ghosts). */
+static void fsdem__level_apply(const fsdem__level *L, int dim, const fsdem_real *x, fsdem_real *y) {
+    int i, j, k, sy = L->sy, sz = L->sz;
+    const fsdem_real *d = L->d, *w0 = L->w[0], *w1 = L->w[1], *w2 = L->w[2];
+    if (dim == 2) {
+        for (j = 0; j < L->n[1]; ++j) {
+            int c0 = (j + 1) * sy + 1;
+            for (i = 0; i < L->n[0]; ++i) {
+                int c = c0 + i;
+                y[c] = d[c] * x[c] - w0[c] * x[c - 1] - w0[c + 1] * x[c + 1] - w1[c] * x[c - sy] -
+                       w1[c + sy] * x[c + sy];
+            }
+        }
+        return;
+    }
+    for (k = 0; k < L->n[2]; ++k)
+        for (j = 0; j < L->n[1]; ++j) {
+            int c0 = (k + 1) * sz + (j + 1) * sy + 1;
+            for (i = 0; i < L->n[0]; ++i) {
+                int c = c0 + i;
+                y[c] = d[c] * x[c] - w0[c] * x[c - 1] - w0[c + 1] * x[c + 1] - w1[c] * x[c - sy] -
+                       w1[c + sy] * x[c + sy] - w2[c] * x[c - sz] - w2[c + sz] * x[c + sz];
+            }
+        }
+}
+
+/* Gauss-Seidel on the cells of one colour ((i + j + k) % 2 == colour) of row (j, k). With
+   `from_zero` the row is treated as if x were 0 before the sweep: cells of this colour get
+   b / d and the others 0 (so no clearing pass is needed). */
+static void fsdem__smooth_row(const fsdem__level *L, int dim, const fsdem_real *b, fsdem_real *x, int colour, int j,
+                              int k, int from_zero) {
+    int i, sy = L->sy, sz = L->sz, n0 = L->n[0], c0 = fsdem__level_index(L, dim, 0, j, k);
+    int i0 = (j + k + colour) & 1;
+    const fsdem_real *inv_d = L->inv_d, *w0 = L->w[0], *w1 = L->w[1], *w2 = L->w[2];
+    if (from_zero) {
+        for (i = 0; i < n0; ++i) x[c0 + i] = 0;
+        for (i = i0; i < n0; i += 2) x[c0 + i] = inv_d[c0 + i] * b[c0 + i];
+        return;
+    }
+    if (dim == 2) {
+        for (i = i0; i < n0; i += 2) {
+            int c = c0 + i;
+            x[c] = inv_d[c] *
+                   (b[c] + w0[c] * x[c - 1] + w0[c + 1] * x[c + 1] + w1[c] * x[c - sy] + w1[c + sy] * x[c + sy]);
+        }
+        return;
+    }
+    for (i = i0; i < n0; i += 2) {
+        int c = c0 + i;
+        x[c] = inv_d[c] * (b[c] + w0[c] * x[c - 1] + w0[c + 1] * x[c + 1] + w1[c] * x[c - sy] + w1[c + sy] * x[c + sy] +
+                           w2[c] * x[c - sz] + w2[c + sz] * x[c + sz]);
+    }
+}
+
+/* Interpolation along one axis for fine index i and coarsening ratio r (1 or 2): the parent's
+   coarse index *I, the offset *o (index step) to the other coarse cell, and the weights of the
+   parent (*a) and of the other cell (*b). */
+static void fsdem__axis_weights(int i, int r, int stride, int *I, int *o, fsdem_real *a, fsdem_real *b) {
+    if (r == 2) {
+        *I = i >> 1;
+        *o = (i & 1) ? stride : -stride;
+        *a = (fsdem_real)0.75;
+        *b = (fsdem_real)0.25;
+    } else {
+        *I = i;
+        *o = 0;
+        *a = 1;
+        *b = 0;
+    }
+}
+
+/* 1 / (sum of the interpolation weights of the non-solid coarse cells) for a fine cell whose
+   stencil has parent pc, offsets o[] and weights a[], b[]. */
+static fsdem_real fsdem__interp_inv_norm(const fsdem__level *C, int pc, const int o[3], const fsdem_real a[3],
+                                         const fsdem_real b[3]) {
+    fsdem_real norm = 0;
+    int u, v, w;
+    for (w = 0; w < 2; ++w)
+        for (v = 0; v < 2; ++v)
+            for (u = 0; u < 2; ++u) {
+                fsdem_real wt = (u ? b[0] : a[0]) * (v ? b[1] : a[1]) * (w ? b[2] : a[2]);
+                if (wt != 0 && FSDEM__TYPE(C->type[pc + u * o[0] + v * o[1] + w * o[2]]) != FSDEM_STENCIL_CELL_SOLID)
+                    norm += wt;
+            }
+    return norm > 0 ? 1 / norm : 0;
+}
+
+static fsdem_real fsdem__interp_inv_norm1(const fsdem__level *C, int pc, int ox, int oy, int oz, fsdem_real ax,
+                                          fsdem_real bx, fsdem_real ay, fsdem_real by, fsdem_real az, fsdem_real bz) {
+    int o[3];
+    fsdem_real a[3], b[3];
+    o[0] = ox;
+    o[1] = oy;
+    o[2] = oz;
+    a[0] = ax;
+    a[1] = ay;
+    a[2] = az;
+    b[0] = bx;
+    b[1] = by;
+    b[2] = bz;
+    return fsdem__interp_inv_norm(C, pc, o, a, b);
+}
+
+/* P and P^T are tensor products of one-dimensional stencils (3/4 to the parent, 1/4 to the next
+   coarse cell on the child's side), times 1/norm on fluid cells next to solids. Both are applied
+   row by row: along x through a row buffer, along y and z as axpys between whole rows, which
+   vectorises. `buf` holds two rows of the fine level (n[0] + 4 each). */
+
+/* xf += P xc at the fluid cells of row (j, k) of F. */
+static void fsdem__prolong_row(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *xc,
+                               fsdem_real *xf, int j, int k, fsdem_real *buf) {
+    int i, I, J, K, oy, oz, crow, f0, nI = C->n[0];
+    fsdem_real ay, by, az, bz, w00, w10, w01, w11;
+    fsdem_real *cx = buf + 1; /* coarse row, indices -1 .. nI */
+    const fsdem_real *x00, *x10, *x01, *x11;
+    const unsigned char *type;
+    fsdem__axis_weights(j, C->ratio[1], C->sy, &J, &oy, &ay, &by);
+    fsdem__axis_weights(k, C->ratio[2], C->sz, &K, &oz, &az, &bz);
+    if (dim == 2) {
+        az = 1;
+        bz = 0;
+        oz = 0;
+    }
+    crow = fsdem__level_index(C, dim, 0, J, K);
+    f0 = fsdem__level_index(F, dim, 0, j, k);
+    x00 = xc + crow;
+    x10 = x00 + oy;
+    x01 = x00 + oz;
+    x11 = x00 + oy + oz;
+    w00 = ay * az;
+    w10 = by * az;
+    w01 = ay * bz;
+    w11 = by * bz;
+    /* y and z: combine up to four coarse rows (ghost ends included; they hold 0) */
+    for (I = -1; I <= nI; ++I) cx[I] = w00 * x00[I] + w10 * x10[I] + w01 * x01[I] + w11 * x11[I];
+    type = F->type + f0;
+    if (C->ratio[0] == 2) {
+        const fsdem_real q = (fsdem_real)0.75, e = (fsdem_real)0.25;
+        for (i = 0; i < F->n[0]; ++i) {
+            unsigned char t = type[i];
+            fsdem_real v;
+            I = i >> 1;
+            v = q * cx[I] + e * cx[(i & 1) ? I + 1 : I - 1];
+            if (t == FSDEM_STENCIL_CELL_FLUID) xf[f0 + i] += v;
+            else if (FSDEM__TYPE(t) == FSDEM_STENCIL_CELL_FLUID)
+                xf[f0 + i] += v * fsdem__interp_inv_norm1(C, crow + I, (i & 1) ? 1 : -1, oy, oz, q, e, ay, by, az, bz);
+        }
+    } else {
+        for (i = 0; i < F->n[0]; ++i) {
+            unsigned char t = type[i];
+            if (t == FSDEM_STENCIL_CELL_FLUID) xf[f0 + i] += cx[i];
+            else if (FSDEM__TYPE(t) == FSDEM_STENCIL_CELL_FLUID)
+                xf[f0 + i] += cx[i] * fsdem__interp_inv_norm1(C, crow + i, 0, oy, oz, 1, 0, ay, by, az, bz);
+        }
+    }
+}
+
+/* bc += P^T (b - A x) over row (j, k) of F, the residual formed on the fly. b is 0 off fluid cells
+   on every level, so the residual is too (d and the couplings vanish there). Coarse ghost and
+   non-fluid entries receive values that fsdem__mg_clean clears. */
+static void fsdem__restrict_row(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *b,
+                                const fsdem_real *x, fsdem_real *bc, int j, int k, fsdem_real *buf) {
+    int i, I, J, K, oy, oz, crow, f0, n0 = F->n[0], nI = C->n[0], sy = F->sy, sz = F->sz;
+    fsdem_real ay, by, az, bz;
+    fsdem_real *r = buf + 2, *cr = buf + F->n[0] + 6;
+    const fsdem_real *d, *w0, *w1, *w2, *bb, *xx;
+    const unsigned char *type;
+    fsdem__axis_weights(j, C->ratio[1], C->sy, &J, &oy, &ay, &by);
+    fsdem__axis_weights(k, C->ratio[2], C->sz, &K, &oz, &az, &bz);
+    if (dim == 2) {
+        az = 1;
+        bz = 0;
+        oz = 0;
+    }
+    crow = fsdem__level_index(C, dim, 0, J, K);
+    f0 = fsdem__level_index(F, dim, 0, j, k);
+    d = F->d + f0;
+    w0 = F->w[0] + f0;
+    w1 = F->w[1] + f0;
+    w2 = F->w[2] + f0;
+    bb = b + f0;
+    xx = x + f0;
+    if (dim == 2)
+        for (i = 0; i < n0; ++i)
+            r[i] = bb[i] - d[i] * xx[i] + w0[i] * xx[i - 1] + w0[i + 1] * xx[i + 1] + w1[i] * xx[i - sy] +
+                   w1[i + sy] * xx[i + sy];
+    else
+        for (i = 0; i < n0; ++i)
+            r[i] = bb[i] - d[i] * xx[i] + w0[i] * xx[i - 1] + w0[i + 1] * xx[i + 1] + w1[i] * xx[i - sy] +
+                   w1[i + sy] * xx[i + sy] + w2[i] * xx[i - sz] + w2[i + sz] * xx[i + sz];
+    type = F->type + f0;
+    for (i = 0; i < n0; ++i)
+        if (type[i] & FSDEM__NEAR_SOLID) {
+            int ox = C->ratio[0] == 2 ? ((i & 1) ? 1 : -1) : 0;
+            fsdem_real ax = C->ratio[0] == 2 ? (fsdem_real)0.75 : 1, bx = C->ratio[0] == 2 ? (fsdem_real)0.25 : 0;
+            r[i] *= fsdem__interp_inv_norm1(C, crow + (C->ratio[0] == 2 ? i >> 1 : i), ox, oy, oz, ax, bx, ay, by, az,
+                                            bz);
+        }
+    /* x: coarse I gathers 1/4, 3/4, 3/4, 1/4 from fine 2I-1 .. 2I+2 (zero beyond the row) */
+    if (C->ratio[0] == 2) {
+        const fsdem_real q = (fsdem_real)0.75, e = (fsdem_real)0.25;
+        r[-1] = r[n0] = r[n0 + 1] = 0;
+        for (I = 0; I < nI; ++I) cr[I] = e * (r[2 * I - 1] + r[2 * I + 2]) + q * (r[2 * I] + r[2 * I + 1]);
+    } else {
+        for (I = 0; I < nI; ++I) cr[I] = r[I];
+    }
+    /* y and z: add to up to four coarse rows */
+    {
+        fsdem_real *c00 = bc + crow, *c10 = c00 + oy, *c01 = c00 + oz, *c11 = c00 + oy + oz;
+        fsdem_real w00 = ay * az, w10 = by * az, w01 = ay * bz, w11 = by * bz;
+        for (I = 0; I < nI; ++I) c00[I] += w00 * cr[I];
+        if (w10 != 0)
+            for (I = 0; I < nI; ++I) c10[I] += w10 * cr[I];
+        if (w01 != 0)
+            for (I = 0; I < nI; ++I) c01[I] += w01 * cr[I];
+        if (w11 != 0)
+            for (I = 0; I < nI; ++I) c11[I] += w11 * cr[I];
+    }
+}
+
+/* Zeroes b on the non-fluid cells (ghosts included) of a level after a restriction. */
+static void fsdem__mg_clean(const fsdem__level *L, fsdem_real *b) {
+    int c;
+    for (c = 0; c < L->count; ++c)
+        if (FSDEM__TYPE(L->type[c]) != FSDEM_STENCIL_CELL_FLUID) b[c] = 0;
+}
+
+/* ---- >>linalg_mg : multigrid V-cycle ---- */
+
+/* The V-cycle works slab by slab (a slab is a row in 2D, a plane in 3D) as a wavefront: in one
+   pass over memory, stage s of a pipeline handles slab t - s at step t. Each Gauss-Seidel
+   half-sweep is a stage, so are the fused residual-restriction and the prolongation. A stage
+   only reads slabs that the stage before it has finished and the stage after it has not yet
+   touched, so the result is exactly that of the half-sweeps one after another, at a fraction of
+   the memory traffic. */
+enum { FSDEM__STAGE_SMOOTH, FSDEM__STAGE_SMOOTH_FROM_ZERO, FSDEM__STAGE_RESTRICT, FSDEM__STAGE_PROLONG };
+
+typedef struct fsdem__stage {
+    int kind, colour;
+} fsdem__stage;
+
+static void fsdem__mg_pipeline(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b,
+                               fsdem_real *x, fsdem_real *xc_or_bc, const fsdem__stage *stage, int stages,
+                               fsdem_real *buf) {
+    int slabs = dim == 3 ? L->n[2] : L->n[1], t, s, j;
+    for (t = 0; t < slabs + stages - 1; ++t)
+        for (s = 0; s < stages; ++s) {
+            int p = t - s, jb = dim == 3 ? 0 : p, je = dim == 3 ? L->n[1] : p + 1, k = dim == 3 ? p : 0;
+            if (p < 0 || p >= slabs) continue;
+            for (j = jb; j < je; ++j) switch (stage[s].kind) {
+                case FSDEM__STAGE_SMOOTH: fsdem__smooth_row(L, dim, b, x, stage[s].colour, j, k, 0); break;
+                case FSDEM__STAGE_SMOOTH_FROM_ZERO: fsdem__smooth_row(L, dim, b, x, stage[s].colour, j, k, 1); break;
+                case FSDEM__STAGE_RESTRICT: fsdem__restrict_row(L, C, dim, b, x, xc_or_bc, j, k, buf); break;
+                default: fsdem__prolong_row(L, C, dim, xc_or_bc, x, j, k, buf); break;
+                }
+        }
+}
+
+/* Pre-smoothing from x = 0 (red first), then (when C is given) bc = P^T (b - A x). */
+static void fsdem__mg_down(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b, fsdem_real *x,
+                           fsdem_real *bc, int sweeps, fsdem_real *buf) {
+    fsdem__stage stage[2 * 64 + 2];
+    int n = 0, s;
+    for (s = 0; s < 2 * sweeps; ++s) {
+        stage[n].kind = s == 0 ? FSDEM__STAGE_SMOOTH_FROM_ZERO : FSDEM__STAGE_SMOOTH;
+        stage[n++].colour = s & 1;
+    }
+    if (C) {
+        stage[n].kind = FSDEM__STAGE_RESTRICT;
+        stage[n++].colour = 0;
+        memset(bc, 0, sizeof(fsdem_real) * (size_t)C->count);
+    }
+    fsdem__mg_pipeline(L, C, dim, b, x, bc, stage, n, buf);
+    if (C) fsdem__mg_clean(C, bc);
+}
+
+/* (When C is given) x += P xc, then post-smoothing (black first: the adjoint of the pre-smoother). */
+static void fsdem__mg_up(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b, fsdem_real *x,
+                         fsdem_real *xc, int sweeps, fsdem_real *buf) {
+    fsdem__stage stage[2 * 64 + 2];
+    int n = 0, s;
+    if (C) {
+        stage[n].kind = FSDEM__STAGE_PROLONG;
+        stage[n++].colour = 0;
+    }
+    for (s = 0; s < 2 * sweeps; ++s) {
+        stage[n].kind = FSDEM__STAGE_SMOOTH;
+        stage[n++].colour = (s & 1) ^ 1;
+    }
+    fsdem__mg_pipeline(L, C, dim, b, x, xc, stage, n, buf);
+}
+
+/* z = M^-1 r: one V-cycle from a zero guess. */
+static void fsdem__mg_vcycle(fsdem_pcg *s, const fsdem_real *r, fsdem_real *z) {
+    int l, dim = s->dim, nu = s->desc.mg_sweeps, last = s->levels - 1;
+    fsdem__level *lv = s->level;
+    lv[0].b = (fsdem_real *)r; /* read only at level 0 */
+    lv[0].x = z;
+    for (l = 0; l < last; ++l) fsdem__mg_down(&lv[l], &lv[l + 1], dim, lv[l].b, lv[l].x, lv[l + 1].b, nu, s->rowbuf);
+    if (lv[last].n[0] * lv[last].n[1] * lv[last].n[2] == 1) {
+        int c = fsdem__level_index(&lv[last], dim, 0, 0, 0);
+        lv[last].x[c] = lv[last].inv_d[c] * lv[last].b[c];
+    } else {
+        fsdem__mg_down(&lv[last], NULL, dim, lv[last].b, lv[last].x, NULL, nu, s->rowbuf);
+        fsdem__mg_up(&lv[last], NULL, dim, lv[last].b, lv[last].x, NULL, nu, s->rowbuf);
+    }
+    for (l = last - 1; l >= 0; --l) fsdem__mg_up(&lv[l], &lv[l + 1], dim, lv[l].b, lv[l].x, lv[l + 1].x, nu, s->rowbuf);
+    lv[0].b = lv[0].x = NULL;
+}
+
+/* ---- >>linalg_ic : incomplete Cholesky on stencils and CSR matrices ---- */
+
+/* Stencil IC(0)/MIC(0): M = L L^T with L = (pivots) on the diagonal and the matrix off-diagonals
+   below it, so only q = 1/sqrt(pivot) is stored. MIC moves tau times the fill that IC(0) drops
+   (between the two upper neighbours of a lower neighbour) to the diagonal. */
+static void fsdem__stencil_ic_build(fsdem_pcg *s, fsdem_real tau) {
+    const fsdem__level *L = &s->level[0];
+    int dim = s->dim, i, j, k, a, b;
+    int st[3];
+    fsdem_real safety = s->desc.ic_safety, *q = s->ic;
+    st[0] = 1;
+    st[1] = L->sy;
+    st[2] = L->sz;
+    memset(q, 0, sizeof(fsdem_real) * (size_t)L->count);
+    for (k = 0; k < L->n[2]; ++k)
+        for (j = 0; j < L->n[1]; ++j)
+            for (i = 0; i < L->n[0]; ++i) {
+                int c = fsdem__level_index(L, dim, i, j, k);
+                fsdem_real e;
+                if (FSDEM__TYPE(L->type[c]) != FSDEM_STENCIL_CELL_FLUID || !(L->d[c] > 0)) continue;
+                e = L->d[c];
+                for (a = 0; a < dim; ++a) {
+                    int lo = c - st[a];
+                    fsdem_real t = L->w[a][c] * q[lo];
+                    e -= t * t;
+                    if (tau > 0 && t != 0)
+                        for (b = 0; b < dim; ++b)
+                            if (b != a) e -= tau * L->w[a][c] * L->w[b][lo + st[b]] * q[lo] * q[lo];
+                }
+                if (!(e >= safety * L->d[c])) e = L->d[c];
+                q[c] = 1 / (fsdem_real)sqrt(e);
+            }
+}
+
+static void fsdem__stencil_ic_apply(const fsdem_pcg *s, const fsdem_real *r, fsdem_real *z) {
+    const fsdem__level *L = &s->level[0];
+    const fsdem_real *q = s->ic, *w0 = L->w[0], *w1 = L->w[1], *w2 = L->w[2];
+    int i, j, k, sy = L->sy, sz = L->sz, dim = s->dim;
+    /* forward: L y = r */
+    for (k = 0; k < L->n[2]; ++k)
+        for (j = 0; j < L->n[1]; ++j) {
+            int c0 = fsdem__level_index(L, dim, 0, j, k);
+            for (i = 0; i < L->n[0]; ++i) {
+                int c = c0 + i;
+                fsdem_real t = r[c] + w0[c] * q[c - 1] * z[c - 1] + w1[c] * q[c - sy] * z[c - sy];
+                if (dim == 3) t += w2[c] * q[c - sz] * z[c - sz];
+                z[c] = t * q[c];
+            }
+        }
+    /* backward: L^T z = y */
+    for (k = L->n[2] - 1; k >= 0; --k)
+        for (j = L->n[1] - 1; j >= 0; --j) {
+            int c0 = fsdem__level_index(L, dim, 0, j, k);
+            for (i = L->n[0] - 1; i >= 0; --i) {
+                int c = c0 + i;
+                fsdem_real t = w0[c + 1] * z[c + 1] + w1[c + sy] * z[c + sy];
+                if (dim == 3) t += w2[c + sz] * z[c + sz];
+                z[c] = q[c] * (z[c] + q[c] * t);
+            }
+        }
+}
+
+/* CSR IC(0)/MIC(0), right-looking on the upper factor U (row k of U is column k of L). */
+static void fsdem__csr_ic_build(fsdem_pcg *s, fsdem_real tau) {
+    const fsdem_csr *m = &s->csr;
+    int n = m->rows, i, k, e, f, cnt = 0;
+    fsdem_real safety = s->desc.ic_safety;
+    fsdem_real *diag0 = s->ic; /* the matrix diagonal, kept for the pivot floor */
+    for (i = 0; i < n; ++i) {
+        s->u_start[i] = cnt;
+        for (e = m->row_start[i]; e < m->row_start[i + 1]; ++e)
+            if (m->col[e] >= i) {
+                if (m->col[e] == i) diag0[i] = m->val[e];
+                s->u_col[cnt] = m->col[e];
+                s->u_val[cnt++] = m->val[e];
+            }
+        s->u_pos[i] = -1;
+    }
+    s->u_start[n] = cnt;
+    for (k = 0; k < n; ++k) {
+        int kb = s->u_start[k], ke = s->u_start[k + 1];
+        fsdem_real piv = s->u_val[kb], dk;
+        if (!(piv >= safety * diag0[k])) piv = diag0[k];
+        dk = (fsdem_real)sqrt(piv);
+        s->u_val[kb] = dk;
+        for (e = kb + 1; e < ke; ++e) s->u_val[e] /= dk;
+        for (e = kb + 1; e < ke; ++e) {
+            int row = s->u_col[e], rb = s->u_start[row], re = s->u_start[row + 1];
+            fsdem_real li = s->u_val[e];
+            for (f = rb; f < re; ++f) s->u_pos[s->u_col[f]] = f;
+            s->u_val[rb] -= li * li;
+            for (f = e + 1; f < ke; ++f) {
+                int col = s->u_col[f];
+                fsdem_real fill = li * s->u_val[f];
+                if (s->u_pos[col] >= 0) s->u_val[s->u_pos[col]] -= fill;
+                else if (tau > 0) {
+                    s->u_val[rb] -= tau * fill;
+                    s->u_val[s->u_start[col]] -= tau * fill;
+                }
+            }
+            for (f = rb; f < re; ++f) s->u_pos[s->u_col[f]] = -1;
+        }
+    }
+}
+
+static void fsdem__csr_ic_apply(const fsdem_pcg *s, const fsdem_real *r, fsdem_real *z) {
+    int n = s->csr.rows, k, e;
+    if (z != r) memcpy(z, r, sizeof(fsdem_real) * (size_t)n);
+    for (k = 0; k < n; ++k) { /* U^T y = r */
+        int kb = s->u_start[k], ke = s->u_start[k + 1];
+        fsdem_real y = z[k] / s->u_val[kb];
+        z[k] = y;
+        for (e = kb + 1; e < ke; ++e) z[s->u_col[e]] -= s->u_val[e] * y;
+    }
+    for (k = n - 1; k >= 0; --k) { /* U z = y */
+        int kb = s->u_start[k], ke = s->u_start[k + 1];
+        fsdem_real t = z[k];
+        for (e = kb + 1; e < ke; ++e) t -= s->u_val[e] * z[s->u_col[e]];
+        z[k] = t / s->u_val[kb];
+    }
+}
+
+/* ---- >>linalg_setup : setup for stencils and CSR matrices ---- */
+
+/* Carves the stencil workspace; `levels` = number of multigrid levels to hold (1 without MG). */
+static void fsdem__stencil_carve(fsdem_pcg *s, fsdem__carver *cv, int levels, int want_ic, int cells,
+                                 int with_extra) {
+    int l, a, N = s->level[0].count;
+    fsdem_real **vec[4];
+    vec[0] = &s->x;
+    vec[1] = &s->r;
+    vec[2] = &s->z;
+    vec[3] = &s->p;
+    for (a = 0; a < 4; ++a) *vec[a] = (fsdem_real *)fsdem__carve(cv, (size_t)N, sizeof(fsdem_real));
+    s->ux = s->uy = NULL;
+    if (with_extra) {
+        s->ux = (fsdem_real *)fsdem__carve(cv, (size_t)cells, sizeof(fsdem_real));
+        s->uy = (fsdem_real *)fsdem__carve(cv, (size_t)cells, sizeof(fsdem_real));
+    }
+    s->ic = want_ic ? (fsdem_real *)fsdem__carve(cv, (size_t)N, sizeof(fsdem_real)) : NULL;
+    s->rowbuf = levels > 1 ? (fsdem_real *)fsdem__carve(cv, 2 * ((size_t)s->level[0].n[0] + 8), sizeof(fsdem_real)) : NULL;
+    s->mark = (unsigned char *)fsdem__carve(cv, (size_t)N, 1);
+    s->ns_cell = (int *)fsdem__carve(cv, (size_t)N, sizeof(int));
+    for (l = 0; l < levels; ++l) {
+        fsdem__level *L = &s->level[l];
+        size_t n = (size_t)L->count;
+        L->type = (unsigned char *)fsdem__carve(cv, n, 1);
+        L->d = (fsdem_real *)fsdem__carve(cv, n, sizeof(fsdem_real));
+        L->inv_d = (fsdem_real *)fsdem__carve(cv, n, sizeof(fsdem_real));
+        for (a = 0; a < 3; ++a)
+            L->w[a] = a < s->dim ? (fsdem_real *)fsdem__carve(cv, n, sizeof(fsdem_real)) : NULL;
+        if (s->dim == 2) L->w[2] = L->w[1]; /* never read in 2D; keeps the kernels' pointers valid */
+        L->x = L->b = NULL;
+        if (l > 0) {
+            L->x = (fsdem_real *)fsdem__carve(cv, n, sizeof(fsdem_real));
+            L->b = (fsdem_real *)fsdem__carve(cv, n, sizeof(fsdem_real));
+        }
+    }
+}
+
+/* Finds the fluid regions that no Dirichlet condition reaches (their matrix is singular: the
+   constant is in its null space). A fluid cell is an anchor when its extra diagonal is positive
+   or a face towards an air cell or a Dirichlet boundary has a positive coefficient, i.e. when
+   d exceeds the sum of its fluid couplings; the test is made on the coefficients, not on d. */
+static void fsdem__stencil_nullspace(fsdem_pcg *s, const fsdem_real *extra) {
+    const fsdem__level *L = &s->level[0];
+    int dim = s->dim, c, a, head, tail, st[3];
+    unsigned char *mark = s->mark;
+    int *queue = s->ns_cell;
+    st[0] = 1;
+    st[1] = L->sy;
+    st[2] = L->sz;
+    memset(mark, 0, (size_t)L->count);
+    tail = 0;
+    for (c = 0; c < L->count; ++c) {
+        int anchor = 0;
+        if (L->type[c] != FSDEM_STENCIL_CELL_FLUID) continue;
+        if (extra[c] > 0) anchor = 1;
+        for (a = 0; a < dim && !anchor; ++a) {
+            /* physical coefficients are still in w here */
+            if (L->w[a][c] > 0 && FSDEM__TYPE(L->type[c - st[a]]) == FSDEM_STENCIL_CELL_AIR) anchor = 1;
+            if (L->w[a][c + st[a]] > 0 && FSDEM__TYPE(L->type[c + st[a]]) == FSDEM_STENCIL_CELL_AIR) anchor = 1;
+        }
+        if (anchor) {
+            mark[c] = 1;
+            queue[tail++] = c;
+        }
+    }
+    for (head = 0; head < tail; ++head) {
+        int u = queue[head];
+        for (a = 0; a < dim; ++a) {
+            int lo = u - st[a], hi = u + st[a];
+            if (!mark[lo] && L->w[a][u] > 0 && L->type[lo] == FSDEM_STENCIL_CELL_FLUID) {
+                mark[lo] = 1;
+                queue[tail++] = lo;
+            }
+            if (!mark[hi] && L->w[a][hi] > 0 && L->type[hi] == FSDEM_STENCIL_CELL_FLUID) {
+                mark[hi] = 1;
+                queue[tail++] = hi;
+            }
+        }
+    }
+    /* the rest: flood each unanchored region, recording its cells */
+    s->ns_components = 0;
+    s->ns_cells = 0;
+    for (c = 0; c < L->count; ++c) {
+        if (mark[c] || L->type[c] != FSDEM_STENCIL_CELL_FLUID) continue;
+        head = s->ns_cells;
+        tail = head;
+        mark[c] = 1;
+        queue[tail++] = c;
+        for (; head < tail; ++head) {
+            int u = queue[head];
+            for (a = 0; a < dim; ++a) {
+                int lo = u - st[a], hi = u + st[a];
+                if (!mark[lo] && L->w[a][u] > 0 && L->type[lo] == FSDEM_STENCIL_CELL_FLUID) {
+                    mark[lo] = 1;
+                    queue[tail++] = lo;
+                }
+                if (!mark[hi] && L->w[a][hi] > 0 && L->type[hi] == FSDEM_STENCIL_CELL_FLUID) {
+                    mark[hi] = 1;
+                    queue[tail++] = hi;
+                }
+            }
+        }
+        queue[s->ns_cells] = -(queue[s->ns_cells] + 1);
+        s->ns_cells = tail;
+        s->ns_components++;
+    }
+}
+
+fsdem_result fsdem_pcg_setup_stencil(fsdem_pcg *s, const fsdem_stencil *st) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem__level plan[FSDEM__MG_MAX_LEVELS];
+    fsdem__carver cv;
+    fsdem_precond pc;
+    fsdem_result res;
+    int n[3], levels, l, cells;
+    fsdem_real *extra, *cextra;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (st && (st->dim == 2 || st->dim == 3) && st->n[0] > 0 && st->n[1] > 0 && (st->dim == 2 || st->n[2] > 0) &&
+        fsdem__stencil_padded(st) > FSDEM__MAX_PADDED)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY,
+                           "fsdem_pcg_setup_stencil: a grid of %d x %d x %d cells does not fit (index overflow)",
+                           st->n[0], st->n[1], st->dim == 3 ? st->n[2] : 1);
+    if (fsdem_stencil_check(st, msg, sizeof msg) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s", msg);
+    pc = s->desc.preconditioner == FSDEM_PRECOND_AUTO ? FSDEM_PRECOND_MG : s->desc.preconditioner;
+    fsdem__stencil_dims(st, n);
+    cells = n[0] * n[1] * n[2];
+    memset(plan, 0, sizeof plan);
+    levels = pc == FSDEM_PRECOND_MG ? fsdem__mg_plan(plan, st->dim, n) : 1;
+    if (levels == 1) {
+        fsdem__level_geometry(&plan[0], st->dim, n);
+        plan[0].ratio[0] = plan[0].ratio[1] = plan[0].ratio[2] = 1;
+        plan[0].h[0] = plan[0].h[1] = plan[0].h[2] = 1;
+    }
+    /* measure on a copy (so a failure leaves the previous setup intact), reserve, carve */
+    {
+        fsdem_pcg probe = *s;
+        memcpy(probe.level, plan, sizeof plan);
+        probe.dim = st->dim;
+        cv.base = NULL;
+        cv.used = 0;
+        cv.overflow = 0;
+        fsdem__stencil_carve(&probe, &cv, levels, pc == FSDEM_PRECOND_IC0 || pc == FSDEM_PRECOND_MIC0, cells,
+                             st->extra != NULL);
+    }
+    if (cv.overflow)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pcg_setup_stencil: workspace size overflows");
+    res = fsdem__pcg_reserve(s, cv.used);
+    if (res != FSDEM_OK)
+        return fsdem__fail(&s->status, res, "fsdem_pcg_setup_stencil: cannot allocate %.0f bytes", (double)cv.used);
+    s->kind = FSDEM__KIND_NONE;
+    memcpy(s->level, plan, sizeof plan);
+    s->dim = st->dim;
+    cv.base = (char *)s->arena;
+    cv.used = 0;
+    fsdem__stencil_carve(s, &cv, levels, pc == FSDEM_PRECOND_IC0 || pc == FSDEM_PRECOND_MIC0, cells, st->extra != NULL);
+    /* every array is written in full below; the CG vectors' ghosts must be 0 */
+    memset(s->x, 0, sizeof(fsdem_real) * (size_t)s->level[0].count);
+    memset(s->r, 0, sizeof(fsdem_real) * (size_t)s->level[0].count);
+
+    /* level 0; the extra diagonals live in the z and p vectors while the levels are built */
+    extra = s->z;
+    cextra = s->p;
+    fsdem__level_from_stencil(&s->level[0], st, extra);
+    fsdem__level_diagonal(&s->level[0], st->dim, extra);
+    fsdem__stencil_nullspace(s, extra);
+    s->levels = 1;
+    if (pc == FSDEM_PRECOND_MG) {
+        for (l = 1; l < levels && s->level[l - 1].fluid > 0; ++l) {
+            fsdem__level *F = &s->level[l - 1], *C = &s->level[l];
+            fsdem__level_coarsen(F, C, st->dim, extra, cextra);
+            fsdem__level_diagonal(C, st->dim, cextra);
+            if (C->fluid == 0) break;
+            fsdem__level_mark_near_solid(F, C, st->dim);
+            fsdem__level_offdiagonal(F, st->dim);
+            memcpy(extra, cextra, sizeof(fsdem_real) * (size_t)C->count);
+            s->levels = l + 1;
+        }
+    }
+    fsdem__level_offdiagonal(&s->level[s->levels - 1], st->dim);
+    for (l = 1; l < s->levels; ++l) /* ghosts stay 0; the V-cycle writes interior cells only */
+        memset(s->level[l].x, 0, sizeof(fsdem_real) * (size_t)s->level[l].count);
+    memset(s->z, 0, sizeof(fsdem_real) * (size_t)s->level[0].count);
+    memset(s->p, 0, sizeof(fsdem_real) * (size_t)s->level[0].count);
+    if (pc == FSDEM_PRECOND_IC0 || pc == FSDEM_PRECOND_MIC0)
+        fsdem__stencil_ic_build(s, pc == FSDEM_PRECOND_MIC0 ? s->desc.mic_tau : 0);
+
+    s->stencil = *st;
+    s->precond = pc;
+    s->length = s->level[0].count;
+    s->user_length = cells;
+    s->kind = FSDEM__KIND_STENCIL;
+    return fsdem__ok(&s->status);
+}
+
+static void fsdem__csr_carve(fsdem_pcg *s, fsdem__carver *cv, int n, int upper, fsdem_precond pc) {
+    fsdem_real **vec[4];
+    int a;
+    vec[0] = &s->x;
+    vec[1] = &s->r;
+    vec[2] = &s->z;
+    vec[3] = &s->p;
+    for (a = 0; a < 4; ++a) *vec[a] = (fsdem_real *)fsdem__carve(cv, (size_t)n, sizeof(fsdem_real));
+    s->ux = s->uy = NULL;
+    s->ic = pc != FSDEM_PRECOND_NONE ? (fsdem_real *)fsdem__carve(cv, (size_t)n, sizeof(fsdem_real)) : NULL;
+    s->u_start = s->u_col = s->u_pos = NULL;
+    s->u_val = NULL;
+    if (pc == FSDEM_PRECOND_IC0 || pc == FSDEM_PRECOND_MIC0) {
+        s->u_start = (int *)fsdem__carve(cv, (size_t)n + 1, sizeof(int));
+        s->u_pos = (int *)fsdem__carve(cv, (size_t)n, sizeof(int));
+        s->u_col = (int *)fsdem__carve(cv, (size_t)upper, sizeof(int));
+        s->u_val = (fsdem_real *)fsdem__carve(cv, (size_t)upper, sizeof(fsdem_real));
+    }
+}
+
+fsdem_result fsdem_pcg_setup_csr(fsdem_pcg *s, const fsdem_csr *m) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem__carver cv;
+    fsdem_precond pc;
+    fsdem_result res;
+    int i, e, upper = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (fsdem_csr_check(m, msg, sizeof msg) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s", msg);
+    pc = s->desc.preconditioner == FSDEM_PRECOND_AUTO ? FSDEM_PRECOND_MIC0 : s->desc.preconditioner;
+    if (pc == FSDEM_PRECOND_MG)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "FSDEM_PRECOND_MG needs a stencil operator (fsdem_pcg_setup_stencil); use "
+                           "FSDEM_PRECOND_MIC0 for a CSR matrix");
+    for (i = 0; i < m->rows; ++i)
+        for (e = m->row_start[i]; e < m->row_start[i + 1]; ++e)
+            if (m->col[e] >= i) upper++;
+    {
+        fsdem_pcg probe = *s;
+        cv.base = NULL;
+        cv.used = 0;
+        cv.overflow = 0;
+        fsdem__csr_carve(&probe, &cv, m->rows, upper, pc);
+    }
+    if (cv.overflow)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pcg_setup_csr: workspace size overflows");
+    res = fsdem__pcg_reserve(s, cv.used);
+    if (res != FSDEM_OK)
+        return fsdem__fail(&s->status, res, "fsdem_pcg_setup_csr: cannot allocate %.0f bytes", (double)cv.used);
+    s->kind = FSDEM__KIND_NONE;
+    cv.base = (char *)s->arena;
+    cv.used = 0;
+    fsdem__csr_carve(s, &cv, m->rows, upper, pc);
+    memset(s->arena, 0, cv.used);
+    s->csr = *m;
+    s->dim = 0;
+    s->levels = 1;
+    s->ns_components = s->ns_cells = 0;
+    if (pc == FSDEM_PRECOND_JACOBI)
+        for (i = 0; i < m->rows; ++i) s->ic[i] = 1 / m->val[fsdem__csr_find(m, i, i)];
+    if (pc == FSDEM_PRECOND_IC0 || pc == FSDEM_PRECOND_MIC0)
+        fsdem__csr_ic_build(s, pc == FSDEM_PRECOND_MIC0 ? s->desc.mic_tau : 0);
+    s->precond = pc;
+    s->length = s->user_length = m->rows;
+    s->kind = FSDEM__KIND_CSR;
+    return fsdem__ok(&s->status);
+}
+
+/* ---- >>linalg_solve : preconditioned conjugate gradients ---- */
+
+/* y = A x on internal vectors. */
+static void fsdem__pcg_apply(fsdem_pcg *s, const fsdem_real *x, fsdem_real *y) {
+    if (s->kind == FSDEM__KIND_CSR) {
+        fsdem_csr_apply(&s->csr, x, y);
+        return;
+    }
+    fsdem__level_apply(&s->level[0], s->dim, x, y);
+    if (s->stencil.extra) {
+        const fsdem__level *L = &s->level[0];
+        int i, j, k, u = 0;
+        for (k = 0; k < L->n[2]; ++k)
+            for (j = 0; j < L->n[1]; ++j)
+                for (i = 0; i < L->n[0]; ++i, ++u) {
+                    s->ux[u] = x[fsdem__level_index(L, s->dim, i, j, k)];
+                    s->uy[u] = 0;
+                }
+        s->stencil.extra(s->stencil.extra_user, s->ux, s->uy);
+        u = 0;
+        for (k = 0; k < L->n[2]; ++k)
+            for (j = 0; j < L->n[1]; ++j)
+                for (i = 0; i < L->n[0]; ++i, ++u) {
+                    int c = fsdem__level_index(L, s->dim, i, j, k);
+                    if (FSDEM__TYPE(L->type[c]) == FSDEM_STENCIL_CELL_FLUID)
+                        y[c] += s->uy[u];
+                }
+    }
+}
+
+/* z = M^-1 r. */
+static void fsdem__pcg_precondition(fsdem_pcg *s, const fsdem_real *r, fsdem_real *z) {
+    int i, n = s->length;
+    switch (s->precond) {
+    case FSDEM_PRECOND_JACOBI: {
+        const fsdem_real *inv = s->kind == FSDEM__KIND_CSR ? s->ic : s->level[0].inv_d;
+        for (i = 0; i < n; ++i) z[i] = inv[i] * r[i];
+        break;
+    }
+    case FSDEM_PRECOND_IC0:
+    case FSDEM_PRECOND_MIC0:
+        if (s->kind == FSDEM__KIND_CSR) fsdem__csr_ic_apply(s, r, z);
+        else fsdem__stencil_ic_apply(s, r, z);
+        break;
+    case FSDEM_PRECOND_MG: fsdem__mg_vcycle(s, r, z); break;
+    default: memcpy(z, r, sizeof(fsdem_real) * (size_t)n); break;
+    }
+}
+
+/* Removes the mean of v over each unanchored fluid region; returns the squared norm removed. */
+static double fsdem__pcg_project(const fsdem_pcg *s, fsdem_real *v) {
+    int e = 0, removed_start;
+    double removed = 0;
+    while (e < s->ns_cells) {
+        double sum = 0;
+        int count = 0, f;
+        removed_start = e;
+        do {
+            int c = s->ns_cell[e];
+            if (c < 0) c = -c - 1;
+            sum += v[c];
+            count++;
+            e++;
+        } while (e < s->ns_cells && s->ns_cell[e] >= 0);
+        sum /= count;
+        for (f = removed_start; f < e; ++f) {
+            int c = s->ns_cell[f];
+            if (c < 0) c = -c - 1;
+            v[c] -= (fsdem_real)sum;
+        }
+        removed += sum * sum * count;
+    }
+    return removed;
+}
+
+/* Copies a caller vector into an internal one (0 off fluid cells). Returns the index of the first
+   non-finite value read, or -1. */
+static int fsdem__pcg_load(const fsdem_pcg *s, const fsdem_real *src, fsdem_real *dst) {
+    int i, j, k, u = 0, bad = -1;
+    if (s->kind == FSDEM__KIND_CSR) {
+        for (i = 0; i < s->length; ++i) {
+            dst[i] = src[i];
+            if (bad < 0 && !fsdem__finite(src[i])) bad = i;
+        }
+        return bad;
+    }
+    {
+        const fsdem__level *L = &s->level[0];
+        for (k = 0; k < L->n[2]; ++k)
+            for (j = 0; j < L->n[1]; ++j)
+                for (i = 0; i < L->n[0]; ++i, ++u) {
+                    int c = fsdem__level_index(L, s->dim, i, j, k);
+                    if (FSDEM__TYPE(L->type[c]) == FSDEM_STENCIL_CELL_FLUID) {
+                        dst[c] = src[u];
+                        if (bad < 0 && !fsdem__finite(src[u])) bad = u;
+                    } else {
+                        dst[c] = 0;
+                    }
+                }
+    }
+    return bad;
+}
+
+static void fsdem__pcg_store(const fsdem_pcg *s, const fsdem_real *src, fsdem_real *dst) {
+    int i, j, k, u = 0;
+    if (s->kind == FSDEM__KIND_CSR) {
+        memcpy(dst, src, sizeof(fsdem_real) * (size_t)s->length);
+        return;
+    }
+    {
+        const fsdem__level *L = &s->level[0];
+        for (k = 0; k < L->n[2]; ++k)
+            for (j = 0; j < L->n[1]; ++j)
+                for (i = 0; i < L->n[0]; ++i, ++u) dst[u] = src[fsdem__level_index(L, s->dim, i, j, k)];
+    }
+}
+
+static double fsdem__vdot(const fsdem_real *a, const fsdem_real *b, int n) {
+    double s0 = 0, s1 = 0;
+    int i;
+    for (i = 0; i + 1 < n; i += 2) {
+        s0 += (double)a[i] * b[i];
+        s1 += (double)a[i + 1] * b[i + 1];
+    }
+    if (i < n) s0 += (double)a[i] * b[i];
+    return s0 + s1;
+}
+
+static int fsdem__finite_d(double v) { return v == v && v - v == 0; }
+
+/* True residual b - A x into `out` (uses z as scratch); returns its squared norm. */
+static double fsdem__pcg_true_residual(fsdem_pcg *s, const fsdem_real *b, fsdem_real *out) {
+    int i;
+    fsdem__pcg_load(s, b, out);
+    fsdem__pcg_project(s, out);
+    fsdem__pcg_apply(s, s->x, s->z);
+    for (i = 0; i < s->length; ++i) out[i] -= s->z[i];
+    return fsdem__vdot(out, out, s->length);
+}
+
+fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, fsdem_pcg_info *info) {
+    fsdem_pcg_info inf;
+    double bb, rr, rz = 0, tol2, removed;
+    int n, i, it = 0, bad, restart = 1, r_is_true = 1;
+    fsdem_result res = FSDEM_OK;
+    memset(&inf, 0, sizeof inf);
+    inf.levels = 1;
+    if (info) *info = inf;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (s->kind == FSDEM__KIND_NONE)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_pcg_solve: no operator; call fsdem_pcg_setup_stencil or fsdem_pcg_setup_csr first");
+    if (!b || !x) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pcg_solve: b and x must not be NULL");
+    n = s->length;
+    inf.levels = s->levels;
+    inf.memory_bytes = s->arena_bytes + sizeof *s;
+    inf.nullspace_components = s->ns_components;
+    bad = fsdem__pcg_load(s, b, s->r);
+    if (bad >= 0) {
+        if (info) *info = inf;
+        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: b[%d] = %g is not finite", bad, (double)b[bad]);
+    }
+    bad = fsdem__pcg_load(s, x, s->x);
+    if (bad >= 0) {
+        if (info) *info = inf;
+        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: initial guess x[%d] = %g is not finite", bad,
+                           (double)x[bad]);
+    }
+    bb = fsdem__vdot(s->r, s->r, n);
+    removed = fsdem__pcg_project(s, s->r);
+    inf.incompatibility = bb > 0 ? (fsdem_real)sqrt(removed / bb) : 0;
+    bb = fsdem__vdot(s->r, s->r, n);
+    if (!fsdem__finite_d(bb)) {
+        if (info) *info = inf;
+        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: ||b|| overflows");
+    }
+    inf.rhs_norm = (fsdem_real)sqrt(bb);
+    if (bb == 0) { /* the solution is 0 */
+        memset(s->x, 0, sizeof(fsdem_real) * (size_t)n);
+        fsdem__pcg_store(s, s->x, x);
+        if (info) *info = inf;
+        return fsdem__ok(&s->status);
+    }
+    tol2 = (double)s->desc.tolerance * s->desc.tolerance * bb;
+    /* r = b - A x */
+    fsdem__pcg_project(s, s->x);
+    fsdem__pcg_apply(s, s->x, s->z);
+    for (i = 0; i < n; ++i) s->r[i] -= s->z[i];
+    rr = fsdem__vdot(s->r, s->r, n);
+    for (;;) {
+        double pq, alpha, rz_new, beta;
+        if (!fsdem__finite_d(rr)) {
+            res = fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: the residual became NaN/Inf at iteration %d", it);
+            break;
+        }
+        if (rr <= tol2) {
+            if (r_is_true) break;
+            rr = fsdem__pcg_true_residual(s, b, s->r); /* guard against a drifted recurrence */
+            r_is_true = 1;
+            if (rr <= tol2) break;
+            restart = 1;
+        }
+        if (it >= s->desc.max_iterations) {
+            if (!r_is_true) {
+                rr = fsdem__pcg_true_residual(s, b, s->r);
+                r_is_true = 1;
+            }
+            res = fsdem__fail(&s->status, FSDEM_ERR_NOT_CONVERGED,
+                              "fsdem_pcg_solve: not converged in %d iterations (relative residual %g, tolerance %g)", it,
+                              sqrt(rr / bb), (double)s->desc.tolerance);
+            break;
+        }
+        if (restart) {
+            fsdem__pcg_precondition(s, s->r, s->z);
+            fsdem__pcg_project(s, s->z);
+            rz = fsdem__vdot(s->r, s->z, n);
+            if (!(rz > 0)) {
+                res = fsdem__fail(&s->status, fsdem__finite_d(rz) ? FSDEM_ERR_INVALID_ARG : FSDEM_ERR_NAN,
+                                  "fsdem_pcg_solve: r.z = %g <= 0 at iteration %d: the preconditioner is not positive "
+                                  "definite (is the operator?)", rz, it);
+                break;
+            }
+            memcpy(s->p, s->z, sizeof(fsdem_real) * (size_t)n);
+            restart = 0;
+        }
+        fsdem__pcg_apply(s, s->p, s->z); /* z is free until the next preconditioning */
+        pq = fsdem__vdot(s->p, s->z, n);
+        if (!fsdem__finite_d(pq)) {
+            res = fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: p.Ap is NaN/Inf at iteration %d", it);
+            break;
+        }
+        if (pq <= 0) {
+            res = fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                              "fsdem_pcg_solve: non-positive curvature p.Ap = %g at iteration %d: the operator is not "
+                              "positive definite", pq, it);
+            break;
+        }
+        alpha = rz / pq;
+        {
+            double acc0 = 0;
+            fsdem_real al = (fsdem_real)alpha;
+            fsdem_real *xv = s->x, *rv = s->r;
+            const fsdem_real *pv = s->p, *qv = s->z;
+            for (i = 0; i < n; ++i) {
+                xv[i] += al * pv[i];
+                rv[i] -= al * qv[i];
+                acc0 += (double)rv[i] * rv[i];
+            }
+            rr = acc0;
+        }
+        ++it;
+        r_is_true = 0;
+        if (!fsdem__finite_d(rr) || rr <= tol2) continue;
+        fsdem__pcg_precondition(s, s->r, s->z);
+        fsdem__pcg_project(s, s->z);
+        rz_new = fsdem__vdot(s->r, s->z, n);
+        if (!fsdem__finite_d(rz_new)) {
+            res = fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: r.z is NaN/Inf at iteration %d", it);
+            break;
+        }
+        if (rz_new <= 0) {
+            res = fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                              "fsdem_pcg_solve: r.z = %g <= 0 at iteration %d: the preconditioner is not positive "
+                              "definite (is the operator?)", rz_new, it);
+            break;
+        }
+        beta = rz_new / rz;
+        rz = rz_new;
+        {
+            fsdem_real be = (fsdem_real)beta;
+            fsdem_real *pv = s->p;
+            const fsdem_real *zv = s->z;
+            for (i = 0; i < n; ++i) pv[i] = zv[i] + be * pv[i];
+        }
+    }
+    inf.iterations = it;
+    if (res == FSDEM_ERR_NAN) { /* x is left as it was */
+        inf.residual = (fsdem_real)(fsdem__finite_d(rr) ? sqrt(rr / bb) : rr);
+        if (info) *info = inf;
+        return res;
+    }
+    if (!r_is_true) rr = fsdem__pcg_true_residual(s, b, s->r);
+    inf.residual = (fsdem_real)sqrt(rr / bb);
+    fsdem__pcg_project(s, s->x);
+    fsdem__pcg_store(s, s->x, x);
+    if (info) *info = inf;
+    return res == FSDEM_OK ? fsdem__ok(&s->status) : res;
 }
 
 /* ===== >>impl_io : CSV and VTK output ============================================================== */

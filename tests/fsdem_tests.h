@@ -6,5 +6,6 @@
 
 Suite *core_suite(void);
 Suite *dem_suite(void);
+Suite *linalg_suite(void);
 
 #endif

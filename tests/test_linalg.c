@@ -1,0 +1,930 @@
+/* Linear algebra: CSR and MAC-grid stencil operators, PCG with Jacobi, IC(0), MIC(0) and the
+   multigrid preconditioner; free-surface / solid masks, null spaces, bad input. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "fsdem_tests.h"
+
+#define LA_PI 3.14159265358979323846
+
+/* ---- helpers ---- */
+
+static double la_rand(unsigned *state) { /* deterministic, platform independent */
+    *state = *state * 1664525u + 1013904223u;
+    return (double)(*state >> 8) / 16777216.0;
+}
+
+static double la_norm_diff(const fsdem_real *a, const fsdem_real *b, int n) {
+    double s = 0;
+    int i;
+    for (i = 0; i < n; ++i) s += ((double)a[i] - b[i]) * ((double)a[i] - b[i]);
+    return sqrt(s);
+}
+
+static double la_norm(const fsdem_real *a, int n) {
+    double s = 0;
+    int i;
+    for (i = 0; i < n; ++i) s += (double)a[i] * a[i];
+    return sqrt(s);
+}
+
+/* Relative residual ||b - A x|| / ||b|| computed with the public reference product. */
+static double la_stencil_residual(const fsdem_stencil *st, const fsdem_real *b, const fsdem_real *x, int cells) {
+    fsdem_real *y = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)cells);
+    double rr = 0, bb = 0;
+    int i;
+    fsdem_stencil_apply(st, x, y);
+    for (i = 0; i < cells; ++i) {
+        if (st->cell && st->cell[i] != FSDEM_STENCIL_CELL_FLUID) continue;
+        rr += ((double)b[i] - y[i]) * ((double)b[i] - y[i]);
+        bb += (double)b[i] * b[i];
+    }
+    free(y);
+    return sqrt(rr / bb);
+}
+
+static double la_csr_residual(const fsdem_csr *m, const fsdem_real *b, const fsdem_real *x) {
+    fsdem_real *y = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)m->rows);
+    double r;
+    fsdem_csr_apply(m, x, y);
+    r = la_norm_diff(b, y, m->rows) / la_norm(b, m->rows);
+    free(y);
+    return r;
+}
+
+/* Solves with a fresh pcg; returns the result, writes iterations and the info. */
+static fsdem_result la_solve_stencil(const fsdem_stencil *st, fsdem_precond pc, fsdem_real tol, int max_it,
+                                     const fsdem_real *b, fsdem_real *x, fsdem_pcg_info *info) {
+    fsdem_pcg_desc d = fsdem_pcg_desc_default();
+    fsdem_pcg *s;
+    fsdem_result r;
+    d.preconditioner = pc;
+    d.tolerance = tol;
+    d.max_iterations = max_it;
+    ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, st), FSDEM_OK);
+    r = fsdem_pcg_solve(s, b, x, info);
+    fsdem_pcg_destroy(s);
+    return r;
+}
+
+static fsdem_result la_solve_csr(const fsdem_csr *m, fsdem_precond pc, fsdem_real tol, const fsdem_real *b,
+                                 fsdem_real *x, fsdem_pcg_info *info) {
+    fsdem_pcg_desc d = fsdem_pcg_desc_default();
+    fsdem_pcg *s;
+    fsdem_result r;
+    d.preconditioner = pc;
+    d.tolerance = tol;
+    d.max_iterations = 5000;
+    ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pcg_setup_csr(s, m), FSDEM_OK);
+    r = fsdem_pcg_solve(s, b, x, info);
+    fsdem_pcg_destroy(s);
+    return r;
+}
+
+/* A growable CSR built row by row. */
+typedef struct la_csr {
+    fsdem_csr m;
+    int *row_start, *col;
+    fsdem_real *val;
+    int nnz, cap;
+} la_csr;
+
+static void la_csr_init(la_csr *a, int rows, int cap) {
+    a->row_start = (int *)calloc((size_t)rows + 1, sizeof(int));
+    a->col = (int *)malloc(sizeof(int) * (size_t)cap);
+    a->val = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)cap);
+    a->nnz = 0;
+    a->cap = cap;
+    a->m.rows = rows;
+    a->m.row_start = a->row_start;
+    a->m.col = a->col;
+    a->m.val = a->val;
+}
+
+static void la_csr_push(la_csr *a, int c, fsdem_real v) {
+    ck_assert_int_lt(a->nnz, a->cap);
+    a->col[a->nnz] = c;
+    a->val[a->nnz++] = v;
+}
+
+static void la_csr_free(la_csr *a) {
+    free(a->row_start);
+    free(a->col);
+    free(a->val);
+}
+
+/* Dense symmetric n x n matrix to CSR (entries with |v| > 0). */
+static void la_csr_from_dense(la_csr *a, const double *dense, int n) {
+    int i, j;
+    la_csr_init(a, n, n * n);
+    for (i = 0; i < n; ++i) {
+        for (j = 0; j < n; ++j)
+            if (dense[i * n + j] != 0 || i == j) la_csr_push(a, j, (fsdem_real)dense[i * n + j]);
+        a->row_start[i + 1] = a->nnz;
+    }
+}
+
+/* Random sparse SPD matrix: (a) diagonally dominant with mixed-sign couplings, or (b) B^T B + 0.1 I
+   with a sparse random B, which is SPD but neither an M-matrix nor diagonally dominant. */
+static void la_random_spd(la_csr *a, int n, int kind, unsigned seed) {
+    double *dense = (double *)calloc((size_t)n * n, sizeof(double));
+    int i, j, k;
+    unsigned st = seed;
+    if (kind == 0) {
+        for (i = 0; i < n; ++i)
+            for (k = 0; k < 3; ++k) {
+                j = (int)(la_rand(&st) * n);
+                if (j == i) continue;
+                dense[i * n + j] = dense[j * n + i] = la_rand(&st) - 0.6;
+            }
+        for (i = 0; i < n; ++i) {
+            double s = 0;
+            for (j = 0; j < n; ++j)
+                if (j != i) s += fabs(dense[i * n + j]);
+            dense[i * n + i] = s + 0.01 + la_rand(&st);
+        }
+    } else {
+        double *B = (double *)calloc((size_t)n * n, sizeof(double));
+        for (i = 0; i < n; ++i) {
+            B[i * n + i] = 1 + la_rand(&st);
+            for (k = 0; k < 2; ++k) B[i * n + (int)(la_rand(&st) * n)] += la_rand(&st) * 2 - 1;
+        }
+        for (i = 0; i < n; ++i)
+            for (j = 0; j < n; ++j) {
+                double s = 0;
+                for (k = 0; k < n; ++k) s += B[k * n + i] * B[k * n + j];
+                dense[i * n + j] = s + (i == j ? 0.1 : 0);
+            }
+        free(B);
+    }
+    la_csr_from_dense(a, dense, n);
+    free(dense);
+}
+
+/* A tank problem: solid walls on the sides and bottom, air above a wavy water line (2D) or
+   plane (3D), a solid disc/sphere, random cut-cell face fractions in (0, 1], ghost-fluid
+   diagonal terms under the free surface, and a random right-hand side. `closed`: no air and
+   no open boundary, so the operator is singular (the constant is in its null space). */
+typedef struct la_tank {
+    fsdem_stencil st;
+    unsigned char *cell;
+    fsdem_real *face[3], *diag, *b;
+    int cells;
+} la_tank;
+
+static void la_tank_make(la_tank *t, int dim, int n, int closed, unsigned seed) {
+    int nz = dim == 3 ? n : 1, i, j, k, a;
+    size_t fc[3];
+    unsigned st = seed;
+    double h = 1.0 / n;
+    fc[0] = (size_t)(n + 1) * n * nz;
+    fc[1] = (size_t)n * (n + 1) * nz;
+    fc[2] = (size_t)n * n * (nz + 1);
+    memset(t, 0, sizeof *t);
+    t->cells = n * n * nz;
+    t->cell = (unsigned char *)malloc((size_t)t->cells);
+    t->diag = (fsdem_real *)calloc((size_t)t->cells, sizeof(fsdem_real));
+    t->b = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)t->cells);
+    for (a = 0; a < 3; ++a) {
+        size_t q;
+        t->face[a] = (fsdem_real *)malloc(sizeof(fsdem_real) * fc[a]);
+        for (q = 0; q < fc[a]; ++q) t->face[a][q] = 1;
+    }
+    for (k = 0; k < nz; ++k)
+        for (j = 0; j < n; ++j)
+            for (i = 0; i < n; ++i) {
+                double x = (i + 0.5) * h, y = (j + 0.5) * h, z = (k + 0.5) * h;
+                double up = dim == 3 ? z : y;
+                double r2 = dim == 3 ? (x - 0.5) * (x - 0.5) + (y - 0.5) * (y - 0.5) + (z - 0.3) * (z - 0.3)
+                                     : (x - 0.5) * (x - 0.5) + (y - 0.3) * (y - 0.3);
+                unsigned char c = FSDEM_STENCIL_CELL_FLUID;
+                if (!closed && up > 0.65 + 0.05 * sin(6 * x)) c = FSDEM_STENCIL_CELL_AIR;
+                if (r2 < 0.15 * 0.15) c = FSDEM_STENCIL_CELL_SOLID;
+                t->cell[(k * n + j) * n + i] = c;
+            }
+    /* walls: every boundary face closed except the top, which is open unless `closed` */
+    for (k = 0; k < nz; ++k)
+        for (j = 0; j < n; ++j) t->face[0][(k * n + j) * (n + 1)] = t->face[0][(k * n + j) * (n + 1) + n] = 0;
+    for (k = 0; k < nz; ++k)
+        for (i = 0; i < n; ++i) {
+            t->face[1][(k * (n + 1)) * n + i] = 0;
+            if (dim == 3 || closed) t->face[1][(k * (n + 1) + n) * n + i] = 0;
+        }
+    if (dim == 3)
+        for (j = 0; j < n; ++j)
+            for (i = 0; i < n; ++i) {
+                t->face[2][j * n + i] = 0;
+                if (closed) t->face[2][((size_t)n * n + j) * n + i] = 0;
+            }
+    /* cut cells: one face in ten gets an open fraction in (0.05, 1] */
+    for (a = 0; a < dim; ++a) {
+        size_t q;
+        for (q = 0; q < fc[a]; ++q)
+            if (t->face[a][q] > 0 && la_rand(&st) < 0.1) t->face[a][q] = (fsdem_real)(0.05 + 0.95 * la_rand(&st));
+    }
+    /* ghost fluid: a fluid cell under an air cell with the interface a fraction theta away */
+    for (k = 0; k < nz; ++k)
+        for (j = 0; j < n; ++j)
+            for (i = 0; i < n; ++i) {
+                int c = (k * n + j) * n + i, above;
+                if (t->cell[c] != FSDEM_STENCIL_CELL_FLUID) continue;
+                above = dim == 3 ? (k + 1 < nz ? c + n * n : -1) : (j + 1 < n ? c + n : -1);
+                if (above >= 0 && t->cell[above] == FSDEM_STENCIL_CELL_AIR) {
+                    double theta = 0.1 + 0.9 * la_rand(&st);
+                    t->diag[c] = (fsdem_real)(1 / theta - 1);
+                }
+            }
+    for (i = 0; i < t->cells; ++i) t->b[i] = (fsdem_real)((la_rand(&st) - 0.5) * h * h);
+    t->st.dim = dim;
+    t->st.n[0] = t->st.n[1] = n;
+    t->st.n[2] = nz;
+    t->st.cell = t->cell;
+    t->st.face[0] = t->face[0];
+    t->st.face[1] = t->face[1];
+    t->st.face[2] = dim == 3 ? t->face[2] : NULL;
+    t->st.diag = t->diag;
+}
+
+static void la_tank_free(la_tank *t) {
+    int a;
+    free(t->cell);
+    free(t->diag);
+    free(t->b);
+    for (a = 0; a < 3; ++a) free(t->face[a]);
+}
+
+/* Iterations of -h^2 lap(u) = h^2 on the unit box, Dirichlet walls (the benchmark problem). */
+static int la_poisson_iterations(int dim, int n, fsdem_precond pc) {
+    fsdem_stencil st;
+    fsdem_pcg_info info;
+    int cells = dim == 3 ? n * n * n : n * n, i;
+    fsdem_real *b = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)cells);
+    fsdem_real *x = (fsdem_real *)calloc((size_t)cells, sizeof(fsdem_real));
+    double h = 1.0 / (n + 1);
+    memset(&st, 0, sizeof st);
+    st.dim = dim;
+    st.n[0] = st.n[1] = st.n[2] = n;
+    for (i = 0; i < cells; ++i) b[i] = (fsdem_real)(h * h);
+    ck_assert_int_eq(la_solve_stencil(&st, pc, 1e-8, 20000, b, x, &info), FSDEM_OK);
+    ck_assert_double_lt(la_stencil_residual(&st, b, x, cells), 1e-8);
+    free(b);
+    free(x);
+    return info.iterations;
+}
+
+/* ---- CSR ---- */
+
+/* Random SPD systems (diagonally dominant with mixed signs, and B^T B + 0.1 I) converge with every
+   CSR preconditioner, the true residual meets the tolerance, and all agree on the solution. */
+START_TEST(csr_random_spd_converges) {
+    int kind, seed;
+    for (kind = 0; kind < 2; ++kind)
+        for (seed = 1; seed <= 3; ++seed) {
+            la_csr a;
+            int n = kind == 0 ? 300 : 120, i, p;
+            fsdem_real *b = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)n);
+            fsdem_real *x = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)n);
+            fsdem_real *x_ref = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)n);
+            unsigned st = 77u * (unsigned)seed;
+            static const fsdem_precond pcs[4] = {FSDEM_PRECOND_NONE, FSDEM_PRECOND_JACOBI, FSDEM_PRECOND_IC0,
+                                                 FSDEM_PRECOND_MIC0};
+            la_random_spd(&a, n, kind, (unsigned)seed * 1000u + (unsigned)kind);
+            ck_assert_int_eq(fsdem_csr_check(&a.m, NULL, 0), FSDEM_OK);
+            for (i = 0; i < n; ++i) b[i] = (fsdem_real)(la_rand(&st) - 0.5);
+            for (p = 0; p < 4; ++p) {
+                fsdem_pcg_info info;
+                memset(x, 0, sizeof(fsdem_real) * (size_t)n);
+                ck_assert_int_eq(la_solve_csr(&a.m, pcs[p], 1e-10, b, x, &info), FSDEM_OK);
+                ck_assert_double_le(info.residual, 1e-10);
+                ck_assert_double_lt(la_csr_residual(&a.m, b, x), 1e-10);
+                if (p == 0) memcpy(x_ref, x, sizeof(fsdem_real) * (size_t)n);
+                else ck_assert_double_lt(la_norm_diff(x, x_ref, n) / la_norm(x_ref, n), 1e-7);
+            }
+            free(b);
+            free(x);
+            free(x_ref);
+            la_csr_free(&a);
+        }
+}
+END_TEST
+
+/* The 2D Poisson matrix as CSR and as a stencil: the same solution, and IC(0)/MIC(0) take the same
+   number of iterations on both (the factorisations are the same in natural ordering). */
+START_TEST(csr_and_stencil_agree) {
+    int n = 24, cells = n * n, i, j, p;
+    la_csr a;
+    fsdem_stencil st;
+    fsdem_real *b = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)cells);
+    fsdem_real *x1 = (fsdem_real *)calloc((size_t)cells, sizeof(fsdem_real));
+    fsdem_real *x2 = (fsdem_real *)calloc((size_t)cells, sizeof(fsdem_real));
+    unsigned s = 5;
+    la_csr_init(&a, cells, 5 * cells);
+    for (j = 0; j < n; ++j)
+        for (i = 0; i < n; ++i) {
+            int r = j * n + i;
+            if (j > 0) la_csr_push(&a, r - n, -1);
+            if (i > 0) la_csr_push(&a, r - 1, -1);
+            la_csr_push(&a, r, 4);
+            if (i < n - 1) la_csr_push(&a, r + 1, -1);
+            if (j < n - 1) la_csr_push(&a, r + n, -1);
+            a.row_start[r + 1] = a.nnz;
+        }
+    for (i = 0; i < cells; ++i) b[i] = (fsdem_real)(la_rand(&s) - 0.3);
+    memset(&st, 0, sizeof st);
+    st.dim = 2;
+    st.n[0] = st.n[1] = n;
+    for (p = FSDEM_PRECOND_JACOBI; p <= FSDEM_PRECOND_MIC0; ++p) {
+        fsdem_pcg_info i1, i2;
+        memset(x1, 0, sizeof(fsdem_real) * (size_t)cells);
+        memset(x2, 0, sizeof(fsdem_real) * (size_t)cells);
+        ck_assert_int_eq(la_solve_csr(&a.m, (fsdem_precond)p, 1e-10, b, x1, &i1), FSDEM_OK);
+        ck_assert_int_eq(la_solve_stencil(&st, (fsdem_precond)p, 1e-10, 5000, b, x2, &i2), FSDEM_OK);
+        ck_assert_double_lt(la_norm_diff(x1, x2, cells) / la_norm(x1, cells), 1e-8);
+        ck_assert_int_le(abs(i1.iterations - i2.iterations), 1);
+    }
+    free(b);
+    free(x1);
+    free(x2);
+    la_csr_free(&a);
+}
+END_TEST
+
+/* ---- stencil operator ---- */
+
+/* The masked variable-coefficient stencil is symmetric and positive definite: x.Ay = y.Ax and
+   x.Ax > 0 for random x, y (checked on the public reference product). */
+START_TEST(stencil_is_symmetric_positive_definite) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        la_tank t;
+        fsdem_real *x, *y, *ax, *ay;
+        double xay = 0, yax = 0, xax = 0;
+        int i;
+        unsigned s = 11;
+        la_tank_make(&t, dim, dim == 2 ? 40 : 14, 0, 3);
+        x = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)t.cells);
+        y = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)t.cells);
+        ax = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)t.cells);
+        ay = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)t.cells);
+        for (i = 0; i < t.cells; ++i) {
+            int fluid = t.cell[i] == FSDEM_STENCIL_CELL_FLUID;
+            x[i] = fluid ? (fsdem_real)(la_rand(&s) - 0.5) : 0;
+            y[i] = fluid ? (fsdem_real)(la_rand(&s) - 0.5) : 0;
+        }
+        fsdem_stencil_apply(&t.st, x, ax);
+        fsdem_stencil_apply(&t.st, y, ay);
+        for (i = 0; i < t.cells; ++i) {
+            xay += (double)x[i] * ay[i];
+            yax += (double)y[i] * ax[i];
+            xax += (double)x[i] * ax[i];
+            if (t.cell[i] != FSDEM_STENCIL_CELL_FLUID) ck_assert(ax[i] == 0);
+        }
+        ck_assert_double_lt(fabs(xay - yax), 1e-12 * fabs(xay) + 1e-14);
+        ck_assert_double_gt(xax, 0);
+        free(x);
+        free(y);
+        free(ax);
+        free(ay);
+        la_tank_free(&t);
+    }
+}
+END_TEST
+
+/* sin(pi x) sin(pi y) (sin(pi z)) is an exact eigenvector of the Dirichlet 5/7-point Laplacian
+   with eigenvalue sum 2(1 - cos(pi h)): with b = lambda u the solver must return u itself. */
+START_TEST(stencil_poisson_eigenvector_is_recovered) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        int n = dim == 2 ? 48 : 20, nz = dim == 3 ? n : 1, cells = n * n * nz, i, j, k, p;
+        double h = 1.0 / (n + 1), lambda = dim * 2 * (1 - cos(LA_PI * h));
+        fsdem_stencil st;
+        fsdem_real *u = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)cells);
+        fsdem_real *b = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)cells);
+        fsdem_real *x = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)cells);
+        for (k = 0; k < nz; ++k)
+            for (j = 0; j < n; ++j)
+                for (i = 0; i < n; ++i) {
+                    int c = (k * n + j) * n + i;
+                    u[c] = (fsdem_real)(sin(LA_PI * (i + 1) * h) * sin(LA_PI * (j + 1) * h) *
+                                        (dim == 3 ? sin(LA_PI * (k + 1) * h) : 1));
+                    b[c] = (fsdem_real)(lambda * u[c]);
+                }
+        memset(&st, 0, sizeof st);
+        st.dim = dim;
+        st.n[0] = st.n[1] = st.n[2] = n;
+        for (p = FSDEM_PRECOND_NONE; p <= FSDEM_PRECOND_MG; ++p) {
+            fsdem_pcg_info info;
+            memset(x, 0, sizeof(fsdem_real) * (size_t)cells);
+            ck_assert_int_eq(la_solve_stencil(&st, (fsdem_precond)p, 1e-12, 5000, b, x, &info), FSDEM_OK);
+            /* error <= residual / lambda_min relative, and lambda_min = lambda here */
+            ck_assert_double_lt(la_norm_diff(x, u, cells) / la_norm(u, cells), 1e-10);
+        }
+        free(u);
+        free(b);
+        free(x);
+    }
+}
+END_TEST
+
+/* ---- multigrid scaling ---- */
+
+/* MGPCG iteration counts stay flat from 32^2 to 256^2 and 16^3 to 64^3 while Jacobi-PCG's grow
+   with n (its condition number grows like n^2). The full sweep (to 512^2 and 128^3) and the timings
+   are in bench/pcg_poisson. */
+START_TEST(mg_iterations_are_mesh_independent) {
+    int mg2[4], mg3[3], jac2[3], jac3[2], i, lo, hi;
+    for (i = 0; i < 4; ++i) mg2[i] = la_poisson_iterations(2, 32 << i, FSDEM_PRECOND_MG);
+    for (i = 0; i < 3; ++i) mg3[i] = la_poisson_iterations(3, 16 << i, FSDEM_PRECOND_MG);
+    for (i = 0; i < 3; ++i) jac2[i] = la_poisson_iterations(2, 32 << i, FSDEM_PRECOND_JACOBI);
+    for (i = 0; i < 2; ++i) jac3[i] = la_poisson_iterations(3, 16 << i, FSDEM_PRECOND_JACOBI);
+    lo = hi = mg2[0];
+    for (i = 1; i < 4; ++i) {
+        lo = mg2[i] < lo ? mg2[i] : lo;
+        hi = mg2[i] > hi ? mg2[i] : hi;
+    }
+    ck_assert_int_le(hi, 12);
+    ck_assert_int_le(hi - lo, 2);
+    lo = hi = mg3[0];
+    for (i = 1; i < 3; ++i) {
+        lo = mg3[i] < lo ? mg3[i] : lo;
+        hi = mg3[i] > hi ? mg3[i] : hi;
+    }
+    ck_assert_int_le(hi, 12);
+    ck_assert_int_le(hi - lo, 2);
+    /* Jacobi: each doubling of n multiplies the count by about 2 */
+    ck_assert_int_gt(jac2[1], (int)(1.7 * jac2[0]));
+    ck_assert_int_gt(jac2[2], (int)(1.7 * jac2[1]));
+    ck_assert_int_gt(jac3[1], (int)(1.7 * jac3[0]));
+    ck_assert_int_gt(jac2[2], 8 * mg2[2]);
+}
+END_TEST
+
+/* Odd and unequal sizes, and a long thin domain (semi-coarsening once an axis reaches one cell)
+   keep the multigrid effective. */
+START_TEST(mg_handles_odd_and_anisotropic_grids) {
+    static const int dims[5][4] = {{2, 37, 23, 1}, {2, 256, 6, 1}, {2, 5, 129, 1}, {3, 19, 11, 7}, {3, 48, 3, 17}};
+    int t;
+    for (t = 0; t < 5; ++t) {
+        fsdem_stencil st;
+        fsdem_pcg_info info;
+        int cells = dims[t][1] * dims[t][2] * dims[t][3], i;
+        fsdem_real *b = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)cells);
+        fsdem_real *x = (fsdem_real *)calloc((size_t)cells, sizeof(fsdem_real));
+        unsigned s = 9;
+        memset(&st, 0, sizeof st);
+        st.dim = dims[t][0];
+        st.n[0] = dims[t][1];
+        st.n[1] = dims[t][2];
+        st.n[2] = dims[t][3];
+        for (i = 0; i < cells; ++i) b[i] = (fsdem_real)(la_rand(&s) - 0.5);
+        ck_assert_int_eq(la_solve_stencil(&st, FSDEM_PRECOND_MG, 1e-10, 1000, b, x, &info), FSDEM_OK);
+        ck_assert_int_le(info.iterations, 15);
+        ck_assert_double_lt(la_stencil_residual(&st, b, x, cells), 1e-10);
+        free(b);
+        free(x);
+    }
+}
+END_TEST
+
+/* ---- masks: free surface, solids, cut cells, null space ---- */
+
+/* A tank with a free surface (air cells, ghost-fluid diagonal), solid walls and a solid obstacle
+   and cut-cell face fractions: every preconditioner converges, to the same solution, and the
+   solution is 0 in air and solid cells. */
+START_TEST(masked_tank_all_preconditioners_agree) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        la_tank t;
+        fsdem_real *x, *x_ref;
+        int p, i;
+        la_tank_make(&t, dim, dim == 2 ? 48 : 16, 0, 1);
+        x = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)t.cells);
+        x_ref = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)t.cells);
+        for (p = FSDEM_PRECOND_NONE; p <= FSDEM_PRECOND_MG; ++p) {
+            fsdem_pcg_info info;
+            for (i = 0; i < t.cells; ++i) x[i] = 7; /* a non-zero guess, also in air and solid cells */
+            ck_assert_int_eq(la_solve_stencil(&t.st, (fsdem_precond)p, 1e-10, 5000, t.b, x, &info), FSDEM_OK);
+            ck_assert_double_lt(la_stencil_residual(&t.st, t.b, x, t.cells), 1.01e-10);
+            ck_assert_int_eq(info.nullspace_components, 0);
+            for (i = 0; i < t.cells; ++i)
+                if (t.cell[i] != FSDEM_STENCIL_CELL_FLUID) ck_assert(x[i] == 0);
+            if (p == FSDEM_PRECOND_MG) ck_assert_int_le(info.iterations, 15);
+            if (p == FSDEM_PRECOND_NONE) memcpy(x_ref, x, sizeof(fsdem_real) * (size_t)t.cells);
+            else ck_assert_double_lt(la_norm_diff(x, x_ref, t.cells) / la_norm(x_ref, t.cells), 1e-7);
+        }
+        free(x);
+        free(x_ref);
+        la_tank_free(&t);
+    }
+}
+END_TEST
+
+/* A closed tank full of water has the constant in its null space: the solver reports one such
+   region, removes b's mean there (reporting how much), and returns the zero-mean solution of the
+   compatible system with every preconditioner. */
+START_TEST(closed_tank_null_space) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        la_tank t;
+        fsdem_real *x, *bc;
+        int p, i, fluid = 0;
+        double mean = 0;
+        la_tank_make(&t, dim, dim == 2 ? 40 : 14, 1, 2);
+        x = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)t.cells);
+        bc = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)t.cells);
+        for (i = 0; i < t.cells; ++i) /* the ghost-fluid terms anchor nothing here: no air */
+            t.diag[i] = 0;
+        for (i = 0; i < t.cells; ++i)
+            if (t.cell[i] == FSDEM_STENCIL_CELL_FLUID) {
+                mean += t.b[i];
+                fluid++;
+            }
+        mean /= fluid;
+        for (i = 0; i < t.cells; ++i) bc[i] = t.cell[i] == FSDEM_STENCIL_CELL_FLUID ? (fsdem_real)(t.b[i] - mean) : 0;
+        for (p = FSDEM_PRECOND_NONE; p <= FSDEM_PRECOND_MG; ++p) {
+            fsdem_pcg_info info;
+            double xm = 0;
+            memset(x, 0, sizeof(fsdem_real) * (size_t)t.cells);
+            ck_assert_int_eq(la_solve_stencil(&t.st, (fsdem_precond)p, 1e-10, 5000, t.b, x, &info), FSDEM_OK);
+            ck_assert_int_eq(info.nullspace_components, 1);
+            ck_assert_double_gt(info.incompatibility, 1e-4); /* the random b had a mean */
+            ck_assert_double_lt(la_stencil_residual(&t.st, bc, x, t.cells), 1.01e-10);
+            for (i = 0; i < t.cells; ++i) xm += x[i];
+            ck_assert_double_lt(fabs(xm) / fluid, 1e-12 * la_norm(x, t.cells));
+            /* a compatible right-hand side is left alone */
+            memset(x, 0, sizeof(fsdem_real) * (size_t)t.cells);
+            ck_assert_int_eq(la_solve_stencil(&t.st, (fsdem_precond)p, 1e-10, 5000, bc, x, &info), FSDEM_OK);
+            ck_assert_double_lt(info.incompatibility, 1e-12);
+        }
+        free(x);
+        free(bc);
+        la_tank_free(&t);
+    }
+}
+END_TEST
+
+/* Adds c * (sum of x over fluid cells) to every fluid cell: a rank-one PSD term like the implicit
+   solid coupling J^T M^-1 J of seed 000 Eq. 6. */
+typedef struct la_rank1 {
+    const unsigned char *cell;
+    int cells;
+    fsdem_real c;
+} la_rank1;
+
+static void la_rank1_apply(void *user, const fsdem_real *x, fsdem_real *y) {
+    const la_rank1 *r = (const la_rank1 *)user;
+    double s = 0;
+    int i;
+    for (i = 0; i < r->cells; ++i)
+        if (r->cell[i] == FSDEM_STENCIL_CELL_FLUID) s += x[i];
+    for (i = 0; i < r->cells; ++i)
+        if (r->cell[i] == FSDEM_STENCIL_CELL_FLUID) y[i] += (fsdem_real)(r->c * s);
+}
+
+/* The extra operator term is part of the solved system (checked with the reference product, which
+   includes it), with every preconditioner; a negative-definite extra term is caught. */
+START_TEST(stencil_extra_term) {
+    la_tank t;
+    la_rank1 r1;
+    fsdem_real *x;
+    fsdem_pcg_info info;
+    int p;
+    la_tank_make(&t, 2, 32, 0, 4);
+    r1.cell = t.cell;
+    r1.cells = t.cells;
+    r1.c = (fsdem_real)0.01;
+    t.st.extra = la_rank1_apply;
+    t.st.extra_user = &r1;
+    x = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)t.cells);
+    for (p = FSDEM_PRECOND_NONE; p <= FSDEM_PRECOND_MG; ++p) {
+        memset(x, 0, sizeof(fsdem_real) * (size_t)t.cells);
+        ck_assert_int_eq(la_solve_stencil(&t.st, (fsdem_precond)p, 1e-10, 5000, t.b, x, &info), FSDEM_OK);
+        ck_assert_double_lt(la_stencil_residual(&t.st, t.b, x, t.cells), 1.01e-10);
+    }
+    r1.c = -10; /* makes the operator indefinite */
+    memset(x, 0, sizeof(fsdem_real) * (size_t)t.cells);
+    ck_assert_int_eq(la_solve_stencil(&t.st, FSDEM_PRECOND_MG, 1e-10, 5000, t.b, x, &info), FSDEM_ERR_INVALID_ARG);
+    free(x);
+    la_tank_free(&t);
+}
+END_TEST
+
+/* ---- memory ---- */
+
+typedef struct la_counting {
+    long allocs, frees;
+    long long bytes;
+} la_counting;
+
+static void *la_count_alloc(void *user, size_t size) {
+    la_counting *c = (la_counting *)user;
+    c->allocs++;
+    c->bytes += (long long)size;
+    return malloc(size);
+}
+
+static void la_count_free(void *user, void *ptr, size_t size) {
+    la_counting *c = (la_counting *)user;
+    c->frees++;
+    c->bytes -= (long long)size;
+    free(ptr);
+}
+
+/* Memory goes through the desc's allocator; a solve allocates nothing, re-setup on a grid that is
+   not larger allocates nothing, and destroy returns every byte. */
+START_TEST(pcg_memory_discipline) {
+    la_counting cnt = {0, 0, 0};
+    fsdem_pcg_desc d = fsdem_pcg_desc_default();
+    fsdem_pcg *s;
+    la_tank t;
+    fsdem_real *x;
+    long before;
+    int p;
+    d.allocator.alloc = la_count_alloc;
+    d.allocator.free = la_count_free;
+    d.allocator.user = &cnt;
+    la_tank_make(&t, 2, 32, 0, 5);
+    x = (fsdem_real *)calloc((size_t)t.cells, sizeof(fsdem_real));
+    for (p = FSDEM_PRECOND_NONE; p <= FSDEM_PRECOND_MG; ++p) {
+        fsdem_pcg_info info;
+        d.preconditioner = (fsdem_precond)p;
+        ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_OK);
+        ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &t.st), FSDEM_OK);
+        before = cnt.allocs;
+        ck_assert_int_eq(fsdem_pcg_solve(s, t.b, x, &info), FSDEM_OK);
+        ck_assert_int_eq(fsdem_pcg_solve(s, t.b, x, &info), FSDEM_OK);
+        ck_assert_int_eq(cnt.allocs, before);
+        ck_assert_int_gt((long)info.memory_bytes, 0);
+        t.st.n[0] = 30; /* smaller grid: setup reuses the memory */
+        ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &t.st), FSDEM_OK);
+        ck_assert_int_eq(cnt.allocs, before);
+        t.st.n[0] = 32;
+        fsdem_pcg_destroy(s);
+        ck_assert_int_eq(cnt.allocs, cnt.frees);
+        ck_assert_int_eq((long)cnt.bytes, 0);
+    }
+    free(x);
+    la_tank_free(&t);
+}
+END_TEST
+
+typedef struct la_failing {
+    int fail;
+} la_failing;
+
+static void *la_fail_alloc(void *user, size_t size) {
+    return ((la_failing *)user)->fail ? NULL : malloc(size);
+}
+
+static void la_fail_free(void *user, void *ptr, size_t size) {
+    (void)user;
+    (void)size;
+    free(ptr);
+}
+
+/* An allocation failure (or a grid too large to index) is FSDEM_ERR_OUT_OF_MEMORY and leaves the
+   previous setup usable. */
+START_TEST(out_of_memory_keeps_previous_setup) {
+    la_failing f = {0};
+    fsdem_pcg_desc d = fsdem_pcg_desc_default();
+    fsdem_pcg *s;
+    fsdem_stencil st;
+    fsdem_pcg_info info;
+    fsdem_real b[64], x[64];
+    int i;
+    d.allocator.alloc = la_fail_alloc;
+    d.allocator.free = la_fail_free;
+    d.allocator.user = &f;
+    memset(&st, 0, sizeof st);
+    st.dim = 2;
+    st.n[0] = st.n[1] = 8;
+    ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_OK);
+    f.fail = 1;
+    st.n[0] = st.n[1] = 64;
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_ERR_OUT_OF_MEMORY);
+    st.dim = 3;
+    st.n[0] = st.n[1] = st.n[2] = 2000;
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_ERR_OUT_OF_MEMORY);
+    ck_assert_ptr_nonnull(strstr(fsdem_pcg_last_error(s), "2000"));
+    st.dim = 2;
+    st.n[0] = st.n[1] = 8;
+    for (i = 0; i < 64; ++i) b[i] = 1, x[i] = 0;
+    ck_assert_int_eq(fsdem_pcg_solve(s, b, x, &info), FSDEM_OK);
+    ck_assert_double_lt(la_stencil_residual(&st, b, x, 64), 1e-8);
+    fsdem_pcg_destroy(s);
+}
+END_TEST
+
+/* ---- result codes ---- */
+
+START_TEST(bad_input_gives_documented_codes) {
+    fsdem_pcg_desc d = fsdem_pcg_desc_default();
+    fsdem_pcg *s;
+    fsdem_stencil st;
+    fsdem_pcg_info info;
+    fsdem_real b[16], x[16], face[20];
+    unsigned char cell[16];
+    char msg[256];
+    int i;
+
+    /* desc */
+    d.tolerance = 0;
+    ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_null(s);
+    d = fsdem_pcg_desc_default();
+    d.preconditioner = (fsdem_precond)42;
+    ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_ERR_INVALID_ARG);
+    d = fsdem_pcg_desc_default();
+    d.max_iterations = 0;
+    ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_ERR_INVALID_ARG);
+    d = fsdem_pcg_desc_default();
+    ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_OK);
+
+    /* solve before setup */
+    for (i = 0; i < 16; ++i) b[i] = 1, x[i] = 0;
+    ck_assert_int_eq(fsdem_pcg_solve(s, b, x, &info), FSDEM_ERR_INVALID_ARG);
+
+    /* sizes */
+    memset(&st, 0, sizeof st);
+    st.dim = 2;
+    st.n[0] = 0;
+    st.n[1] = 4;
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(fsdem_pcg_last_error(s), "n[0]"));
+    st.n[0] = -3;
+    ck_assert_int_eq(fsdem_stencil_check(&st, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    st.n[0] = 4;
+    st.dim = 4;
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_ERR_INVALID_ARG);
+    st.dim = 3;
+    st.n[2] = 0;
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_ERR_INVALID_ARG);
+    st.dim = 2;
+
+    /* bad cell type, negative / NaN face coefficient, negative diagonal */
+    for (i = 0; i < 16; ++i) cell[i] = FSDEM_STENCIL_CELL_FLUID;
+    cell[5] = 9;
+    st.cell = cell;
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_ERR_INVALID_ARG);
+    cell[5] = FSDEM_STENCIL_CELL_FLUID;
+    for (i = 0; i < 20; ++i) face[i] = 1;
+    face[7] = -1;
+    st.face[0] = face;
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(fsdem_pcg_last_error(s), "face[0]"));
+    face[7] = (fsdem_real)NAN;
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_ERR_INVALID_ARG);
+    face[7] = 1;
+    {
+        fsdem_real diag[16];
+        for (i = 0; i < 16; ++i) diag[i] = 0;
+        diag[3] = -1;
+        st.diag = diag;
+        ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_ERR_INVALID_ARG);
+        st.diag = NULL;
+    }
+    /* a face between two non-fluid cells is never read, so garbage there is fine */
+    cell[0] = cell[1] = FSDEM_STENCIL_CELL_SOLID;
+    face[1] = (fsdem_real)NAN;
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_OK);
+    face[1] = 1;
+    ck_assert_int_eq(fsdem_pcg_solve(s, b, x, &info), FSDEM_OK);
+
+    /* NaN in b (at a fluid cell) and in the initial guess: FSDEM_ERR_NAN, x untouched */
+    b[6] = (fsdem_real)NAN;
+    for (i = 0; i < 16; ++i) x[i] = 3;
+    ck_assert_int_eq(fsdem_pcg_solve(s, b, x, &info), FSDEM_ERR_NAN);
+    ck_assert_ptr_nonnull(strstr(fsdem_pcg_last_error(s), "b[6]"));
+    for (i = 0; i < 16; ++i) ck_assert(x[i] == 3);
+    b[6] = 1;
+    b[0] = (fsdem_real)NAN; /* a solid cell: ignored */
+    ck_assert_int_eq(fsdem_pcg_solve(s, b, x, &info), FSDEM_OK);
+    b[0] = 1;
+    x[9] = (fsdem_real)INFINITY;
+    ck_assert_int_eq(fsdem_pcg_solve(s, b, x, &info), FSDEM_ERR_NAN);
+    x[9] = 0;
+    ck_assert_int_eq(fsdem_pcg_solve(s, b, NULL, &info), FSDEM_ERR_INVALID_ARG);
+
+    /* not converged: x holds the last iterate, info the residual reached */
+    ck_assert_int_eq(fsdem_pcg_set_tolerance(s, 1e-12, 1), FSDEM_OK);
+    for (i = 0; i < 16; ++i) x[i] = 0;
+    ck_assert_int_eq(fsdem_pcg_solve(s, b, x, &info), FSDEM_ERR_NOT_CONVERGED);
+    ck_assert_int_eq(info.iterations, 1);
+    ck_assert_double_gt(info.residual, 1e-12);
+    ck_assert_double_gt(la_norm(x, 16), 0);
+    ck_assert_int_eq(fsdem_pcg_set_tolerance(s, 0, 10), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_pcg_set_tolerance(s, 1e-8, 0), FSDEM_ERR_INVALID_ARG);
+    fsdem_pcg_destroy(s);
+
+    /* CSR: not symmetric, non-positive diagonal, missing diagonal, unsorted columns, bad index */
+    {
+        static const int rs[3] = {0, 2, 4};
+        static const int cols[4] = {0, 1, 0, 1};
+        static const int cols_unsorted[4] = {1, 0, 0, 1};
+        static const int cols_bad[4] = {0, 2, 0, 1};
+        fsdem_real nonsym[4] = {2, 1, 0.5, 2};
+        fsdem_real negdiag[4] = {-2, 1, 1, 2};
+        fsdem_csr m;
+        m.rows = 2;
+        m.row_start = rs;
+        m.col = cols;
+        m.val = nonsym;
+        ck_assert_int_eq(fsdem_csr_check(&m, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+        ck_assert_ptr_nonnull(strstr(msg, "symmetric"));
+        m.val = negdiag;
+        ck_assert_int_eq(fsdem_csr_check(&m, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+        ck_assert_ptr_nonnull(strstr(msg, "positive"));
+        m.col = cols_unsorted;
+        ck_assert_int_eq(fsdem_csr_check(&m, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+        m.col = cols_bad;
+        ck_assert_int_eq(fsdem_csr_check(&m, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+        m.rows = 0;
+        ck_assert_int_eq(fsdem_csr_check(&m, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    }
+    /* CSR: symmetric indefinite with a positive diagonal passes the checks; CG then finds a
+       non-positive curvature (Jacobi, none) and reports it instead of returning garbage */
+    {
+        double dense[9] = {1, 2, 0, 2, 1, 2, 0, 2, 1}; /* eigenvalues 1 - 2 sqrt(2), 1, 1 + 2 sqrt(2) */
+        fsdem_real bb[3] = {1, 0, 0}, xx[3];
+        la_csr a;
+        int p;
+        la_csr_from_dense(&a, dense, 3);
+        ck_assert_int_eq(fsdem_csr_check(&a.m, NULL, 0), FSDEM_OK);
+        for (p = FSDEM_PRECOND_NONE; p <= FSDEM_PRECOND_MIC0; ++p) {
+            fsdem_pcg_desc dd = fsdem_pcg_desc_default();
+            dd.preconditioner = (fsdem_precond)p;
+            ck_assert_int_eq(fsdem_pcg_create(&dd, &s), FSDEM_OK);
+            ck_assert_int_eq(fsdem_pcg_setup_csr(s, &a.m), FSDEM_OK);
+            xx[0] = xx[1] = xx[2] = 0;
+            ck_assert_int_eq(fsdem_pcg_solve(s, bb, xx, &info), FSDEM_ERR_INVALID_ARG);
+            ck_assert_ptr_nonnull(strstr(fsdem_pcg_last_error(s), "positive definite"));
+            fsdem_pcg_destroy(s);
+        }
+        /* multigrid needs a stencil */
+        d = fsdem_pcg_desc_default();
+        d.preconditioner = FSDEM_PRECOND_MG;
+        ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_OK);
+        ck_assert_int_eq(fsdem_pcg_setup_csr(s, &a.m), FSDEM_ERR_INVALID_ARG);
+        fsdem_pcg_destroy(s);
+        la_csr_free(&a);
+    }
+}
+END_TEST
+
+/* A failed setup leaves the previous one usable; b = 0 gives x = 0 in no iterations. */
+START_TEST(failed_setup_keeps_previous_and_zero_rhs) {
+    fsdem_pcg_desc d = fsdem_pcg_desc_default();
+    fsdem_pcg *s;
+    fsdem_stencil st, bad;
+    fsdem_pcg_info info;
+    fsdem_real b[64], x[64];
+    int i;
+    memset(&st, 0, sizeof st);
+    st.dim = 2;
+    st.n[0] = st.n[1] = 8;
+    ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &st), FSDEM_OK);
+    bad = st;
+    bad.n[1] = -1;
+    ck_assert_int_eq(fsdem_pcg_setup_stencil(s, &bad), FSDEM_ERR_INVALID_ARG);
+    for (i = 0; i < 64; ++i) b[i] = 1, x[i] = 0;
+    ck_assert_int_eq(fsdem_pcg_solve(s, b, x, &info), FSDEM_OK);
+    ck_assert_double_lt(la_stencil_residual(&st, b, x, 64), 1e-8);
+    ck_assert_str_eq(fsdem_pcg_last_error(s), "");
+    for (i = 0; i < 64; ++i) b[i] = 0, x[i] = 5;
+    ck_assert_int_eq(fsdem_pcg_solve(s, b, x, &info), FSDEM_OK);
+    ck_assert_int_eq(info.iterations, 0);
+    for (i = 0; i < 64; ++i) ck_assert(x[i] == 0);
+    fsdem_pcg_destroy(s);
+}
+END_TEST
+
+Suite *linalg_suite(void) {
+    Suite *s = suite_create("linalg");
+    TCase *csr = tcase_create("linalg_csr"), *op = tcase_create("linalg_stencil");
+    TCase *mg = tcase_create("linalg_mg"), *mask = tcase_create("linalg_masks"), *api = tcase_create("linalg_api");
+    tcase_add_test(csr, csr_random_spd_converges);
+    tcase_add_test(csr, csr_and_stencil_agree);
+    tcase_add_test(op, stencil_is_symmetric_positive_definite);
+    tcase_add_test(op, stencil_poisson_eigenvector_is_recovered);
+    tcase_add_test(mg, mg_iterations_are_mesh_independent);
+    tcase_add_test(mg, mg_handles_odd_and_anisotropic_grids);
+    tcase_add_test(mask, masked_tank_all_preconditioners_agree);
+    tcase_add_test(mask, closed_tank_null_space);
+    tcase_add_test(mask, stencil_extra_term);
+    tcase_add_test(api, pcg_memory_discipline);
+    tcase_add_test(api, out_of_memory_keeps_previous_setup);
+    tcase_add_test(api, bad_input_gives_documented_codes);
+    tcase_add_test(api, failed_setup_keeps_previous_and_zero_rhs);
+    tcase_set_timeout(mg, 300); /* generous for valgrind */
+    tcase_set_timeout(mask, 300);
+    suite_add_tcase(s, csr);
+    suite_add_tcase(s, op);
+    suite_add_tcase(s, mg);
+    suite_add_tcase(s, mask);
+    suite_add_tcase(s, api);
+    return s;
+}
