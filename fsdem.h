@@ -16,6 +16,8 @@
      >>dem      discrete element method: particles, materials, contact laws, walls, integration
      >>linalg   CSR and MAC-grid stencil operators, preconditioned conjugate gradients (Jacobi,
                 IC(0), MIC(0), geometric multigrid) shared by the pressure solves
+     >>pic      PIC/FLIP/APIC free-surface solver on a MAC grid: cut-cell obstacles, ghost-fluid
+                pressure, implicit viscosity, density projection (seeds 000 and 004)
      >>io       CSV time series and particle snapshots (CSV, legacy VTK for ParaView)
      >>impl     implementation, in the same order
      >>licence  MIT
@@ -570,6 +572,326 @@ FSDEM_API void fsdem_stencil_apply(const fsdem_stencil *stencil, const fsdem_rea
 FSDEM_API fsdem_result fsdem_csr_check(const fsdem_csr *matrix, char *message, size_t message_size);
 /* y = A x for a CSR matrix. No validation. x and y must not overlap. */
 FSDEM_API void fsdem_csr_apply(const fsdem_csr *matrix, const fsdem_real *x, fsdem_real *y);
+
+/* ===== >>pic : PIC/FLIP free-surface solver on a MAC grid ===== */
+
+/* Incompressible Navier-Stokes (seed 000 Eq. 1-2) for one liquid with a free surface, solved by
+   marker particles on a staggered (MAC) grid: particle-to-grid transfer, body forces, implicit
+   viscosity, pressure projection, grid-to-particle transfer (PIC, FLIP, their blend, or APIC),
+   particle advection through the grid velocity, then the density projection of seed 004 §5.1 and
+   Appendix B (alpha_s = 0) that keeps the particle distribution, hence the water volume, uniform.
+
+   Grid. Cells of edge `cell_size` cover [domain_min, domain_max]; the extent is rounded to whole
+   cells (domain_max moves by less than half a cell). Velocities live on cell faces in the layout of
+   >>linalg: face[0] holds (n[0]+1) n[1] n[2] x-faces, face (i,j,k) at (k n[1] + j)(n[0]+1) + i lies
+   between cells i-1 and i; likewise y- and z-faces. Cells are FLUID, AIR or SOLID
+   (fsdem_stencil_cell values).
+
+   Free surface. The fluid fraction of a cell is the particle count around its centre (tent kernel,
+   normalised by what a uniformly filled neighbourhood would give, seed 004 Eq. 7b); a signed
+   distance phi (m, < 0 in water) follows from it, exact for a plane surface. Cells with
+   phi < -ghost_theta_min dx are FLUID. p = 0 at phi = 0 through the second-order ghost-fluid method.
+   Cells mostly inside obstacles take phi from their open neighbours.
+
+   Solids. Static obstacles (boxes, spheres/discs, cylinders, 2D polygons, callbacks) are signed
+   distances turned into face-area fractions E in [0, 1] (the cut-cell weights of seed 000 Eq. 5).
+   The pressure equation of a cell is sum_f E_f (p_c - p_nb) = -(rho dx^2/dt) div, with the divergence
+   sum_f n_f (E_f u_f + (1 - E_f) us_f)/dx, where us_f is the solid velocity on the face. Domain walls
+   are faces with E = 0 and a prescribed (kinematic) velocity. A coupler adds moving solids through
+   fsdem_pic_coupling_view(): per-face open fractions and solid velocities, a per-face acceleration, and
+   an optional extra SPD term of the pressure operator (the implicit solid velocity of seed 000
+   Eq. 6), all without touching the projection.
+
+   Step (fsdem_pic_step): P2G -> classify cells -> extrapolate -> save the grid velocity for FLIP ->
+   gravity and coupler accelerations -> implicit viscosity -> pressure projection -> extrapolate ->
+   G2P -> RK2/RK3 advection -> push particles out of solids, drop those leaving through outflows ->
+   density projection -> reseeding. No allocation happens inside a step. */
+
+typedef struct fsdem_pic fsdem_pic;
+
+/* Grid-to-particle velocity update. */
+typedef enum fsdem_pic_transfer {
+    FSDEM_PIC_TRANSFER_PIC = 0,  /* particles take the grid velocity (dissipative, stable) */
+    FSDEM_PIC_TRANSFER_FLIP = 1, /* particles add the grid velocity change; blended with PIC by */
+                                 /*    flip_ratio (1 = pure FLIP) */
+    FSDEM_PIC_TRANSFER_APIC = 2  /* affine PIC: each particle also carries a velocity gradient */
+} fsdem_pic_transfer;
+
+/* Particle-grid interpolation kernel of the P2G/G2P transfers. */
+typedef enum fsdem_pic_kernel {
+    FSDEM_PIC_KERNEL_LINEAR = 0,   /* 2^dim faces per particle and component */
+    FSDEM_PIC_KERNEL_QUADRATIC = 1 /* quadratic B-spline, 3^dim faces, smoother */
+} fsdem_pic_kernel;
+
+/* Boundary condition on one side of the domain box. */
+typedef enum fsdem_pic_boundary {
+    FSDEM_PIC_BC_SLIP = 0,    /* impermeable wall, free slip */
+    FSDEM_PIC_BC_NO_SLIP = 1, /* impermeable wall; viscous no slip at the wall's tangential */
+                              /*    velocity (a moving lid is a tangential boundary_velocity) */
+    FSDEM_PIC_BC_INFLOW = 2,  /* prescribed velocity boundary_velocity (all components); the cells */
+                              /*    next to it are kept filled with particles of that velocity */
+    FSDEM_PIC_BC_OUTFLOW = 3  /* open: p = 0 on the boundary, particles crossing it are removed */
+} fsdem_pic_boundary;
+
+typedef struct fsdem_pic_desc {
+    int dim;                          /* 2 or 3 */
+    fsdem_vec3 domain_min;            /* m; default (0,0,0) */
+    fsdem_vec3 domain_max;            /* m; default (1,1,1) (z unused in 2D) */
+    fsdem_real cell_size;             /* m; edge of a grid cell, > 0; default 1/32 */
+    fsdem_real density;               /* kg/m^3; liquid density rho; default 1000 */
+    fsdem_real viscosity;             /* m^2/s; kinematic viscosity nu (seed 000 Eq. 2), implicit; */
+                                      /*    default 0 (inviscid) */
+    fsdem_vec3 gravity;               /* m/s^2; default (0,-9.81,0) in 2D, (0,0,-9.81) in 3D */
+    fsdem_pic_boundary boundary[6];   /* sides -x,+x,-y,+y,-z,+z; default FSDEM_PIC_BC_SLIP */
+    fsdem_vec3 boundary_velocity[6];  /* m/s; lid or inflow velocity per side; default 0 */
+    int free_surface;                 /* 1: cells are FLUID where particles are; 0: every open cell */
+                                      /*    is FLUID (a completely filled box, e.g. a cavity); default 1 */
+    fsdem_pic_transfer transfer;      /* default FSDEM_PIC_TRANSFER_FLIP */
+    fsdem_real flip_ratio;            /* -; FLIP share of the blend in [0, 1]; default 0.97 */
+    fsdem_pic_kernel kernel;          /* default FSDEM_PIC_KERNEL_LINEAR */
+    int particles_per_cell;           /* seeding density; default 4 (2D) / 8 (3D) */
+    fsdem_real jitter;                /* -; random displacement of seeds as a fraction of their */
+                                      /*    spacing, in [0, 1]; default 0.5 */
+    unsigned seed;                    /* random seed of jitter and reseeding; default 1 */
+    int min_particles_per_cell;       /* reseeding moves particles from crowded neighbour cells into */
+                                      /*    interior fluid cells with fewer (volume-neutral); */
+                                      /*    0 = never; default particles_per_cell / 2 */
+    int max_particles_per_cell;       /* reseeding removes particles from cells with more; 0 = never; */
+                                      /*    default 3 particles_per_cell */
+    int advection_order;              /* 2 (midpoint) or 3 (Ralston RK3); default 2 */
+    fsdem_real cfl;                   /* -; adaptive dt = cfl dx / (u_max + sqrt(|g| dx)); default 1 */
+    fsdem_real cfl_max;               /* -; a fixed dt beyond this CFL number is refused; default 5 */
+    fsdem_real dt_max;                /* s; largest step; default 0.01 */
+    int density_projection;           /* 1: seed 004 §5.1 density projection after advection; default 1 */
+    fsdem_real ghost_theta_min;       /* -; smallest interface fraction of the ghost-fluid method; */
+                                      /*    default 0.01 */
+    int extrapolation_layers;         /* faces of velocity extrapolation into air and solids; */
+                                      /*    0 = auto (cfl_max + 2); default 0 */
+    fsdem_precond pressure_precond;   /* default FSDEM_PRECOND_AUTO (multigrid) */
+    fsdem_real pressure_tolerance;    /* -; relative residual of the pressure solve; default 1e-8 */
+    int pressure_max_iterations;      /* default 500 */
+    fsdem_precond viscosity_precond;  /* default FSDEM_PRECOND_MIC0 */
+    fsdem_real viscosity_tolerance;   /* -; relative residual of the viscous solves; default 1e-8 */
+    size_t max_memory;                /* bytes; creation fails when the grid would need more; */
+                                      /*    0 = no limit beyond the allocator; default 0 */
+    fsdem_allocator allocator;        /* default: FSDEM_MALLOC/FSDEM_FREE */
+    fsdem_log_fn log;                 /* optional; default NULL */
+    void *log_user;
+} fsdem_pic_desc;
+
+/* Defaults for dim = 2 (x-y plane, gravity -y) or 3 (gravity -z); see the field comments. */
+FSDEM_API fsdem_pic_desc fsdem_pic_desc_default(int dim);
+/* Checks a desc without creating anything (also the memory the grid needs against max_memory); the
+   reason, naming the field, goes to `message` (may be NULL). Returns FSDEM_OK,
+   FSDEM_ERR_INVALID_ARG or FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_pic_desc_check(const fsdem_pic_desc *desc, char *message,
+                                            size_t message_size);
+/* Creates a solver with an empty domain (no particles, no obstacles). All grid memory and the
+   linear solvers are set up here. *out is NULL on failure. Errors: FSDEM_ERR_INVALID_ARG (the
+   reason goes to desc->log and fsdem_pic_desc_check), FSDEM_ERR_OUT_OF_MEMORY (the grid does not
+   fit max_memory, int indices or the allocator). Destroy with fsdem_pic_destroy. */
+FSDEM_API fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out);
+FSDEM_API void fsdem_pic_destroy(fsdem_pic *pic);
+/* Message of the last failed call on this object ("" after success). Valid until the next call. */
+FSDEM_API const char *fsdem_pic_last_error(const fsdem_pic *pic);
+
+/* ---- obstacles ---- */
+
+typedef enum fsdem_pic_obstacle_type {
+    FSDEM_PIC_OBSTACLE_BOX = 0,      /* axis-aligned solid box [a, b] */
+    FSDEM_PIC_OBSTACLE_SPHERE = 1,   /* sphere (3D) or disc (2D), centre a, radius `radius` */
+    FSDEM_PIC_OBSTACLE_CYLINDER = 2, /* 3D: flat-capped cylinder with axis a-b and `radius`; */
+                                     /*    2D: a disc like SPHERE */
+    FSDEM_PIC_OBSTACLE_POLYGON = 3,  /* 2D: closed polygon `vertices` (x, y used), any orientation */
+    FSDEM_PIC_OBSTACLE_SDF = 4       /* callback: signed distance, positive on the liquid side */
+} fsdem_pic_obstacle_type;
+
+typedef struct fsdem_pic_obstacle {
+    fsdem_pic_obstacle_type type;
+    fsdem_vec3 a, b;              /* m; geometry, meaning per type */
+    fsdem_real radius;            /* m; SPHERE, CYLINDER */
+    const fsdem_vec3 *vertices;   /* POLYGON: `vertex_count` >= 3 points, copied when added */
+    int vertex_count;
+    fsdem_sdf_fn sdf;             /* SDF: distance (m) and unit normal towards the liquid */
+    void *sdf_user;               /*    (must stay valid while the solver lives) */
+    fsdem_vec3 velocity;          /* m/s; kinematic surface velocity (the geometry does not move): */
+                                  /*    normal flux through cut faces and no-slip value; default 0 */
+} fsdem_pic_obstacle;
+
+FSDEM_API fsdem_pic_obstacle fsdem_pic_obstacle_box(fsdem_vec3 lo, fsdem_vec3 hi);
+FSDEM_API fsdem_pic_obstacle fsdem_pic_obstacle_sphere(fsdem_vec3 centre, fsdem_real radius);
+FSDEM_API fsdem_pic_obstacle fsdem_pic_obstacle_cylinder(fsdem_vec3 a, fsdem_vec3 b, fsdem_real radius);
+FSDEM_API fsdem_pic_obstacle fsdem_pic_obstacle_polygon(const fsdem_vec3 *vertices, int count);
+FSDEM_API fsdem_pic_obstacle fsdem_pic_obstacle_sdf(fsdem_sdf_fn sdf, void *user);
+
+/* Adds a static obstacle; its index goes to *id (may be NULL). Recomputes the face fractions of
+   the union of all obstacles (each face sampled on a 4 x 4 sub-grid, linear in between: walls
+   thinner than about a quarter cell may leak) and removes the particles now inside a solid.
+   Allocates (outside any step). Errors: FSDEM_ERR_INVALID_ARG (bad geometry, non-finite values, or the obstacle would
+   leave no open cell: "covers the whole domain"; the solver is unchanged), FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_pic_add_obstacle(fsdem_pic *pic, const fsdem_pic_obstacle *obstacle,
+                                              int *id);
+/* Signed distance (m) from p to the nearest obstacle or closed domain wall, positive in the open
+   domain; writes the unit normal towards the open side to *normal (may be NULL). */
+FSDEM_API fsdem_real fsdem_pic_solid_distance(const fsdem_pic *pic, fsdem_vec3 p, fsdem_vec3 *normal);
+
+/* ---- particles ---- */
+
+/* Seeds particles_per_cell particles per cell (stratified with jitter) in the part of the box
+   [lo, hi] that is inside the domain and outside every obstacle, all with `velocity` (m/s). The number
+   added goes to *added (may be NULL). Errors: FSDEM_ERR_INVALID_ARG (non-finite input, empty box),
+   FSDEM_ERR_OUT_OF_MEMORY (nothing added). Allocates (outside any step). */
+FSDEM_API fsdem_result fsdem_pic_fill_box(fsdem_pic *pic, fsdem_vec3 lo, fsdem_vec3 hi,
+                                          fsdem_vec3 velocity, int *added);
+/* Like fsdem_pic_fill_box for the region where region(user, p, NULL) > 0. */
+FSDEM_API fsdem_result fsdem_pic_fill_sdf(fsdem_pic *pic, fsdem_sdf_fn region, void *user,
+                                          fsdem_vec3 velocity, int *added);
+/* Adds `count` particles (positions m, velocities m/s; velocities may be NULL for rest). All or
+   nothing: FSDEM_ERR_INVALID_ARG names the first non-finite particle, FSDEM_ERR_OUT_OF_DOMAIN the
+   first one outside the domain or inside a solid, FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_pic_add_particles(fsdem_pic *pic, const fsdem_vec3 *positions,
+                                               const fsdem_vec3 *velocities, int count);
+/* Reserves room for `count` particles so later steps can reseed and inject without refusing
+   (steps never allocate; by default room for 1.5 x the particles present is kept). */
+FSDEM_API fsdem_result fsdem_pic_reserve(fsdem_pic *pic, int count);
+
+/* Views of the marker particles (structure of arrays), valid until particles are added or a step
+   runs (steps reorder, remove and add particles). `velocity` may be edited between steps. */
+typedef struct fsdem_pic_particles {
+    int count;
+    int dim;
+    fsdem_real volume;          /* m^3 (m^2 in 2D) represented by one particle: dx^dim / ppc */
+    const fsdem_vec3 *position; /* m */
+    fsdem_vec3 *velocity;       /* m/s */
+} fsdem_pic_particles;
+
+FSDEM_API fsdem_pic_particles fsdem_pic_get_particles(fsdem_pic *pic);
+
+/* ---- time stepping ---- */
+
+/* Advances by one step of the adaptive size min(dt_max, cfl dx / (u_max + sqrt(|g| dx))).
+   Errors (the step is complete, the message names the culprit): FSDEM_ERR_NAN (a particle
+   velocity became non-finite), FSDEM_ERR_NOT_CONVERGED (a linear solve stopped at its iteration
+   limit), FSDEM_ERR_CFL (the projected velocity moved particles more than cfl_max cells). */
+FSDEM_API fsdem_result fsdem_pic_step(fsdem_pic *pic);
+/* One step of a given dt (s). FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite, FSDEM_ERR_CFL when
+   u_max dt / dx > cfl_max (the message names the fastest particle); in both cases nothing moved.
+   Otherwise as fsdem_pic_step. */
+FSDEM_API fsdem_result fsdem_pic_step_dt(fsdem_pic *pic, fsdem_real dt);
+/* Advances by `duration` (s) with adaptive steps, the last one shortened to land on the end time.
+   Stops at the first error and returns it. Steps taken go to *steps (may be NULL). */
+FSDEM_API fsdem_result fsdem_pic_advance(fsdem_pic *pic, fsdem_real duration, int *steps);
+/* The adaptive step the next fsdem_pic_step would take (s). */
+FSDEM_API fsdem_real fsdem_pic_dt_estimate(const fsdem_pic *pic);
+FSDEM_API fsdem_real fsdem_pic_time(const fsdem_pic *pic);
+
+/* ---- grid and coupling ---- */
+
+/* Read-only view of the grid after the last step (valid while the solver lives). */
+typedef struct fsdem_pic_grid {
+    int dim;
+    int n[3];                      /* cells per axis (n[2] = 1 in 2D) */
+    int face_count[3];             /* faces per axis (0 for z in 2D) */
+    fsdem_real cell_size;          /* m */
+    fsdem_vec3 origin;             /* m, lower corner */
+    const unsigned char *cell;     /* fsdem_stencil_cell per cell */
+    const fsdem_real *pressure;    /* Pa per cell (0 outside the fluid) */
+    const fsdem_real *phi;         /* m; signed distance to the surface, < 0 in water, |phi| <= dx */
+    const fsdem_real *fraction;    /* -; particle fluid fraction per cell (1 = uniformly filled) */
+    const fsdem_real *velocity[3]; /* m/s; face velocity after projection and extrapolation */
+    const fsdem_real *open[3];     /* -; effective face-area fraction E used by the projection */
+    const fsdem_real *solid_velocity[3]; /* m/s; velocity of the solid part of each face (walls, */
+                                   /*    inflow, obstacles, coupler): face flux E u + (1 - E) us */
+} fsdem_pic_grid;
+
+FSDEM_API fsdem_pic_grid fsdem_pic_get_grid(const fsdem_pic *pic);
+
+/* Writable per-face arrays for a coupler (layout of fsdem_pic_grid), read by every step:
+   - open[a][f]: fraction of face f not covered by moving solids (default 1); the projection uses
+     min(static obstacle fraction, open);
+   - solid_velocity[a][f]: velocity component a (m/s) of the moving solid on that face (default 0),
+     used where open < the static fraction;
+   - acceleration[a][f]: extra acceleration (m/s^2) added with gravity (default 0; not cleared);
+   - pressure_extra / pressure_extra_user: an optional symmetric positive semi-definite term y += K p
+     added to the pressure operator of the equation sum_f E_f (p_c - p_nb) = -(rho dx^2/dt) div
+     (p and y in Pa; e.g. the implicit solid response dt J^T M^-1 J of seed 000 Eq. 6 in these
+     units). It must write only to FLUID cells; the preconditioner does not see it. NULL: none;
+   - pressure_rhs[c]: added to the right-hand side of that equation (Pa; default 0, not cleared).
+   A cell whose faces are all closed becomes SOLID. Particles are pushed out of static obstacles
+   only; keeping them out of moving solids is the coupler's part. */
+typedef struct fsdem_pic_coupling {
+    int dim;
+    int n[3];
+    int face_count[3];
+    fsdem_real *open[3];
+    fsdem_real *solid_velocity[3];
+    fsdem_real *acceleration[3];
+    fsdem_real *pressure_rhs;
+    fsdem_operator_fn pressure_extra;
+    void *pressure_extra_user;
+} fsdem_pic_coupling;
+
+/* Pointer to the coupler view; edit its arrays and hooks between steps. */
+FSDEM_API fsdem_pic_coupling *fsdem_pic_coupling_view(fsdem_pic *pic);
+
+/* Grid velocity (m/s, trilinear from the faces) and pressure (Pa, trilinear from the cells) at a
+   point (clamped into the domain). */
+FSDEM_API fsdem_vec3 fsdem_pic_sample_velocity(const fsdem_pic *pic, fsdem_vec3 p);
+FSDEM_API fsdem_real fsdem_pic_sample_pressure(const fsdem_pic *pic, fsdem_vec3 p);
+
+/* ---- diagnostics ---- */
+
+typedef struct fsdem_pic_stats {
+    fsdem_real time;               /* s */
+    fsdem_real dt;                 /* s, last step */
+    long long steps;
+    int particles;
+    int fluid_cells;
+    fsdem_real fluid_volume;       /* m^3 (m^2 in 2D): liquid volume the solver sees, the sum over */
+                                   /*    open cells of clamp(1/2 - phi/dx, 0, 1) dx^dim (all open */
+                                   /*    cells when free_surface = 0); cut cells count whole */
+    fsdem_real particle_volume;    /* m^3 (m^2 in 2D): particles x particle volume */
+    fsdem_real kinetic_energy;     /* J (J/m in 2D): sum of rho V_p |v_p|^2 / 2 */
+    fsdem_real max_speed;          /* m/s, particles */
+    fsdem_real max_divergence;     /* 1/s; largest |div u| over fluid cells after the projection */
+    fsdem_real divergence_before;  /* 1/s; l2 norm over fluid cells of div u before the projection */
+    int pressure_iterations;       /* last step */
+    fsdem_real pressure_residual;  /* -; relative, last step */
+    int viscosity_iterations;      /* last step, summed over components */
+    int density_iterations;        /* last step */
+    long long reseeded;            /* particles added by the inflow sides, total */
+    long long moved;               /* particles moved by reseeding from crowded to sparse cells, total */
+    long long removed;             /* particles removed (over-full cells, outflow, solids), total */
+    long long refused;             /* inflow seeds refused because the particle capacity was full */
+    double seconds_total;          /* CPU seconds spent in steps (clock()) */
+    double seconds_pressure;       /* CPU seconds in pressure setup + solve */
+    double seconds_density;        /* CPU seconds in the density projection's setup + solve */
+    size_t memory_bytes;           /* bytes held by the solver, linear solvers included */
+} fsdem_pic_stats;
+
+FSDEM_API fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *pic);
+
+/* ---- output ---- */
+
+/* Particles as CSV (x,y,z,vx,vy,vz) or as VTK XML polydata (.vtp, ASCII) with a velocity vector.
+   FSDEM_ERR_IO. */
+FSDEM_API fsdem_result fsdem_pic_write_particles_csv(const fsdem_pic *pic, const char *path);
+FSDEM_API fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *pic, const char *path);
+/* Grid cells as CSV (i,j,k,x,y,z,type,p,phi,fraction,u,v,w with cell-centred velocity) or as VTK
+   XML image data (.vti, ASCII) with the same cell data. FSDEM_ERR_IO. */
+FSDEM_API fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *pic, const char *path);
+FSDEM_API fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *pic, const char *path);
+
+/* A ParaView time series (.pvd collection): open, add one entry per written file (its name as
+   seen from the .pvd's folder), close. Owned by the caller. */
+typedef struct fsdem_pvd {
+    void *file; /* FILE*, NULL when closed */
+} fsdem_pvd;
+
+/* FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG for NULL arguments. */
+FSDEM_API fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path);
+FSDEM_API fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file);
+FSDEM_API fsdem_result fsdem_pvd_close(fsdem_pvd *pvd);
 
 /* ===== >>io : CSV time series and particle snapshots =============================================== */
 
@@ -3918,6 +4240,2685 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
     fsdem__pcg_store(s, s->x, x);
     if (info) *info = inf;
     return res == FSDEM_OK ? fsdem__ok(&s->status) : res;
+}
+
+/* ===== >>impl_pic : PIC/FLIP solver ===== */
+
+#include <time.h>
+
+/* ---- >>pic_types : the solver object ---- */
+
+typedef struct fsdem__pic_obst {
+    fsdem_pic_obstacle d;
+    fsdem_vec3 *verts; /* POLYGON: owned copy */
+    fsdem_vec3 box_lo, box_hi; /* bounding box (m), inflated by two cells */
+} fsdem__pic_obst;
+
+/* Kernel weights of one particle along each axis: nodes lo[b] .. lo[b]+cnt[b]-1 (indices are
+   clamped into the grid when used), weights w and their derivatives dw (per grid unit). */
+typedef struct fsdem__pic_st {
+    int lo[3];
+    int idx[3][3]; /* node indices clamped into the grid */
+    int cnt[3];
+    fsdem_real w[3][3];
+    fsdem_real dw[3][3];
+} fsdem__pic_st;
+
+struct fsdem_pic {
+    fsdem_pic_desc desc;
+    fsdem__status status;
+    fsdem_allocator allocator;
+    int dim, n[3], ncell;
+    int fn[3][3];      /* face grid sizes: fn[a][b] = n[b] + (a == b) */
+    int nface[3];      /* faces per axis (0 above dim) */
+    int cstep[3];      /* cell index stride per axis */
+    int fstep[3][3];   /* face index stride of axis-a faces along b */
+    fsdem_real dx, inv_dx;
+    fsdem_vec3 lo, hi; /* grid box */
+    double time;
+    fsdem_real dt_last;
+    long long steps;
+    unsigned long long rng;
+    int ppc, sub;      /* particles per cell; seeds per axis when ppc = sub^dim, else 0 */
+    fsdem_real pvol;   /* m^dim per particle */
+    fsdem_real gmag;   /* |g| */
+
+    /* particles, structure of arrays */
+    int np, pcap;
+    fsdem_vec3 *px, *pv, *ptmp;
+    fsdem_vec3 *pc[3]; /* APIC: gradient of velocity component a (1/s); NULL otherwise */
+    int *pcell, *pidx;
+    unsigned char *pflag;
+
+    /* faces, per axis */
+    fsdem_real *u[3], *uold[3], *wsum[3], *ftmp[3];
+    fsdem_real *sopen[3], *svel[3];           /* static obstacles: open fraction, solid velocity */
+    fsdem_real *copen[3], *cvel[3], *cacc[3]; /* coupler arrays */
+    fsdem_real *E[3], *us[3];                 /* effective open fraction and solid velocity */
+    unsigned char *fvalid[3], *fvalid2[3];
+    int *fqueue; /* breadth-first front of the extrapolation, max(nface) entries */
+    int fqueue_size;
+
+    /* cells */
+    fsdem_real *frac, *fref, *phi, *pres, *rhs, *diag, *ctmp, *crhs;
+    unsigned char *ctype, *cnear, *csolid;
+    int *cstart; /* ncell + 1 */
+
+    /* implicit viscosity: per axis a the face grid is a stencil grid of its own */
+    fsdem_real *vface[3][3]; /* coefficients 1 inside, 0 on the face grid's boundary */
+    unsigned char *vcell[3];
+
+    fsdem__pic_obst *obst;
+    int obst_count, obst_capacity;
+
+    fsdem_pcg *pcg_p;
+    fsdem_pcg *pcg_v[3];
+    fsdem_pic_coupling coupling;
+
+    /* diagnostics */
+    int cells_fresh; /* frac/phi hold the current particle positions (set at the end of a step) */
+    int fluid_cells, p_iters, v_iters, d_iters;
+    fsdem_real p_res, max_div, div_before, umax_part;
+    long long reseeded, removed, refused, moved;
+    double sec_total, sec_pressure, sec_density;
+    size_t bytes;
+};
+
+/* ---- >>pic_desc : defaults, validation, creation ---- */
+
+fsdem_pic_desc fsdem_pic_desc_default(int dim) {
+    fsdem_pic_desc d;
+    int k;
+    memset(&d, 0, sizeof d);
+    d.dim = dim;
+    d.domain_min = fsdem_v3(0, 0, 0);
+    d.domain_max = fsdem_v3(1, 1, 1);
+    d.cell_size = (fsdem_real)(1.0 / 32.0);
+    d.density = 1000;
+    d.viscosity = 0;
+    d.gravity = dim == 3 ? fsdem_v3(0, 0, (fsdem_real)-9.81) : fsdem_v3(0, (fsdem_real)-9.81, 0);
+    for (k = 0; k < 6; ++k) {
+        d.boundary[k] = FSDEM_PIC_BC_SLIP;
+        d.boundary_velocity[k] = fsdem_v3(0, 0, 0);
+    }
+    d.free_surface = 1;
+    d.transfer = FSDEM_PIC_TRANSFER_FLIP;
+    d.flip_ratio = (fsdem_real)0.97;
+    d.kernel = FSDEM_PIC_KERNEL_LINEAR;
+    d.particles_per_cell = dim == 3 ? 8 : 4;
+    d.jitter = (fsdem_real)0.5;
+    d.seed = 1;
+    d.min_particles_per_cell = d.particles_per_cell / 2;
+    d.max_particles_per_cell = 3 * d.particles_per_cell;
+    d.advection_order = 2;
+    d.cfl = 1;
+    d.cfl_max = 5;
+    d.dt_max = (fsdem_real)0.01;
+    d.density_projection = 1;
+    d.ghost_theta_min = (fsdem_real)0.01;
+    d.extrapolation_layers = 0;
+    d.pressure_precond = FSDEM_PRECOND_AUTO;
+#ifdef FSDEM_USE_FLOAT
+    d.pressure_tolerance = (fsdem_real)1e-5;
+    d.viscosity_tolerance = (fsdem_real)1e-5;
+#else
+    d.pressure_tolerance = (fsdem_real)1e-8;
+    d.viscosity_tolerance = (fsdem_real)1e-8;
+#endif
+    d.pressure_max_iterations = 500;
+    d.viscosity_precond = FSDEM_PRECOND_MIC0;
+    d.max_memory = 0;
+    return d;
+}
+
+static const char *fsdem__pic_side_name(int side) {
+    static const char *names[6] = {"-x", "+x", "-y", "+y", "-z", "+z"};
+    return side >= 0 && side < 6 ? names[side] : "?";
+}
+
+/* Grid size of a desc: cells per axis as doubles (may be huge), and an estimate of the bytes the
+   solver needs for it. */
+static void fsdem__pic_grid_size(const fsdem_pic_desc *d, double cells[3], double *total,
+                                 double *bytes) {
+    int a;
+    double faces = 0, per_cell, per_face;
+    *total = 1;
+    for (a = 0; a < 3; ++a) {
+        cells[a] = 1;
+        if (a < d->dim) {
+            double e = (double)fsdem__comp(d->domain_max, a) - (double)fsdem__comp(d->domain_min, a);
+            cells[a] = floor(e / (double)d->cell_size + 0.5);
+            if (cells[a] < 1) cells[a] = 1;
+        }
+        *total *= cells[a];
+    }
+    for (a = 0; a < d->dim; ++a) faces += *total / cells[a] * (cells[a] + 1);
+    per_face = 15.0 * sizeof(fsdem_real) + 2 + sizeof(int);
+    per_cell = 8.0 * sizeof(fsdem_real) + 3 + sizeof(int);
+    per_cell += 12.0 * sizeof(fsdem_real); /* pressure solver: vectors and multigrid levels */
+    if (d->viscosity > 0) per_face += 16.0 * sizeof(fsdem_real) + 1;
+    *bytes = *total * per_cell + faces * per_face;
+}
+
+static fsdem_result fsdem__pic_check(const fsdem_pic_desc *d, char *msg, size_t size) {
+    int a, k;
+    double cells[3], total, bytes;
+#define FSDEM__PIC_BAD(...)                                                                        \
+    do {                                                                                           \
+        if (msg && size) snprintf(msg, size, __VA_ARGS__);                                         \
+        return FSDEM_ERR_INVALID_ARG;                                                              \
+    } while (0)
+    if (msg && size) msg[0] = '\0';
+    if (d->dim != 2 && d->dim != 3) FSDEM__PIC_BAD("pic desc: dim = %d must be 2 or 3", d->dim);
+    if (!(d->cell_size > 0) || !fsdem__finite(d->cell_size))
+        FSDEM__PIC_BAD("pic desc: cell_size = %g m must be > 0 and finite", (double)d->cell_size);
+    if (!fsdem__finite3(d->domain_min) || !fsdem__finite3(d->domain_max))
+        FSDEM__PIC_BAD("pic desc: domain_min/domain_max must be finite");
+    for (a = 0; a < d->dim; ++a)
+        if (!(fsdem__comp(d->domain_max, a) > fsdem__comp(d->domain_min, a)))
+            FSDEM__PIC_BAD("pic desc: domain_max.%c = %g must exceed domain_min.%c = %g", "xyz"[a],
+                           (double)fsdem__comp(d->domain_max, a), "xyz"[a],
+                           (double)fsdem__comp(d->domain_min, a));
+    if (!(d->density > 0) || !fsdem__finite(d->density))
+        FSDEM__PIC_BAD("pic desc: density = %g kg/m^3 must be > 0", (double)d->density);
+    if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
+        FSDEM__PIC_BAD("pic desc: viscosity = %g m^2/s must be >= 0", (double)d->viscosity);
+    if (!fsdem__finite3(d->gravity)) FSDEM__PIC_BAD("pic desc: gravity must be finite");
+    for (k = 0; k < 2 * d->dim; ++k) {
+        if ((int)d->boundary[k] < 0 || (int)d->boundary[k] > 3)
+            FSDEM__PIC_BAD("pic desc: boundary[%d] (%s side) = %d is not a fsdem_pic_boundary", k,
+                           fsdem__pic_side_name(k), (int)d->boundary[k]);
+        if (!fsdem__finite3(d->boundary_velocity[k]))
+            FSDEM__PIC_BAD("pic desc: boundary_velocity[%d] must be finite", k);
+    }
+    if ((int)d->transfer < 0 || (int)d->transfer > 2)
+        FSDEM__PIC_BAD("pic desc: transfer = %d is not a fsdem_pic_transfer", (int)d->transfer);
+    if (!(d->flip_ratio >= 0 && d->flip_ratio <= 1))
+        FSDEM__PIC_BAD("pic desc: flip_ratio = %g must be in [0, 1]", (double)d->flip_ratio);
+    if ((int)d->kernel < 0 || (int)d->kernel > 1)
+        FSDEM__PIC_BAD("pic desc: kernel = %d is not a fsdem_pic_kernel", (int)d->kernel);
+    if (d->particles_per_cell < 1 || d->particles_per_cell > 64)
+        FSDEM__PIC_BAD("pic desc: particles_per_cell = %d must be in [1, 64]", d->particles_per_cell);
+    if (!(d->jitter >= 0 && d->jitter <= 1))
+        FSDEM__PIC_BAD("pic desc: jitter = %g must be in [0, 1]", (double)d->jitter);
+    if (d->min_particles_per_cell < 0 || d->min_particles_per_cell > d->particles_per_cell)
+        FSDEM__PIC_BAD("pic desc: min_particles_per_cell = %d must be in [0, particles_per_cell = %d]",
+                       d->min_particles_per_cell, d->particles_per_cell);
+    if (d->max_particles_per_cell != 0 && d->max_particles_per_cell < d->particles_per_cell)
+        FSDEM__PIC_BAD("pic desc: max_particles_per_cell = %d must be 0 or >= particles_per_cell = %d",
+                       d->max_particles_per_cell, d->particles_per_cell);
+    if (d->advection_order != 2 && d->advection_order != 3)
+        FSDEM__PIC_BAD("pic desc: advection_order = %d must be 2 or 3", d->advection_order);
+    if (!(d->cfl > 0) || !fsdem__finite(d->cfl))
+        FSDEM__PIC_BAD("pic desc: cfl = %g must be > 0", (double)d->cfl);
+    if (!(d->cfl_max >= d->cfl) || !fsdem__finite(d->cfl_max))
+        FSDEM__PIC_BAD("pic desc: cfl_max = %g must be >= cfl = %g", (double)d->cfl_max, (double)d->cfl);
+    if (!(d->dt_max > 0) || !fsdem__finite(d->dt_max))
+        FSDEM__PIC_BAD("pic desc: dt_max = %g s must be > 0", (double)d->dt_max);
+    if (!(d->ghost_theta_min > 0 && d->ghost_theta_min <= 1))
+        FSDEM__PIC_BAD("pic desc: ghost_theta_min = %g must be in (0, 1]", (double)d->ghost_theta_min);
+    if (d->extrapolation_layers < 0 || d->extrapolation_layers > 1000)
+        FSDEM__PIC_BAD("pic desc: extrapolation_layers = %d must be in [0, 1000]", d->extrapolation_layers);
+    if ((int)d->pressure_precond < 0 || (int)d->pressure_precond > 5)
+        FSDEM__PIC_BAD("pic desc: pressure_precond = %d is not a fsdem_precond", (int)d->pressure_precond);
+    if ((int)d->viscosity_precond < 0 || (int)d->viscosity_precond > 5)
+        FSDEM__PIC_BAD("pic desc: viscosity_precond = %d is not a fsdem_precond", (int)d->viscosity_precond);
+    if (!(d->pressure_tolerance > 0 && d->pressure_tolerance < 1))
+        FSDEM__PIC_BAD("pic desc: pressure_tolerance = %g must be in (0, 1)", (double)d->pressure_tolerance);
+    if (!(d->viscosity_tolerance > 0 && d->viscosity_tolerance < 1))
+        FSDEM__PIC_BAD("pic desc: viscosity_tolerance = %g must be in (0, 1)", (double)d->viscosity_tolerance);
+    if (d->pressure_max_iterations < 1)
+        FSDEM__PIC_BAD("pic desc: pressure_max_iterations = %d must be >= 1", d->pressure_max_iterations);
+    if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
+        FSDEM__PIC_BAD("pic desc: allocator needs both alloc and free, or neither");
+#undef FSDEM__PIC_BAD
+    fsdem__pic_grid_size(d, cells, &total, &bytes);
+    if (total > 4e8 || cells[0] + 1 > 2e9 || cells[1] + 1 > 2e9 || cells[2] + 1 > 2e9 ||
+        (d->max_memory > 0 && bytes > (double)d->max_memory) || bytes > (double)((size_t)-1) / 2) {
+        if (msg && size)
+            snprintf(msg, size,
+                     "pic desc: the grid of %.0f x %.0f x %.0f = %.4g cells (cell_size %g m) needs about "
+                     "%.4g bytes, more than %s",
+                     cells[0], cells[1], cells[2], total, (double)d->cell_size, bytes,
+                     d->max_memory > 0 && bytes > (double)d->max_memory ? "max_memory allows"
+                                                                         : "fits in memory");
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    }
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_pic_desc_check(const fsdem_pic_desc *desc, char *message, size_t message_size) {
+    if (!desc) {
+        if (message && message_size) snprintf(message, message_size, "pic desc: NULL");
+        return FSDEM_ERR_INVALID_ARG;
+    }
+    return fsdem__pic_check(desc, message, message_size);
+}
+
+/* Allocation that is counted in the solver's memory figure. */
+static void *fsdem__pic_alloc(fsdem_pic *s, size_t bytes) {
+    void *p = fsdem__alloc(&s->allocator, bytes);
+    if (p) s->bytes += bytes;
+    return p;
+}
+
+static fsdem_real *fsdem__pic_reals(fsdem_pic *s, int count, fsdem_real fill, int *ok) {
+    fsdem_real *p = (fsdem_real *)fsdem__pic_alloc(s, sizeof(fsdem_real) * (size_t)(count > 0 ? count : 1));
+    int i;
+    if (!p) {
+        *ok = 0;
+        return NULL;
+    }
+    for (i = 0; i < count; ++i) p[i] = fill;
+    return p;
+}
+
+static unsigned char *fsdem__pic_bytes(fsdem_pic *s, int count, int *ok) {
+    unsigned char *p = (unsigned char *)fsdem__pic_alloc(s, (size_t)(count > 0 ? count : 1));
+    if (!p) {
+        *ok = 0;
+        return NULL;
+    }
+    memset(p, 0, (size_t)(count > 0 ? count : 1));
+    return p;
+}
+
+static void fsdem__pic_release(fsdem_pic *s, void *p, size_t bytes) {
+    if (p) {
+        fsdem__free(&s->allocator, p, bytes);
+        s->bytes -= bytes;
+    }
+}
+
+static void fsdem__pic_free_particles(fsdem_pic *s) {
+    size_t cap = (size_t)s->pcap;
+    int a;
+    fsdem__pic_release(s, s->px, cap * sizeof(fsdem_vec3));
+    fsdem__pic_release(s, s->pv, cap * sizeof(fsdem_vec3));
+    fsdem__pic_release(s, s->ptmp, cap * sizeof(fsdem_vec3));
+    for (a = 0; a < 3; ++a) fsdem__pic_release(s, s->pc[a], cap * sizeof(fsdem_vec3));
+    fsdem__pic_release(s, s->pcell, cap * sizeof(int));
+    fsdem__pic_release(s, s->pidx, cap * sizeof(int));
+    fsdem__pic_release(s, s->pflag, cap);
+    s->px = s->pv = s->ptmp = s->pc[0] = s->pc[1] = s->pc[2] = NULL;
+    s->pcell = s->pidx = NULL;
+    s->pflag = NULL;
+    s->pcap = 0;
+}
+
+void fsdem_pic_destroy(fsdem_pic *s) {
+    int a, b;
+    size_t nc, nf;
+    fsdem_allocator al;
+    if (!s) return;
+    nc = (size_t)s->ncell;
+    fsdem__pic_free_particles(s);
+    for (a = 0; a < 3; ++a) {
+        nf = (size_t)(s->nface[a] > 0 ? s->nface[a] : 1);
+        fsdem__pic_release(s, s->u[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->uold[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->wsum[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->ftmp[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->sopen[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->svel[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->copen[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->cvel[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->cacc[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->E[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->us[a], nf * sizeof(fsdem_real));
+        fsdem__pic_release(s, s->fvalid[a], nf);
+        fsdem__pic_release(s, s->fvalid2[a], nf);
+        fsdem__pic_release(s, s->vcell[a], nf);
+        for (b = 0; b < 3; ++b) {
+            size_t m = 1;
+            int c;
+            if (!s->vface[a][b]) continue;
+            for (c = 0; c < 3; ++c) m *= (size_t)(s->fn[a][c] + (c == b));
+            fsdem__pic_release(s, s->vface[a][b], m * sizeof(fsdem_real));
+        }
+        if (s->pcg_v[a]) fsdem_pcg_destroy(s->pcg_v[a]);
+    }
+    fsdem__pic_release(s, s->frac, nc * sizeof(fsdem_real));
+    fsdem__pic_release(s, s->fref, nc * sizeof(fsdem_real));
+    fsdem__pic_release(s, s->phi, nc * sizeof(fsdem_real));
+    fsdem__pic_release(s, s->pres, nc * sizeof(fsdem_real));
+    fsdem__pic_release(s, s->rhs, nc * sizeof(fsdem_real));
+    fsdem__pic_release(s, s->diag, nc * sizeof(fsdem_real));
+    fsdem__pic_release(s, s->ctmp, nc * sizeof(fsdem_real));
+    fsdem__pic_release(s, s->crhs, nc * sizeof(fsdem_real));
+    fsdem__pic_release(s, s->ctype, nc);
+    fsdem__pic_release(s, s->cnear, nc);
+    fsdem__pic_release(s, s->csolid, nc);
+    fsdem__pic_release(s, s->cstart, (nc + 1) * sizeof(int));
+    fsdem__pic_release(s, s->fqueue, (size_t)s->fqueue_size * sizeof(int));
+    for (a = 0; a < s->obst_count; ++a)
+        if (s->obst[a].verts)
+            fsdem__pic_release(s, s->obst[a].verts, sizeof(fsdem_vec3) * (size_t)s->obst[a].d.vertex_count);
+    fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
+    if (s->pcg_p) fsdem_pcg_destroy(s->pcg_p);
+    al = s->allocator;
+    fsdem__free(&al, s, sizeof *s);
+}
+
+const char *fsdem_pic_last_error(const fsdem_pic *s) { return s ? s->status.message : "NULL solver"; }
+
+static int fsdem__pic_cell(const fsdem_pic *s, int i, int j, int k) { return (k * s->n[1] + j) * s->n[0] + i; }
+static int fsdem__pic_face(const fsdem_pic *s, int a, int i, int j, int k) {
+    return (k * s->fn[a][1] + j) * s->fn[a][0] + i;
+}
+
+/* Fill the viscous face-grid coefficients of axis a: 1 between two faces, 0 on the boundary. */
+static void fsdem__pic_fill_vface(fsdem_pic *s, int a) {
+    int b, i, j, k, m[3], c;
+    for (b = 0; b < s->dim; ++b) {
+        for (c = 0; c < 3; ++c) m[c] = s->fn[a][c] + (c == b);
+        for (k = 0; k < m[2]; ++k)
+            for (j = 0; j < m[1]; ++j)
+                for (i = 0; i < m[0]; ++i) {
+                    int coord = b == 0 ? i : b == 1 ? j : k;
+                    s->vface[a][b][(k * m[1] + j) * m[0] + i] =
+                        (coord == 0 || coord == m[b] - 1) ? (fsdem_real)0 : (fsdem_real)1;
+                }
+    }
+}
+
+static void fsdem__pic_static_flags(fsdem_pic *s);
+static void fsdem__pic_compute_fref(fsdem_pic *s);
+
+fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_result r;
+    fsdem_allocator al;
+    fsdem_pic *s;
+    fsdem_pcg_desc pd;
+    fsdem_stencil st;
+    double cells[3], total, bytes;
+    int a, b, ok = 1, root;
+    if (out) *out = NULL;
+    if (!desc || !out) return FSDEM_ERR_INVALID_ARG;
+    r = fsdem__pic_check(desc, msg, sizeof msg);
+    if (r != FSDEM_OK) {
+        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
+        return r;
+    }
+    al = desc->allocator;
+    s = (fsdem_pic *)fsdem__alloc(&al, sizeof *s);
+    if (!s) return FSDEM_ERR_OUT_OF_MEMORY;
+    memset(s, 0, sizeof *s);
+    s->desc = *desc;
+    s->allocator = al;
+    s->bytes = sizeof *s;
+    s->status.log = desc->log;
+    s->status.log_user = desc->log_user;
+    s->dim = desc->dim;
+    s->dx = desc->cell_size;
+    s->inv_dx = 1 / s->dx;
+    fsdem__pic_grid_size(desc, cells, &total, &bytes);
+    for (a = 0; a < 3; ++a) s->n[a] = (int)cells[a];
+    s->ncell = s->n[0] * s->n[1] * s->n[2];
+    s->lo = desc->domain_min;
+    s->hi = s->lo;
+    if (s->dim == 2) s->lo.z = s->hi.z = 0;
+    s->hi.x = s->lo.x + s->dx * (fsdem_real)s->n[0];
+    s->hi.y = s->lo.y + s->dx * (fsdem_real)s->n[1];
+    if (s->dim == 3) s->hi.z = s->lo.z + s->dx * (fsdem_real)s->n[2];
+    s->cstep[0] = 1;
+    s->cstep[1] = s->n[0];
+    s->cstep[2] = s->n[0] * s->n[1];
+    for (a = 0; a < 3; ++a) {
+        for (b = 0; b < 3; ++b) s->fn[a][b] = s->n[b] + (a == b && a < s->dim);
+        s->nface[a] = a < s->dim ? s->fn[a][0] * s->fn[a][1] * s->fn[a][2] : 0;
+        s->fstep[a][0] = 1;
+        s->fstep[a][1] = s->fn[a][0];
+        s->fstep[a][2] = s->fn[a][0] * s->fn[a][1];
+    }
+    s->ppc = desc->particles_per_cell;
+    root = (int)floor(pow((double)s->ppc, 1.0 / s->dim) + 0.5);
+    s->sub = (int)pow((double)root, (double)s->dim) == s->ppc ? root : 0;
+    s->pvol = (fsdem_real)pow((double)s->dx, (double)s->dim) / (fsdem_real)s->ppc;
+    s->gmag = fsdem__norm(desc->gravity);
+    s->rng = 0x9E3779B97F4A7C15ull ^ (unsigned long long)desc->seed;
+    if (s->dim == 2) s->desc.domain_max.z = s->desc.domain_min.z;
+
+    for (a = 0; a < s->dim && ok; ++a) {
+        int nf = s->nface[a];
+        s->u[a] = fsdem__pic_reals(s, nf, 0, &ok);
+        s->uold[a] = fsdem__pic_reals(s, nf, 0, &ok);
+        s->wsum[a] = fsdem__pic_reals(s, nf, 0, &ok);
+        s->ftmp[a] = fsdem__pic_reals(s, nf, 0, &ok);
+        s->sopen[a] = fsdem__pic_reals(s, nf, 1, &ok);
+        s->svel[a] = fsdem__pic_reals(s, nf, 0, &ok);
+        s->copen[a] = fsdem__pic_reals(s, nf, 1, &ok);
+        s->cvel[a] = fsdem__pic_reals(s, nf, 0, &ok);
+        s->cacc[a] = fsdem__pic_reals(s, nf, 0, &ok);
+        s->E[a] = fsdem__pic_reals(s, nf, 1, &ok);
+        s->us[a] = fsdem__pic_reals(s, nf, 0, &ok);
+        s->fvalid[a] = fsdem__pic_bytes(s, nf, &ok);
+        s->fvalid2[a] = fsdem__pic_bytes(s, nf, &ok);
+        if (desc->viscosity > 0 && ok) {
+            s->vcell[a] = fsdem__pic_bytes(s, nf, &ok);
+            for (b = 0; b < s->dim && ok; ++b) {
+                int m = 1, c;
+                for (c = 0; c < 3; ++c) m *= s->fn[a][c] + (c == b);
+                s->vface[a][b] = fsdem__pic_reals(s, m, 0, &ok);
+            }
+            if (ok) fsdem__pic_fill_vface(s, a);
+        }
+    }
+    if (ok) {
+        s->frac = fsdem__pic_reals(s, s->ncell, 0, &ok);
+        s->fref = fsdem__pic_reals(s, s->ncell, 1, &ok);
+        s->phi = fsdem__pic_reals(s, s->ncell, 0, &ok);
+        s->pres = fsdem__pic_reals(s, s->ncell, 0, &ok);
+        s->rhs = fsdem__pic_reals(s, s->ncell, 0, &ok);
+        s->diag = fsdem__pic_reals(s, s->ncell, 0, &ok);
+        s->ctmp = fsdem__pic_reals(s, s->ncell, 0, &ok);
+        s->crhs = fsdem__pic_reals(s, s->ncell, 0, &ok);
+        s->ctype = fsdem__pic_bytes(s, s->ncell, &ok);
+        s->cnear = fsdem__pic_bytes(s, s->ncell, &ok);
+        s->csolid = fsdem__pic_bytes(s, s->ncell, &ok);
+        s->cstart = (int *)fsdem__pic_alloc(s, sizeof(int) * (size_t)(s->ncell + 1));
+        if (!s->cstart) ok = 0;
+        s->fqueue_size = s->nface[0] > s->nface[1] ? s->nface[0] : s->nface[1];
+        if (s->nface[2] > s->fqueue_size) s->fqueue_size = s->nface[2];
+        s->fqueue = (int *)fsdem__pic_alloc(s, sizeof(int) * (size_t)s->fqueue_size);
+        if (!s->fqueue) ok = 0;
+    }
+    if (!ok) {
+        snprintf(msg, sizeof msg, "pic create: out of memory allocating the %d x %d x %d grid", s->n[0],
+                 s->n[1], s->n[2]);
+        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
+        fsdem_pic_destroy(s);
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    }
+    for (a = 0; a < s->ncell; ++a) s->ctype[a] = FSDEM_STENCIL_CELL_AIR;
+
+    /* Linear solvers, set up once on the full grid so that steps never allocate. */
+    pd = fsdem_pcg_desc_default();
+    pd.preconditioner = desc->pressure_precond;
+    pd.tolerance = desc->pressure_tolerance;
+    pd.max_iterations = desc->pressure_max_iterations;
+    pd.allocator = al;
+    r = fsdem_pcg_create(&pd, &s->pcg_p);
+    if (r == FSDEM_OK) {
+        memset(&st, 0, sizeof st);
+        st.dim = s->dim;
+        for (a = 0; a < 3; ++a) st.n[a] = s->n[a];
+        r = fsdem_pcg_setup_stencil(s->pcg_p, &st);
+    }
+    for (a = 0; a < s->dim && r == FSDEM_OK && desc->viscosity > 0; ++a) {
+        pd.preconditioner = desc->viscosity_precond;
+        pd.tolerance = desc->viscosity_tolerance;
+        pd.max_iterations = desc->pressure_max_iterations;
+        r = fsdem_pcg_create(&pd, &s->pcg_v[a]);
+        if (r == FSDEM_OK) {
+            memset(&st, 0, sizeof st);
+            st.dim = s->dim;
+            for (b = 0; b < 3; ++b) st.n[b] = s->fn[a][b];
+            r = fsdem_pcg_setup_stencil(s->pcg_v[a], &st);
+        }
+    }
+    if (r != FSDEM_OK) {
+        snprintf(msg, sizeof msg, "pic create: setting up the linear solvers failed (%s)",
+                 fsdem_result_string(r));
+        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
+        fsdem_pic_destroy(s);
+        return r == FSDEM_ERR_INVALID_ARG ? FSDEM_ERR_INVALID_ARG : FSDEM_ERR_OUT_OF_MEMORY;
+    }
+
+    s->coupling.dim = s->dim;
+    for (a = 0; a < 3; ++a) {
+        s->coupling.n[a] = s->n[a];
+        s->coupling.face_count[a] = s->nface[a];
+        s->coupling.open[a] = s->copen[a];
+        s->coupling.solid_velocity[a] = s->cvel[a];
+        s->coupling.acceleration[a] = s->cacc[a];
+    }
+    s->coupling.pressure_rhs = s->crhs;
+    fsdem__pic_static_flags(s);
+    fsdem__pic_compute_fref(s);
+    *out = s;
+    fsdem__ok(&s->status);
+    return FSDEM_OK;
+}
+
+/* splitmix64, uniform in [0, 1) */
+static fsdem_real fsdem__pic_rand(fsdem_pic *s) {
+    unsigned long long z = (s->rng += 0x9E3779B97F4A7C15ull);
+    /* (the right shifts are written as divisions by powers of two, which keeps '>' '>' out of the
+       grep map of the file) */
+    z = (z ^ (z / 1073741824ull)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z / 134217728ull)) * 0x94D049BB133111EBull;
+    z ^= z / 2147483648ull;
+    return (fsdem_real)((double)(z / 2048ull) * (1.0 / 9007199254740992.0));
+}
+
+/* ---- >>pic_geometry : obstacles, signed distances, cut-cell face fractions ---- */
+
+static fsdem_real fsdem__pic_seg_dist2(fsdem_vec3 p, fsdem_vec3 a, fsdem_vec3 b) {
+    fsdem_real ex = b.x - a.x, ey = b.y - a.y, px = p.x - a.x, py = p.y - a.y;
+    fsdem_real len2 = ex * ex + ey * ey, t = len2 > 0 ? (px * ex + py * ey) / len2 : 0;
+    if (t < 0) t = 0;
+    if (t > 1) t = 1;
+    px -= t * ex;
+    py -= t * ey;
+    return px * px + py * py;
+}
+
+/* Signed distance of one obstacle, positive outside the solid. */
+static fsdem_real fsdem__pic_obst_sdf(const fsdem_pic *s, const fsdem__pic_obst *o, fsdem_vec3 p) {
+    const fsdem_pic_obstacle *d = &o->d;
+    int b;
+    switch (d->type) {
+    case FSDEM_PIC_OBSTACLE_BOX: {
+        fsdem_real out = 0, in = -1e30f, q;
+        for (b = 0; b < s->dim; ++b) {
+            fsdem_real c = (fsdem__comp(d->a, b) + fsdem__comp(d->b, b)) / 2;
+            fsdem_real h = (fsdem__comp(d->b, b) - fsdem__comp(d->a, b)) / 2;
+            q = (fsdem_real)fabs(fsdem__comp(p, b) - c) - h;
+            if (q > 0) out += q * q;
+            if (q > in) in = q;
+        }
+        return out > 0 ? (fsdem_real)sqrt(out) : in;
+    }
+    case FSDEM_PIC_OBSTACLE_CYLINDER:
+        if (s->dim == 3) {
+            fsdem_vec3 e = fsdem__sub(d->b, d->a), m = fsdem__scale(fsdem__add(d->a, d->b), (fsdem_real)0.5);
+            fsdem_real len = fsdem__norm(e), z, rad, dr, dz, o2;
+            fsdem_vec3 q;
+            e = fsdem__scale(e, 1 / len);
+            q = fsdem__sub(p, m);
+            z = fsdem__dot(q, e);
+            rad = fsdem__norm(fsdem__madd(q, e, -z));
+            dr = rad - d->radius;
+            dz = (fsdem_real)fabs(z) - len / 2;
+            o2 = (dr > 0 ? dr * dr : 0) + (dz > 0 ? dz * dz : 0);
+            return (dr > dz ? (dr < 0 ? dr : 0) : (dz < 0 ? dz : 0)) + (fsdem_real)sqrt(o2);
+        } else { /* a disc in 2D */
+            fsdem_vec3 q = fsdem__sub(p, d->a);
+            q.z = 0;
+            return fsdem__norm(q) - d->radius;
+        }
+    case FSDEM_PIC_OBSTACLE_SPHERE: {
+        fsdem_vec3 q = fsdem__sub(p, d->a);
+        if (s->dim == 2) q.z = 0;
+        return fsdem__norm(q) - d->radius;
+    }
+    case FSDEM_PIC_OBSTACLE_POLYGON: {
+        fsdem_real best = 1e30f;
+        int i, j, inside = 0, nv = d->vertex_count;
+        for (i = 0, j = nv - 1; i < nv; j = i++) {
+            fsdem_vec3 vi = o->verts[i], vj = o->verts[j];
+            fsdem_real d2 = fsdem__pic_seg_dist2(p, vj, vi);
+            if (d2 < best) best = d2;
+            if ((vi.y > p.y) != (vj.y > p.y) && p.x < (vj.x - vi.x) * (p.y - vi.y) / (vj.y - vi.y) + vi.x)
+                inside = !inside;
+        }
+        best = (fsdem_real)sqrt(best);
+        return inside ? -best : best;
+    }
+    case FSDEM_PIC_OBSTACLE_SDF: {
+        fsdem_vec3 nrm;
+        return d->sdf(d->sdf_user, p, &nrm);
+    }
+    }
+    return 1e30f;
+}
+
+/* Signed distance to the union of the obstacles (large when there are none); *which gets the
+   nearest obstacle (or -1). Obstacles whose inflated bounding box does not hold p are skipped: they
+   are more than two cells away. */
+static fsdem_real fsdem__pic_obst_min(const fsdem_pic *s, fsdem_vec3 p, int *which) {
+    fsdem_real best = (fsdem_real)1e30, d;
+    int o, b, w = -1;
+    for (o = 0; o < s->obst_count; ++o) {
+        const fsdem__pic_obst *ob = &s->obst[o];
+        int outside = 0;
+        for (b = 0; b < s->dim; ++b)
+            if (fsdem__comp(p, b) < fsdem__comp(ob->box_lo, b) || fsdem__comp(p, b) > fsdem__comp(ob->box_hi, b))
+                outside = 1;
+        if (outside) continue;
+        d = fsdem__pic_obst_sdf(s, ob, p);
+        if (d < best) {
+            best = d;
+            w = o;
+        }
+    }
+    if (which) *which = w;
+    return best;
+}
+
+static int fsdem__pic_side_closed(const fsdem_pic *s, int side) {
+    return s->desc.boundary[side] != FSDEM_PIC_BC_OUTFLOW;
+}
+
+/* Distance to obstacles and closed walls, positive in the open domain; gradient by differences. */
+static fsdem_real fsdem__pic_solid_sdf(const fsdem_pic *s, fsdem_vec3 p) {
+    fsdem_real d = fsdem__pic_obst_min(s, p, NULL), w;
+    int b;
+    for (b = 0; b < s->dim; ++b) {
+        if (fsdem__pic_side_closed(s, 2 * b)) {
+            w = fsdem__comp(p, b) - fsdem__comp(s->lo, b);
+            if (w < d) d = w;
+        }
+        if (fsdem__pic_side_closed(s, 2 * b + 1)) {
+            w = fsdem__comp(s->hi, b) - fsdem__comp(p, b);
+            if (w < d) d = w;
+        }
+    }
+    return d;
+}
+
+static fsdem_vec3 fsdem__pic_axis_shift(fsdem_vec3 p, int b, fsdem_real h) {
+    if (b == 0) p.x += h;
+    else if (b == 1) p.y += h;
+    else p.z += h;
+    return p;
+}
+
+/* Unit gradient of the obstacle distance at p by central differences (obstacles only). */
+static fsdem_vec3 fsdem__pic_obst_normal(const fsdem_pic *s, fsdem_vec3 p) {
+    fsdem_real h = s->dx * (fsdem_real)1e-3, g[3] = {0, 0, 0}, len;
+    int b;
+    for (b = 0; b < s->dim; ++b)
+        g[b] = fsdem__pic_obst_min(s, fsdem__pic_axis_shift(p, b, h), NULL) -
+               fsdem__pic_obst_min(s, fsdem__pic_axis_shift(p, b, -h), NULL);
+    len = (fsdem_real)sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+    if (!(len > 0)) return fsdem_v3(0, 0, 0);
+    return fsdem_v3(g[0] / len, g[1] / len, g[2] / len);
+}
+
+fsdem_real fsdem_pic_solid_distance(const fsdem_pic *s, fsdem_vec3 p, fsdem_vec3 *normal) {
+    fsdem_real d = fsdem__pic_solid_sdf(s, p);
+    if (normal) {
+        fsdem_real h = s->dx * (fsdem_real)1e-3, g[3] = {0, 0, 0}, len;
+        int b;
+        for (b = 0; b < s->dim; ++b)
+            g[b] = fsdem__pic_solid_sdf(s, fsdem__pic_axis_shift(p, b, h)) -
+                   fsdem__pic_solid_sdf(s, fsdem__pic_axis_shift(p, b, -h));
+        len = (fsdem_real)sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        *normal = len > 0 ? fsdem_v3(g[0] / len, g[1] / len, g[2] / len) : fsdem_v3(0, 0, 0);
+    }
+    return d;
+}
+
+/* Fraction of a segment with end values a, b that lies where the distance is > 0 (linear). */
+static fsdem_real fsdem__pic_frac2(fsdem_real a, fsdem_real b) {
+    if (a > 0 && b > 0) return 1;
+    if (a <= 0 && b <= 0) return 0;
+    return a > 0 ? a / (a - b) : b / (b - a);
+}
+
+/* Same for a triangle with vertex values a, b, c (exact for a linear distance). */
+static fsdem_real fsdem__pic_frac3(fsdem_real a, fsdem_real b, fsdem_real c) {
+    int pos = (a > 0) + (b > 0) + (c > 0);
+    fsdem_real t;
+    if (pos == 3) return 1;
+    if (pos == 0) return 0;
+    if (pos == 1) { /* the lone positive vertex first */
+        if (b > 0) { t = a; a = b; b = t; }
+        else if (c > 0) { t = a; a = c; c = t; }
+        return a * a / ((a - b) * (a - c));
+    }
+    if (b <= 0) { t = a; a = b; b = t; }
+    else if (c <= 0) { t = a; a = c; c = t; }
+    return 1 - a * a / ((a - b) * (a - c));
+}
+
+#define FSDEM__PIC_SUB 4 /* sub-segments (sub-squares per side) of a face for its open fraction */
+
+/* Open fraction of the face of axis a with lower corner `c0` (m), spanning one cell along the
+   other axes, for the obstacle union. */
+static fsdem_real fsdem__pic_face_fraction(const fsdem_pic *s, int a, fsdem_vec3 c0) {
+    const int S = FSDEM__PIC_SUB;
+    fsdem_real h = s->dx / S, v[FSDEM__PIC_SUB + 1][FSDEM__PIC_SUB + 1], sum = 0;
+    int b1 = (a + 1) % 3, b2 = (a + 2) % 3, i, j;
+    if (s->dim == 2) {
+        int b = a == 0 ? 1 : 0;
+        for (i = 0; i <= S; ++i) v[0][i] = fsdem__pic_obst_min(s, fsdem__pic_axis_shift(c0, b, h * (fsdem_real)i), NULL);
+        for (i = 0; i < S; ++i) sum += fsdem__pic_frac2(v[0][i], v[0][i + 1]);
+        return sum / S;
+    }
+    for (j = 0; j <= S; ++j)
+        for (i = 0; i <= S; ++i)
+            v[j][i] = fsdem__pic_obst_min(
+                s, fsdem__pic_axis_shift(fsdem__pic_axis_shift(c0, b1, h * (fsdem_real)i), b2, h * (fsdem_real)j), NULL);
+    for (j = 0; j < S; ++j)
+        for (i = 0; i < S; ++i) {
+            fsdem_vec3 m = fsdem__pic_axis_shift(fsdem__pic_axis_shift(c0, b1, h * ((fsdem_real)i + (fsdem_real)0.5)), b2,
+                                                 h * ((fsdem_real)j + (fsdem_real)0.5));
+            fsdem_real vc = fsdem__pic_obst_min(s, m, NULL);
+            sum += fsdem__pic_frac3(vc, v[j][i], v[j][i + 1]) + fsdem__pic_frac3(vc, v[j][i + 1], v[j + 1][i + 1]) +
+                   fsdem__pic_frac3(vc, v[j + 1][i + 1], v[j + 1][i]) + fsdem__pic_frac3(vc, v[j + 1][i], v[j][i]);
+        }
+    return sum / (4 * S * S);
+}
+
+/* Face centre (m) of face (i, j, k) of axis a. */
+static fsdem_vec3 fsdem__pic_face_pos(const fsdem_pic *s, int a, int i, int j, int k) {
+    fsdem_vec3 p;
+    p.x = s->lo.x + s->dx * ((fsdem_real)i + (a == 0 ? 0 : (fsdem_real)0.5));
+    p.y = s->lo.y + s->dx * ((fsdem_real)j + (a == 1 ? 0 : (fsdem_real)0.5));
+    p.z = s->dim == 3 ? s->lo.z + s->dx * ((fsdem_real)k + (a == 2 ? 0 : (fsdem_real)0.5)) : 0;
+    return p;
+}
+
+static fsdem_vec3 fsdem__pic_cell_pos(const fsdem_pic *s, int i, int j, int k) {
+    return fsdem_v3(s->lo.x + s->dx * ((fsdem_real)i + (fsdem_real)0.5), s->lo.y + s->dx * ((fsdem_real)j + (fsdem_real)0.5),
+                    s->dim == 3 ? s->lo.z + s->dx * ((fsdem_real)k + (fsdem_real)0.5) : 0);
+}
+
+/* Face fractions and solid velocities of the obstacle union into open[a], vel[a]. Returns the
+   number of cells with at least one face open. */
+static int fsdem__pic_static_faces(const fsdem_pic *s, fsdem_real *open[3], fsdem_real *vel[3]) {
+    int a, i, j, k, which, open_cells = 0;
+    fsdem_real reach = s->dx * (fsdem_real)0.9;
+    for (a = 0; a < s->dim; ++a)
+        for (k = 0; k < s->fn[a][2]; ++k)
+            for (j = 0; j < s->fn[a][1]; ++j)
+                for (i = 0; i < s->fn[a][0]; ++i) {
+                    int f = fsdem__pic_face(s, a, i, j, k);
+                    fsdem_vec3 p = fsdem__pic_face_pos(s, a, i, j, k);
+                    fsdem_real d = fsdem__pic_obst_min(s, p, &which);
+                    open[a][f] = 1;
+                    vel[a][f] = 0;
+                    if (which < 0) continue;
+                    vel[a][f] = fsdem__comp(s->obst[which].d.velocity, a);
+                    if (d > reach) continue;
+                    p = fsdem__pic_axis_shift(p, (a + 1) % s->dim, -s->dx / 2);
+                    if (s->dim == 3) p = fsdem__pic_axis_shift(p, (a + 2) % 3, -s->dx / 2);
+                    open[a][f] = fsdem__pic_face_fraction(s, a, p);
+                }
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                int any = 0;
+                for (a = 0; a < s->dim && !any; ++a) {
+                    int f = fsdem__pic_face(s, a, i, j, k);
+                    if (open[a][f] > 0 || open[a][f + s->fstep[a][a]] > 0) any = 1;
+                }
+                open_cells += any;
+            }
+    return open_cells;
+}
+
+/* Static-solid and near-solid flags of the cells from sopen. */
+static void fsdem__pic_static_flags(fsdem_pic *s) {
+    int a, i, j, k, c, di, dj, dk, zr = s->dim == 3 ? 1 : 0;
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                int any_open = 0, any_cut = 0;
+                c = fsdem__pic_cell(s, i, j, k);
+                for (a = 0; a < s->dim; ++a) {
+                    int f = fsdem__pic_face(s, a, i, j, k), g = f + s->fstep[a][a];
+                    if (s->sopen[a][f] > 0 || s->sopen[a][g] > 0) any_open = 1;
+                    if (s->sopen[a][f] < 1 || s->sopen[a][g] < 1) any_cut = 1;
+                }
+                s->csolid[c] = (unsigned char)!any_open;
+                s->ctmp[c] = (fsdem_real)any_cut;
+            }
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                int near = 0;
+                for (dk = -zr; dk <= zr; ++dk)
+                    for (dj = -1; dj <= 1; ++dj)
+                        for (di = -1; di <= 1; ++di) {
+                            int x = i + di, y = j + dj, z = k + dk;
+                            if (x < 0 || y < 0 || z < 0 || x >= s->n[0] || y >= s->n[1] || z >= s->n[2]) continue;
+                            if (s->ctmp[fsdem__pic_cell(s, x, y, z)] > 0) near = 1;
+                        }
+                s->cnear[fsdem__pic_cell(s, i, j, k)] = (unsigned char)near;
+            }
+}
+
+/* One-dimensional integral of the tent kernel of cell i (of n) over the domain, per cell volume. */
+static fsdem_real fsdem__pic_tent_1d(int i, int n) {
+    fsdem_real v = 1;
+    if (i == 0) v -= (fsdem_real)0.125;
+    if (i == n - 1) v -= (fsdem_real)0.125;
+    return v;
+}
+
+/* Reference fluid fraction of each cell: what the tent kernel collects from a uniformly filled open
+   domain. Walls truncate it analytically. Near obstacles it is summed over the seeding lattice
+   (the unjittered sub-cell sites of the 3^dim cells around, those outside the solids), so a freshly
+   seeded cut cell reads exactly 1; with a particle count that is not a perfect power the seeding is
+   random and the expected value, the kernel integral over the open space, is sampled instead (8
+   points per axis over the support). Dividing the particle count by it makes a full cell read 1 next
+   to any solid. */
+static void fsdem__pic_compute_fref(fsdem_pic *s) {
+    int i, j, k, c, q[3], m, S = s->sub ? s->sub : 8;
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                c = fsdem__pic_cell(s, i, j, k);
+                if (s->csolid[c]) {
+                    s->fref[c] = 0;
+                    continue;
+                }
+                if (!s->cnear[c] || s->obst_count == 0) {
+                    s->fref[c] = fsdem__pic_tent_1d(i, s->n[0]) * fsdem__pic_tent_1d(j, s->n[1]) *
+                                 (s->dim == 3 ? fsdem__pic_tent_1d(k, s->n[2]) : 1);
+                } else {
+                    /* sites at offsets (q + 1/2) h from the lower corner of the 2-cell-wide support
+                       [centre - dx, centre + dx] (lattice: h = dx / sub; sampling: h = 2 dx / 8) */
+                    fsdem_vec3 cc = fsdem__pic_cell_pos(s, i, j, k);
+                    fsdem_real h = s->sub ? s->dx / (fsdem_real)S : 2 * s->dx / (fsdem_real)S, lo_off;
+                    int per = s->sub ? 2 * S + 1 : S; /* lattice: the sites of the 3 cells that the kernel reaches */
+                    double sum = 0, wsum = 0;
+                    int qz = s->dim == 3 ? per : 1;
+                    lo_off = s->sub ? -(fsdem_real)1.5 * s->dx : -s->dx;
+                    for (q[2] = 0; q[2] < qz; ++q[2])
+                        for (q[1] = 0; q[1] < per; ++q[1])
+                            for (q[0] = 0; q[0] < per; ++q[0]) {
+                                fsdem_real off[3], w = 1;
+                                fsdem_vec3 p;
+                                int inside = 1;
+                                for (m = 0; m < 3; ++m) {
+                                    off[m] = m < s->dim ? lo_off + h * ((fsdem_real)q[m] + (fsdem_real)0.5) : 0;
+                                    if (m < s->dim) {
+                                        fsdem_real t = 1 - (fsdem_real)fabs(off[m]) * s->inv_dx;
+                                        w *= t > 0 ? t : 0;
+                                    }
+                                }
+                                if (w <= 0) continue;
+                                p = fsdem_v3(cc.x + off[0], cc.y + off[1], cc.z + off[2]);
+                                for (m = 0; m < s->dim; ++m)
+                                    if (fsdem__comp(p, m) < fsdem__comp(s->lo, m) || fsdem__comp(p, m) > fsdem__comp(s->hi, m))
+                                        inside = 0;
+                                wsum += w;
+                                if (inside && fsdem__pic_obst_min(s, p, NULL) > 0) sum += w;
+                            }
+                    s->fref[c] = (fsdem_real)(wsum > 0 ? sum / wsum : 0);
+                }
+            }
+}
+
+fsdem_pic_obstacle fsdem_pic_obstacle_box(fsdem_vec3 lo, fsdem_vec3 hi) {
+    fsdem_pic_obstacle o;
+    memset(&o, 0, sizeof o);
+    o.type = FSDEM_PIC_OBSTACLE_BOX;
+    o.a = lo;
+    o.b = hi;
+    return o;
+}
+
+fsdem_pic_obstacle fsdem_pic_obstacle_sphere(fsdem_vec3 centre, fsdem_real radius) {
+    fsdem_pic_obstacle o;
+    memset(&o, 0, sizeof o);
+    o.type = FSDEM_PIC_OBSTACLE_SPHERE;
+    o.a = centre;
+    o.radius = radius;
+    return o;
+}
+
+fsdem_pic_obstacle fsdem_pic_obstacle_cylinder(fsdem_vec3 a, fsdem_vec3 b, fsdem_real radius) {
+    fsdem_pic_obstacle o;
+    memset(&o, 0, sizeof o);
+    o.type = FSDEM_PIC_OBSTACLE_CYLINDER;
+    o.a = a;
+    o.b = b;
+    o.radius = radius;
+    return o;
+}
+
+fsdem_pic_obstacle fsdem_pic_obstacle_polygon(const fsdem_vec3 *vertices, int count) {
+    fsdem_pic_obstacle o;
+    memset(&o, 0, sizeof o);
+    o.type = FSDEM_PIC_OBSTACLE_POLYGON;
+    o.vertices = vertices;
+    o.vertex_count = count;
+    return o;
+}
+
+fsdem_pic_obstacle fsdem_pic_obstacle_sdf(fsdem_sdf_fn sdf, void *user) {
+    fsdem_pic_obstacle o;
+    memset(&o, 0, sizeof o);
+    o.type = FSDEM_PIC_OBSTACLE_SDF;
+    o.sdf = sdf;
+    o.sdf_user = user;
+    return o;
+}
+
+static void fsdem__pic_remove_marked(fsdem_pic *s);
+static void fsdem__pic_refresh(fsdem_pic *s);
+
+fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, int *id) {
+    fsdem__pic_obst o;
+    fsdem_real *open[3], *vel[3];
+    int b, i, open_cells, inside;
+    static const char *names[5] = {"box", "sphere", "cylinder", "polygon", "sdf"};
+    const char *name;
+    if (id) *id = -1;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!ob) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle: NULL obstacle");
+    if ((int)ob->type < 0 || (int)ob->type > 4)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle: type %d is not a fsdem_pic_obstacle_type",
+                           (int)ob->type);
+    name = names[ob->type];
+    if (!fsdem__finite3(ob->a) || !fsdem__finite3(ob->b) || !fsdem__finite(ob->radius) || !fsdem__finite3(ob->velocity))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (%s): non-finite geometry or velocity",
+                           s->obst_count, name);
+    memset(&o, 0, sizeof o);
+    o.d = *ob;
+    switch (ob->type) {
+    case FSDEM_PIC_OBSTACLE_BOX:
+        for (b = 0; b < s->dim; ++b)
+            if (!(fsdem__comp(ob->b, b) > fsdem__comp(ob->a, b)))
+                return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (box): b.%c must exceed a.%c",
+                                   s->obst_count, "xyz"[b], "xyz"[b]);
+        o.box_lo = ob->a;
+        o.box_hi = ob->b;
+        break;
+    case FSDEM_PIC_OBSTACLE_SPHERE:
+    case FSDEM_PIC_OBSTACLE_CYLINDER:
+        if (!(ob->radius > 0))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (%s): radius = %g must be > 0",
+                               s->obst_count, name, (double)ob->radius);
+        if (ob->type == FSDEM_PIC_OBSTACLE_CYLINDER && s->dim == 3 && !(fsdem__norm(fsdem__sub(ob->b, ob->a)) > 0))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (cylinder): axis a-b has zero length",
+                               s->obst_count);
+        o.box_lo = fsdem__sub(ob->a, fsdem_v3(ob->radius, ob->radius, ob->radius));
+        o.box_hi = fsdem__add(ob->a, fsdem_v3(ob->radius, ob->radius, ob->radius));
+        if (ob->type == FSDEM_PIC_OBSTACLE_CYLINDER && s->dim == 3)
+            for (b = 0; b < 3; ++b) {
+                fsdem_real lo = fsdem__comp(ob->b, b) - ob->radius, hi = fsdem__comp(ob->b, b) + ob->radius;
+                if (b == 0) { if (lo < o.box_lo.x) o.box_lo.x = lo; if (hi > o.box_hi.x) o.box_hi.x = hi; }
+                if (b == 1) { if (lo < o.box_lo.y) o.box_lo.y = lo; if (hi > o.box_hi.y) o.box_hi.y = hi; }
+                if (b == 2) { if (lo < o.box_lo.z) o.box_lo.z = lo; if (hi > o.box_hi.z) o.box_hi.z = hi; }
+            }
+        break;
+    case FSDEM_PIC_OBSTACLE_POLYGON:
+        if (s->dim != 2)
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (polygon): polygons are 2D only",
+                               s->obst_count);
+        if (!ob->vertices || ob->vertex_count < 3)
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (polygon): needs >= 3 vertices, has %d",
+                               s->obst_count, ob->vertices ? ob->vertex_count : 0);
+        o.box_lo = o.box_hi = ob->vertices[0];
+        for (i = 0; i < ob->vertex_count; ++i) {
+            fsdem_vec3 v = ob->vertices[i];
+            if (!fsdem__finite3(v))
+                return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (polygon): vertex %d is not finite",
+                                   s->obst_count, i);
+            if (v.x < o.box_lo.x) o.box_lo.x = v.x;
+            if (v.y < o.box_lo.y) o.box_lo.y = v.y;
+            if (v.x > o.box_hi.x) o.box_hi.x = v.x;
+            if (v.y > o.box_hi.y) o.box_hi.y = v.y;
+        }
+        break;
+    case FSDEM_PIC_OBSTACLE_SDF:
+        if (!ob->sdf)
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (sdf): NULL callback", s->obst_count);
+        o.box_lo = fsdem__sub(s->lo, fsdem_v3(1e30f, 1e30f, 1e30f));
+        o.box_hi = fsdem__add(s->hi, fsdem_v3(1e30f, 1e30f, 1e30f));
+        break;
+    }
+    if (ob->type != FSDEM_PIC_OBSTACLE_SDF) {
+        fsdem_real pad = 2 * s->dx;
+        o.box_lo = fsdem__sub(o.box_lo, fsdem_v3(pad, pad, pad));
+        o.box_hi = fsdem__add(o.box_hi, fsdem_v3(pad, pad, pad));
+    }
+    if (s->dim == 2) {
+        o.box_lo.z = -1e30f;
+        o.box_hi.z = 1e30f;
+    }
+    if (ob->type == FSDEM_PIC_OBSTACLE_POLYGON) {
+        o.verts = (fsdem_vec3 *)fsdem__pic_alloc(s, sizeof(fsdem_vec3) * (size_t)ob->vertex_count);
+        if (!o.verts) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "pic add_obstacle: out of memory");
+        memcpy(o.verts, ob->vertices, sizeof(fsdem_vec3) * (size_t)ob->vertex_count);
+        o.d.vertices = o.verts;
+    }
+    if (s->obst_count == s->obst_capacity) {
+        int cap = s->obst_capacity ? 2 * s->obst_capacity : 4;
+        fsdem__pic_obst *fresh = (fsdem__pic_obst *)fsdem__pic_alloc(s, sizeof(fsdem__pic_obst) * (size_t)cap);
+        if (!fresh) {
+            if (o.verts) fsdem__pic_release(s, o.verts, sizeof(fsdem_vec3) * (size_t)ob->vertex_count);
+            return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "pic add_obstacle: out of memory");
+        }
+        if (s->obst) memcpy(fresh, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_count);
+        fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
+        s->obst = fresh;
+        s->obst_capacity = cap;
+    }
+    /* Compute the new fractions into scratch arrays; commit only when some cell stays open. */
+    s->obst[s->obst_count++] = o;
+    for (b = 0; b < 3; ++b) {
+        open[b] = s->ftmp[b];
+        vel[b] = s->uold[b];
+    }
+    open_cells = fsdem__pic_static_faces(s, open, vel);
+    if (open_cells == 0) {
+        s->obst_count--;
+        if (o.verts) fsdem__pic_release(s, o.verts, sizeof(fsdem_vec3) * (size_t)ob->vertex_count);
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "pic add_obstacle %d (%s) covers the whole domain: no open cell is left", s->obst_count, name);
+    }
+    for (b = 0; b < s->dim; ++b) {
+        memcpy(s->sopen[b], open[b], sizeof(fsdem_real) * (size_t)s->nface[b]);
+        memcpy(s->svel[b], vel[b], sizeof(fsdem_real) * (size_t)s->nface[b]);
+    }
+    fsdem__pic_static_flags(s);
+    fsdem__pic_compute_fref(s);
+    s->cells_fresh = 0;
+    inside = 0;
+    for (i = 0; i < s->np; ++i) {
+        s->pflag[i] = fsdem__pic_obst_min(s, s->px[i], NULL) <= 0;
+        inside += s->pflag[i];
+    }
+    if (inside) {
+        fsdem__pic_remove_marked(s);
+        s->removed += inside;
+    }
+    fsdem__pic_refresh(s);
+    if (id) *id = s->obst_count - 1;
+    return fsdem__ok(&s->status);
+}
+
+/* ---- >>pic_particles : storage, seeding ---- */
+
+/* Reallocates every particle array to `cap` (>= np). Leaves everything unchanged on failure. */
+static fsdem_result fsdem__pic_set_capacity(fsdem_pic *s, int cap) {
+    fsdem_vec3 *x, *v, *t, *c[3] = {NULL, NULL, NULL};
+    int *cell, *idx, a, apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC, ok = 1;
+    unsigned char *flag;
+    size_t n = (size_t)s->np, vb = sizeof(fsdem_vec3) * (size_t)cap;
+    if (cap < s->np || cap > (1 << 29)) return FSDEM_ERR_OUT_OF_MEMORY;
+    x = (fsdem_vec3 *)fsdem__pic_alloc(s, vb);
+    v = (fsdem_vec3 *)fsdem__pic_alloc(s, vb);
+    t = (fsdem_vec3 *)fsdem__pic_alloc(s, vb);
+    for (a = 0; a < 3 && apic; ++a) {
+        c[a] = (fsdem_vec3 *)fsdem__pic_alloc(s, vb);
+        if (!c[a]) ok = 0;
+    }
+    cell = (int *)fsdem__pic_alloc(s, sizeof(int) * (size_t)cap);
+    idx = (int *)fsdem__pic_alloc(s, sizeof(int) * (size_t)cap);
+    flag = (unsigned char *)fsdem__pic_alloc(s, (size_t)cap);
+    if (!x || !v || !t || !cell || !idx || !flag || !ok) {
+        fsdem__pic_release(s, x, x ? vb : 0);
+        fsdem__pic_release(s, v, v ? vb : 0);
+        fsdem__pic_release(s, t, t ? vb : 0);
+        for (a = 0; a < 3; ++a) fsdem__pic_release(s, c[a], c[a] ? vb : 0);
+        fsdem__pic_release(s, cell, cell ? sizeof(int) * (size_t)cap : 0);
+        fsdem__pic_release(s, idx, idx ? sizeof(int) * (size_t)cap : 0);
+        fsdem__pic_release(s, flag, flag ? (size_t)cap : 0);
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    }
+    if (n) {
+        memcpy(x, s->px, n * sizeof(fsdem_vec3));
+        memcpy(v, s->pv, n * sizeof(fsdem_vec3));
+        for (a = 0; a < 3 && apic; ++a) memcpy(c[a], s->pc[a], n * sizeof(fsdem_vec3));
+    }
+    memset(flag, 0, (size_t)cap);
+    n = (size_t)s->np;
+    fsdem__pic_free_particles(s);
+    s->np = (int)n;
+    s->px = x;
+    s->pv = v;
+    s->ptmp = t;
+    for (a = 0; a < 3; ++a) s->pc[a] = c[a];
+    s->pcell = cell;
+    s->pidx = idx;
+    s->pflag = flag;
+    s->pcap = cap;
+    return FSDEM_OK;
+}
+
+/* Makes room for `need` particles plus half as many again for reseeding and inflow. */
+static fsdem_result fsdem__pic_make_room(fsdem_pic *s, long need) {
+    long want = need + need / 2 + 64;
+    if (need > (1 << 28)) return FSDEM_ERR_OUT_OF_MEMORY;
+    if (need <= s->pcap && s->pcap >= need + need / 4) return FSDEM_OK;
+    return fsdem__pic_set_capacity(s, (int)want);
+}
+
+fsdem_result fsdem_pic_reserve(fsdem_pic *s, int count) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (count < 0) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic reserve: count = %d < 0", count);
+    if (count <= s->pcap) return fsdem__ok(&s->status);
+    if (fsdem__pic_set_capacity(s, count) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "pic reserve: out of memory for %d particles", count);
+    return fsdem__ok(&s->status);
+}
+
+/* Removes the particles whose pflag is set, keeping the order of the others. */
+static void fsdem__pic_remove_marked(fsdem_pic *s) {
+    int i, j = 0, a, apic = s->pc[0] != NULL;
+    for (i = 0; i < s->np; ++i) {
+        if (s->pflag[i]) continue;
+        if (j != i) {
+            s->px[j] = s->px[i];
+            s->pv[j] = s->pv[i];
+            for (a = 0; a < 3 && apic; ++a) s->pc[a][j] = s->pc[a][i];
+        }
+        ++j;
+    }
+    s->np = j;
+    memset(s->pflag, 0, (size_t)s->pcap);
+    s->cells_fresh = 0;
+}
+
+static int fsdem__pic_coord(const fsdem_pic *s, fsdem_real x, int axis) {
+    fsdem_real t = (x - fsdem__comp(s->lo, axis)) * s->inv_dx;
+    if (!(t > 0)) return 0; /* also NaN */
+    return t < (fsdem_real)s->n[axis] ? (int)t : s->n[axis] - 1;
+}
+
+static int fsdem__pic_cell_of(const fsdem_pic *s, fsdem_vec3 p) {
+    return fsdem__pic_cell(s, fsdem__pic_coord(s, p.x, 0), fsdem__pic_coord(s, p.y, 1),
+                           s->dim == 3 ? fsdem__pic_coord(s, p.z, 2) : 0);
+}
+
+/* Is p a valid place for a particle: inside the grid box and outside the obstacles. */
+static int fsdem__pic_open_at(const fsdem_pic *s, fsdem_vec3 p) {
+    int b;
+    for (b = 0; b < s->dim; ++b)
+        if (!(fsdem__comp(p, b) > fsdem__comp(s->lo, b) && fsdem__comp(p, b) < fsdem__comp(s->hi, b))) return 0;
+    if (s->cnear[fsdem__pic_cell_of(s, p)] && fsdem__pic_obst_min(s, p, NULL) <= 0) return 0;
+    return 1;
+}
+
+/* Seed position q (0 .. ppc-1) in cell (i, j, k): stratified with jitter when ppc = sub^dim. */
+static fsdem_vec3 fsdem__pic_seed_pos(fsdem_pic *s, int i, int j, int k, int q) {
+    fsdem_real f[3];
+    int b, idx[3];
+    idx[0] = i;
+    idx[1] = j;
+    idx[2] = k;
+    for (b = 0; b < 3; ++b) {
+        if (b >= s->dim) {
+            f[b] = 0;
+            continue;
+        }
+        if (s->sub) {
+            int sq = q % s->sub;
+            q /= s->sub;
+            f[b] = ((fsdem_real)sq + (fsdem_real)0.5 + s->desc.jitter * (fsdem__pic_rand(s) - (fsdem_real)0.5)) /
+                   (fsdem_real)s->sub;
+        } else {
+            f[b] = fsdem__pic_rand(s);
+        }
+        f[b] = fsdem__comp(s->lo, b) + s->dx * ((fsdem_real)idx[b] + f[b]);
+    }
+    return fsdem_v3(f[0], f[1], s->dim == 3 ? f[2] : 0);
+}
+
+static fsdem_result fsdem__pic_fill(fsdem_pic *s, fsdem_vec3 lo, fsdem_vec3 hi, fsdem_sdf_fn region, void *user,
+                                    fsdem_vec3 vel, int *added, const char *what) {
+    int c0[3], c1[3], b, i, j, k, q, start = s->np;
+    long cells = 1;
+    for (b = 0; b < 3; ++b) {
+        if (b >= s->dim) {
+            c0[b] = 0;
+            c1[b] = 0;
+            continue;
+        }
+        c0[b] = fsdem__pic_coord(s, fsdem__comp(lo, b), b);
+        c1[b] = fsdem__pic_coord(s, fsdem__comp(hi, b), b);
+        cells *= c1[b] - c0[b] + 1;
+    }
+    if (fsdem__pic_make_room(s, (long)s->np + cells * s->ppc) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "pic %s: out of memory for %ld more particles", what,
+                           cells * s->ppc);
+    for (k = c0[2]; k <= c1[2]; ++k)
+        for (j = c0[1]; j <= c1[1]; ++j)
+            for (i = c0[0]; i <= c1[0]; ++i) {
+                if (s->csolid[fsdem__pic_cell(s, i, j, k)]) continue;
+                for (q = 0; q < s->ppc; ++q) {
+                    fsdem_vec3 p = fsdem__pic_seed_pos(s, i, j, k, q);
+                    int inside = 1;
+                    for (b = 0; b < s->dim; ++b)
+                        if (fsdem__comp(p, b) < fsdem__comp(lo, b) || fsdem__comp(p, b) >= fsdem__comp(hi, b)) inside = 0;
+                    if (!inside || !fsdem__pic_open_at(s, p)) continue;
+                    if (region) {
+                        fsdem_vec3 nrm;
+                        if (!(region(user, p, &nrm) > 0)) continue;
+                    }
+                    s->px[s->np] = p;
+                    s->pv[s->np] = vel;
+                    if (s->pc[0]) s->pc[0][s->np] = s->pc[1][s->np] = s->pc[2][s->np] = fsdem__zero3();
+                    s->np++;
+                }
+            }
+    if (added) *added = s->np - start;
+    fsdem__pic_refresh(s);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_pic_fill_box(fsdem_pic *s, fsdem_vec3 lo, fsdem_vec3 hi, fsdem_vec3 velocity, int *added) {
+    int b;
+    if (added) *added = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!fsdem__finite3(lo) || !fsdem__finite3(hi) || !fsdem__finite3(velocity))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic fill_box: non-finite corner or velocity");
+    for (b = 0; b < s->dim; ++b) {
+        if (!(fsdem__comp(hi, b) > fsdem__comp(lo, b)))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic fill_box: hi.%c must exceed lo.%c", "xyz"[b], "xyz"[b]);
+        if (fsdem__comp(lo, b) < fsdem__comp(s->lo, b)) lo = fsdem__pic_axis_shift(lo, b, fsdem__comp(s->lo, b) - fsdem__comp(lo, b));
+        if (fsdem__comp(hi, b) > fsdem__comp(s->hi, b)) hi = fsdem__pic_axis_shift(hi, b, fsdem__comp(s->hi, b) - fsdem__comp(hi, b));
+        if (!(fsdem__comp(hi, b) > fsdem__comp(lo, b)))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic fill_box: the box is outside the domain along %c",
+                               "xyz"[b]);
+    }
+    return fsdem__pic_fill(s, lo, hi, NULL, NULL, velocity, added, "fill_box");
+}
+
+fsdem_result fsdem_pic_fill_sdf(fsdem_pic *s, fsdem_sdf_fn region, void *user, fsdem_vec3 velocity, int *added) {
+    if (added) *added = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!region) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic fill_sdf: NULL region");
+    if (!fsdem__finite3(velocity)) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic fill_sdf: non-finite velocity");
+    return fsdem__pic_fill(s, s->lo, s->hi, region, user, velocity, added, "fill_sdf");
+}
+
+fsdem_result fsdem_pic_add_particles(fsdem_pic *s, const fsdem_vec3 *x, const fsdem_vec3 *v, int count) {
+    int i;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (count < 0 || (count > 0 && !x))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_particles: bad count %d or NULL positions", count);
+    for (i = 0; i < count; ++i) {
+        fsdem_vec3 p = x[i];
+        if (!fsdem__finite3(p) || (v && !fsdem__finite3(v[i])))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                               "pic add_particles: particle %d has a non-finite position or velocity", i);
+        if (s->dim == 2) p.z = 0;
+        if (!fsdem__pic_open_at(s, p))
+            return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN,
+                               "pic add_particles: particle %d at (%g, %g, %g) is outside the domain or inside a solid", i,
+                               (double)p.x, (double)p.y, (double)p.z);
+    }
+    if (fsdem__pic_make_room(s, (long)s->np + count) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "pic add_particles: out of memory for %d particles",
+                           s->np + count);
+    for (i = 0; i < count; ++i) {
+        s->px[s->np] = x[i];
+        if (s->dim == 2) s->px[s->np].z = 0;
+        s->pv[s->np] = v ? v[i] : fsdem__zero3();
+        if (s->dim == 2) s->pv[s->np].z = 0;
+        if (s->pc[0]) s->pc[0][s->np] = s->pc[1][s->np] = s->pc[2][s->np] = fsdem__zero3();
+        s->np++;
+    }
+    fsdem__pic_refresh(s);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_pic_particles fsdem_pic_get_particles(fsdem_pic *s) {
+    fsdem_pic_particles v;
+    v.count = s->np;
+    v.dim = s->dim;
+    v.volume = s->pvol;
+    v.position = s->px;
+    v.velocity = s->pv;
+    return v;
+}
+
+/* ---- >>pic_transfer : kernels, particle-to-grid, grid-to-particle ---- */
+
+static void fsdem__pic_stencil(const fsdem_pic *s, int a, fsdem_vec3 x, int quadratic, fsdem__pic_st *st) {
+    int b;
+    for (b = 0; b < 3; ++b) {
+        fsdem_real sx, t;
+        int i0;
+        if (b >= s->dim) {
+            st->lo[b] = 0;
+            st->idx[b][0] = 0;
+            st->cnt[b] = 1;
+            st->w[b][0] = 1;
+            st->dw[b][0] = 0;
+            continue;
+        }
+        sx = (fsdem__comp(x, b) - fsdem__comp(s->lo, b)) * s->inv_dx - (b == a ? 0 : (fsdem_real)0.5);
+        if (!(sx > -4)) sx = -4; /* also NaN */
+        if (sx > (fsdem_real)s->n[b] + 4) sx = (fsdem_real)s->n[b] + 4;
+        if (!quadratic) {
+            i0 = (int)(sx + 8) - 8; /* floor: sx > -8 here */
+            t = sx - (fsdem_real)i0;
+            st->lo[b] = i0;
+            st->cnt[b] = 2;
+            st->w[b][0] = 1 - t;
+            st->w[b][1] = t;
+            st->dw[b][0] = -1;
+            st->dw[b][1] = 1;
+        } else {
+            i0 = (int)(sx + (fsdem_real)7.5) - 8; /* floor(sx - 1/2) */
+            t = sx - (fsdem_real)i0;
+            st->lo[b] = i0;
+            st->cnt[b] = 3;
+            st->w[b][0] = (fsdem_real)0.5 * ((fsdem_real)1.5 - t) * ((fsdem_real)1.5 - t);
+            st->w[b][1] = (fsdem_real)0.75 - (t - 1) * (t - 1);
+            st->w[b][2] = (fsdem_real)0.5 * (t - (fsdem_real)0.5) * (t - (fsdem_real)0.5);
+            st->dw[b][0] = t - (fsdem_real)1.5;
+            st->dw[b][1] = -2 * (t - 1);
+            st->dw[b][2] = t - (fsdem_real)0.5;
+        }
+        {
+            int q, nmax = s->fn[a][b] - 1;
+            for (q = 0; q < st->cnt[b]; ++q) {
+                int i = i0 + q;
+                st->idx[b][q] = i < 0 ? 0 : i > nmax ? nmax : i;
+            }
+        }
+    }
+}
+
+static int fsdem__pic_clampi(int i, int n) { return i < 0 ? 0 : i >= n ? n - 1 : i; }
+
+/* Linear interpolation of a face field of axis a at x. */
+static fsdem_real fsdem__pic_interp_face(const fsdem_pic *s, const fsdem_real *field, int a, fsdem_vec3 x) {
+    fsdem__pic_st st;
+    fsdem_real sum = 0;
+    int q0, q1, q2;
+    fsdem__pic_stencil(s, a, x, 0, &st);
+    for (q2 = 0; q2 < st.cnt[2]; ++q2) {
+        int k = st.idx[2][q2];
+        for (q1 = 0; q1 < st.cnt[1]; ++q1) {
+            int j = st.idx[1][q1];
+            fsdem_real w12 = st.w[2][q2] * st.w[1][q1];
+            int row = (k * s->fn[a][1] + j) * s->fn[a][0];
+            for (q0 = 0; q0 < st.cnt[0]; ++q0)
+                sum += w12 * st.w[0][q0] * field[row + st.idx[0][q0]];
+        }
+    }
+    return sum;
+}
+
+static fsdem_vec3 fsdem__pic_interp_vel(const fsdem_pic *s, fsdem_real *const f[3], fsdem_vec3 x) {
+    fsdem_vec3 v;
+    v.x = fsdem__pic_interp_face(s, f[0], 0, x);
+    v.y = fsdem__pic_interp_face(s, f[1], 1, x);
+    v.z = s->dim == 3 ? fsdem__pic_interp_face(s, f[2], 2, x) : 0;
+    return v;
+}
+
+/* Particle velocities (and APIC affine terms) to the faces: u = sum w m v / sum w m. Faces that
+   received weight are marked valid. */
+static void fsdem__pic_p2g(fsdem_pic *s) {
+    int a, p, q0, q1, q2, f, quad = s->desc.kernel == FSDEM_PIC_KERNEL_QUADRATIC;
+    fsdem__pic_st st;
+    for (a = 0; a < s->dim; ++a) {
+        fsdem_real *u = s->u[a], *m = s->wsum[a];
+        const fsdem_vec3 *ca = s->pc[0] ? s->pc[a] : NULL;
+        memset(u, 0, sizeof(fsdem_real) * (size_t)s->nface[a]);
+        memset(m, 0, sizeof(fsdem_real) * (size_t)s->nface[a]);
+        for (p = 0; p < s->np; ++p) {
+            fsdem_vec3 x = s->px[p];
+            fsdem_real va = fsdem__comp(s->pv[p], a);
+            fsdem__pic_stencil(s, a, x, quad, &st);
+            for (q2 = 0; q2 < st.cnt[2]; ++q2) {
+                int k = st.idx[2][q2];
+                for (q1 = 0; q1 < st.cnt[1]; ++q1) {
+                    int j = st.idx[1][q1];
+                    fsdem_real w12 = st.w[2][q2] * st.w[1][q1];
+                    int row = (k * s->fn[a][1] + j) * s->fn[a][0];
+                    for (q0 = 0; q0 < st.cnt[0]; ++q0) {
+                        int i = st.idx[0][q0];
+                        fsdem_real w = w12 * st.w[0][q0], v = va;
+                        f = row + i;
+                        if (ca) {
+                            fsdem_vec3 xf = fsdem__pic_face_pos(s, a, i, j, k);
+                            v += fsdem__dot(ca[p], fsdem__sub(xf, x));
+                        }
+                        m[f] += w;
+                        u[f] += w * v;
+                    }
+                }
+            }
+        }
+        for (f = 0; f < s->nface[a]; ++f) {
+            s->fvalid[a][f] = m[f] > (fsdem_real)1e-9;
+            u[f] = s->fvalid[a][f] ? u[f] / m[f] : 0;
+        }
+    }
+}
+
+/* Grid to particles. `du` holds u_new - u_old (FLIP) in uold. Returns the first particle with a
+   non-finite velocity, or -1. */
+static int fsdem__pic_g2p(fsdem_pic *s) {
+    int a, p, q0, q1, q2, bad = -1, b;
+    int quad = s->desc.kernel == FSDEM_PIC_KERNEL_QUADRATIC;
+    fsdem_real ratio = s->desc.transfer == FSDEM_PIC_TRANSFER_FLIP ? s->desc.flip_ratio : 0;
+    int apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC;
+    fsdem_real dfac = 4 * s->inv_dx * s->inv_dx;
+    fsdem__pic_st st;
+    for (p = 0; p < s->np; ++p) {
+        fsdem_vec3 x = s->px[p];
+        fsdem_real vnew[3] = {0, 0, 0};
+        for (a = 0; a < s->dim; ++a) {
+            fsdem_real pic = 0, flip = 0, c[3] = {0, 0, 0};
+            const fsdem_real *u = s->u[a], *du = s->uold[a];
+            fsdem__pic_stencil(s, a, x, quad, &st);
+            for (q2 = 0; q2 < st.cnt[2]; ++q2) {
+                int k = st.idx[2][q2];
+                for (q1 = 0; q1 < st.cnt[1]; ++q1) {
+                    int j = st.idx[1][q1];
+                    int row = (k * s->fn[a][1] + j) * s->fn[a][0];
+                    for (q0 = 0; q0 < st.cnt[0]; ++q0) {
+                        int i = st.idx[0][q0], f = row + i;
+                        fsdem_real w = st.w[2][q2] * st.w[1][q1] * st.w[0][q0];
+                        pic += w * u[f];
+                        if (ratio > 0) flip += w * du[f];
+                        if (apic) {
+                            if (quad) {
+                                fsdem_vec3 d = fsdem__sub(fsdem__pic_face_pos(s, a, i, j, k), x);
+                                c[0] += w * u[f] * d.x * dfac;
+                                c[1] += w * u[f] * d.y * dfac;
+                                c[2] += w * u[f] * d.z * dfac;
+                            } else {
+                                c[0] += st.dw[0][q0] * st.w[1][q1] * st.w[2][q2] * u[f] * s->inv_dx;
+                                c[1] += st.w[0][q0] * st.dw[1][q1] * st.w[2][q2] * u[f] * s->inv_dx;
+                                if (s->dim == 3) c[2] += st.w[0][q0] * st.w[1][q1] * st.dw[2][q2] * u[f] * s->inv_dx;
+                            }
+                        }
+                    }
+                }
+            }
+            if (ratio > 0) vnew[a] = ratio * (fsdem__comp(s->pv[p], a) + flip) + (1 - ratio) * pic;
+            else vnew[a] = pic;
+            if (apic) {
+                if (s->dim == 2) c[2] = 0;
+                s->pc[a][p] = fsdem_v3(c[0], c[1], c[2]);
+            }
+        }
+        s->pv[p] = fsdem_v3(vnew[0], vnew[1], vnew[2]);
+        for (b = 0; b < s->dim; ++b)
+            if (!fsdem__finite(vnew[b]) && bad < 0) bad = p;
+    }
+    return bad;
+}
+
+/* ---- >>pic_cells : effective faces, fluid fraction, level set, cell types ---- */
+
+/* Reference fractions below this mark cells mostly inside obstacles (see fsdem__pic_fraction). */
+#define FSDEM__PIC_FREF_RELIABLE ((fsdem_real)0.5)
+
+/* E and us of every face from the static obstacles, the coupler arrays and the domain sides. */
+static void fsdem__pic_effective_faces(fsdem_pic *s) {
+    int a, i, j, k;
+    for (a = 0; a < s->dim; ++a)
+        for (k = 0; k < s->fn[a][2]; ++k)
+            for (j = 0; j < s->fn[a][1]; ++j)
+                for (i = 0; i < s->fn[a][0]; ++i) {
+                    int f = fsdem__pic_face(s, a, i, j, k), coord = a == 0 ? i : a == 1 ? j : k;
+                    fsdem_real so = s->sopen[a][f], co = s->copen[a][f];
+                    if (co < 0) co = 0;
+                    if (co > 1) co = 1;
+                    if (coord == 0 || coord == s->n[a]) {
+                        int side = 2 * a + (coord != 0);
+                        fsdem_pic_boundary bc = s->desc.boundary[side];
+                        if (bc == FSDEM_PIC_BC_OUTFLOW) {
+                            s->E[a][f] = so < co ? so : co;
+                            s->us[a][f] = co < so ? s->cvel[a][f] : s->svel[a][f];
+                        } else {
+                            s->E[a][f] = 0;
+                            s->us[a][f] = bc == FSDEM_PIC_BC_INFLOW ? fsdem__comp(s->desc.boundary_velocity[side], a) : 0;
+                        }
+                    } else {
+                        s->E[a][f] = so < co ? so : co;
+                        s->us[a][f] = co < so ? s->cvel[a][f] : s->svel[a][f];
+                    }
+                }
+}
+
+/* Fluid fraction of each cell from the particles (tent kernel at cell centres, seed 004 Eq. 7b,
+   divided by the reference fraction) and the level set phi derived from it: for a plane surface
+   at distance d from a cell centre the tent kernel collects 1 - (dx - d)^2 / (2 dx^2), which is
+   inverted here, so phi is exact for plane surfaces and bounded by one cell. */
+static void fsdem__pic_fraction(fsdem_pic *s) {
+    int p, c, b, q0, q1, q2;
+    fsdem_real inv_ppc = 1 / (fsdem_real)s->ppc;
+    memset(s->frac, 0, sizeof(fsdem_real) * (size_t)s->ncell);
+    for (p = 0; p < s->np; ++p) {
+        int i0[3];
+        fsdem_real w[3][2];
+        for (b = 0; b < 3; ++b) {
+            if (b < s->dim) {
+                fsdem_real sx = (fsdem__comp(s->px[p], b) - fsdem__comp(s->lo, b)) * s->inv_dx - (fsdem_real)0.5, t;
+                if (!(sx > -2)) sx = -2;
+                if (sx > (fsdem_real)s->n[b] + 2) sx = (fsdem_real)s->n[b] + 2;
+                i0[b] = (int)(sx + 8) - 8; /* floor: sx >= -2 here */
+                t = sx - (fsdem_real)i0[b];
+                w[b][0] = 1 - t;
+                w[b][1] = t;
+            } else {
+                i0[b] = 0;
+                w[b][0] = 1;
+                w[b][1] = 0;
+            }
+        }
+        for (q2 = 0; q2 < (s->dim == 3 ? 2 : 1); ++q2) {
+            int k = i0[2] + q2;
+            if (k < 0 || k >= s->n[2]) continue;
+            for (q1 = 0; q1 < 2; ++q1) {
+                int j = i0[1] + q1;
+                if (j < 0 || j >= s->n[1]) continue;
+                for (q0 = 0; q0 < 2; ++q0) {
+                    int i = i0[0] + q0;
+                    if (i < 0 || i >= s->n[0]) continue;
+                    s->frac[fsdem__pic_cell(s, i, j, k)] += w[0][q0] * w[1][q1] * w[2][q2];
+                }
+            }
+        }
+    }
+    for (c = 0; c < s->ncell; ++c) {
+        fsdem_real f = s->fref[c] > (fsdem_real)1e-3 ? s->frac[c] * inv_ppc / s->fref[c] : 0;
+        s->frac[c] = f;
+        if (f >= 1) s->phi[c] = -s->dx;
+        else if (f >= (fsdem_real)0.5) s->phi[c] = -s->dx * (1 - (fsdem_real)sqrt(2 * (1 - f)));
+        else s->phi[c] = s->dx * (1 - (fsdem_real)sqrt(2 * f));
+    }
+    /* In cells mostly inside obstacles the count of a few particles over a small reference is
+       unreliable (an isolated "air" cell under water would put p = 0 deep in the liquid); their
+       phi is extended from the neighbours that are mostly open, as level sets are extended into
+       solids. */
+    if (s->obst_count) {
+        int i, j, k, a, sg, coord[3];
+        for (k = 0; k < s->n[2]; ++k)
+            for (j = 0; j < s->n[1]; ++j)
+                for (i = 0; i < s->n[0]; ++i) {
+                    fsdem_real sum = 0;
+                    int cnt = 0;
+                    c = fsdem__pic_cell(s, i, j, k);
+                    if (!s->cnear[c] || s->fref[c] >= FSDEM__PIC_FREF_RELIABLE) continue;
+                    coord[0] = i;
+                    coord[1] = j;
+                    coord[2] = k;
+                    for (a = 0; a < s->dim; ++a)
+                        for (sg = -1; sg <= 1; sg += 2) {
+                            int nc = coord[a] + sg, nb;
+                            if (nc < 0 || nc >= s->n[a]) continue;
+                            nb = c + sg * s->cstep[a];
+                            if (s->fref[nb] < FSDEM__PIC_FREF_RELIABLE) continue;
+                            sum += s->phi[nb];
+                            cnt++;
+                        }
+                    if (cnt) s->ctmp[c] = sum / (fsdem_real)cnt;
+                    else s->ctmp[c] = s->phi[c];
+                }
+        for (c = 0; c < s->ncell; ++c)
+            if (s->cnear[c] && s->fref[c] < FSDEM__PIC_FREF_RELIABLE) s->phi[c] = s->ctmp[c];
+    }
+}
+
+/* Cell types from the effective faces and phi; returns the number of fluid cells. A cell is FLUID
+   when phi < -theta_min dx: a surface through (or within theta_min dx of) a cell centre leaves
+   that cell AIR whatever the rounding, so a flat surface is reconstructed the same in every column
+   and the ghost-fluid fraction theta never needs clamping. */
+static int fsdem__pic_types(fsdem_pic *s) {
+    int a, i, j, k, c, fluid = 0;
+    fsdem_real thresh = -s->desc.ghost_theta_min * s->dx;
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                int open = 0;
+                c = fsdem__pic_cell(s, i, j, k);
+                for (a = 0; a < s->dim && !open; ++a) {
+                    int f = fsdem__pic_face(s, a, i, j, k);
+                    if (s->E[a][f] > 0 || s->E[a][f + s->fstep[a][a]] > 0) open = 1;
+                }
+                if (!open) s->ctype[c] = FSDEM_STENCIL_CELL_SOLID;
+                else if (!s->desc.free_surface || s->phi[c] < thresh) s->ctype[c] = FSDEM_STENCIL_CELL_FLUID;
+                else s->ctype[c] = FSDEM_STENCIL_CELL_AIR;
+                fluid += s->ctype[c] == FSDEM_STENCIL_CELL_FLUID;
+            }
+    s->fluid_cells = fluid;
+    return fluid;
+}
+
+/* Effective faces, fluid fraction, level set and cell types of the current particles (after the
+   particles or the obstacles changed outside a step), so views and statistics are current. */
+static void fsdem__pic_refresh(fsdem_pic *s) {
+    fsdem__pic_effective_faces(s);
+    fsdem__pic_fraction(s);
+    fsdem__pic_types(s);
+    s->cells_fresh = 1;
+}
+
+/* ---- >>pic_extrapolate : velocity extrapolation into air and solids ---- */
+
+/* Extends `field` (a face field, valid where fvalid is set) by `layers` rings of faces, each new
+   face taking the mean of its valid neighbours along the grid axes (breadth first: only the
+   current front is visited). Faces still invalid get 0. */
+static void fsdem__pic_extrapolate(fsdem_pic *s, fsdem_real *const field[3], int layers) {
+    int a, b, i, j, k, layer;
+    for (a = 0; a < s->dim; ++a) {
+        unsigned char *valid = s->fvalid[a], *queued = s->fvalid2[a];
+        fsdem_real *tmp = s->ftmp[a], *u = field[a];
+        const int *fn = s->fn[a];
+        int *queue = s->fqueue, head = 0, tail = 0, q;
+        memset(queued, 0, (size_t)s->nface[a]);
+        /* the first front: invalid faces next to a valid one */
+        for (k = 0; k < fn[2]; ++k)
+            for (j = 0; j < fn[1]; ++j)
+                for (i = 0; i < fn[0]; ++i) {
+                    int f = (k * fn[1] + j) * fn[0] + i, coord[3], near = 0;
+                    if (valid[f]) continue;
+                    coord[0] = i;
+                    coord[1] = j;
+                    coord[2] = k;
+                    for (b = 0; b < s->dim && !near; ++b) {
+                        int st = s->fstep[a][b];
+                        if ((coord[b] > 0 && valid[f - st]) || (coord[b] < fn[b] - 1 && valid[f + st])) near = 1;
+                    }
+                    if (near) {
+                        queue[tail++] = f;
+                        queued[f] = 1;
+                    }
+                }
+        for (layer = 0; layer < layers && head < tail; ++layer) {
+            int end = tail;
+            for (q = head; q < end; ++q) {
+                int f = queue[q], cnt = 0, coord[3], rest = f;
+                fsdem_real sum = 0;
+                coord[0] = rest % fn[0];
+                rest /= fn[0];
+                coord[1] = rest % fn[1];
+                coord[2] = rest / fn[1];
+                for (b = 0; b < s->dim; ++b) {
+                    int st = s->fstep[a][b];
+                    if (coord[b] > 0 && valid[f - st]) {
+                        sum += u[f - st];
+                        ++cnt;
+                    }
+                    if (coord[b] < fn[b] - 1 && valid[f + st]) {
+                        sum += u[f + st];
+                        ++cnt;
+                    }
+                }
+                tmp[f] = cnt ? sum / (fsdem_real)cnt : 0;
+            }
+            for (q = head; q < end; ++q) {
+                u[queue[q]] = tmp[queue[q]];
+                valid[queue[q]] = 1;
+            }
+            if (layer + 1 < layers)
+                for (q = head; q < end; ++q) {
+                    int f = queue[q], coord[3], rest = f;
+                    coord[0] = rest % fn[0];
+                    rest /= fn[0];
+                    coord[1] = rest % fn[1];
+                    coord[2] = rest / fn[1];
+                    for (b = 0; b < s->dim; ++b) {
+                        int st = s->fstep[a][b];
+                        if (coord[b] > 0 && !valid[f - st] && !queued[f - st]) {
+                            queue[tail++] = f - st;
+                            queued[f - st] = 1;
+                        }
+                        if (coord[b] < fn[b] - 1 && !valid[f + st] && !queued[f + st]) {
+                            queue[tail++] = f + st;
+                            queued[f + st] = 1;
+                        }
+                    }
+                }
+            head = end;
+        }
+        for (i = 0; i < s->nface[a]; ++i)
+            if (!valid[i]) u[i] = 0;
+    }
+}
+
+/* Faces fully covered by a solid (E = 0) carry the solid's velocity. */
+static void fsdem__pic_solid_faces(fsdem_pic *s, fsdem_real *const field[3], int zero) {
+    int a, f;
+    for (a = 0; a < s->dim; ++a)
+        for (f = 0; f < s->nface[a]; ++f)
+            if (s->E[a][f] <= 0) field[a][f] = zero ? 0 : s->us[a][f];
+}
+
+static int fsdem__pic_layers(const fsdem_pic *s) {
+    return s->desc.extrapolation_layers > 0 ? s->desc.extrapolation_layers : (int)ceil(s->desc.cfl_max) + 2;
+}
+
+/* ---- >>pic_viscosity : implicit nu lap(u), one stencil solve per component ---- */
+
+/* Solves (I - dt nu L) u = u* on every face with E > 0 next to a fluid cell. The face grid of each
+   component is a stencil grid of its own; the equation is divided by k = dt nu / dx^2:
+       u/k + sum_nb (u - u_nb) + sum_dirichlet c (u - U) = u_star/k,
+   with neighbours outside the unknowns either Dirichlet (a solid face at distance dx: c = 1, U its
+   solid velocity; a no-slip or inflow side half a cell away: c = 2, U the side's velocity) or
+   Neumann (air, slip sides, outflow). */
+static fsdem_result fsdem__pic_viscosity(fsdem_pic *s, fsdem_real dt) {
+    fsdem_real k = dt * s->desc.viscosity * s->inv_dx * s->inv_dx, inv_k = 1 / k;
+    int a, b, i, j, kk;
+    fsdem_result worst = FSDEM_OK;
+    s->v_iters = 0;
+    for (a = 0; a < s->dim; ++a) {
+        const int *fn = s->fn[a];
+        unsigned char *cell = s->vcell[a];
+        fsdem_real *dg = s->ftmp[a], *rhs = s->wsum[a];
+        fsdem_stencil st;
+        fsdem_pcg_info info;
+        fsdem_result r;
+        int unknowns = 0;
+        for (kk = 0; kk < fn[2]; ++kk)
+            for (j = 0; j < fn[1]; ++j)
+                for (i = 0; i < fn[0]; ++i) {
+                    int f = (kk * fn[1] + j) * fn[0] + i, coord = a == 0 ? i : a == 1 ? j : kk, fluid = 0;
+                    if (s->E[a][f] > 0) {
+                        int cidx = fsdem__pic_cell(s, i < s->n[0] ? i : s->n[0] - 1, j < s->n[1] ? j : s->n[1] - 1,
+                                                   kk < s->n[2] ? kk : s->n[2] - 1);
+                        if (coord < s->n[a] && s->ctype[cidx] == FSDEM_STENCIL_CELL_FLUID) fluid = 1;
+                        if (coord > 0 && s->ctype[cidx - (coord < s->n[a] ? s->cstep[a] : 0)] == FSDEM_STENCIL_CELL_FLUID) fluid = 1;
+                    }
+                    cell[f] = fluid ? FSDEM_STENCIL_CELL_FLUID : FSDEM_STENCIL_CELL_SOLID;
+                    unknowns += fluid;
+                }
+        if (!unknowns) continue;
+        for (kk = 0; kk < fn[2]; ++kk)
+            for (j = 0; j < fn[1]; ++j)
+                for (i = 0; i < fn[0]; ++i) {
+                    int f = (kk * fn[1] + j) * fn[0] + i, coord[3], sg;
+                    fsdem_real d = 0, r0 = 0;
+                    if (cell[f] != FSDEM_STENCIL_CELL_FLUID) {
+                        dg[f] = 0;
+                        rhs[f] = 0;
+                        continue;
+                    }
+                    coord[0] = i;
+                    coord[1] = j;
+                    coord[2] = kk;
+                    for (b = 0; b < s->dim; ++b)
+                        for (sg = -1; sg <= 1; sg += 2) {
+                            int nc = coord[b] + sg, g;
+                            if (nc < 0 || nc >= fn[b]) {
+                                if (b != a) {
+                                    int side = 2 * b + (sg > 0);
+                                    fsdem_pic_boundary bc = s->desc.boundary[side];
+                                    if (bc == FSDEM_PIC_BC_NO_SLIP || bc == FSDEM_PIC_BC_INFLOW) {
+                                        d += 2;
+                                        r0 += 2 * fsdem__comp(s->desc.boundary_velocity[side], a);
+                                    }
+                                }
+                                continue;
+                            }
+                            g = f + sg * s->fstep[a][b];
+                            if (cell[g] == FSDEM_STENCIL_CELL_FLUID) continue;
+                            if (s->E[a][g] <= 0) {
+                                d += 1;
+                                r0 += s->us[a][g];
+                            }
+                        }
+                    dg[f] = inv_k + d;
+                    rhs[f] = inv_k * s->u[a][f] + r0;
+                }
+        memset(&st, 0, sizeof st);
+        st.dim = s->dim;
+        for (b = 0; b < 3; ++b) st.n[b] = fn[b];
+        st.cell = cell;
+        for (b = 0; b < s->dim; ++b) st.face[b] = s->vface[a][b];
+        st.diag = dg;
+        r = fsdem_pcg_setup_stencil(s->pcg_v[a], &st);
+        if (r == FSDEM_OK) r = fsdem_pcg_solve(s->pcg_v[a], rhs, s->u[a], &info);
+        else info.iterations = 0;
+        s->v_iters += info.iterations;
+        if (r != FSDEM_OK && worst == FSDEM_OK) {
+            worst = r;
+            fsdem__fail(&s->status, r, "pic step: viscous solve of component %c failed: %s", "xyz"[a],
+                        fsdem_pcg_last_error(s->pcg_v[a]));
+        }
+    }
+    return worst;
+}
+
+/* ---- >>pic_projection : pressure (and density) projection ---- */
+
+static fsdem_real fsdem__pic_theta(const fsdem_pic *s, fsdem_real phi_in, fsdem_real phi_out) {
+    fsdem_real t = phi_in < phi_out ? phi_in / (phi_in - phi_out) : 1;
+    if (!(t >= s->desc.ghost_theta_min)) t = s->desc.ghost_theta_min;
+    if (t > 1) t = 1;
+    return t;
+}
+
+/* Fills s->diag with the ghost-fluid terms: a fluid cell whose neighbour across an open face is air
+   (phi of the two gives the interface fraction theta) or an outflow side (p = 0 on the side,
+   theta = 1/2) adds E (1/theta - 1) to the stencil's E (p_c - 0). Returns 1 when a cell has an
+   air or outflow neighbour (a Dirichlet condition somewhere). */
+static void fsdem__pic_ghost_diag(fsdem_pic *s) {
+    int a, i, j, k, c, sg, coord[3];
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                fsdem_real d = 0;
+                c = fsdem__pic_cell(s, i, j, k);
+                if (s->ctype[c] != FSDEM_STENCIL_CELL_FLUID) {
+                    s->diag[c] = 0;
+                    continue;
+                }
+                coord[0] = i;
+                coord[1] = j;
+                coord[2] = k;
+                for (a = 0; a < s->dim; ++a)
+                    for (sg = 0; sg < 2; ++sg) {
+                        int f = fsdem__pic_face(s, a, i, j, k) + sg * s->fstep[a][a], nc = coord[a] + (sg ? 1 : -1);
+                        fsdem_real e = s->E[a][f];
+                        if (e <= 0) continue;
+                        if (nc < 0 || nc >= s->n[a]) {
+                            d += e; /* outflow side: theta = 1/2 */
+                            continue;
+                        }
+                        {
+                            int nb = c + (sg ? 1 : -1) * s->cstep[a];
+                            if (s->ctype[nb] == FSDEM_STENCIL_CELL_AIR)
+                                d += e * (1 / fsdem__pic_theta(s, s->phi[c], s->phi[nb]) - 1);
+                        }
+                    }
+                s->diag[c] = d;
+            }
+}
+
+/* Gradient of a cell field `q` across face f of axis a (lower cell index cl, upper cu, -1 outside)
+   with the ghost-fluid treatment; *ok = 0 when the face is not next to a fluid cell. */
+static fsdem_real fsdem__pic_face_grad(const fsdem_pic *s, const fsdem_real *q, int cl, int cu, int *ok) {
+    int fl = cl >= 0 && s->ctype[cl] == FSDEM_STENCIL_CELL_FLUID;
+    int fu = cu >= 0 && s->ctype[cu] == FSDEM_STENCIL_CELL_FLUID;
+    *ok = 1;
+    if (fl && fu) return q[cu] - q[cl];
+    if (fl) {
+        if (cu < 0) return -2 * q[cl];
+        if (s->ctype[cu] == FSDEM_STENCIL_CELL_AIR) return -q[cl] / fsdem__pic_theta(s, s->phi[cl], s->phi[cu]);
+    } else if (fu) {
+        if (cl < 0) return 2 * q[cu];
+        if (s->ctype[cl] == FSDEM_STENCIL_CELL_AIR) return q[cu] / fsdem__pic_theta(s, s->phi[cu], s->phi[cl]);
+    }
+    *ok = 0;
+    return 0;
+}
+
+/* Divergence of the face field u (with the solid fluxes) of cell (i, j, k), 1/s. */
+static fsdem_real fsdem__pic_divergence(const fsdem_pic *s, fsdem_real *const u[3], int i, int j, int k) {
+    fsdem_real sum = 0;
+    int a;
+    for (a = 0; a < s->dim; ++a) {
+        int f = fsdem__pic_face(s, a, i, j, k), g = f + s->fstep[a][a];
+        sum += s->E[a][g] * u[a][g] + (1 - s->E[a][g]) * s->us[a][g];
+        sum -= s->E[a][f] * u[a][f] + (1 - s->E[a][f]) * s->us[a][f];
+    }
+    return sum * s->inv_dx;
+}
+
+static void fsdem__pic_stencil_view(const fsdem_pic *s, fsdem_stencil *st, int with_extra) {
+    int a;
+    memset(st, 0, sizeof *st);
+    st->dim = s->dim;
+    for (a = 0; a < 3; ++a) st->n[a] = s->n[a];
+    st->cell = s->ctype;
+    for (a = 0; a < s->dim; ++a) st->face[a] = s->E[a];
+    st->diag = s->diag;
+    if (with_extra) {
+        st->extra = s->coupling.pressure_extra;
+        st->extra_user = s->coupling.pressure_extra_user;
+    }
+}
+
+/* Applies the gradient of the cell field q to the face field `out`: out -= scale grad q over faces
+   next to fluid, which are marked valid (others invalid). */
+static void fsdem__pic_apply_grad(fsdem_pic *s, const fsdem_real *q, fsdem_real scale, fsdem_real *const out[3]) {
+    int a, i, j, k;
+    for (a = 0; a < s->dim; ++a)
+        for (k = 0; k < s->fn[a][2]; ++k)
+            for (j = 0; j < s->fn[a][1]; ++j)
+                for (i = 0; i < s->fn[a][0]; ++i) {
+                    int f = fsdem__pic_face(s, a, i, j, k), coord = a == 0 ? i : a == 1 ? j : k, ok;
+                    int cu = -1, cl = -1;
+                    fsdem_real g;
+                    s->fvalid[a][f] = 0;
+                    if (s->E[a][f] <= 0) continue;
+                    if (coord < s->n[a]) cu = fsdem__pic_cell(s, i, j, k);
+                    if (coord > 0) cl = fsdem__pic_cell(s, i - (a == 0), j - (a == 1), k - (a == 2));
+                    g = fsdem__pic_face_grad(s, q, cl, cu, &ok);
+                    if (!ok) continue;
+                    out[a][f] -= scale * g;
+                    s->fvalid[a][f] = 1;
+                }
+}
+
+/* Pressure projection: sum_f E_f (p_c - p_nb) (+ ghost-fluid diag, + coupler term) =
+   -(rho dx^2 / dt) div(u*) (seed 000 Eq. 5; the solid fluxes of partly covered faces enter the
+   divergence), then u -= dt/(rho dx) grad p on every face next to fluid. */
+static fsdem_result fsdem__pic_project(fsdem_pic *s, fsdem_real dt) {
+    fsdem_stencil st;
+    fsdem_pcg_info info;
+    fsdem_result r;
+    fsdem_real scale = -s->desc.density * s->dx * s->dx / dt, d2 = 0, dmax = 0;
+    int i, j, k, c;
+    clock_t t0 = clock();
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                c = fsdem__pic_cell(s, i, j, k);
+                if (s->ctype[c] != FSDEM_STENCIL_CELL_FLUID) {
+                    s->rhs[c] = 0;
+                    s->pres[c] = 0;
+                    continue;
+                }
+                {
+                    fsdem_real dv = fsdem__pic_divergence(s, s->u, i, j, k);
+                    d2 += dv * dv;
+                    s->rhs[c] = scale * dv + s->crhs[c];
+                }
+            }
+    s->div_before = (fsdem_real)sqrt(d2);
+    fsdem__pic_ghost_diag(s);
+    fsdem__pic_stencil_view(s, &st, 1);
+    r = fsdem_pcg_setup_stencil(s->pcg_p, &st);
+    info.iterations = 0;
+    info.residual = 0;
+    if (r == FSDEM_OK && s->fluid_cells > 0) r = fsdem_pcg_solve(s->pcg_p, s->rhs, s->pres, &info);
+    s->p_iters = info.iterations;
+    s->p_res = info.residual;
+    s->sec_pressure += (double)(clock() - t0) / CLOCKS_PER_SEC;
+    if (r != FSDEM_OK)
+        fsdem__fail(&s->status, r, "pic step: pressure solve failed (%d iterations, residual %g): %s", info.iterations,
+                    (double)info.residual, fsdem_pcg_last_error(s->pcg_p));
+    fsdem__pic_apply_grad(s, s->pres, dt / (s->desc.density * s->dx), s->u);
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                c = fsdem__pic_cell(s, i, j, k);
+                if (s->ctype[c] == FSDEM_STENCIL_CELL_FLUID) {
+                    fsdem_real dv = (fsdem_real)fabs(fsdem__pic_divergence(s, s->u, i, j, k));
+                    if (dv > dmax) dmax = dv;
+                }
+            }
+    s->max_div = dmax;
+    return r;
+}
+
+/* ---- >>pic_advection : particle motion, solids, outflow ---- */
+
+static void fsdem__pic_advect(fsdem_pic *s, fsdem_real dt) {
+    int p;
+    for (p = 0; p < s->np; ++p) {
+        fsdem_vec3 x = s->px[p], k1, k2, k3;
+        k1 = fsdem__pic_interp_vel(s, s->u, x);
+        if (s->desc.advection_order == 2) {
+            k2 = fsdem__pic_interp_vel(s, s->u, fsdem__madd(x, k1, dt / 2));
+            x = fsdem__madd(x, k2, dt);
+        } else { /* Ralston's third-order method */
+            k2 = fsdem__pic_interp_vel(s, s->u, fsdem__madd(x, k1, dt / 2));
+            k3 = fsdem__pic_interp_vel(s, s->u, fsdem__madd(x, k2, dt * (fsdem_real)0.75));
+            x = fsdem__madd(x, fsdem__add(fsdem__add(fsdem__scale(k1, 2), fsdem__scale(k2, 3)), fsdem__scale(k3, 4)),
+                            dt / 9);
+        }
+        if (s->dim == 2) x.z = 0;
+        s->px[p] = x;
+    }
+}
+
+/* Keeps particles in the open domain: those beyond an outflow side are marked for removal, the
+   others are clamped inside the walls and pushed out of obstacles along the distance gradient
+   (seed 004 Eq. 61). Returns the number marked. */
+static int fsdem__pic_constrain(fsdem_pic *s) {
+    fsdem_real eps = s->dx * (fsdem_real)1e-3;
+    int p, b, marked = 0, it;
+    for (p = 0; p < s->np; ++p) {
+        fsdem_real xb[3];
+        int gone = 0;
+        xb[0] = s->px[p].x;
+        xb[1] = s->px[p].y;
+        xb[2] = s->px[p].z;
+        for (b = 0; b < s->dim; ++b) {
+            fsdem_real lo = fsdem__comp(s->lo, b), hi = fsdem__comp(s->hi, b);
+            if (xb[b] < lo && s->desc.boundary[2 * b] == FSDEM_PIC_BC_OUTFLOW) gone = 1;
+            if (xb[b] > hi && s->desc.boundary[2 * b + 1] == FSDEM_PIC_BC_OUTFLOW) gone = 1;
+            if (!(xb[b] > lo + eps)) xb[b] = lo + eps;
+            if (xb[b] > hi - eps) xb[b] = hi - eps;
+        }
+        if (gone) {
+            s->pflag[p] = 1;
+            ++marked;
+            continue;
+        }
+        s->px[p] = fsdem_v3(xb[0], xb[1], xb[2]);
+        if (s->obst_count && s->cnear[fsdem__pic_cell_of(s, s->px[p])]) {
+            for (it = 0; it < 3; ++it) {
+                fsdem_real d = fsdem__pic_obst_min(s, s->px[p], NULL);
+                fsdem_vec3 nrm;
+                if (d > eps) break;
+                nrm = fsdem__pic_obst_normal(s, s->px[p]);
+                s->px[p] = fsdem__madd(s->px[p], nrm, eps - d);
+            }
+            if (fsdem__pic_obst_min(s, s->px[p], NULL) <= 0 || !fsdem__pic_open_at(s, s->px[p])) {
+                s->pflag[p] = 1;
+                ++marked;
+            }
+        }
+    }
+    return marked;
+}
+
+/* Density projection of seed 004 §5.1 with alpha_s = 0 (target fraction 1): solve
+   lap q = 1 - alpha_star (Eq. 12b with q = dt^2 p2 / rho; the ratio alpha_star/alpha_target clamped to [0.5, 1.5]) with
+   q = 0 at the free surface (ghost fluid) and zero flux through solids (particles are already out
+   of them, so the push-out term of Appendix B Eq. 64 vanishes), then move every particle by the
+   interpolated dx = -grad q (Eq. 13), limited to one cell. Surface cells are only decompressed:
+   their deficit is geometry, not a hole. */
+static fsdem_result fsdem__pic_density_projection(fsdem_pic *s) {
+    fsdem_stencil st;
+    fsdem_pcg_info info;
+    fsdem_result r;
+    int i, j, k, c, a, sg, p, any = 0;
+    fsdem_real dx2 = s->dx * s->dx;
+    clock_t t0;
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                fsdem_real f, rr;
+                int surface = 0, coord[3];
+                c = fsdem__pic_cell(s, i, j, k);
+                s->ctmp[c] = 0;
+                if (s->ctype[c] != FSDEM_STENCIL_CELL_FLUID) {
+                    s->rhs[c] = 0;
+                    continue;
+                }
+                coord[0] = i;
+                coord[1] = j;
+                coord[2] = k;
+                for (a = 0; a < s->dim; ++a)
+                    for (sg = 0; sg < 2; ++sg) {
+                        int f = fsdem__pic_face(s, a, i, j, k) + sg * s->fstep[a][a], nc = coord[a] + (sg ? 1 : -1);
+                        if (s->E[a][f] <= 0) continue;
+                        if (nc < 0 || nc >= s->n[a] || s->ctype[c + (sg ? 1 : -1) * s->cstep[a]] == FSDEM_STENCIL_CELL_AIR)
+                            surface = 1;
+                    }
+                f = s->frac[c];
+                if (f < (fsdem_real)0.5) f = (fsdem_real)0.5;
+                if (f > (fsdem_real)1.5) f = (fsdem_real)1.5;
+                rr = 1 - f;
+                if (surface && rr > 0) rr = 0;
+                if (s->fref[c] < FSDEM__PIC_FREF_RELIABLE) rr = 0; /* count unreliable (mostly solid) */
+                if (rr != 0) any = 1;
+                /* the volume to move is the deficit of the open part of the cell; the fluxes
+                   through the faces are weighted by their open fractions E like the pressure's */
+                s->rhs[c] = -dx2 * rr * (s->fref[c] < 1 ? s->fref[c] : 1);
+            }
+    s->d_iters = 0;
+    if (!any) return FSDEM_OK;
+    t0 = clock();
+    fsdem__pic_ghost_diag(s);
+    fsdem__pic_stencil_view(s, &st, 0);
+    r = fsdem_pcg_setup_stencil(s->pcg_p, &st);
+    info.iterations = 0;
+    if (r == FSDEM_OK) {
+        fsdem_pcg_set_tolerance(s->pcg_p, (fsdem_real)1e-4, s->desc.pressure_max_iterations);
+        r = fsdem_pcg_solve(s->pcg_p, s->rhs, s->ctmp, &info);
+        fsdem_pcg_set_tolerance(s->pcg_p, s->desc.pressure_tolerance, s->desc.pressure_max_iterations);
+    }
+    s->d_iters = info.iterations;
+    s->sec_density += (double)(clock() - t0) / CLOCKS_PER_SEC;
+    if (r != FSDEM_OK && r != FSDEM_ERR_NOT_CONVERGED) return r; /* keep the particles where they are */
+    for (a = 0; a < s->dim; ++a) memset(s->uold[a], 0, sizeof(fsdem_real) * (size_t)s->nface[a]);
+    fsdem__pic_apply_grad(s, s->ctmp, s->inv_dx, s->uold);
+    for (p = 0; p < s->np; ++p) {
+        fsdem_vec3 d = fsdem__pic_interp_vel(s, s->uold, s->px[p]);
+        fsdem_real len = fsdem__norm(d);
+        if (len > s->dx) d = fsdem__scale(d, s->dx / len);
+        s->px[p] = fsdem__add(s->px[p], d);
+    }
+    return FSDEM_OK;
+}
+
+/* ---- >>pic_reseed : particle counts per cell ---- */
+
+/* Counting sort of the particles by cell: cstart (ncell + 1 offsets), pidx (particle order). */
+static void fsdem__pic_bin(fsdem_pic *s) {
+    int p, c, sum = 0;
+    memset(s->cstart, 0, sizeof(int) * (size_t)(s->ncell + 1));
+    for (p = 0; p < s->np; ++p) {
+        c = fsdem__pic_cell_of(s, s->px[p]);
+        s->pcell[p] = c;
+        s->cstart[c + 1]++;
+    }
+    for (c = 0; c < s->ncell; ++c) {
+        sum += s->cstart[c + 1];
+        s->cstart[c + 1] = sum;
+    }
+    for (p = 0; p < s->np; ++p) s->pidx[s->cstart[s->pcell[p]]++] = p;
+    for (c = s->ncell; c > 0; --c) s->cstart[c] = s->cstart[c - 1];
+    s->cstart[0] = 0;
+}
+
+/* Reorders the particle arrays by cell (cache locality of the transfers). */
+static void fsdem__pic_sort(fsdem_pic *s) {
+    fsdem_vec3 **arrays[5];
+    int n = 2, a, p;
+    fsdem__pic_bin(s);
+    arrays[0] = &s->px;
+    arrays[1] = &s->pv;
+    if (s->pc[0]) {
+        arrays[2] = &s->pc[0];
+        arrays[3] = &s->pc[1];
+        arrays[4] = &s->pc[2];
+        n = 5;
+    }
+    for (a = 0; a < n; ++a) {
+        fsdem_vec3 *src = *arrays[a], *dst = s->ptmp;
+        for (p = 0; p < s->np; ++p) dst[p] = src[s->pidx[p]];
+        s->ptmp = src;
+        *arrays[a] = dst;
+    }
+}
+
+static int fsdem__pic_append(fsdem_pic *s, fsdem_vec3 x, fsdem_vec3 v) {
+    if (s->np >= s->pcap) {
+        s->refused++;
+        return 0;
+    }
+    if (s->dim == 2) {
+        x.z = 0;
+        v.z = 0;
+    }
+    s->px[s->np] = x;
+    s->pv[s->np] = v;
+    if (s->pc[0]) s->pc[0][s->np] = s->pc[1][s->np] = s->pc[2][s->np] = fsdem__zero3();
+    s->pflag[s->np] = 0;
+    s->np++;
+    s->reseeded++;
+    return 1;
+}
+
+/* Random open position in cell (i, j, k); 0 when none was found in a few tries. */
+static int fsdem__pic_random_in_cell(fsdem_pic *s, int i, int j, int k, fsdem_vec3 *out) {
+    int t;
+    for (t = 0; t < 8; ++t) {
+        fsdem_vec3 p = fsdem_v3(s->lo.x + s->dx * ((fsdem_real)i + fsdem__pic_rand(s)),
+                                s->lo.y + s->dx * ((fsdem_real)j + fsdem__pic_rand(s)),
+                                s->dim == 3 ? s->lo.z + s->dx * ((fsdem_real)k + fsdem__pic_rand(s)) : 0);
+        if (fsdem__pic_open_at(s, p)) {
+            *out = p;
+            return 1;
+        }
+    }
+    return 0;
+}
+
+/* A particle that a crowded neighbour of cell (i, j, k) can give up for volume-neutral reseeding:
+   from the cell of the 3^dim block around with the most particles, if it holds more than
+   particles_per_cell (counting those already taken, in taken[]); -1 when there is none. */
+static int fsdem__pic_donor(fsdem_pic *s, int i, int j, int k, int *taken) {
+    int di, dj, dk, best = -1, best_count = s->ppc, zr = s->dim == 3 ? 1 : 0, maxp = s->desc.max_particles_per_cell;
+    for (dk = -zr; dk <= zr; ++dk)
+        for (dj = -1; dj <= 1; ++dj)
+            for (di = -1; di <= 1; ++di) {
+                int x = i + di, y = j + dj, z = k + dk, c, count;
+                if (x < 0 || y < 0 || z < 0 || x >= s->n[0] || y >= s->n[1] || z >= s->n[2]) continue;
+                c = fsdem__pic_cell(s, x, y, z);
+                count = s->cstart[c + 1] - s->cstart[c];
+                if (maxp > 0 && count > maxp) count = maxp; /* the rest is already removed */
+                count -= taken[c];
+                if (count > best_count) {
+                    best_count = count;
+                    best = c;
+                }
+            }
+    if (best < 0) return -1;
+    taken[best]++;
+    return s->pidx[s->cstart[best] + best_count - 1];
+}
+
+/* Keeps the particle counts of the cells in range without changing the water volume (the particle
+   count is the volume once the density projection has evened the particles out):
+   - cells with more than max_particles_per_cell lose the excess;
+   - interior fluid cells (no air neighbour) with fewer than min_particles_per_cell and a fluid
+     fraction below 1 get particles up to that minimum (with the grid velocity), each one taken
+     from a crowded neighbour (more than particles_per_cell); without such a neighbour nothing is
+     added (the density projection evens out the rest);
+   - cells along inflow sides are topped up to particles_per_cell with the inflow velocity (the
+     inflow brings volume in).
+   Uses the cell types of the current positions. Returns 1 when particles changed. */
+static int fsdem__pic_reseed(fsdem_pic *s) {
+    int c, i, j, k, a, sg, q, maxp = s->desc.max_particles_per_cell, minp = s->desc.min_particles_per_cell;
+    int removed = 0, moved = 0, *taken = s->fqueue; /* fqueue has >= ncell entries and is free here */
+    int np0 = s->np;
+    fsdem__pic_bin(s);
+    memset(taken, 0, sizeof(int) * (size_t)s->ncell);
+    if (maxp > 0)
+        for (c = 0; c < s->ncell; ++c) {
+            int count = s->cstart[c + 1] - s->cstart[c];
+            if (count > maxp) {
+                for (q = maxp; q < count; ++q) s->pflag[s->pidx[s->cstart[c] + q]] = 1;
+                removed += count - maxp;
+            }
+        }
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                int count, coord[3], interior = 1, inflow = -1;
+                c = fsdem__pic_cell(s, i, j, k);
+                count = s->cstart[c + 1] - s->cstart[c] - taken[c];
+                if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID || (maxp > 0 && count > maxp)) continue;
+                coord[0] = i;
+                coord[1] = j;
+                coord[2] = k;
+                for (a = 0; a < s->dim; ++a)
+                    for (sg = 0; sg < 2; ++sg) {
+                        int nc = coord[a] + (sg ? 1 : -1);
+                        if (nc < 0 || nc >= s->n[a]) {
+                            if (s->desc.boundary[2 * a + sg] == FSDEM_PIC_BC_INFLOW) inflow = 2 * a + sg;
+                            continue;
+                        }
+                        if (s->ctype[c + (sg ? 1 : -1) * s->cstep[a]] == FSDEM_STENCIL_CELL_AIR) interior = 0;
+                    }
+                if (inflow >= 0) {
+                    fsdem_vec3 x;
+                    for (q = count; q < s->ppc; ++q)
+                        if (fsdem__pic_random_in_cell(s, i, j, k, &x)) fsdem__pic_append(s, x, s->desc.boundary_velocity[inflow]);
+                    continue;
+                }
+                if (minp > 0 && count < minp && interior && s->ctype[c] == FSDEM_STENCIL_CELL_FLUID && s->frac[c] < 1) {
+                    fsdem_vec3 x;
+                    for (q = count; q < minp; ++q) {
+                        int donor;
+                        if (!fsdem__pic_random_in_cell(s, i, j, k, &x)) break;
+                        donor = fsdem__pic_donor(s, i, j, k, taken);
+                        if (donor < 0) break;
+                        if (!fsdem__pic_append(s, x, fsdem__pic_interp_vel(s, s->u, x))) {
+                            break;
+                        }
+                        s->reseeded--; /* a move, not a new particle */
+                        s->pflag[donor] = 1;
+                        moved++;
+                    }
+                }
+            }
+    if (removed || moved) fsdem__pic_remove_marked(s);
+    s->removed += removed;
+    s->moved += moved;
+    return removed || moved || s->np != np0;
+}
+
+/* ---- >>pic_step : time stepping ---- */
+
+static fsdem_real fsdem__pic_umax(const fsdem_pic *s, int *who) {
+    fsdem_real m2 = 0;
+    int p, k, w = -1;
+    for (p = 0; p < s->np; ++p) {
+        fsdem_real v2 = fsdem__dot(s->pv[p], s->pv[p]);
+        if (v2 > m2 || v2 != v2) {
+            m2 = v2;
+            w = p;
+            if (v2 != v2) break;
+        }
+    }
+    for (k = 0; k < 2 * s->dim; ++k) {
+        fsdem_pic_boundary bc = s->desc.boundary[k];
+        if (bc == FSDEM_PIC_BC_NO_SLIP || bc == FSDEM_PIC_BC_INFLOW) {
+            fsdem_real v2 = fsdem__dot(s->desc.boundary_velocity[k], s->desc.boundary_velocity[k]);
+            if (v2 > m2) {
+                m2 = v2;
+                w = -2 - k;
+            }
+        }
+    }
+    if (who) *who = w;
+    return (fsdem_real)sqrt(m2);
+}
+
+static fsdem_real fsdem__pic_dt_from(const fsdem_pic *s, fsdem_real umax) {
+    fsdem_real speed = umax + (fsdem_real)sqrt(s->gmag * s->dx), dt = s->desc.dt_max;
+    if (speed > 0 && s->desc.cfl * s->dx / speed < dt) dt = s->desc.cfl * s->dx / speed;
+    return dt;
+}
+
+fsdem_real fsdem_pic_dt_estimate(const fsdem_pic *s) { return fsdem__pic_dt_from(s, fsdem__pic_umax(s, NULL)); }
+
+fsdem_real fsdem_pic_time(const fsdem_pic *s) { return (fsdem_real)s->time; }
+
+static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
+    fsdem_result r, worst = FSDEM_OK;
+    int a, f, bad, layers = fsdem__pic_layers(s);
+    fsdem_real umax = 0;
+    clock_t t0 = clock();
+    fsdem__ok(&s->status);
+
+    /* 1. particles to grid, cells, extrapolation, FLIP reference */
+    fsdem__pic_effective_faces(s);
+    if (!s->cells_fresh) fsdem__pic_fraction(s);
+    fsdem__pic_types(s);
+    fsdem__pic_p2g(s);
+    fsdem__pic_extrapolate(s, s->u, layers);
+    fsdem__pic_solid_faces(s, s->u, 0);
+    for (a = 0; a < s->dim; ++a) memcpy(s->uold[a], s->u[a], sizeof(fsdem_real) * (size_t)s->nface[a]);
+
+    /* 2. body forces and coupler accelerations */
+    for (a = 0; a < s->dim; ++a) {
+        fsdem_real g = fsdem__comp(s->desc.gravity, a) * dt;
+        for (f = 0; f < s->nface[a]; ++f) s->u[a][f] += g + dt * s->cacc[a][f];
+    }
+
+    /* 3. implicit viscosity, pressure projection */
+    if (s->desc.viscosity > 0) {
+        r = fsdem__pic_viscosity(s, dt);
+        if (r != FSDEM_OK && worst == FSDEM_OK) worst = r;
+    }
+    r = fsdem__pic_project(s, dt);
+    if (r != FSDEM_OK && worst == FSDEM_OK) worst = r;
+    for (a = 0; a < s->dim; ++a)
+        for (f = 0; f < s->nface[a]; ++f)
+            if (s->fvalid[a][f] && (fsdem_real)fabs(s->u[a][f]) > umax) umax = (fsdem_real)fabs(s->u[a][f]);
+    fsdem__pic_extrapolate(s, s->u, layers);
+    fsdem__pic_solid_faces(s, s->u, 0);
+
+    /* 4. grid to particles */
+    for (a = 0; a < s->dim; ++a)
+        for (f = 0; f < s->nface[a]; ++f) s->uold[a][f] = s->u[a][f] - s->uold[a][f];
+    bad = fsdem__pic_g2p(s);
+
+    /* 5. advection, solids and outflow, density projection */
+    fsdem__pic_advect(s, dt);
+    if (fsdem__pic_constrain(s)) {
+        int before = s->np;
+        fsdem__pic_remove_marked(s);
+        s->removed += before - s->np;
+    }
+    if (s->desc.density_projection) {
+        fsdem__pic_fraction(s);
+        fsdem__pic_types(s);
+        r = fsdem__pic_density_projection(s);
+        if (r != FSDEM_OK && worst == FSDEM_OK)
+            worst = fsdem__fail(&s->status, r, "pic step: density projection failed: %s", fsdem_pcg_last_error(s->pcg_p));
+        if (fsdem__pic_constrain(s)) {
+            int before = s->np;
+            fsdem__pic_remove_marked(s);
+            s->removed += before - s->np;
+        }
+    }
+
+    /* 6. reseeding, cell order, cells of the final positions (for diagnostics) */
+    fsdem__pic_fraction(s);
+    fsdem__pic_types(s);
+    if (fsdem__pic_reseed(s)) {
+        fsdem__pic_fraction(s);
+        fsdem__pic_types(s);
+    }
+    if ((s->steps & 7) == 0) fsdem__pic_sort(s);
+    s->cells_fresh = 1;
+
+    s->time += dt;
+    s->dt_last = dt;
+    s->steps++;
+    s->sec_total += (double)(clock() - t0) / CLOCKS_PER_SEC;
+    if (bad >= 0 && worst == FSDEM_OK)
+        worst = fsdem__fail(&s->status, FSDEM_ERR_NAN, "pic step %lld: particle %d has a non-finite velocity", s->steps, bad);
+    if (worst == FSDEM_OK && umax * dt * s->inv_dx > s->desc.cfl_max)
+        worst = fsdem__fail(&s->status, FSDEM_ERR_CFL,
+                            "pic step %lld: the projected grid velocity %g m/s moves %g cells in dt = %g s (cfl_max %g)",
+                            s->steps, (double)umax, (double)(umax * dt * s->inv_dx), (double)dt, (double)s->desc.cfl_max);
+    return worst;
+}
+
+fsdem_result fsdem_pic_step_dt(fsdem_pic *s, fsdem_real dt) {
+    int who;
+    fsdem_real umax, cfl;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic step_dt: dt = %g s must be > 0 and finite", (double)dt);
+    umax = fsdem__pic_umax(s, &who);
+    if (!fsdem__finite(umax))
+        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "pic step: particle %d has a non-finite velocity", who);
+    cfl = umax * dt * s->inv_dx;
+    if (cfl > s->desc.cfl_max) {
+        if (who >= 0)
+            return fsdem__fail(&s->status, FSDEM_ERR_CFL,
+                               "pic step_dt: dt = %g s gives CFL %g > cfl_max %g (particle %d at %g m/s; dt <= %g s)", (double)dt,
+                               (double)cfl, (double)s->desc.cfl_max, who, (double)umax,
+                               (double)(s->desc.cfl_max * s->dx / umax));
+        return fsdem__fail(&s->status, FSDEM_ERR_CFL, "pic step_dt: dt = %g s gives CFL %g > cfl_max %g (%s side velocity %g m/s)",
+                           (double)dt, (double)cfl, (double)s->desc.cfl_max, fsdem__pic_side_name(-2 - who), (double)umax);
+    }
+    return fsdem__pic_do_step(s, dt);
+}
+
+fsdem_result fsdem_pic_step(fsdem_pic *s) {
+    int who;
+    fsdem_real umax;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    umax = fsdem__pic_umax(s, &who);
+    if (!fsdem__finite(umax))
+        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "pic step: particle %d has a non-finite velocity", who);
+    return fsdem__pic_do_step(s, fsdem__pic_dt_from(s, umax));
+}
+
+fsdem_result fsdem_pic_advance(fsdem_pic *s, fsdem_real duration, int *steps) {
+    double end;
+    int n = 0;
+    fsdem_result r = FSDEM_OK;
+    if (steps) *steps = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic advance: duration = %g s must be >= 0", (double)duration);
+    end = s->time + (double)duration;
+    while (s->time < end - 1e-12 * (end > 1 ? end : 1)) {
+        int who;
+        fsdem_real umax = fsdem__pic_umax(s, &who), dt;
+        if (!fsdem__finite(umax)) {
+            r = fsdem__fail(&s->status, FSDEM_ERR_NAN, "pic advance: particle %d has a non-finite velocity", who);
+            break;
+        }
+        dt = fsdem__pic_dt_from(s, umax);
+        if (s->time + dt > end) dt = (fsdem_real)(end - s->time);
+        else if (s->time + 1.5 * dt > end) dt = (fsdem_real)((end - s->time) / 2);
+        r = fsdem__pic_do_step(s, dt);
+        ++n;
+        if (r != FSDEM_OK) break;
+    }
+    if (steps) *steps = n;
+    return r;
+}
+
+/* ---- >>pic_views : grid, coupling, sampling, statistics ---- */
+
+fsdem_pic_grid fsdem_pic_get_grid(const fsdem_pic *s) {
+    fsdem_pic_grid g;
+    int a;
+    memset(&g, 0, sizeof g);
+    g.dim = s->dim;
+    for (a = 0; a < 3; ++a) {
+        g.n[a] = s->n[a];
+        g.face_count[a] = s->nface[a];
+        g.velocity[a] = s->u[a];
+        g.open[a] = s->E[a];
+        g.solid_velocity[a] = s->us[a];
+    }
+    g.cell_size = s->dx;
+    g.origin = s->lo;
+    g.cell = s->ctype;
+    g.pressure = s->pres;
+    g.phi = s->phi;
+    g.fraction = s->frac;
+    return g;
+}
+
+fsdem_pic_coupling *fsdem_pic_coupling_view(fsdem_pic *s) { return &s->coupling; }
+
+fsdem_vec3 fsdem_pic_sample_velocity(const fsdem_pic *s, fsdem_vec3 p) { return fsdem__pic_interp_vel(s, s->u, p); }
+
+fsdem_real fsdem_pic_sample_pressure(const fsdem_pic *s, fsdem_vec3 p) {
+    fsdem_real t[3], sum = 0;
+    int i0[3], b, q0, q1, q2;
+    for (b = 0; b < 3; ++b) {
+        fsdem_real sx = b < s->dim ? (fsdem__comp(p, b) - fsdem__comp(s->lo, b)) * s->inv_dx - (fsdem_real)0.5 : 0;
+        if (!(sx > 0)) sx = 0;
+        if (sx > (fsdem_real)(s->n[b] - 1)) sx = (fsdem_real)(s->n[b] - 1);
+        i0[b] = (int)floor(sx);
+        if (i0[b] > s->n[b] - 2) i0[b] = s->n[b] > 1 ? s->n[b] - 2 : 0;
+        t[b] = sx - (fsdem_real)i0[b];
+    }
+    for (q2 = 0; q2 < 2; ++q2)
+        for (q1 = 0; q1 < 2; ++q1)
+            for (q0 = 0; q0 < 2; ++q0) {
+                fsdem_real w = (q0 ? t[0] : 1 - t[0]) * (q1 ? t[1] : 1 - t[1]) * (q2 ? t[2] : 1 - t[2]);
+                int i = fsdem__pic_clampi(i0[0] + q0, s->n[0]), j = fsdem__pic_clampi(i0[1] + q1, s->n[1]);
+                int k = fsdem__pic_clampi(i0[2] + q2, s->n[2]);
+                if (w != 0) sum += w * s->pres[fsdem__pic_cell(s, i, j, k)];
+            }
+    return sum;
+}
+
+fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *s) {
+    fsdem_pic_stats st;
+    int c, p, a;
+    double vol = 0, ke = 0, cellv = pow((double)s->dx, (double)s->dim);
+    memset(&st, 0, sizeof st);
+    for (c = 0; c < s->ncell; ++c) {
+        double f;
+        if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID) continue;
+        if (!s->desc.free_surface) {
+            vol += 1;
+            continue;
+        }
+        f = 0.5 - (double)s->phi[c] * (double)s->inv_dx;
+        vol += f < 0 ? 0 : f > 1 ? 1 : f;
+    }
+    for (p = 0; p < s->np; ++p) ke += (double)fsdem__dot(s->pv[p], s->pv[p]);
+    st.time = (fsdem_real)s->time;
+    st.dt = s->dt_last;
+    st.steps = s->steps;
+    st.particles = s->np;
+    st.fluid_cells = s->fluid_cells;
+    st.fluid_volume = (fsdem_real)(vol * cellv);
+    st.particle_volume = s->pvol * (fsdem_real)s->np;
+    st.kinetic_energy = (fsdem_real)(0.5 * (double)s->desc.density * (double)s->pvol * ke);
+    st.max_speed = fsdem__pic_umax(s, &a);
+    st.max_divergence = s->max_div;
+    st.divergence_before = s->div_before;
+    st.pressure_iterations = s->p_iters;
+    st.pressure_residual = s->p_res;
+    st.viscosity_iterations = s->v_iters;
+    st.density_iterations = s->d_iters;
+    st.reseeded = s->reseeded;
+    st.removed = s->removed;
+    st.refused = s->refused;
+    st.moved = s->moved;
+    st.seconds_total = s->sec_total;
+    st.seconds_pressure = s->sec_pressure;
+    st.seconds_density = s->sec_density;
+    st.memory_bytes = s->bytes;
+    return st;
+}
+
+/* ---- >>pic_output : CSV, VTK XML, PVD ---- */
+
+fsdem_result fsdem_pic_write_particles_csv(const fsdem_pic *s, const char *path) {
+    FILE *fp = path ? fopen(path, "w") : NULL;
+    int p, bad;
+    if (!fp) return FSDEM_ERR_IO;
+    fprintf(fp, "x,y,z,vx,vy,vz\n");
+    for (p = 0; p < s->np; ++p)
+        fprintf(fp, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", (double)s->px[p].x, (double)s->px[p].y, (double)s->px[p].z,
+                (double)s->pv[p].x, (double)s->pv[p].y, (double)s->pv[p].z);
+    bad = ferror(fp);
+    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *s, const char *path) {
+    FILE *fp = path ? fopen(path, "w") : NULL;
+    int p, bad;
+    if (!fp) return FSDEM_ERR_IO;
+    fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+                "<PolyData>\n<Piece NumberOfPoints=\"%d\" NumberOfVerts=\"%d\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
+                "NumberOfPolys=\"0\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
+            s->np, s->np);
+    for (p = 0; p < s->np; ++p) fprintf(fp, "%.9g %.9g %.9g\n", (double)s->px[p].x, (double)s->px[p].y, (double)s->px[p].z);
+    fprintf(fp, "</DataArray>\n</Points>\n<Verts>\n<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n");
+    for (p = 0; p < s->np; ++p) fprintf(fp, "%d\n", p);
+    fprintf(fp, "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n");
+    for (p = 0; p < s->np; ++p) fprintf(fp, "%d\n", p + 1);
+    fprintf(fp, "</DataArray>\n</Verts>\n<PointData Vectors=\"velocity\">\n"
+                "<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for (p = 0; p < s->np; ++p) fprintf(fp, "%.9g %.9g %.9g\n", (double)s->pv[p].x, (double)s->pv[p].y, (double)s->pv[p].z);
+    fprintf(fp, "</DataArray>\n</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
+    bad = ferror(fp);
+    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+/* Cell-centred velocity: mean of the two faces along each axis. */
+static fsdem_vec3 fsdem__pic_cell_velocity(const fsdem_pic *s, int i, int j, int k) {
+    fsdem_real v[3] = {0, 0, 0};
+    int a;
+    for (a = 0; a < s->dim; ++a) {
+        int f = fsdem__pic_face(s, a, i, j, k);
+        v[a] = (s->u[a][f] + s->u[a][f + s->fstep[a][a]]) / 2;
+    }
+    return fsdem_v3(v[0], v[1], v[2]);
+}
+
+fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *s, const char *path) {
+    FILE *fp = path ? fopen(path, "w") : NULL;
+    int i, j, k, bad;
+    if (!fp) return FSDEM_ERR_IO;
+    fprintf(fp, "i,j,k,x,y,z,type,p,phi,fraction,u,v,w\n");
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                int c = fsdem__pic_cell(s, i, j, k);
+                fsdem_vec3 x = fsdem__pic_cell_pos(s, i, j, k), v = fsdem__pic_cell_velocity(s, i, j, k);
+                fprintf(fp, "%d,%d,%d,%.9g,%.9g,%.9g,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", i, j, k, (double)x.x, (double)x.y,
+                        (double)x.z, (int)s->ctype[c], (double)s->pres[c], (double)s->phi[c], (double)s->frac[c], (double)v.x,
+                        (double)v.y, (double)v.z);
+            }
+    bad = ferror(fp);
+    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *s, const char *path) {
+    FILE *fp = path ? fopen(path, "w") : NULL;
+    int i, j, k, c, bad, nz = s->dim == 3 ? s->n[2] : 0;
+    if (!fp) return FSDEM_ERR_IO;
+    fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+                "<ImageData WholeExtent=\"0 %d 0 %d 0 %d\" Origin=\"%.9g %.9g %.9g\" Spacing=\"%.9g %.9g %.9g\">\n"
+                "<Piece Extent=\"0 %d 0 %d 0 %d\">\n<CellData Scalars=\"pressure\" Vectors=\"velocity\">\n",
+            s->n[0], s->n[1], nz, (double)s->lo.x, (double)s->lo.y, (double)s->lo.z, (double)s->dx, (double)s->dx,
+            (double)s->dx, s->n[0], s->n[1], nz);
+    fprintf(fp, "<DataArray type=\"Float64\" Name=\"pressure\" format=\"ascii\">\n");
+    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%.9g\n", (double)s->pres[c]);
+    fprintf(fp, "</DataArray>\n<DataArray type=\"Float64\" Name=\"phi\" format=\"ascii\">\n");
+    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%.9g\n", (double)s->phi[c]);
+    fprintf(fp, "</DataArray>\n<DataArray type=\"Float64\" Name=\"fraction\" format=\"ascii\">\n");
+    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%.9g\n", (double)s->frac[c]);
+    fprintf(fp, "</DataArray>\n<DataArray type=\"UInt8\" Name=\"type\" format=\"ascii\">\n");
+    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%d\n", (int)s->ctype[c]);
+    fprintf(fp, "</DataArray>\n<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    for (k = 0; k < s->n[2]; ++k)
+        for (j = 0; j < s->n[1]; ++j)
+            for (i = 0; i < s->n[0]; ++i) {
+                fsdem_vec3 v = fsdem__pic_cell_velocity(s, i, j, k);
+                fprintf(fp, "%.9g %.9g %.9g\n", (double)v.x, (double)v.y, (double)v.z);
+            }
+    fprintf(fp, "</DataArray>\n</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n");
+    bad = ferror(fp);
+    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path) {
+    FILE *fp;
+    if (!pvd || !path) return FSDEM_ERR_INVALID_ARG;
+    pvd->file = NULL;
+    fp = fopen(path, "w");
+    if (!fp) return FSDEM_ERR_IO;
+    pvd->file = fp;
+    if (fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n") < 0)
+        return FSDEM_ERR_IO;
+    fflush(fp);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file) {
+    if (!pvd || !pvd->file || !file) return FSDEM_ERR_INVALID_ARG;
+    if (fprintf((FILE *)pvd->file, "<DataSet timestep=\"%.9g\" part=\"0\" file=\"%s\"/>\n", (double)time, file) < 0)
+        return FSDEM_ERR_IO;
+    fflush((FILE *)pvd->file);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_pvd_close(fsdem_pvd *pvd) {
+    int bad;
+    if (!pvd || !pvd->file) return FSDEM_ERR_INVALID_ARG;
+    bad = fprintf((FILE *)pvd->file, "</Collection>\n</VTKFile>\n") < 0;
+    bad |= fclose((FILE *)pvd->file) != 0;
+    pvd->file = NULL;
+    return bad ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
 /* ===== >>impl_io : CSV and VTK output ============================================================== */

@@ -7,6 +7,7 @@ int main(void) {
     int failed;
     srunner_add_suite(runner, dem_suite());
     srunner_add_suite(runner, linalg_suite());
+    srunner_add_suite(runner, pic_suite());
     srunner_run_all(runner, CK_NORMAL);
     failed = srunner_ntests_failed(runner);
     srunner_free(runner);

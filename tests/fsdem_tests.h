@@ -7,5 +7,6 @@
 Suite *core_suite(void);
 Suite *dem_suite(void);
 Suite *linalg_suite(void);
+Suite *pic_suite(void);
 
 #endif

@@ -1,0 +1,601 @@
+/* PIC/FLIP: still water (2D, 3D), discrete incompressibility, flux through an open box with an
+   obstacle, implicit viscosity, particles kept out of solids, output files, bad input. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "fsdem_tests.h"
+
+#define RHO 1000.0
+#define G 9.81
+
+/* A closed tank with still water of depth h (0.5 m) on a coarse grid. Seeds are not jittered, so the
+   discrete initial state is a flat surface: any motion after 1 s is the scheme's own. */
+static fsdem_pic *still_tank(int dim, fsdem_pic_transfer transfer, fsdem_pic_kernel kernel) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(dim);
+    fsdem_pic *s = NULL;
+    d.cell_size = 0.1;
+    d.jitter = 0;
+    d.transfer = transfer;
+    d.kernel = kernel;
+    if (dim == 2) {
+        d.domain_max = fsdem_v3(1.0, 0.8, 0);
+    } else {
+        d.domain_max = fsdem_v3(0.4, 0.3, 0.8);
+    }
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), dim == 2 ? fsdem_v3(1.0, 0.5, 0) : fsdem_v3(0.4, 0.3, 0.5),
+                                        fsdem_v3(0, 0, 0), NULL),
+                     FSDEM_OK);
+    return s;
+}
+
+/* Bottom pressure averaged over the bottom cells, extrapolated from the two lowest cell centres to
+   the floor. */
+static double bottom_pressure(const fsdem_pic *s) {
+    fsdem_pic_grid g = fsdem_pic_get_grid(s);
+    int up = g.dim - 1, i, stride = up == 1 ? g.n[0] : g.n[0] * g.n[1];
+    double sum = 0;
+    for (i = 0; i < stride; ++i) sum += 1.5 * (double)g.pressure[i] - 0.5 * (double)g.pressure[i + stride];
+    return sum / stride;
+}
+
+static void check_still(int dim, fsdem_pic_transfer transfer, fsdem_pic_kernel kernel) {
+    fsdem_pic *s = still_tank(dim, transfer, kernel);
+    fsdem_pic_stats st;
+    double p, ref = RHO * G * 0.5;
+    ck_assert_int_eq(fsdem_pic_advance(s, 1.0, NULL), FSDEM_OK);
+    st = fsdem_pic_get_stats(s);
+    ck_assert_msg(fabs((double)st.time - 1.0) < 1e-9, "time %g", (double)st.time);
+    ck_assert_msg(st.max_speed < 1e-3, "%dD still water: max speed %g m/s after 1 s", dim, (double)st.max_speed);
+    p = bottom_pressure(s);
+    ck_assert_msg(fabs(p - ref) < 0.01 * ref, "%dD bottom pressure %g Pa vs rho g h = %g Pa", dim, p, ref);
+    ck_assert_msg(fabs((double)st.fluid_volume / (double)st.particle_volume - 1) < 1e-3, "volume %g vs %g",
+                  (double)st.fluid_volume, (double)st.particle_volume);
+    fsdem_pic_destroy(s);
+}
+
+START_TEST(still_water_2d_stays_still) { check_still(2, FSDEM_PIC_TRANSFER_FLIP, FSDEM_PIC_KERNEL_LINEAR); }
+END_TEST
+
+START_TEST(still_water_3d_stays_still) { check_still(3, FSDEM_PIC_TRANSFER_FLIP, FSDEM_PIC_KERNEL_LINEAR); }
+END_TEST
+
+START_TEST(still_water_apic_quadratic_stays_still) {
+    check_still(2, FSDEM_PIC_TRANSFER_APIC, FSDEM_PIC_KERNEL_QUADRATIC);
+}
+END_TEST
+
+/* Still water around submerged obstacles (2D: a disc and a wedge polygon; 3D: a sphere and a
+   horizontal cylinder) stays still: the cut-cell fractions E, the solid fluxes and the fluid
+   fraction next to solids are consistent with the hydrostatic state. */
+START_TEST(still_water_around_obstacles_stays_still) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        fsdem_pic_desc d = fsdem_pic_desc_default(dim);
+        fsdem_pic *s;
+        fsdem_pic_obstacle o1, o2;
+        fsdem_vec3 tri[3];
+        fsdem_pic_stats st;
+        fsdem_pic_grid g;
+        double err = 0, ref = RHO * G * 0.5;
+        int c;
+        d.cell_size = dim == 2 ? 0.05 : 0.1;
+        d.jitter = 0;
+        d.domain_max = dim == 2 ? fsdem_v3(1.0, 0.8, 0) : fsdem_v3(0.8, 0.4, 0.8);
+        ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+        if (dim == 2) {
+            tri[0] = fsdem_v3(0.7, 0, 0);
+            tri[1] = fsdem_v3(0.95, 0, 0);
+            tri[2] = fsdem_v3(0.95, 0.3, 0);
+            o1 = fsdem_pic_obstacle_sphere(fsdem_v3(0.43, 0.21, 0), 0.13);
+            o2 = fsdem_pic_obstacle_polygon(tri, 3);
+        } else {
+            o1 = fsdem_pic_obstacle_sphere(fsdem_v3(0.25, 0.2, 0.22), 0.13);
+            o2 = fsdem_pic_obstacle_cylinder(fsdem_v3(0.6, -0.1, 0.15), fsdem_v3(0.6, 0.5, 0.15), 0.09);
+        }
+        ck_assert_int_eq(fsdem_pic_add_obstacle(s, &o1, NULL), FSDEM_OK);
+        ck_assert_int_eq(fsdem_pic_add_obstacle(s, &o2, NULL), FSDEM_OK);
+        ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), dim == 2 ? fsdem_v3(1, 0.5, 0) : fsdem_v3(1, 1, 0.5),
+                                            fsdem_v3(0, 0, 0), NULL),
+                         FSDEM_OK);
+        ck_assert_int_eq(fsdem_pic_advance(s, 1.0, NULL), FSDEM_OK);
+        st = fsdem_pic_get_stats(s);
+        ck_assert_msg(st.max_speed < 1e-3, "%dD: max speed %g m/s after 1 s", dim, (double)st.max_speed);
+        g = fsdem_pic_get_grid(s);
+        for (c = 0; c < g.n[0] * g.n[1] * g.n[2]; ++c) {
+            int up = dim == 2 ? c / g.n[0] : c / (g.n[0] * g.n[1]);
+            double y = (up + 0.5) * (double)g.cell_size;
+            if (g.cell[c] != FSDEM_STENCIL_CELL_FLUID) continue;
+            if (fabs((double)g.pressure[c] - RHO * G * (0.5 - y)) > err) err = fabs((double)g.pressure[c] - RHO * G * (0.5 - y));
+        }
+        ck_assert_msg(err < 0.01 * ref, "%dD: pressure off the hydrostatic one by %g Pa", dim, err);
+        fsdem_pic_destroy(s);
+    }
+}
+END_TEST
+
+/* A small 2D dam break around a disc: after each step the projected velocity's divergence (with the
+   cut-cell fluxes) is zero in every fluid cell to the solver tolerance:
+   max |div| <= ||div||_2 after <= tol ||div u*||_2. */
+START_TEST(projection_is_discretely_divergence_free) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(2);
+    fsdem_pic *s;
+    fsdem_pic_obstacle disc = fsdem_pic_obstacle_sphere(fsdem_v3(0.55, 0.12, 0), 0.08);
+    int k;
+    d.cell_size = 0.04;
+    d.domain_max = fsdem_v3(1.0, 0.6, 0);
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_add_obstacle(s, &disc, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(0.3, 0.5, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    for (k = 0; k < 25; ++k) {
+        fsdem_pic_stats st;
+        ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+        st = fsdem_pic_get_stats(s);
+        ck_assert_int_gt(st.fluid_cells, 0);
+        ck_assert_msg(st.divergence_before > 0, "nothing to project");
+        ck_assert_msg(st.max_divergence <= 2 * d.pressure_tolerance * st.divergence_before,
+                      "step %d: max |div| %g 1/s, before %g 1/s", k, (double)st.max_divergence,
+                      (double)st.divergence_before);
+    }
+    ck_assert_msg(fsdem_pic_get_stats(s).max_speed > 0.5, "the column should be collapsing");
+    fsdem_pic_destroy(s);
+}
+END_TEST
+
+/* Flux through an open box: inflow U on -x, outflow on +x, slip walls, a disc in the middle, the
+   box completely filled (no free surface). Every section x = const carries U H. */
+START_TEST(open_box_conserves_flux_past_obstacle) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(2);
+    fsdem_pic *s;
+    fsdem_pic_obstacle disc = fsdem_pic_obstacle_sphere(fsdem_v3(0.5, 0.25, 0), 0.1);
+    fsdem_pic_grid g;
+    double U = 1.0, H = 0.5, vmax = 0;
+    int k, i, j;
+    d.cell_size = 0.025;
+    d.domain_max = fsdem_v3(1.0, H, 0);
+    d.gravity = fsdem_v3(0, 0, 0);
+    d.free_surface = 0;
+    d.boundary[0] = FSDEM_PIC_BC_INFLOW;
+    d.boundary_velocity[0] = fsdem_v3(U, 0, 0);
+    d.boundary[1] = FSDEM_PIC_BC_OUTFLOW;
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_add_obstacle(s, &disc, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(1.0, H, 0), fsdem_v3(U, 0, 0), NULL), FSDEM_OK);
+    for (k = 0; k < 10; ++k) ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+    g = fsdem_pic_get_grid(s);
+    for (i = 0; i <= g.n[0]; ++i) {
+        double flux = 0;
+        for (j = 0; j < g.n[1]; ++j) {
+            int f = j * (g.n[0] + 1) + i;
+            double e = (double)g.open[0][f];
+            flux += (e * (double)g.velocity[0][f] + (1 - e) * (double)g.solid_velocity[0][f]) * (double)g.cell_size;
+            if (fabs((double)g.velocity[0][f]) > vmax) vmax = fabs((double)g.velocity[0][f]);
+        }
+        ck_assert_msg(fabs(flux - U * H) < 1e-6 * U * H, "section %d: flux %.9g vs %.9g", i, flux, U * H);
+    }
+    ck_assert_msg(vmax > 1.2 * U, "the flow should accelerate past the disc (max u %g)", vmax);
+    ck_assert_int_gt(fsdem_pic_get_stats(s).particles, 0);
+    fsdem_pic_destroy(s);
+}
+END_TEST
+
+/* Every option combination (PIC, FLIP, APIC; linear and quadratic kernels; RK2 and RK3; with and
+   without density projection) runs a short 3D dam break without error, divergence-free, with the
+   particles inside the tank and no volume lost beyond 2 %. */
+START_TEST(option_matrix_runs_clean) {
+    int transfer, kernel, order, dp;
+    for (transfer = 0; transfer < 3; ++transfer)
+        for (kernel = 0; kernel < 2; ++kernel)
+            for (order = 2; order <= 3; ++order)
+                for (dp = 0; dp <= 1; ++dp) {
+                    fsdem_pic_desc d = fsdem_pic_desc_default(3);
+                    fsdem_pic *s;
+                    fsdem_pic_stats st;
+                    fsdem_pic_particles p;
+                    double v0;
+                    int k, i;
+                    d.cell_size = 0.1;
+                    d.domain_max = fsdem_v3(0.8, 0.3, 0.5);
+                    d.transfer = (fsdem_pic_transfer)transfer;
+                    d.kernel = (fsdem_pic_kernel)kernel;
+                    d.advection_order = order;
+                    d.density_projection = dp;
+                    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+                    ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(0.3, 0.3, 0.4), fsdem_v3(0, 0, 0), NULL),
+                                     FSDEM_OK);
+                    v0 = (double)fsdem_pic_get_stats(s).fluid_volume;
+                    for (k = 0; k < 8; ++k) {
+                        ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+                        st = fsdem_pic_get_stats(s);
+                        ck_assert_msg(st.max_divergence <= 2 * d.pressure_tolerance * st.divergence_before + 1e-12,
+                                      "transfer %d kernel %d order %d: div %g", transfer, kernel, order,
+                                      (double)st.max_divergence);
+                    }
+                    ck_assert_msg(st.max_speed > 0.3, "the column should be collapsing (%g m/s)", (double)st.max_speed);
+                    ck_assert_msg(fabs((double)st.fluid_volume / v0 - 1) < 0.02, "volume %g -> %g", v0, (double)st.fluid_volume);
+                    p = fsdem_pic_get_particles(s);
+                    for (i = 0; i < p.count; ++i)
+                        ck_assert(p.position[i].x > 0 && p.position[i].x < 0.8 && p.position[i].y > 0 && p.position[i].y < 0.3 &&
+                                  p.position[i].z > 0 && p.position[i].z < 0.5);
+                    fsdem_pic_destroy(s);
+                }
+}
+END_TEST
+
+/* Particles never stay inside a solid or outside the walls, and reseeding keeps every cell at or
+   below max_particles_per_cell. */
+START_TEST(particles_stay_out_of_solids) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(2);
+    fsdem_pic *s;
+    fsdem_vec3 tri[3];
+    fsdem_pic_obstacle wedge;
+    fsdem_pic_particles p;
+    fsdem_pic_grid g;
+    int k, i, *count;
+    tri[0] = fsdem_v3(0.45, 0.0, 0);
+    tri[1] = fsdem_v3(0.9, 0.0, 0);
+    tri[2] = fsdem_v3(0.9, 0.25, 0);
+    wedge = fsdem_pic_obstacle_polygon(tri, 3);
+    d.cell_size = 0.04;
+    d.domain_max = fsdem_v3(1.0, 0.6, 0);
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_add_obstacle(s, &wedge, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(0.3, 0.5, 0), fsdem_v3(1, 0, 0), NULL), FSDEM_OK);
+    for (k = 0; k < 30; ++k) ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+    p = fsdem_pic_get_particles(s);
+    g = fsdem_pic_get_grid(s);
+    count = (int *)calloc((size_t)(g.n[0] * g.n[1]), sizeof(int));
+    for (i = 0; i < p.count; ++i) {
+        fsdem_vec3 x = p.position[i];
+        int ci = (int)(x.x / g.cell_size), cj = (int)(x.y / g.cell_size);
+        ck_assert_msg(fsdem_pic_solid_distance(s, x, NULL) > 0, "particle %d at (%g, %g) is inside a solid", i, (double)x.x,
+                      (double)x.y);
+        count[cj * g.n[0] + ci]++;
+    }
+    for (i = 0; i < g.n[0] * g.n[1]; ++i) ck_assert_int_le(count[i], d.max_particles_per_cell);
+    free(count);
+    ck_assert_msg(p.velocity[0].x == p.velocity[0].x, "finite");
+    fsdem_pic_destroy(s);
+}
+END_TEST
+
+/* Implicit viscosity is unconditionally stable: with nu dt / dx^2 = 10 (explicit diffusion needs
+   <= 1/4) a shear flow sin(2 pi y / L) in a closed no-slip box decays every step (backward Euler
+   keeps 1/(1 + nu dt k^2) ~ 0.2 of the velocity of this mode, kinetic energy ~ 0.04) instead of
+   blowing up. PIC transfer, so the particles carry exactly the grid velocity. */
+START_TEST(implicit_viscosity_is_stable) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(2);
+    fsdem_pic *s;
+    fsdem_pic_particles p;
+    double ke, last, first;
+    int k, i;
+    d.cell_size = 0.05;
+    d.domain_max = fsdem_v3(0.5, 0.5, 0);
+    d.gravity = fsdem_v3(0, 0, 0);
+    d.viscosity = 2.5;
+    d.free_surface = 0;
+    d.transfer = FSDEM_PIC_TRANSFER_PIC;
+    for (k = 0; k < 4; ++k) d.boundary[k] = FSDEM_PIC_BC_NO_SLIP;
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(0.5, 0.5, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    p = fsdem_pic_get_particles(s);
+    for (i = 0; i < p.count; ++i) p.velocity[i] = fsdem_v3((fsdem_real)sin(2 * 3.14159265358979 * p.position[i].y / 0.5), 0, 0);
+    first = last = (double)fsdem_pic_get_stats(s).kinetic_energy;
+    for (k = 0; k < 5; ++k) {
+        ck_assert_int_eq(fsdem_pic_step_dt(s, 0.01), FSDEM_OK);
+        ck_assert_int_gt(fsdem_pic_get_stats(s).viscosity_iterations, 0);
+        ke = (double)fsdem_pic_get_stats(s).kinetic_energy;
+        ck_assert_msg(ke < 0.1 * last, "step %d: kinetic energy went from %g to %g J/m", k, last, ke);
+        last = ke;
+    }
+    ck_assert_msg(last < 1e-6 * first, "kinetic energy %g J/m of %g J/m left", last, first);
+    fsdem_pic_destroy(s);
+}
+END_TEST
+
+static int file_starts_with(const char *path, const char *text) {
+    char buf[256];
+    FILE *fp = fopen(path, "r");
+    size_t n;
+    if (!fp) return 0;
+    n = fread(buf, 1, sizeof buf - 1, fp);
+    buf[n] = '\0';
+    fclose(fp);
+    return strncmp(buf, text, strlen(text)) == 0;
+}
+
+START_TEST(output_files_are_written) {
+    fsdem_pic *s = still_tank(2, FSDEM_PIC_TRANSFER_FLIP, FSDEM_PIC_KERNEL_LINEAR);
+    fsdem_pvd pvd;
+    ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_write_particles_csv(s, "build/test_pic_particles.csv"), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_write_particles_vtp(s, "build/test_pic_particles.vtp"), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_write_grid_csv(s, "build/test_pic_grid.csv"), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_write_grid_vti(s, "build/test_pic_grid.vti"), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pvd_open(&pvd, "build/test_pic.pvd"), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pvd_add(&pvd, fsdem_pic_time(s), "test_pic_grid.vti"), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pvd_close(&pvd), FSDEM_OK);
+    ck_assert(file_starts_with("build/test_pic_particles.csv", "x,y,z,vx,vy,vz\n"));
+    ck_assert(file_starts_with("build/test_pic_particles.vtp", "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\""));
+    ck_assert(file_starts_with("build/test_pic_grid.csv", "i,j,k,x,y,z,type,p,phi,fraction,u,v,w\n"));
+    ck_assert(file_starts_with("build/test_pic_grid.vti", "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\""));
+    ck_assert(file_starts_with("build/test_pic.pvd", "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\""));
+    ck_assert_int_eq(fsdem_pic_write_grid_vti(s, "/nonexistent-dir/x.vti"), FSDEM_ERR_IO);
+    fsdem_pic_destroy(s);
+}
+END_TEST
+
+START_TEST(bad_desc_is_rejected) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(2);
+    fsdem_pic *s = (fsdem_pic *)&d;
+    char msg[256];
+    d.cell_size = 0;
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_null(s);
+    ck_assert_int_eq(fsdem_pic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_msg(strstr(msg, "cell_size") != NULL, "message: %s", msg);
+    d.cell_size = -0.1;
+    ck_assert_int_eq(fsdem_pic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    d = fsdem_pic_desc_default(3);
+    d.cell_size = 1e-5; /* 1e15 cells */
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_ERR_OUT_OF_MEMORY);
+    ck_assert_int_eq(fsdem_pic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_OUT_OF_MEMORY);
+    ck_assert_msg(strstr(msg, "cells") != NULL, "message: %s", msg);
+    d = fsdem_pic_desc_default(3);
+    d.cell_size = 0.01;
+    d.max_memory = 1000000; /* 1e6 cells do not fit in 1 MB */
+    ck_assert_int_eq(fsdem_pic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_OUT_OF_MEMORY);
+    ck_assert_msg(strstr(msg, "max_memory") != NULL, "message: %s", msg);
+    d = fsdem_pic_desc_default(2);
+    d.dim = 4;
+    ck_assert_int_eq(fsdem_pic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    d = fsdem_pic_desc_default(2);
+    d.cfl = 0;
+    ck_assert_int_eq(fsdem_pic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_msg(strstr(msg, "cfl") != NULL, "message: %s", msg);
+}
+END_TEST
+
+/* Bad particles, an obstacle covering everything and a CFL-violating dt are refused with a code and
+   a message naming the culprit; the solver is unchanged and keeps working. */
+START_TEST(bad_input_leaves_solver_usable) {
+    fsdem_pic *s = still_tank(2, FSDEM_PIC_TRANSFER_FLIP, FSDEM_PIC_KERNEL_LINEAR);
+    fsdem_vec3 x[3], v[3];
+    fsdem_pic_obstacle all = fsdem_pic_obstacle_box(fsdem_v3(-1, -1, -1), fsdem_v3(2, 2, 2));
+    fsdem_pic_obstacle bad = fsdem_pic_obstacle_sphere(fsdem_v3(0.5, 0.5, 0), -1);
+    fsdem_pic_particles p;
+    fsdem_vec3 first;
+    int before;
+    before = fsdem_pic_get_stats(s).particles;
+    x[0] = fsdem_v3(0.5, 0.6, 0);
+    x[1] = fsdem_v3(0.5, (fsdem_real)NAN, 0);
+    x[2] = fsdem_v3(0.6, 0.6, 0);
+    v[0] = v[1] = v[2] = fsdem_v3(0, 0, 0);
+    ck_assert_int_eq(fsdem_pic_add_particles(s, x, v, 3), FSDEM_ERR_INVALID_ARG);
+    ck_assert_msg(strstr(fsdem_pic_last_error(s), "particle 1") != NULL, "%s", fsdem_pic_last_error(s));
+    x[1] = fsdem_v3(0.5, 5.0, 0);
+    ck_assert_int_eq(fsdem_pic_add_particles(s, x, v, 3), FSDEM_ERR_OUT_OF_DOMAIN);
+    ck_assert_msg(strstr(fsdem_pic_last_error(s), "particle 1") != NULL, "%s", fsdem_pic_last_error(s));
+    ck_assert_int_eq(fsdem_pic_get_stats(s).particles, before);
+
+    ck_assert_int_eq(fsdem_pic_add_obstacle(s, &all, NULL), FSDEM_ERR_INVALID_ARG);
+    ck_assert_msg(strstr(fsdem_pic_last_error(s), "whole domain") != NULL, "%s", fsdem_pic_last_error(s));
+    ck_assert_int_eq(fsdem_pic_add_obstacle(s, &bad, NULL), FSDEM_ERR_INVALID_ARG);
+    ck_assert_msg(strstr(fsdem_pic_last_error(s), "radius") != NULL, "%s", fsdem_pic_last_error(s));
+    ck_assert_int_eq(fsdem_pic_get_stats(s).particles, before);
+
+    p = fsdem_pic_get_particles(s);
+    p.velocity[0] = fsdem_v3(3, 0, 0);
+    first = p.position[0];
+    ck_assert_int_eq(fsdem_pic_step_dt(s, 1.0), FSDEM_ERR_CFL);
+    ck_assert_msg(strstr(fsdem_pic_last_error(s), "particle 0") != NULL, "%s", fsdem_pic_last_error(s));
+    ck_assert(p.position[0].x == first.x && p.position[0].y == first.y);
+    ck_assert_int_eq(fsdem_pic_step_dt(s, 0.0), FSDEM_ERR_INVALID_ARG);
+    ck_assert_double_eq(fsdem_pic_time(s), 0);
+    p.velocity[0] = fsdem_v3(0, (fsdem_real)NAN, 0);
+    ck_assert_int_eq(fsdem_pic_step(s), FSDEM_ERR_NAN);
+    ck_assert_msg(strstr(fsdem_pic_last_error(s), "particle 0") != NULL, "%s", fsdem_pic_last_error(s));
+    p.velocity[0] = fsdem_v3(0, 0, 0);
+
+    ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+    ck_assert_str_eq(fsdem_pic_last_error(s), "");
+    ck_assert_int_eq(fsdem_pic_add_particles(s, x, v, 1), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+    fsdem_pic_destroy(s);
+}
+END_TEST
+
+/* Steps never allocate: a counting allocator sees no call during 20 steps of a dam break around an
+   obstacle with reseeding, density projection and viscosity (all memory comes from create, fill
+   and add_obstacle). */
+typedef struct counting {
+    long allocs, frees;
+} counting;
+
+static void *counting_alloc(void *user, size_t size) {
+    ((counting *)user)->allocs++;
+    return malloc(size);
+}
+
+static void counting_free(void *user, void *ptr, size_t size) {
+    (void)size;
+    ((counting *)user)->frees++;
+    free(ptr);
+}
+
+START_TEST(steps_do_not_allocate) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(2);
+    fsdem_pic *s;
+    fsdem_pic_obstacle box = fsdem_pic_obstacle_box(fsdem_v3(0.5, 0, 0), fsdem_v3(0.6, 0.15, 0));
+    counting c = {0, 0};
+    long allocs;
+    int k;
+    d.cell_size = 0.04;
+    d.domain_max = fsdem_v3(1.0, 0.6, 0);
+    d.viscosity = 1e-3;
+    d.allocator.alloc = counting_alloc;
+    d.allocator.free = counting_free;
+    d.allocator.user = &c;
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_add_obstacle(s, &box, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(0.3, 0.5, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    allocs = c.allocs;
+    ck_assert_int_gt(allocs, 0);
+    for (k = 0; k < 20; ++k) ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+    ck_assert_msg(c.allocs == allocs, "%ld allocations during the steps", c.allocs - allocs);
+    fsdem_pic_destroy(s);
+    ck_assert_int_eq(c.allocs, c.frees);
+}
+END_TEST
+
+/* The coupler arrays enter the projection: faces closed by a "moving solid" (open = 0) carry the
+   solid's velocity as flux. A column of faces across the open box closed with solid velocity U
+   leaves the uniform flow U untouched: flux U H through every section, no vertical velocity. */
+START_TEST(coupler_faces_carry_solid_flux) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(2);
+    fsdem_pic *s;
+    fsdem_pic_coupling *cp;
+    fsdem_pic_grid g;
+    double U = 0.5, H = 0.5;
+    int k, i, j, col = 20;
+    d.cell_size = 0.025;
+    d.domain_max = fsdem_v3(1.0, H, 0);
+    d.gravity = fsdem_v3(0, 0, 0);
+    d.free_surface = 0;
+    d.boundary[0] = FSDEM_PIC_BC_INFLOW;
+    d.boundary_velocity[0] = fsdem_v3(U, 0, 0);
+    d.boundary[1] = FSDEM_PIC_BC_OUTFLOW;
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(1.0, H, 0), fsdem_v3(U, 0, 0), NULL), FSDEM_OK);
+    cp = fsdem_pic_coupling_view(s);
+    ck_assert_int_eq(cp->face_count[0], (cp->n[0] + 1) * cp->n[1]);
+    for (j = 0; j < cp->n[1]; ++j) {
+        cp->open[0][j * (cp->n[0] + 1) + col] = 0;
+        cp->solid_velocity[0][j * (cp->n[0] + 1) + col] = (fsdem_real)U;
+    }
+    for (k = 0; k < 5; ++k) ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+    g = fsdem_pic_get_grid(s);
+    for (i = 0; i <= g.n[0]; ++i) {
+        double flux = 0;
+        for (j = 0; j < g.n[1]; ++j) {
+            int f = j * (g.n[0] + 1) + i;
+            double e = (double)g.open[0][f];
+            flux += (e * (double)g.velocity[0][f] + (1 - e) * (double)g.solid_velocity[0][f]) * (double)g.cell_size;
+        }
+        ck_assert_msg(fabs(flux - U * H) < 1e-6 * U * H, "section %d: flux %.9g vs %.9g", i, flux, U * H);
+    }
+    for (j = 0; j < g.n[1]; ++j) {
+        int f = j * (g.n[0] + 1) + col;
+        ck_assert(g.open[0][f] == 0);
+    }
+    for (i = 0; i < g.face_count[1]; ++i) ck_assert_msg(fabs((double)g.velocity[1][i]) < 1e-6, "v = %g", (double)g.velocity[1][i]);
+    fsdem_pic_destroy(s);
+}
+END_TEST
+
+/* A user signed-distance callback gives the same cut-cell face fractions as the built-in shape it
+   describes (a disc), and they are fractions: 0 inside, 1 far away, in between on the rim, with the
+   open length of a face row through the centre equal to the chord outside the disc. */
+static fsdem_real disc_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
+    const fsdem_real *c = (const fsdem_real *)user;
+    fsdem_real dx = p.x - c[0], dy = p.y - c[1], r = (fsdem_real)sqrt(dx * dx + dy * dy);
+    if (normal) *normal = r > 0 ? fsdem_v3(dx / r, dy / r, 0) : fsdem_v3(1, 0, 0);
+    return r - c[2];
+}
+
+START_TEST(sdf_callback_matches_builtin_obstacle) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(2);
+    fsdem_pic *a, *b;
+    fsdem_real disc[3] = {(fsdem_real)0.51, (fsdem_real)0.47, (fsdem_real)0.23};
+    fsdem_pic_obstacle o1 = fsdem_pic_obstacle_sphere(fsdem_v3(disc[0], disc[1], 0), disc[2]);
+    fsdem_pic_obstacle o2 = fsdem_pic_obstacle_sdf(disc_sdf, disc);
+    fsdem_pic_grid ga, gb;
+    int ax, f, partial = 0;
+    double open = 0;
+    d.cell_size = 0.05;
+    ck_assert_int_eq(fsdem_pic_create(&d, &a), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_create(&d, &b), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_add_obstacle(a, &o1, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_add_obstacle(b, &o2, NULL), FSDEM_OK);
+    ga = fsdem_pic_get_grid(a);
+    gb = fsdem_pic_get_grid(b);
+    for (ax = 0; ax < 2; ++ax)
+        for (f = 0; f < ga.face_count[ax]; ++f) {
+            ck_assert_msg(fabs((double)ga.open[ax][f] - (double)gb.open[ax][f]) < 1e-12, "axis %d face %d: %g vs %g", ax, f,
+                          (double)ga.open[ax][f], (double)gb.open[ax][f]);
+            ck_assert(ga.open[ax][f] >= 0 && ga.open[ax][f] <= 1);
+            partial += ga.open[ax][f] > 0 && ga.open[ax][f] < 1;
+        }
+    ck_assert_int_gt(partial, 20);
+    /* the vertical faces at x = 0.5 (i = 10) span y in [0, 1]: their open length is 1 minus the
+       chord 2 sqrt(r^2 - 0.01^2) of the disc */
+    for (f = 0; f < ga.n[1]; ++f) open += (double)ga.open[0][f * (ga.n[0] + 1) + 10] * (double)ga.cell_size;
+    ck_assert_msg(fabs(open - (1 - 2 * sqrt(0.23 * 0.23 - 0.01 * 0.01))) < 5e-3, "open length %g", open);
+    fsdem_pic_destroy(a);
+    fsdem_pic_destroy(b);
+}
+END_TEST
+
+/* Reseeding keeps the particle count of every fluid cell in [min, max] without creating volume: a
+   closed, completely filled box seeded twice (8 per cell) except for an empty column of cells has,
+   after one step, at least min_particles_per_cell particles in every cell and exactly as many
+   particles as before (moved from the crowded neighbours). The density projection is off so that
+   reseeding alone does it. */
+START_TEST(reseeding_moves_particles_into_sparse_cells) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(2);
+    fsdem_pic *s;
+    fsdem_pic_particles p;
+    fsdem_pic_grid g;
+    int *count, i, before;
+    d.cell_size = 0.1;
+    d.domain_max = fsdem_v3(1.0, 0.5, 0);
+    d.gravity = fsdem_v3(0, 0, 0);
+    d.free_surface = 0;
+    d.density_projection = 0;
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    for (i = 0; i < 2; ++i) {
+        ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(0.5, 0.5, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+        ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0.6, 0, 0), fsdem_v3(1.0, 0.5, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    }
+    before = fsdem_pic_get_stats(s).particles;
+    ck_assert_int_eq(before, 8 * 45);
+    ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+    p = fsdem_pic_get_particles(s);
+    g = fsdem_pic_get_grid(s);
+    ck_assert_int_eq(p.count, before);
+    ck_assert_int_gt((int)fsdem_pic_get_stats(s).moved, 0);
+    count = (int *)calloc((size_t)(g.n[0] * g.n[1]), sizeof(int));
+    for (i = 0; i < p.count; ++i) count[(int)(p.position[i].y / g.cell_size) * g.n[0] + (int)(p.position[i].x / g.cell_size)]++;
+    for (i = 0; i < g.n[0] * g.n[1]; ++i) {
+        ck_assert_msg(count[i] >= d.min_particles_per_cell, "cell %d has %d particles", i, count[i]);
+        ck_assert_int_le(count[i], d.max_particles_per_cell);
+    }
+    free(count);
+    fsdem_pic_destroy(s);
+}
+END_TEST
+
+Suite *pic_suite(void) {
+    Suite *s = suite_create("pic");
+    TCase *tc = tcase_create("pic");
+    tcase_set_timeout(tc, 60);
+    tcase_add_test(tc, still_water_2d_stays_still);
+    tcase_add_test(tc, still_water_3d_stays_still);
+    tcase_add_test(tc, still_water_apic_quadratic_stays_still);
+    tcase_add_test(tc, still_water_around_obstacles_stays_still);
+    tcase_add_test(tc, projection_is_discretely_divergence_free);
+    tcase_add_test(tc, open_box_conserves_flux_past_obstacle);
+    tcase_add_test(tc, option_matrix_runs_clean);
+    tcase_add_test(tc, particles_stay_out_of_solids);
+    tcase_add_test(tc, reseeding_moves_particles_into_sparse_cells);
+    tcase_add_test(tc, implicit_viscosity_is_stable);
+    tcase_add_test(tc, output_files_are_written);
+    tcase_add_test(tc, bad_desc_is_rejected);
+    tcase_add_test(tc, bad_input_leaves_solver_usable);
+    tcase_add_test(tc, steps_do_not_allocate);
+    tcase_add_test(tc, sdf_callback_matches_builtin_obstacle);
+    tcase_add_test(tc, coupler_faces_carry_solid_flux);
+    suite_add_tcase(s, tc);
+    return s;
+}

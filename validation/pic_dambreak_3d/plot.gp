@@ -1,0 +1,16 @@
+# Plots of pic_dambreak_3d; run by validation/report.sh inside build/validation/pic_dambreak_3d.
+set datafile separator ','
+set key autotitle columnhead
+set terminal pngcairo size 800,600 font ",11"
+set grid
+a = 0.05715
+g = 9.81
+set output 'front_3d.png'
+set title 'surge front, 3D against 2D (a/20)'
+set xlabel 'T = t sqrt(2g/a)'
+set ylabel 'Z = x_front / a'
+set key top left
+plot 'front_2d.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 3 title '2D', \
+     'front_thin.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 2 dt 2 title '3D thin (a/4)', \
+     'front_wide.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 2 dt 3 title '3D wide (a)', \
+     'ref_front.csv' using ($1*sqrt(2*g/a)):($2/a) with points pt 7 ps 1.2 title 'Martin & Moyce 1952'
