@@ -4093,6 +4093,17 @@ static double fsdem__pcg_true_residual(fsdem_pcg *s, const fsdem_real *b, fsdem_
     return fsdem__vdot(out, out, s->length);
 }
 
+/* r.z must be positive and finite for a symmetric positive definite preconditioner and operator. */
+static fsdem_result fsdem__pcg_check_rz(fsdem_pcg *s, double rz, int it) {
+    if (!fsdem__finite_d(rz))
+        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: r.z is NaN/Inf at iteration %d", it);
+    if (rz <= 0)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_pcg_solve: r.z = %g <= 0 at iteration %d: the preconditioner is not positive "
+                           "definite (is the operator?)", rz, it);
+    return FSDEM_OK;
+}
+
 fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, fsdem_pcg_info *info) {
     fsdem_pcg_info inf;
     double bb, rr, rz = 0, tol2, removed;
@@ -4169,12 +4180,8 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
             fsdem__pcg_precondition(s, s->r, s->z);
             fsdem__pcg_project(s, s->z);
             rz = fsdem__vdot(s->r, s->z, n);
-            if (!(rz > 0)) {
-                res = fsdem__fail(&s->status, fsdem__finite_d(rz) ? FSDEM_ERR_INVALID_ARG : FSDEM_ERR_NAN,
-                                  "fsdem_pcg_solve: r.z = %g <= 0 at iteration %d: the preconditioner is not positive "
-                                  "definite (is the operator?)", rz, it);
-                break;
-            }
+            res = fsdem__pcg_check_rz(s, rz, it);
+            if (res != FSDEM_OK) break;
             memcpy(s->p, s->z, sizeof(fsdem_real) * (size_t)n);
             restart = 0;
         }
@@ -4209,16 +4216,8 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
         fsdem__pcg_precondition(s, s->r, s->z);
         fsdem__pcg_project(s, s->z);
         rz_new = fsdem__vdot(s->r, s->z, n);
-        if (!fsdem__finite_d(rz_new)) {
-            res = fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: r.z is NaN/Inf at iteration %d", it);
-            break;
-        }
-        if (rz_new <= 0) {
-            res = fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
-                              "fsdem_pcg_solve: r.z = %g <= 0 at iteration %d: the preconditioner is not positive "
-                              "definite (is the operator?)", rz_new, it);
-            break;
-        }
+        res = fsdem__pcg_check_rz(s, rz_new, it);
+        if (res != FSDEM_OK) break;
         beta = rz_new / rz;
         rz = rz_new;
         {
