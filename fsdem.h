@@ -18,6 +18,9 @@
                 IC(0), MIC(0), geometric multigrid) shared by the pressure solves
      >>pic      PIC/FLIP/APIC free-surface solver on a MAC grid: cut-cell obstacles, ghost-fluid
                 pressure, implicit viscosity, density projection (seeds 000 and 004)
+     >>swe      shallow-water equations in 1D and 2D: HLL, MUSCL-Hancock, wet/dry, well-balanced
+                (seed 003)
+     >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
      >>io       CSV time series and particle snapshots (CSV, legacy VTK for ParaView)
      >>impl     implementation, in the same order
      >>licence  MIT
@@ -892,6 +895,346 @@ typedef struct fsdem_pvd {
 FSDEM_API fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path);
 FSDEM_API fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file);
 FSDEM_API fsdem_result fsdem_pvd_close(fsdem_pvd *pvd);
+
+/* ===== >>swe : shallow-water equations (seed 003) ================================================= */
+
+/* Depth-averaged shallow-water flow on a uniform Cartesian grid, 1D (x) or 2D (x-y), solved in the
+   pre-balanced form of seed 003 Eq. 1-2 (Liang and Borthwick 2009; Liang and Marche 2009):
+       q = [eta, uh, vh],  f = [uh, u^2 h + g (eta^2 - 2 eta z_b)/2, uvh],
+       s = [0, -tau_bx/rho - g eta dz_b/dx + S_vx + S_px, ... y likewise]
+   eta is the surface elevation, z_b the bed, h = eta - z_b the depth. Godunov-type finite volumes with
+   the HLL Riemann solver; second order in space and time by MUSCL-Hancock with a slope limiter, or
+   first order. Wet/dry fronts use the non-negative depth (hydrostatic) reconstruction with Liang's
+   local bed modification, so still water stays still over any bed, wet or dry, to the last bit, and
+   depths never go negative. Bed friction (Manning) is implicit; an eddy viscosity, rain, point
+   sources and a per-cell momentum source (S_px, for couplers) are optional.
+
+   Grid and storage: nx x ny cells (ny = 1 in 1D), cell (i, j) has centre
+   (x_min + (i + 1/2) dx, y_min + (j + 1/2) dy) and index k = i + nx j in every array of this section.
+   In 1D the channel has a `width` (default 1 m) so volumes and momenta have their 3D units.
+   Units: m, s, m^2/s for unit discharges uh and vh, kg/m^3 for the water density.
+   One thread: the sweep is sequential (no OpenMP in this section); distinct solvers may run in
+   distinct threads. */
+
+typedef struct fsdem_swe fsdem_swe;
+
+/* Slope limiter of the second-order reconstruction (all are TVD, so reconstructed depths stay within
+   the neighbours' range and never go negative). */
+typedef enum fsdem_swe_limiter {
+    FSDEM_SWE_LIMITER_MINMOD = 0,   /* most dissipative, the default */
+    FSDEM_SWE_LIMITER_VAN_LEER = 1, /* harmonic mean */
+    FSDEM_SWE_LIMITER_MC = 2,       /* monotonised central */
+    FSDEM_SWE_LIMITER_SUPERBEE = 3  /* least dissipative, steepens fronts */
+} fsdem_swe_limiter;
+
+/* Sides of the domain, the index into fsdem_swe_desc.boundary. 1D uses XMIN and XMAX only. */
+typedef enum fsdem_swe_side {
+    FSDEM_SWE_XMIN = 0,
+    FSDEM_SWE_XMAX = 1,
+    FSDEM_SWE_YMIN = 2,
+    FSDEM_SWE_YMAX = 3
+} fsdem_swe_side;
+
+typedef enum fsdem_swe_bc {
+    FSDEM_SWE_BC_WALL = 0,         /* reflective, free slip: no mass flux, mirrored normal velocity */
+    FSDEM_SWE_BC_TRANSMISSIVE = 1, /* zero gradient: waves leave (approximately) without reflection */
+    FSDEM_SWE_BC_DISCHARGE = 2,    /* inflow of a unit discharge `value` (m^2/s, >= 0, into the domain)
+                                      imposed exactly as the boundary mass flux; the boundary depth comes
+                                      from the outgoing Riemann invariant (subcritical inflow) */
+    FSDEM_SWE_BC_STAGE = 3         /* fixed surface elevation `value` (m) outside; the normal velocity
+                                      comes from the outgoing Riemann invariant */
+} fsdem_swe_bc;
+
+/* One side's boundary condition. With a series, `value` follows it in time (linear interpolation,
+   held constant before the first and after the last point): a hydrograph for DISCHARGE, a stage
+   record for STAGE. The series is copied when the boundary is set. */
+typedef struct fsdem_swe_boundary {
+    fsdem_swe_bc type;               /* default FSDEM_SWE_BC_WALL */
+    fsdem_real value;                /* m^2/s (DISCHARGE) or m (STAGE); default 0 */
+    const fsdem_real *series_time;   /* s, strictly increasing; NULL: constant `value`; default NULL */
+    const fsdem_real *series_value;  /* m^2/s or m, one per time; default NULL */
+    int series_count;                /* points in the series; default 0 */
+} fsdem_swe_boundary;
+
+typedef struct fsdem_swe_desc {
+    int dim;                         /* 1 or 2 */
+    int nx, ny;                      /* cells along x and y (ny must be 1 in 1D); default 100 (1D: 100 x 1) */
+    fsdem_real x_min, x_max;         /* m; extent along x; default 0 .. 1 */
+    fsdem_real y_min, y_max;         /* m; extent along y, 2D only; default 0 .. 1 */
+    fsdem_real width;                /* m; 1D only: channel width for volumes, momenta, forces; default 1 */
+    fsdem_real gravity;              /* m/s^2; default 9.81 */
+    fsdem_real density;              /* kg/m^3; water density for momentum and force; default 1000 */
+    fsdem_real cfl;                  /* -; Courant number of adaptive steps, in (0, 1]; default 0.5 */
+    fsdem_real dt_max;               /* s; longest adaptive step (used when nothing moves); default 1 */
+    int order;                       /* 1 (first order) or 2 (MUSCL-Hancock); default 2 */
+    fsdem_swe_limiter limiter;       /* order 2 only; default FSDEM_SWE_LIMITER_MINMOD */
+    fsdem_real dry_depth;            /* m; cells shallower than this have zero velocity; default 1e-6 */
+    fsdem_real manning;              /* s/m^(1/3); uniform Manning n, 0 = frictionless; default 0 */
+    fsdem_real eddy_viscosity;       /* m^2/s; turbulent viscosity of S_v = div(nu h grad u); default 0 */
+    fsdem_real rain_rate;            /* m/s; uniform rain on every cell; default 0 */
+    fsdem_swe_boundary boundary[4];  /* indexed by fsdem_swe_side; default all walls */
+    const fsdem_real *bed;           /* m; nx*ny bed elevations z_b, copied; NULL: flat at 0; default NULL */
+    const fsdem_real *depth;         /* m; nx*ny initial depths >= 0, copied; NULL: dry; default NULL */
+    fsdem_allocator allocator;       /* default: FSDEM_MALLOC/FSDEM_FREE */
+    fsdem_log_fn log;                /* optional; default NULL */
+    void *log_user;
+} fsdem_swe_desc;
+
+/* Defaults for a 1D or 2D grid (see the field comments). */
+FSDEM_API fsdem_swe_desc fsdem_swe_desc_default(int dim);
+/* Checks a desc, including every value of `bed` and `depth`, without creating anything; on failure
+   writes the reason, naming the field or cell, to `message` (may be NULL). Returns FSDEM_OK or
+   FSDEM_ERR_INVALID_ARG (zero or negative cell counts, an empty extent, cfl outside (0, 1], a NaN
+   bed, a negative or NaN depth, a bad boundary or series, ...). */
+FSDEM_API fsdem_result fsdem_swe_desc_check(const fsdem_swe_desc *desc, char *message, size_t message_size);
+/* Creates a solver (time 0). All memory is allocated here; steps allocate nothing. On
+   FSDEM_ERR_INVALID_ARG the reason goes to desc->log (and is available from fsdem_swe_desc_check);
+   also FSDEM_ERR_OUT_OF_MEMORY. *out is NULL on failure. Destroy with fsdem_swe_destroy. */
+FSDEM_API fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out);
+FSDEM_API void fsdem_swe_destroy(fsdem_swe *swe);
+/* Message of the last failed call on this object ("" after success). Valid until the next call. */
+FSDEM_API const char *fsdem_swe_last_error(const fsdem_swe *swe);
+
+/* ---- state ---- */
+
+/* Geometry of the grid. */
+typedef struct fsdem_swe_grid {
+    int dim, nx, ny;
+    fsdem_real dx, dy;        /* m; dy = width in 1D */
+    fsdem_real x_min, y_min;  /* m; lower corner (y_min = 0 in 1D) */
+    fsdem_real cell_area;     /* m^2; dx dy */
+} fsdem_swe_grid;
+
+FSDEM_API fsdem_swe_grid fsdem_swe_get_grid(const fsdem_swe *swe);
+
+/* Replaces the bed (nx*ny values, m), keeping each cell's depth. FSDEM_ERR_INVALID_ARG names the
+   first non-finite value; the state is then unchanged. */
+FSDEM_API fsdem_result fsdem_swe_set_bed(fsdem_swe *swe, const fsdem_real *bed);
+/* Sets the depths (m, >= 0), keeping the unit discharges. FSDEM_ERR_INVALID_ARG names the first
+   negative or non-finite value; the state is then unchanged. */
+FSDEM_API fsdem_result fsdem_swe_set_depth(fsdem_swe *swe, const fsdem_real *depth);
+/* Sets the surface elevation (m); cells whose bed is above it become dry (h = 0). */
+FSDEM_API fsdem_result fsdem_swe_set_surface(fsdem_swe *swe, const fsdem_real *eta);
+/* Sets the velocities (m/s; v may be NULL, ignored in 1D): uh = u h, vh = v h. */
+FSDEM_API fsdem_result fsdem_swe_set_velocity(fsdem_swe *swe, const fsdem_real *u, const fsdem_real *v);
+
+/* State of one cell (or of a point, interpolated), as set by or returned to the caller. */
+typedef struct fsdem_swe_cell {
+    fsdem_real bed;    /* m, z_b */
+    fsdem_real depth;  /* m, h >= 0 */
+    fsdem_real eta;    /* m, surface elevation z_b + h (output only) */
+    fsdem_real u, v;   /* m/s */
+} fsdem_swe_cell;
+
+/* Initial condition from a function of the cell centre (y = 0 in 1D): `fn` fills bed, depth, u, v.
+   Validated like the array setters; nothing changes on failure. */
+typedef void (*fsdem_swe_init_fn)(void *user, fsdem_real x, fsdem_real y, fsdem_swe_cell *cell);
+FSDEM_API fsdem_result fsdem_swe_set_cells(fsdem_swe *swe, fsdem_swe_init_fn fn, void *user);
+
+/* Views of the state arrays (nx*ny each, index i + nx j), valid until the solver is destroyed.
+   The conserved variables are read-only; change them with the setters. `source_x/y` are the
+   coupling momentum source S_p of seed 003 Eq. 2 and 8 in m^2/s^2 (acceleration times depth,
+   i.e. force per unit plan area divided by the density): written by the caller or a coupler,
+   added to d(uh)/dt and d(vh)/dt, and held over steps until changed (zero at creation). A source in
+   a dry cell is dropped (dry cells carry no momentum). */
+typedef struct fsdem_swe_fields {
+    int nx, ny;
+    const fsdem_real *eta;  /* m */
+    const fsdem_real *qx;   /* m^2/s, uh */
+    const fsdem_real *qy;   /* m^2/s, vh (all zero in 1D) */
+    const fsdem_real *bed;  /* m */
+    fsdem_real *source_x;   /* m^2/s^2 */
+    fsdem_real *source_y;   /* m^2/s^2 (ignored in 1D) */
+} fsdem_swe_fields;
+
+FSDEM_API fsdem_swe_fields fsdem_swe_get_fields(fsdem_swe *swe);
+
+typedef enum fsdem_swe_field {
+    FSDEM_SWE_FIELD_DEPTH = 0, /* m */
+    FSDEM_SWE_FIELD_ETA = 1,   /* m */
+    FSDEM_SWE_FIELD_U = 2,     /* m/s (0 in dry cells) */
+    FSDEM_SWE_FIELD_V = 3,     /* m/s */
+    FSDEM_SWE_FIELD_BED = 4,   /* m */
+    FSDEM_SWE_FIELD_QX = 5,    /* m^2/s */
+    FSDEM_SWE_FIELD_QY = 6     /* m^2/s */
+} fsdem_swe_field;
+
+/* Copies one field (nx*ny values) to `out`. FSDEM_ERR_INVALID_ARG for a bad field or NULL. */
+FSDEM_API fsdem_result fsdem_swe_copy_field(const fsdem_swe *swe, fsdem_swe_field field, fsdem_real *out);
+
+/* Cell holding the point (x, y) (y ignored in 1D): its index k = i + nx j, or -1 outside. */
+FSDEM_API int fsdem_swe_cell_at(const fsdem_swe *swe, fsdem_real x, fsdem_real y);
+/* State at a point, interpolated (bi)linearly between cell centres (clamped to the outermost centres
+   near the boundary): bed, depth, eta and velocity. FSDEM_ERR_OUT_OF_DOMAIN outside the grid. */
+FSDEM_API fsdem_result fsdem_swe_sample(const fsdem_swe *swe, fsdem_real x, fsdem_real y, fsdem_swe_cell *out);
+/* Adds a force (N) exerted on the water at (x, y) to the momentum source of the cell there,
+   as F / (rho dx dy) (1D: dy = width), so over a step of dt the water gains exactly F dt of momentum
+   (unless the cell is dry). Clear the sources with fsdem_swe_clear_sources. FSDEM_ERR_OUT_OF_DOMAIN. */
+FSDEM_API fsdem_result fsdem_swe_add_force(fsdem_swe *swe, fsdem_real x, fsdem_real y, fsdem_vec3 force);
+/* Sets source_x and source_y to zero. */
+FSDEM_API void fsdem_swe_clear_sources(fsdem_swe *swe);
+
+/* ---- boundaries, friction and sources ---- */
+
+/* Replaces one side's boundary condition (the series is copied). FSDEM_ERR_INVALID_ARG for a bad
+   side (Y sides in 1D), type, value or series; the old condition stays. FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_swe_set_boundary(fsdem_swe *swe, fsdem_swe_side side, const fsdem_swe_boundary *bc);
+/* Per-cell Manning coefficients (nx*ny values, s/m^(1/3), >= 0), copied; NULL returns to the uniform
+   desc.manning. FSDEM_ERR_INVALID_ARG names a negative or non-finite value. */
+FSDEM_API fsdem_result fsdem_swe_set_manning(fsdem_swe *swe, const fsdem_real *manning);
+/* Uniform rain rate (m/s, >= 0) from now on. */
+FSDEM_API fsdem_result fsdem_swe_set_rain(fsdem_swe *swe, fsdem_real rate);
+
+/* A point source (Q > 0) or sink (Q < 0) of discharge Q (m^3/s; 1D: the whole channel width) in the
+   cell holding (x, y); with a series, Q follows it in time like a boundary series. A sink takes no
+   more than the water in its cell. */
+typedef struct fsdem_swe_point_source {
+    fsdem_real x, y;                 /* m */
+    fsdem_real discharge;            /* m^3/s */
+    const fsdem_real *series_time;   /* s, optional (NULL) */
+    const fsdem_real *series_value;  /* m^3/s */
+    int series_count;
+} fsdem_swe_point_source;
+
+/* Adds a point source; its id goes to *id (may be NULL). FSDEM_ERR_OUT_OF_DOMAIN, INVALID_ARG,
+   OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_swe_add_point_source(fsdem_swe *swe, const fsdem_swe_point_source *src, int *id);
+/* Removes a point source (the id is not reused). FSDEM_ERR_NOT_FOUND. */
+FSDEM_API fsdem_result fsdem_swe_remove_point_source(fsdem_swe *swe, int id);
+
+/* ---- time integration ---- */
+
+/* Stable time step (s) of the current state: the dt with r dt + a dt^2 = cfl, where r is the max over
+   wet cells (and inflow/stage boundary states) of (|u| + c)/dx + (|v| + c)/dy, c = sqrt(g h), and
+   a = g max(|deta/dx|/dx + |deta/dy|/dy) bounds the velocity gained within the step (it matters for
+   thin films on steep beds; minmod slopes, so it is 0 for a lake at rest, islands included). Capped
+   by desc.dt_max and, with an eddy viscosity, by 2 nu dt (1/dx^2 + 1/dy^2) <= cfl. */
+FSDEM_API fsdem_real fsdem_swe_stable_dt(const fsdem_swe *swe);
+/* Advances by one adaptive step of min(stable dt, dt_cap) (dt_cap <= 0: no cap); the step taken goes
+   to *dt (may be NULL). Errors: FSDEM_ERR_NAN (the step is complete, the message names the first bad
+   cell; the state is then not usable), FSDEM_ERR_IO (a gauge row could not be written). */
+FSDEM_API fsdem_result fsdem_swe_step(fsdem_swe *swe, fsdem_real dt_cap, fsdem_real *dt);
+/* Advances by exactly dt (s). FSDEM_ERR_CFL, with nothing changed, when dt exceeds the stability
+   limit (Courant number > 1); FSDEM_ERR_INVALID_ARG for dt <= 0; otherwise as fsdem_swe_step. */
+FSDEM_API fsdem_result fsdem_swe_step_fixed(fsdem_swe *swe, fsdem_real dt);
+/* Adaptive steps until `duration` (s) has elapsed exactly (the last step is shortened); the number
+   of steps goes to *steps (may be NULL). Stops at the first error. */
+FSDEM_API fsdem_result fsdem_swe_advance(fsdem_swe *swe, fsdem_real duration, long long *steps);
+FSDEM_API fsdem_real fsdem_swe_time(const fsdem_swe *swe);
+
+/* ---- diagnostics ---- */
+
+/* Water volume (m^3): sum of h dx dy (1D: h dx width). */
+FSDEM_API fsdem_real fsdem_swe_volume(const fsdem_swe *swe);
+/* Water momentum (kg m/s): rho times the sum of (uh, vh, 0) dx dy. */
+FSDEM_API fsdem_vec3 fsdem_swe_momentum(const fsdem_swe *swe);
+
+typedef struct fsdem_swe_stats {
+    long long steps;              /* steps taken */
+    fsdem_real time;              /* s */
+    fsdem_real dt;                /* s, the last step */
+    fsdem_real max_depth;         /* m, over the cells */
+    fsdem_real max_speed;         /* m/s, largest |velocity| over wet cells */
+    int wet_cells;                /* cells with h >= dry_depth */
+    fsdem_real boundary_volume;   /* m^3, net volume that entered through the boundaries */
+    fsdem_real source_volume;     /* m^3, net volume added by rain and point sources */
+    fsdem_real clipped_volume;    /* m^3, volume added to keep depths non-negative (0 in practice) */
+    long long predictor_fallbacks;/* cells whose MUSCL-Hancock predictor was skipped for positivity */
+    size_t memory_bytes;          /* bytes held by the object */
+} fsdem_swe_stats;
+
+/* Statistics; conservation reads volume(t) = volume(0) + boundary_volume + source_volume
+   + clipped_volume to rounding. */
+FSDEM_API fsdem_swe_stats fsdem_swe_get_stats(const fsdem_swe *swe);
+
+/* ---- output ---- */
+
+/* Field snapshot as CSV, one row per cell: x,y,bed,h,eta,u,v (1D: x,bed,h,eta,u). FSDEM_ERR_IO. */
+FSDEM_API fsdem_result fsdem_swe_write_csv(const fsdem_swe *swe, const char *path);
+/* Field snapshot as legacy VTK image data (STRUCTURED_POINTS, cell data h, eta, bed, velocity) for
+   ParaView. FSDEM_ERR_IO. */
+FSDEM_API fsdem_result fsdem_swe_write_vtk(const fsdem_swe *swe, const char *path);
+
+/* Adds a gauge at (x, y) (before fsdem_swe_gauges_open); its id goes to *id (may be NULL).
+   FSDEM_ERR_OUT_OF_DOMAIN, FSDEM_ERR_OUT_OF_MEMORY, FSDEM_ERR_INVALID_ARG while a file is open. */
+FSDEM_API fsdem_result fsdem_swe_add_gauge(fsdem_swe *swe, fsdem_real x, fsdem_real y, int *id);
+/* Samples gauge `id` now (as fsdem_swe_sample). FSDEM_ERR_NOT_FOUND. */
+FSDEM_API fsdem_result fsdem_swe_gauge(const fsdem_swe *swe, int id, fsdem_swe_cell *out);
+/* Opens a gauge time series: a CSV with columns t, then h_<id>,eta_<id>,u_<id>,v_<id> per gauge.
+   A row is written now and after every step that reaches the next multiple of `interval` (s; 0:
+   every step). FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (no gauges, interval < 0). */
+FSDEM_API fsdem_result fsdem_swe_gauges_open(fsdem_swe *swe, const char *path, fsdem_real interval);
+/* Closes the gauge file (also done by fsdem_swe_destroy). FSDEM_ERR_IO. */
+FSDEM_API fsdem_result fsdem_swe_gauges_close(fsdem_swe *swe);
+
+/* ===== >>couple_swe : SWE-DEM floating debris (seed 003) ========================================== */
+
+/* Two-way coupling of a shallow-water solver (1D along x, or 2D in x-y) with DEM debris after seed 003
+   Eq. 3-8. The debris are the spheres of a 3D fsdem_dem whose z axis is vertical (gravity along -z);
+   the water surface and velocity at a sphere come from the fsdem_swe. On each sphere:
+     buoyancy      F_b = rho g V_sub, upwards, V_sub the submerged spherical cap (Eq. 5);
+     horizontal    F_h = p_B S_B - p_F S_F per horizontal axis (Eq. 6-7): the hydrostatic part
+                   rho g z integrated over the submerged circular segments of the sphere's back and
+                   front (with the surface elevations sampled at x - r and x + r), plus the dynamic
+                   pressure rho (beta u - w)^2 on the side facing the relative flow.
+   The vertical position follows from buoyancy against gravity in the DEM (floating), and a sphere in
+   water too shallow to float it rests on the bed with friction when the DEM has a bed wall (a plane,
+   or fsdem_swe_bed_sdf for the solver's own bathymetry). On the water, the reaction -F_h is a momentum
+   source spread over the wet cells under the sphere's footprint as force per unit plan area divided by
+   rho (Eq. 8 as printed, S_px = p/rho, is loose about units; this form makes the exchange exact: the
+   water gains exactly -F_h dt per step while the debris gains F_h dt).
+   Each coupled step: forces from the current state, one adaptive SWE step dt, then K DEM substeps of
+   dt with the fluid forces held fixed (fsdem_dem_advance, seed 000 Eq. 25). The coupler owns the
+   SWE's source_x/source_y and the DEM's external_force while it is used. */
+
+typedef struct fsdem_swe_dem fsdem_swe_dem;
+
+typedef struct fsdem_swe_dem_desc {
+    fsdem_swe *swe;               /* water; not owned; must outlive the coupler */
+    fsdem_dem *dem;               /* debris: dim 3, gravity along -z; not owned */
+    fsdem_real beta;              /* -; surface-velocity correction of seed 003 Eq. 6; default 1.1 */
+    int two_way;                  /* 1: the water feels the reaction (Eq. 8); 0: one-way; default 1 */
+    fsdem_real heave_damping;     /* -; fraction of critical damping of the bobbing about the floating
+                                     draft (wave radiation is not in the SWE); default 0 */
+    fsdem_log_fn log;             /* optional; default NULL */
+    void *log_user;
+} fsdem_swe_dem_desc;
+
+FSDEM_API fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void);
+/* Creates a coupler. FSDEM_ERR_INVALID_ARG (missing solver, DEM not 3D, gravity not along -z or
+   different from the SWE's, beta <= 0, negative damping; the reason goes to desc->log and to
+   `message` of fsdem_swe_dem_desc_check), FSDEM_ERR_OUT_OF_MEMORY. Destroy with fsdem_swe_dem_destroy
+   (which leaves the solvers alive). */
+FSDEM_API fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *desc, char *message, size_t message_size);
+FSDEM_API fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out);
+FSDEM_API void fsdem_swe_dem_destroy(fsdem_swe_dem *coupler);
+FSDEM_API const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *coupler);
+
+/* Fluid forces on one sphere, as the last fsdem_swe_dem_update_forces computed them. */
+typedef struct fsdem_swe_dem_force {
+    fsdem_vec3 buoyancy;          /* N, (0, 0, rho g V_sub) */
+    fsdem_vec3 hydrostatic;       /* N, horizontal */
+    fsdem_vec3 dynamic;           /* N, horizontal */
+    fsdem_vec3 heave;             /* N, vertical damping (0 unless heave_damping > 0) */
+    fsdem_real submerged_volume;  /* m^3 */
+    fsdem_real frontal_area;      /* m^2, submerged area facing +x (S_F of seed 003 along x) */
+} fsdem_swe_dem_force;
+
+/* Computes the fluid forces on every free sphere from the current states, writes them to the DEM's
+   external forces and, with two_way, the reactions to the SWE's momentum sources. */
+FSDEM_API fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *coupler);
+/* Forces on particle `index` from the last update (zero for fixed particles and dry spheres).
+   FSDEM_ERR_NOT_FOUND for a bad index. */
+FSDEM_API fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *coupler, int index, fsdem_swe_dem_force *out);
+/* One coupled step: update the forces, one adaptive SWE step of at most dt_cap (<= 0: no cap), then
+   the DEM over the same dt in substeps. The step goes to *dt and the substep count to *substeps (both
+   may be NULL). Errors of either solver are passed on with their message. */
+FSDEM_API fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *coupler, fsdem_real dt_cap, fsdem_real *dt, int *substeps);
+
+/* Signed distance from p to the SWE bed surface z = z_b(x, y), for fsdem_wall_sdf(fsdem_swe_bed_sdf,
+   swe, material): (z - z_b)/sqrt(1 + |grad z_b|^2) with the bed normal; exact on planar beds. `user` is
+   the fsdem_swe. Points outside the SWE grid take the nearest cell's bed. */
+FSDEM_API fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal);
 
 /* ===== >>io : CSV time series and particle snapshots =============================================== */
 
@@ -6918,6 +7261,1901 @@ fsdem_result fsdem_pvd_close(fsdem_pvd *pvd) {
     bad |= fclose((FILE *)pvd->file) != 0;
     pvd->file = NULL;
     return bad ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+/* ===== >>impl_swe : shallow-water solver ========================================================== */
+
+/* Scheme (one step of dt, >>swe_step):
+     1. MUSCL reconstruction of eta, h, u, v per cell with the limiter (slopes per cell width); z_b at
+        a face is eta_face - h_face, so the bed is never reconstructed on its own. Ghost cells mirror
+        the cell at a wall; at other sides they copy h, u, v and extrapolate the bed linearly.
+     2. Hancock predictor: each cell's face values are advanced by dt/2 with the flux difference of
+        its own faces plus sources (the pressure/bed-slope pair in the form g h (eta_E - eta_W), which
+        vanishes for a flat surface over any bed) and half a step of friction. Skipped in a cell
+        where it would make a face depth negative (counted in stats.predictor_fallbacks).
+     3. Faces: non-negative depth reconstruction with Liang's local bed modification,
+            z_f = max(z_L, z_R), m = min(eta_L, eta_R);
+            if z_f <= m: h*_s = eta_s - z_f, eta*_s = eta_s                      (plain)
+            else:        h*_s = max(0, eta_s - z_f), eta*_s = h*_s + m, z_f -> m (dz = z_f - m)
+        then HLL with the two-rarefaction wave speeds, or, when one side is dry, the exact Godunov
+        flux of the rarefaction into dry bed (sharper wet fronts than HLL's estimate).
+     4. Update. Mass uses the single face flux, so volume is conserved to rounding. Normal momentum
+        uses the algebraically identical "side" form of the pre-balanced scheme (seed 003 Eq. 2 with
+        the source -g eta_bar dz_b/dx of Liang and Marche 2009): the face flux seen from side s is
+            F = A_s + g h*_s^2/2 + D_s,  D_L = s_L (s_R dU - dF)/(s_R - s_L),  D_R = s_R (s_L dU - dF)/(s_R - s_L)
+        (A = advective part), and the cell's pressure flux difference plus bed-slope source combine to
+            -(g/2) (h*_E + h*_W) (eta*_E - eta*_W) / dx,
+        which is exactly zero when the cell's own face surfaces are equal: a lake at rest stays at rest
+        bit for bit, also against dry islands (there eta*_s = m = the lake's surface).
+     5. Point sources, rain, momentum source S_p (explicit), eddy viscosity (explicit, time n), Manning
+        friction (backward Euler, exact: |q| = 2|q*| / (1 + sqrt(1 + 4 dt C |q*|)), C = g n^2 / h^(7/3)),
+        which never reverses the flow, is stable at any depth and keeps uniform flow at normal depth.
+     6. Depths stay non-negative: TVD reconstruction, the predictor fallback, and a time step that also
+        bounds the velocity gained within the step (fsdem_swe_stable_dt). Should a depth still come out
+        negative, the deficit is taken from the wet neighbours (stats.clipped_volume counts any part
+        they cannot give; zero in every test and validation case).
+   Thin layers: cells shallower than dry_depth carry no momentum; face depths below 1e-9 dry_depth
+   carry no flux and unit discharges below 1e-100 m^2/s are set to zero, which stops the scheme's
+   geometrically decaying leaks ahead of fronts and waves before they become subnormal numbers.
+   Sweeps: rows are processed bottom to top with ring buffers of three rows of primitive values and two
+   rows of predicted face states, so each state array is read once and written once per step; the
+   row kernel is specialised per limiter. Single-threaded (no OpenMP in this section). */
+
+/* Work data of one cell of a row in flight (2D): the predicted states at its north and south faces
+   and its increments from the x faces. Kept together so the y-face sweep streams one array. */
+typedef struct fsdem__swe_rowcell {
+    fsdem_real n[4];   /* north face: eta, h, v (normal), u (tangential) */
+    fsdem_real s[4];   /* south face */
+    fsdem_real acc[3]; /* eta, uh, vh increments from the x faces (and viscosity) */
+    fsdem_real pad;
+} fsdem__swe_rowcell;
+
+/* South-face fluxes of a cell, kept until its north face is computed on the next row. */
+typedef struct fsdem__swe_sface {
+    fsdem_real mass, a, t, h, e, pad;
+} fsdem__swe_sface;
+
+/* Forces inlining where the compiler allows it: the row kernel is instantiated once per limiter and
+   dimension so that its inner loop has neither a limiter switch nor 2D branches in 1D. */
+#if defined(__GNUC__) || defined(__clang__)
+#define FSDEM__SWE_FORCE_INLINE static inline __attribute__((always_inline))
+#elif defined(_MSC_VER)
+#define FSDEM__SWE_FORCE_INLINE static __forceinline
+#else
+#define FSDEM__SWE_FORCE_INLINE static inline
+#endif
+
+/* m^2/s: unit discharges below this are set to zero (no physical meaning; see fsdem__swe_finish) */
+#define FSDEM__SWE_QTINY ((fsdem_real)(sizeof(fsdem_real) < sizeof(double) ? 1e-12 : 1e-100))
+
+typedef struct fsdem__swe_bnd {
+    fsdem_swe_bc type;
+    fsdem_real value;
+    fsdem_real *t, *v; /* owned series, n points */
+    int n;
+} fsdem__swe_bnd;
+
+typedef struct fsdem__swe_src {
+    fsdem_real discharge;
+    fsdem_real *t, *v;
+    int n, cell, id, active;
+} fsdem__swe_src;
+
+struct fsdem_swe {
+    fsdem_swe_desc desc; /* bed, depth and the boundary series pointers are not kept */
+    fsdem__status status;
+    fsdem_allocator allocator;
+    int dim, nx, ny, n;
+    fsdem_real dx, dy, area, g, tiny;
+    fsdem_real time, dt_last;
+    long long steps, fallbacks;
+    fsdem_real max_wave;  /* 1/s, max over wet cells of (|u|+c)/dx + (|v|+c)/dy of the current state */
+    fsdem_real max_accel; /* 1/s^2, max over wet cells of g (|deta/dx|/dx + |deta/dy|/dy), minmod slopes */
+    fsdem_real max_speed, max_depth;
+    int wet_cells;
+    fsdem_real vol_boundary, vol_source, vol_clipped;
+    fsdem_real rain;
+
+    /* state, structure of arrays */
+    fsdem_real *block; /* one allocation holding the state and the work rows */
+    size_t block_bytes;
+    fsdem_real *eta, *qx, *qy, *bed, *sx, *sy;
+    fsdem_real *manning; /* NULL: uniform desc.manning */
+    int sources_used;
+
+    /* work rows */
+    int slots;            /* primitive row slots: 3 in 2D, 1 in 1D */
+    fsdem_real *prim;     /* slots x 4 x (nx + 2): eta, h, u, v with one ghost cell at each end */
+    fsdem__swe_rowcell *rows; /* 2D: 2 x nx, ring of the last two rows (>>swe_step) */
+    fsdem__swe_sface *south;  /* 2D: nx south-face data of the row in flight */
+
+    fsdem__swe_bnd bnd[4];
+    fsdem_real bvalue[4]; /* boundary values at the middle of the step in flight */
+
+    fsdem__swe_src *src;
+    int src_count, src_capacity, src_next_id;
+
+    fsdem_real *gauge_xy;
+    int gauge_count, gauge_capacity;
+    void *gauge_file;
+    fsdem_real gauge_interval, gauge_next;
+};
+
+/* ---- >>swe_desc : defaults and validation ---- */
+
+fsdem_swe_desc fsdem_swe_desc_default(int dim) {
+    fsdem_swe_desc d;
+    int k;
+    memset(&d, 0, sizeof d);
+    d.dim = dim;
+    d.nx = 100;
+    d.ny = dim == 2 ? 100 : 1;
+    d.x_min = 0;
+    d.x_max = 1;
+    d.y_min = 0;
+    d.y_max = 1;
+    d.width = 1;
+    d.gravity = (fsdem_real)9.81;
+    d.density = 1000;
+    d.cfl = (fsdem_real)0.5;
+    d.dt_max = 1;
+    d.order = 2;
+    d.limiter = FSDEM_SWE_LIMITER_MINMOD;
+    d.dry_depth = (fsdem_real)1e-6;
+    d.manning = 0;
+    d.eddy_viscosity = 0;
+    d.rain_rate = 0;
+    for (k = 0; k < 4; ++k) d.boundary[k].type = FSDEM_SWE_BC_WALL;
+    return d;
+}
+
+static const char *fsdem__swe_side_name(int side) {
+    static const char *names[4] = {"XMIN", "XMAX", "YMIN", "YMAX"};
+    return side >= 0 && side < 4 ? names[side] : "?";
+}
+
+static fsdem_result fsdem__swe_series_check(const fsdem_real *t, const fsdem_real *v, int n, int non_negative,
+                                            const char *what, char *msg, size_t size) {
+    int k;
+    if (n == 0 && !t && !v) return FSDEM_OK;
+    if (n < 1 || !t || !v)
+        return fsdem__reject(msg, size, "%s: a series needs series_count >= 1 and both arrays (got %d points)",
+                             what, n);
+    for (k = 0; k < n; ++k) {
+        if (!fsdem__finite(t[k]) || !fsdem__finite(v[k]))
+            return fsdem__reject(msg, size, "%s: series point %d is not finite", what, k);
+        if (k > 0 && !(t[k] > t[k - 1]))
+            return fsdem__reject(msg, size, "%s: series times must increase strictly (point %d: %g after %g s)",
+                                 what, k, (double)t[k], (double)t[k - 1]);
+        if (non_negative && v[k] < 0)
+            return fsdem__reject(msg, size, "%s: series value %d must be >= 0 (got %g)", what, k, (double)v[k]);
+    }
+    return FSDEM_OK;
+}
+
+static fsdem_result fsdem__swe_boundary_check(const fsdem_swe_boundary *b, int side, char *msg, size_t size) {
+    char what[64];
+    snprintf(what, sizeof what, "boundary[%s]", fsdem__swe_side_name(side));
+    if (!b) return fsdem__reject(msg, size, "%s is NULL", what);
+    if (b->type != FSDEM_SWE_BC_WALL && b->type != FSDEM_SWE_BC_TRANSMISSIVE && b->type != FSDEM_SWE_BC_DISCHARGE &&
+        b->type != FSDEM_SWE_BC_STAGE)
+        return fsdem__reject(msg, size, "%s.type is not a fsdem_swe_bc (%d)", what, (int)b->type);
+    if (!fsdem__finite(b->value)) return fsdem__reject(msg, size, "%s.value is not finite", what);
+    if (b->type == FSDEM_SWE_BC_DISCHARGE && b->value < 0)
+        return fsdem__reject(msg, size, "%s.value: an inflow discharge must be >= 0 (got %g m^2/s)", what,
+                             (double)b->value);
+    return fsdem__swe_series_check(b->series_time, b->series_value, b->series_count,
+                                   b->type == FSDEM_SWE_BC_DISCHARGE, what, msg, size);
+}
+
+/* First bad value of a per-cell array: returns its index or -1. */
+static int fsdem__swe_first_bad(const fsdem_real *a, int n, int non_negative) {
+    int k;
+    for (k = 0; k < n; ++k)
+        if (!fsdem__finite(a[k]) || (non_negative && a[k] < 0)) return k;
+    return -1;
+}
+
+fsdem_result fsdem_swe_desc_check(const fsdem_swe_desc *d, char *msg, size_t size) {
+    int k, n;
+    fsdem_result res;
+    if (!d) return fsdem__reject(msg, size, "fsdem_swe_desc is NULL");
+    if (d->dim != 1 && d->dim != 2) return fsdem__reject(msg, size, "fsdem_swe_desc.dim must be 1 or 2 (got %d)", d->dim);
+    if (d->nx < 1) return fsdem__reject(msg, size, "fsdem_swe_desc.nx must be >= 1 cell (got %d)", d->nx);
+    if (d->ny < 1) return fsdem__reject(msg, size, "fsdem_swe_desc.ny must be >= 1 cell (got %d)", d->ny);
+    if (d->dim == 1 && d->ny != 1) return fsdem__reject(msg, size, "fsdem_swe_desc.ny must be 1 in 1D (got %d)", d->ny);
+    if ((double)d->nx * (double)d->ny > (double)(1 << 30))
+        return fsdem__reject(msg, size, "fsdem_swe_desc: nx*ny = %g cells is too many", (double)d->nx * (double)d->ny);
+    if (!fsdem__finite(d->x_min) || !fsdem__finite(d->x_max) || !(d->x_max > d->x_min))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.x_max must exceed x_min (got %g .. %g m)", (double)d->x_min,
+                             (double)d->x_max);
+    if (d->dim == 2 && (!fsdem__finite(d->y_min) || !fsdem__finite(d->y_max) || !(d->y_max > d->y_min)))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.y_max must exceed y_min (got %g .. %g m)", (double)d->y_min,
+                             (double)d->y_max);
+    if (d->dim == 1 && (!(d->width > 0) || !fsdem__finite(d->width)))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.width must be > 0 (got %g m)", (double)d->width);
+    if (!(d->gravity > 0) || !fsdem__finite(d->gravity))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.gravity must be > 0 (got %g m/s^2)", (double)d->gravity);
+    if (!(d->density > 0) || !fsdem__finite(d->density))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.density must be > 0 (got %g kg/m^3)", (double)d->density);
+    if (!(d->cfl > 0 && d->cfl <= 1))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.cfl must be in (0, 1] (got %g)", (double)d->cfl);
+    if (!(d->dt_max > 0) || !fsdem__finite(d->dt_max))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.dt_max must be > 0 (got %g s)", (double)d->dt_max);
+    if (d->order != 1 && d->order != 2)
+        return fsdem__reject(msg, size, "fsdem_swe_desc.order must be 1 or 2 (got %d)", d->order);
+    if ((int)d->limiter < 0 || (int)d->limiter > 3)
+        return fsdem__reject(msg, size, "fsdem_swe_desc.limiter is not a fsdem_swe_limiter (%d)", (int)d->limiter);
+    if (!(d->dry_depth > 0) || !fsdem__finite(d->dry_depth))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.dry_depth must be > 0 (got %g m)", (double)d->dry_depth);
+    if (!(d->manning >= 0) || !fsdem__finite(d->manning))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.manning must be >= 0 (got %g s/m^(1/3))", (double)d->manning);
+    if (!(d->eddy_viscosity >= 0) || !fsdem__finite(d->eddy_viscosity))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.eddy_viscosity must be >= 0 (got %g m^2/s)",
+                             (double)d->eddy_viscosity);
+    if (!(d->rain_rate >= 0) || !fsdem__finite(d->rain_rate))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.rain_rate must be >= 0 (got %g m/s)", (double)d->rain_rate);
+    for (k = 0; k < (d->dim == 2 ? 4 : 2); ++k) {
+        res = fsdem__swe_boundary_check(&d->boundary[k], k, msg, size);
+        if (res != FSDEM_OK) return res;
+    }
+    if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.allocator: set both alloc and free, or neither");
+    n = d->nx * d->ny;
+    if (d->bed && (k = fsdem__swe_first_bad(d->bed, n, 0)) >= 0)
+        return fsdem__reject(msg, size, "fsdem_swe_desc.bed[%d] (cell i=%d, j=%d) is not finite (got %g m)", k,
+                             k % d->nx, k / d->nx, (double)d->bed[k]);
+    if (d->depth && (k = fsdem__swe_first_bad(d->depth, n, 1)) >= 0)
+        return fsdem__reject(msg, size, "fsdem_swe_desc.depth[%d] (cell i=%d, j=%d) must be finite and >= 0 (got %g m)",
+                             k, k % d->nx, k / d->nx, (double)d->depth[k]);
+    return FSDEM_OK;
+}
+
+/* ---- >>swe_object : creation, series, state ---- */
+
+static fsdem_real fsdem__swe_limit(int limiter, fsdem_real a, fsdem_real b);
+
+static void fsdem__swe_free_series(fsdem_swe *s, fsdem_real **t, fsdem_real **v, int *n) {
+    fsdem__free(&s->allocator, *t, sizeof(fsdem_real) * (size_t)*n);
+    fsdem__free(&s->allocator, *v, sizeof(fsdem_real) * (size_t)*n);
+    *t = *v = NULL;
+    *n = 0;
+}
+
+/* Copies a series into freshly allocated arrays (n = 0: none). */
+static fsdem_result fsdem__swe_copy_series(fsdem_swe *s, const fsdem_real *t, const fsdem_real *v, int n,
+                                           fsdem_real **tout, fsdem_real **vout) {
+    *tout = *vout = NULL;
+    if (n <= 0) return FSDEM_OK;
+    *tout = (fsdem_real *)fsdem__alloc(&s->allocator, sizeof(fsdem_real) * (size_t)n);
+    *vout = (fsdem_real *)fsdem__alloc(&s->allocator, sizeof(fsdem_real) * (size_t)n);
+    if (!*tout || !*vout) {
+        fsdem__free(&s->allocator, *tout, sizeof(fsdem_real) * (size_t)n);
+        fsdem__free(&s->allocator, *vout, sizeof(fsdem_real) * (size_t)n);
+        *tout = *vout = NULL;
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    }
+    memcpy(*tout, t, sizeof(fsdem_real) * (size_t)n);
+    memcpy(*vout, v, sizeof(fsdem_real) * (size_t)n);
+    return FSDEM_OK;
+}
+
+/* Value of a series at time t (linear, held constant outside), or `constant` without a series. */
+static fsdem_real fsdem__swe_series_at(const fsdem_real *ts, const fsdem_real *vs, int n, fsdem_real constant,
+                                       fsdem_real t) {
+    int lo = 0, hi = n - 1;
+    if (n <= 0) return constant;
+    if (t <= ts[0]) return vs[0];
+    if (t >= ts[n - 1]) return vs[n - 1];
+    while (hi - lo > 1) {
+        int mid = (lo + hi) / 2;
+        if (ts[mid] <= t) lo = mid;
+        else hi = mid;
+    }
+    return vs[lo] + (vs[hi] - vs[lo]) * (t - ts[lo]) / (ts[hi] - ts[lo]);
+}
+
+static fsdem_result fsdem__swe_store_boundary(fsdem_swe *s, int side, const fsdem_swe_boundary *b) {
+    fsdem_real *t, *v;
+    fsdem_result res = fsdem__swe_copy_series(s, b->series_time, b->series_value, b->series_count, &t, &v);
+    if (res != FSDEM_OK) return res;
+    fsdem__swe_free_series(s, &s->bnd[side].t, &s->bnd[side].v, &s->bnd[side].n);
+    s->bnd[side].type = b->type;
+    s->bnd[side].value = b->value;
+    s->bnd[side].t = t;
+    s->bnd[side].v = v;
+    s->bnd[side].n = t ? b->series_count : 0;
+    return FSDEM_OK;
+}
+
+/* Velocity of a cell (0 when dry). */
+static void fsdem__swe_velocity(const fsdem_swe *s, int k, fsdem_real *u, fsdem_real *v) {
+    fsdem_real h = s->eta[k] - s->bed[k];
+    if (h < s->desc.dry_depth) {
+        *u = *v = 0;
+        return;
+    }
+    *u = s->qx[k] / h;
+    *v = s->qy[k] / h;
+}
+
+/* Recomputes the wave-speed bound and the statistics of the current state (after a setter). */
+static void fsdem__swe_scan(fsdem_swe *s) {
+    int k, wet = 0;
+    fsdem_real wave = 0, speed2 = 0, hmax = 0, accel = 0;
+    fsdem_real idx = 1 / s->dx, idy = s->dim == 2 ? 1 / s->dy : 0;
+    for (k = 0; k < s->n; ++k) {
+        fsdem_real h = s->eta[k] - s->bed[k], u, v, c, w;
+        if (h > hmax) hmax = h;
+        if (h < s->desc.dry_depth) continue;
+        fsdem__swe_velocity(s, k, &u, &v);
+        c = (fsdem_real)sqrt(s->g * h);
+        w = (fsdem_real)fabs(u) * idx + (fsdem_real)fabs(v) * idy + c * (idx + idy);
+        if (w > wave) wave = w;
+        {
+            int i = k % s->nx, j = k / s->nx;
+            fsdem_real a = 0;
+            if (i > 0 && i < s->nx - 1)
+                a += (fsdem_real)fabs(fsdem__swe_limit(0, s->eta[k] - s->eta[k - 1], s->eta[k + 1] - s->eta[k])) * idx * idx;
+            if (j > 0 && j < s->ny - 1)
+                a += (fsdem_real)fabs(fsdem__swe_limit(0, s->eta[k] - s->eta[k - s->nx], s->eta[k + s->nx] - s->eta[k])) *
+                     idy * idy;
+            if (s->g * a > accel) accel = s->g * a;
+        }
+        if (u * u + v * v > speed2) speed2 = u * u + v * v;
+        wet++;
+    }
+    s->max_wave = wave;
+    s->max_accel = accel;
+    s->max_speed = (fsdem_real)sqrt(speed2);
+    s->max_depth = hmax;
+    s->wet_cells = wet;
+}
+
+fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_allocator al;
+    fsdem_swe *s;
+    size_t n, nx, reals;
+    int k;
+    if (out) *out = NULL;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    if (fsdem_swe_desc_check(desc, msg, sizeof msg) != FSDEM_OK) {
+        if (desc && desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
+        return FSDEM_ERR_INVALID_ARG;
+    }
+    al = desc->allocator;
+    s = (fsdem_swe *)fsdem__alloc(&al, sizeof *s);
+    if (!s) return FSDEM_ERR_OUT_OF_MEMORY;
+    memset(s, 0, sizeof *s);
+    s->desc = *desc;
+    s->desc.bed = s->desc.depth = NULL;
+    s->allocator = al;
+    s->status.log = desc->log;
+    s->status.log_user = desc->log_user;
+    s->dim = desc->dim;
+    s->nx = desc->nx;
+    s->ny = desc->ny;
+    s->n = desc->nx * desc->ny;
+    s->g = desc->gravity;
+    s->tiny = desc->dry_depth * (fsdem_real)1e-9;
+    s->dx = (desc->x_max - desc->x_min) / (fsdem_real)desc->nx;
+    s->dy = desc->dim == 2 ? (desc->y_max - desc->y_min) / (fsdem_real)desc->ny : desc->width;
+    s->area = s->dx * s->dy;
+    s->rain = desc->rain_rate;
+    s->slots = desc->dim == 2 ? 3 : 1;
+    n = (size_t)s->n;
+    nx = (size_t)s->nx;
+    reals = 6 * n + (size_t)s->slots * 4 * (nx + 2);
+    if (s->dim == 2)
+        reals += (2 * sizeof(fsdem__swe_rowcell) + sizeof(fsdem__swe_sface)) / sizeof(fsdem_real) * nx;
+    s->block_bytes = reals * sizeof(fsdem_real);
+    s->block = (fsdem_real *)fsdem__alloc(&al, s->block_bytes);
+    if (!s->block) {
+        fsdem__free(&al, s, sizeof *s);
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    }
+    memset(s->block, 0, s->block_bytes);
+    s->eta = s->block;
+    s->qx = s->eta + n;
+    s->qy = s->qx + n;
+    s->bed = s->qy + n;
+    s->sx = s->bed + n;
+    s->sy = s->sx + n;
+    s->prim = s->sy + n;
+    if (s->dim == 2) {
+        s->rows = (fsdem__swe_rowcell *)(void *)(s->prim + (size_t)s->slots * 4 * (nx + 2));
+        s->south = (fsdem__swe_sface *)(void *)(s->rows + 2 * nx);
+    }
+    for (k = 0; k < 4; ++k) {
+        s->bnd[k].type = FSDEM_SWE_BC_WALL;
+        if (k < (s->dim == 2 ? 4 : 2) && fsdem__swe_store_boundary(s, k, &desc->boundary[k]) != FSDEM_OK) {
+            fsdem_swe_destroy(s);
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        }
+        s->desc.boundary[k].series_time = s->desc.boundary[k].series_value = NULL;
+        s->desc.boundary[k].series_count = 0;
+    }
+    for (k = 0; k < s->n; ++k) {
+        s->bed[k] = desc->bed ? desc->bed[k] : 0;
+        s->eta[k] = s->bed[k] + (desc->depth ? desc->depth[k] : 0);
+    }
+    fsdem__swe_scan(s);
+    *out = s;
+    return FSDEM_OK;
+}
+
+void fsdem_swe_destroy(fsdem_swe *s) {
+    int k;
+    if (!s) return;
+    if (s->gauge_file) fclose((FILE *)s->gauge_file);
+    for (k = 0; k < 4; ++k) fsdem__swe_free_series(s, &s->bnd[k].t, &s->bnd[k].v, &s->bnd[k].n);
+    for (k = 0; k < s->src_count; ++k) fsdem__swe_free_series(s, &s->src[k].t, &s->src[k].v, &s->src[k].n);
+    fsdem__free(&s->allocator, s->src, sizeof(fsdem__swe_src) * (size_t)s->src_capacity);
+    fsdem__free(&s->allocator, s->gauge_xy, 2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+    fsdem__free(&s->allocator, s->manning, sizeof(fsdem_real) * (size_t)s->n);
+    fsdem__free(&s->allocator, s->block, s->block_bytes);
+    fsdem__free(&s->allocator, s, sizeof *s);
+}
+
+const char *fsdem_swe_last_error(const fsdem_swe *s) { return s ? s->status.message : "fsdem_swe is NULL"; }
+
+fsdem_swe_grid fsdem_swe_get_grid(const fsdem_swe *s) {
+    fsdem_swe_grid g;
+    g.dim = s->dim;
+    g.nx = s->nx;
+    g.ny = s->ny;
+    g.dx = s->dx;
+    g.dy = s->dy;
+    g.x_min = s->desc.x_min;
+    g.y_min = s->dim == 2 ? s->desc.y_min : 0;
+    g.cell_area = s->area;
+    return g;
+}
+
+/* Rejects a per-cell input array: NULL, or its first bad value named. */
+static fsdem_result fsdem__swe_array_check(fsdem_swe *s, const fsdem_real *a, int non_negative, const char *what,
+                                           const char *unit) {
+    int k;
+    if (!a) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: array is NULL", what);
+    k = fsdem__swe_first_bad(a, s->n, non_negative);
+    if (k >= 0)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: value %d (cell i=%d, j=%d) must be finite%s (got %g %s)",
+                           what, k, k % s->nx, k / s->nx, non_negative ? " and >= 0" : "", (double)a[k], unit);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_swe_set_bed(fsdem_swe *s, const fsdem_real *bed) {
+    int k;
+    if (fsdem__swe_array_check(s, bed, 0, "fsdem_swe_set_bed", "m") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
+    for (k = 0; k < s->n; ++k) {
+        fsdem_real h = s->eta[k] - s->bed[k];
+        s->bed[k] = bed[k];
+        s->eta[k] = bed[k] + h;
+    }
+    fsdem__swe_scan(s);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_set_depth(fsdem_swe *s, const fsdem_real *depth) {
+    int k;
+    if (fsdem__swe_array_check(s, depth, 1, "fsdem_swe_set_depth", "m") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
+    for (k = 0; k < s->n; ++k) {
+        s->eta[k] = s->bed[k] + depth[k];
+        if (depth[k] < s->desc.dry_depth) s->qx[k] = s->qy[k] = 0;
+    }
+    fsdem__swe_scan(s);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_set_surface(fsdem_swe *s, const fsdem_real *eta) {
+    int k;
+    if (fsdem__swe_array_check(s, eta, 0, "fsdem_swe_set_surface", "m") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
+    for (k = 0; k < s->n; ++k) {
+        s->eta[k] = eta[k] > s->bed[k] ? eta[k] : s->bed[k];
+        if (s->eta[k] - s->bed[k] < s->desc.dry_depth) s->qx[k] = s->qy[k] = 0;
+    }
+    fsdem__swe_scan(s);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_set_velocity(fsdem_swe *s, const fsdem_real *u, const fsdem_real *v) {
+    int k;
+    if (fsdem__swe_array_check(s, u, 0, "fsdem_swe_set_velocity (u)", "m/s") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
+    if (v && s->dim == 2 && fsdem__swe_array_check(s, v, 0, "fsdem_swe_set_velocity (v)", "m/s") != FSDEM_OK)
+        return FSDEM_ERR_INVALID_ARG;
+    for (k = 0; k < s->n; ++k) {
+        fsdem_real h = s->eta[k] - s->bed[k];
+        int wet = h >= s->desc.dry_depth;
+        s->qx[k] = wet ? u[k] * h : 0;
+        s->qy[k] = wet && v && s->dim == 2 ? v[k] * h : 0;
+    }
+    fsdem__swe_scan(s);
+    return fsdem__ok(&s->status);
+}
+
+static void fsdem__swe_centre(const fsdem_swe *s, int k, fsdem_real *x, fsdem_real *y) {
+    *x = s->desc.x_min + ((fsdem_real)(k % s->nx) + (fsdem_real)0.5) * s->dx;
+    *y = s->dim == 2 ? s->desc.y_min + ((fsdem_real)(k / s->nx) + (fsdem_real)0.5) * s->dy : 0;
+}
+
+fsdem_result fsdem_swe_set_cells(fsdem_swe *s, fsdem_swe_init_fn fn, void *user) {
+    int k, pass;
+    if (!fn) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_set_cells: fn is NULL");
+    /* pass 0 validates everything, pass 1 writes, so a bad cell leaves the state unchanged */
+    for (pass = 0; pass < 2; ++pass)
+        for (k = 0; k < s->n; ++k) {
+            fsdem_swe_cell c;
+            fsdem_real x, y;
+            fsdem__swe_centre(s, k, &x, &y);
+            c.bed = 0;
+            c.depth = 0;
+            c.eta = 0;
+            c.u = c.v = 0;
+            fn(user, x, y, &c);
+            if (pass == 0) {
+                if (!fsdem__finite(c.bed) || !fsdem__finite(c.depth) || c.depth < 0 || !fsdem__finite(c.u) ||
+                    !fsdem__finite(c.v))
+                    return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                                       "fsdem_swe_set_cells: cell %d (i=%d, j=%d, x=%g, y=%g) has bed %g m, depth %g m, "
+                                       "u %g, v %g m/s: all must be finite and the depth >= 0",
+                                       k, k % s->nx, k / s->nx, (double)x, (double)y, (double)c.bed, (double)c.depth,
+                                       (double)c.u, (double)c.v);
+                continue;
+            }
+            s->bed[k] = c.bed;
+            s->eta[k] = c.bed + c.depth;
+            if (c.depth >= s->desc.dry_depth) {
+                s->qx[k] = c.u * c.depth;
+                s->qy[k] = s->dim == 2 ? c.v * c.depth : 0;
+            } else {
+                s->qx[k] = s->qy[k] = 0;
+            }
+        }
+    fsdem__swe_scan(s);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_swe_fields fsdem_swe_get_fields(fsdem_swe *s) {
+    fsdem_swe_fields f;
+    f.nx = s->nx;
+    f.ny = s->ny;
+    f.eta = s->eta;
+    f.qx = s->qx;
+    f.qy = s->qy;
+    f.bed = s->bed;
+    f.source_x = s->sx;
+    f.source_y = s->sy;
+    s->sources_used = 1; /* the caller may write them from now on */
+    return f;
+}
+
+fsdem_result fsdem_swe_copy_field(const fsdem_swe *s, fsdem_swe_field field, fsdem_real *out) {
+    int k;
+    if (!s || !out) return FSDEM_ERR_INVALID_ARG;
+    for (k = 0; k < s->n; ++k) {
+        fsdem_real u, v;
+        switch (field) {
+        case FSDEM_SWE_FIELD_DEPTH: out[k] = s->eta[k] - s->bed[k]; break;
+        case FSDEM_SWE_FIELD_ETA: out[k] = s->eta[k]; break;
+        case FSDEM_SWE_FIELD_U: fsdem__swe_velocity(s, k, &u, &v); out[k] = u; break;
+        case FSDEM_SWE_FIELD_V: fsdem__swe_velocity(s, k, &u, &v); out[k] = v; break;
+        case FSDEM_SWE_FIELD_BED: out[k] = s->bed[k]; break;
+        case FSDEM_SWE_FIELD_QX: out[k] = s->qx[k]; break;
+        case FSDEM_SWE_FIELD_QY: out[k] = s->qy[k]; break;
+        default: return FSDEM_ERR_INVALID_ARG;
+        }
+    }
+    return FSDEM_OK;
+}
+
+int fsdem_swe_cell_at(const fsdem_swe *s, fsdem_real x, fsdem_real y) {
+    fsdem_real fx = (x - s->desc.x_min) / s->dx, fy = s->dim == 2 ? (y - s->desc.y_min) / s->dy : 0;
+    int i, j;
+    if (!(fx >= 0 && fx <= (fsdem_real)s->nx) || !(fy >= 0 && fy <= (fsdem_real)s->ny)) return -1;
+    i = (int)fx;
+    j = (int)fy;
+    if (i >= s->nx) i = s->nx - 1;
+    if (j >= s->ny) j = s->ny - 1;
+    return i + s->nx * j;
+}
+
+fsdem_result fsdem_swe_sample(const fsdem_swe *s, fsdem_real x, fsdem_real y, fsdem_swe_cell *out) {
+    fsdem_real fx, fy, wx, wy, w[4];
+    int i0, j0, i1, j1, c[4], q;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    if (fsdem_swe_cell_at(s, x, y) < 0) return FSDEM_ERR_OUT_OF_DOMAIN;
+    /* (bi)linear between the centres around the point, clamped at the outermost centres */
+    fx = (x - s->desc.x_min) / s->dx - (fsdem_real)0.5;
+    fy = s->dim == 2 ? (y - s->desc.y_min) / s->dy - (fsdem_real)0.5 : 0;
+    if (fx < 0) fx = 0;
+    if (fy < 0) fy = 0;
+    if (fx > (fsdem_real)(s->nx - 1)) fx = (fsdem_real)(s->nx - 1);
+    if (fy > (fsdem_real)(s->ny - 1)) fy = (fsdem_real)(s->ny - 1);
+    i0 = (int)fx;
+    j0 = (int)fy;
+    i1 = i0 + 1 < s->nx ? i0 + 1 : i0;
+    j1 = j0 + 1 < s->ny ? j0 + 1 : j0;
+    wx = fx - (fsdem_real)i0;
+    wy = fy - (fsdem_real)j0;
+    c[0] = i0 + s->nx * j0;
+    c[1] = i1 + s->nx * j0;
+    c[2] = i0 + s->nx * j1;
+    c[3] = i1 + s->nx * j1;
+    w[0] = (1 - wx) * (1 - wy);
+    w[1] = wx * (1 - wy);
+    w[2] = (1 - wx) * wy;
+    w[3] = wx * wy;
+    out->bed = out->depth = out->u = out->v = 0;
+    for (q = 0; q < 4; ++q) {
+        fsdem_real u, v;
+        fsdem__swe_velocity(s, c[q], &u, &v);
+        out->bed += w[q] * s->bed[c[q]];
+        out->depth += w[q] * (s->eta[c[q]] - s->bed[c[q]]);
+        out->u += w[q] * u;
+        out->v += w[q] * v;
+    }
+    out->eta = out->bed + out->depth;
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_swe_add_force(fsdem_swe *s, fsdem_real x, fsdem_real y, fsdem_vec3 force) {
+    int k = fsdem_swe_cell_at(s, x, y);
+    fsdem_real scale;
+    if (k < 0)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_swe_add_force: point (%g, %g) is outside the grid",
+                           (double)x, (double)y);
+    if (!fsdem__finite3(force))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_force: force is not finite");
+    scale = 1 / (s->desc.density * s->area);
+    s->sx[k] += force.x * scale;
+    if (s->dim == 2) s->sy[k] += force.y * scale;
+    s->sources_used = 1;
+    return fsdem__ok(&s->status);
+}
+
+void fsdem_swe_clear_sources(fsdem_swe *s) {
+    memset(s->sx, 0, sizeof(fsdem_real) * (size_t)s->n);
+    memset(s->sy, 0, sizeof(fsdem_real) * (size_t)s->n);
+}
+
+fsdem_result fsdem_swe_set_boundary(fsdem_swe *s, fsdem_swe_side side, const fsdem_swe_boundary *bc) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    if ((int)side < 0 || (int)side >= (s->dim == 2 ? 4 : 2))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_set_boundary: side %d does not exist in %dD",
+                           (int)side, s->dim);
+    if (fsdem__swe_boundary_check(bc, (int)side, msg, sizeof msg) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_set_boundary: %s", msg);
+    if (fsdem__swe_store_boundary(s, (int)side, bc) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_set_boundary: out of memory");
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_set_manning(fsdem_swe *s, const fsdem_real *manning) {
+    if (!manning) {
+        fsdem__free(&s->allocator, s->manning, sizeof(fsdem_real) * (size_t)s->n);
+        s->manning = NULL;
+        return fsdem__ok(&s->status);
+    }
+    if (fsdem__swe_array_check(s, manning, 1, "fsdem_swe_set_manning", "s/m^(1/3)") != FSDEM_OK)
+        return FSDEM_ERR_INVALID_ARG;
+    if (!s->manning) {
+        s->manning = (fsdem_real *)fsdem__alloc(&s->allocator, sizeof(fsdem_real) * (size_t)s->n);
+        if (!s->manning) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_set_manning: out of memory");
+    }
+    memcpy(s->manning, manning, sizeof(fsdem_real) * (size_t)s->n);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_set_rain(fsdem_swe *s, fsdem_real rate) {
+    if (!(rate >= 0) || !fsdem__finite(rate))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_set_rain: rate must be >= 0 (got %g m/s)",
+                           (double)rate);
+    s->rain = rate;
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_add_point_source(fsdem_swe *s, const fsdem_swe_point_source *p, int *id) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem__swe_src *q;
+    int k;
+    if (!p) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_point_source: source is NULL");
+    if (!fsdem__finite(p->discharge))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_point_source: discharge is not finite");
+    if (fsdem__swe_series_check(p->series_time, p->series_value, p->series_count, 0, "point source", msg, sizeof msg) !=
+        FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_point_source: %s", msg);
+    k = fsdem_swe_cell_at(s, p->x, p->y);
+    if (k < 0)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN,
+                           "fsdem_swe_add_point_source: point (%g, %g) is outside the grid", (double)p->x, (double)p->y);
+    if (fsdem__grow(&s->allocator, (void **)&s->src, &s->src_capacity, s->src_count, s->src_count + 1,
+                    sizeof(fsdem__swe_src)) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_add_point_source: out of memory");
+    q = &s->src[s->src_count];
+    memset(q, 0, sizeof *q);
+    if (fsdem__swe_copy_series(s, p->series_time, p->series_value, p->series_count, &q->t, &q->v) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_add_point_source: out of memory");
+    q->n = q->t ? p->series_count : 0;
+    q->discharge = p->discharge;
+    q->cell = k;
+    q->id = s->src_next_id++;
+    q->active = 1;
+    s->src_count++;
+    if (id) *id = q->id;
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_remove_point_source(fsdem_swe *s, int id) {
+    int k;
+    for (k = 0; k < s->src_count; ++k)
+        if (s->src[k].active && s->src[k].id == id) {
+            s->src[k].active = 0;
+            return fsdem__ok(&s->status);
+        }
+    return fsdem__fail(&s->status, FSDEM_ERR_NOT_FOUND, "fsdem_swe_remove_point_source: no source with id %d", id);
+}
+
+/* ---- >>swe_riemann : face fluxes ---- */
+
+/* Fluxes through one face along its normal. Inputs are the reconstructed states of the lower (L) and
+   upper (R) sides: surface eta, depth h, normal velocity un, tangential velocity ut. */
+typedef struct fsdem__swe_flux {
+    fsdem_real mass;   /* m^2/s, along the normal */
+    fsdem_real tan;    /* m^3/s^2, flux of tangential momentum */
+    fsdem_real aL, aR; /* m^3/s^2, normal-momentum flux seen from each side minus g h*_s^2 / 2 */
+    fsdem_real hL, hR; /* m, h* after the non-negative reconstruction */
+    fsdem_real eL, eR; /* m, eta* */
+} fsdem__swe_flux;
+
+static inline void fsdem__swe_riemann(fsdem_real g, fsdem_real tiny, fsdem_real eL, fsdem_real hL, fsdem_real uL,
+                                      fsdem_real vL, fsdem_real eR, fsdem_real hR, fsdem_real uR, fsdem_real vR,
+                                      fsdem__swe_flux *f) {
+    fsdem_real zL = eL - hL, zR = eR - hR;
+    fsdem_real zf = zL > zR ? zL : zR, m = eL < eR ? eL : eR;
+    fsdem_real hsL, hsR, cL, cR, qL, qR, sL, sR, advL, advR, pL, pR;
+    if (zf <= m) {
+        hsL = eL - zf;
+        hsR = eR - zf;
+        f->eL = eL;
+        f->eR = eR;
+    } else {
+        /* the lower surface is below the face bed: lower the face bed to it (Liang's dz) */
+        hsL = eL > zf ? eL - zf : 0;
+        hsR = eR > zf ? eR - zf : 0;
+        f->eL = hsL + m;
+        f->eR = hsR + m;
+    }
+    f->hL = hsL;
+    f->hR = hsR;
+    /* depths below `tiny` (1e-9 dry_depth) carry no flux: they would only feed ever thinner films
+       ahead of a front, whose squares end in slow subnormal arithmetic */
+    if (hsL < tiny) hsL = 0;
+    if (hsR < tiny) hsR = 0;
+    if (!(hsL > 0) && !(hsR > 0)) {
+        f->mass = f->tan = f->aL = f->aR = 0;
+        return;
+    }
+    cL = (fsdem_real)sqrt(g * hsL);
+    cR = (fsdem_real)sqrt(g * hsR);
+    qL = hsL * uL;
+    qR = hsR * uR;
+    if (!(hsR > 0) || !(hsL > 0)) {
+        /* one side dry: the exact Godunov flux of the rarefaction into dry bed (Toro 2001, ch. 5):
+           for a dry right side the fan spans uL - cL .. uL + 2cL with u + 2c = uL + 2cL, so at x/t = 0
+           u = c = (uL + 2cL)/3 (mirror image for a dry left side) */
+        fsdem_real h0, u0, v0, a0;
+        if (!(hsR > 0)) {
+            a0 = uL + 2 * cL;
+            if (uL - cL >= 0) { h0 = hsL; u0 = uL; }
+            else if (a0 <= 0) { h0 = 0; u0 = 0; }
+            else { u0 = a0 / 3; h0 = u0 * u0 / g; }
+            v0 = vL;
+        } else {
+            a0 = uR - 2 * cR;
+            if (uR + cR <= 0) { h0 = hsR; u0 = uR; }
+            else if (a0 >= 0) { h0 = 0; u0 = 0; }
+            else { u0 = a0 / 3; h0 = u0 * u0 / g; }
+            v0 = vR;
+        }
+        f->mass = h0 * u0;
+        f->tan = h0 * u0 * v0;
+        a0 = h0 * u0 * u0 + (fsdem_real)0.5 * g * h0 * h0;
+        f->aL = a0 - (fsdem_real)0.5 * g * hsL * hsL;
+        f->aR = a0 - (fsdem_real)0.5 * g * hsR * hsR;
+        return;
+    } else {
+        fsdem_real us = (fsdem_real)0.5 * (uL + uR) + cL - cR;
+        fsdem_real cs = (fsdem_real)0.5 * (cL + cR) + (fsdem_real)0.25 * (uL - uR);
+        if (cs < 0) cs = 0;
+        sL = uL - cL < us - cs ? uL - cL : us - cs;
+        sR = uR + cR > us + cs ? uR + cR : us + cs;
+    }
+    advL = qL * uL;
+    advR = qR * uR;
+    pL = (fsdem_real)0.5 * g * hsL * hsL;
+    pR = (fsdem_real)0.5 * g * hsR * hsR;
+    if (sL >= 0) {
+        f->mass = qL;
+        f->tan = qL * vL;
+        f->aL = advL;
+        f->aR = advL + pL - pR;
+    } else if (sR <= 0) {
+        f->mass = qR;
+        f->tan = qR * vR;
+        f->aR = advR;
+        f->aL = advR + pR - pL;
+    } else {
+        fsdem_real inv = 1 / (sR - sL), dU = qR - qL, dF = (advR + pR) - (advL + pL);
+        f->mass = (sR * qL - sL * qR + sL * sR * (hsR - hsL)) * inv;
+        f->tan = (sR * qL * vL - sL * qR * vR + sL * sR * (hsR * vR - hsL * vL)) * inv;
+        f->aL = advL + sL * (sR * dU - dF) * inv;
+        f->aR = advR + sR * (sL * dU - dF) * inv;
+    }
+}
+
+/* Boundary depth of an inflow of unit discharge q >= 0 whose outgoing Riemann invariant is R:
+   solves 2 sqrt(g h) - q/h = R (increasing in h) by safeguarded Newton on s = sqrt(h). */
+static fsdem_real fsdem__swe_inflow_depth(fsdem_real g, fsdem_real q, fsdem_real R) {
+    double sg = sqrt((double)g), lo = 0, hi = 1e-3, s, f, df;
+    int it;
+    if (q <= 0) return R > 0 ? (fsdem_real)(R * R / (4 * g)) : 0;
+    while (2 * sg * hi - q / (hi * hi) - R < 0 && hi < 1e6) hi *= 2;
+    s = hi;
+    for (it = 0; it < 100; ++it) {
+        double next;
+        f = 2 * sg * s - q / (s * s) - R;
+        if (f < 0) lo = s;
+        else hi = s;
+        df = 2 * sg + 2 * q / (s * s * s);
+        next = s - f / df;
+        if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+        if (fabs(next - s) <= 1e-15 * s) {
+            s = next;
+            break;
+        }
+        s = next;
+    }
+    return (fsdem_real)(s * s);
+}
+
+/* Flux through a boundary face. `in_*` is the interior state; `upper` is 1 when the boundary is at the
+   upper end of the axis (the interior is then the L side). Returns the fluxes in f, with the interior
+   side's aL/aR, hL/hR, eL/eR filled. */
+static void fsdem__swe_boundary_flux(const fsdem_swe *s, int side, int upper, fsdem_real ein, fsdem_real hin,
+                                     fsdem_real unin, fsdem_real utin, fsdem__swe_flux *f) {
+    const fsdem__swe_bnd *b = &s->bnd[side];
+    fsdem_real value = s->bvalue[side], g = s->g, sgn = upper ? 1 : -1;
+    fsdem_real zin = ein - hin, eex = ein, hex = hin, unex = unin, utex = utin;
+    switch (b->type) {
+    case FSDEM_SWE_BC_WALL: unex = -unin; break;
+    case FSDEM_SWE_BC_TRANSMISSIVE: break;
+    case FSDEM_SWE_BC_STAGE: {
+        /* outgoing invariant w + 2c (w = outward normal velocity) carried from the interior */
+        fsdem_real cin = (fsdem_real)sqrt(g * hin), cex, w;
+        hex = value > zin ? value - zin : 0;
+        cex = (fsdem_real)sqrt(g * hex);
+        w = sgn * unin + 2 * (cin - cex);
+        unex = hex > 0 ? sgn * w : 0;
+        eex = zin + hex;
+        break;
+    }
+    case FSDEM_SWE_BC_DISCHARGE: {
+        fsdem_real R = sgn * unin + 2 * (fsdem_real)sqrt(g * hin);
+        fsdem_real hb = fsdem__swe_inflow_depth(g, value, R);
+        fsdem_real fn = hb > 0 ? value * value / hb + (fsdem_real)0.5 * g * hb * hb : 0;
+        fsdem_real own = (fsdem_real)0.5 * g * hin * hin;
+        f->mass = -sgn * value;
+        f->tan = 0;
+        f->hL = f->hR = hin;
+        f->eL = f->eR = ein;
+        f->aL = f->aR = fn - own;
+        return;
+    }
+    }
+    if (upper) fsdem__swe_riemann(g, s->tiny, ein, hin, unin, utin, eex, hex, unex, utex, f);
+    else fsdem__swe_riemann(g, s->tiny, eex, hex, unex, utex, ein, hin, unin, utin, f);
+    if (b->type == FSDEM_SWE_BC_WALL) f->mass = f->tan = 0;
+}
+
+/* ---- >>swe_step : the sweep ---- */
+
+/* Limited slope (per cell) from the backward and forward differences. */
+FSDEM__SWE_FORCE_INLINE fsdem_real fsdem__swe_limit(int limiter, fsdem_real a, fsdem_real b) {
+    fsdem_real aa = (fsdem_real)fabs(a), ab = (fsdem_real)fabs(b), m;
+    if (limiter == FSDEM_SWE_LIMITER_MINMOD) {
+        /* (sign a + sign b)/2 min(|a|, |b|): arithmetic only, no data-dependent branch */
+        m = aa < ab ? a : b;
+        return a * b > 0 ? m : 0;
+    }
+    if (a * b <= 0) return 0;
+    switch (limiter) {
+    case FSDEM_SWE_LIMITER_VAN_LEER: return 2 * a * b / (a + b);
+    case FSDEM_SWE_LIMITER_MC:
+        m = (fsdem_real)0.5 * (aa + ab);
+        if (2 * aa < m) m = 2 * aa;
+        if (2 * ab < m) m = 2 * ab;
+        return a > 0 ? m : -m;
+    case FSDEM_SWE_LIMITER_SUPERBEE: {
+        fsdem_real m1 = 2 * aa < ab ? 2 * aa : ab, m2 = aa < 2 * ab ? aa : 2 * ab;
+        m = m1 > m2 ? m1 : m2;
+        return a > 0 ? m : -m;
+    }
+    default: return aa < ab ? a : b;
+    }
+}
+
+/* Per-step constants and accumulators. */
+typedef struct fsdem__swe_ctx {
+    fsdem_real dt, lx, ly, g, dry, tiny, rain_dt, idx, idy, manning, visc;
+    int order, limiter, two_d, sources, friction;
+    /* results */
+    fsdem_real wave, speed2, hmax, bflux, accel;
+    int wet, negative, bad;
+    long long fallbacks;
+} fsdem__swe_ctx;
+
+/* Row j of the primitive ring (slot j mod slots), pointer to its `var` array (0 eta, 1 h, 2 u, 3 v). */
+static fsdem_real *fsdem__swe_prim(const fsdem_swe *s, int j, int var) {
+    int slot = ((j % s->slots) + s->slots) % s->slots;
+    return s->prim + ((size_t)slot * 4 + (size_t)var) * (size_t)(s->nx + 2);
+}
+
+static fsdem__swe_rowcell *fsdem__swe_rowcells(const fsdem_swe *s, int j) {
+    return s->rows + (size_t)(j & 1) * (size_t)s->nx;
+}
+
+/* Loads row `src` of the state as primitive values into ring row `dst`, with one ghost cell at each
+   end. A ghost row (dst != src) beyond a wall mirrors `src` (v flips); beyond other sides it copies
+   h, u, v and extrapolates the bed linearly from row `ext` (ext < 0: flat), so a uniform flow down
+   a slope keeps its gravity forcing in the boundary cells. Ghost cells at the row ends do the same. */
+static void fsdem__swe_load_row(const fsdem_swe *s, int src, int dst, int flip_v, int ext) {
+    fsdem_real *e = fsdem__swe_prim(s, dst, 0) + 1, *h = fsdem__swe_prim(s, dst, 1) + 1;
+    fsdem_real *u = fsdem__swe_prim(s, dst, 2) + 1, *v = fsdem__swe_prim(s, dst, 3) + 1;
+    const fsdem_real *eta = s->eta + (size_t)src * (size_t)s->nx, *bed = s->bed + (size_t)src * (size_t)s->nx;
+    const fsdem_real *qx = s->qx + (size_t)src * (size_t)s->nx, *qy = s->qy + (size_t)src * (size_t)s->nx;
+    fsdem_real dry = s->desc.dry_depth, vs = flip_v ? -1 : 1;
+    int i, nx = s->nx;
+    for (i = 0; i < nx; ++i) {
+        fsdem_real ee = eta[i], hh = ee - bed[i];
+        e[i] = ee;
+        if (hh >= dry) {
+            fsdem_real inv = 1 / hh;
+            h[i] = hh;
+            u[i] = qx[i] * inv;
+            v[i] = vs * qy[i] * inv;
+        } else {
+            h[i] = hh > 0 ? hh : 0;
+            u[i] = v[i] = 0;
+        }
+    }
+    if (ext >= 0) {
+        const fsdem_real *bx = s->bed + (size_t)ext * (size_t)nx;
+        for (i = 0; i < nx; ++i) e[i] += bed[i] - bx[i];
+    }
+    e[-1] = e[0];
+    h[-1] = h[0];
+    v[-1] = v[0];
+    if (s->bnd[FSDEM_SWE_XMIN].type == FSDEM_SWE_BC_WALL) u[-1] = -u[0];
+    else {
+        u[-1] = u[0];
+        if (nx > 1) e[-1] += bed[0] - bed[1];
+    }
+    e[nx] = e[nx - 1];
+    h[nx] = h[nx - 1];
+    v[nx] = v[nx - 1];
+    if (s->bnd[FSDEM_SWE_XMAX].type == FSDEM_SWE_BC_WALL) u[nx] = -u[nx - 1];
+    else {
+        u[nx] = u[nx - 1];
+        if (nx > 1) e[nx] += bed[nx - 1] - bed[nx - 2];
+    }
+}
+
+/* Completes cell k: adds the increments, the sources and friction, writes the state back and
+   updates the step's statistics. */
+static inline void fsdem__swe_finish(fsdem_swe *s, fsdem__swe_ctx *c, int k, fsdem_real de, fsdem_real dqx,
+                                     fsdem_real dqy) {
+    fsdem_real e = s->eta[k] + de + c->rain_dt, qx = s->qx[k] + dqx, qy = s->qy[k] + dqy, h;
+    if (c->sources) {
+        qx += c->dt * s->sx[k];
+        qy += c->dt * s->sy[k];
+    }
+    if (!c->two_d) qy = 0;
+    /* the scheme leaks geometrically decaying momentum ahead of a wave into still water; flush it
+       long before it reaches subnormal numbers, whose arithmetic is ~100 times slower */
+    if (fabs(qx) < FSDEM__SWE_QTINY) qx = 0;
+    if (fabs(qy) < FSDEM__SWE_QTINY) qy = 0;
+    h = e - s->bed[k];
+    if (h < c->dry) {
+        qx = qy = 0;
+        if (h < 0) c->negative = 1;
+    } else {
+        fsdem_real n = s->manning ? s->manning[k] : c->manning, u, v, cc, w;
+        if (n > 0) {
+            fsdem_real qm = (fsdem_real)sqrt(qx * qx + qy * qy);
+            if (qm > 0) {
+                fsdem_real C = c->g * n * n / (h * h * (fsdem_real)cbrt(h));
+                fsdem_real fac = 2 / (1 + (fsdem_real)sqrt(1 + 4 * c->dt * C * qm));
+                qx *= fac;
+                qy *= fac;
+            }
+        }
+        u = qx / h;
+        v = qy / h;
+        cc = (fsdem_real)sqrt(c->g * h);
+        w = ((u < 0 ? -u : u) + cc) * c->idx + ((v < 0 ? -v : v) + cc) * c->idy;
+        if (w > c->wave) c->wave = w;
+        if (u * u + v * v > c->speed2) c->speed2 = u * u + v * v;
+        if (h > c->hmax) c->hmax = h;
+        c->wet++;
+    }
+    if (!((e + qx + qy) - (e + qx + qy) == 0) && c->bad < 0) c->bad = k;
+    s->eta[k] = e;
+    s->qx[k] = qx;
+    s->qy[k] = qy;
+}
+
+/* Explicit eddy-viscosity increment of cell i of row j (time-n velocities, face depth the smaller of
+   the two cells, so nothing diffuses into dry cells): dt div(nu h grad u). */
+static void fsdem__swe_viscous(const fsdem_swe *s, const fsdem__swe_ctx *c, int j, int i, fsdem_real *dqx,
+                               fsdem_real *dqy) {
+    const fsdem_real *h = fsdem__swe_prim(s, j, 1) + 1, *u = fsdem__swe_prim(s, j, 2) + 1, *v = fsdem__swe_prim(s, j, 3) + 1;
+    fsdem_real kx = c->visc * c->dt * c->idx * c->idx, hc = h[i], fx, fy;
+    fsdem_real hw = h[i - 1] < hc ? h[i - 1] : hc, he = h[i + 1] < hc ? h[i + 1] : hc;
+    fx = kx * (he * (u[i + 1] - u[i]) - hw * (u[i] - u[i - 1]));
+    fy = kx * (he * (v[i + 1] - v[i]) - hw * (v[i] - v[i - 1]));
+    if (c->two_d) {
+        const fsdem_real *hs = fsdem__swe_prim(s, j - 1, 1) + 1, *us = fsdem__swe_prim(s, j - 1, 2) + 1;
+        const fsdem_real *vs = fsdem__swe_prim(s, j - 1, 3) + 1, *hn = fsdem__swe_prim(s, j + 1, 1) + 1;
+        const fsdem_real *un = fsdem__swe_prim(s, j + 1, 2) + 1, *vn = fsdem__swe_prim(s, j + 1, 3) + 1;
+        fsdem_real ky = c->visc * c->dt * c->idy * c->idy;
+        fsdem_real hS = hs[i] < hc ? hs[i] : hc, hN = hn[i] < hc ? hn[i] : hc;
+        fx += ky * (hN * (un[i] - u[i]) - hS * (u[i] - us[i]));
+        fy += ky * (hN * (vn[i] - v[i]) - hS * (v[i] - vs[i]));
+    }
+    *dqx = fx;
+    *dqy = fy;
+}
+
+/* Row j: reconstruction and predictor of every cell (stored for the y faces in 2D), the x faces, and
+   the x-direction increments (2D: into the accumulator row; 1D: the cells are finished here). */
+FSDEM__SWE_FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, int j, const int limiter,
+                                                  const int two_d) {
+    const int nx = s->nx, order2 = c->order == 2;
+    const fsdem_real *pe = fsdem__swe_prim(s, j, 0) + 1, *ph = fsdem__swe_prim(s, j, 1) + 1;
+    const fsdem_real *pu = fsdem__swe_prim(s, j, 2) + 1, *pv = fsdem__swe_prim(s, j, 3) + 1;
+    const fsdem_real *se = NULL, *sh = NULL, *su = NULL, *sv = NULL, *ne = NULL, *nh = NULL, *nu = NULL, *nv = NULL;
+    fsdem__swe_rowcell *rc = NULL;
+    const fsdem_real *srcx = s->sx + (size_t)j * (size_t)nx, *srcy = s->sy + (size_t)j * (size_t)nx;
+    const fsdem_real g = c->g, dry = c->dry, hlx = (fsdem_real)0.5 * c->lx, hly = (fsdem_real)0.5 * c->ly;
+    const fsdem_real hdt = (fsdem_real)0.5 * c->dt, lx = c->lx, half = (fsdem_real)0.5;
+    fsdem_real Ee = 0, Eh = 0, Eu = 0, Ev = 0; /* east state of the previous cell */
+    fsdem_real Wm = 0, Wa = 0, Wt = 0, Wh = 0, We = 0; /* west-face data of the previous cell */
+    fsdem_real vx = 0, vy = 0; /* viscous increment of the previous cell */
+    fsdem__swe_flux f;
+    int i;
+    if (two_d) {
+        se = fsdem__swe_prim(s, j - 1, 0) + 1;
+        sh = fsdem__swe_prim(s, j - 1, 1) + 1;
+        su = fsdem__swe_prim(s, j - 1, 2) + 1;
+        sv = fsdem__swe_prim(s, j - 1, 3) + 1;
+        ne = fsdem__swe_prim(s, j + 1, 0) + 1;
+        nh = fsdem__swe_prim(s, j + 1, 1) + 1;
+        nu = fsdem__swe_prim(s, j + 1, 2) + 1;
+        nv = fsdem__swe_prim(s, j + 1, 3) + 1;
+        rc = fsdem__swe_rowcells(s, j);
+    }
+    for (i = 0; i <= nx; ++i) {
+        fsdem_real e = 0, h = 0, u = 0, w = 0;
+        fsdem_real sex = 0, shx = 0, sux = 0, svx = 0, sey = 0, shy = 0, suy = 0, svy = 0;
+        fsdem_real cvx = 0, cvy = 0;
+        if (i < nx) {
+            /* ---- reconstruction and predictor of cell i ---- */
+            e = pe[i];
+            h = ph[i];
+            u = pu[i];
+            w = pv[i];
+            /* a dry cell among dry neighbours: nothing to reconstruct or predict */
+            if (h < c->tiny && ph[i - 1] < c->tiny && ph[i + 1] < c->tiny &&
+                (!two_d || (sh[i] < c->tiny && nh[i] < c->tiny))) {
+                /* slopes stay 0 */
+            } else if (order2) {
+                sex = fsdem__swe_limit(limiter, e - pe[i - 1], pe[i + 1] - e);
+                shx = fsdem__swe_limit(limiter, h - ph[i - 1], ph[i + 1] - h);
+                sux = fsdem__swe_limit(limiter, u - pu[i - 1], pu[i + 1] - u);
+                svx = fsdem__swe_limit(limiter, w - pv[i - 1], pv[i + 1] - w);
+                if (two_d) {
+                    sey = fsdem__swe_limit(limiter, e - se[i], ne[i] - e);
+                    shy = fsdem__swe_limit(limiter, h - sh[i], nh[i] - h);
+                    suy = fsdem__swe_limit(limiter, u - su[i], nu[i] - u);
+                    svy = fsdem__swe_limit(limiter, w - sv[i], nv[i] - w);
+                }
+                if (h >= dry) {
+                    fsdem_real hE = h + half * shx, hW = h - half * shx, uE = u + half * sux, uW = u - half * sux;
+                    fsdem_real qE = hE * uE, qW = hW * uW, de, dqx, dqy, hp, need;
+                    de = -hlx * (qE - qW);
+                    dqx = -hlx * (qE * uE - qW * uW + g * h * sex);
+                    dqy = -hlx * (qE * (w + half * svx) - qW * (w - half * svx));
+                    if (two_d) {
+                        fsdem_real hN = h + half * shy, hS = h - half * shy, vN = w + half * svy, vS = w - half * svy;
+                        fsdem_real rN = hN * vN, rS = hS * vS;
+                        de -= hly * (rN - rS);
+                        dqx -= hly * (rN * (u + half * suy) - rS * (u - half * suy));
+                        dqy -= hly * (rN * vN - rS * vS + g * h * sey);
+                    }
+                    if (c->sources) {
+                        dqx += hdt * srcx[i];
+                        dqy += hdt * srcy[i];
+                    }
+                    hp = h + de;
+                    if (c->friction && hp >= dry) {
+                        /* half-step friction, as in the corrector (>>impl_swe item 5), so a steady
+                           frictional flow has face velocities equal to its cell velocities */
+                        fsdem_real n = s->manning ? s->manning[(size_t)j * (size_t)nx + (size_t)i] : c->manning;
+                        fsdem_real fx = h * u + dqx, fy = two_d ? h * w + dqy : 0;
+                        fsdem_real qm = (fsdem_real)sqrt(fx * fx + fy * fy);
+                        if (n > 0 && qm > 0) {
+                            fsdem_real C = g * n * n / (hp * hp * (fsdem_real)cbrt(hp));
+                            fsdem_real fac = 2 / (1 + (fsdem_real)sqrt(1 + 4 * hdt * C * qm)) - 1;
+                            dqx += fx * fac;
+                            dqy += fy * fac;
+                        }
+                    }
+                    need = half * ((shx < 0 ? -shx : shx) > (shy < 0 ? -shy : shy) ? (shx < 0 ? -shx : shx)
+                                                                                    : (shy < 0 ? -shy : shy));
+                    if (hp >= need && hp > 0) {
+                        if (hp >= dry) {
+                            fsdem_real inv = 1 / hp;
+                            u = (h * u + dqx) * inv;
+                            w = two_d ? (h * w + dqy) * inv : 0;
+                        } else {
+                            u = w = 0;
+                        }
+                        e += de;
+                        h = hp;
+                    } else {
+                        c->fallbacks++;
+                    }
+                }
+            }
+            if (h >= dry) {
+                /* acceleration bound for the next step's dt (g |grad eta| with minmod slopes, which
+                   vanish at a lake's shore and at a dam; a thin film on a slope feels the slope) */
+                fsdem_real ax = limiter == FSDEM_SWE_LIMITER_MINMOD && order2
+                                    ? sex
+                                    : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, pe[i] - pe[i - 1], pe[i + 1] - pe[i]);
+                fsdem_real a = (ax < 0 ? -ax : ax) * c->idx * c->idx;
+                if (two_d) {
+                    fsdem_real ay = limiter == FSDEM_SWE_LIMITER_MINMOD && order2
+                                        ? sey
+                                        : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, pe[i] - se[i], ne[i] - pe[i]);
+                    a += (ay < 0 ? -ay : ay) * c->idy * c->idy;
+                }
+                if (a > c->accel) c->accel = a;
+            }
+            if (two_d) {
+                fsdem__swe_rowcell *q = rc + i;
+                q->n[0] = e + half * sey;
+                q->n[1] = h + half * shy;
+                q->n[2] = w + half * svy;
+                q->n[3] = u + half * suy;
+                q->s[0] = e - half * sey;
+                q->s[1] = h - half * shy;
+                q->s[2] = w - half * svy;
+                q->s[3] = u - half * suy;
+            }
+            if (c->visc > 0) fsdem__swe_viscous(s, c, j, i, &cvx, &cvy);
+            /* ---- face i - 1/2 ---- */
+            if (i == 0) {
+                fsdem__swe_boundary_flux(s, FSDEM_SWE_XMIN, 0, e - half * sex, h - half * shx, u - half * sux,
+                                         w - half * svx, &f);
+                c->bflux += f.mass * s->dy * c->dt;
+            } else {
+                fsdem__swe_riemann(g, c->tiny, Ee, Eh, Eu, Ev, e - half * sex, h - half * shx, u - half * sux, w - half * svx, &f);
+            }
+        } else {
+            fsdem__swe_boundary_flux(s, FSDEM_SWE_XMAX, 1, Ee, Eh, Eu, Ev, &f);
+            c->bflux -= f.mass * s->dy * c->dt;
+        }
+        if (i > 0) {
+            /* cell i - 1 has both x faces now */
+            fsdem_real de = -lx * (f.mass - Wm);
+            fsdem_real dqx = -lx * (f.aL - Wa + half * g * (f.hL + Wh) * (f.eL - We)) + vx;
+            fsdem_real dqy = -lx * (f.tan - Wt) + vy;
+            if (two_d) {
+                rc[i - 1].acc[0] = de;
+                rc[i - 1].acc[1] = dqx;
+                rc[i - 1].acc[2] = dqy;
+            } else {
+                fsdem__swe_finish(s, c, i - 1, de, dqx, dqy);
+            }
+        }
+        Wm = f.mass;
+        Wa = f.aR;
+        Wt = f.tan;
+        Wh = f.hR;
+        We = f.eR;
+        Ee = e + half * sex;
+        Eh = h + half * shx;
+        Eu = u + half * sux;
+        Ev = w + half * svx;
+        vx = cvx;
+        vy = cvy;
+    }
+}
+
+/* The row kernel specialised for each limiter and dimension, so the inner loop has no switch. */
+static void fsdem__swe_row(fsdem_swe *s, fsdem__swe_ctx *c, int j) {
+    if (c->two_d) {
+        switch (c->limiter) {
+        case FSDEM_SWE_LIMITER_VAN_LEER: fsdem__swe_row_impl(s, c, j, FSDEM_SWE_LIMITER_VAN_LEER, 1); break;
+        case FSDEM_SWE_LIMITER_MC: fsdem__swe_row_impl(s, c, j, FSDEM_SWE_LIMITER_MC, 1); break;
+        case FSDEM_SWE_LIMITER_SUPERBEE: fsdem__swe_row_impl(s, c, j, FSDEM_SWE_LIMITER_SUPERBEE, 1); break;
+        default: fsdem__swe_row_impl(s, c, j, FSDEM_SWE_LIMITER_MINMOD, 1); break;
+        }
+    } else {
+        switch (c->limiter) {
+        case FSDEM_SWE_LIMITER_VAN_LEER: fsdem__swe_row_impl(s, c, j, FSDEM_SWE_LIMITER_VAN_LEER, 0); break;
+        case FSDEM_SWE_LIMITER_MC: fsdem__swe_row_impl(s, c, j, FSDEM_SWE_LIMITER_MC, 0); break;
+        case FSDEM_SWE_LIMITER_SUPERBEE: fsdem__swe_row_impl(s, c, j, FSDEM_SWE_LIMITER_SUPERBEE, 0); break;
+        default: fsdem__swe_row_impl(s, c, j, FSDEM_SWE_LIMITER_MINMOD, 0); break;
+        }
+    }
+}
+
+/* y faces between rows j-1 and j (j = 0: the YMIN boundary; j = ny: the YMAX boundary). Cells of row
+   j-1 get their north faces and are finished; the south-face data of row j are stored. */
+static void fsdem__swe_yfaces(fsdem_swe *s, fsdem__swe_ctx *c, int j) {
+    const int nx = s->nx, ny = s->ny;
+    const fsdem_real g = c->g, ly = c->ly, half = (fsdem_real)0.5;
+    fsdem__swe_sface *S = s->south;
+    const fsdem__swe_rowcell *lo = j > 0 ? fsdem__swe_rowcells(s, j - 1) : NULL;
+    const fsdem__swe_rowcell *hi = j < ny ? fsdem__swe_rowcells(s, j) : NULL;
+    fsdem__swe_flux f;
+    int i, row = (j - 1) * nx;
+    for (i = 0; i < nx; ++i) {
+        if (j == 0) {
+            const fsdem_real *R = hi[i].s;
+            fsdem__swe_boundary_flux(s, FSDEM_SWE_YMIN, 0, R[0], R[1], R[2], R[3], &f);
+            c->bflux += f.mass * s->dx * c->dt;
+        } else if (j == ny) {
+            const fsdem_real *L = lo[i].n;
+            fsdem__swe_boundary_flux(s, FSDEM_SWE_YMAX, 1, L[0], L[1], L[2], L[3], &f);
+            c->bflux -= f.mass * s->dx * c->dt;
+        } else {
+            const fsdem_real *L = lo[i].n, *R = hi[i].s;
+            fsdem__swe_riemann(g, c->tiny, L[0], L[1], L[2], L[3], R[0], R[1], R[2], R[3], &f);
+        }
+        if (j > 0) {
+            const fsdem__swe_sface *q = S + i;
+            fsdem_real de = lo[i].acc[0] - ly * (f.mass - q->mass);
+            fsdem_real dqy = lo[i].acc[2] - ly * (f.aL - q->a + half * g * (f.hL + q->h) * (f.eL - q->e));
+            fsdem_real dqx = lo[i].acc[1] - ly * (f.tan - q->t);
+            fsdem__swe_finish(s, c, row + i, de, dqx, dqy);
+        }
+        S[i].mass = f.mass;
+        S[i].a = f.aR;
+        S[i].t = f.tan;
+        S[i].h = f.hR;
+        S[i].e = f.eR;
+    }
+}
+
+/* Restores non-negative depths after a step that produced a negative one (not expected with
+   cfl <= 0.5; kept as a guarantee): the deficit is taken from the wet neighbours, and what they
+   cannot give is counted in vol_clipped. */
+static void fsdem__swe_repair(fsdem_swe *s) {
+    int k, q;
+    for (k = 0; k < s->n; ++k) {
+        fsdem_real deficit = s->bed[k] - s->eta[k], avail = 0, take;
+        int nb[4], nn = 0, i = k % s->nx, j = k / s->nx;
+        if (!(deficit > 0)) continue;
+        if (i > 0) nb[nn++] = k - 1;
+        if (i < s->nx - 1) nb[nn++] = k + 1;
+        if (j > 0) nb[nn++] = k - s->nx;
+        if (j < s->ny - 1) nb[nn++] = k + s->nx;
+        for (q = 0; q < nn; ++q) {
+            fsdem_real hq = s->eta[nb[q]] - s->bed[nb[q]];
+            if (hq > 0) avail += hq;
+        }
+        take = deficit < avail ? deficit : avail;
+        for (q = 0; q < nn && take > 0; ++q) {
+            fsdem_real hq = s->eta[nb[q]] - s->bed[nb[q]];
+            if (hq > 0) s->eta[nb[q]] -= take * hq / avail;
+        }
+        s->vol_clipped += (deficit - take) * s->area;
+        s->eta[k] = s->bed[k];
+        s->qx[k] = s->qy[k] = 0;
+    }
+}
+
+/* Largest (|un| + c)/d of the states outside DISCHARGE and STAGE boundaries (they may move faster than
+   the cells). */
+static fsdem_real fsdem__swe_boundary_wave(const fsdem_swe *s, fsdem_real t) {
+    fsdem_real wave = 0;
+    int side, i;
+    for (side = 0; side < (s->dim == 2 ? 4 : 2); ++side) {
+        const fsdem__swe_bnd *b = &s->bnd[side];
+        int count = side < 2 ? s->ny : s->nx;
+        fsdem_real value, d = side < 2 ? s->dx : s->dy, sgn = (side & 1) ? 1 : -1;
+        if (b->type != FSDEM_SWE_BC_DISCHARGE && b->type != FSDEM_SWE_BC_STAGE) continue;
+        value = fsdem__swe_series_at(b->t, b->v, b->n, b->value, t);
+        for (i = 0; i < count; ++i) {
+            int k = side == 0 ? i * s->nx : side == 1 ? i * s->nx + s->nx - 1 : side == 2 ? i : (s->ny - 1) * s->nx + i;
+            fsdem_real h = s->eta[k] - s->bed[k], u, v, un, hb, ub, w;
+            fsdem__swe_velocity(s, k, &u, &v);
+            if (h < 0) h = 0;
+            un = side < 2 ? u : v;
+            if (b->type == FSDEM_SWE_BC_DISCHARGE) {
+                hb = fsdem__swe_inflow_depth(s->g, value, sgn * un + 2 * (fsdem_real)sqrt(s->g * h));
+                ub = hb > 0 ? value / hb : 0;
+            } else {
+                hb = value > s->bed[k] ? value - s->bed[k] : 0;
+                ub = (fsdem_real)fabs(sgn * un + 2 * ((fsdem_real)sqrt(s->g * h) - (fsdem_real)sqrt(s->g * hb)));
+            }
+            w = (ub + (fsdem_real)sqrt(s->g * hb)) / d;
+            if (s->dim == 2) w += (fsdem_real)sqrt(s->g * hb) / (side < 2 ? s->dy : s->dx);
+            if (w > wave) wave = w;
+        }
+    }
+    return wave;
+}
+
+/* Inverse of the stable step without the cfl factor: max wave rate (1/s) and the viscous rate. */
+static fsdem_real fsdem__swe_rate(const fsdem_swe *s) {
+    fsdem_real rate = s->max_wave, bw = fsdem__swe_boundary_wave(s, s->time), vr;
+    if (bw > rate) rate = bw;
+    if (s->desc.eddy_viscosity > 0) {
+        vr = 2 * s->desc.eddy_viscosity * (1 / (s->dx * s->dx) + (s->dim == 2 ? 1 / (s->dy * s->dy) : 0));
+        if (vr > rate) rate = vr;
+    }
+    return rate;
+}
+
+/* Largest dt with Courant number `cfl` when the velocities may also grow by max_accel dt within the
+   step: solves max_accel dt^2 + rate dt = cfl. */
+static fsdem_real fsdem__swe_dt_for(const fsdem_swe *s, fsdem_real cfl) {
+    fsdem_real rate = fsdem__swe_rate(s), a = s->max_accel, dt = s->desc.dt_max, lim;
+    if (rate <= 0 && a <= 0) return dt;
+    lim = 2 * cfl / (rate + (fsdem_real)sqrt(rate * rate + 4 * a * cfl));
+    return lim < dt ? lim : dt;
+}
+
+fsdem_real fsdem_swe_stable_dt(const fsdem_swe *s) { return fsdem__swe_dt_for(s, s->desc.cfl); }
+
+/* Writes a gauge row when the time has reached the next output time. */
+static fsdem_result fsdem__swe_gauge_row(fsdem_swe *s, int force) {
+    FILE *fp = (FILE *)s->gauge_file;
+    int k;
+    if (!fp) return FSDEM_OK;
+    if (!force && s->time < s->gauge_next * (1 - 1e-12)) return FSDEM_OK;
+    fprintf(fp, "%.10g", (double)s->time);
+    for (k = 0; k < s->gauge_count; ++k) {
+        fsdem_swe_cell c;
+        memset(&c, 0, sizeof c);
+        fsdem_swe_sample(s, s->gauge_xy[2 * k], s->gauge_xy[2 * k + 1], &c);
+        fprintf(fp, ",%.10g,%.10g,%.10g,%.10g", (double)c.depth, (double)c.eta, (double)c.u, (double)c.v);
+    }
+    fputc('\n', fp);
+    if (s->gauge_interval > 0)
+        while (s->gauge_next <= s->time * (1 + 1e-12)) s->gauge_next += s->gauge_interval;
+    return ferror(fp) ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+/* One step of exactly dt (already validated). */
+static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
+    fsdem__swe_ctx c;
+    int j, k, side;
+    fsdem_real tm = s->time + (fsdem_real)0.5 * dt;
+    memset(&c, 0, sizeof c);
+    c.dt = dt;
+    c.lx = dt / s->dx;
+    c.ly = s->dim == 2 ? dt / s->dy : 0;
+    c.idx = 1 / s->dx;
+    c.idy = s->dim == 2 ? 1 / s->dy : 0;
+    c.g = s->g;
+    c.dry = s->desc.dry_depth;
+    c.tiny = s->tiny;
+    c.rain_dt = s->rain * dt;
+    c.manning = s->desc.manning;
+    c.visc = s->desc.eddy_viscosity;
+    c.order = s->desc.order;
+    c.limiter = (int)s->desc.limiter;
+    c.two_d = s->dim == 2;
+    c.sources = s->sources_used;
+    c.friction = s->manning != NULL || s->desc.manning > 0;
+    c.bad = -1;
+    for (side = 0; side < 4; ++side)
+        s->bvalue[side] = fsdem__swe_series_at(s->bnd[side].t, s->bnd[side].v, s->bnd[side].n, s->bnd[side].value, tm);
+    if (!c.two_d) {
+        fsdem__swe_load_row(s, 0, 0, 0, -1);
+        fsdem__swe_row(s, &c, 0);
+    } else {
+        int wall_lo = s->bnd[FSDEM_SWE_YMIN].type == FSDEM_SWE_BC_WALL;
+        int wall_hi = s->bnd[FSDEM_SWE_YMAX].type == FSDEM_SWE_BC_WALL;
+        fsdem__swe_load_row(s, 0, -1, wall_lo, !wall_lo && s->ny > 1 ? 1 : -1);
+        fsdem__swe_load_row(s, 0, 0, 0, -1);
+        for (j = 0; j < s->ny; ++j) {
+            if (j + 1 < s->ny) fsdem__swe_load_row(s, j + 1, j + 1, 0, -1);
+            else fsdem__swe_load_row(s, j, j + 1, wall_hi, !wall_hi && s->ny > 1 ? j - 1 : -1);
+            fsdem__swe_row(s, &c, j);
+            fsdem__swe_yfaces(s, &c, j);
+        }
+        fsdem__swe_yfaces(s, &c, s->ny);
+    }
+    s->vol_boundary += c.bflux;
+    s->vol_source += c.rain_dt * s->area * (fsdem_real)s->n;
+    for (k = 0; k < s->src_count; ++k) {
+        fsdem__swe_src *p = &s->src[k];
+        fsdem_real dh, h;
+        if (!p->active) continue;
+        dh = fsdem__swe_series_at(p->t, p->v, p->n, p->discharge, tm) * dt / s->area;
+        h = s->eta[p->cell] - s->bed[p->cell];
+        if (dh < -h) dh = h > 0 ? -h : 0;
+        s->eta[p->cell] += dh;
+        s->vol_source += dh * s->area;
+        h += dh;
+        if (h < c.dry) s->qx[p->cell] = s->qy[p->cell] = 0;
+        else {
+            fsdem_real w = (fsdem_real)sqrt(c.g * h) * (c.idx + c.idy) +
+                           ((fsdem_real)fabs(s->qx[p->cell]) * c.idx + (fsdem_real)fabs(s->qy[p->cell]) * c.idy) / h;
+            if (w > c.wave) c.wave = w;
+        }
+    }
+    if (c.negative) fsdem__swe_repair(s);
+    s->fallbacks += c.fallbacks;
+    s->max_wave = c.wave;
+    s->max_accel = c.g * c.accel;
+    s->max_speed = (fsdem_real)sqrt(c.speed2);
+    s->max_depth = c.hmax;
+    s->wet_cells = c.wet;
+    s->time += dt;
+    s->dt_last = dt;
+    s->steps++;
+    if (c.bad >= 0)
+        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_swe_step: non-finite state in cell %d (i=%d, j=%d) at t=%g s",
+                           c.bad, c.bad % s->nx, c.bad / s->nx, (double)s->time);
+    if (fsdem__swe_gauge_row(s, 0) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_step: could not write the gauge file");
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_step(fsdem_swe *s, fsdem_real dt_cap, fsdem_real *dt_out) {
+    fsdem_real dt = fsdem_swe_stable_dt(s);
+    if (dt_cap > 0 && dt_cap < dt) dt = dt_cap;
+    if (dt_out) *dt_out = dt;
+    return fsdem__swe_do_step(s, dt);
+}
+
+fsdem_result fsdem_swe_step_fixed(fsdem_swe *s, fsdem_real dt) {
+    fsdem_real courant;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_step_fixed: dt must be > 0 (got %g s)", (double)dt);
+    courant = dt * fsdem__swe_rate(s) + dt * dt * s->max_accel;
+    if (courant > 1)
+        return fsdem__fail(&s->status, FSDEM_ERR_CFL,
+                           "fsdem_swe_step_fixed: dt = %g s gives Courant number %g > 1 (stable dt at cfl 1: %g s)",
+                           (double)dt, (double)courant, (double)fsdem__swe_dt_for(s, 1));
+    return fsdem__swe_do_step(s, dt);
+}
+
+fsdem_result fsdem_swe_advance(fsdem_swe *s, fsdem_real duration, long long *steps) {
+    fsdem_real t_end = s->time + duration;
+    fsdem_result res = FSDEM_OK;
+    long long count = 0;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_advance: duration must be >= 0 (got %g s)",
+                           (double)duration);
+    while (s->time < t_end) {
+        fsdem_real dt = fsdem_swe_stable_dt(s), left = t_end - s->time;
+        int last = dt >= left;
+        res = fsdem__swe_do_step(s, last ? left : dt);
+        count++;
+        if (last) s->time = t_end;
+        if (res != FSDEM_OK) break;
+    }
+    if (steps) *steps = count;
+    return res;
+}
+
+fsdem_real fsdem_swe_time(const fsdem_swe *s) { return s->time; }
+
+/* ---- >>swe_diag : diagnostics and output ---- */
+
+fsdem_real fsdem_swe_volume(const fsdem_swe *s) {
+    double sum = 0;
+    int k;
+    for (k = 0; k < s->n; ++k) sum += (double)(s->eta[k] - s->bed[k]);
+    return (fsdem_real)(sum * (double)s->area);
+}
+
+fsdem_vec3 fsdem_swe_momentum(const fsdem_swe *s) {
+    double mx = 0, my = 0, scale = (double)s->desc.density * (double)s->area;
+    int k;
+    for (k = 0; k < s->n; ++k) {
+        mx += (double)s->qx[k];
+        my += (double)s->qy[k];
+    }
+    return fsdem_v3((fsdem_real)(mx * scale), (fsdem_real)(my * scale), 0);
+}
+
+fsdem_swe_stats fsdem_swe_get_stats(const fsdem_swe *s) {
+    fsdem_swe_stats st;
+    int k;
+    memset(&st, 0, sizeof st);
+    st.steps = s->steps;
+    st.time = s->time;
+    st.dt = s->dt_last;
+    st.max_depth = s->max_depth;
+    st.max_speed = s->max_speed;
+    st.wet_cells = s->wet_cells;
+    st.boundary_volume = s->vol_boundary;
+    st.source_volume = s->vol_source;
+    st.clipped_volume = s->vol_clipped;
+    st.predictor_fallbacks = s->fallbacks;
+    st.memory_bytes = sizeof *s + s->block_bytes + (s->manning ? sizeof(fsdem_real) * (size_t)s->n : 0) +
+                      sizeof(fsdem__swe_src) * (size_t)s->src_capacity +
+                      2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity;
+    for (k = 0; k < 4; ++k) st.memory_bytes += 2 * sizeof(fsdem_real) * (size_t)s->bnd[k].n;
+    for (k = 0; k < s->src_count; ++k) st.memory_bytes += 2 * sizeof(fsdem_real) * (size_t)s->src[k].n;
+    return st;
+}
+
+fsdem_result fsdem_swe_write_csv(const fsdem_swe *s, const char *path) {
+    FILE *fp = path ? fopen(path, "w") : NULL;
+    int k, bad;
+    if (!fp) return FSDEM_ERR_IO;
+    fprintf(fp, s->dim == 2 ? "x,y,bed,h,eta,u,v\n" : "x,bed,h,eta,u\n");
+    for (k = 0; k < s->n; ++k) {
+        fsdem_real x, y, u, v;
+        fsdem__swe_centre(s, k, &x, &y);
+        fsdem__swe_velocity(s, k, &u, &v);
+        if (s->dim == 2)
+            fprintf(fp, "%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", (double)x, (double)y, (double)s->bed[k],
+                    (double)(s->eta[k] - s->bed[k]), (double)s->eta[k], (double)u, (double)v);
+        else
+            fprintf(fp, "%.10g,%.10g,%.10g,%.10g,%.10g\n", (double)x, (double)s->bed[k],
+                    (double)(s->eta[k] - s->bed[k]), (double)s->eta[k], (double)u);
+    }
+    bad = ferror(fp);
+    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+static void fsdem__swe_vtk_scalars(FILE *fp, const fsdem_swe *s, const char *name, int field) {
+    int k;
+    fprintf(fp, "SCALARS %s double 1\nLOOKUP_TABLE default\n", name);
+    for (k = 0; k < s->n; ++k) {
+        double v = field == 0 ? (double)(s->eta[k] - s->bed[k]) : field == 1 ? (double)s->eta[k] : (double)s->bed[k];
+        fprintf(fp, "%.10g\n", v);
+    }
+}
+
+fsdem_result fsdem_swe_write_vtk(const fsdem_swe *s, const char *path) {
+    FILE *fp = path ? fopen(path, "w") : NULL;
+    int k, bad;
+    if (!fp) return FSDEM_ERR_IO;
+    fprintf(fp, "# vtk DataFile Version 3.0\nfsdem shallow water t=%.10g s\nASCII\nDATASET STRUCTURED_POINTS\n",
+            (double)s->time);
+    fprintf(fp, "DIMENSIONS %d %d 1\nORIGIN %.10g %.10g 0\nSPACING %.10g %.10g 1\nCELL_DATA %d\n", s->nx + 1,
+            s->dim == 2 ? s->ny + 1 : 1, (double)s->desc.x_min, (double)(s->dim == 2 ? s->desc.y_min : 0),
+            (double)s->dx, (double)(s->dim == 2 ? s->dy : 1), s->n);
+    fsdem__swe_vtk_scalars(fp, s, "h", 0);
+    fsdem__swe_vtk_scalars(fp, s, "eta", 1);
+    fsdem__swe_vtk_scalars(fp, s, "bed", 2);
+    fprintf(fp, "VECTORS velocity double\n");
+    for (k = 0; k < s->n; ++k) {
+        fsdem_real u, v;
+        fsdem__swe_velocity(s, k, &u, &v);
+        fprintf(fp, "%.10g %.10g 0\n", (double)u, (double)v);
+    }
+    bad = ferror(fp);
+    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+fsdem_result fsdem_swe_add_gauge(fsdem_swe *s, fsdem_real x, fsdem_real y, int *id) {
+    if (s->gauge_file)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_gauge: close the gauge file first");
+    if (fsdem_swe_cell_at(s, x, y) < 0)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_swe_add_gauge: point (%g, %g) is outside the grid",
+                           (double)x, (double)y);
+    if (fsdem__grow(&s->allocator, (void **)&s->gauge_xy, &s->gauge_capacity, s->gauge_count, s->gauge_count + 1,
+                    2 * sizeof(fsdem_real)) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_add_gauge: out of memory");
+    s->gauge_xy[2 * s->gauge_count] = x;
+    s->gauge_xy[2 * s->gauge_count + 1] = y;
+    if (id) *id = s->gauge_count;
+    s->gauge_count++;
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_gauge(const fsdem_swe *s, int id, fsdem_swe_cell *out) {
+    if (id < 0 || id >= s->gauge_count || !out) return FSDEM_ERR_NOT_FOUND;
+    return fsdem_swe_sample(s, s->gauge_xy[2 * id], s->gauge_xy[2 * id + 1], out);
+}
+
+fsdem_result fsdem_swe_gauges_open(fsdem_swe *s, const char *path, fsdem_real interval) {
+    FILE *fp;
+    int k;
+    if (s->gauge_count == 0)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_gauges_open: add gauges first");
+    if (!(interval >= 0) || !fsdem__finite(interval))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_gauges_open: interval must be >= 0 (got %g s)",
+                           (double)interval);
+    if (s->gauge_file) fsdem_swe_gauges_close(s);
+    fp = path ? fopen(path, "w") : NULL;
+    if (!fp) return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_gauges_open: cannot open '%s'", path ? path : "(null)");
+    fprintf(fp, "t");
+    for (k = 0; k < s->gauge_count; ++k) fprintf(fp, ",h_%d,eta_%d,u_%d,v_%d", k, k, k, k);
+    fputc('\n', fp);
+    s->gauge_file = fp;
+    s->gauge_interval = interval;
+    s->gauge_next = s->time;
+    if (fsdem__swe_gauge_row(s, 1) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_gauges_open: cannot write '%s'", path);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_gauges_close(fsdem_swe *s) {
+    int bad;
+    if (!s->gauge_file) return FSDEM_OK;
+    bad = ferror((FILE *)s->gauge_file);
+    bad |= fclose((FILE *)s->gauge_file) != 0;
+    s->gauge_file = NULL;
+    return bad ? fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_gauges_close: write error") : fsdem__ok(&s->status);
+}
+
+/* ===== >>impl_couple_swe : SWE-DEM floating debris ================================================= */
+
+struct fsdem_swe_dem {
+    fsdem_swe_dem_desc desc;
+    fsdem__status status;
+    fsdem_allocator allocator;
+    fsdem_swe_dem_force *force; /* one per DEM particle */
+    int force_capacity;
+};
+
+fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void) {
+    fsdem_swe_dem_desc d;
+    memset(&d, 0, sizeof d);
+    d.beta = (fsdem_real)1.1;
+    d.two_way = 1;
+    d.heave_damping = 0;
+    return d;
+}
+
+fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *d, char *msg, size_t size) {
+    fsdem_vec3 g;
+    fsdem_real gs;
+    if (!d) return fsdem__reject(msg, size, "fsdem_swe_dem_desc is NULL");
+    if (!d->swe || !d->dem) return fsdem__reject(msg, size, "fsdem_swe_dem_desc.swe and .dem must both be set");
+    if (d->dem->desc.dim != 3)
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.dem must be 3D (spheres, z vertical); it has dim %d",
+                             d->dem->desc.dim);
+    g = d->dem->desc.gravity;
+    gs = d->swe->g;
+    if (g.x != 0 || g.y != 0 || !(fabs(g.z + gs) <= 1e-12 * gs))
+        return fsdem__reject(msg, size,
+                             "the DEM gravity (%g, %g, %g) must be (0, 0, -g) with the SWE's g = %g m/s^2",
+                             (double)g.x, (double)g.y, (double)g.z, (double)gs);
+    if (!(d->beta > 0) || !fsdem__finite(d->beta))
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.beta must be > 0 (got %g)", (double)d->beta);
+    if (!(d->heave_damping >= 0) || !fsdem__finite(d->heave_damping))
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.heave_damping must be >= 0 (got %g)",
+                             (double)d->heave_damping);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_swe_dem *c;
+    if (out) *out = NULL;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    if (fsdem_swe_dem_desc_check(desc, msg, sizeof msg) != FSDEM_OK) {
+        if (desc && desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
+        return FSDEM_ERR_INVALID_ARG;
+    }
+    c = (fsdem_swe_dem *)fsdem__alloc(&desc->dem->allocator, sizeof *c);
+    if (!c) return FSDEM_ERR_OUT_OF_MEMORY;
+    memset(c, 0, sizeof *c);
+    c->desc = *desc;
+    c->allocator = desc->dem->allocator;
+    c->status.log = desc->log;
+    c->status.log_user = desc->log_user;
+    *out = c;
+    return FSDEM_OK;
+}
+
+void fsdem_swe_dem_destroy(fsdem_swe_dem *c) {
+    fsdem_allocator al;
+    if (!c) return;
+    al = c->allocator;
+    fsdem__free(&al, c->force, sizeof(fsdem_swe_dem_force) * (size_t)c->force_capacity);
+    fsdem__free(&al, c, sizeof *c);
+}
+
+const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *c) { return c ? c->status.message : "fsdem_swe_dem is NULL"; }
+
+/* ---- >>couple_swe_geometry : submerged parts of a sphere ---- */
+
+/* Submerged part of a vertical circle of radius r centred at height zc under a surface at eta: its
+   area and its first moment M = int (eta - z) w(z) dz, so the hydrostatic force on it is rho g M.
+   With z = zc - r cos(phi) and w = 2 r sin(phi) both integrals are closed forms in the angle theta of
+   the waterline: area r^2 (theta - sin cos), M = 2 r^2 [(eta - zc)(theta - sin cos)/2 + r sin^3 / 3]. */
+static void fsdem__submerged_disc(fsdem_real r, fsdem_real zc, fsdem_real eta, fsdem_real *area, fsdem_real *moment) {
+    fsdem_real top = eta < zc + r ? eta : zc + r, c, s, th;
+    if (top <= zc - r) {
+        *area = *moment = 0;
+        return;
+    }
+    c = (zc - top) / r;
+    c = c < -1 ? -1 : c > 1 ? 1 : c;
+    th = (fsdem_real)acos(c);
+    s = (fsdem_real)sin(th);
+    *area = r * r * (th - s * c);
+    *moment = 2 * r * r * ((eta - zc) * (th - s * c) / 2 + r * s * s * s / 3);
+}
+
+/* Volume of the part of a sphere (radius r, centre height zc) below the surface eta: a cap. */
+static fsdem_real fsdem__submerged_sphere(fsdem_real r, fsdem_real zc, fsdem_real eta) {
+    fsdem_real s = eta - (zc - r);
+    if (s <= 0) return 0;
+    if (s > 2 * r) s = 2 * r;
+    return (fsdem_real)FSDEM__PI * s * s * (3 * r - s) / 3;
+}
+
+/* Water at p shifted by `shift` along a horizontal axis (0: x, 1: y); off the grid it is `fallback`. */
+static fsdem_swe_cell fsdem__swe_water_at(const fsdem_swe *swe, fsdem_vec3 p, int axis, fsdem_real shift,
+                                          fsdem_swe_cell fallback) {
+    fsdem_swe_cell cell;
+    fsdem_real x = p.x + (axis == 0 ? shift : 0), y = p.y + (axis == 1 ? shift : 0);
+    return fsdem_swe_sample(swe, x, y, &cell) == FSDEM_OK ? cell : fallback;
+}
+
+/* Spreads the force -f (N, horizontal) exerted by a sphere on the water over the wet cells under its
+   footprint [x-r, x+r] (x [y-r, y+r] in 2D), weighted by overlap, as momentum sources (m^2/s^2). */
+static void fsdem__swe_spread_reaction(fsdem_swe *swe, fsdem_vec3 p, fsdem_real r, fsdem_vec3 f) {
+    const fsdem_real dry = swe->desc.dry_depth;
+    int i0, i1, j0, j1, i, j, pass;
+    fsdem_real total = 0;
+    i0 = (int)floor((p.x - r - swe->desc.x_min) / swe->dx);
+    i1 = (int)floor((p.x + r - swe->desc.x_min) / swe->dx);
+    i0 = i0 < 0 ? 0 : i0;
+    i1 = i1 >= swe->nx ? swe->nx - 1 : i1;
+    if (swe->dim == 2) {
+        j0 = (int)floor((p.y - r - swe->desc.y_min) / swe->dy);
+        j1 = (int)floor((p.y + r - swe->desc.y_min) / swe->dy);
+        j0 = j0 < 0 ? 0 : j0;
+        j1 = j1 >= swe->ny ? swe->ny - 1 : j1;
+    } else {
+        j0 = j1 = 0;
+    }
+    /* pass 0 sums the wet weights, pass 1 deposits -f w / (rho A) with the weights normalised */
+    for (pass = 0; pass < 2; ++pass)
+        for (j = j0; j <= j1; ++j)
+            for (i = i0; i <= i1; ++i) {
+                const int k = i + swe->nx * j;
+                fsdem_real xa = swe->desc.x_min + i * swe->dx, w;
+                w = (p.x + r < xa + swe->dx ? p.x + r : xa + swe->dx) - (p.x - r > xa ? p.x - r : xa);
+                if (swe->dim == 2) {
+                    fsdem_real ya = swe->desc.y_min + j * swe->dy;
+                    w *= (p.y + r < ya + swe->dy ? p.y + r : ya + swe->dy) - (p.y - r > ya ? p.y - r : ya);
+                }
+                if (!(w > 0) || swe->eta[k] - swe->bed[k] < dry) continue;
+                if (pass == 0) total += w;
+                else {
+                    const fsdem_real scale = -w / (total * swe->desc.density * swe->area);
+                    swe->sx[k] += f.x * scale;
+                    if (swe->dim == 2) swe->sy[k] += f.y * scale;
+                }
+            }
+}
+
+/* ---- >>couple_swe_forces : seed 003 Eq. 5-8 ---- */
+
+fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
+    fsdem_swe *swe = c->desc.swe;
+    fsdem_dem *dem = c->desc.dem;
+    const fsdem_real rho = swe->desc.density, g = swe->g, beta = c->desc.beta;
+    const int axes = swe->dim;
+    int i, a;
+    if (fsdem__grow(&c->allocator, (void **)&c->force, &c->force_capacity, 0, dem->n, sizeof(fsdem_swe_dem_force)) !=
+        FSDEM_OK)
+        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "out of memory for the forces of %d particles", dem->n);
+    if (c->desc.two_way) {
+        fsdem_swe_clear_sources(swe);
+        swe->sources_used = 1; /* the step must apply them */
+    }
+    for (i = 0; i < dem->n; ++i) {
+        fsdem_swe_dem_force *out = &c->force[i];
+        const fsdem_vec3 p = dem->x[i], w = dem->v[i];
+        const fsdem_real r = dem->r[i];
+        fsdem_swe_cell centre, back[2], front[2], flow;
+        fsdem_vec3 horizontal;
+        memset(out, 0, sizeof *out);
+        dem->fext[i] = fsdem__zero3();
+        if (dem->fixed[i] || fsdem_swe_sample(swe, p.x, p.y, &centre) != FSDEM_OK) continue;
+        /* the water at the centre, and at the back (-r) and front (+r) along each horizontal axis; the
+           flow velocity is the centre's, or that of the deepest side while a front reaches the sphere */
+        flow = centre;
+        for (a = 0; a < axes; ++a) {
+            back[a] = fsdem__swe_water_at(swe, p, a, -r, centre);
+            front[a] = fsdem__swe_water_at(swe, p, a, r, centre);
+            if (flow.depth < swe->desc.dry_depth && back[a].depth > flow.depth) flow = back[a];
+            if (flow.depth < swe->desc.dry_depth && front[a].depth > flow.depth) flow = front[a];
+        }
+        if (flow.depth < swe->desc.dry_depth) continue;
+        out->submerged_volume = fsdem__submerged_sphere(r, p.z, centre.eta);
+        out->buoyancy = fsdem_v3(0, 0, rho * g * out->submerged_volume); /* Eq. 5 */
+        for (a = 0; a < axes; ++a) {
+            /* Eq. 6-7 along axis a */
+            fsdem_real area_b, area_f, m_b, m_f, rel, hydro, dyn;
+            fsdem__submerged_disc(r, p.z, back[a].eta, &area_b, &m_b);
+            fsdem__submerged_disc(r, p.z, front[a].eta, &area_f, &m_f);
+            rel = beta * (a == 0 ? flow.u : flow.v) - (a == 0 ? w.x : w.y);
+            hydro = rho * g * (m_b - m_f);
+            dyn = rho * rel * (rel < 0 ? -rel : rel) * (rel > 0 ? area_b : area_f);
+            if (a == 0) {
+                out->hydrostatic.x = hydro;
+                out->dynamic.x = dyn;
+                out->frontal_area = area_f;
+            } else {
+                out->hydrostatic.y = hydro;
+                out->dynamic.y = dyn;
+            }
+        }
+        if (c->desc.heave_damping > 0) {
+            /* critical damping of the hydrostatic spring rho g A_waterplane of the bobbing */
+            fsdem_real a2 = r * r - (centre.eta - p.z) * (centre.eta - p.z);
+            if (a2 > 0)
+                out->heave = fsdem_v3(0, 0, -2 * c->desc.heave_damping *
+                                                    (fsdem_real)sqrt(rho * g * (fsdem_real)FSDEM__PI * a2 * dem->m[i]) * w.z);
+        }
+        horizontal = fsdem__add(out->hydrostatic, out->dynamic);
+        dem->fext[i] = fsdem__add(fsdem__add(horizontal, out->buoyancy), out->heave);
+        if (c->desc.two_way) fsdem__swe_spread_reaction(swe, p, r, horizontal);
+    }
+    return fsdem__ok(&c->status);
+}
+
+fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *c, int index, fsdem_swe_dem_force *out) {
+    if (!out || index < 0 || index >= c->desc.dem->n || index >= c->force_capacity) return FSDEM_ERR_NOT_FOUND;
+    *out = c->force[index];
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c, fsdem_real dt_cap, fsdem_real *dt_out, int *substeps) {
+    fsdem_real dt = 0;
+    fsdem_result res = fsdem_swe_dem_update_forces(c);
+    if (res != FSDEM_OK) return res;
+    res = fsdem_swe_step(c->desc.swe, dt_cap, &dt);
+    if (res != FSDEM_OK)
+        return fsdem__fail(&c->status, res, "shallow-water step: %s", fsdem_swe_last_error(c->desc.swe));
+    res = fsdem_dem_advance(c->desc.dem, dt, substeps);
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
+    if (dt_out) *dt_out = dt;
+    return fsdem__ok(&c->status);
+}
+
+fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
+    const fsdem_swe *swe = (const fsdem_swe *)user;
+    const fsdem_real x0 = swe->desc.x_min + swe->dx / 2, x1 = swe->desc.x_min + (swe->nx - (fsdem_real)0.5) * swe->dx;
+    const fsdem_real y0 = swe->desc.y_min + swe->dy / 2, y1 = swe->desc.y_min + (swe->ny - (fsdem_real)0.5) * swe->dy;
+    fsdem_real x = p.x < x0 ? x0 : p.x > x1 ? x1 : p.x, y = p.y < y0 ? y0 : p.y > y1 ? y1 : p.y, gx, gy, len;
+    fsdem_swe_cell c0, cm, cp;
+    fsdem_swe_sample(swe, x, y, &c0);
+    /* bed slope from centred differences over one cell */
+    fsdem_swe_sample(swe, x - swe->dx / 2, y, &cm);
+    fsdem_swe_sample(swe, x + swe->dx / 2, y, &cp);
+    gx = (cp.bed - cm.bed) / swe->dx;
+    gy = 0;
+    if (swe->dim == 2) {
+        fsdem_swe_sample(swe, x, y - swe->dy / 2, &cm);
+        fsdem_swe_sample(swe, x, y + swe->dy / 2, &cp);
+        gy = (cp.bed - cm.bed) / swe->dy;
+    }
+    len = (fsdem_real)sqrt(1 + gx * gx + gy * gy);
+    *normal = fsdem_v3(-gx / len, -gy / len, 1 / len);
+    return (p.z - c0.bed) / len;
 }
 
 /* ===== >>impl_io : CSV and VTK output ============================================================== */

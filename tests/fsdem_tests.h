@@ -8,5 +8,7 @@ Suite *core_suite(void);
 Suite *dem_suite(void);
 Suite *linalg_suite(void);
 Suite *pic_suite(void);
+Suite *swe_suite(void);
+Suite *couple_swe_suite(void);
 
 #endif

@@ -1,0 +1,221 @@
+/* SWE-DEM floating debris (seed 003 Eq. 3-8): buoyancy, hydrostatic and dynamic pressure forces,
+   exact momentum exchange with the water, input validation. */
+#include <math.h>
+#include <stdlib.h>
+#include "fsdem_tests.h"
+
+#define PI 3.14159265358979323846
+
+typedef struct world {
+    fsdem_swe *swe;
+    fsdem_dem *dem;
+    fsdem_swe_dem *cpl;
+} world;
+
+/* A 1D channel [0, length] of n cells at depth `depth`, velocity `u`, walls at both ends, and a 3D
+   DEM over it with one sphere of radius r and density rho_s at (x, 0, z), coupled with the given heave
+   damping, one- or two-way. */
+static world world_new(double length, int n, double depth, double u, double r, double rho_s, double x, double z,
+                       double heave, int two_way) {
+    world w;
+    fsdem_swe_desc sd = fsdem_swe_desc_default(1);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(3);
+    fsdem_swe_dem_desc cd = fsdem_swe_dem_desc_default();
+    fsdem_material m = fsdem_material_default();
+    fsdem_particle_desc p = fsdem_particle_desc_default();
+    fsdem_real *h = malloc(sizeof(fsdem_real) * (size_t)n), *v = malloc(sizeof(fsdem_real) * (size_t)n);
+    int k, mat;
+    for (k = 0; k < n; ++k) {
+        h[k] = depth;
+        v[k] = u;
+    }
+    sd.nx = n;
+    sd.x_max = length;
+    sd.depth = h;
+    ck_assert_int_eq(fsdem_swe_create(&sd, &w.swe), FSDEM_OK);
+    ck_assert_int_eq(fsdem_swe_set_velocity(w.swe, v, NULL), FSDEM_OK);
+    dd.domain_min = fsdem_v3(0, -1, -1);
+    dd.domain_max = fsdem_v3(length, 1, 2);
+    dd.dt = 1e-4;
+    ck_assert_int_eq(fsdem_dem_create(&dd, &w.dem), FSDEM_OK);
+    m.density = rho_s;
+    m.restitution = 1;
+    ck_assert_int_eq(fsdem_dem_add_material(w.dem, &m, &mat), FSDEM_OK);
+    p.position = fsdem_v3(x, 0, z);
+    p.radius = r;
+    p.material = mat;
+    ck_assert_int_eq(fsdem_dem_add_particle(w.dem, &p, NULL), FSDEM_OK);
+    cd.swe = w.swe;
+    cd.dem = w.dem;
+    cd.heave_damping = heave;
+    cd.two_way = two_way;
+    ck_assert_int_eq(fsdem_swe_dem_create(&cd, &w.cpl), FSDEM_OK);
+    free(h);
+    free(v);
+    return w;
+}
+
+static void world_free(world *w) {
+    fsdem_swe_dem_destroy(w->cpl);
+    fsdem_dem_destroy(w->dem);
+    fsdem_swe_destroy(w->swe);
+}
+
+/* Submerged cap height s of a floating sphere: pi s^2 (3r - s)/3 = (rho_s/rho) (4/3) pi r^3, by
+   bisection (the cap volume grows monotonically with s). */
+static double floating_draft(double r, double ratio) {
+    double lo = 0, hi = 2 * r;
+    int it;
+    for (it = 0; it < 200; ++it) {
+        double s = 0.5 * (lo + hi);
+        if (PI * s * s * (3 * r - s) / 3 < ratio * 4.0 / 3.0 * PI * r * r * r) lo = s;
+        else hi = s;
+    }
+    return 0.5 * (lo + hi);
+}
+
+/* A sphere released at the surface bobs and, with heave damping, settles where buoyancy (Eq. 5, the
+   submerged cap) equals its weight. */
+START_TEST(floating_sphere_settles_at_buoyancy_equilibrium) {
+    const double r = 0.05, depth = 1, ratios[2] = {0.3, 0.8};
+    int c, s;
+    for (c = 0; c < 2; ++c) {
+        world w = world_new(4, 40, depth, 0, r, 1000 * ratios[c], 2, depth, 1.0, 1);
+        double draft, expected = floating_draft(r, ratios[c]);
+        for (s = 0; s < 400; ++s) ck_assert_int_eq(fsdem_swe_dem_step(w.cpl, 5e-3, NULL, NULL), FSDEM_OK);
+        draft = depth - (fsdem_dem_particles(w.dem).position[0].z - r);
+        /* critically damped heave (period ~0.5 s) decays within 2 s; the still water stays flat, so
+           the equilibrium is exact up to the bisection; 1e-3 relative allows for the residual decay */
+        ck_assert_msg(fabs(draft / expected - 1) < 1e-3, "ratio %g: draft %g, expected %g", ratios[c], draft, expected);
+        world_free(&w);
+    }
+}
+END_TEST
+
+/* Over a step in the surface (deeper water behind the sphere) the horizontal force is the hydrostatic
+   push rho g (M_back - M_front), M = int (eta - z) w(z) dz over the submerged circular segment; checked
+   against a brute-force midpoint quadrature of the same integral. */
+static double segment_moment_quadrature(double r, double zc, double eta) {
+    const int n = 200000;
+    double sum = 0, lo = zc - r, hi = fmin(eta, zc + r), dz = (hi - lo) / n;
+    int k;
+    if (hi <= lo) return 0;
+    for (k = 0; k < n; ++k) {
+        double z = lo + (k + 0.5) * dz, half = r * r - (z - zc) * (z - zc);
+        sum += (eta - z) * 2 * sqrt(half > 0 ? half : 0) * dz;
+    }
+    return sum;
+}
+
+static void surface_step(void *user, fsdem_real x, fsdem_real y, fsdem_swe_cell *cell) {
+    (void)y;
+    (void)user;
+    cell->bed = 0;
+    cell->depth = x < 2 ? 0.5 : 0.42; /* the step is at x = 2, the sphere's centre */
+    cell->u = cell->v = 0;
+}
+
+START_TEST(hydrostatic_force_matches_quadrature) {
+    const double r = 0.05, rho = 1000, g = 9.81, zc = 0.45;
+    world w = world_new(4, 400, 0.5, 0, r, 500, 2, zc, 0, 1);
+    fsdem_swe_dem_force f;
+    fsdem_swe_cell back, front;
+    double expected;
+    ck_assert_int_eq(fsdem_swe_set_cells(w.swe, surface_step, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_swe_dem_update_forces(w.cpl), FSDEM_OK);
+    ck_assert_int_eq(fsdem_swe_dem_get_force(w.cpl, 0, &f), FSDEM_OK);
+    fsdem_swe_sample(w.swe, 2 - r, 0, &back);
+    fsdem_swe_sample(w.swe, 2 + r, 0, &front);
+    expected = rho * g * (segment_moment_quadrature(r, zc, back.eta) - segment_moment_quadrature(r, zc, front.eta));
+    /* the midpoint rule with 2e5 intervals is exact to ~1e-9 relative on this integrand */
+    ck_assert_msg(fabs(f.hydrostatic.x / expected - 1) < 1e-6, "hydrostatic %g, quadrature %g", (double)f.hydrostatic.x,
+                  expected);
+    ck_assert(f.hydrostatic.x > 0);          /* pushed from the deep side */
+    ck_assert(fabs(f.dynamic.x) < 1e-300);   /* nothing moves */
+    world_free(&w);
+}
+END_TEST
+
+/* A sphere thrown at 1 m/s through still water: the water gains exactly the momentum the sphere
+   loses (two-way, Eq. 8 in force-per-area form), before any wave reaches the walls. One-way coupling
+   leaves the water's momentum untouched. */
+START_TEST(momentum_is_exchanged_not_created) {
+    int two_way, s;
+    for (two_way = 0; two_way <= 1; ++two_way) {
+        world w = world_new(20, 400, 0.4, 0, 0.05, 500, 10, 0.4, 0, two_way);
+        fsdem_particles p;
+        fsdem_vec3 pw0, pw;
+        double pd0, pd;
+        ck_assert_int_eq(fsdem_dem_set_particle_state(w.dem, 0, fsdem_v3(10, 0, 0.4), fsdem_v3(1, 0, 0),
+                                                      fsdem_v3(0, 0, 0)),
+                         FSDEM_OK);
+        p = fsdem_dem_particles(w.dem);
+        pw0 = fsdem_swe_momentum(w.swe);
+        pd0 = p.mass[0] * p.velocity[0].x;
+        for (s = 0; s < 100; ++s) ck_assert_int_eq(fsdem_swe_dem_step(w.cpl, 5e-3, NULL, NULL), FSDEM_OK);
+        /* 0.5 s: waves travel sqrt(g h) t = 1 m, far from the walls 10 m away */
+        p = fsdem_dem_particles(w.dem);
+        pw = fsdem_swe_momentum(w.swe);
+        pd = p.mass[0] * p.velocity[0].x;
+        ck_assert_msg(pd < 0.9 * pd0, "the water must slow the sphere (%g -> %g)", pd0, pd);
+        if (two_way)
+            /* flux-form finite volumes on a flat frictionless bed conserve momentum to rounding; the
+               exchange is exact, so the total changes by rounding only (1e-12 of what moved) */
+            ck_assert_msg(fabs((pw.x - pw0.x) + (pd - pd0)) < 1e-12 * fabs(pd - pd0) + 1e-15,
+                          "water %g + debris %g", (double)(pw.x - pw0.x), pd - pd0);
+        else
+            ck_assert_msg(fabs(pw.x - pw0.x) < 1e-15, "one-way: water momentum changed by %g", (double)(pw.x - pw0.x));
+        world_free(&w);
+    }
+}
+END_TEST
+
+START_TEST(invalid_coupler_desc_is_rejected) {
+    world w = world_new(4, 40, 0.5, 0, 0.05, 500, 2, 0.5, 0, 1);
+    fsdem_swe_dem_desc cd = fsdem_swe_dem_desc_default();
+    fsdem_dem_desc dd2 = fsdem_dem_desc_default(2);
+    fsdem_dem *flat;
+    fsdem_swe_dem *c = NULL;
+    char msg[256];
+    ck_assert_int_eq(fsdem_swe_dem_create(&cd, &c), FSDEM_ERR_INVALID_ARG); /* no solvers */
+    ck_assert_ptr_null(c);
+    cd.swe = w.swe;
+    cd.dem = w.dem;
+    cd.beta = 0;
+    ck_assert_int_eq(fsdem_swe_dem_desc_check(&cd, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(msg, "beta"));
+    cd.beta = 1.1;
+    cd.heave_damping = -1;
+    ck_assert_int_eq(fsdem_swe_dem_desc_check(&cd, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(msg, "heave_damping"));
+    cd.heave_damping = 0;
+    ck_assert_int_eq(fsdem_dem_create(&dd2, &flat), FSDEM_OK);
+    cd.dem = flat;
+    ck_assert_int_eq(fsdem_swe_dem_desc_check(&cd, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(msg, "3D"));
+    fsdem_dem_destroy(flat);
+    dd2 = fsdem_dem_desc_default(3);
+    dd2.gravity = fsdem_v3(0, -9.81, 0);
+    ck_assert_int_eq(fsdem_dem_create(&dd2, &flat), FSDEM_OK);
+    cd.dem = flat;
+    ck_assert_int_eq(fsdem_swe_dem_desc_check(&cd, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(msg, "gravity"));
+    fsdem_dem_destroy(flat);
+    ck_assert_int_eq(fsdem_swe_dem_get_force(w.cpl, 5, NULL), FSDEM_ERR_NOT_FOUND);
+    /* the existing coupler is unaffected */
+    ck_assert_int_eq(fsdem_swe_dem_step(w.cpl, 1e-3, NULL, NULL), FSDEM_OK);
+    world_free(&w);
+}
+END_TEST
+
+Suite *couple_swe_suite(void) {
+    Suite *s = suite_create("couple_swe");
+    TCase *tc = tcase_create("couple_swe");
+    tcase_set_timeout(tc, 120);
+    tcase_add_test(tc, floating_sphere_settles_at_buoyancy_equilibrium);
+    tcase_add_test(tc, hydrostatic_force_matches_quadrature);
+    tcase_add_test(tc, momentum_is_exchanged_not_created);
+    tcase_add_test(tc, invalid_coupler_desc_is_rejected);
+    suite_add_tcase(s, tc);
+    return s;
+}

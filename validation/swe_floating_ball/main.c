@@ -1,0 +1,112 @@
+/* validation/swe_floating_ball: seed 003's analytical case. A ball (r = 0.02 m, rho = 500 kg/m^3)
+   floats half-submerged in a steady flow h = 0.4 m, u = 0.5 m/s of a 20 m flume and is released at
+   rest at s0 = 0.5 m. With equal levels at back and front only the dynamic pressure rho (beta u - w)^2
+   on the submerged frontal area S_F = pi r^2 / 2 drives it, and Eq. 9-11 give w(t), s(t), a(t).
+   Two-way coupling is on, so the water feels the reaction. Writes ball.csv. See README.md. */
+#define FSDEM_IMPLEMENTATION
+#include "fsdem.h"
+#include "../common.h"
+
+#define CASE "swe_floating_ball"
+
+int main(void) {
+    const double h0 = 0.4, u0 = 0.5, length = 20, r = 0.02, rho_s = 500, rho = 1000, beta = 1.1, s0 = 0.5;
+    const double t_end = 5, dt_cap = 5e-4, dt_out = 0.05;
+    const double pi = 3.14159265358979323846, m = rho_s * 4.0 / 3.0 * pi * r * r * r, area = pi * r * r / 2;
+    fsdem_swe_desc sd = fsdem_swe_desc_default(1);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(3);
+    fsdem_swe *swe;
+    fsdem_dem *dem;
+    fsdem_swe_dem *cpl;
+    fsdem_swe_dem_desc cd = fsdem_swe_dem_desc_default();
+    fsdem_material wood = fsdem_material_default();
+    fsdem_particle_desc ball = fsdem_particle_desc_default();
+    fsdem_csv csv;
+    fsdem_real *depth, *vel;
+    double t = 0, next_out = 0, err_x = 0, err_w = 0, err_a = 0;
+    int k, mat;
+
+    /* 1D flume: 400 cells of 5 cm, inflow q = h u upstream, fixed stage h downstream */
+    sd.nx = 400;
+    sd.x_min = 0;
+    sd.x_max = length;
+    sd.boundary[FSDEM_SWE_XMIN].type = FSDEM_SWE_BC_DISCHARGE;
+    sd.boundary[FSDEM_SWE_XMIN].value = h0 * u0;
+    sd.boundary[FSDEM_SWE_XMAX].type = FSDEM_SWE_BC_STAGE;
+    sd.boundary[FSDEM_SWE_XMAX].value = h0;
+    depth = malloc(sizeof(fsdem_real) * 400);
+    vel = malloc(sizeof(fsdem_real) * 400);
+    for (k = 0; k < 400; ++k) {
+        depth[k] = h0;
+        vel[k] = u0;
+    }
+    sd.depth = depth;
+    if (fsdem_swe_create(&sd, &swe) != FSDEM_OK || fsdem_swe_set_velocity(swe, vel, NULL) != FSDEM_OK) return 2;
+
+    /* the ball: a 3D DEM sphere, z vertical, floating with its centre on the surface */
+    dd.domain_min = fsdem_v3(0, -0.5, -0.5);
+    dd.domain_max = fsdem_v3(length, 0.5, 1.5);
+    dd.dt = 1e-4;
+    if (fsdem_dem_create(&dd, &dem) != FSDEM_OK) return 2;
+    wood.density = rho_s;
+    wood.restitution = 1;
+    fsdem_dem_add_material(dem, &wood, &mat);
+    ball.position = fsdem_v3(s0, 0, h0);
+    ball.radius = r;
+    ball.material = mat;
+    if (fsdem_dem_add_particle(dem, &ball, NULL) != FSDEM_OK) return 2;
+
+    cd.swe = swe;
+    cd.dem = dem;
+    cd.beta = beta;
+    if (fsdem_swe_dem_create(&cd, &cpl) != FSDEM_OK) return 2;
+    if (fsdem_csv_open(&csv, "ball.csv", "t,x,w,a,x_exact,w_exact,a_exact") != FSDEM_OK) return 2;
+
+    for (;;) {
+        fsdem_particles p = fsdem_dem_particles(dem);
+        fsdem_swe_dem_force f;
+        fsdem_real dt;
+        double x, w, a, den = beta * u0 * area * rho * t + m;
+        double w_ex = beta * u0 - beta * u0 * m / den;                                       /* Eq. 9 */
+        double x_ex = beta * u0 * t - m / (area * rho) * log(area * rho * beta * u0 / m * t + 1) + s0; /* Eq. 10 */
+        double a_ex = beta * beta * u0 * u0 * rho * area * m / (den * den);                  /* Eq. 11 */
+        fsdem_swe_dem_update_forces(cpl);
+        fsdem_swe_dem_get_force(cpl, 0, &f);
+        x = p.position[0].x;
+        w = p.velocity[0].x;
+        a = (f.hydrostatic.x + f.dynamic.x) / m;
+        /* relative errors; velocity from 0.1 s on, where w is no longer ~0 */
+        if (fabs(x - x_ex) / x_ex > err_x) err_x = fabs(x - x_ex) / x_ex;
+        if (t >= 0.1 && fabs(w - w_ex) / w_ex > err_w) err_w = fabs(w - w_ex) / w_ex;
+        if (fabs(a - a_ex) / a_ex > err_a) err_a = fabs(a - a_ex) / a_ex;
+        if (t >= next_out - 1e-12) {
+            fsdem_real row[7];
+            row[0] = t; row[1] = x; row[2] = w; row[3] = a; row[4] = x_ex; row[5] = w_ex; row[6] = a_ex;
+            fsdem_csv_row(&csv, row, 7);
+            next_out += dt_out;
+        }
+        if (t >= t_end - 1e-12) break;
+        if (fsdem_swe_dem_step(cpl, fmin(dt_cap, t_end - t), &dt, NULL) != FSDEM_OK) {
+            printf("step failed: %s\n", fsdem_swe_dem_last_error(cpl));
+            return 2;
+        }
+        t += dt;
+    }
+    fsdem_csv_close(&csv);
+    vc_info(CASE, "ball at t = %.1f s: x = %.5f m, w = %.5f m/s (exact %.5f, %.5f)", t_end,
+            (double)fsdem_dem_particles(dem).position[0].x, (double)fsdem_dem_particles(dem).velocity[0].x,
+            beta * u0 * t_end - m / (area * rho) * log(area * rho * beta * u0 / m * t_end + 1) + s0,
+            beta * u0 - beta * u0 * m / (beta * u0 * area * rho * t_end + m));
+    /* The coupling holds the fluid force over each outer step, a first-order lag: the errors halve
+       with dt_cap (1 ms: 0.39% in w, 1.5% in a; 0.5 ms: 0.20%, 0.75%). With 0.5 ms they sit at
+       under half the required 0.5% (position, velocity) and 2% (acceleration). */
+    vc_check(CASE, "position_max_rel_error", err_x, 0, 0.005);
+    vc_check(CASE, "velocity_max_rel_error", err_w, 0, 0.005);
+    vc_check(CASE, "acceleration_max_rel_error", err_a, 0, 0.02);
+    fsdem_swe_dem_destroy(cpl);
+    fsdem_dem_destroy(dem);
+    fsdem_swe_destroy(swe);
+    free(depth);
+    free(vel);
+    return vc_exit_code();
+}
