@@ -90,6 +90,7 @@ validate: $(foreach v,$(VALIDATION),$(BUILD)/validation/$(v)/run)
 	done; sh validation/report.sh $(BUILD)/validation; exit $$status
 
 $(BUILD)/bench/%: bench/%/main.c fsdem.h | $(BUILD)
+	@mkdir -p $(dir $@)
 	$(CC) $(STD) $(WARN) -O3 -DNDEBUG -I. $< -o $@ $(LDLIBS)
 
 bench: $(foreach b,$(BENCHES),$(BUILD)/bench/$(b))
