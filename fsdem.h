@@ -1365,6 +1365,23 @@ static fsdem_result fsdem__ok(fsdem__status *s) {
     return FSDEM_OK;
 }
 
+/* The common start of every fsdem_<object>_create: `checked` is the result of the desc check and `why`
+   its reason, which goes to the desc's log on failure; otherwise a zeroed object of `size` bytes is
+   allocated with `al`. Returns it, or NULL with *res set. */
+static void *fsdem__object_new(fsdem_result checked, const char *why, fsdem_log_fn log, void *log_user,
+                               const fsdem_allocator *al, size_t size, fsdem_result *res) {
+    void *obj;
+    if (checked != FSDEM_OK) {
+        if (log) log(log_user, FSDEM_LOG_ERROR, why);
+        *res = checked;
+        return NULL;
+    }
+    obj = fsdem__alloc(al, size);
+    *res = obj ? FSDEM_OK : FSDEM_ERR_OUT_OF_MEMORY;
+    if (obj) memset(obj, 0, size);
+    return obj;
+}
+
 static int fsdem__finite(fsdem_real x) { return x == x && x - x == 0; }
 static int fsdem__finite3(fsdem_vec3 v) {
     return fsdem__finite(v.x) && fsdem__finite(v.y) && fsdem__finite(v.z);
@@ -1934,25 +1951,20 @@ static void fsdem__list_free(fsdem_dem *d, fsdem__list *l) {
 
 fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     char msg[FSDEM__MESSAGE_SIZE];
-    fsdem_allocator al;
     fsdem_dem *d;
     fsdem_result res;
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
-    if (fsdem_dem_desc_check(desc, msg, sizeof msg) != FSDEM_OK) {
-        if (desc && desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
-        return FSDEM_ERR_INVALID_ARG;
-    }
-    al = desc->allocator;
-    d = (fsdem_dem *)fsdem__alloc(&al, sizeof *d);
-    if (!d) return FSDEM_ERR_OUT_OF_MEMORY;
-    memset(d, 0, sizeof *d);
+    res = fsdem_dem_desc_check(desc, msg, sizeof msg);
+    d = (fsdem_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
+                                       desc ? &desc->allocator : NULL, sizeof *d, &res);
+    if (!d) return res;
     d->desc = *desc;
-    d->allocator = al;
+    d->allocator = desc->allocator;
     d->status.log = desc->log;
     d->status.log_user = desc->log_user;
     d->dt = desc->dt;
-    d->grid.allocator = al;
+    d->grid.allocator = desc->allocator;
     d->need_rebuild = 1;
     {
         fsdem_real accel = desc->linear_accel > 0 ? desc->linear_accel : fsdem__norm(desc->gravity);
@@ -3285,15 +3297,13 @@ static fsdem_result fsdem__pcg_desc_check(const fsdem_pcg_desc *d, char *msg, si
 fsdem_result fsdem_pcg_create(const fsdem_pcg_desc *desc, fsdem_pcg **out) {
     char msg[FSDEM__MESSAGE_SIZE];
     fsdem_pcg *s;
+    fsdem_result res;
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
-    if (fsdem__pcg_desc_check(desc, msg, sizeof msg) != FSDEM_OK) {
-        if (desc && desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
-        return FSDEM_ERR_INVALID_ARG;
-    }
-    s = (fsdem_pcg *)fsdem__alloc(&desc->allocator, sizeof *s);
-    if (!s) return FSDEM_ERR_OUT_OF_MEMORY;
-    memset(s, 0, sizeof *s);
+    res = fsdem__pcg_desc_check(desc, msg, sizeof msg);
+    s = (fsdem_pcg *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
+                                       desc ? &desc->allocator : NULL, sizeof *s, &res);
+    if (!s) return res;
     s->desc = *desc;
     s->allocator = desc->allocator;
     s->status.log = desc->log;
@@ -4979,14 +4989,9 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
     if (out) *out = NULL;
     if (!desc || !out) return FSDEM_ERR_INVALID_ARG;
     r = fsdem__pic_check(desc, msg, sizeof msg);
-    if (r != FSDEM_OK) {
-        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
-        return r;
-    }
+    s = (fsdem_pic *)fsdem__object_new(r, msg, desc->log, desc->log_user, &desc->allocator, sizeof *s, &r);
+    if (!s) return r;
     al = desc->allocator;
-    s = (fsdem_pic *)fsdem__alloc(&al, sizeof *s);
-    if (!s) return FSDEM_ERR_OUT_OF_MEMORY;
-    memset(s, 0, sizeof *s);
     s->desc = *desc;
     s->allocator = al;
     s->bytes = sizeof *s;
@@ -7616,18 +7621,16 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
     char msg[FSDEM__MESSAGE_SIZE];
     fsdem_allocator al;
     fsdem_swe *s;
+    fsdem_result res;
     size_t n, nx, reals;
     int k;
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
-    if (fsdem_swe_desc_check(desc, msg, sizeof msg) != FSDEM_OK) {
-        if (desc && desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
-        return FSDEM_ERR_INVALID_ARG;
-    }
+    res = fsdem_swe_desc_check(desc, msg, sizeof msg);
+    s = (fsdem_swe *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
+                                       desc ? &desc->allocator : NULL, sizeof *s, &res);
+    if (!s) return res;
     al = desc->allocator;
-    s = (fsdem_swe *)fsdem__alloc(&al, sizeof *s);
-    if (!s) return FSDEM_ERR_OUT_OF_MEMORY;
-    memset(s, 0, sizeof *s);
     s->desc = *desc;
     s->desc.bed = s->desc.depth = NULL;
     s->allocator = al;
@@ -8948,15 +8951,13 @@ fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *d, char *msg, si
 fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out) {
     char msg[FSDEM__MESSAGE_SIZE];
     fsdem_swe_dem *c;
+    fsdem_result res;
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
-    if (fsdem_swe_dem_desc_check(desc, msg, sizeof msg) != FSDEM_OK) {
-        if (desc && desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
-        return FSDEM_ERR_INVALID_ARG;
-    }
-    c = (fsdem_swe_dem *)fsdem__alloc(&desc->dem->allocator, sizeof *c);
-    if (!c) return FSDEM_ERR_OUT_OF_MEMORY;
-    memset(c, 0, sizeof *c);
+    res = fsdem_swe_dem_desc_check(desc, msg, sizeof msg);
+    c = (fsdem_swe_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
+                                           res == FSDEM_OK ? &desc->dem->allocator : NULL, sizeof *c, &res);
+    if (!c) return res;
     c->desc = *desc;
     c->allocator = desc->dem->allocator;
     c->status.log = desc->log;
