@@ -21,7 +21,7 @@
      >>swe      shallow-water equations in 1D and 2D: HLL, MUSCL-Hancock, wet/dry, well-balanced
                 (seed 003)
      >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
-     >>io       CSV time series and particle snapshots (CSV, legacy VTK for ParaView)
+     >>io       CSV time series, ParaView .pvd series, DEM particle snapshots (CSV, legacy VTK)
      >>impl     implementation, in the same order
      >>licence  MIT
 
@@ -885,16 +885,6 @@ FSDEM_API fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *pic, const
 FSDEM_API fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *pic, const char *path);
 FSDEM_API fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *pic, const char *path);
 
-/* A ParaView time series (.pvd collection): open, add one entry per written file (its name as
-   seen from the .pvd's folder), close. Owned by the caller. */
-typedef struct fsdem_pvd {
-    void *file; /* FILE*, NULL when closed */
-} fsdem_pvd;
-
-/* FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG for NULL arguments. */
-FSDEM_API fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path);
-FSDEM_API fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file);
-FSDEM_API fsdem_result fsdem_pvd_close(fsdem_pvd *pvd);
 
 /* ===== >>swe : shallow-water equations (seed 003) ================================================= */
 
@@ -1250,6 +1240,17 @@ FSDEM_API fsdem_result fsdem_csv_open(fsdem_csv *csv, const char *path, const ch
 /* Writes one row; `count` must equal the number of header columns. */
 FSDEM_API fsdem_result fsdem_csv_row(fsdem_csv *csv, const fsdem_real *values, int count);
 FSDEM_API fsdem_result fsdem_csv_close(fsdem_csv *csv);
+
+/* A ParaView time series (.pvd collection): open, add one entry per written file (its name as
+   seen from the .pvd's folder), close. Owned by the caller. */
+typedef struct fsdem_pvd {
+    void *file; /* FILE*, NULL when closed */
+} fsdem_pvd;
+
+/* FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG for NULL arguments. */
+FSDEM_API fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path);
+FSDEM_API fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file);
+FSDEM_API fsdem_result fsdem_pvd_close(fsdem_pvd *pvd);
 
 /* Particle snapshot as CSV: id,x,y,z,vx,vy,vz,wx,wy,wz,radius,material. */
 FSDEM_API fsdem_result fsdem_dem_write_csv(const fsdem_dem *dem, const char *path);
@@ -7238,36 +7239,6 @@ fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *s, const char *path) {
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
-fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path) {
-    FILE *fp;
-    if (!pvd || !path) return FSDEM_ERR_INVALID_ARG;
-    pvd->file = NULL;
-    fp = fopen(path, "w");
-    if (!fp) return FSDEM_ERR_IO;
-    pvd->file = fp;
-    if (fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n") < 0)
-        return FSDEM_ERR_IO;
-    fflush(fp);
-    return FSDEM_OK;
-}
-
-fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file) {
-    if (!pvd || !pvd->file || !file) return FSDEM_ERR_INVALID_ARG;
-    if (fprintf((FILE *)pvd->file, "<DataSet timestep=\"%.9g\" part=\"0\" file=\"%s\"/>\n", (double)time, file) < 0)
-        return FSDEM_ERR_IO;
-    fflush((FILE *)pvd->file);
-    return FSDEM_OK;
-}
-
-fsdem_result fsdem_pvd_close(fsdem_pvd *pvd) {
-    int bad;
-    if (!pvd || !pvd->file) return FSDEM_ERR_INVALID_ARG;
-    bad = fprintf((FILE *)pvd->file, "</Collection>\n</VTKFile>\n") < 0;
-    bad |= fclose((FILE *)pvd->file) != 0;
-    pvd->file = NULL;
-    return bad ? FSDEM_ERR_IO : FSDEM_OK;
-}
-
 /* ===== >>impl_swe : shallow-water solver ========================================================== */
 
 /* Scheme (one step of dt, >>swe_step):
@@ -9193,6 +9164,38 @@ fsdem_result fsdem_csv_close(fsdem_csv *csv) {
     if (!csv || !csv->file) return FSDEM_ERR_INVALID_ARG;
     bad = fclose((FILE *)csv->file) != 0;
     csv->file = NULL;
+    return bad ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path) {
+    FILE *fp;
+    if (!pvd || !path) return FSDEM_ERR_INVALID_ARG;
+    pvd->file = NULL;
+    fp = fopen(path, "w");
+    if (!fp) return FSDEM_ERR_IO;
+    if (fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n") < 0) {
+        fclose(fp);
+        return FSDEM_ERR_IO;
+    }
+    pvd->file = fp;
+    fflush(fp);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file) {
+    if (!pvd || !pvd->file || !file) return FSDEM_ERR_INVALID_ARG;
+    if (fprintf((FILE *)pvd->file, "<DataSet timestep=\"%.9g\" part=\"0\" file=\"%s\"/>\n", (double)time, file) < 0)
+        return FSDEM_ERR_IO;
+    fflush((FILE *)pvd->file);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_pvd_close(fsdem_pvd *pvd) {
+    int bad;
+    if (!pvd || !pvd->file) return FSDEM_ERR_INVALID_ARG;
+    bad = fprintf((FILE *)pvd->file, "</Collection>\n</VTKFile>\n") < 0;
+    bad |= fclose((FILE *)pvd->file) != 0;
+    pvd->file = NULL;
     return bad ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
