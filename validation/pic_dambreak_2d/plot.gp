@@ -14,12 +14,12 @@ set key top left
 plot [0:5.5] 'front.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 2 title 'fsdem a/40', \
      'front_n20.csv' using ($1*sqrt(2*g/a)):($2/a) with lines dt 2 title 'fsdem a/20', \
      'front_n10.csv' using ($1*sqrt(2*g/a)):($2/a) with lines dt 3 title 'fsdem a/10', \
-     'ref_front.csv' using ($1*sqrt(2*g/a)):($2/a) with points pt 7 ps 1.2 title 'Martin & Moyce 1952'
+     'ref_front.csv' using ($1*sqrt(2*g/a)):($2/a) with points pt 7 ps 1.2 title 'Martin and Moyce 1952'
 set title 'residual column height'
 set xlabel 'tau = t sqrt(g/a)'
 set ylabel 'eta = h / (2a)'
 set key top right
 plot [0:8] 'front.csv' using ($1*sqrt(g/a)):($3/(2*a)) with lines lw 2 title 'fsdem a/40', \
      'front_n20.csv' using ($1*sqrt(g/a)):($3/(2*a)) with lines dt 2 title 'fsdem a/20', \
-     'ref_height.csv' using ($1*sqrt(g/a)):($2/(2*a)) with points pt 7 ps 1.2 title 'Martin & Moyce 1952'
+     'ref_height.csv' using ($1*sqrt(g/a)):($2/(2*a)) with points pt 7 ps 1.2 title 'Martin and Moyce 1952'
 unset multiplot

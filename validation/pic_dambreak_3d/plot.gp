@@ -13,4 +13,4 @@ set key top left
 plot 'front_2d.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 3 title '2D', \
      'front_thin.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 2 dt 2 title '3D thin (a/4)', \
      'front_wide.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 2 dt 3 title '3D wide (a)', \
-     'ref_front.csv' using ($1*sqrt(2*g/a)):($2/a) with points pt 7 ps 1.2 title 'Martin & Moyce 1952'
+     'ref_front.csv' using ($1*sqrt(2*g/a)):($2/a) with points pt 7 ps 1.2 title 'Martin and Moyce 1952'
