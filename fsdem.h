@@ -315,7 +315,7 @@ typedef enum fsdem_wall_type {
     FSDEM_WALL_BOX_OUTSIDE = 2, /* axis-aligned solid box [a, b]; particles stay outside */
     FSDEM_WALL_SEGMENT = 3,     /* 2D segment a-b (both sides) */
     FSDEM_WALL_TRIANGLE = 4,    /* 3D triangle a-b-c (both sides) */
-    FSDEM_WALL_SDF = 5          /* signed distance given by a callback */
+    FSDEM_WALL_SDF = 5          /* signed distance given by a callback (moved by it: fsdem_dem_wall_moved) */
 } fsdem_wall_type;
 
 /* Signed distance (m) from p to a solid, positive on the particles' side; writes the unit outward
@@ -343,17 +343,23 @@ FSDEM_API fsdem_result fsdem_dem_add_wall(fsdem_dem *dem, const fsdem_wall_desc 
 /* Removes a wall (the id is not reused). */
 FSDEM_API fsdem_result fsdem_dem_remove_wall(fsdem_dem *dem, int id);
 FSDEM_API fsdem_result fsdem_dem_set_wall_velocity(fsdem_dem *dem, int id, fsdem_vec3 velocity);
+/* Tells the neighbour search that wall `id` moved by up to `distance` (m) outside the library, as an
+   SDF wall moved by its callback does; without it, particles that were far from the wall at the last
+   rebuild would not see it come. FSDEM_ERR_NOT_FOUND, FSDEM_ERR_INVALID_ARG (negative distance). */
+FSDEM_API fsdem_result fsdem_dem_wall_moved(fsdem_dem *dem, int id, fsdem_real distance);
 /* Force (N) the particles exert on the wall at the last force evaluation. */
 FSDEM_API fsdem_vec3 fsdem_dem_wall_force(const fsdem_dem *dem, int id);
-/* Impulse (N s) the wall has given to the particles since it was added (integrated consistently
-   with the integrator, so total particle momentum changes by exactly the sum over walls). */
+/* Impulse (N s) the wall's contacts have given to the particles since it was added, integrated as
+   the integrator does: the momentum of the free particles changes by the sum over walls plus the
+   impulses of gravity, external forces and contacts with fixed particles. */
 FSDEM_API fsdem_vec3 fsdem_dem_wall_impulse(const fsdem_dem *dem, int id);
 
 /* ---- time integration ---- */
 
 /* Advances by one step of desc.dt (or the last fsdem_dem_set_dt). Errors: FSDEM_ERR_NAN,
    FSDEM_ERR_OUT_OF_DOMAIN (the step is complete and the message names the particle),
-   FSDEM_ERR_OUT_OF_MEMORY (neighbour lists could not grow; nothing moved). */
+   FSDEM_ERR_OUT_OF_MEMORY (the neighbour lists could not grow: the step stopped part way, after the
+   drift, and is not undone; the object stays consistent and a later step rebuilds the lists). */
 FSDEM_API fsdem_result fsdem_dem_step(fsdem_dem *dem);
 /* Advances by an outer (fluid) step dt_outer with K = INT(dt_outer/dt) substeps of dt_outer/K, or
    one substep of dt_outer when dt > dt_outer (seed 000 Eq. 25). External forces stay fixed over
@@ -1174,8 +1180,11 @@ FSDEM_API fsdem_result fsdem_swe_gauges_close(fsdem_swe *swe);
    rho (Eq. 8 as printed, S_px = p/rho, is loose about units; this form makes the exchange exact: the
    water gains exactly -F_h dt per step while the debris gains F_h dt).
    Each coupled step: forces from the current state, one adaptive SWE step dt, then K DEM substeps of
-   dt with the fluid forces held fixed (fsdem_dem_advance, seed 000 Eq. 25). The coupler owns the
-   SWE's source_x/source_y and the DEM's external_force while it is used. */
+   dt/K (seed 000 Eq. 25) with the horizontal forces held fixed and the buoyancy (and heave damping)
+   recomputed in every substep from the sphere's height against the held water surface: buoyancy is
+   a stiff spring, and holding it over a whole fluid step would let bobbing grow without bound. A
+   horizontal force is only applied while wet cells under (or next to) the sphere can take its
+   reaction. The coupler owns the SWE's source_x/source_y and the DEM's external_force. */
 
 typedef struct fsdem_swe_dem fsdem_swe_dem;
 
@@ -1208,6 +1217,8 @@ typedef struct fsdem_swe_dem_force {
     fsdem_vec3 heave;             /* N, vertical damping (0 unless heave_damping > 0) */
     fsdem_real submerged_volume;  /* m^3 */
     fsdem_real frontal_area;      /* m^2, submerged area facing +x (S_F of seed 003 along x) */
+    fsdem_real surface;           /* m, water surface at the centre, held over the DEM substeps */
+    int in_water;                 /* 1 when water reaches the sphere */
 } fsdem_swe_dem_force;
 
 /* Computes the fluid forces on every free sphere from the current states, writes them to the DEM's
@@ -2410,6 +2421,16 @@ fsdem_result fsdem_dem_set_wall_velocity(fsdem_dem *d, int id, fsdem_vec3 veloci
     return fsdem__ok(&d->status);
 }
 
+fsdem_result fsdem_dem_wall_moved(fsdem_dem *d, int id, fsdem_real distance) {
+    fsdem__wall *w = fsdem__wall_by_id(d, id, "fsdem_dem_wall_moved");
+    if (!w) return FSDEM_ERR_NOT_FOUND;
+    if (!(distance >= 0) || !fsdem__finite(distance))
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_moved: distance must be >= 0 (got %g m)",
+                           (double)distance);
+    w->moved += distance;
+    return fsdem__ok(&d->status);
+}
+
 fsdem_vec3 fsdem_dem_wall_force(const fsdem_dem *d, int id) {
     return id >= 0 && id < d->wall_count ? d->walls[id].force : fsdem__zero3();
 }
@@ -2513,19 +2534,20 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
     d->pp.start[d->n] = d->pp.count;
     d->pw.start[d->n] = d->pw.count;
     d->pp.rows = d->pw.rows = d->n;
-    for (i = 0, k = 0; i < d->n; ++i)
-        if (d->pw.start[i + 1] - d->pw.start[i] > k) k = d->pw.start[i + 1] - d->pw.start[i];
-    if (fsdem__grow(&d->allocator, (void **)&d->hits, &d->hit_capacity, 0, k, sizeof(fsdem__wall_hit)) != FSDEM_OK)
-        return FSDEM_ERR_OUT_OF_MEMORY;
     for (i = 0; i < d->n; ++i) {
         d->x_ref[i] = d->x[i];
         d->old_of[i] = i;
     }
     for (k = 0; k < d->wall_count; ++k) d->walls[k].moved = 0;
     d->max_disp2 = 0;
-    d->need_rebuild = 0;
     d->rebuilds++;
-    return FSDEM_OK;
+    /* scratch for the longest wall row; the lists above are complete, so a failure here only asks
+       for another rebuild */
+    for (i = 0, k = 0; i < d->n; ++i)
+        if (d->pw.start[i + 1] - d->pw.start[i] > k) k = d->pw.start[i + 1] - d->pw.start[i];
+    d->need_rebuild = fsdem__grow(&d->allocator, (void **)&d->hits, &d->hit_capacity, 0, k, sizeof(fsdem__wall_hit)) !=
+                      FSDEM_OK;
+    return d->need_rebuild ? FSDEM_ERR_OUT_OF_MEMORY : FSDEM_OK;
 }
 
 static int fsdem__lists_stale(const fsdem_dem *d) {
@@ -2812,16 +2834,25 @@ fsdem_result fsdem_dem_step(fsdem_dem *d) {
     return res == FSDEM_OK ? fsdem__ok(&d->status) : res;
 }
 
-fsdem_result fsdem_dem_advance(fsdem_dem *d, fsdem_real dt_outer, int *substeps) {
-    int k, count;
-    fsdem_result res;
+/* Substeps of an outer step (seed 000): K = INT(dt/dt_DEM), dt_DEM = dt/K, and Eq. 25: one substep of
+   dt when dt_DEM > dt. The relative 1e-9 keeps an exact multiple (3e-4/1e-4 = 2.9999999999999996)
+   from losing a step. */
+static fsdem_result fsdem__substep_count(fsdem_dem *d, fsdem_real dt_outer, int *count) {
+    double ratio = (double)dt_outer / d->dt * (1 + 1e-9);
     if (!(dt_outer > 0) || !fsdem__finite(dt_outer))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_advance: dt_outer must be > 0 (got %g s)",
                            (double)dt_outer);
-    /* seed 000: K = INT(dt/dt_DEM), dt_DEM = dt/K; Eq. 25: dt_DEM = dt when dt_DEM > dt */
-    /* the relative 1e-9 keeps an exact multiple (3e-4/1e-4 = 2.9999999999999996) from losing a step */
-    count = d->dt >= dt_outer ? 1 : (int)(dt_outer / d->dt * (1 + 1e-9));
-    if (count < 1) count = 1;
+    if (ratio > 1e9)
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_dem_advance: dt_outer / dt = %g substeps is more than 1e9", ratio);
+    *count = ratio < 1 ? 1 : (int)ratio;
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_dem_advance(fsdem_dem *d, fsdem_real dt_outer, int *substeps) {
+    int k, count;
+    fsdem_result res = fsdem__substep_count(d, dt_outer, &count);
+    if (res != FSDEM_OK) return res;
     if (substeps) *substeps = count;
     for (k = 0; k < count; ++k) {
         res = fsdem__step(d, dt_outer / count);
@@ -2918,6 +2949,7 @@ fsdem_energy fsdem_dem_energy(const fsdem_dem *d) {
         for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
             int j = d->pp.entry[k].other;
             fsdem_real dist = fsdem__norm(fsdem__sub(d->x[i], d->x[j]));
+            if (d->inv_m[i] + d->inv_m[j] == 0) continue; /* two fixed particles exert nothing */
             c.delta = d->r[i] + d->r[j] + d->desc.contact_offset - dist;
             if (c.delta <= 0) continue;
             c.m_mean = (d->m[i] + d->m[j]) / 2;
@@ -2925,7 +2957,7 @@ fsdem_energy fsdem_dem_energy(const fsdem_dem *d) {
             c.pair = row + d->material[j];
             e.elastic += fsdem__contact_energy(d, &c, d->pp.entry[k].history);
         }
-        nh = fsdem__wall_hits((fsdem_dem *)d, i, 0);
+        nh = d->inv_m[i] > 0 ? fsdem__wall_hits((fsdem_dem *)d, i, 0) : 0; /* fixed: no wall force */
         for (k = 0; k < nh; ++k) {
             const fsdem__wall_hit *hit = &d->hits[k];
             c.delta = hit->delta;
@@ -8984,42 +9016,65 @@ static fsdem_swe_cell fsdem__swe_water_at(const fsdem_swe *swe, fsdem_vec3 p, in
 }
 
 /* Spreads the force -f (N, horizontal) exerted by a sphere on the water over the wet cells under its
-   footprint [x-r, x+r] (x [y-r, y+r] in 2D), weighted by overlap, as momentum sources (m^2/s^2). */
-static void fsdem__swe_spread_reaction(fsdem_swe *swe, fsdem_vec3 p, fsdem_real r, fsdem_vec3 f) {
+   footprint [x-r, x+r] (x [y-r, y+r] in 2D), weighted by overlap, as momentum sources (m^2/s^2). At a
+   wet/dry edge the sphere can feel water sampled from a neighbouring cell while its own cells are dry:
+   then the wet cells of the footprint grown by one cell share it equally. Returns 0 when no wet cell
+   can take it (the caller then drops the force, so momentum is exchanged, never created). */
+static int fsdem__swe_spread_reaction(fsdem_swe *swe, fsdem_vec3 p, fsdem_real r, fsdem_vec3 f) {
     const fsdem_real dry = swe->desc.dry_depth;
-    int i0, i1, j0, j1, i, j, pass;
+    int lo[2], hi[2], i, j, pass, grown;
     fsdem_real total = 0;
-    i0 = (int)floor((p.x - r - swe->desc.x_min) / swe->dx);
-    i1 = (int)floor((p.x + r - swe->desc.x_min) / swe->dx);
-    i0 = i0 < 0 ? 0 : i0;
-    i1 = i1 >= swe->nx ? swe->nx - 1 : i1;
-    if (swe->dim == 2) {
-        j0 = (int)floor((p.y - r - swe->desc.y_min) / swe->dy);
-        j1 = (int)floor((p.y + r - swe->desc.y_min) / swe->dy);
-        j0 = j0 < 0 ? 0 : j0;
-        j1 = j1 >= swe->ny ? swe->ny - 1 : j1;
-    } else {
-        j0 = j1 = 0;
+    for (grown = 0; grown < 2 && total == 0; ++grown) {
+        lo[0] = (int)floor((p.x - r - swe->desc.x_min) / swe->dx) - grown;
+        hi[0] = (int)floor((p.x + r - swe->desc.x_min) / swe->dx) + grown;
+        lo[1] = swe->dim == 2 ? (int)floor((p.y - r - swe->desc.y_min) / swe->dy) - grown : 0;
+        hi[1] = swe->dim == 2 ? (int)floor((p.y + r - swe->desc.y_min) / swe->dy) + grown : 0;
+        lo[0] = lo[0] < 0 ? 0 : lo[0];
+        hi[0] = hi[0] >= swe->nx ? swe->nx - 1 : hi[0];
+        lo[1] = lo[1] < 0 ? 0 : lo[1];
+        hi[1] = hi[1] >= swe->ny ? swe->ny - 1 : hi[1];
+        /* pass 0 sums the wet weights, pass 1 deposits -f w / (rho A) with the weights normalised */
+        for (pass = 0; pass < 2; ++pass)
+            for (j = lo[1]; j <= hi[1]; ++j)
+                for (i = lo[0]; i <= hi[0]; ++i) {
+                    const int k = i + swe->nx * j;
+                    fsdem_real w = 1;
+                    if (!grown) {
+                        fsdem_real xa = swe->desc.x_min + i * swe->dx;
+                        w = (p.x + r < xa + swe->dx ? p.x + r : xa + swe->dx) - (p.x - r > xa ? p.x - r : xa);
+                        if (swe->dim == 2) {
+                            fsdem_real ya = swe->desc.y_min + j * swe->dy;
+                            w *= (p.y + r < ya + swe->dy ? p.y + r : ya + swe->dy) - (p.y - r > ya ? p.y - r : ya);
+                        }
+                    }
+                    if (!(w > 0) || swe->eta[k] - swe->bed[k] < dry) continue;
+                    if (pass == 0) total += w;
+                    else if (total > 0) {
+                        const fsdem_real scale = -w / (total * swe->desc.density * swe->area);
+                        swe->sx[k] += f.x * scale;
+                        if (swe->dim == 2) swe->sy[k] += f.y * scale;
+                    }
+                }
     }
-    /* pass 0 sums the wet weights, pass 1 deposits -f w / (rho A) with the weights normalised */
-    for (pass = 0; pass < 2; ++pass)
-        for (j = j0; j <= j1; ++j)
-            for (i = i0; i <= i1; ++i) {
-                const int k = i + swe->nx * j;
-                fsdem_real xa = swe->desc.x_min + i * swe->dx, w;
-                w = (p.x + r < xa + swe->dx ? p.x + r : xa + swe->dx) - (p.x - r > xa ? p.x - r : xa);
-                if (swe->dim == 2) {
-                    fsdem_real ya = swe->desc.y_min + j * swe->dy;
-                    w *= (p.y + r < ya + swe->dy ? p.y + r : ya + swe->dy) - (p.y - r > ya ? p.y - r : ya);
-                }
-                if (!(w > 0) || swe->eta[k] - swe->bed[k] < dry) continue;
-                if (pass == 0) total += w;
-                else {
-                    const fsdem_real scale = -w / (total * swe->desc.density * swe->area);
-                    swe->sx[k] += f.x * scale;
-                    if (swe->dim == 2) swe->sy[k] += f.y * scale;
-                }
-            }
+    return total > 0;
+}
+
+/* Buoyancy (Eq. 5) and heave damping of sphere i at its current height and vertical speed, against
+   the water surface held in out->surface; updates `out` and returns the vertical force (N). */
+static fsdem_real fsdem__swe_dem_vertical(const fsdem_swe_dem *c, int i, fsdem_swe_dem_force *out) {
+    const fsdem_dem *dem = c->desc.dem;
+    const fsdem_real rho = c->desc.swe->desc.density, g = c->desc.swe->g, r = dem->r[i], z = dem->x[i].z;
+    out->submerged_volume = fsdem__submerged_sphere(r, z, out->surface);
+    out->buoyancy = fsdem_v3(0, 0, rho * g * out->submerged_volume);
+    out->heave = fsdem__zero3();
+    if (c->desc.heave_damping > 0) {
+        /* critical damping of the hydrostatic spring rho g A_waterplane of the bobbing */
+        fsdem_real a2 = r * r - (out->surface - z) * (out->surface - z);
+        if (a2 > 0)
+            out->heave.z = -2 * c->desc.heave_damping *
+                           (fsdem_real)sqrt(rho * g * (fsdem_real)FSDEM__PI * a2 * dem->m[i]) * dem->v[i].z;
+    }
+    return out->buoyancy.z + out->heave.z;
 }
 
 /* ---- >>couple_swe_forces : seed 003 Eq. 5-8 ---- */
@@ -9056,8 +9111,8 @@ fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
             if (flow.depth < swe->desc.dry_depth && front[a].depth > flow.depth) flow = front[a];
         }
         if (flow.depth < swe->desc.dry_depth) continue;
-        out->submerged_volume = fsdem__submerged_sphere(r, p.z, centre.eta);
-        out->buoyancy = fsdem_v3(0, 0, rho * g * out->submerged_volume); /* Eq. 5 */
+        out->in_water = 1;
+        out->surface = centre.eta;
         for (a = 0; a < axes; ++a) {
             /* Eq. 6-7 along axis a */
             fsdem_real area_b, area_f, m_b, m_f, rel, hydro, dyn;
@@ -9075,16 +9130,12 @@ fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
                 out->dynamic.y = dyn;
             }
         }
-        if (c->desc.heave_damping > 0) {
-            /* critical damping of the hydrostatic spring rho g A_waterplane of the bobbing */
-            fsdem_real a2 = r * r - (centre.eta - p.z) * (centre.eta - p.z);
-            if (a2 > 0)
-                out->heave = fsdem_v3(0, 0, -2 * c->desc.heave_damping *
-                                                    (fsdem_real)sqrt(rho * g * (fsdem_real)FSDEM__PI * a2 * dem->m[i]) * w.z);
-        }
         horizontal = fsdem__add(out->hydrostatic, out->dynamic);
-        dem->fext[i] = fsdem__add(fsdem__add(horizontal, out->buoyancy), out->heave);
-        if (c->desc.two_way) fsdem__swe_spread_reaction(swe, p, r, horizontal);
+        if (c->desc.two_way && !fsdem__swe_spread_reaction(swe, p, r, horizontal)) {
+            out->hydrostatic = out->dynamic = horizontal = fsdem__zero3();
+        }
+        horizontal.z = fsdem__swe_dem_vertical(c, i, out);
+        dem->fext[i] = horizontal;
     }
     return fsdem__ok(&c->status);
 }
@@ -9102,8 +9153,19 @@ fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c, fsdem_real dt_cap, fsdem_real 
     res = fsdem_swe_step(c->desc.swe, dt_cap, &dt);
     if (res != FSDEM_OK)
         return fsdem__fail(&c->status, res, "shallow-water step: %s", fsdem_swe_last_error(c->desc.swe));
-    res = fsdem_dem_advance(c->desc.dem, dt, substeps);
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
+    {
+        fsdem_dem *dem = c->desc.dem;
+        int count, k, i;
+        res = fsdem__substep_count(dem, dt, &count);
+        for (k = 0; k < count && res == FSDEM_OK; ++k) {
+            for (i = 0; i < dem->n; ++i)
+                if (c->force[i].in_water) dem->fext[i].z = fsdem__swe_dem_vertical(c, i, &c->force[i]);
+            res = fsdem__step(dem, dt / count);
+        }
+        if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "DEM substeps: %s", fsdem_dem_last_error(dem));
+        fsdem__ok(&dem->status);
+        if (substeps) *substeps = count;
+    }
     if (dt_out) *dt_out = dt;
     return fsdem__ok(&c->status);
 }

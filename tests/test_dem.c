@@ -802,6 +802,39 @@ START_TEST(mesh_edges_and_vertices_push_once) {
 }
 END_TEST
 
+/* A wall moved by its own callback (an SDF plane z = *height) must reach particles that were far from
+   it at the last neighbour-list build: fsdem_dem_wall_moved tells the search. Without it the plane
+   would rise through a resting particle (measured: it does, the particle stays at z = 0.05). */
+static fsdem_real sdf_rising_floor(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
+    *normal = fsdem_v3(0, 0, 1);
+    return p.z - *(const fsdem_real *)user;
+}
+
+START_TEST(moving_sdf_wall_reaches_resting_particles) {
+    fsdem_dem_desc d = fsdem_dem_desc_default(3);
+    fsdem_dem *dem;
+    fsdem_real height = 0;
+    int mat, wall, s;
+    d.gravity = fsdem_v3(0, 0, 0);
+    d.dt = 1e-5;
+    dem = dem_new(&d);
+    mat = add_plain_material(dem);
+    wall = add_wall(dem, fsdem_wall_sdf(sdf_rising_floor, &height, mat));
+    add_particle(dem, fsdem_v3(0, 0, 0.05), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.01, mat, 0);
+    for (s = 0; s < 10000; ++s) { /* the floor rises 0.1 m at 1 m/s */
+        height += 1e-5;
+        ck_assert_int_eq(fsdem_dem_wall_moved(dem, wall, 1e-5), FSDEM_OK);
+        step_n(dem, 1);
+    }
+    /* the particle rides on the floor: centre at least r minus a Hertz overlap (< 1 mm here) above it */
+    ck_assert_msg(fsdem_dem_particles(dem).position[0].z > height + 0.01 - 1e-3, "particle at %g, floor at %g",
+                  (double)fsdem_dem_particles(dem).position[0].z, (double)height);
+    ck_assert_int_eq(fsdem_dem_wall_moved(dem, wall, -1), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_dem_wall_moved(dem, 7, 1), FSDEM_ERR_NOT_FOUND);
+    fsdem_dem_destroy(dem);
+}
+END_TEST
+
 /* ---- 6. input validation ------------------------------------------------------------------------- */
 
 typedef struct log_capture {
@@ -1298,6 +1331,7 @@ Suite *dem_suite(void) {
     tcase_add_test(tc_laws, incline_rolling_and_sliding);
     tcase_add_test(tc_laws, resting_particle_settles_to_static_overlap);
     tcase_add_test(tc_laws, mesh_edges_and_vertices_push_once);
+    tcase_add_test(tc_laws, moving_sdf_wall_reaches_resting_particles);
     tcase_set_timeout(tc_laws, 300);
     tcase_add_test(tc_api, invalid_desc_is_rejected);
     tcase_add_test(tc_api, invalid_material_and_particle_are_rejected);
