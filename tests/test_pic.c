@@ -143,15 +143,11 @@ START_TEST(projection_is_discretely_divergence_free) {
 }
 END_TEST
 
-/* Flux through an open box: inflow U on -x, outflow on +x, slip walls, a disc in the middle, the
-   box completely filled (no free surface). Every section x = const carries U H. */
-START_TEST(open_box_conserves_flux_past_obstacle) {
+/* A 1 m x H open box completely filled with water (no free surface), 0.025 m cells, no gravity:
+   inflow U on -x, outflow on +x, slip walls. The particles are the caller's to add. */
+static fsdem_pic *open_channel(double U, double H) {
     fsdem_pic_desc d = fsdem_pic_desc_default(2);
     fsdem_pic *s;
-    fsdem_pic_obstacle disc = fsdem_pic_obstacle_sphere(fsdem_v3(0.5, 0.25, 0), 0.1);
-    fsdem_pic_grid g;
-    double U = 1.0, H = 0.5, vmax = 0;
-    int k, i, j;
     d.cell_size = 0.025;
     d.domain_max = fsdem_v3(1.0, H, 0);
     d.gravity = fsdem_v3(0, 0, 0);
@@ -160,6 +156,18 @@ START_TEST(open_box_conserves_flux_past_obstacle) {
     d.boundary_velocity[0] = fsdem_v3(U, 0, 0);
     d.boundary[1] = FSDEM_PIC_BC_OUTFLOW;
     ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    return s;
+}
+
+/* Flux through an open box: inflow U on -x, outflow on +x, slip walls, a disc in the middle, the
+   box completely filled (no free surface). Every section x = const carries U H. */
+START_TEST(open_box_conserves_flux_past_obstacle) {
+    fsdem_pic *s;
+    fsdem_pic_obstacle disc = fsdem_pic_obstacle_sphere(fsdem_v3(0.5, 0.25, 0), 0.1);
+    fsdem_pic_grid g;
+    double U = 1.0, H = 0.5, vmax = 0;
+    int k, i, j;
+    s = open_channel(U, H);
     ck_assert_int_eq(fsdem_pic_add_obstacle(s, &disc, NULL), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(1.0, H, 0), fsdem_v3(U, 0, 0), NULL), FSDEM_OK);
     for (k = 0; k < 10; ++k) ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
@@ -453,20 +461,12 @@ END_TEST
    solid's velocity as flux. A column of faces across the open box closed with solid velocity U
    leaves the uniform flow U untouched: flux U H through every section, no vertical velocity. */
 START_TEST(coupler_faces_carry_solid_flux) {
-    fsdem_pic_desc d = fsdem_pic_desc_default(2);
     fsdem_pic *s;
     fsdem_pic_coupling *cp;
     fsdem_pic_grid g;
     double U = 0.5, H = 0.5;
     int k, i, j, col = 20;
-    d.cell_size = 0.025;
-    d.domain_max = fsdem_v3(1.0, H, 0);
-    d.gravity = fsdem_v3(0, 0, 0);
-    d.free_surface = 0;
-    d.boundary[0] = FSDEM_PIC_BC_INFLOW;
-    d.boundary_velocity[0] = fsdem_v3(U, 0, 0);
-    d.boundary[1] = FSDEM_PIC_BC_OUTFLOW;
-    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    s = open_channel(U, H);
     ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(1.0, H, 0), fsdem_v3(U, 0, 0), NULL), FSDEM_OK);
     cp = fsdem_pic_coupling_view(s);
     ck_assert_int_eq(cp->face_count[0], (cp->n[0] + 1) * cp->n[1]);

@@ -170,6 +170,20 @@ static int db_load_ref(const char *dir, db_ref *r) {
     return r->nz > 0 && r->ne > 0 ? 0 : -1;
 }
 
+/* Writes the front table as ref_front.csv (t in s, x_front in m) for the plots. */
+static void db_write_ref_front(const db_ref *r) {
+    fsdem_csv rf;
+    int i;
+    fsdem_csv_open(&rf, "ref_front.csv", "t,x_front");
+    for (i = 0; i < r->nz; ++i) {
+        fsdem_real row[2];
+        row[0] = (fsdem_real)(r->T[i] * sqrt(DB_A / (2 * DB_G)));
+        row[1] = (fsdem_real)(r->Z[i] * DB_A);
+        fsdem_csv_row(&rf, row, 2);
+    }
+    fsdem_csv_close(&rf);
+}
+
 /* RMS of Z_sim(T + shift) - Z over the front table (shift in units of T). */
 static double db_rms_front(const db_series *s, const db_ref *r, double shift) {
     double sum = 0, k = sqrt(DB_A / (2 * DB_G));

@@ -28,14 +28,7 @@ int main(int argc, char **argv) {
     /* long enough for both tables (the residual height runs to tau = 7.4) */
     t_end = ref.tau[ref.ne - 1] * sqrt(DB_A / DB_G) + 0.01;
     if (ref.T[ref.nz - 1] * sqrt(DB_A / (2 * DB_G)) > t_end) t_end = ref.T[ref.nz - 1] * sqrt(DB_A / (2 * DB_G)) + 0.01;
-    fsdem_csv_open(&rf, "ref_front.csv", "t,x_front");
-    for (i = 0; i < ref.nz; ++i) {
-        fsdem_real row[2];
-        row[0] = (fsdem_real)(ref.T[i] * sqrt(DB_A / (2 * DB_G)));
-        row[1] = (fsdem_real)(ref.Z[i] * DB_A);
-        fsdem_csv_row(&rf, row, 2);
-    }
-    fsdem_csv_close(&rf);
+    db_write_ref_front(&ref);
     fsdem_csv_open(&rf, "ref_height.csv", "t,h_column");
     for (i = 0; i < ref.ne; ++i) {
         fsdem_real row[2];

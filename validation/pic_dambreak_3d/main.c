@@ -44,18 +44,7 @@ int main(int argc, char **argv) {
         return vc_exit_code();
     }
     t_end = ref.T[ref.nz - 1] * sqrt(DB_A / (2 * DB_G)) + 0.01;
-    {
-        fsdem_csv rf;
-        int i;
-        fsdem_csv_open(&rf, "ref_front.csv", "t,x_front");
-        for (i = 0; i < ref.nz; ++i) {
-            fsdem_real row[2];
-            row[0] = (fsdem_real)(ref.T[i] * sqrt(DB_A / (2 * DB_G)));
-            row[1] = (fsdem_real)(ref.Z[i] * DB_A);
-            fsdem_csv_row(&rf, row, 2);
-        }
-        fsdem_csv_close(&rf);
-    }
+    db_write_ref_front(&ref);
     db_run(2, n, 0, t_end, "front_2d.csv", &s2);
     vc_info(CASE, "2D at a/%d: %d particles, %d steps, %.1f s CPU, max deviation from the table %.1f%%", n, s2.particles,
             s2.steps, s2.cpu, 100 * max_rel_table(&s2, &ref));
