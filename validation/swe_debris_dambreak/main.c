@@ -41,7 +41,9 @@ static void dambreak_exact(double hl, double hr, double *h_gate, double *front_s
     *front_speed = hm * um / (hm - hr);
 }
 
-static int run_case(const char *name, double hl, double hr) {
+/* Runs one case with the given slope limiter; checks it when `checked`, otherwise only reports it.
+   Returns 0 on success, 2 when a create or step fails. */
+static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter limiter, int checked) {
     fsdem_swe_desc sd = fsdem_swe_desc_default(1);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     fsdem_swe_dem_desc cd = fsdem_swe_dem_desc_default();
@@ -57,10 +59,10 @@ static int run_case(const char *name, double hl, double hr) {
     const double x_debris = x_gate + debris_offset, dx = length / nx;
     double h_gate_exact, speed, t = 0, t_front = -1, t_move = -1, t_visible = -1, gate_err_sum = 0, draft_z;
     int k, mat, gate_samples = 0;
-    int failures_before = vc_failures;
     dambreak_exact(hl, hr, &h_gate_exact, &speed);
 
     sd.nx = nx;
+    sd.limiter = limiter;
     sd.x_max = length;
     for (k = 0; k < nx; ++k) depth[k] = (k + 0.5) * dx < x_gate ? hl : hr;
     sd.depth = depth;
@@ -101,9 +103,9 @@ static int run_case(const char *name, double hl, double hr) {
     cd.heave_damping = 0.5; /* bobbing is not resolved by the SWE; damp it (see README) */
     if (fsdem_swe_dem_create(&cd, &cpl) != FSDEM_OK) return 2;
 
-    snprintf(path, sizeof path, "gauges_%s.csv", name);
+    snprintf(path, sizeof path, "gauges_%s%s.csv", name, checked ? "" : "_minmod");
     fsdem_csv_open(&gauges, path, "t,h_gate,h_gate_exact,h_debris,h_x20,h_x25");
-    snprintf(path, sizeof path, "debris_%s.csv", name);
+    snprintf(path, sizeof path, "debris_%s%s.csv", name, checked ? "" : "_minmod");
     fsdem_csv_open(&track, path, "t,x,z,u");
     /* run until just before the first reflection: the rarefaction head (speed sqrt(g h_L)) meets the
        upstream wall at x_g / c_L, the front/shock the downstream wall at (L - x_g)/speed */
@@ -148,10 +150,11 @@ static int run_case(const char *name, double hl, double hr) {
     }
     fsdem_csv_close(&gauges);
     fsdem_csv_close(&track);
-    vc_info(CASE, "%s: front at the debris t = %.3f s, debris moves from t = %.3f s (0.1 mm at %.3f s), x(end) = %.3f m; "
-                  "exact gate depth %.4f m, front/shock speed %.3f m/s",
-            name, t_front, t_move, t_visible, (double)fsdem_dem_particles(dem).position[0].x, h_gate_exact, speed);
-    {
+    vc_info(CASE, "%s (%s limiter): front at the debris t = %.3f s, debris moves from t = %.3f s (0.1 mm at %.3f s), "
+                  "start delay %+.3f s, x(end) = %.3f m; exact gate depth %.4f m, front/shock speed %.3f m/s",
+            name, limiter == FSDEM_SWE_LIMITER_MC ? "MC" : "minmod", t_front, t_move, t_visible, t_move - t_front,
+            (double)fsdem_dem_particles(dem).position[0].x, h_gate_exact, speed);
+    if (checked) {
         char metric[64];
         /* moving within the front's transit time over one cell, dx / speed */
         snprintf(metric, sizeof metric, "%s_start_delay_s", name);
@@ -164,12 +167,19 @@ static int run_case(const char *name, double hl, double hr) {
     fsdem_swe_dem_destroy(cpl);
     fsdem_dem_destroy(dem);
     fsdem_swe_destroy(swe);
-    return vc_failures > failures_before;
+    return 0;
 }
 
 int main(void) {
-    run_case("h0.2_0", 0.2, 0);
-    run_case("h0.2_0.1", 0.2, 0.1);
-    run_case("h0.3_0.1", 0.3, 0.1);
+    /* The checked runs use the MC limiter. A bore rises from 10% to 90% over 2 cells with either
+       limiter, but minmod's foot is longer: its 1e-5 h_L precursor runs 3 cells ahead of the 1e-3 h_L
+       front, against 1 cell with MC, and a floating sphere feels it. Minmod is reported (README). */
+    static const struct { const char *name; double hl, hr; } cases[] = {{"h0.2_0", 0.2, 0}, {"h0.2_0.1", 0.2, 0.1},
+                                                                         {"h0.3_0.1", 0.3, 0.1}};
+    int k;
+    for (k = 0; k < 3; ++k)
+        if (run_case(cases[k].name, cases[k].hl, cases[k].hr, FSDEM_SWE_LIMITER_MC, 1) ||
+            run_case(cases[k].name, cases[k].hl, cases[k].hr, FSDEM_SWE_LIMITER_MINMOD, 0))
+            return 2;
     return vc_exit_code();
 }
