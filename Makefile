@@ -52,8 +52,8 @@ $(BUILD)/check_fsdem: $(TEST_SRC) tests/fsdem_tests.h fsdem.h | $(BUILD) check-d
 # The header compiles warning-free as C99 with gcc and clang, and as C++.
 compile-checks: | $(BUILD)
 	@for c in gcc clang; do if command -v $$c >/dev/null; then \
-	  $$c $(STD) $(WARN) -Werror -c tests/fsdem_impl.c -I. -o $(BUILD)/impl_$$c.o || exit 1; \
-	  $$c $(STD) $(WARN) -Werror -DFSDEM_USE_FLOAT -c tests/fsdem_impl.c -I. -o $(BUILD)/impl_float_$$c.o || exit 1; fi; done
+	  $$c $(STD) $(WARN) -O2 -Werror -c tests/fsdem_impl.c -I. -o $(BUILD)/impl_$$c.o || exit 1; \
+	  $$c $(STD) $(WARN) -O2 -Werror -DFSDEM_USE_FLOAT -c tests/fsdem_impl.c -I. -o $(BUILD)/impl_float_$$c.o || exit 1; fi; done
 	$(CXX) $(WARN) -Werror -c tests/compile_cpp.cpp -I. -o $(BUILD)/compile_cpp.o
 	@echo "compile checks: gcc, clang (C99, double and float) and C++ are warning-free"
 

@@ -1304,6 +1304,26 @@ FSDEM_API fsdem_result fsdem_dem_write_vtk(const fsdem_dem *dem, const char *pat
 #define FSDEM__PI 3.14159265358979323846
 #define FSDEM__MESSAGE_SIZE 256
 
+/* Forces inlining where the compiler allows it: a kernel written once with a constant argument (a
+   contact law, a limiter) is instantiated per value, so hot loops carry no switch. */
+#if defined(__GNUC__) || defined(__clang__)
+#define FSDEM__FORCE_INLINE static inline __attribute__((always_inline))
+#elif defined(_MSC_VER)
+#define FSDEM__FORCE_INLINE static __forceinline
+#else
+#define FSDEM__FORCE_INLINE static inline
+#endif
+
+/* Promise that pointers do not alias, so loops over several particle arrays keep them in registers
+   (C99 restrict; the compilers' spelling in C++). */
+#if defined(__cplusplus) && (defined(__GNUC__) || defined(__clang__) || defined(_MSC_VER))
+#define FSDEM__RESTRICT __restrict
+#elif defined(__cplusplus)
+#define FSDEM__RESTRICT
+#else
+#define FSDEM__RESTRICT restrict
+#endif
+
 const char *fsdem_result_string(fsdem_result result) {
     switch (result) {
     case FSDEM_OK: return "FSDEM_OK";
@@ -2705,16 +2725,64 @@ static fsdem_vec3 fsdem__spin_rate(const fsdem_dem *d, const fsdem_vec3 *t, int 
     return d->desc.rotation ? fsdem__scale(fsdem__add(t[i], d->text[i]), d->inv_i[i]) : fsdem__zero3();
 }
 
-/* Velocity update v += h a, w += h alpha of the free particles, and the walls' impulse. */
-static void fsdem__kick(fsdem_dem *d, fsdem_real h) {
-    int i, k;
-    for (i = 0; i < d->n; ++i) {
-        if (d->fixed[i]) continue;
-        d->v[i] = fsdem__madd(d->v[i], fsdem__accel(d, d->f, i), h);
-        d->w[i] = fsdem__madd(d->w[i], fsdem__spin_rate(d, d->t, i), h);
-        fsdem__planar(d, &d->x[i], &d->v[i], &d->w[i]);
+/* One pass of Verlet over the particles: the velocity update v += h a, w += h alpha of the free
+   particles, then, with `drift`, the position update x += h_drift v of all of them and the largest
+   displacement since the last rebuild. Returns nonzero when the pass may have produced a state that
+   is not finite or outside the domain; fsdem__check_particles then finds and names the particle.
+   (Positions are checked after the drift, velocities after a pass without one.) Written once and
+   instantiated with and without the drift, so each pass reads every array once. */
+FSDEM__FORCE_INLINE int fsdem__verlet_pass(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift) {
+    const fsdem_vec3 g = d->desc.gravity, lo = d->desc.domain_min, hi = d->desc.domain_max;
+    const fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t;
+    const fsdem_vec3 *FSDEM__RESTRICT fe = d->fext, *FSDEM__RESTRICT te = d->text, *FSDEM__RESTRICT x_ref = d->x_ref;
+    const fsdem_real *FSDEM__RESTRICT inv_m = d->inv_m, *FSDEM__RESTRICT inv_i = d->inv_i;
+    const unsigned char *FSDEM__RESTRICT fixed = d->fixed;
+    fsdem_vec3 *FSDEM__RESTRICT x = d->x, *FSDEM__RESTRICT v = d->v, *FSDEM__RESTRICT w = d->w;
+    const fsdem_real h_spin = d->desc.rotation ? h : 0;
+    const int planar = d->desc.dim == 2, n = d->n;
+    fsdem_real disp2 = d->max_disp2, sum = 0;
+    int i, k, outside = 0;
+    for (i = 0; i < n; ++i) {
+        if (!fixed[i]) {
+            const fsdem_real a = h * inv_m[i], b = h_spin * inv_i[i];
+            v[i].x += h * g.x + a * (f[i].x + fe[i].x);
+            v[i].y += h * g.y + a * (f[i].y + fe[i].y);
+            v[i].z += h * g.z + a * (f[i].z + fe[i].z);
+            w[i].x += b * (t[i].x + te[i].x);
+            w[i].y += b * (t[i].y + te[i].y);
+            w[i].z += b * (t[i].z + te[i].z);
+            if (planar) v[i].z = w[i].x = w[i].y = 0;
+        }
+        if (drift) {
+            fsdem_real dx, dy, dz, d2;
+            x[i].x += h_drift * v[i].x;
+            x[i].y += h_drift * v[i].y;
+            x[i].z += h_drift * v[i].z;
+            dx = x[i].x - x_ref[i].x;
+            dy = x[i].y - x_ref[i].y;
+            dz = x[i].z - x_ref[i].z;
+            d2 = dx * dx + dy * dy + dz * dz;
+            if (d2 > disp2) disp2 = d2;
+            /* false for NaN too */
+            outside |= !(x[i].x >= lo.x && x[i].x <= hi.x && x[i].y >= lo.y && x[i].y <= hi.y &&
+                         (planar || (x[i].z >= lo.z && x[i].z <= hi.z)));
+        } else {
+            /* not finite if any term is; may overflow to infinity with finite terms, which the
+               check then clears */
+            sum += v[i].x + v[i].y + v[i].z + w[i].x + w[i].y + w[i].z;
+        }
     }
+    d->max_disp2 = disp2;
     for (k = 0; k < d->wall_count; ++k) d->walls[k].impulse = fsdem__madd(d->walls[k].impulse, d->walls[k].force, -h);
+    return outside || !fsdem__finite(sum);
+}
+
+/* Velocity update v += h a, w += h alpha of the free particles, and the walls' impulse. */
+static int fsdem__kick(fsdem_dem *d, fsdem_real h) { return fsdem__verlet_pass(d, h, 0, 0); }
+
+/* Kick h, then drift h_drift. */
+static int fsdem__kick_drift(fsdem_dem *d, fsdem_real h, fsdem_real h_drift) {
+    return fsdem__verlet_pass(d, h, 1, h_drift);
 }
 
 static void fsdem__track_displacement(fsdem_dem *d, int i) {
@@ -2760,20 +2828,16 @@ static fsdem_result fsdem__check_particles(fsdem_dem *d) {
     return FSDEM_OK;
 }
 
-/* Velocity Verlet: kick h/2, drift h, forces, kick h/2. */
-static fsdem_result fsdem__step_verlet(fsdem_dem *d, fsdem_real h) {
-    int i;
+/* Velocity Verlet: kick h/2 and drift h (one pass), forces, kick h/2. *suspect is set when a pass
+   saw a state that fsdem__check_particles should look at. */
+static fsdem_result fsdem__step_verlet(fsdem_dem *d, fsdem_real h, int *suspect) {
     if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     if (!d->forces_valid) fsdem__compute_forces(d, h, 0);
-    fsdem__kick(d, h / 2);
-    for (i = 0; i < d->n; ++i) {
-        d->x[i] = fsdem__madd(d->x[i], d->v[i], h);
-        fsdem__track_displacement(d, i);
-    }
+    *suspect = fsdem__kick_drift(d, h / 2, h);
     fsdem__move_walls(d, h);
     if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     fsdem__compute_forces(d, h, 1);
-    fsdem__kick(d, h / 2);
+    *suspect |= fsdem__kick(d, h / 2);
     return FSDEM_OK;
 }
 
@@ -2821,12 +2885,13 @@ static fsdem_result fsdem__step_predictor_corrector(fsdem_dem *d, fsdem_real h) 
 }
 
 static fsdem_result fsdem__step(fsdem_dem *d, fsdem_real h) {
+    int suspect = 1;
     fsdem_result res = d->desc.integrator == FSDEM_INTEGRATOR_PREDICTOR_CORRECTOR ? fsdem__step_predictor_corrector(d, h)
-                                                                                  : fsdem__step_verlet(d, h);
+                                                                                  : fsdem__step_verlet(d, h, &suspect);
     if (res != FSDEM_OK) return res;
     d->time += h;
     d->steps++;
-    return fsdem__check_particles(d);
+    return suspect ? fsdem__check_particles(d) : FSDEM_OK;
 }
 
 fsdem_result fsdem_dem_step(fsdem_dem *d) {
@@ -2850,7 +2915,7 @@ static fsdem_result fsdem__substep_count(fsdem_dem *d, fsdem_real dt_outer, int 
 }
 
 fsdem_result fsdem_dem_advance(fsdem_dem *d, fsdem_real dt_outer, int *substeps) {
-    int k, count;
+    int k, count = 0;
     fsdem_result res = fsdem__substep_count(d, dt_outer, &count);
     if (res != FSDEM_OK) return res;
     if (substeps) *substeps = count;
@@ -7323,15 +7388,8 @@ typedef struct fsdem__swe_sface {
     fsdem_real mass, a, t, h, e, pad;
 } fsdem__swe_sface;
 
-/* Forces inlining where the compiler allows it: the row kernel is instantiated once per limiter and
-   dimension so that its inner loop has neither a limiter switch nor 2D branches in 1D. */
-#if defined(__GNUC__) || defined(__clang__)
-#define FSDEM__SWE_FORCE_INLINE static inline __attribute__((always_inline))
-#elif defined(_MSC_VER)
-#define FSDEM__SWE_FORCE_INLINE static __forceinline
-#else
-#define FSDEM__SWE_FORCE_INLINE static inline
-#endif
+/* The row kernel is instantiated once per limiter and dimension (FSDEM__FORCE_INLINE) so that its
+   inner loop has neither a limiter switch nor 2D branches in 1D. */
 
 /* m^2/s: unit discharges below this are set to zero (no physical meaning; see fsdem__swe_finish) */
 #define FSDEM__SWE_QTINY ((fsdem_real)(sizeof(fsdem_real) < sizeof(double) ? 1e-12 : 1e-100))
@@ -8167,7 +8225,7 @@ static void fsdem__swe_boundary_flux(const fsdem_swe *s, int side, int upper, fs
 /* ---- >>swe_step : the sweep ---- */
 
 /* Limited slope (per cell) from the backward and forward differences. */
-FSDEM__SWE_FORCE_INLINE fsdem_real fsdem__swe_limit(int limiter, fsdem_real a, fsdem_real b) {
+FSDEM__FORCE_INLINE fsdem_real fsdem__swe_limit(int limiter, fsdem_real a, fsdem_real b) {
     fsdem_real aa = (fsdem_real)fabs(a), ab = (fsdem_real)fabs(b), m;
     if (limiter == FSDEM_SWE_LIMITER_MINMOD) {
         /* (sign a + sign b)/2 min(|a|, |b|): arithmetic only, no data-dependent branch */
@@ -8325,7 +8383,7 @@ static void fsdem__swe_viscous(const fsdem_swe *s, const fsdem__swe_ctx *c, int 
 
 /* Row j: reconstruction and predictor of every cell (stored for the y faces in 2D), the x faces, and
    the x-direction increments (2D: into the accumulator row; 1D: the cells are finished here). */
-FSDEM__SWE_FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, int j, const int limiter,
+FSDEM__FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, int j, const int limiter,
                                                   const int two_d) {
     const int nx = s->nx, order2 = c->order == 2;
     const fsdem_real *pe = fsdem__swe_prim(s, j, 0) + 1, *ph = fsdem__swe_prim(s, j, 1) + 1;
@@ -9155,7 +9213,7 @@ fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c, fsdem_real dt_cap, fsdem_real 
         return fsdem__fail(&c->status, res, "shallow-water step: %s", fsdem_swe_last_error(c->desc.swe));
     {
         fsdem_dem *dem = c->desc.dem;
-        int count, k, i;
+        int count = 0, k, i;
         res = fsdem__substep_count(dem, dt, &count);
         for (k = 0; k < count && res == FSDEM_OK; ++k) {
             for (i = 0; i < dem->n; ++i)
