@@ -1371,6 +1371,58 @@ static fsdem_result fsdem__grow(const fsdem_allocator *a, void **ptr, int *capac
     return FSDEM_OK;
 }
 
+/* Per-step scratch arena: one block that a step carves up and gives back whole at its end. It is
+   reserved, growing only when a step needs more than any step before (when the lists it serves grew),
+   so a steady run allocates nothing; pushes within a reservation cannot fail. Blocks are aligned for
+   the widest vector (fsdem__lane). */
+typedef struct fsdem__arena {
+    unsigned char *base;
+    size_t size, used;
+} fsdem__arena;
+
+#define FSDEM__ARENA_ALIGN 64
+
+/* Empties the arena and makes room for `bytes` in pushes (each rounded up to FSDEM__ARENA_ALIGN).
+   FSDEM_ERR_OUT_OF_MEMORY leaves it empty and as large as before. */
+static fsdem_result fsdem__arena_reserve(const fsdem_allocator *al, fsdem__arena *a, size_t bytes) {
+    size_t size = a->size ? a->size : 4096;
+    unsigned char *fresh;
+    a->used = 0;
+    if (bytes + FSDEM__ARENA_ALIGN <= a->size) return FSDEM_OK;
+    while (size < bytes + FSDEM__ARENA_ALIGN) {
+        if (size > ((size_t)-1) / 4) return FSDEM_ERR_OUT_OF_MEMORY;
+        size *= 2;
+    }
+    fresh = (unsigned char *)fsdem__alloc(al, size);
+    if (!fresh) return FSDEM_ERR_OUT_OF_MEMORY;
+    fsdem__free(al, a->base, a->size);
+    a->base = fresh;
+    a->size = size;
+    return FSDEM_OK;
+}
+
+static void fsdem__arena_reset(fsdem__arena *a) { a->used = 0; }
+
+/* Rounds a push up so that the next one starts aligned. */
+static size_t fsdem__arena_bytes(size_t bytes) {
+    return (bytes + FSDEM__ARENA_ALIGN - 1) / FSDEM__ARENA_ALIGN * FSDEM__ARENA_ALIGN;
+}
+
+/* `bytes` of the reservation, aligned to FSDEM__ARENA_ALIGN. */
+static void *fsdem__arena_push(fsdem__arena *a, size_t bytes) {
+    unsigned char *p = a->base + a->used;
+    size_t pad = (size_t)(FSDEM__ARENA_ALIGN - ((size_t)p % FSDEM__ARENA_ALIGN)) % FSDEM__ARENA_ALIGN;
+    FSDEM_ASSERT(a->used + pad + bytes <= a->size);
+    a->used += pad + bytes;
+    return p + pad;
+}
+
+static void fsdem__arena_free(const fsdem_allocator *al, fsdem__arena *a) {
+    fsdem__free(al, a->base, a->size);
+    a->base = NULL;
+    a->size = a->used = 0;
+}
+
 /* Message and log sink shared by all objects. */
 typedef struct fsdem__status {
     char message[FSDEM__MESSAGE_SIZE];
@@ -1432,6 +1484,88 @@ static fsdem_vec3 fsdem__cross(fsdem_vec3 a, fsdem_vec3 b) {
 static fsdem_real fsdem__norm(fsdem_vec3 a) { return (fsdem_real)sqrt(fsdem__dot(a, a)); }
 static fsdem_vec3 fsdem__zero3(void) { return fsdem_v3(0, 0, 0); }
 static fsdem_real fsdem__comp(fsdem_vec3 v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+
+/* ---- >>core_lane : short vectors for batched kernels ---- */
+
+/* An fsdem__lane holds FSDEM__LANES reals that one instruction processes, where the compiler has GNU
+   vector extensions (gcc, clang): 16 bytes (SSE2, NEON), 32 with AVX, 64 with AVX-512, as the target
+   flags allow. Elsewhere, or with FSDEM_NO_SIMD, it is a single real. A kernel written with + - * /
+   on lanes and the functions below compiles to either, so its arithmetic exists once. Comparisons
+   give an fsdem__mask (all bits set or clear per lane) for fsdem__lane_select; combine masks with
+   & and |. Kernels keep every lane finite (padding repeats a real entry, divisors are guarded), so
+   they raise no floating-point exceptions. */
+#if (defined(__GNUC__) || defined(__clang__)) && !defined(FSDEM_NO_SIMD)
+#if defined(__AVX512F__)
+#define FSDEM__LANE_BYTES 64
+#elif defined(__AVX__)
+#define FSDEM__LANE_BYTES 32
+#else
+#define FSDEM__LANE_BYTES 16
+#endif
+#define FSDEM__LANES ((int)(FSDEM__LANE_BYTES / sizeof(fsdem_real)))
+typedef fsdem_real fsdem__lane __attribute__((vector_size(FSDEM__LANE_BYTES)));
+#ifdef FSDEM_USE_FLOAT
+typedef int fsdem__mask __attribute__((vector_size(FSDEM__LANE_BYTES)));
+#else
+typedef long long fsdem__mask __attribute__((vector_size(FSDEM__LANE_BYTES)));
+#endif
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+#elif defined(__aarch64__)
+#include <arm_neon.h>
+#endif
+
+FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_select(fsdem__mask m, fsdem__lane a, fsdem__lane b) {
+    return (fsdem__lane)(((fsdem__mask)a & m) | ((fsdem__mask)b & ~m));
+}
+
+/* libm's sqrt sets errno and is called lane by lane; the instructions are not */
+FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_sqrt(fsdem__lane a) {
+#if defined(FSDEM_USE_FLOAT) && FSDEM__LANE_BYTES == 64
+    return (fsdem__lane)_mm512_sqrt_ps((__m512)a);
+#elif FSDEM__LANE_BYTES == 64
+    return (fsdem__lane)_mm512_sqrt_pd((__m512d)a);
+#elif defined(FSDEM_USE_FLOAT) && FSDEM__LANE_BYTES == 32
+    return (fsdem__lane)_mm256_sqrt_ps((__m256)a);
+#elif FSDEM__LANE_BYTES == 32
+    return (fsdem__lane)_mm256_sqrt_pd((__m256d)a);
+#elif defined(FSDEM_USE_FLOAT) && defined(__SSE__)
+    return (fsdem__lane)_mm_sqrt_ps((__m128)a);
+#elif defined(__SSE2__)
+    return (fsdem__lane)_mm_sqrt_pd((__m128d)a);
+#elif defined(FSDEM_USE_FLOAT) && defined(__aarch64__)
+    return (fsdem__lane)vsqrtq_f32((float32x4_t)a);
+#elif defined(__aarch64__)
+    return (fsdem__lane)vsqrtq_f64((float64x2_t)a);
+#else
+    int l;
+    for (l = 0; l < FSDEM__LANES; ++l) a[l] = (fsdem_real)sqrt(a[l]);
+    return a;
+#endif
+}
+#else
+#define FSDEM__LANES 1
+typedef fsdem_real fsdem__lane;
+typedef int fsdem__mask; /* 0 or 1 */
+
+FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_select(fsdem__mask m, fsdem__lane a, fsdem__lane b) { return m ? a : b; }
+FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_sqrt(fsdem__lane a) { return (fsdem_real)sqrt(a); }
+#endif
+
+/* Lanes from and to reals at p (no alignment needed). */
+FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_load(const fsdem_real *p) {
+    fsdem__lane a;
+    memcpy(&a, p, sizeof a);
+    return a;
+}
+FSDEM__FORCE_INLINE void fsdem__lane_store(fsdem_real *p, fsdem__lane a) { memcpy(p, &a, sizeof a); }
+FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_max(fsdem__lane a, fsdem__lane b) { return fsdem__lane_select(a > b, a, b); }
+FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_set(fsdem_real s) {
+    fsdem__lane a;
+    int l;
+    for (l = 0; l < FSDEM__LANES; ++l) memcpy((fsdem_real *)&a + l, &s, sizeof s);
+    return a;
+}
 
 /* ===== >>impl_grid : cell grid ===================================================================== */
 
@@ -1567,6 +1701,13 @@ typedef struct fsdem__pair {
     fsdem_real rolling;  /* -, mean mu_r */
     fsdem_real restitution; /* -, mean e */
     fsdem_real tsuji;    /* -, damping coefficient giving that restitution (>>dem_law) */
+    /* The law's coefficients in the form the contact kernel evaluates (fsdem__batch_law):
+         law      kn                  cn                      kt                 ct
+         Hertz    (4/3) E* (Pa)       tsuji^2 (4/3) E* (Pa)   8 G* (Pa)          sqrt(4 G* / E*)
+         linear   ||g||/(theta dx)    2 alpha sqrt(kn)        1/(2(1+psi))       1/sqrt(2(1+psi))
+                  (1/s^2)             (1/s)                   seed 000 Eq. 10-13 per unit m_ij
+         GIC      2 E_pair (Pa)       0                       1/(2(1+nu))        0 */
+    fsdem_real kn, cn, kt, ct;
 } fsdem__pair;
 
 typedef struct fsdem__wall {
@@ -1578,21 +1719,23 @@ typedef struct fsdem__wall {
     fsdem_real moved;   /* m, distance travelled since the last neighbour-list build */
 } fsdem__wall;
 
-/* Neighbour list in compressed rows: the entries of particle i are start[i] .. start[i+1]-1. Each
-   entry names a partner (particle j > i, or wall*8+face) and keeps the contact's tangential spring
-   displacement, which is the contact history carried across steps and rebuilds. */
-typedef struct fsdem__entry {
-    int other;
-    fsdem_vec3 history; /* m */
-} fsdem__entry;
-
+/* Neighbour list in compressed rows: the entries of particle i are start[i] .. start[i+1]-1, and
+   first[k] = i. Entry k names a partner in key[k] (particle j > i, or wall*8+face) and keeps the
+   contact's tangential spring displacement in history[k], the contact history carried across steps
+   and rebuilds. history[k] means something only while key[k] carries FSDEM__HELD (the contact
+   touched at the last committed force evaluation); without it the spring is zero. So a separation
+   costs one bit and the many entries that do not touch are passed over without reading history. */
 typedef struct fsdem__list {
     int *start;
     int start_capacity;
     int rows; /* particles the list was built for */
-    fsdem__entry *entry;
+    int *first, *key;
+    fsdem_vec3 *history; /* m */
     int count, capacity;
 } fsdem__list;
+
+#define FSDEM__HELD (1 << 30) /* above every partner: particles and wall keys stay below 2^30 */
+#define FSDEM__PARTNER(key) ((key) & ~FSDEM__HELD)
 
 /* One particle-wall contact of the current positions. */
 typedef struct fsdem__wall_hit {
@@ -1603,8 +1746,8 @@ typedef struct fsdem__wall_hit {
 } fsdem__wall_hit;
 
 #define FSDEM__WALL_KEY(wall, face) ((wall) * 8 + (face))
-#define FSDEM__WALL_OF(key) ((key) / 8)
-#define FSDEM__FACE_OF(key) ((key) % 8)
+#define FSDEM__WALL_OF(key) (FSDEM__PARTNER(key) / 8)
+#define FSDEM__FACE_OF(key) (FSDEM__PARTNER(key) % 8)
 
 struct fsdem_dem {
     fsdem_dem_desc desc;
@@ -1631,6 +1774,7 @@ struct fsdem_dem {
 
     fsdem__list pp, pp_old, pw, pw_old;
     struct fsdem__wall_hit *hits; /* scratch: one particle's wall contacts (fsdem__wall_hits) */
+    fsdem__arena arena;           /* per-step scratch of the force evaluation, reserved by rebuilds */
     int hit_capacity;
     fsdem_cellgrid grid;
     fsdem_real skin, r_max, max_disp2, k0_linear;
@@ -1808,7 +1952,7 @@ static fsdem_real fsdem__tsuji_coefficient(fsdem_real e) {
 static fsdem_real fsdem__inv_or_zero(fsdem_real x) { return fsdem__finite(x) ? 1 / x : 0; }
 
 static void fsdem__pair_setup(fsdem__pair *p, const fsdem_material *a, const fsdem_material *b, fsdem_contact_law law,
-                              const fsdem__pair *known, int known_count) {
+                              fsdem_real k0_linear, const fsdem__pair *known, int known_count) {
     fsdem_real ea = a->young_modulus, eb = b->young_modulus, na = a->poisson_ratio, nb = b->poisson_ratio;
     fsdem_real e = (a->restitution + b->restitution) / 2;
     fsdem_real inv_e = (1 - na * na) * fsdem__inv_or_zero(ea) + (1 - nb * nb) * fsdem__inv_or_zero(eb);
@@ -1824,99 +1968,268 @@ static void fsdem__pair_setup(fsdem__pair *p, const fsdem_material *a, const fsd
     p->rolling = (a->rolling_friction + b->rolling_friction) / 2;
     p->restitution = e;
     p->tsuji = 0;
-    if (law != FSDEM_CONTACT_HERTZ_MINDLIN) return;
-    /* The calibration costs a few milliseconds; reuse it for a restitution seen before. */
-    for (k = 0; k < known_count; ++k)
-        if (known[k].restitution == e) {
-            p->tsuji = known[k].tsuji;
-            return;
+    if (law == FSDEM_CONTACT_HERTZ_MINDLIN) {
+        /* The calibration costs a few milliseconds; reuse it for a restitution seen before. */
+        for (k = 0; k < known_count && known[k].restitution != e; ++k) {
         }
-    p->tsuji = fsdem__tsuji_coefficient(e);
-}
-
-/* One contact as the laws see it. */
-typedef struct fsdem__contact {
-    fsdem_vec3 n;        /* unit normal from the partner to particle i */
-    fsdem_real delta;    /* m, overlap > 0 */
-    fsdem_vec3 vrel;     /* m/s, velocity of i's contact point relative to the partner's */
-    fsdem_real m_eff;    /* kg, reduced mass (m_i for a wall) */
-    fsdem_real m_mean;   /* kg, m_ij = (m_i + m_j)/2 of seed 000 Eq. 10 (m_i for a wall) */
-    fsdem_real r_eff;    /* m, R* = r_i r_j/(r_i + r_j) (r_i for a wall) */
-    const fsdem__pair *pair;
-} fsdem__contact;
-
-/* Rotates a stored tangential displacement into the current tangent plane, keeping its length. */
-static fsdem_vec3 fsdem__rotate_history(fsdem_vec3 xi, fsdem_vec3 n) {
-    fsdem_real len2 = fsdem__dot(xi, xi), proj2;
-    if (len2 == 0) return xi;
-    xi = fsdem__madd(xi, n, -fsdem__dot(xi, n));
-    proj2 = fsdem__dot(xi, xi);
-    return proj2 > 0 ? fsdem__scale(xi, (fsdem_real)sqrt(len2 / proj2)) : xi;
-}
-
-/* Force on particle i (N). *fn gets the normal force magnitude; the history is updated in place
-   when `commit` (the predictor of the predictor-corrector evaluates without committing). */
-static fsdem_vec3 fsdem__contact_force(const fsdem_dem *d, const fsdem__contact *c, fsdem_vec3 *history,
-                                       int commit, fsdem_real h, fsdem_real *fn_out) {
-    const fsdem__pair *p = c->pair;
-    fsdem_real vn = fsdem__dot(c->vrel, c->n), fn, ft_len, ft_max;
-    fsdem_vec3 vt = fsdem__madd(c->vrel, c->n, -vn), ft;
-    switch (d->desc.law) {
-    case FSDEM_CONTACT_LINEAR: {
-        /* seed 000 Eq. 10-13 with m_ij the mean mass, k_n = m_ij ||g|| / (theta dx) */
-        fsdem_real kn = c->m_mean * d->k0_linear;
-        fsdem_real cn = 2 * p->alpha * c->m_mean * (fsdem_real)sqrt(d->k0_linear);
-        fsdem_real kt = kn / (2 * (1 + p->nu));
-        fsdem_real ct = cn / (fsdem_real)sqrt(2 * (1 + p->nu));
-        fn = kn * c->delta - cn * vn;           /* Eq. 7, no tension cut-off as printed */
-        ft = fsdem__scale(vt, -(kt * h + ct));  /* Eq. 8: spring over one DEM step plus dashpot */
-        (void)history;
+        p->tsuji = k < known_count ? known[k].tsuji : fsdem__tsuji_coefficient(e);
+    }
+    switch (law) {
+    case FSDEM_CONTACT_LINEAR:
+        p->kn = k0_linear;
+        p->cn = 2 * p->alpha * (fsdem_real)sqrt(k0_linear);
+        p->kt = 1 / (2 * (1 + p->nu));
+        p->ct = 1 / (fsdem_real)sqrt(2 * (1 + p->nu));
+        break;
+    case FSDEM_CONTACT_GIC:
+        p->kn = 2 * p->e_pair;
+        p->cn = p->ct = 0;
+        p->kt = 1 / (2 * (1 + p->nu));
+        break;
+    default:
+        p->kn = (fsdem_real)(4.0 / 3.0) * p->e_star;
+        p->cn = p->tsuji * p->tsuji * p->kn;
+        p->kt = 8 * p->g_star;
+        /* both moduli are infinite only for two rigid materials, which never meet a finite contact */
+        p->ct = fsdem__finite(p->e_star) ? (fsdem_real)sqrt(4 * p->g_star / p->e_star) : 1;
         break;
     }
-    case FSDEM_CONTACT_GIC: {
-        /* seed 004 Eq. 1a-1c. k_n = E r for equal spheres; here E_pair * 2R*, the same for one
-           material. The viscous tangential coefficient k_t is not given in the seed: we take the
-           critical damping of the tangential spring k_n/(2(1+nu)) (seed 000 Eq. 12). */
-        fsdem_real kn = p->e_pair * 2 * c->r_eff;
-        fsdem_real kt = 2 * (fsdem_real)sqrt(c->m_eff * kn / (2 * (1 + p->nu)));
-        fn = kn * c->delta;
-        ft = fsdem__scale(vt, -kt);
-        break;
+}
+
+/* Contacts in structure-of-arrays form, up to FSDEM__BATCH at a time, for the vector kernels below
+   (fsdem__compute_forces fills and drains them). A particle pair enters as the bodies' data and
+   fsdem__batch_geometry turns it into a contact; a wall contact enters as a contact. */
+#define FSDEM__BATCH 32
+
+typedef struct fsdem__batch {
+    int count;
+    int i[FSDEM__BATCH];     /* particle */
+    int other[FSDEM__BATCH]; /* partner particle, or wall index */
+    int entry[FSDEM__BATCH]; /* neighbour-list entry (its spring) */
+    int pair[FSDEM__BATCH];  /* material pair */
+    /* particle pairs: geometry input */
+    fsdem_real dx[3][FSDEM__BATCH];       /* m, x_i - x_j */
+    fsdem_real dv[3][FSDEM__BATCH];       /* m/s, v_i - v_j */
+    fsdem_real wi[3][FSDEM__BATCH], wj[3][FSDEM__BATCH]; /* rad/s */
+    fsdem_real ri[FSDEM__BATCH], rj[FSDEM__BATCH];       /* m */
+    fsdem_real inv_mi[FSDEM__BATCH], inv_mj[FSDEM__BATCH]; /* 1/kg */
+    /* the contact: law input */
+    fsdem_real n[3][FSDEM__BATCH];    /* unit normal from the partner to i */
+    fsdem_real delta[FSDEM__BATCH];   /* m, overlap > 0 */
+    fsdem_real vrel[3][FSDEM__BATCH]; /* m/s, velocity of i's contact point relative to the partner's */
+    fsdem_real m_eff[FSDEM__BATCH];   /* kg, reduced mass (m_i for a wall) */
+    fsdem_real m_mean[FSDEM__BATCH];  /* kg, m_ij = (m_i + m_j)/2 of seed 000 Eq. 10 (m_i for a wall) */
+    fsdem_real r_eff[FSDEM__BATCH];   /* m, R* = r_i r_j/(r_i + r_j) (r_i for a wall) */
+    fsdem_real arm_i[FSDEM__BATCH], arm_j[FSDEM__BATCH]; /* m, centre to contact point */
+    fsdem_real kn[FSDEM__BATCH], cn[FSDEM__BATCH], kt[FSDEM__BATCH], ct[FSDEM__BATCH]; /* fsdem__pair */
+    fsdem_real mu[FSDEM__BATCH];      /* -, Coulomb coefficient */
+    fsdem_real spring[3][FSDEM__BATCH]; /* m, tangential spring: held value in, new value out */
+    /* output */
+    fsdem_real force[3][FSDEM__BATCH];    /* N, on i */
+    fsdem_real torque_i[3][FSDEM__BATCH]; /* N m, on i */
+    fsdem_real torque_j[3][FSDEM__BATCH]; /* N m, on the partner particle */
+    fsdem_real fn[FSDEM__BATCH];          /* N, normal force */
+} fsdem__batch;
+
+/* Copies contact 0 into the lanes after `count` up to a whole lane, so the kernels see real data
+   there: the pair input for a batch of particle pairs (`pairs`), the contact otherwise. */
+static void fsdem__batch_pad(fsdem__batch *b, int pairs) {
+    int c, a;
+    for (c = b->count; c % FSDEM__LANES; ++c) {
+        for (a = 0; a < 3; ++a) {
+            if (pairs) {
+                b->dx[a][c] = b->dx[a][0];
+                b->dv[a][c] = b->dv[a][0];
+                b->wi[a][c] = b->wi[a][0];
+                b->wj[a][c] = b->wj[a][0];
+            } else {
+                b->n[a][c] = b->n[a][0];
+                b->vrel[a][c] = b->vrel[a][0];
+            }
+            b->spring[a][c] = b->spring[a][0];
+        }
+        if (pairs) {
+            b->ri[c] = b->ri[0];
+            b->rj[c] = b->rj[0];
+            b->inv_mi[c] = b->inv_mi[0];
+            b->inv_mj[c] = b->inv_mj[0];
+        } else {
+            b->delta[c] = b->delta[0];
+            b->m_eff[c] = b->m_eff[0];
+            b->r_eff[c] = b->r_eff[0];
+            b->arm_i[c] = b->arm_i[0];
+            b->arm_j[c] = b->arm_j[0];
+        }
+        b->m_mean[c] = b->m_mean[0];
+        b->kn[c] = b->kn[0];
+        b->cn[c] = b->cn[0];
+        b->kt[c] = b->kt[0];
+        b->ct[c] = b->ct[0];
+        b->mu[c] = b->mu[0];
     }
-    default: {
-        /* Hertz-Mindlin. Normal stiffness S_n = 2 E* sqrt(R* d), elastic force (2/3) S_n d =
-           (4/3) E* sqrt(R*) d^1.5; tangential stiffness S_t = 8 G* sqrt(R* d) on the accumulated
-           tangential displacement (seed 002 Eq. 20). Damping eta = a sqrt((2/3) m* S), which is
-           Tsuji's a sqrt(m* k) d^(1/4) with a calibrated from e (fsdem__tsuji_coefficient). */
-        fsdem_real srd = (fsdem_real)sqrt(c->r_eff * c->delta);
-        fsdem_real sn = 2 * p->e_star * srd, st = 8 * p->g_star * srd;
-        fsdem_real eta_n = p->tsuji * (fsdem_real)sqrt((fsdem_real)(2.0 / 3.0) * c->m_eff * sn);
-        fsdem_real eta_t = p->tsuji * (fsdem_real)sqrt((fsdem_real)(2.0 / 3.0) * c->m_eff * st);
-        fsdem_vec3 xi = fsdem__madd(fsdem__rotate_history(*history, c->n), vt, h);
-        fn = (fsdem_real)(2.0 / 3.0) * sn * c->delta - eta_n * vn;
-        if (fn < 0) fn = 0;
-        ft = fsdem__add(fsdem__scale(xi, -st), fsdem__scale(vt, -eta_t));
-        ft_max = p->friction * fn;
-        ft_len = fsdem__norm(ft);
-        if (ft_len > ft_max) {
+}
+
+#define FSDEM__LOAD3(v, arr, c)                \
+    v##x = fsdem__lane_load(&(arr)[0][c]);     \
+    v##y = fsdem__lane_load(&(arr)[1][c]);     \
+    v##z = fsdem__lane_load(&(arr)[2][c])
+#define FSDEM__STORE3(arr, c, vx, vy, vz)      \
+    fsdem__lane_store(&(arr)[0][c], vx);       \
+    fsdem__lane_store(&(arr)[1][c], vy);       \
+    fsdem__lane_store(&(arr)[2][c], vz)
+
+/* Particle pairs of a batch into contacts: normal, overlap (offset `off` included), velocity of the
+   contact point, effective mass and radius, lever arms (each body's radius less half the overlap). */
+static void fsdem__batch_geometry(fsdem__batch *b, fsdem_real off) {
+    int c;
+    for (c = 0; c < b->count; c += FSDEM__LANES) {
+        fsdem__lane dxx, dxy, dxz, dvx, dvy, dvz, wix, wiy, wiz, wjx, wjy, wjz, ax, ay, az, nx, ny, nz;
+        const fsdem__lane ri = fsdem__lane_load(&b->ri[c]), rj = fsdem__lane_load(&b->rj[c]);
+        const fsdem__lane inv_m = fsdem__lane_load(&b->inv_mi[c]) + fsdem__lane_load(&b->inv_mj[c]);
+        const fsdem__lane one = fsdem__lane_set(1), zero = fsdem__lane_set(0);
+        fsdem__lane dist, q, safe, inv, delta, la_i, la_j;
+        fsdem__mask apart;
+        FSDEM__LOAD3(dx, b->dx, c);
+        FSDEM__LOAD3(dv, b->dv, c);
+        FSDEM__LOAD3(wi, b->wi, c);
+        FSDEM__LOAD3(wj, b->wj, c);
+        dist = fsdem__lane_sqrt(dxx * dxx + dxy * dxy + dxz * dxz);
+        /* 1/dist and 1/q, q = (1/m_i + 1/m_j)(r_i + r_j) > 0, from one division; coincident
+           centres take the normal (1, 0, 0) */
+        apart = dist > 0;
+        safe = fsdem__lane_select(apart, dist, one);
+        q = inv_m * (ri + rj);
+        inv = 1 / (safe * q);
+        nx = fsdem__lane_select(apart, dxx * (q * inv), one);
+        ny = fsdem__lane_select(apart, dxy * (q * inv), zero);
+        nz = fsdem__lane_select(apart, dxz * (q * inv), zero);
+        delta = ri + rj + off - dist;
+        la_i = ri - delta * (fsdem_real)0.5;
+        la_j = rj - delta * (fsdem_real)0.5;
+        /* contact-point velocity: v_i - v_j - (w_i l_i + w_j l_j) x n */
+        ax = wix * la_i + wjx * la_j;
+        ay = wiy * la_i + wjy * la_j;
+        az = wiz * la_i + wjz * la_j;
+        FSDEM__STORE3(b->n, c, nx, ny, nz);
+        FSDEM__STORE3(b->vrel, c, dvx - (ay * nz - az * ny), dvy - (az * nx - ax * nz), dvz - (ax * ny - ay * nx));
+        fsdem__lane_store(&b->delta[c], delta);
+        fsdem__lane_store(&b->arm_i[c], la_i);
+        fsdem__lane_store(&b->arm_j[c], la_j);
+        /* m* = 1/(1/m_i + 1/m_j) = (r_i + r_j)/q, R* = r_i r_j/(r_i + r_j) = r_i r_j (1/m_i + 1/m_j)/q */
+        fsdem__lane_store(&b->m_eff[c], (ri + rj) * (safe * inv));
+        fsdem__lane_store(&b->r_eff[c], ri * rj * inv_m * (safe * inv));
+    }
+}
+
+/* The contact law on every contact of a batch: force and torques, normal force, new spring (laws
+   with history). Written once, branch-free, and inlined with a constant `law`. h is the step the
+   spring and seed 000's one-step tangential spring (Eq. 8) use. */
+FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_law law, fsdem_real h) {
+    int c;
+    for (c = 0; c < b->count; c += FSDEM__LANES) {
+        fsdem__lane nx, ny, nz, vx, vy, vz, sx, sy, sz, tx, ty, tz, mx, my, mz;
+        const fsdem__lane delta = fsdem__lane_load(&b->delta[c]), mu = fsdem__lane_load(&b->mu[c]);
+        const fsdem__lane kn = fsdem__lane_load(&b->kn[c]), cn = fsdem__lane_load(&b->cn[c]);
+        const fsdem__lane kt = fsdem__lane_load(&b->kt[c]), ct = fsdem__lane_load(&b->ct[c]);
+        const fsdem__lane one = fsdem__lane_set(1);
+        fsdem__lane vn, fn, ft2, ft_max, scale, arm;
+        fsdem__mask slide;
+        FSDEM__LOAD3(n, b->n, c);
+        FSDEM__LOAD3(v, b->vrel, c);
+        vn = vx * nx + vy * ny + vz * nz;
+        vx -= vn * nx; /* tangential relative velocity */
+        vy -= vn * ny;
+        vz -= vn * nz;
+        if (law == FSDEM_CONTACT_LINEAR) {
+            /* seed 000 Eq. 7-13 with m_ij the mean mass: k_n = m_ij ||g|| / (theta dx), c_n = 2 alpha
+               sqrt(m_ij k_n), k_t = k_n/(2(1+psi)), c_t = c_n/sqrt(2(1+psi)); the tangential spring
+               acts over one DEM step (Eq. 8); no tension cut-off, as printed */
+            const fsdem__lane m = fsdem__lane_load(&b->m_mean[c]), g = -m * (kn * kt * h + cn * ct);
+            fn = m * (kn * delta - cn * vn);
+            tx = g * vx;
+            ty = g * vy;
+            tz = g * vz;
+            ft_max = mu * fsdem__lane_max(fn, -fn);
+        } else if (law == FSDEM_CONTACT_GIC) {
+            /* seed 004 Eq. 1a-1c: k_n = E r for equal spheres (here E_pair 2 R*); the viscous
+               tangential coefficient is not given in the seed: we take the critical damping of the
+               tangential spring k_n/(2(1+nu)) (seed 000 Eq. 12) */
+            const fsdem__lane k = kn * fsdem__lane_load(&b->r_eff[c]);
+            const fsdem__lane g = -2 * fsdem__lane_sqrt(fsdem__lane_load(&b->m_eff[c]) * k * kt);
+            fn = k * delta;
+            tx = g * vx;
+            ty = g * vy;
+            tz = g * vz;
+            ft_max = mu * fn;
+        } else {
+            /* Hertz-Mindlin. With s = sqrt(R* d): normal stiffness S_n = 2 E* s, elastic force
+               (2/3) S_n d = (4/3) E* s d; tangential stiffness S_t = 8 G* s on the accumulated
+               tangential displacement (seed 002 Eq. 20, Coulomb sliding Eq. 22). Damping
+               eta = a sqrt((2/3) m* S), Tsuji's a sqrt(m* k) d^(1/4) with a calibrated from e
+               (fsdem__tsuji_coefficient), so eta_n = sqrt(cn m* s) and eta_t = ct eta_n. */
+            const fsdem__lane s = fsdem__lane_sqrt(fsdem__lane_load(&b->r_eff[c]) * delta);
+            const fsdem__lane eta_n = fsdem__lane_sqrt(cn * fsdem__lane_load(&b->m_eff[c]) * s), st = kt * s;
+            fsdem__lane sn, len2, proj2, inv;
+            fsdem__mask turned;
+            /* the held spring, turned into the current tangent plane with its length kept */
+            FSDEM__LOAD3(s, b->spring, c);
+            len2 = sx * sx + sy * sy + sz * sz;
+            sn = sx * nx + sy * ny + sz * nz;
+            sx -= sn * nx;
+            sy -= sn * ny;
+            sz -= sn * nz;
+            proj2 = sx * sx + sy * sy + sz * sz;
+            turned = proj2 > 0;
+            scale = fsdem__lane_sqrt(fsdem__lane_select(turned, len2, one) / fsdem__lane_select(turned, proj2, one));
+            sx = sx * scale + vx * h;
+            sy = sy * scale + vy * h;
+            sz = sz * scale + vz * h;
+            fn = fsdem__lane_max(kn * s * delta - eta_n * vn, fsdem__lane_set(0));
+            tx = -st * sx - ct * eta_n * vx;
+            ty = -st * sy - ct * eta_n * vy;
+            tz = -st * sz - ct * eta_n * vz;
+            ft_max = mu * fn;
+            ft2 = tx * tx + ty * ty + tz * tz;
+            slide = ft2 > ft_max * ft_max;
             /* Sliding: cap at Coulomb and let the spring carry the capped force alone. Folding the
                damping term into the spring (-(F_t + eta_t v_t)/S_t) would store energy along the
-               slip at first touch, where eta_t ~ d^(1/4) outgrows mu F_n ~ d^(3/2). */
-            ft = fsdem__scale(ft, ft_max / ft_len);
-            xi = st > 0 ? fsdem__scale(ft, -1 / st) : fsdem__zero3();
+               slip at first touch, where eta_t ~ d^(1/4) outgrows mu F_n ~ d^(3/2). One division
+               gives both 1/|F_t| and 1/S_t. */
+            ft2 = fsdem__lane_sqrt(fsdem__lane_select(slide, ft2, one)); /* |F_t| where sliding */
+            inv = 1 / (ft2 * fsdem__lane_select(slide, st, one));
+            scale = fsdem__lane_select(slide, ft_max * st * inv, one);
+            tx *= scale;
+            ty *= scale;
+            tz *= scale;
+            inv = -ft2 * inv; /* -1/S_t where sliding */
+            FSDEM__STORE3(b->spring, c, fsdem__lane_select(slide, tx * inv, sx), fsdem__lane_select(slide, ty * inv, sy),
+                          fsdem__lane_select(slide, tz * inv, sz));
         }
-        if (commit) *history = xi;
-        *fn_out = fn;
-        return fsdem__madd(ft, c->n, fn);
+        if (law != FSDEM_CONTACT_HERTZ_MINDLIN) {
+            /* Coulomb cap (seed 000 Eq. 15, seed 004 Eq. 1b) for the laws without history */
+            ft2 = tx * tx + ty * ty + tz * tz;
+            slide = ft2 > ft_max * ft_max;
+            scale = fsdem__lane_select(slide, ft_max / fsdem__lane_sqrt(fsdem__lane_select(slide, ft2, one)), one);
+            tx *= scale;
+            ty *= scale;
+            tz *= scale;
+        }
+        FSDEM__STORE3(b->force, c, tx + fn * nx, ty + fn * ny, tz + fn * nz);
+        fsdem__lane_store(&b->fn[c], fn);
+        /* torques: the arms point along -n from i and +n from the partner, torque = arm x F, and
+           n x F = n x F_t */
+        mx = ny * tz - nz * ty;
+        my = nz * tx - nx * tz;
+        mz = nx * ty - ny * tx;
+        arm = -fsdem__lane_load(&b->arm_i[c]);
+        FSDEM__STORE3(b->torque_i, c, arm * mx, arm * my, arm * mz);
+        arm = -fsdem__lane_load(&b->arm_j[c]);
+        FSDEM__STORE3(b->torque_j, c, arm * mx, arm * my, arm * mz);
     }
-    }
-    /* Coulomb cap (seed 000 Eq. 15, seed 004 Eq. 1b) for the laws without history */
-    ft_max = p->friction * (fn < 0 ? -fn : fn);
-    ft_len = fsdem__norm(ft);
-    if (ft_len > ft_max) ft = fsdem__scale(ft, ft_max / ft_len);
-    *fn_out = fn;
-    return fsdem__madd(ft, c->n, fn);
 }
+
+#undef FSDEM__LOAD3
+#undef FSDEM__STORE3
 
 /* Constant-torque rolling resistance on i: -mu_r R* |F_n| along the relative spin, limited so that
    it cannot reverse the relative spin within one step. */
@@ -1975,9 +2288,15 @@ static fsdem_result fsdem__reserve_particles(fsdem_dem *d, int need) {
     return FSDEM_OK;
 }
 
+static void fsdem__list_free_entries(fsdem_dem *d, fsdem__list *l) {
+    fsdem__free(&d->allocator, l->first, sizeof(int) * (size_t)l->capacity);
+    fsdem__free(&d->allocator, l->key, sizeof(int) * (size_t)l->capacity);
+    fsdem__free(&d->allocator, l->history, sizeof(fsdem_vec3) * (size_t)l->capacity);
+}
+
 static void fsdem__list_free(fsdem_dem *d, fsdem__list *l) {
     fsdem__free(&d->allocator, l->start, sizeof(int) * (size_t)l->start_capacity);
-    fsdem__free(&d->allocator, l->entry, sizeof(fsdem__entry) * (size_t)l->capacity);
+    fsdem__list_free_entries(d, l);
     memset(l, 0, sizeof *l);
 }
 
@@ -2028,6 +2347,7 @@ void fsdem_dem_destroy(fsdem_dem *d) {
     fsdem__list_free(d, &d->pw);
     fsdem__list_free(d, &d->pw_old);
     fsdem__free(&al, d->hits, sizeof(fsdem__wall_hit) * (size_t)d->hit_capacity);
+    fsdem__arena_free(&al, &d->arena);
     fsdem_cellgrid_free(&d->grid);
     fsdem__free(&al, d, sizeof *d);
 }
@@ -2050,8 +2370,8 @@ fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_material *mat, int
         for (b = 0; b < nm; ++b) {
             if (a < nm - 1 && b < nm - 1) pairs[a * nm + b] = d->pairs[a * (nm - 1) + b];
             else if (b < a) pairs[a * nm + b] = pairs[b * nm + a];
-            else fsdem__pair_setup(&pairs[a * nm + b], &d->materials[a], &d->materials[b], d->desc.law, pairs,
-                                   a * nm + b);
+            else fsdem__pair_setup(&pairs[a * nm + b], &d->materials[a], &d->materials[b], d->desc.law, d->k0_linear,
+                                   pairs, a * nm + b);
         }
     /* the loop reads earlier rows only, which are already in the new table */
     fsdem__free(&d->allocator, d->pairs, sizeof(fsdem__pair) * (size_t)d->pair_capacity);
@@ -2397,7 +2717,9 @@ fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_wall_desc *desc, int *
     default:
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_desc.type %d is not a fsdem_wall_type", (int)g.type);
     }
-    if (fsdem__grow(&d->allocator, (void **)&d->walls, &d->wall_capacity, d->wall_count, d->wall_count + 1,
+    /* wall keys (wall * 8 + face) stay below FSDEM__HELD */
+    if (d->wall_count >= FSDEM__HELD / 8 ||
+        fsdem__grow(&d->allocator, (void **)&d->walls, &d->wall_capacity, d->wall_count, d->wall_count + 1,
                     sizeof(fsdem__wall)) != FSDEM_OK)
         return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "out of memory adding a wall");
     w = &d->walls[d->wall_count];
@@ -2461,23 +2783,60 @@ fsdem_vec3 fsdem_dem_wall_impulse(const fsdem_dem *d, int id) {
 
 /* ---- >>dem_neighbours : neighbour lists with contact history ---- */
 
-static fsdem_result fsdem__list_append(fsdem_dem *d, fsdem__list *l, int other, fsdem_vec3 history) {
-    if (l->count == l->capacity && fsdem__grow(&d->allocator, (void **)&l->entry, &l->capacity, l->count, l->count + 1,
-                                               sizeof(fsdem__entry)) != FSDEM_OK)
+/* Doubles the entry arrays of a list (all three or none). */
+static fsdem_result fsdem__list_grow(fsdem_dem *d, fsdem__list *l) {
+    const size_t n = (size_t)l->count;
+    int cap = l->capacity > 0 ? 2 * l->capacity : 256;
+    int *first, *key;
+    fsdem_vec3 *history;
+    if (l->capacity > (1 << 29)) return FSDEM_ERR_OUT_OF_MEMORY;
+    first = (int *)fsdem__alloc(&d->allocator, sizeof(int) * (size_t)cap);
+    key = (int *)fsdem__alloc(&d->allocator, sizeof(int) * (size_t)cap);
+    history = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * (size_t)cap);
+    if (!first || !key || !history) {
+        fsdem__free(&d->allocator, first, sizeof(int) * (size_t)cap);
+        fsdem__free(&d->allocator, key, sizeof(int) * (size_t)cap);
+        fsdem__free(&d->allocator, history, sizeof(fsdem_vec3) * (size_t)cap);
         return FSDEM_ERR_OUT_OF_MEMORY;
-    l->entry[l->count].other = other;
-    l->entry[l->count].history = history;
+    }
+    if (n) {
+        memcpy(first, l->first, sizeof(int) * n);
+        memcpy(key, l->key, sizeof(int) * n);
+        memcpy(history, l->history, sizeof(fsdem_vec3) * n);
+    }
+    fsdem__list_free_entries(d, l);
+    l->first = first;
+    l->key = key;
+    l->history = history;
+    l->capacity = cap;
+    return FSDEM_OK;
+}
+
+/* Appends (row, partner `key`) with the history that entry `from` of list `old` holds (none for -1). */
+static fsdem_result fsdem__list_append(fsdem_dem *d, fsdem__list *l, int row, int key, const fsdem__list *old, int from) {
+    if (l->count == l->capacity && fsdem__list_grow(d, l) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    l->first[l->count] = row;
+    l->key[l->count] = key;
+    if (from >= 0 && (old->key[from] & FSDEM__HELD)) {
+        l->key[l->count] |= FSDEM__HELD;
+        l->history[l->count] = old->history[from];
+    }
     l->count++;
     return FSDEM_OK;
 }
 
-/* History stored under (row, key) in a previous list, or zero. */
-static fsdem_vec3 fsdem__old_history(const fsdem__list *old, int row, int key) {
+/* The tangential spring of entry k (zero unless held). */
+static fsdem_vec3 fsdem__spring(const fsdem__list *l, int k) {
+    return l->key[k] & FSDEM__HELD ? l->history[k] : fsdem__zero3();
+}
+
+/* Entry of (row, partner) in a previous list, or -1. */
+static int fsdem__old_entry(const fsdem__list *old, int row, int partner) {
     int k;
     if (row >= 0 && row < old->rows)
         for (k = old->start[row]; k < old->start[row + 1]; ++k)
-            if (old->entry[k].other == key) return old->entry[k].history;
-    return fsdem__zero3();
+            if (FSDEM__PARTNER(old->key[k]) == partner) return k;
+    return -1;
 }
 
 static void fsdem__swap_lists(fsdem__list *a, fsdem__list *b) {
@@ -2490,8 +2849,9 @@ static void fsdem__swap_lists(fsdem__list *a, fsdem__list *b) {
    r_i + offset + skin, carrying each surviving contact's history over from the previous lists. */
 static fsdem_result fsdem__rebuild(fsdem_dem *d) {
     const fsdem_real off = d->desc.contact_offset;
-    fsdem_real r_max = 0, skin;
-    int i, k, dim = d->desc.dim, max_cells;
+    fsdem_real r_max = 0, skin, *reach_s;
+    fsdem_vec3 *xs;
+    int i, k, dim = d->desc.dim, max_cells, *fixed_s, *partners;
     fsdem_result res = FSDEM_OK;
     for (i = 0; i < d->n; ++i)
         if (d->r[i] > r_max) r_max = d->r[i];
@@ -2503,6 +2863,23 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
                              r_max > 0 ? 2 * r_max + off + skin : 1, max_cells) != FSDEM_OK ||
         fsdem_cellgrid_build(&d->grid, d->x, d->n) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
+    /* scratch: the particles' positions, reaches and fixed flags in cell order, so the search below
+       reads them in sequence, and one particle's partners */
+    if (fsdem__arena_reserve(&d->allocator, &d->arena,
+                             fsdem__arena_bytes(sizeof(fsdem_vec3) * (size_t)d->n) +
+                                 fsdem__arena_bytes(sizeof(fsdem_real) * (size_t)d->n) +
+                                 2 * fsdem__arena_bytes(sizeof(int) * (size_t)d->n)) != FSDEM_OK)
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    xs = (fsdem_vec3 *)fsdem__arena_push(&d->arena, sizeof(fsdem_vec3) * (size_t)d->n);
+    reach_s = (fsdem_real *)fsdem__arena_push(&d->arena, sizeof(fsdem_real) * (size_t)d->n);
+    fixed_s = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->n);
+    partners = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->n);
+    for (k = 0; k < d->n; ++k) {
+        const int j = d->grid.items[k];
+        xs[k] = d->x[j];
+        reach_s[k] = d->r[j] + off + skin;
+        fixed_s[k] = d->inv_m[j] == 0;
+    }
     fsdem__swap_lists(&d->pp, &d->pp_old);
     fsdem__swap_lists(&d->pw, &d->pw_old);
     if (fsdem__grow(&d->allocator, (void **)&d->pp.start, &d->pp.start_capacity, 0, d->n + 1, sizeof(int)) != FSDEM_OK ||
@@ -2510,27 +2887,25 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
         res = FSDEM_ERR_OUT_OF_MEMORY;
     d->pp.count = d->pw.count = 0;
     for (i = 0; i < d->n && res == FSDEM_OK; ++i) {
-        int coord[3], cells[27], nc, c, oi = d->old_of[i];
-        fsdem_vec3 xi = d->x[i];
-        fsdem_real ri = d->r[i];
+        int coord[3], cells[27], nc, c, q, found = 0, oi = d->old_of[i];
+        const int fixed_i = d->inv_m[i] == 0;
+        const fsdem_vec3 xi = d->x[i];
+        const fsdem_real ri = d->r[i];
         d->pp.start[i] = d->pp.count;
         fsdem_cellgrid_cell(&d->grid, xi, coord);
         nc = fsdem_cellgrid_neighbourhood(&d->grid, coord, cells);
-        for (c = 0; c < nc && res == FSDEM_OK; ++c) {
+        for (c = 0; c < nc; ++c)
             for (k = d->grid.cell_start[cells[c]]; k < d->grid.cell_start[cells[c] + 1]; ++k) {
-                int j = d->grid.items[k], oj, lo, hi;
-                fsdem_vec3 dx;
-                fsdem_real reach;
-                if (j <= i) continue;
-                dx = fsdem__sub(xi, d->x[j]);
-                reach = ri + d->r[j] + off + skin;
-                if (fsdem__dot(dx, dx) >= reach * reach) continue;
-                oj = d->old_of[j];
-                lo = oi < oj ? oi : oj;
-                hi = oi < oj ? oj : oi;
-                res = fsdem__list_append(d, &d->pp, j, lo >= 0 ? fsdem__old_history(&d->pp_old, lo, hi) : fsdem__zero3());
-                if (res != FSDEM_OK) break;
+                /* partners j > i within reach; two fixed particles exert nothing on each other.
+                   Arithmetic, not branches, which would mispredict. */
+                const fsdem_real ex = xi.x - xs[k].x, ey = xi.y - xs[k].y, ez = xi.z - xs[k].z, reach = ri + reach_s[k];
+                const int j = d->grid.items[k];
+                partners[found] = j;
+                found += (j > i) & (ex * ex + ey * ey + ez * ez < reach * reach) & !(fixed_i & fixed_s[k]);
             }
+        for (q = 0; q < found && res == FSDEM_OK; ++q) {
+            const int j = partners[q], oj = d->old_of[j], lo = oi < oj ? oi : oj, hi = oi < oj ? oj : oi;
+            res = fsdem__list_append(d, &d->pp, i, j, &d->pp_old, lo >= 0 ? fsdem__old_entry(&d->pp_old, lo, hi) : -1);
         }
         d->pw.start[i] = d->pw.count;
         for (k = 0; k < d->wall_count && res == FSDEM_OK; ++k) {
@@ -2541,7 +2916,7 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
                 fsdem_vec3 nrm;
                 int key = FSDEM__WALL_KEY(k, face), on_feature;
                 if (fsdem__wall_distance(w, face, xi, dim, &nrm, &on_feature) >= ri + off + skin) continue;
-                res = fsdem__list_append(d, &d->pw, key, fsdem__old_history(&d->pw_old, oi, key));
+                res = fsdem__list_append(d, &d->pw, i, key, &d->pw_old, fsdem__old_entry(&d->pw_old, oi, key));
                 if (res != FSDEM_OK) break;
             }
         }
@@ -2561,12 +2936,16 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
     for (k = 0; k < d->wall_count; ++k) d->walls[k].moved = 0;
     d->max_disp2 = 0;
     d->rebuilds++;
-    /* scratch for the longest wall row; the lists above are complete, so a failure here only asks
+    /* scratch for the longest wall row, and the force evaluation's arena (fsdem__compute_forces) for
+       the new list; the lists above are complete, so a failure here only asks
        for another rebuild */
     for (i = 0, k = 0; i < d->n; ++i)
         if (d->pw.start[i + 1] - d->pw.start[i] > k) k = d->pw.start[i + 1] - d->pw.start[i];
     d->need_rebuild = fsdem__grow(&d->allocator, (void **)&d->hits, &d->hit_capacity, 0, k, sizeof(fsdem__wall_hit)) !=
-                      FSDEM_OK;
+                          FSDEM_OK ||
+                      fsdem__arena_reserve(&d->allocator, &d->arena,
+                                           fsdem__arena_bytes(sizeof(int) * (size_t)d->pp.count) +
+                                               fsdem__arena_bytes(sizeof(fsdem__batch))) != FSDEM_OK;
     return d->need_rebuild ? FSDEM_ERR_OUT_OF_MEMORY : FSDEM_OK;
 }
 
@@ -2589,7 +2968,7 @@ static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
     const fsdem_vec3 xi = d->x[i];
     int k, a, b, count = 0, kept = 0;
     for (k = d->pw.start[i]; k < d->pw.start[i + 1]; ++k) {
-        const int key = d->pw.entry[k].other;
+        const int key = d->pw.key[k];
         const fsdem__wall *wall = &d->walls[FSDEM__WALL_OF(key)];
         fsdem__wall_hit *h = &d->hits[count];
         if (wall->active) {
@@ -2600,7 +2979,7 @@ static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
                 continue;
             }
         }
-        if (reset) d->pw.entry[k].history = fsdem__zero3();
+        if (reset) d->pw.key[k] &= ~FSDEM__HELD;
     }
     for (a = 0; a < count; ++a) {
         fsdem__wall_hit h = d->hits[a];
@@ -2619,7 +2998,7 @@ static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
             }
         }
         if (duplicate) {
-            if (reset) d->pw.entry[h.entry].history = fsdem__zero3();
+            if (reset) d->pw.key[h.entry] &= ~FSDEM__HELD;
             continue;
         }
         d->hits[kept++] = h;
@@ -2629,90 +3008,188 @@ static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
 
 /* ---- >>dem_forces : contact force evaluation ---- */
 
-/* Contact forces and torques of all particle pairs and particle-wall contacts into f, t and the
-   walls' force; `h` is the step the history and the one-step spring of seed 000 Eq. 8 use. */
-static void fsdem__compute_forces(fsdem_dem *d, fsdem_real h, int commit) {
-    const fsdem_real off = d->desc.contact_offset;
-    const int nm = d->material_count;
-    fsdem_vec3 *f = d->f, *t = d->t;
-    const fsdem_vec3 *x = d->x, *v = d->v, *w = d->w;
-    const fsdem_real *r = d->r, *m = d->m, *inv_m = d->inv_m, *inv_i = d->inv_i;
-    int i, k, nh, contacts = 0, wall_contacts = 0;
-    fsdem_real max_overlap = 0;
-    for (i = 0; i < d->n; ++i) f[i] = t[i] = fsdem__zero3();
-    for (k = 0; k < d->wall_count; ++k) d->walls[k].force = fsdem__zero3();
-    for (i = 0; i < d->n; ++i) {
-        const fsdem_vec3 xi = x[i], vi = v[i], wi = w[i];
-        const fsdem_real ri = r[i];
-        const fsdem__pair *row = d->pairs + d->material[i] * nm;
-        fsdem_vec3 fi = fsdem__zero3(), ti = fsdem__zero3();
-        for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
-            const int j = d->pp.entry[k].other;
-            const fsdem_vec3 dx = fsdem__sub(xi, x[j]);
-            const fsdem_real reach = ri + r[j] + off, d2 = fsdem__dot(dx, dx);
-            fsdem__contact c;
-            fsdem_real dist, la_i, la_j, fn;
-            fsdem_vec3 force, nxf;
-            if (d2 >= reach * reach || inv_m[i] + inv_m[j] == 0) {
-                if (commit) d->pp.entry[k].history = fsdem__zero3(); /* separated: the spring is reset */
-                continue;
-            }
-            dist = (fsdem_real)sqrt(d2);
-            c.n = dist > 0 ? fsdem__scale(dx, 1 / dist) : fsdem_v3(1, 0, 0);
-            c.delta = reach - dist;
-            la_i = ri - c.delta / 2;
-            la_j = r[j] - c.delta / 2;
-            c.vrel = fsdem__sub(fsdem__sub(vi, v[j]),
-                                fsdem__add(fsdem__scale(fsdem__cross(wi, c.n), la_i), fsdem__scale(fsdem__cross(w[j], c.n), la_j)));
-            c.m_eff = 1 / (inv_m[i] + inv_m[j]);
-            c.m_mean = (m[i] + m[j]) / 2;
-            c.r_eff = ri * r[j] / (ri + r[j]);
-            c.pair = row + d->material[j];
-            force = fsdem__contact_force(d, &c, &d->pp.entry[k].history, commit, h, &fn);
-            fi = fsdem__add(fi, force);
-            f[j] = fsdem__sub(f[j], force);
-            nxf = fsdem__cross(c.n, force); /* arms are along -n (i) and +n (j): torque = arm x F */
-            ti = fsdem__madd(ti, nxf, -la_i);
-            t[j] = fsdem__madd(t[j], nxf, -la_j);
-            if (c.pair->rolling > 0) {
-                fsdem_vec3 tr = fsdem__rolling_torque(fsdem__sub(wi, w[j]), c.pair->rolling, c.r_eff, fn,
-                                                      inv_i[i] + inv_i[j], h);
-                ti = fsdem__add(ti, tr);
-                t[j] = fsdem__sub(t[j], tr);
-            }
-            contacts++;
-            if (c.delta > max_overlap) max_overlap = c.delta;
+/* Contact `k` of the particle-pair list into lane c of a batch. */
+static void fsdem__gather_pair(const fsdem_dem *d, fsdem__batch *b, int c, int k) {
+    const int i = d->pp.first[k], key = d->pp.key[k], j = FSDEM__PARTNER(key);
+    const fsdem__pair *p = d->pairs + d->material[i] * d->material_count + d->material[j];
+    const fsdem_vec3 xi = d->x[i], xj = d->x[j], vi = d->v[i], vj = d->v[j], wi = d->w[i], wj = d->w[j];
+    const fsdem_vec3 spring = key & FSDEM__HELD ? d->pp.history[k] : fsdem__zero3();
+    b->i[c] = i;
+    b->other[c] = j;
+    b->entry[c] = k;
+    b->pair[c] = (int)(p - d->pairs);
+    b->dx[0][c] = xi.x - xj.x;
+    b->dx[1][c] = xi.y - xj.y;
+    b->dx[2][c] = xi.z - xj.z;
+    b->dv[0][c] = vi.x - vj.x;
+    b->dv[1][c] = vi.y - vj.y;
+    b->dv[2][c] = vi.z - vj.z;
+    b->wi[0][c] = wi.x;
+    b->wi[1][c] = wi.y;
+    b->wi[2][c] = wi.z;
+    b->wj[0][c] = wj.x;
+    b->wj[1][c] = wj.y;
+    b->wj[2][c] = wj.z;
+    b->ri[c] = d->r[i];
+    b->rj[c] = d->r[j];
+    b->inv_mi[c] = d->inv_m[i];
+    b->inv_mj[c] = d->inv_m[j];
+    b->m_mean[c] = (d->m[i] + d->m[j]) / 2;
+    b->kn[c] = p->kn;
+    b->cn[c] = p->cn;
+    b->kt[c] = p->kt;
+    b->ct[c] = p->ct;
+    b->mu[c] = p->friction;
+    b->spring[0][c] = spring.x;
+    b->spring[1][c] = spring.y;
+    b->spring[2][c] = spring.z;
+}
+
+/* Wall contact `hit` of particle i into lane c of a batch. */
+static void fsdem__gather_wall(const fsdem_dem *d, fsdem__batch *b, int c, int i, const fsdem__wall_hit *hit) {
+    const int key = d->pw.key[hit->entry], wall = FSDEM__WALL_OF(key);
+    const fsdem__pair *p = d->pairs + d->material[i] * d->material_count + d->walls[wall].d.material;
+    const fsdem_real arm = d->r[i] - hit->delta / 2;
+    const fsdem_vec3 n = hit->n, spring = key & FSDEM__HELD ? d->pw.history[hit->entry] : fsdem__zero3();
+    const fsdem_vec3 vrel = fsdem__sub(fsdem__sub(d->v[i], fsdem__scale(fsdem__cross(d->w[i], n), arm)),
+                                       d->walls[wall].d.velocity);
+    b->i[c] = i;
+    b->other[c] = wall;
+    b->entry[c] = hit->entry;
+    b->pair[c] = (int)(p - d->pairs);
+    b->n[0][c] = n.x;
+    b->n[1][c] = n.y;
+    b->n[2][c] = n.z;
+    b->delta[c] = hit->delta;
+    b->vrel[0][c] = vrel.x;
+    b->vrel[1][c] = vrel.y;
+    b->vrel[2][c] = vrel.z;
+    b->m_eff[c] = b->m_mean[c] = d->m[i];
+    b->r_eff[c] = d->r[i];
+    b->arm_i[c] = arm;
+    b->arm_j[c] = 0;
+    b->kn[c] = p->kn;
+    b->cn[c] = p->cn;
+    b->kt[c] = p->kt;
+    b->ct[c] = p->ct;
+    b->mu[c] = p->friction;
+    b->spring[0][c] = spring.x;
+    b->spring[1][c] = spring.y;
+    b->spring[2][c] = spring.z;
+}
+
+static fsdem_vec3 fsdem__batch_vec(const fsdem_real (*a)[FSDEM__BATCH], int c) { return fsdem_v3(a[0][c], a[1][c], a[2][c]); }
+
+/* Adds a batch's forces and torques to the particles (and its walls, `walls`), commits the springs
+   when `commit` and the law has history, and applies rolling resistance. */
+static void fsdem__scatter(fsdem_dem *d, const fsdem__batch *b, int walls, int commit, fsdem_real h) {
+    fsdem__list *l = walls ? &d->pw : &d->pp;
+    int c;
+    for (c = 0; c < b->count; ++c) {
+        const int i = b->i[c], o = b->other[c];
+        const fsdem_vec3 force = fsdem__batch_vec(b->force, c), torque = fsdem__batch_vec(b->torque_i, c);
+        const fsdem__pair *p = d->pairs + b->pair[c];
+        d->f[i] = fsdem__add(d->f[i], force);
+        d->t[i] = fsdem__add(d->t[i], torque);
+        if (walls) d->walls[o].force = fsdem__sub(d->walls[o].force, force);
+        else {
+            d->f[o] = fsdem__sub(d->f[o], force);
+            d->t[o] = fsdem__add(d->t[o], fsdem__batch_vec(b->torque_j, c));
         }
-        nh = d->pw.start[i + 1] > d->pw.start[i] && inv_m[i] > 0 ? fsdem__wall_hits(d, i, commit) : 0;
-        for (k = 0; k < nh; ++k) {
-            const fsdem__wall_hit *hit = &d->hits[k];
-            fsdem__wall *wall = &d->walls[FSDEM__WALL_OF(d->pw.entry[hit->entry].other)];
-            fsdem__contact c;
-            fsdem_real la, fn;
-            fsdem_vec3 force;
-            c.n = hit->n;
-            c.delta = hit->delta;
-            la = ri - c.delta / 2;
-            c.vrel = fsdem__sub(fsdem__sub(vi, fsdem__scale(fsdem__cross(wi, c.n), la)), wall->d.velocity);
-            c.m_eff = c.m_mean = m[i];
-            c.r_eff = ri;
-            c.pair = row + wall->d.material;
-            force = fsdem__contact_force(d, &c, &d->pw.entry[hit->entry].history, commit, h, &fn);
-            fi = fsdem__add(fi, force);
-            wall->force = fsdem__sub(wall->force, force);
-            ti = fsdem__madd(ti, fsdem__cross(c.n, force), -la);
-            if (c.pair->rolling > 0)
-                ti = fsdem__add(ti, fsdem__rolling_torque(wi, c.pair->rolling, c.r_eff, fn, inv_i[i], h));
-            wall_contacts++;
-            if (c.delta > max_overlap) max_overlap = c.delta;
+        if (commit) {
+            l->history[b->entry[c]] = fsdem__batch_vec(b->spring, c);
+            l->key[b->entry[c]] |= FSDEM__HELD;
         }
-        f[i] = fsdem__add(f[i], fi);
-        t[i] = fsdem__add(t[i], ti);
+        if (p->rolling > 0) {
+            const fsdem_vec3 w_rel = walls ? d->w[i] : fsdem__sub(d->w[i], d->w[o]);
+            const fsdem_vec3 tr = fsdem__rolling_torque(w_rel, p->rolling, b->r_eff[c], b->fn[c],
+                                                        d->inv_i[i] + (walls ? 0 : d->inv_i[o]), h);
+            d->t[i] = fsdem__add(d->t[i], tr);
+            if (!walls) d->t[o] = fsdem__sub(d->t[o], tr);
+        }
+        if (b->delta[c] > d->max_overlap) d->max_overlap = b->delta[c];
     }
-    d->contacts = contacts;
-    d->wall_contacts = wall_contacts;
-    d->max_overlap = max_overlap;
+}
+
+/* The entries of the particle-pair list whose pair touches, into `touching`; returns their number.
+   With `commit`, the pairs that do not touch lose their spring. Branch-free, and instantiated with
+   and without `commit`. */
+FSDEM__FORCE_INLINE int fsdem__touching(fsdem_dem *d, int *FSDEM__RESTRICT touching, const int commit) {
+    const fsdem_real off = d->desc.contact_offset;
+    const fsdem_vec3 *FSDEM__RESTRICT x = d->x;
+    const fsdem_real *FSDEM__RESTRICT r = d->r;
+    const int *FSDEM__RESTRICT first = d->pp.first;
+    int *FSDEM__RESTRICT keys = d->pp.key;
+    const int pairs = d->pp.count;
+    int k, count = 0;
+    for (k = 0; k < pairs; ++k) {
+        const int key = keys[k], i = first[k], j = FSDEM__PARTNER(key);
+        const fsdem_real ex = x[i].x - x[j].x, ey = x[i].y - x[j].y, ez = x[i].z - x[j].z, reach = r[i] + r[j] + off;
+        const int touch = ex * ex + ey * ey + ez * ez < reach * reach;
+        touching[count] = k;
+        count += touch;
+        if (commit) keys[k] = key & ~((touch - 1) & FSDEM__HELD); /* arithmetic: a branch here would mispredict */
+    }
+    return count;
+}
+
+/* Runs the kernels on a filled batch (particle pairs or, with `walls`, wall contacts), applies it
+   and empties it; returns the number of contacts it held. */
+FSDEM__FORCE_INLINE int fsdem__drain(fsdem_dem *d, fsdem__batch *b, int walls, const fsdem_contact_law law, fsdem_real h,
+                                     int keep) {
+    const int count = b->count;
+    fsdem__batch_pad(b, !walls);
+    if (!walls) fsdem__batch_geometry(b, d->desc.contact_offset);
+    fsdem__batch_law(b, law, h);
+    fsdem__scatter(d, b, walls, keep, h);
+    b->count = 0;
+    return count;
+}
+
+/* Contact forces and torques of all particle pairs and particle-wall contacts into f, t and the
+   walls' force; `h` is the step the history and the one-step spring of seed 000 Eq. 8 use, and the
+   springs are kept when `commit` (the predictor of the predictor-corrector does not keep them).
+   A pass over the whole pair list finds the touching pairs without branching; they and the wall
+   contacts then go through the vector kernels a batch at a time. Written once, instantiated per
+   contact law (fsdem__compute_forces). */
+FSDEM__FORCE_INLINE void fsdem__compute_forces_law(fsdem_dem *d, fsdem_real h, int commit, const fsdem_contact_law law) {
+    const int n = d->n, keep = commit && law == FSDEM_CONTACT_HERTZ_MINDLIN;
+    fsdem__batch *b;
+    int *touching, i, k, c, nt = 0, nw = 0;
+    fsdem__arena_reset(&d->arena);
+    touching = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->pp.count);
+    b = (fsdem__batch *)fsdem__arena_push(&d->arena, sizeof *b);
+    memset(d->f, 0, sizeof *d->f * (size_t)n);
+    memset(d->t, 0, sizeof *d->t * (size_t)n);
+    for (k = 0; k < d->wall_count; ++k) d->walls[k].force = fsdem__zero3();
+    d->max_overlap = 0;
+    nt = commit ? fsdem__touching(d, touching, 1) : fsdem__touching(d, touching, 0);
+    b->count = 0;
+    for (k = 0; k < nt; ++k) {
+        fsdem__gather_pair(d, b, b->count++, touching[k]);
+        if (b->count == FSDEM__BATCH || k == nt - 1) fsdem__drain(d, b, 0, law, h, keep);
+    }
+    for (i = 0; i < n; ++i) {
+        int nh;
+        if (d->pw.start[i + 1] == d->pw.start[i] || d->inv_m[i] == 0) continue; /* fixed: no wall force */
+        nh = fsdem__wall_hits(d, i, commit);
+        for (c = 0; c < nh; ++c) {
+            fsdem__gather_wall(d, b, b->count++, i, &d->hits[c]);
+            if (b->count == FSDEM__BATCH) nw += fsdem__drain(d, b, 1, law, h, keep);
+        }
+    }
+    if (b->count) nw += fsdem__drain(d, b, 1, law, h, keep);
+    d->contacts = nt;
+    d->wall_contacts = nw;
     d->forces_valid = 1;
+}
+
+static void fsdem__compute_forces(fsdem_dem *d, fsdem_real h, int commit) {
+    switch (d->desc.law) {
+    case FSDEM_CONTACT_LINEAR: fsdem__compute_forces_law(d, h, commit, FSDEM_CONTACT_LINEAR); break;
+    case FSDEM_CONTACT_GIC: fsdem__compute_forces_law(d, h, commit, FSDEM_CONTACT_GIC); break;
+    default: fsdem__compute_forces_law(d, h, commit, FSDEM_CONTACT_HERTZ_MINDLIN); break;
+    }
 }
 
 /* ---- >>dem_integrate : time integration ---- */
@@ -2740,8 +3217,8 @@ FSDEM__FORCE_INLINE int fsdem__verlet_pass(fsdem_dem *d, fsdem_real h, const int
     fsdem_vec3 *FSDEM__RESTRICT x = d->x, *FSDEM__RESTRICT v = d->v, *FSDEM__RESTRICT w = d->w;
     const fsdem_real h_spin = d->desc.rotation ? h : 0;
     const int planar = d->desc.dim == 2, n = d->n;
-    fsdem_real disp2 = d->max_disp2, sum = 0;
-    int i, k, outside = 0;
+    fsdem_real disp2 = d->max_disp2;
+    int i, k, outside = 0; /* or suspect: not finite */
     for (i = 0; i < n; ++i) {
         if (!fixed[i]) {
             const fsdem_real a = h * inv_m[i], b = h_spin * inv_i[i];
@@ -2767,14 +3244,15 @@ FSDEM__FORCE_INLINE int fsdem__verlet_pass(fsdem_dem *d, fsdem_real h, const int
             outside |= !(x[i].x >= lo.x && x[i].x <= hi.x && x[i].y >= lo.y && x[i].y <= hi.y &&
                          (planar || (x[i].z >= lo.z && x[i].z <= hi.z)));
         } else {
-            /* not finite if any term is; may overflow to infinity with finite terms, which the
-               check then clears */
-            sum += v[i].x + v[i].y + v[i].z + w[i].x + w[i].y + w[i].z;
+            /* not finite if any term is (and, rarely, when finite terms overflow: the check then
+               finds nothing); a tree, so no long chain of dependent additions */
+            const fsdem_real sum = (v[i].x + v[i].y) + (v[i].z + w[i].x) + (w[i].y + w[i].z);
+            outside |= !(sum - sum == 0);
         }
     }
     d->max_disp2 = disp2;
     for (k = 0; k < d->wall_count; ++k) d->walls[k].impulse = fsdem__madd(d->walls[k].impulse, d->walls[k].force, -h);
-    return outside || !fsdem__finite(sum);
+    return outside;
 }
 
 /* Velocity update v += h a, w += h alpha of the free particles, and the walls' impulse. */
@@ -2980,16 +3458,17 @@ fsdem_result fsdem_dem_dt_estimate(const fsdem_dem *d, fsdem_dt_rule rule, fsdem
     return fsdem__ok(st);
 }
 
-/* Elastic energy (J) stored in one contact's normal and tangential springs. */
-static fsdem_real fsdem__contact_energy(const fsdem_dem *d, const fsdem__contact *c, fsdem_vec3 history) {
-    const fsdem__pair *p = c->pair;
+/* Elastic energy (J) stored in one contact's normal and tangential springs: overlap delta, mean
+   and effective radius as the force kernels see them (fsdem__batch). */
+static fsdem_real fsdem__contact_energy(const fsdem_dem *d, const fsdem__pair *p, fsdem_real delta, fsdem_real m_mean,
+                                        fsdem_real r_eff, fsdem_vec3 history) {
     switch (d->desc.law) {
-    case FSDEM_CONTACT_LINEAR: return (fsdem_real)0.5 * c->m_mean * d->k0_linear * c->delta * c->delta;
-    case FSDEM_CONTACT_GIC: return (fsdem_real)0.5 * p->e_pair * 2 * c->r_eff * c->delta * c->delta;
+    case FSDEM_CONTACT_LINEAR: return (fsdem_real)0.5 * m_mean * d->k0_linear * delta * delta;
+    case FSDEM_CONTACT_GIC: return (fsdem_real)0.5 * p->e_pair * 2 * r_eff * delta * delta;
     default: {
-        fsdem_real srd = (fsdem_real)sqrt(c->r_eff * c->delta);
+        fsdem_real srd = (fsdem_real)sqrt(r_eff * delta);
         /* integral of (4/3) E* sqrt(R*) d^1.5 = (8/15) E* sqrt(R*) d^2.5, plus the Mindlin spring */
-        return (fsdem_real)(8.0 / 15.0) * p->e_star * srd * c->delta * c->delta +
+        return (fsdem_real)(8.0 / 15.0) * p->e_star * srd * delta * delta +
                (fsdem_real)0.5 * 8 * p->g_star * srd * fsdem__dot(history, history);
     }
     }
@@ -3010,26 +3489,18 @@ fsdem_energy fsdem_dem_energy(const fsdem_dem *d) {
     if (d->need_rebuild) return e; /* lists are stale after edits; springs are counted after a step */
     for (i = 0; i < d->n; ++i) {
         const fsdem__pair *row = d->pairs + d->material[i] * nm;
-        fsdem__contact c;
         for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
-            int j = d->pp.entry[k].other;
-            fsdem_real dist = fsdem__norm(fsdem__sub(d->x[i], d->x[j]));
-            if (d->inv_m[i] + d->inv_m[j] == 0) continue; /* two fixed particles exert nothing */
-            c.delta = d->r[i] + d->r[j] + d->desc.contact_offset - dist;
-            if (c.delta <= 0) continue;
-            c.m_mean = (d->m[i] + d->m[j]) / 2;
-            c.r_eff = d->r[i] * d->r[j] / (d->r[i] + d->r[j]);
-            c.pair = row + d->material[j];
-            e.elastic += fsdem__contact_energy(d, &c, d->pp.entry[k].history);
+            int j = FSDEM__PARTNER(d->pp.key[k]);
+            fsdem_real delta = d->r[i] + d->r[j] + d->desc.contact_offset - fsdem__norm(fsdem__sub(d->x[i], d->x[j]));
+            if (delta <= 0) continue;
+            e.elastic += fsdem__contact_energy(d, row + d->material[j], delta, (d->m[i] + d->m[j]) / 2,
+                                               d->r[i] * d->r[j] / (d->r[i] + d->r[j]), fsdem__spring(&d->pp, k));
         }
         nh = d->inv_m[i] > 0 ? fsdem__wall_hits((fsdem_dem *)d, i, 0) : 0; /* fixed: no wall force */
         for (k = 0; k < nh; ++k) {
             const fsdem__wall_hit *hit = &d->hits[k];
-            c.delta = hit->delta;
-            c.m_mean = d->m[i];
-            c.r_eff = d->r[i];
-            c.pair = row + d->walls[FSDEM__WALL_OF(d->pw.entry[hit->entry].other)].d.material;
-            e.elastic += fsdem__contact_energy(d, &c, d->pw.entry[hit->entry].history);
+            e.elastic += fsdem__contact_energy(d, row + d->walls[FSDEM__WALL_OF(d->pw.key[hit->entry])].d.material,
+                                               hit->delta, d->m[i], d->r[i], fsdem__spring(&d->pw, hit->entry));
         }
     }
     return e;
@@ -3055,7 +3526,7 @@ fsdem_dem_stats fsdem_dem_get_stats(const fsdem_dem *d) {
     s.max_overlap = d->max_overlap;
     s.memory_bytes = sizeof *d + fsdem__particle_bytes((fsdem_dem *)d) +
                      (size_t)(d->pp.capacity + d->pp_old.capacity + d->pw.capacity + d->pw_old.capacity) *
-                         sizeof(fsdem__entry) +
+                         (2 * sizeof(int) + sizeof(fsdem_vec3)) +
                      (size_t)(d->pp.start_capacity + d->pp_old.start_capacity + d->pw.start_capacity +
                               d->pw_old.start_capacity) * sizeof(int) +
                      (size_t)(d->grid.cell_capacity + 2 * d->grid.item_capacity) * sizeof(int) +
@@ -3080,7 +3551,7 @@ int fsdem_dem_contacts(fsdem_dem *d, fsdem_contact_info *out, int capacity) {
     if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     for (i = 0; i < d->n; ++i) {
         for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
-            int j = d->pp.entry[k].other;
+            int j = FSDEM__PARTNER(d->pp.key[k]);
             fsdem_real dist;
             fsdem_vec3 n = fsdem__direction(d->x[i], d->x[j], fsdem_v3(1, 0, 0), &dist);
             if (d->r[i] + d->r[j] + off - dist <= 0) continue;
@@ -3088,7 +3559,7 @@ int fsdem_dem_contacts(fsdem_dem *d, fsdem_contact_info *out, int capacity) {
         }
         nh = fsdem__wall_hits(d, i, 0);
         for (k = 0; k < nh; ++k)
-            fsdem__report_contact(out, capacity, count++, i, -1 - FSDEM__WALL_OF(d->pw.entry[d->hits[k].entry].other),
+            fsdem__report_contact(out, capacity, count++, i, -1 - FSDEM__WALL_OF(d->pw.key[d->hits[k].entry]),
                                   d->hits[k].n, d->hits[k].delta);
     }
     return count;
