@@ -287,7 +287,9 @@ FSDEM_API fsdem_result fsdem_dem_set_particle_state(fsdem_dem *dem, int index, f
 /* Views of the particle arrays (structure of arrays), valid until particles are added or removed.
    `force` and `torque` are the contact forces of the last step (N, N m), without gravity and
    without the external ones. `external_force`/`external_torque` are written by the caller or a
-   coupler and are held fixed over steps (a fluid force during DEM substeps). */
+   coupler and are held fixed over steps (a fluid force during DEM substeps). They start at zero
+   and steps read them only once this function has handed them out (or a coupler wrote them), so
+   a run without external loads does not pay for them. */
 typedef struct fsdem_particles {
     int count;
     int dim;
@@ -1779,6 +1781,9 @@ struct fsdem_dem {
     fsdem_cellgrid grid;
     fsdem_real skin, r_max, max_disp2, k0_linear;
     int need_rebuild, forces_valid;
+    int rolling;  /* some material pair has rolling resistance */
+    int external; /* fext/text may be nonzero (handed out, or written by a coupler) */
+    int forces_cleared; /* f and t were zeroed by the last Verlet pass, for the force evaluation */
     int contacts, wall_contacts;
     fsdem_real max_overlap;
 };
@@ -1996,9 +2001,9 @@ static void fsdem__pair_setup(fsdem__pair *p, const fsdem_material *a, const fsd
     }
 }
 
-/* Contacts in structure-of-arrays form, up to FSDEM__BATCH at a time, for the vector kernels below
-   (fsdem__compute_forces fills and drains them). A particle pair enters as the bodies' data and
-   fsdem__batch_geometry turns it into a contact; a wall contact enters as a contact. */
+/* Contacts in structure-of-arrays form, up to FSDEM__BATCH at a time, for the vector kernel below
+   (fsdem__compute_forces fills and drains them). A particle pair enters as the bodies' data, which
+   the kernel turns into a contact; a wall contact enters as a contact. */
 #define FSDEM__BATCH 32
 
 typedef struct fsdem__batch {
@@ -2020,7 +2025,7 @@ typedef struct fsdem__batch {
     fsdem_real m_eff[FSDEM__BATCH];   /* kg, reduced mass (m_i for a wall) */
     fsdem_real m_mean[FSDEM__BATCH];  /* kg, m_ij = (m_i + m_j)/2 of seed 000 Eq. 10 (m_i for a wall) */
     fsdem_real r_eff[FSDEM__BATCH];   /* m, R* = r_i r_j/(r_i + r_j) (r_i for a wall) */
-    fsdem_real arm_i[FSDEM__BATCH], arm_j[FSDEM__BATCH]; /* m, centre to contact point */
+    fsdem_real arm_i[FSDEM__BATCH];   /* m, centre of i to the contact point */
     fsdem_real kn[FSDEM__BATCH], cn[FSDEM__BATCH], kt[FSDEM__BATCH], ct[FSDEM__BATCH]; /* fsdem__pair */
     fsdem_real mu[FSDEM__BATCH];      /* -, Coulomb coefficient */
     fsdem_real spring[3][FSDEM__BATCH]; /* m, tangential spring: held value in, new value out */
@@ -2031,9 +2036,10 @@ typedef struct fsdem__batch {
     fsdem_real fn[FSDEM__BATCH];          /* N, normal force */
 } fsdem__batch;
 
-/* Copies contact 0 into the lanes after `count` up to a whole lane, so the kernels see real data
-   there: the pair input for a batch of particle pairs (`pairs`), the contact otherwise. */
-static void fsdem__batch_pad(fsdem__batch *b, int pairs) {
+/* Copies contact 0 into the lanes after `count` up to a whole lane, so the kernel sees real data
+   there: the pair input for a batch of particle pairs (`pairs`), the contact otherwise, and the
+   coefficients unless the batch is `uniform`. */
+static void fsdem__batch_pad(fsdem__batch *b, int pairs, int uniform) {
     int c, a;
     for (c = b->count; c % FSDEM__LANES; ++c) {
         for (a = 0; a < 3; ++a) {
@@ -2058,14 +2064,15 @@ static void fsdem__batch_pad(fsdem__batch *b, int pairs) {
             b->m_eff[c] = b->m_eff[0];
             b->r_eff[c] = b->r_eff[0];
             b->arm_i[c] = b->arm_i[0];
-            b->arm_j[c] = b->arm_j[0];
         }
-        b->m_mean[c] = b->m_mean[0];
-        b->kn[c] = b->kn[0];
-        b->cn[c] = b->cn[0];
-        b->kt[c] = b->kt[0];
-        b->ct[c] = b->ct[0];
-        b->mu[c] = b->mu[0];
+        b->m_mean[c] = b->m_mean[0]; /* may be unset (laws that do not read it): copied, never used */
+        if (!uniform) {
+            b->kn[c] = b->kn[0];
+            b->cn[c] = b->cn[0];
+            b->kt[c] = b->kt[0];
+            b->ct[c] = b->ct[0];
+            b->mu[c] = b->mu[0];
+        }
     }
 }
 
@@ -2078,64 +2085,76 @@ static void fsdem__batch_pad(fsdem__batch *b, int pairs) {
     fsdem__lane_store(&(arr)[1][c], vy);       \
     fsdem__lane_store(&(arr)[2][c], vz)
 
-/* Particle pairs of a batch into contacts: normal, overlap (offset `off` included), velocity of the
-   contact point, effective mass and radius, lever arms (each body's radius less half the overlap). */
-static void fsdem__batch_geometry(fsdem__batch *b, fsdem_real off) {
-    int c;
-    for (c = 0; c < b->count; c += FSDEM__LANES) {
-        fsdem__lane dxx, dxy, dxz, dvx, dvy, dvz, wix, wiy, wiz, wjx, wjy, wjz, ax, ay, az, nx, ny, nz;
-        const fsdem__lane ri = fsdem__lane_load(&b->ri[c]), rj = fsdem__lane_load(&b->rj[c]);
-        const fsdem__lane inv_m = fsdem__lane_load(&b->inv_mi[c]) + fsdem__lane_load(&b->inv_mj[c]);
-        const fsdem__lane one = fsdem__lane_set(1), zero = fsdem__lane_set(0);
-        fsdem__lane dist, q, safe, inv, delta, la_i, la_j;
-        fsdem__mask apart;
-        FSDEM__LOAD3(dx, b->dx, c);
-        FSDEM__LOAD3(dv, b->dv, c);
-        FSDEM__LOAD3(wi, b->wi, c);
-        FSDEM__LOAD3(wj, b->wj, c);
-        dist = fsdem__lane_sqrt(dxx * dxx + dxy * dxy + dxz * dxz);
-        /* 1/dist and 1/q, q = (1/m_i + 1/m_j)(r_i + r_j) > 0, from one division; coincident
-           centres take the normal (1, 0, 0) */
-        apart = dist > 0;
-        safe = fsdem__lane_select(apart, dist, one);
-        q = inv_m * (ri + rj);
-        inv = 1 / (safe * q);
-        nx = fsdem__lane_select(apart, dxx * (q * inv), one);
-        ny = fsdem__lane_select(apart, dxy * (q * inv), zero);
-        nz = fsdem__lane_select(apart, dxz * (q * inv), zero);
-        delta = ri + rj + off - dist;
-        la_i = ri - delta * (fsdem_real)0.5;
-        la_j = rj - delta * (fsdem_real)0.5;
-        /* contact-point velocity: v_i - v_j - (w_i l_i + w_j l_j) x n */
-        ax = wix * la_i + wjx * la_j;
-        ay = wiy * la_i + wjy * la_j;
-        az = wiz * la_i + wjz * la_j;
-        FSDEM__STORE3(b->n, c, nx, ny, nz);
-        FSDEM__STORE3(b->vrel, c, dvx - (ay * nz - az * ny), dvy - (az * nx - ax * nz), dvz - (ax * ny - ay * nx));
-        fsdem__lane_store(&b->delta[c], delta);
-        fsdem__lane_store(&b->arm_i[c], la_i);
-        fsdem__lane_store(&b->arm_j[c], la_j);
-        /* m* = 1/(1/m_i + 1/m_j) = (r_i + r_j)/q, R* = r_i r_j/(r_i + r_j) = r_i r_j (1/m_i + 1/m_j)/q */
-        fsdem__lane_store(&b->m_eff[c], (ri + rj) * (safe * inv));
-        fsdem__lane_store(&b->r_eff[c], ri * rj * inv_m * (safe * inv));
-    }
-}
-
 /* The contact law on every contact of a batch: force and torques, normal force, new spring (laws
-   with history). Written once, branch-free, and inlined with a constant `law`. h is the step the
-   spring and seed 000's one-step tangential spring (Eq. 8) use. */
-FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_law law, fsdem_real h) {
+   with history). With `pairs`, the contacts are first made from the particle-pair input: normal,
+   overlap (offset `off` included), velocity of the contact point, effective mass and radius, lever
+   arms (each body's radius less half the overlap). With `uniform`, every contact has that material
+   pair and the batch holds no coefficients. Written once, branch-free, and inlined with a constant
+   `law` and `pairs`. h is the step the spring and seed 000's one-step tangential spring (Eq. 8) use. */
+FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_law law, fsdem_real h, const int pairs,
+                                          fsdem_real off, const fsdem__pair *uniform) {
+    const fsdem__lane one = fsdem__lane_set(1), zero = fsdem__lane_set(0);
     int c;
     for (c = 0; c < b->count; c += FSDEM__LANES) {
         fsdem__lane nx, ny, nz, vx, vy, vz, sx, sy, sz, tx, ty, tz, mx, my, mz;
-        const fsdem__lane delta = fsdem__lane_load(&b->delta[c]), mu = fsdem__lane_load(&b->mu[c]);
-        const fsdem__lane kn = fsdem__lane_load(&b->kn[c]), cn = fsdem__lane_load(&b->cn[c]);
-        const fsdem__lane kt = fsdem__lane_load(&b->kt[c]), ct = fsdem__lane_load(&b->ct[c]);
-        const fsdem__lane one = fsdem__lane_set(1);
-        fsdem__lane vn, fn, ft2, ft_max, scale, arm;
+        fsdem__lane delta, m_eff, r_eff, arm_i, arm_j, kn, cn, kt, ct, mu, vn, fn, ft2, ft_max, scale;
         fsdem__mask slide;
-        FSDEM__LOAD3(n, b->n, c);
-        FSDEM__LOAD3(v, b->vrel, c);
+        if (pairs) {
+            fsdem__lane dxx, dxy, dxz, wix, wiy, wiz, wjx, wjy, wjz, ax, ay, az, dist, q, safe, inv;
+            const fsdem__lane ri = fsdem__lane_load(&b->ri[c]), rj = fsdem__lane_load(&b->rj[c]);
+            const fsdem__lane inv_m = fsdem__lane_load(&b->inv_mi[c]) + fsdem__lane_load(&b->inv_mj[c]);
+            fsdem__mask apart;
+            FSDEM__LOAD3(dx, b->dx, c);
+            FSDEM__LOAD3(v, b->dv, c);
+            FSDEM__LOAD3(wi, b->wi, c);
+            FSDEM__LOAD3(wj, b->wj, c);
+            dist = fsdem__lane_sqrt(dxx * dxx + dxy * dxy + dxz * dxz);
+            /* 1/dist and 1/q, q = (1/m_i + 1/m_j)(r_i + r_j) > 0, from one division; coincident
+               centres take the normal (1, 0, 0) */
+            apart = dist > 0;
+            safe = fsdem__lane_select(apart, dist, one);
+            q = inv_m * (ri + rj);
+            inv = 1 / (safe * q);
+            nx = fsdem__lane_select(apart, dxx * (q * inv), one);
+            ny = fsdem__lane_select(apart, dxy * (q * inv), zero);
+            nz = fsdem__lane_select(apart, dxz * (q * inv), zero);
+            delta = ri + rj + off - dist;
+            arm_i = ri - delta * (fsdem_real)0.5;
+            arm_j = rj - delta * (fsdem_real)0.5;
+            /* m* = 1/(1/m_i + 1/m_j) = (r_i + r_j)/q, R* = r_i r_j/(r_i + r_j) = r_i r_j (1/m_i + 1/m_j)/q */
+            m_eff = (ri + rj) * (safe * inv);
+            r_eff = ri * rj * inv_m * (safe * inv);
+            /* contact-point velocity: v_i - v_j - (w_i l_i + w_j l_j) x n */
+            ax = wix * arm_i + wjx * arm_j;
+            ay = wiy * arm_i + wjy * arm_j;
+            az = wiz * arm_i + wjz * arm_j;
+            vx -= ay * nz - az * ny;
+            vy -= az * nx - ax * nz;
+            vz -= ax * ny - ay * nx;
+            fsdem__lane_store(&b->delta[c], delta);
+            fsdem__lane_store(&b->r_eff[c], r_eff);
+        } else {
+            FSDEM__LOAD3(n, b->n, c);
+            FSDEM__LOAD3(v, b->vrel, c);
+            delta = fsdem__lane_load(&b->delta[c]);
+            m_eff = fsdem__lane_load(&b->m_eff[c]);
+            r_eff = fsdem__lane_load(&b->r_eff[c]);
+            arm_i = fsdem__lane_load(&b->arm_i[c]);
+            arm_j = zero;
+        }
+        if (uniform) {
+            kn = fsdem__lane_set(uniform->kn);
+            cn = fsdem__lane_set(uniform->cn);
+            kt = fsdem__lane_set(uniform->kt);
+            ct = fsdem__lane_set(uniform->ct);
+            mu = fsdem__lane_set(uniform->friction);
+        } else {
+            kn = fsdem__lane_load(&b->kn[c]);
+            cn = fsdem__lane_load(&b->cn[c]);
+            kt = fsdem__lane_load(&b->kt[c]);
+            ct = fsdem__lane_load(&b->ct[c]);
+            mu = fsdem__lane_load(&b->mu[c]);
+        }
         vn = vx * nx + vy * ny + vz * nz;
         vx -= vn * nx; /* tangential relative velocity */
         vy -= vn * ny;
@@ -2154,8 +2173,7 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             /* seed 004 Eq. 1a-1c: k_n = E r for equal spheres (here E_pair 2 R*); the viscous
                tangential coefficient is not given in the seed: we take the critical damping of the
                tangential spring k_n/(2(1+nu)) (seed 000 Eq. 12) */
-            const fsdem__lane k = kn * fsdem__lane_load(&b->r_eff[c]);
-            const fsdem__lane g = -2 * fsdem__lane_sqrt(fsdem__lane_load(&b->m_eff[c]) * k * kt);
+            const fsdem__lane k = kn * r_eff, g = -2 * fsdem__lane_sqrt(m_eff * k * kt);
             fn = k * delta;
             tx = g * vx;
             ty = g * vy;
@@ -2167,8 +2185,8 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
                tangential displacement (seed 002 Eq. 20, Coulomb sliding Eq. 22). Damping
                eta = a sqrt((2/3) m* S), Tsuji's a sqrt(m* k) d^(1/4) with a calibrated from e
                (fsdem__tsuji_coefficient), so eta_n = sqrt(cn m* s) and eta_t = ct eta_n. */
-            const fsdem__lane s = fsdem__lane_sqrt(fsdem__lane_load(&b->r_eff[c]) * delta);
-            const fsdem__lane eta_n = fsdem__lane_sqrt(cn * fsdem__lane_load(&b->m_eff[c]) * s), st = kt * s;
+            const fsdem__lane s = fsdem__lane_sqrt(r_eff * delta);
+            const fsdem__lane eta_n = fsdem__lane_sqrt(cn * m_eff * s), st = kt * s;
             fsdem__lane sn, len2, proj2, inv;
             fsdem__mask turned;
             /* the held spring, turned into the current tangent plane with its length kept */
@@ -2184,7 +2202,7 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             sx = sx * scale + vx * h;
             sy = sy * scale + vy * h;
             sz = sz * scale + vz * h;
-            fn = fsdem__lane_max(kn * s * delta - eta_n * vn, fsdem__lane_set(0));
+            fn = fsdem__lane_max(kn * s * delta - eta_n * vn, zero);
             tx = -st * sx - ct * eta_n * vx;
             ty = -st * sy - ct * eta_n * vy;
             tz = -st * sz - ct * eta_n * vz;
@@ -2221,10 +2239,10 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
         mx = ny * tz - nz * ty;
         my = nz * tx - nx * tz;
         mz = nx * ty - ny * tx;
-        arm = -fsdem__lane_load(&b->arm_i[c]);
-        FSDEM__STORE3(b->torque_i, c, arm * mx, arm * my, arm * mz);
-        arm = -fsdem__lane_load(&b->arm_j[c]);
-        FSDEM__STORE3(b->torque_j, c, arm * mx, arm * my, arm * mz);
+        FSDEM__STORE3(b->torque_i, c, -arm_i * mx, -arm_i * my, -arm_i * mz);
+        if (pairs) {
+            FSDEM__STORE3(b->torque_j, c, -arm_j * mx, -arm_j * my, -arm_j * mz);
+        }
     }
 }
 
@@ -2378,6 +2396,7 @@ fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_material *mat, int
     d->pairs = pairs;
     d->pair_capacity = nm * nm;
     d->material_count = nm;
+    for (a = 0; a < nm * nm; ++a) d->rolling |= pairs[a].rolling > 0;
     d->forces_valid = 0;
     if (index) *index = nm - 1;
     return fsdem__ok(&d->status);
@@ -2510,6 +2529,7 @@ fsdem_particles fsdem_dem_particles(fsdem_dem *d) {
     p.torque = d->t;
     p.external_force = d->fext;
     p.external_torque = d->text;
+    d->external = 1; /* the caller may write them from now on */
     p.radius = d->r;
     p.mass = d->m;
     p.material = d->material;
@@ -3008,16 +3028,27 @@ static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
 
 /* ---- >>dem_forces : contact force evaluation ---- */
 
-/* Contact `k` of the particle-pair list into lane c of a batch. */
-static void fsdem__gather_pair(const fsdem_dem *d, fsdem__batch *b, int c, int k) {
+/* Material pair `pair`'s coefficients into lane c of a batch. */
+static void fsdem__gather_pair_coefficients(const fsdem_dem *d, fsdem__batch *b, int c, int pair) {
+    const fsdem__pair *p = d->pairs + pair;
+    b->pair[c] = pair;
+    b->kn[c] = p->kn;
+    b->cn[c] = p->cn;
+    b->kt[c] = p->kt;
+    b->ct[c] = p->ct;
+    b->mu[c] = p->friction;
+}
+
+/* Contact `k` of the particle-pair list into lane c of a batch; the coefficients of its material
+   pair unless the batch is `uniform`, the mean mass only for the law that uses it. */
+FSDEM__FORCE_INLINE void fsdem__gather_pair(const fsdem_dem *d, fsdem__batch *b, int c, int k, const fsdem_contact_law law,
+                                            int uniform) {
     const int i = d->pp.first[k], key = d->pp.key[k], j = FSDEM__PARTNER(key);
-    const fsdem__pair *p = d->pairs + d->material[i] * d->material_count + d->material[j];
     const fsdem_vec3 xi = d->x[i], xj = d->x[j], vi = d->v[i], vj = d->v[j], wi = d->w[i], wj = d->w[j];
     const fsdem_vec3 spring = key & FSDEM__HELD ? d->pp.history[k] : fsdem__zero3();
     b->i[c] = i;
     b->other[c] = j;
     b->entry[c] = k;
-    b->pair[c] = (int)(p - d->pairs);
     b->dx[0][c] = xi.x - xj.x;
     b->dx[1][c] = xi.y - xj.y;
     b->dx[2][c] = xi.z - xj.z;
@@ -3034,21 +3065,17 @@ static void fsdem__gather_pair(const fsdem_dem *d, fsdem__batch *b, int c, int k
     b->rj[c] = d->r[j];
     b->inv_mi[c] = d->inv_m[i];
     b->inv_mj[c] = d->inv_m[j];
-    b->m_mean[c] = (d->m[i] + d->m[j]) / 2;
-    b->kn[c] = p->kn;
-    b->cn[c] = p->cn;
-    b->kt[c] = p->kt;
-    b->ct[c] = p->ct;
-    b->mu[c] = p->friction;
+    if (law == FSDEM_CONTACT_LINEAR) b->m_mean[c] = (d->m[i] + d->m[j]) / 2;
     b->spring[0][c] = spring.x;
     b->spring[1][c] = spring.y;
     b->spring[2][c] = spring.z;
+    if (!uniform) fsdem__gather_pair_coefficients(d, b, c, d->material[i] * d->material_count + d->material[j]);
+    else b->pair[c] = 0;
 }
 
-/* Wall contact `hit` of particle i into lane c of a batch. */
-static void fsdem__gather_wall(const fsdem_dem *d, fsdem__batch *b, int c, int i, const fsdem__wall_hit *hit) {
+/* Wall contact `hit` of particle i into lane c of a batch (coefficients as fsdem__gather_pair). */
+static void fsdem__gather_wall(const fsdem_dem *d, fsdem__batch *b, int c, int i, const fsdem__wall_hit *hit, int uniform) {
     const int key = d->pw.key[hit->entry], wall = FSDEM__WALL_OF(key);
-    const fsdem__pair *p = d->pairs + d->material[i] * d->material_count + d->walls[wall].d.material;
     const fsdem_real arm = d->r[i] - hit->delta / 2;
     const fsdem_vec3 n = hit->n, spring = key & FSDEM__HELD ? d->pw.history[hit->entry] : fsdem__zero3();
     const fsdem_vec3 vrel = fsdem__sub(fsdem__sub(d->v[i], fsdem__scale(fsdem__cross(d->w[i], n), arm)),
@@ -3056,7 +3083,6 @@ static void fsdem__gather_wall(const fsdem_dem *d, fsdem__batch *b, int c, int i
     b->i[c] = i;
     b->other[c] = wall;
     b->entry[c] = hit->entry;
-    b->pair[c] = (int)(p - d->pairs);
     b->n[0][c] = n.x;
     b->n[1][c] = n.y;
     b->n[2][c] = n.z;
@@ -3067,15 +3093,11 @@ static void fsdem__gather_wall(const fsdem_dem *d, fsdem__batch *b, int c, int i
     b->m_eff[c] = b->m_mean[c] = d->m[i];
     b->r_eff[c] = d->r[i];
     b->arm_i[c] = arm;
-    b->arm_j[c] = 0;
-    b->kn[c] = p->kn;
-    b->cn[c] = p->cn;
-    b->kt[c] = p->kt;
-    b->ct[c] = p->ct;
-    b->mu[c] = p->friction;
     b->spring[0][c] = spring.x;
     b->spring[1][c] = spring.y;
     b->spring[2][c] = spring.z;
+    if (!uniform) fsdem__gather_pair_coefficients(d, b, c, d->material[i] * d->material_count + d->walls[wall].d.material);
+    else b->pair[c] = 0;
 }
 
 static fsdem_vec3 fsdem__batch_vec(const fsdem_real (*a)[FSDEM__BATCH], int c) { return fsdem_v3(a[0][c], a[1][c], a[2][c]); }
@@ -3088,7 +3110,6 @@ static void fsdem__scatter(fsdem_dem *d, const fsdem__batch *b, int walls, int c
     for (c = 0; c < b->count; ++c) {
         const int i = b->i[c], o = b->other[c];
         const fsdem_vec3 force = fsdem__batch_vec(b->force, c), torque = fsdem__batch_vec(b->torque_i, c);
-        const fsdem__pair *p = d->pairs + b->pair[c];
         d->f[i] = fsdem__add(d->f[i], force);
         d->t[i] = fsdem__add(d->t[i], torque);
         if (walls) d->walls[o].force = fsdem__sub(d->walls[o].force, force);
@@ -3100,9 +3121,9 @@ static void fsdem__scatter(fsdem_dem *d, const fsdem__batch *b, int walls, int c
             l->history[b->entry[c]] = fsdem__batch_vec(b->spring, c);
             l->key[b->entry[c]] |= FSDEM__HELD;
         }
-        if (p->rolling > 0) {
+        if (d->rolling && d->pairs[b->pair[c]].rolling > 0) {
             const fsdem_vec3 w_rel = walls ? d->w[i] : fsdem__sub(d->w[i], d->w[o]);
-            const fsdem_vec3 tr = fsdem__rolling_torque(w_rel, p->rolling, b->r_eff[c], b->fn[c],
+            const fsdem_vec3 tr = fsdem__rolling_torque(w_rel, d->pairs[b->pair[c]].rolling, b->r_eff[c], b->fn[c],
                                                         d->inv_i[i] + (walls ? 0 : d->inv_i[o]), h);
             d->t[i] = fsdem__add(d->t[i], tr);
             if (!walls) d->t[o] = fsdem__sub(d->t[o], tr);
@@ -3138,9 +3159,10 @@ FSDEM__FORCE_INLINE int fsdem__touching(fsdem_dem *d, int *FSDEM__RESTRICT touch
 FSDEM__FORCE_INLINE int fsdem__drain(fsdem_dem *d, fsdem__batch *b, int walls, const fsdem_contact_law law, fsdem_real h,
                                      int keep) {
     const int count = b->count;
-    fsdem__batch_pad(b, !walls);
-    if (!walls) fsdem__batch_geometry(b, d->desc.contact_offset);
-    fsdem__batch_law(b, law, h);
+    const fsdem__pair *uniform = d->material_count == 1 ? d->pairs : NULL;
+    fsdem__batch_pad(b, !walls, uniform != NULL);
+    if (walls) fsdem__batch_law(b, law, h, 0, 0, uniform);
+    else fsdem__batch_law(b, law, h, 1, d->desc.contact_offset, uniform);
     fsdem__scatter(d, b, walls, keep, h);
     b->count = 0;
     return count;
@@ -3153,20 +3175,23 @@ FSDEM__FORCE_INLINE int fsdem__drain(fsdem_dem *d, fsdem__batch *b, int walls, c
    contacts then go through the vector kernels a batch at a time. Written once, instantiated per
    contact law (fsdem__compute_forces). */
 FSDEM__FORCE_INLINE void fsdem__compute_forces_law(fsdem_dem *d, fsdem_real h, int commit, const fsdem_contact_law law) {
-    const int n = d->n, keep = commit && law == FSDEM_CONTACT_HERTZ_MINDLIN;
+    const int n = d->n, keep = commit && law == FSDEM_CONTACT_HERTZ_MINDLIN, uniform = d->material_count == 1;
     fsdem__batch *b;
     int *touching, i, k, c, nt = 0, nw = 0;
     fsdem__arena_reset(&d->arena);
     touching = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->pp.count);
     b = (fsdem__batch *)fsdem__arena_push(&d->arena, sizeof *b);
-    memset(d->f, 0, sizeof *d->f * (size_t)n);
-    memset(d->t, 0, sizeof *d->t * (size_t)n);
+    if (!d->forces_cleared) {
+        memset(d->f, 0, sizeof *d->f * (size_t)n);
+        memset(d->t, 0, sizeof *d->t * (size_t)n);
+    }
+    d->forces_cleared = 0;
     for (k = 0; k < d->wall_count; ++k) d->walls[k].force = fsdem__zero3();
     d->max_overlap = 0;
     nt = commit ? fsdem__touching(d, touching, 1) : fsdem__touching(d, touching, 0);
     b->count = 0;
     for (k = 0; k < nt; ++k) {
-        fsdem__gather_pair(d, b, b->count++, touching[k]);
+        fsdem__gather_pair(d, b, b->count++, touching[k], law, uniform);
         if (b->count == FSDEM__BATCH || k == nt - 1) fsdem__drain(d, b, 0, law, h, keep);
     }
     for (i = 0; i < n; ++i) {
@@ -3174,7 +3199,7 @@ FSDEM__FORCE_INLINE void fsdem__compute_forces_law(fsdem_dem *d, fsdem_real h, i
         if (d->pw.start[i + 1] == d->pw.start[i] || d->inv_m[i] == 0) continue; /* fixed: no wall force */
         nh = fsdem__wall_hits(d, i, commit);
         for (c = 0; c < nh; ++c) {
-            fsdem__gather_wall(d, b, b->count++, i, &d->hits[c]);
+            fsdem__gather_wall(d, b, b->count++, i, &d->hits[c], uniform);
             if (b->count == FSDEM__BATCH) nw += fsdem__drain(d, b, 1, law, h, keep);
         }
     }
@@ -3203,14 +3228,16 @@ static fsdem_vec3 fsdem__spin_rate(const fsdem_dem *d, const fsdem_vec3 *t, int 
 }
 
 /* One pass of Verlet over the particles: the velocity update v += h a, w += h alpha of the free
-   particles, then, with `drift`, the position update x += h_drift v of all of them and the largest
-   displacement since the last rebuild. Returns nonzero when the pass may have produced a state that
-   is not finite or outside the domain; fsdem__check_particles then finds and names the particle.
-   (Positions are checked after the drift, velocities after a pass without one.) Written once and
-   instantiated with and without the drift, so each pass reads every array once. */
-FSDEM__FORCE_INLINE int fsdem__verlet_pass(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift) {
+   particles (with the external loads when `external`), then, with `drift`, the position update
+   x += h_drift v of all of them, the largest displacement since the last rebuild, and f and t
+   cleared for the force evaluation that follows. Returns nonzero when the pass may have produced a
+   state that is not finite or outside the domain; fsdem__check_particles then finds and names the
+   particle. (Positions are checked after the drift, velocities after a pass without one.) Written
+   once and instantiated per flag, so each pass reads every array it needs once. */
+FSDEM__FORCE_INLINE int fsdem__verlet_pass(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift,
+                                           const int external) {
     const fsdem_vec3 g = d->desc.gravity, lo = d->desc.domain_min, hi = d->desc.domain_max;
-    const fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t;
+    fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t;
     const fsdem_vec3 *FSDEM__RESTRICT fe = d->fext, *FSDEM__RESTRICT te = d->text, *FSDEM__RESTRICT x_ref = d->x_ref;
     const fsdem_real *FSDEM__RESTRICT inv_m = d->inv_m, *FSDEM__RESTRICT inv_i = d->inv_i;
     const unsigned char *FSDEM__RESTRICT fixed = d->fixed;
@@ -3222,15 +3249,16 @@ FSDEM__FORCE_INLINE int fsdem__verlet_pass(fsdem_dem *d, fsdem_real h, const int
     for (i = 0; i < n; ++i) {
         if (!fixed[i]) {
             const fsdem_real a = h * inv_m[i], b = h_spin * inv_i[i];
-            v[i].x += h * g.x + a * (f[i].x + fe[i].x);
-            v[i].y += h * g.y + a * (f[i].y + fe[i].y);
-            v[i].z += h * g.z + a * (f[i].z + fe[i].z);
-            w[i].x += b * (t[i].x + te[i].x);
-            w[i].y += b * (t[i].y + te[i].y);
-            w[i].z += b * (t[i].z + te[i].z);
+            v[i].x += h * g.x + a * (external ? f[i].x + fe[i].x : f[i].x);
+            v[i].y += h * g.y + a * (external ? f[i].y + fe[i].y : f[i].y);
+            v[i].z += h * g.z + a * (external ? f[i].z + fe[i].z : f[i].z);
+            w[i].x += b * (external ? t[i].x + te[i].x : t[i].x);
+            w[i].y += b * (external ? t[i].y + te[i].y : t[i].y);
+            w[i].z += b * (external ? t[i].z + te[i].z : t[i].z);
             if (planar) v[i].z = w[i].x = w[i].y = 0;
         }
         if (drift) {
+            f[i] = t[i] = fsdem__zero3();
             fsdem_real dx, dy, dz, d2;
             x[i].x += h_drift * v[i].x;
             x[i].y += h_drift * v[i].y;
@@ -3251,16 +3279,22 @@ FSDEM__FORCE_INLINE int fsdem__verlet_pass(fsdem_dem *d, fsdem_real h, const int
         }
     }
     d->max_disp2 = disp2;
+    if (drift) {
+        d->forces_valid = 0; /* they are cleared now */
+        d->forces_cleared = 1;
+    }
     for (k = 0; k < d->wall_count; ++k) d->walls[k].impulse = fsdem__madd(d->walls[k].impulse, d->walls[k].force, -h);
     return outside;
 }
 
 /* Velocity update v += h a, w += h alpha of the free particles, and the walls' impulse. */
-static int fsdem__kick(fsdem_dem *d, fsdem_real h) { return fsdem__verlet_pass(d, h, 0, 0); }
+static int fsdem__kick(fsdem_dem *d, fsdem_real h) {
+    return d->external ? fsdem__verlet_pass(d, h, 0, 0, 1) : fsdem__verlet_pass(d, h, 0, 0, 0);
+}
 
-/* Kick h, then drift h_drift. */
+/* Kick h, then drift h_drift (and clear the forces). */
 static int fsdem__kick_drift(fsdem_dem *d, fsdem_real h, fsdem_real h_drift) {
-    return fsdem__verlet_pass(d, h, 1, h_drift);
+    return d->external ? fsdem__verlet_pass(d, h, 1, h_drift, 1) : fsdem__verlet_pass(d, h, 1, h_drift, 0);
 }
 
 static void fsdem__track_displacement(fsdem_dem *d, int i) {
@@ -9629,6 +9663,7 @@ fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
         fsdem_vec3 horizontal;
         memset(out, 0, sizeof *out);
         dem->fext[i] = fsdem__zero3();
+        dem->external = 1;
         if (dem->fixed[i] || fsdem_swe_sample(swe, p.x, p.y, &centre) != FSDEM_OK) continue;
         /* the water at the centre, and at the back (-r) and front (+r) along each horizontal axis; the
            flow velocity is the centre's, or that of the deepest side while a front reaches the sphere */
