@@ -1220,6 +1220,96 @@ START_TEST(advance_subcycles_like_seed000) {
 }
 END_TEST
 
+/* A gravity-free box of dense, damped, frictional Hertz spheres, shaken with random velocities and
+   spins: many contacts that touch, slide and separate. */
+static fsdem_dem *shaken_box(int *box) {
+    fsdem_dem_desc d = fsdem_dem_desc_default(3);
+    fsdem_dem *dem;
+    const double L = 0.05, r = 0.004;
+    int mat, i, j, k;
+    d.domain_min = fsdem_v3(0, 0, 0);
+    d.domain_max = fsdem_v3(L, L, L);
+    d.dt = 2e-6;
+    dem = dem_new(&d);
+    mat = add_material(dem, 2500, 1e7, 0.3, 0.7, 0.4, 0.4);
+    *box = add_wall(dem, fsdem_wall_box(fsdem_v3(0, 0, 0), fsdem_v3(L, L, L), 1, mat));
+    rng_seed(77);
+    for (k = 0; k < 5; ++k)
+        for (j = 0; j < 5; ++j)
+            for (i = 0; i < 5; ++i)
+                add_particle(dem, fsdem_v3(0.005 + 0.0085 * i, 0.005 + 0.0085 * j, 0.005 + 0.0085 * k),
+                             fsdem_v3(urange(-1, 1), urange(-1, 1), urange(-1, 1)),
+                             fsdem_v3(urange(-200, 200), urange(-200, 200), urange(-200, 200)), r, mat, 0);
+    return dem;
+}
+
+/* fsdem_dem_advance runs its Verlet substeps as leapfrog (one pass per substep); it must give the
+   state of as many fsdem_dem_step calls. The two differ only in rounding (one kick of h instead of
+   two of h/2), which the collisions amplify; 1e-9 of the scale over 600 steps is far above that
+   and far below any error of the integration itself (a missed half kick changes velocities by
+   g_contact h / 2, of order 1e-2 of the scale here). */
+START_TEST(advance_equals_steps) {
+    fsdem_dem *a, *b;
+    fsdem_particles pa, pb;
+    fsdem_vec3 ja, jb;
+    int box_a, box_b, i, k, n, contacts = 0;
+    double dx = 0, dv = 0, dw = 0;
+    a = shaken_box(&box_a);
+    b = shaken_box(&box_b);
+    for (k = 0; k < 600; ++k) {
+        ck_assert_int_eq(fsdem_dem_step(a), FSDEM_OK);
+        contacts += fsdem_dem_get_stats(a).contacts;
+    }
+    ck_assert_int_eq(fsdem_dem_advance(b, 600 * 2e-6, &n), FSDEM_OK);
+    pa = fsdem_dem_particles(a);
+    pb = fsdem_dem_particles(b);
+    for (i = 0; i < pa.count; ++i) {
+        dx = fmax(dx, vnorm(vsub(pa.position[i], pb.position[i])));
+        dv = fmax(dv, vnorm(vsub(pa.velocity[i], pb.velocity[i])));
+        dw = fmax(dw, vnorm(vsub(pa.angular_velocity[i], pb.angular_velocity[i])));
+    }
+    ja = fsdem_dem_wall_impulse(a, box_a);
+    jb = fsdem_dem_wall_impulse(b, box_b);
+    REPORT("advance vs steps: %d substeps, %d contact-steps; max |dx| %.2e m, |dv| %.2e m/s, |dw| %.2e rad/s, "
+           "wall impulse %.2e of %.2e N s",
+           n, contacts, dx, dv, dw, vnorm(vsub(ja, jb)), vnorm(ja));
+    ck_assert_int_eq(n, 600);
+    ck_assert(fsdem_dem_get_stats(b).steps == 600 && fabs(fsdem_dem_time(a) - fsdem_dem_time(b)) < 1e-15);
+    ck_assert_msg(contacts > 600 * 10, "the test needs contacts (%d contact-steps)", contacts);
+    ck_assert_msg(dx < 1e-9 * 0.05 && dv < 1e-9 * 1 && dw < 1e-9 * 200, "dx %g dv %g dw %g", dx, dv, dw);
+    ck_assert(vnorm(vsub(ja, jb)) < 1e-9 * vnorm(ja));
+    fsdem_dem_destroy(a);
+    fsdem_dem_destroy(b);
+}
+END_TEST
+
+/* A particle that leaves the domain stops fsdem_dem_advance at that substep, with the step
+   complete and the particle named, as fsdem_dem_step does. */
+START_TEST(advance_stops_where_a_particle_leaves) {
+    fsdem_dem_desc d = fsdem_dem_desc_default(3);
+    fsdem_dem *dem;
+    fsdem_result res;
+    int mat;
+    d.gravity = fsdem_v3(0, 0, 0);
+    d.domain_min = fsdem_v3(0, 0, 0);
+    d.domain_max = fsdem_v3(1, 1, 1);
+    d.dt = 1e-3;
+    dem = dem_new(&d);
+    mat = add_plain_material(dem);
+    add_particle(dem, fsdem_v3(0.5, 0.5, 0.5), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.01, mat, 0);
+    /* 0.9455 m at 1 m/s: out after 945 or 946 steps */
+    add_particle(dem, fsdem_v3(0.2, 0.2, 0.0545), fsdem_v3(0, 0, 1), fsdem_v3(0, 0, 0), 0.01, mat, 0);
+    res = fsdem_dem_advance(dem, 2.0, NULL);
+    REPORT("advance stopped after %lld steps: %s", fsdem_dem_get_stats(dem).steps, fsdem_dem_last_error(dem));
+    ck_assert_int_eq(res, FSDEM_ERR_OUT_OF_DOMAIN);
+    ck_assert(fsdem_dem_get_stats(dem).steps >= 945 && fsdem_dem_get_stats(dem).steps <= 946);
+    ck_assert_ptr_nonnull(strstr(fsdem_dem_last_error(dem), "particle 1"));
+    /* the step is complete: the velocity is the full-step one, unchanged by the free flight */
+    ck_assert(fabs(fsdem_dem_particles(dem).velocity[1].z - 1) < 1e-12);
+    fsdem_dem_destroy(dem);
+}
+END_TEST
+
 /* ---- 9. time-step estimates ---------------------------------------------------------------------- */
 
 START_TEST(dt_estimates_follow_their_formulas) {
@@ -1338,6 +1428,8 @@ Suite *dem_suite(void) {
     tcase_add_test(tc_api, invalid_walls_and_calls_are_rejected);
     tcase_add_test(tc_api, particle_leaving_domain_is_reported);
     tcase_add_test(tc_api, advance_subcycles_like_seed000);
+    tcase_add_test(tc_api, advance_equals_steps);
+    tcase_add_test(tc_api, advance_stops_where_a_particle_leaves);
     tcase_add_test(tc_api, dt_estimates_follow_their_formulas);
     tcase_add_test(tc_api, particle_masses);
     tcase_set_timeout(tc_api, 120);
