@@ -179,6 +179,10 @@ FSDEM_API int fsdem_cellgrid_cell(const fsdem_cellgrid *grid, fsdem_vec3 p, int 
    `cells` (room for 27) and returns their number. */
 FSDEM_API int fsdem_cellgrid_neighbourhood(const fsdem_cellgrid *grid, const int coord[3],
                                            int cells[27]);
+/* The cell at `coord` and the neighbours after it in the 3^dim block (those inside the grid), into
+   `cells` (room for 14), returning their number: visiting every cell against these finds each pair
+   of neighbouring cells once. The cell itself comes first. */
+FSDEM_API int fsdem_cellgrid_forward(const fsdem_cellgrid *grid, const int coord[3], int cells[14]);
 /* Releases the memory; the struct may be set up again. */
 FSDEM_API void fsdem_cellgrid_free(fsdem_cellgrid *grid);
 
@@ -1682,6 +1686,18 @@ int fsdem_cellgrid_neighbourhood(const fsdem_cellgrid *g, const int coord[3], in
     return count;
 }
 
+int fsdem_cellgrid_forward(const fsdem_cellgrid *g, const int coord[3], int cells[14]) {
+    int count = 0, dx, dy, dz, zr = g->dim == 3 ? 1 : 0;
+    for (dz = 0; dz <= zr; ++dz)
+        for (dy = dz ? -1 : 0; dy <= 1; ++dy)
+            for (dx = dz || dy ? -1 : 0; dx <= 1; ++dx) {
+                const int x = coord[0] + dx, y = coord[1] + dy, z = coord[2] + dz;
+                if (x < 0 || x >= g->n[0] || y < 0 || y >= g->n[1] || z >= g->n[2]) continue;
+                cells[count++] = (z * g->n[1] + y) * g->n[0] + x;
+            }
+    return count;
+}
+
 void fsdem_cellgrid_free(fsdem_cellgrid *g) {
     fsdem__free(&g->allocator, g->cell_start, sizeof(int) * (size_t)g->cell_capacity);
     fsdem__free(&g->allocator, g->items, sizeof(int) * (size_t)g->item_capacity);
@@ -1777,6 +1793,7 @@ struct fsdem_dem {
     fsdem__list pp, pp_old, pw, pw_old;
     struct fsdem__wall_hit *hits; /* scratch: one particle's wall contacts (fsdem__wall_hits) */
     fsdem__arena arena;           /* per-step scratch of the force evaluation, reserved by rebuilds */
+    int *found, found_capacity;   /* scratch of the rebuild: pairs within reach (fsdem__find_pairs) */
     int hit_capacity;
     fsdem_cellgrid grid;
     fsdem_real skin, r_max, max_disp2, k0_linear;
@@ -2366,6 +2383,7 @@ void fsdem_dem_destroy(fsdem_dem *d) {
     fsdem__list_free(d, &d->pw_old);
     fsdem__free(&al, d->hits, sizeof(fsdem__wall_hit) * (size_t)d->hit_capacity);
     fsdem__arena_free(&al, &d->arena);
+    fsdem__free(&al, d->found, sizeof(int) * (size_t)d->found_capacity);
     fsdem_cellgrid_free(&d->grid);
     fsdem__free(&al, d, sizeof *d);
 }
@@ -2865,13 +2883,81 @@ static void fsdem__swap_lists(fsdem__list *a, fsdem__list *b) {
     *b = t;
 }
 
+/* Pairs within reach (r_i + r_j + offset + skin), each found once by scanning every cell against
+   itself and its forward neighbours (fsdem_cellgrid_forward), into d->found as pairs of cell-order
+   indices; xs, reach_s and fixed_s are the positions, radii plus offset and skin, and fixed flags in
+   cell order, so the scan reads them in sequence. Two fixed particles exert nothing on each other
+   and are left out. Returns the number of pairs, or -1 when d->found cannot grow. */
+static int fsdem__find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_real *reach_s, const int *fixed_s) {
+    const fsdem_cellgrid *g = &d->grid;
+    int c, f, a, b, count = 0;
+    for (c = 0; c < g->cell_count; ++c) {
+        int coord[3], cells[14], nf;
+        if (g->cell_start[c] == g->cell_start[c + 1]) continue;
+        coord[0] = c % g->n[0];
+        coord[1] = c / g->n[0] % g->n[1];
+        coord[2] = c / (g->n[0] * g->n[1]);
+        nf = fsdem_cellgrid_forward(g, coord, cells);
+        for (f = 0; f < nf; ++f) {
+            const int b1 = g->cell_start[cells[f] + 1];
+            for (a = g->cell_start[c]; a < g->cell_start[c + 1]; ++a) {
+                const int b0 = f == 0 ? a + 1 : g->cell_start[cells[f]];
+                if (fsdem__grow(&d->allocator, (void **)&d->found, &d->found_capacity, 2 * count,
+                                2 * (count + (b1 > b0 ? b1 - b0 : 0)), sizeof(int)) != FSDEM_OK)
+                    return -1;
+                for (b = b0; b < b1; ++b) {
+                    /* arithmetic, not branches, which would mispredict */
+                    const fsdem_real ex = xs[a].x - xs[b].x, ey = xs[a].y - xs[b].y, ez = xs[a].z - xs[b].z;
+                    const fsdem_real reach = reach_s[a] + reach_s[b];
+                    d->found[2 * count] = a;
+                    d->found[2 * count + 1] = b;
+                    count += (ex * ex + ey * ey + ez * ez < reach * reach) & !(fixed_s[a] & fixed_s[b]);
+                }
+            }
+        }
+    }
+    return count;
+}
+
+/* The particle-pair list from the `count` pairs in d->found: row min(i, j), partner max(i, j), each
+   carrying its history from the previous list; `cursor` is scratch for n rows. */
+static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
+    fsdem__list *l = &d->pp;
+    const int *items = d->grid.items;
+    int k, i;
+    while (l->capacity < count)
+        if (fsdem__list_grow(d, l) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    memset(l->start, 0, sizeof(int) * (size_t)(d->n + 1));
+    for (k = 0; k < count; ++k) {
+        const int a = items[d->found[2 * k]], b = items[d->found[2 * k + 1]];
+        l->start[(a < b ? a : b) + 1]++;
+    }
+    for (i = 0; i < d->n; ++i) {
+        l->start[i + 1] += l->start[i];
+        cursor[i] = l->start[i];
+    }
+    for (k = 0; k < count; ++k) {
+        const int a = items[d->found[2 * k]], b = items[d->found[2 * k + 1]];
+        const int i0 = a < b ? a : b, j = a < b ? b : a, e = cursor[i0]++;
+        const int oi = d->old_of[i0], oj = d->old_of[j], lo = oi < oj ? oi : oj, hi = oi < oj ? oj : oi;
+        const int from = lo >= 0 ? fsdem__old_entry(&d->pp_old, lo, hi) : -1, src = from >= 0 ? from : 0;
+        l->first[e] = i0;
+        /* arithmetic, not branches: the spring is copied whether held or not (it means nothing
+           without the flag) */
+        l->key[e] = j | ((from >= 0) & (d->pp_old.count > 0) ? d->pp_old.key[src] & FSDEM__HELD : 0);
+        if (d->pp_old.count > 0) l->history[e] = d->pp_old.history[src];
+    }
+    l->count = count;
+    return FSDEM_OK;
+}
+
 /* Rebuilds both lists: pairs within r_i + r_j + offset + skin, and particle-wall faces within
    r_i + offset + skin, carrying each surviving contact's history over from the previous lists. */
 static fsdem_result fsdem__rebuild(fsdem_dem *d) {
     const fsdem_real off = d->desc.contact_offset;
     fsdem_real r_max = 0, skin, *reach_s;
     fsdem_vec3 *xs;
-    int i, k, dim = d->desc.dim, max_cells, *fixed_s, *partners;
+    int i, k, dim = d->desc.dim, max_cells, *fixed_s, *cursor, pairs;
     fsdem_result res = FSDEM_OK;
     for (i = 0; i < d->n; ++i)
         if (d->r[i] > r_max) r_max = d->r[i];
@@ -2883,8 +2969,8 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
                              r_max > 0 ? 2 * r_max + off + skin : 1, max_cells) != FSDEM_OK ||
         fsdem_cellgrid_build(&d->grid, d->x, d->n) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
-    /* scratch: the particles' positions, reaches and fixed flags in cell order, so the search below
-       reads them in sequence, and one particle's partners */
+    /* scratch: positions, reaches (half each: r + (offset + skin)/2) and fixed flags in cell order,
+       and row cursors */
     if (fsdem__arena_reserve(&d->allocator, &d->arena,
                              fsdem__arena_bytes(sizeof(fsdem_vec3) * (size_t)d->n) +
                                  fsdem__arena_bytes(sizeof(fsdem_real) * (size_t)d->n) +
@@ -2893,40 +2979,24 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
     xs = (fsdem_vec3 *)fsdem__arena_push(&d->arena, sizeof(fsdem_vec3) * (size_t)d->n);
     reach_s = (fsdem_real *)fsdem__arena_push(&d->arena, sizeof(fsdem_real) * (size_t)d->n);
     fixed_s = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->n);
-    partners = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->n);
+    cursor = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->n);
     for (k = 0; k < d->n; ++k) {
         const int j = d->grid.items[k];
         xs[k] = d->x[j];
-        reach_s[k] = d->r[j] + off + skin;
+        reach_s[k] = d->r[j] + (off + skin) / 2;
         fixed_s[k] = d->inv_m[j] == 0;
     }
+    pairs = fsdem__find_pairs(d, xs, reach_s, fixed_s);
+    if (pairs < 0) return FSDEM_ERR_OUT_OF_MEMORY;
     fsdem__swap_lists(&d->pp, &d->pp_old);
     fsdem__swap_lists(&d->pw, &d->pw_old);
     if (fsdem__grow(&d->allocator, (void **)&d->pp.start, &d->pp.start_capacity, 0, d->n + 1, sizeof(int)) != FSDEM_OK ||
-        fsdem__grow(&d->allocator, (void **)&d->pw.start, &d->pw.start_capacity, 0, d->n + 1, sizeof(int)) != FSDEM_OK)
+        fsdem__grow(&d->allocator, (void **)&d->pw.start, &d->pw.start_capacity, 0, d->n + 1, sizeof(int)) != FSDEM_OK ||
+        fsdem__fill_pairs(d, pairs, cursor) != FSDEM_OK)
         res = FSDEM_ERR_OUT_OF_MEMORY;
-    d->pp.count = d->pw.count = 0;
+    d->pw.count = 0;
     for (i = 0; i < d->n && res == FSDEM_OK; ++i) {
-        int coord[3], cells[27], nc, c, q, found = 0, oi = d->old_of[i];
-        const int fixed_i = d->inv_m[i] == 0;
-        const fsdem_vec3 xi = d->x[i];
-        const fsdem_real ri = d->r[i];
-        d->pp.start[i] = d->pp.count;
-        fsdem_cellgrid_cell(&d->grid, xi, coord);
-        nc = fsdem_cellgrid_neighbourhood(&d->grid, coord, cells);
-        for (c = 0; c < nc; ++c)
-            for (k = d->grid.cell_start[cells[c]]; k < d->grid.cell_start[cells[c] + 1]; ++k) {
-                /* partners j > i within reach; two fixed particles exert nothing on each other.
-                   Arithmetic, not branches, which would mispredict. */
-                const fsdem_real ex = xi.x - xs[k].x, ey = xi.y - xs[k].y, ez = xi.z - xs[k].z, reach = ri + reach_s[k];
-                const int j = d->grid.items[k];
-                partners[found] = j;
-                found += (j > i) & (ex * ex + ey * ey + ez * ez < reach * reach) & !(fixed_i & fixed_s[k]);
-            }
-        for (q = 0; q < found && res == FSDEM_OK; ++q) {
-            const int j = partners[q], oj = d->old_of[j], lo = oi < oj ? oi : oj, hi = oi < oj ? oj : oi;
-            res = fsdem__list_append(d, &d->pp, i, j, &d->pp_old, lo >= 0 ? fsdem__old_entry(&d->pp_old, lo, hi) : -1);
-        }
+        const int oi = d->old_of[i];
         d->pw.start[i] = d->pw.count;
         for (k = 0; k < d->wall_count && res == FSDEM_OK; ++k) {
             const fsdem__wall *w = &d->walls[k];
@@ -2935,7 +3005,7 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
             for (face = 0; face < faces; ++face) {
                 fsdem_vec3 nrm;
                 int key = FSDEM__WALL_KEY(k, face), on_feature;
-                if (fsdem__wall_distance(w, face, xi, dim, &nrm, &on_feature) >= ri + off + skin) continue;
+                if (fsdem__wall_distance(w, face, d->x[i], dim, &nrm, &on_feature) >= d->r[i] + off + skin) continue;
                 res = fsdem__list_append(d, &d->pw, i, key, &d->pw_old, fsdem__old_entry(&d->pw_old, oi, key));
                 if (res != FSDEM_OK) break;
             }
@@ -2946,7 +3016,6 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
         fsdem__swap_lists(&d->pw, &d->pw_old);
         return res;
     }
-    d->pp.start[d->n] = d->pp.count;
     d->pw.start[d->n] = d->pw.count;
     d->pp.rows = d->pw.rows = d->n;
     for (i = 0; i < d->n; ++i) {
@@ -2957,8 +3026,7 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
     d->max_disp2 = 0;
     d->rebuilds++;
     /* scratch for the longest wall row, and the force evaluation's arena (fsdem__compute_forces) for
-       the new list; the lists above are complete, so a failure here only asks
-       for another rebuild */
+       the new list; the lists above are complete, so a failure here only asks for another rebuild */
     for (i = 0, k = 0; i < d->n; ++i)
         if (d->pw.start[i + 1] - d->pw.start[i] > k) k = d->pw.start[i + 1] - d->pw.start[i];
     d->need_rebuild = fsdem__grow(&d->allocator, (void **)&d->hits, &d->hit_capacity, 0, k, sizeof(fsdem__wall_hit)) !=
@@ -3593,7 +3661,8 @@ fsdem_dem_stats fsdem_dem_get_stats(const fsdem_dem *d) {
                               d->pw_old.start_capacity) * sizeof(int) +
                      (size_t)(d->grid.cell_capacity + 2 * d->grid.item_capacity) * sizeof(int) +
                      (size_t)d->pair_capacity * sizeof(fsdem__pair) + (size_t)d->wall_capacity * sizeof(fsdem__wall) +
-                     (size_t)d->material_capacity * sizeof(fsdem_material);
+                     (size_t)d->material_capacity * sizeof(fsdem_material) + d->arena.size +
+                     (size_t)d->found_capacity * sizeof(int) + (size_t)d->hit_capacity * sizeof(fsdem__wall_hit);
     return s;
 }
 
