@@ -2127,14 +2127,14 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             FSDEM__LOAD3(wj, b->wj, c);
             dist = fsdem__lane_sqrt(dxx * dxx + dxy * dxy + dxz * dxz);
             /* 1/dist and 1/q, q = (1/m_i + 1/m_j)(r_i + r_j) > 0, from one division; coincident
-               centres take the normal (1, 0, 0) */
+               centres (dx = 0) take the normal (1, 0, 0) */
             apart = dist > 0;
             safe = fsdem__lane_select(apart, dist, one);
             q = inv_m * (ri + rj);
             inv = 1 / (safe * q);
             nx = fsdem__lane_select(apart, dxx * (q * inv), one);
-            ny = fsdem__lane_select(apart, dxy * (q * inv), zero);
-            nz = fsdem__lane_select(apart, dxz * (q * inv), zero);
+            ny = dxy * (q * inv);
+            nz = dxz * (q * inv);
             delta = ri + rj + off - dist;
             arm_i = ri - delta * (fsdem_real)0.5;
             arm_j = rj - delta * (fsdem_real)0.5;
@@ -2205,7 +2205,6 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             const fsdem__lane s = fsdem__lane_sqrt(r_eff * delta);
             const fsdem__lane eta_n = fsdem__lane_sqrt(cn * m_eff * s), st = kt * s;
             fsdem__lane sn, len2, proj2, inv;
-            fsdem__mask turned;
             /* the held spring, turned into the current tangent plane with its length kept */
             FSDEM__LOAD3(s, b->spring, c);
             len2 = sx * sx + sy * sy + sz * sz;
@@ -2214,8 +2213,8 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             sy -= sn * ny;
             sz -= sn * nz;
             proj2 = sx * sx + sy * sy + sz * sz;
-            turned = proj2 > 0;
-            scale = fsdem__lane_sqrt(fsdem__lane_select(turned, len2, one) / fsdem__lane_select(turned, proj2, one));
+            /* proj2 = 0 leaves a zero spring, whatever finite scale multiplies it */
+            scale = fsdem__lane_sqrt(len2 / fsdem__lane_select(proj2 > 0, proj2, one));
             sx = sx * scale + vx * h;
             sy = sy * scale + vy * h;
             sz = sz * scale + vz * h;
@@ -2231,7 +2230,7 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
                slip at first touch, where eta_t ~ d^(1/4) outgrows mu F_n ~ d^(3/2). One division
                gives both 1/|F_t| and 1/S_t. */
             ft2 = fsdem__lane_sqrt(fsdem__lane_select(slide, ft2, one)); /* |F_t| where sliding */
-            inv = 1 / (ft2 * fsdem__lane_select(slide, st, one));
+            inv = 1 / (ft2 * st); /* S_t > 0: the overlap is */
             scale = fsdem__lane_select(slide, ft_max * st * inv, one);
             tx *= scale;
             ty *= scale;
@@ -3109,7 +3108,7 @@ static void fsdem__gather_pair_coefficients(const fsdem_dem *d, fsdem__batch *b,
 
 /* Contact `k` of the particle-pair list into lane c of a batch; the coefficients of its material
    pair unless the batch is `uniform`, the mean mass only for the law that uses it. */
-FSDEM__FORCE_INLINE void fsdem__gather_pair(const fsdem_dem *d, fsdem__batch *b, int c, int k, const fsdem_contact_law law,
+FSDEM__FORCE_INLINE void fsdem__gather_pair(const fsdem_dem *d, fsdem__batch *FSDEM__RESTRICT b, int c, int k, const fsdem_contact_law law,
                                             int uniform) {
     const int i = d->pp.first[k], key = d->pp.key[k], j = FSDEM__PARTNER(key);
     const fsdem_vec3 xi = d->x[i], xj = d->x[j], vi = d->v[i], vj = d->v[j], wi = d->w[i], wj = d->w[j];
@@ -3172,32 +3171,41 @@ static fsdem_vec3 fsdem__batch_vec(const fsdem_real (*a)[FSDEM__BATCH], int c) {
 
 /* Adds a batch's forces and torques to the particles (and its walls, `walls`), commits the springs
    when `commit` and the law has history, and applies rolling resistance. */
-static void fsdem__scatter(fsdem_dem *d, const fsdem__batch *b, int walls, int commit, fsdem_real h) {
+FSDEM__FORCE_INLINE void fsdem__scatter(fsdem_dem *d, const fsdem__batch *FSDEM__RESTRICT b, const int walls, int commit,
+                                        fsdem_real h) {
     fsdem__list *l = walls ? &d->pw : &d->pp;
+    fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t, *FSDEM__RESTRICT history = l->history;
+    int *FSDEM__RESTRICT keys = l->key;
+    fsdem_real max_overlap = d->max_overlap;
     int c;
     for (c = 0; c < b->count; ++c) {
         const int i = b->i[c], o = b->other[c];
         const fsdem_vec3 force = fsdem__batch_vec(b->force, c), torque = fsdem__batch_vec(b->torque_i, c);
-        d->f[i] = fsdem__add(d->f[i], force);
-        d->t[i] = fsdem__add(d->t[i], torque);
+        f[i] = fsdem__add(f[i], force);
+        t[i] = fsdem__add(t[i], torque);
         if (walls) d->walls[o].force = fsdem__sub(d->walls[o].force, force);
         else {
-            d->f[o] = fsdem__sub(d->f[o], force);
-            d->t[o] = fsdem__add(d->t[o], fsdem__batch_vec(b->torque_j, c));
+            f[o] = fsdem__sub(f[o], force);
+            t[o] = fsdem__add(t[o], fsdem__batch_vec(b->torque_j, c));
         }
         if (commit) {
-            l->history[b->entry[c]] = fsdem__batch_vec(b->spring, c);
-            l->key[b->entry[c]] |= FSDEM__HELD;
+            history[b->entry[c]] = fsdem__batch_vec(b->spring, c);
+            keys[b->entry[c]] |= FSDEM__HELD;
         }
-        if (d->rolling && d->pairs[b->pair[c]].rolling > 0) {
-            const fsdem_vec3 w_rel = walls ? d->w[i] : fsdem__sub(d->w[i], d->w[o]);
-            const fsdem_vec3 tr = fsdem__rolling_torque(w_rel, d->pairs[b->pair[c]].rolling, b->r_eff[c], b->fn[c],
-                                                        d->inv_i[i] + (walls ? 0 : d->inv_i[o]), h);
-            d->t[i] = fsdem__add(d->t[i], tr);
-            if (!walls) d->t[o] = fsdem__sub(d->t[o], tr);
-        }
-        if (b->delta[c] > d->max_overlap) d->max_overlap = b->delta[c];
+        if (b->delta[c] > max_overlap) max_overlap = b->delta[c];
     }
+    d->max_overlap = max_overlap;
+    if (d->rolling)
+        for (c = 0; c < b->count; ++c) {
+            const int i = b->i[c], o = b->other[c];
+            const fsdem_real mu_r = d->pairs[b->pair[c]].rolling;
+            fsdem_vec3 w_rel, tr;
+            if (!(mu_r > 0)) continue;
+            w_rel = walls ? d->w[i] : fsdem__sub(d->w[i], d->w[o]);
+            tr = fsdem__rolling_torque(w_rel, mu_r, b->r_eff[c], b->fn[c], d->inv_i[i] + (walls ? 0 : d->inv_i[o]), h);
+            t[i] = fsdem__add(t[i], tr);
+            if (!walls) t[o] = fsdem__sub(t[o], tr);
+        }
 }
 
 /* The entries of the particle-pair list whose pair touches, into `touching`; returns their number.
