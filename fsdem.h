@@ -3270,9 +3270,11 @@ FSDEM__FORCE_INLINE void fsdem__compute_forces_law(fsdem_dem *d, fsdem_real h, i
         fsdem__gather_pair(d, b, b->count++, touching[k], law, uniform);
         if (b->count == FSDEM__BATCH || k == nt - 1) fsdem__drain(d, b, 0, law, h, keep);
     }
-    for (i = 0; i < n; ++i) {
+    for (k = 0; k < d->pw.count; k = d->pw.start[i + 1]) {
+        /* row to row through the particles with wall entries */
         int nh;
-        if (d->pw.start[i + 1] == d->pw.start[i] || d->inv_m[i] == 0) continue; /* fixed: no wall force */
+        i = d->pw.first[k];
+        if (d->inv_m[i] == 0) continue; /* fixed: no wall force */
         nh = fsdem__wall_hits(d, i, commit);
         for (c = 0; c < nh; ++c) {
             fsdem__gather_wall(d, b, b->count++, i, &d->hits[c], uniform);
