@@ -32,6 +32,10 @@
      FSDEM_FREE(p)           object.
      FSDEM_ASSERT(c)         programmer-error checks (default: assert from <assert.h>).
      FSDEM_API               decoration of public functions (default: extern).
+     FSDEM_NO_SIMD           batched kernels (the DEM contact law) use one real per lane instead of
+                             the compiler's vectors. By default they use GNU vector extensions as wide
+                             as the target flags allow: 2 doubles with SSE2 (any x86-64), 4 with
+                             -mavx2, 8 with -mavx512f or -march=native on such a CPU.
 
    CONCEPTS
      Units are SI throughout: metres, seconds, kilograms, newtons, pascals, radians.
@@ -1527,10 +1531,10 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_select(fsdem__mask m, fsdem__lane a,
 
 /* libm's sqrt sets errno and is called lane by lane; the instructions are not */
 FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_sqrt(fsdem__lane a) {
-#if defined(FSDEM_USE_FLOAT) && FSDEM__LANE_BYTES == 64
-    return (fsdem__lane)_mm512_sqrt_ps((__m512)a);
+#if defined(FSDEM_USE_FLOAT) && FSDEM__LANE_BYTES == 64 /* (the zero-masked forms: g++ 12 warns inside the plain ones) */
+    return (fsdem__lane)_mm512_maskz_sqrt_ps((__mmask16)0xFFFF, (__m512)a);
 #elif FSDEM__LANE_BYTES == 64
-    return (fsdem__lane)_mm512_sqrt_pd((__m512d)a);
+    return (fsdem__lane)_mm512_maskz_sqrt_pd((__mmask8)0xFF, (__m512d)a);
 #elif defined(FSDEM_USE_FLOAT) && FSDEM__LANE_BYTES == 32
     return (fsdem__lane)_mm256_sqrt_ps((__m256)a);
 #elif FSDEM__LANE_BYTES == 32
@@ -1567,10 +1571,10 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_load(const fsdem_real *p) {
 FSDEM__FORCE_INLINE void fsdem__lane_store(fsdem_real *p, fsdem__lane a) { memcpy(p, &a, sizeof a); }
 FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_max(fsdem__lane a, fsdem__lane b) { return fsdem__lane_select(a > b, a, b); }
 FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_set(fsdem_real s) {
-    fsdem__lane a;
+    fsdem_real v[FSDEM__LANES];
     int l;
-    for (l = 0; l < FSDEM__LANES; ++l) memcpy((fsdem_real *)&a + l, &s, sizeof s);
-    return a;
+    for (l = 0; l < FSDEM__LANES; ++l) v[l] = s;
+    return fsdem__lane_load(v);
 }
 
 /* ===== >>impl_grid : cell grid ===================================================================== */
@@ -2943,7 +2947,7 @@ static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
         l->first[e] = i0;
         /* arithmetic, not branches: the spring is copied whether held or not (it means nothing
            without the flag) */
-        l->key[e] = j | ((from >= 0) & (d->pp_old.count > 0) ? d->pp_old.key[src] & FSDEM__HELD : 0);
+        l->key[e] = j | (((from >= 0) & (d->pp_old.count > 0)) ? d->pp_old.key[src] & FSDEM__HELD : 0);
         if (d->pp_old.count > 0) l->history[e] = d->pp_old.history[src];
     }
     l->count = count;
