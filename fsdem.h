@@ -1756,8 +1756,10 @@ typedef struct fsdem__list {
     int count, capacity;
 } fsdem__list;
 
-#define FSDEM__HELD (1 << 30) /* above every partner: particles and wall keys stay below 2^30 */
-#define FSDEM__PARTNER(key) ((key) & ~FSDEM__HELD)
+#define FSDEM__HELD (1 << 30)  /* the entry's spring is live */
+#define FSDEM__INERT (1 << 29) /* two fixed particles: listed (fsdem_dem_contacts), never a force */
+#define FSDEM__PARTNER(key) ((key) & ~(FSDEM__HELD | FSDEM__INERT))
+#define FSDEM__MAX_PARTICLES (FSDEM__INERT - 1) /* partners and wall keys stay below the flags */
 
 /* One particle-wall contact of the current positions. */
 typedef struct fsdem__wall_hit {
@@ -2139,7 +2141,8 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             nx = fsdem__lane_select(apart, dxx * (q * inv), one);
             ny = dxy * (q * inv);
             nz = dxz * (q * inv);
-            delta = ri + rj + off - dist;
+            /* >= 0: the pair touched (d^2 < reach^2), but sqrt may round dist up to the reach */
+            delta = fsdem__lane_max(ri + rj + off - dist, zero);
             arm_i = ri - delta * (fsdem_real)0.5;
             arm_j = rj - delta * (fsdem_real)0.5;
             /* m* = 1/(1/m_i + 1/m_j) = (r_i + r_j)/q, R* = r_i r_j/(r_i + r_j) = r_i r_j (1/m_i + 1/m_j)/q */
@@ -2234,7 +2237,7 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
                slip at first touch, where eta_t ~ d^(1/4) outgrows mu F_n ~ d^(3/2). One division
                gives both 1/|F_t| and 1/S_t. */
             ft2 = fsdem__lane_sqrt(fsdem__lane_select(slide, ft2, one)); /* |F_t| where sliding */
-            inv = 1 / (ft2 * st); /* S_t > 0: the overlap is */
+            inv = 1 / (ft2 * fsdem__lane_select(slide, st, one)); /* a sliding contact has S_t > 0 */
             scale = fsdem__lane_select(slide, ft_max * st * inv, one);
             tx *= scale;
             ty *= scale;
@@ -2305,10 +2308,8 @@ static fsdem_result fsdem__reserve_particles(fsdem_dem *d, int need) {
     size_t size[FSDEM__PARTICLE_ARRAYS];
     int k, cap = d->capacity > 0 ? d->capacity : 64;
     if (need <= d->capacity) return FSDEM_OK;
-    while (cap < need) {
-        if (cap > (1 << 29)) return FSDEM_ERR_OUT_OF_MEMORY;
-        cap *= 2;
-    }
+    if (need > FSDEM__MAX_PARTICLES) return FSDEM_ERR_OUT_OF_MEMORY;
+    while (cap < need) cap = cap > FSDEM__MAX_PARTICLES / 2 ? FSDEM__MAX_PARTICLES : 2 * cap;
     fsdem__particle_arrays(d, ptr, size);
     for (k = 0; k < FSDEM__PARTICLE_ARRAYS; ++k) {
         fresh[k] = fsdem__alloc(&d->allocator, size[k] * (size_t)cap);
@@ -2758,9 +2759,10 @@ fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_wall_desc *desc, int *
     default:
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_desc.type %d is not a fsdem_wall_type", (int)g.type);
     }
-    /* wall keys (wall * 8 + face) stay below FSDEM__HELD */
-    if (d->wall_count >= FSDEM__HELD / 8 ||
-        fsdem__grow(&d->allocator, (void **)&d->walls, &d->wall_capacity, d->wall_count, d->wall_count + 1,
+    /* wall keys (wall * 8 + face) stay below the entry flags */
+    if (d->wall_count >= FSDEM__INERT / 8)
+        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_wall: at most %d walls", FSDEM__INERT / 8);
+    if (fsdem__grow(&d->allocator, (void **)&d->walls, &d->wall_capacity, d->wall_count, d->wall_count + 1,
                     sizeof(fsdem__wall)) != FSDEM_OK)
         return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "out of memory adding a wall");
     w = &d->walls[d->wall_count];
@@ -2888,10 +2890,9 @@ static void fsdem__swap_lists(fsdem__list *a, fsdem__list *b) {
 
 /* Pairs within reach (r_i + r_j + offset + skin), each found once by scanning every cell against
    itself and its forward neighbours (fsdem_cellgrid_forward), into d->found as pairs of cell-order
-   indices; xs, reach_s and fixed_s are the positions, radii plus offset and skin, and fixed flags in
-   cell order, so the scan reads them in sequence. Two fixed particles exert nothing on each other
-   and are left out. Returns the number of pairs, or -1 when d->found cannot grow. */
-static int fsdem__find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_real *reach_s, const int *fixed_s) {
+   indices; xs and reach_s are the positions and radii plus half the offset and skin in cell order, so
+   the scan reads them in sequence. Returns the number of pairs, or -1 when d->found cannot grow. */
+static int fsdem__find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_real *reach_s) {
     const fsdem_cellgrid *g = &d->grid;
     int c, f, a, b, count = 0;
     for (c = 0; c < g->cell_count; ++c) {
@@ -2914,7 +2915,7 @@ static int fsdem__find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_rea
                     const fsdem_real reach = reach_s[a] + reach_s[b];
                     d->found[2 * count] = a;
                     d->found[2 * count + 1] = b;
-                    count += (ex * ex + ey * ey + ez * ez < reach * reach) & !(fixed_s[a] & fixed_s[b]);
+                    count += ex * ex + ey * ey + ez * ez < reach * reach;
                 }
             }
         }
@@ -2923,7 +2924,8 @@ static int fsdem__find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_rea
 }
 
 /* The particle-pair list from the `count` pairs in d->found: row min(i, j), partner max(i, j), each
-   carrying its history from the previous list; `cursor` is scratch for n rows. */
+   carrying its history from the previous list, and a pair of fixed particles marked FSDEM__INERT;
+   `cursor` is scratch for n rows. */
 static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
     fsdem__list *l = &d->pp;
     const int *items = d->grid.items;
@@ -2945,9 +2947,9 @@ static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
         const int oi = d->old_of[i0], oj = d->old_of[j], lo = oi < oj ? oi : oj, hi = oi < oj ? oj : oi;
         const int from = lo >= 0 ? fsdem__old_entry(&d->pp_old, lo, hi) : -1, src = from >= 0 ? from : 0;
         l->first[e] = i0;
-        /* arithmetic, not branches: the spring is copied whether held or not (it means nothing
-           without the flag) */
-        l->key[e] = j | (((from >= 0) & (d->pp_old.count > 0)) ? d->pp_old.key[src] & FSDEM__HELD : 0);
+        /* the spring is copied whether held or not (it means nothing without the flag) */
+        l->key[e] = j | (((from >= 0) & (d->pp_old.count > 0)) ? d->pp_old.key[src] & FSDEM__HELD : 0) |
+                    (d->inv_m[i0] == 0 && d->inv_m[j] == 0 ? FSDEM__INERT : 0);
         if (d->pp_old.count > 0) l->history[e] = d->pp_old.history[src];
     }
     l->count = count;
@@ -2960,7 +2962,7 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
     const fsdem_real off = d->desc.contact_offset;
     fsdem_real r_max = 0, skin, *reach_s;
     fsdem_vec3 *xs;
-    int i, k, dim = d->desc.dim, max_cells, *fixed_s, *cursor, pairs;
+    int i, k, dim = d->desc.dim, max_cells, *cursor, pairs;
     fsdem_result res = FSDEM_OK;
     for (i = 0; i < d->n; ++i)
         if (d->r[i] > r_max) r_max = d->r[i];
@@ -2972,24 +2974,21 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
                              r_max > 0 ? 2 * r_max + off + skin : 1, max_cells) != FSDEM_OK ||
         fsdem_cellgrid_build(&d->grid, d->x, d->n) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
-    /* scratch: positions, reaches (half each: r + (offset + skin)/2) and fixed flags in cell order,
-       and row cursors */
+    /* scratch: positions and reaches (half each: r + (offset + skin)/2) in cell order, row cursors */
     if (fsdem__arena_reserve(&d->allocator, &d->arena,
                              fsdem__arena_bytes(sizeof(fsdem_vec3) * (size_t)d->n) +
                                  fsdem__arena_bytes(sizeof(fsdem_real) * (size_t)d->n) +
-                                 2 * fsdem__arena_bytes(sizeof(int) * (size_t)d->n)) != FSDEM_OK)
+                                 fsdem__arena_bytes(sizeof(int) * (size_t)d->n)) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
     xs = (fsdem_vec3 *)fsdem__arena_push(&d->arena, sizeof(fsdem_vec3) * (size_t)d->n);
     reach_s = (fsdem_real *)fsdem__arena_push(&d->arena, sizeof(fsdem_real) * (size_t)d->n);
-    fixed_s = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->n);
     cursor = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->n);
     for (k = 0; k < d->n; ++k) {
         const int j = d->grid.items[k];
         xs[k] = d->x[j];
         reach_s[k] = d->r[j] + (off + skin) / 2;
-        fixed_s[k] = d->inv_m[j] == 0;
     }
-    pairs = fsdem__find_pairs(d, xs, reach_s, fixed_s);
+    pairs = fsdem__find_pairs(d, xs, reach_s);
     if (pairs < 0) return FSDEM_ERR_OUT_OF_MEMORY;
     fsdem__swap_lists(&d->pp, &d->pp_old);
     fsdem__swap_lists(&d->pw, &d->pw_old);
@@ -3226,7 +3225,7 @@ FSDEM__FORCE_INLINE int fsdem__touching(fsdem_dem *d, int *FSDEM__RESTRICT touch
     for (k = 0; k < pairs; ++k) {
         const int key = keys[k], i = first[k], j = FSDEM__PARTNER(key);
         const fsdem_real ex = x[i].x - x[j].x, ey = x[i].y - x[j].y, ez = x[i].z - x[j].z, reach = r[i] + r[j] + off;
-        const int touch = ex * ex + ey * ey + ez * ez < reach * reach;
+        const int touch = (ex * ex + ey * ey + ez * ez < reach * reach) & !(key & FSDEM__INERT);
         touching[count] = k;
         count += touch;
         if (commit) keys[k] = key & ~((touch - 1) & FSDEM__HELD); /* arithmetic: a branch here would mispredict */
@@ -3636,7 +3635,7 @@ fsdem_energy fsdem_dem_energy(const fsdem_dem *d) {
         for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
             int j = FSDEM__PARTNER(d->pp.key[k]);
             fsdem_real delta = d->r[i] + d->r[j] + d->desc.contact_offset - fsdem__norm(fsdem__sub(d->x[i], d->x[j]));
-            if (delta <= 0) continue;
+            if (delta <= 0 || (d->pp.key[k] & FSDEM__INERT)) continue;
             e.elastic += fsdem__contact_energy(d, row + d->material[j], delta, (d->m[i] + d->m[j]) / 2,
                                                d->r[i] * d->r[j] / (d->r[i] + d->r[j]), fsdem__spring(&d->pp, k));
         }

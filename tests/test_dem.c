@@ -4,6 +4,7 @@
    Every test asserts physics that would be false if the code were wrong, against an independent
    computation (brute force, an analytical solution, a conservation law). Each tolerance is justified
    next to its check. Set FSDEM_TEST_VERBOSE=1 to print the measured values. */
+#include <fenv.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -248,7 +249,7 @@ static void neighbour_case(int dim, double offset_factor, unsigned long long see
     fsdem_dem_desc d = fsdem_dem_desc_default(dim);
     fsdem_dem *dem;
     nb_geometry g;
-    int mat, i, s, contacts0, reused = 0, min_contacts = 1 << 30, wall_seen = 0;
+    int mat, i, s, contacts0, reused = 0, min_contacts = 1 << 30, wall_seen = 0, inert_seen = 0;
     long long rebuilds0;
     fsdem_dem_stats st;
     rng_seed(seed);
@@ -277,7 +278,8 @@ static void neighbour_case(int dim, double offset_factor, unsigned long long see
         fsdem_vec3 v = fsdem_v3(urange(-vmax, vmax), urange(-vmax, vmax), dim == 3 ? urange(-vmax, vmax) : 0);
         double r = r0 * urange(0.5, 1.5); /* polydisperse: radii differ by up to a factor 3 */
         if (vdot(vsub(x, g.plane_point), g.plane_normal) < 0) continue; /* keep centres on the open side */
-        add_particle(dem, x, v, fsdem_v3(0, 0, 0), r, mat, 0);
+        /* one in eight is fixed (kinematic): pairs of them are geometric contacts that exert nothing */
+        add_particle(dem, x, v, fsdem_v3(0, 0, 0), r, mat, i % 8 == 0);
         ++i;
     }
     /* fresh set: the lists are built by this call */
@@ -292,12 +294,20 @@ static void neighbour_case(int dim, double offset_factor, unsigned long long see
         st = fsdem_dem_get_stats(dem);
         if (st.rebuilds == before) reused++;
         if (c < min_contacts) min_contacts = c;
-        /* The forces of the step were evaluated at these same positions, so they saw the same
-           contacts (no particle is fixed, so none is skipped). */
-        ck_assert_int_eq(st.contacts + st.wall_contacts, c);
         info = (fsdem_contact_info *)malloc(sizeof *info * (size_t)(c + 1));
         ck_assert_int_eq(fsdem_dem_contacts(dem, info, c), c);
-        for (k = 0; k < c; ++k) wall_seen |= info[k].j < 0 ? (info[k].j == -1 - g.plane_id ? 2 : 1) : 0;
+        {
+            /* The forces of the step were evaluated at these same positions, so they saw the same
+               contacts but those that exert nothing: two fixed particles, a fixed one and a wall. */
+            const unsigned char *fixed = fsdem_dem_particles(dem).fixed;
+            int inert = 0;
+            for (k = 0; k < c; ++k) {
+                wall_seen |= info[k].j < 0 ? (info[k].j == -1 - g.plane_id ? 2 : 1) : 0;
+                inert += fixed[info[k].i] && (info[k].j < 0 || fixed[info[k].j]);
+                inert_seen |= info[k].j >= 0 && fixed[info[k].i] && fixed[info[k].j];
+            }
+            ck_assert_int_eq(st.contacts + st.wall_contacts, c - inert);
+        }
         free(info);
     }
     st = fsdem_dem_get_stats(dem);
@@ -308,6 +318,7 @@ static void neighbour_case(int dim, double offset_factor, unsigned long long see
        moved far enough to need rebuilds, and most comparisons used lists that were not fresh. */
     ck_assert_int_gt(contacts0, n / 2);
     ck_assert_int_eq(wall_seen, 3);
+    ck_assert_msg(inert_seen, "no pair of fixed particles touched: the case does not test them");
     ck_assert_int_ge(st.rebuilds - rebuilds0, 2);
     ck_assert_int_ge(reused, steps / 2);
     fsdem_dem_destroy(dem);
@@ -318,6 +329,58 @@ START_TEST(neighbour_lists_match_brute_force) {
     neighbour_case(3, 0.0, 12);
     neighbour_case(2, 0.3, 13);
     neighbour_case(3, 0.3, 14);
+}
+END_TEST
+
+/* Pairs that touch (d^2 < (r_i + r_j)^2) with an overlap that rounds to zero, sliding past each
+   other, under each law: the contact kernel (vector lanes, padding, guarded divisors) must raise
+   neither a division by zero nor an invalid operation, which would trap a user running with
+   floating-point exceptions enabled. The pairs are searched for with the library's own arithmetic
+   (the difference of the stored centres, squared and summed; the root subtracted from the reach). */
+START_TEST(touching_pairs_raise_no_fp_exceptions) {
+    const fsdem_contact_law laws[3] = {FSDEM_CONTACT_HERTZ_MINDLIN, FSDEM_CONTACT_LINEAR, FSDEM_CONTACT_GIC};
+    const double r = 0.01, reach = r + r;
+    fsdem_vec3 xa[8], xb[8];
+    int law, k, m, pairs = 0, flags = 0, contacts = 0;
+    for (m = 0; m < 200 && pairs < 8; ++m) {
+        const double angle = 0.1 + 0.0137 * m;
+        const fsdem_vec3 base = fsdem_v3(-0.8 + 0.2 * pairs, 0.2, 0);
+        for (k = -6; k <= 6; ++k) {
+            const fsdem_vec3 other = fsdem_v3(base.x + reach * cos(angle) * (1 + k * 1.1e-16), base.y + reach * sin(angle), 0);
+            const double ex = base.x - other.x, ey = base.y - other.y, d2 = ex * ex + ey * ey;
+            if (d2 < reach * reach && reach - sqrt(d2) <= 0) {
+                xa[pairs] = base; /* one pair at each base point, 0.2 m from the next */
+                xb[pairs++] = other;
+                break;
+            }
+        }
+    }
+    ck_assert_msg(pairs >= 2, "found %d pairs with a zero overlap", pairs);
+    for (law = 0; law < 3; ++law) {
+        fsdem_dem_desc d = fsdem_dem_desc_default(3);
+        fsdem_dem *dem;
+        int mat;
+        d.gravity = fsdem_v3(0, 0, 0);
+        d.law = laws[law];
+        d.linear_dx = 0.001;
+        d.linear_accel = 9.81;
+        d.dt = 1e-6;
+        dem = dem_new(&d);
+        mat = add_material(dem, 2500, 1e7, 0.3, 0.5, 0.3, 0.4);
+        for (k = 0; k < pairs; ++k) {
+            add_particle(dem, xa[k], fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), r, mat, 0);
+            add_particle(dem, xb[k], fsdem_v3(0, 0, 0.1), fsdem_v3(0, 0, 3), r, mat, 0);
+        }
+        feclearexcept(FE_ALL_EXCEPT);
+        ck_assert_int_eq(fsdem_dem_step(dem), FSDEM_OK); /* its first force evaluation is at these positions */
+        flags |= fetestexcept(FE_DIVBYZERO | FE_INVALID);
+        contacts += fsdem_dem_get_stats(dem).contacts;
+        fsdem_dem_destroy(dem);
+    }
+    REPORT("%d pairs touching with a zero overlap, %d contacts after the step (3 laws); FP flags %s%s", pairs, contacts,
+           flags & FE_DIVBYZERO ? "divide-by-zero " : "", flags & FE_INVALID ? "invalid" : "");
+    ck_assert_msg(flags == 0, "floating-point exceptions raised: %s%s", flags & FE_DIVBYZERO ? "divide-by-zero " : "",
+                  flags & FE_INVALID ? "invalid" : "");
 }
 END_TEST
 
@@ -1412,6 +1475,7 @@ Suite *dem_suite(void) {
     TCase *tc_laws = tcase_create("contact_laws");
     TCase *tc_api = tcase_create("api");
     tcase_add_test(tc_geom, neighbour_lists_match_brute_force);
+    tcase_add_test(tc_geom, touching_pairs_raise_no_fp_exceptions);
     tcase_add_test(tc_geom, contact_history_survives_rebuilds_and_removal);
     tcase_set_timeout(tc_geom, 300);
     tcase_add_test(tc_cons, elastic_box_conserves_momentum_and_energy);
