@@ -292,12 +292,9 @@ FSDEM_API fsdem_result fsdem_dem_set_particle_state(fsdem_dem *dem, int index, f
                                                     fsdem_vec3 velocity,
                                                     fsdem_vec3 angular_velocity);
 
-/* Views of the particle arrays (structure of arrays), valid until particles are added or removed.
-   `force` and `torque` are the contact forces of the last step (N, N m), without gravity and
-   without the external ones. `external_force`/`external_torque` are written by the caller or a
-   coupler and are held fixed over steps (a fluid force during DEM substeps). They start at zero
-   and steps read them only once this function has handed them out (or a coupler wrote them), so
-   a run without external loads does not pay for them. */
+/* Read-only views of the particle arrays (structure of arrays), valid until particles are added or
+   removed. `force` and `torque` are the contact forces of the last step (N, N m), without gravity
+   and without the external loads (fsdem_dem_external_loads), which are shown too. */
 typedef struct fsdem_particles {
     int count;
     int dim;
@@ -307,15 +304,28 @@ typedef struct fsdem_particles {
     const fsdem_vec3 *angular_velocity;
     const fsdem_vec3 *force;
     const fsdem_vec3 *torque;
-    fsdem_vec3 *external_force;
-    fsdem_vec3 *external_torque;
+    const fsdem_vec3 *external_force;
+    const fsdem_vec3 *external_torque;
     const fsdem_real *radius;
     const fsdem_real *mass;
     const int *material;
     const unsigned char *fixed;
 } fsdem_particles;
 
-FSDEM_API fsdem_particles fsdem_dem_particles(fsdem_dem *dem);
+FSDEM_API fsdem_particles fsdem_dem_particles(const fsdem_dem *dem);
+
+/* External loads of every particle, written by the caller: a force (N) and a torque (N m) at the
+   centre, besides contacts and gravity, held fixed over steps (a fluid force during DEM substeps).
+   They start at zero; steps read them only once this function has handed them out (or a coupler
+   wrote them), so a run without them does not pay for them. Valid until particles are added or
+   removed. */
+typedef struct fsdem_external_loads {
+    int count;
+    fsdem_vec3 *force;
+    fsdem_vec3 *torque;
+} fsdem_external_loads;
+
+FSDEM_API fsdem_external_loads fsdem_dem_external_loads(fsdem_dem *dem);
 
 /* ---- walls ---- */
 
@@ -1288,6 +1298,7 @@ FSDEM_API fsdem_result fsdem_dem_write_vtk(const fsdem_dem *dem, const char *pat
 #ifndef FSDEM_IMPLEMENTATION_DONE
 #define FSDEM_IMPLEMENTATION_DONE
 
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -1325,8 +1336,9 @@ FSDEM_API fsdem_result fsdem_dem_write_vtk(const fsdem_dem *dem, const char *pat
 #endif
 
 /* Promise that pointers do not alias, so loops over several particle arrays keep them in registers
-   (C99 restrict; the compilers' spelling in C++). */
-#if defined(__cplusplus) && (defined(__GNUC__) || defined(__clang__) || defined(_MSC_VER))
+   (C99 restrict; the compilers' own spelling in C++ and in MSVC, whose C mode lacks the keyword
+   before C11). */
+#if defined(_MSC_VER) || (defined(__cplusplus) && (defined(__GNUC__) || defined(__clang__)))
 #define FSDEM__RESTRICT __restrict
 #elif defined(__cplusplus)
 #define FSDEM__RESTRICT
@@ -1477,6 +1489,17 @@ static void *fsdem__object_new(fsdem_result checked, const char *why, fsdem_log_
 }
 
 static int fsdem__finite(fsdem_real x) { return x == x && x - x == 0; }
+
+/* A relative tolerance of at least `floor` and of 100 roundings of fsdem_real, so a test written for
+   double still holds in float. */
+static double fsdem__tolerance(double floor) {
+#ifdef FSDEM_USE_FLOAT
+    const double eps = FLT_EPSILON;
+#else
+    const double eps = DBL_EPSILON;
+#endif
+    return floor > 100 * eps ? floor : 100 * eps;
+}
 static int fsdem__finite3(fsdem_vec3 v) {
     return fsdem__finite(v.x) && fsdem__finite(v.y) && fsdem__finite(v.z);
 }
@@ -1805,7 +1828,7 @@ struct fsdem_dem {
     fsdem_real skin, r_max, max_disp2, k0_linear;
     int need_rebuild, forces_valid;
     int rolling;  /* some material pair has rolling resistance */
-    int external; /* fext/text may be nonzero (handed out, or written by a coupler) */
+    int external; /* fext/text may be nonzero (fsdem_dem_external_loads handed them out, or a coupler wrote them) */
     int forces_cleared; /* f and t were zeroed by the last Verlet pass, for the force evaluation */
     int contacts, wall_contacts;
     fsdem_real max_overlap;
@@ -2539,7 +2562,7 @@ fsdem_result fsdem_dem_set_particle_state(fsdem_dem *d, int index, fsdem_vec3 x,
     return fsdem__ok(&d->status);
 }
 
-fsdem_particles fsdem_dem_particles(fsdem_dem *d) {
+fsdem_particles fsdem_dem_particles(const fsdem_dem *d) {
     fsdem_particles p;
     p.count = d->n;
     p.dim = d->desc.dim;
@@ -2551,12 +2574,20 @@ fsdem_particles fsdem_dem_particles(fsdem_dem *d) {
     p.torque = d->t;
     p.external_force = d->fext;
     p.external_torque = d->text;
-    d->external = 1; /* the caller may write them from now on */
     p.radius = d->r;
     p.mass = d->m;
     p.material = d->material;
     p.fixed = d->fixed;
     return p;
+}
+
+fsdem_external_loads fsdem_dem_external_loads(fsdem_dem *d) {
+    fsdem_external_loads e;
+    e.count = d->n;
+    e.force = d->fext;
+    e.torque = d->text;
+    d->external = 1; /* the caller may write them from now on */
+    return e;
 }
 
 /* ---- >>dem_wall : wall geometry ---- */
@@ -3054,7 +3085,7 @@ static int fsdem__lists_stale(const fsdem_dem *d) {
    face), or when an edge/vertex contact kept before has the same normal (one edge seen from two
    elements). With `reset`, entries without a kept contact lose their tangential history. */
 static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
-    const fsdem_real off = d->desc.contact_offset, tol = (fsdem_real)1e-9 * d->r[i];
+    const fsdem_real off = d->desc.contact_offset, tol = (fsdem_real)fsdem__tolerance(1e-9) * d->r[i];
     const fsdem_vec3 xi = d->x[i];
     int k, a, b, count = 0, kept = 0;
     for (k = d->pw.start[i]; k < d->pw.start[i + 1]; ++k) {
@@ -3084,7 +3115,7 @@ static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
                     duplicate = fsdem__dot(q_rel, o->n) + (d->r[i] + off - o->delta) <= tol &&
                                 fsdem__dot(q_rel, o->n) + (d->r[i] + off - o->delta) >= -tol;
                 else if (b < a)
-                    duplicate = fsdem__dot(h.n, o->n) >= 1 - (fsdem_real)1e-12;
+                    duplicate = fsdem__dot(h.n, o->n) >= 1 - (fsdem_real)fsdem__tolerance(1e-12);
             }
         }
         if (duplicate) {
@@ -3494,10 +3525,10 @@ fsdem_result fsdem_dem_step(fsdem_dem *d) {
 }
 
 /* Substeps of an outer step (seed 000): K = INT(dt/dt_DEM), dt_DEM = dt/K, and Eq. 25: one substep of
-   dt when dt_DEM > dt. The relative 1e-9 keeps an exact multiple (3e-4/1e-4 = 2.9999999999999996)
-   from losing a step. */
+   dt when dt_DEM > dt. The relative tolerance (1e-9, more in float) keeps an exact multiple
+   (3e-4/1e-4 = 2.9999999999999996, or 1000 dt rounded to float) from losing a step. */
 static fsdem_result fsdem__substep_count(fsdem_dem *d, fsdem_real dt_outer, int *count) {
-    double ratio = (double)dt_outer / d->dt * (1 + 1e-9);
+    double ratio = (double)dt_outer / d->dt * (1 + fsdem__tolerance(1e-9));
     if (!(dt_outer > 0) || !fsdem__finite(dt_outer))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_advance: dt_outer must be > 0 (got %g s)",
                            (double)dt_outer);

@@ -1093,9 +1093,8 @@ START_TEST(invalid_walls_and_calls_are_rejected) {
     expect_usable(dem, mat);
 
     /* a NaN external force is a result, naming the particle; removing it lets the run go on */
-    p = fsdem_dem_particles(dem);
-    ck_assert_int_eq(p.count, 2);
-    p.external_force[1].x = NAN;
+    ck_assert_int_eq(fsdem_dem_external_loads(dem).count, 2);
+    fsdem_dem_external_loads(dem).force[1].x = NAN;
     expect_error(dem, fsdem_dem_step(dem), FSDEM_ERR_NAN, "particle 1");
     ck_assert_int_eq(fsdem_dem_remove_particle(dem, 1), FSDEM_OK);
     step_n(dem, 3);
@@ -1244,7 +1243,7 @@ static void advance_case(double dt, double dt_outer, int expected_k) {
     step_n(dem, 3); /* start from a non-zero time */
     p = fsdem_dem_particles(dem);
     m = p.mass[0];
-    p.external_force[0] = fsdem_v3(force, 0, 0);
+    fsdem_dem_external_loads(dem).force[0] = fsdem_v3(force, 0, 0);
     t0 = fsdem_dem_time(dem);
     steps = fsdem_dem_get_stats(dem).steps;
     res = fsdem_dem_advance(dem, dt_outer, &k);
