@@ -1779,10 +1779,9 @@ typedef struct fsdem__list {
     int count, capacity;
 } fsdem__list;
 
-#define FSDEM__HELD (1 << 30)  /* the entry's spring is live */
-#define FSDEM__INERT (1 << 29) /* two fixed particles: listed (fsdem_dem_contacts), never a force */
-#define FSDEM__PARTNER(key) ((key) & ~(FSDEM__HELD | FSDEM__INERT))
-#define FSDEM__MAX_PARTICLES (FSDEM__INERT - 1) /* partners and wall keys stay below the flags */
+#define FSDEM__HELD (1 << 30) /* the entry's spring is live */
+#define FSDEM__PARTNER(key) ((key) & ~FSDEM__HELD)
+#define FSDEM__MAX_PARTICLES (FSDEM__HELD - 1) /* partners and wall keys stay below the flag */
 
 /* One particle-wall contact of the current positions. */
 typedef struct fsdem__wall_hit {
@@ -1823,6 +1822,7 @@ struct fsdem_dem {
     struct fsdem__wall_hit *hits; /* scratch: one particle's wall contacts (fsdem__wall_hits) */
     fsdem__arena arena;           /* per-step scratch of the force evaluation, reserved by rebuilds */
     int *found, found_capacity;   /* scratch of the rebuild: pairs within reach (fsdem__find_pairs) */
+    int *inert, inert_count, inert_capacity; /* pairs of fixed particles within reach (i, j), listed aside */
     int hit_capacity;
     fsdem_cellgrid grid;
     fsdem_real skin, r_max, max_disp2, k0_linear;
@@ -2411,6 +2411,7 @@ void fsdem_dem_destroy(fsdem_dem *d) {
     fsdem__free(&al, d->hits, sizeof(fsdem__wall_hit) * (size_t)d->hit_capacity);
     fsdem__arena_free(&al, &d->arena);
     fsdem__free(&al, d->found, sizeof(int) * (size_t)d->found_capacity);
+    fsdem__free(&al, d->inert, sizeof(int) * (size_t)d->inert_capacity);
     fsdem_cellgrid_free(&d->grid);
     fsdem__free(&al, d, sizeof *d);
 }
@@ -2791,8 +2792,8 @@ fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_wall_desc *desc, int *
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_desc.type %d is not a fsdem_wall_type", (int)g.type);
     }
     /* wall keys (wall * 8 + face) stay below the entry flags */
-    if (d->wall_count >= FSDEM__INERT / 8)
-        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_wall: at most %d walls", FSDEM__INERT / 8);
+    if (d->wall_count >= FSDEM__HELD / 8)
+        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_wall: at most %d walls", FSDEM__HELD / 8);
     if (fsdem__grow(&d->allocator, (void **)&d->walls, &d->wall_capacity, d->wall_count, d->wall_count + 1,
                     sizeof(fsdem__wall)) != FSDEM_OK)
         return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "out of memory adding a wall");
@@ -2955,12 +2956,29 @@ static int fsdem__find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_rea
 }
 
 /* The particle-pair list from the `count` pairs in d->found: row min(i, j), partner max(i, j), each
-   carrying its history from the previous list, and a pair of fixed particles marked FSDEM__INERT;
-   `cursor` is scratch for n rows. */
+   carrying its history from the previous list. Pairs of fixed particles exert nothing, so they go
+   to d->inert instead, where fsdem_dem_contacts still finds them. `cursor` is scratch for n rows. */
 static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
     fsdem__list *l = &d->pp;
     const int *items = d->grid.items;
-    int k, i;
+    int k, i, inert = 0;
+    for (k = 0; k < count; ++k) {
+        /* partition: the pairs of fixed particles to the end of d->found, as particle indices */
+        const int a = items[d->found[2 * k]], b = items[d->found[2 * k + 1]];
+        if (d->inv_m[a] == 0 && d->inv_m[b] == 0) {
+            const int last = --count;
+            d->found[2 * k] = d->found[2 * last];
+            d->found[2 * k + 1] = d->found[2 * last + 1];
+            d->found[2 * last] = a;
+            d->found[2 * last + 1] = b;
+            ++inert;
+            --k;
+        }
+    }
+    if (fsdem__grow(&d->allocator, (void **)&d->inert, &d->inert_capacity, 0, 2 * inert, sizeof(int)) != FSDEM_OK)
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    memcpy(d->inert, d->found + 2 * count, sizeof(int) * 2 * (size_t)inert);
+    d->inert_count = inert;
     while (l->capacity < count)
         if (fsdem__list_grow(d, l) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     memset(l->start, 0, sizeof(int) * (size_t)(d->n + 1));
@@ -2979,8 +2997,7 @@ static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
         const int from = lo >= 0 ? fsdem__old_entry(&d->pp_old, lo, hi) : -1, src = from >= 0 ? from : 0;
         l->first[e] = i0;
         /* the spring is copied whether held or not (it means nothing without the flag) */
-        l->key[e] = j | (((from >= 0) & (d->pp_old.count > 0)) ? d->pp_old.key[src] & FSDEM__HELD : 0) |
-                    (d->inv_m[i0] == 0 && d->inv_m[j] == 0 ? FSDEM__INERT : 0);
+        l->key[e] = j | (((from >= 0) & (d->pp_old.count > 0)) ? d->pp_old.key[src] & FSDEM__HELD : 0);
         if (d->pp_old.count > 0) l->history[e] = d->pp_old.history[src];
     }
     l->count = count;
@@ -3256,7 +3273,7 @@ FSDEM__FORCE_INLINE int fsdem__touching(fsdem_dem *d, int *FSDEM__RESTRICT touch
     for (k = 0; k < pairs; ++k) {
         const int key = keys[k], i = first[k], j = FSDEM__PARTNER(key);
         const fsdem_real ex = x[i].x - x[j].x, ey = x[i].y - x[j].y, ez = x[i].z - x[j].z, reach = r[i] + r[j] + off;
-        const int touch = (ex * ex + ey * ey + ez * ez < reach * reach) & !(key & FSDEM__INERT);
+        const int touch = ex * ex + ey * ey + ez * ez < reach * reach;
         touching[count] = k;
         count += touch;
         if (commit) keys[k] = key & ~((touch - 1) & FSDEM__HELD); /* arithmetic: a branch here would mispredict */
@@ -3666,7 +3683,7 @@ fsdem_energy fsdem_dem_energy(const fsdem_dem *d) {
         for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
             int j = FSDEM__PARTNER(d->pp.key[k]);
             fsdem_real delta = d->r[i] + d->r[j] + d->desc.contact_offset - fsdem__norm(fsdem__sub(d->x[i], d->x[j]));
-            if (delta <= 0 || (d->pp.key[k] & FSDEM__INERT)) continue;
+            if (delta <= 0) continue;
             e.elastic += fsdem__contact_energy(d, row + d->material[j], delta, (d->m[i] + d->m[j]) / 2,
                                                d->r[i] * d->r[j] / (d->r[i] + d->r[j]), fsdem__spring(&d->pp, k));
         }
@@ -3696,7 +3713,7 @@ fsdem_dem_stats fsdem_dem_get_stats(const fsdem_dem *d) {
     s.rebuilds = d->rebuilds;
     s.contacts = d->contacts;
     s.wall_contacts = d->wall_contacts;
-    s.neighbour_pairs = d->pp.count;
+    s.neighbour_pairs = d->pp.count + d->inert_count;
     s.max_overlap = d->max_overlap;
     s.memory_bytes = sizeof *d + fsdem__particle_bytes((fsdem_dem *)d) +
                      (size_t)(d->pp.capacity + d->pp_old.capacity + d->pw.capacity + d->pw_old.capacity) *
@@ -3706,7 +3723,8 @@ fsdem_dem_stats fsdem_dem_get_stats(const fsdem_dem *d) {
                      (size_t)(d->grid.cell_capacity + 2 * d->grid.item_capacity) * sizeof(int) +
                      (size_t)d->pair_capacity * sizeof(fsdem__pair) + (size_t)d->wall_capacity * sizeof(fsdem__wall) +
                      (size_t)d->material_capacity * sizeof(fsdem_material) + d->arena.size +
-                     (size_t)d->found_capacity * sizeof(int) + (size_t)d->hit_capacity * sizeof(fsdem__wall_hit);
+                     (size_t)(d->found_capacity + d->inert_capacity) * sizeof(int) +
+                     (size_t)d->hit_capacity * sizeof(fsdem__wall_hit);
     return s;
 }
 
@@ -3720,18 +3738,26 @@ static void fsdem__report_contact(fsdem_contact_info *out, int capacity, int cou
     out[count].overlap = overlap;
 }
 
+/* Reports particles i < j as contact `count` when they overlap; returns the new count. */
+static int fsdem__report_pair(const fsdem_dem *d, fsdem_contact_info *out, int capacity, int count, int i, int j) {
+    fsdem_real dist;
+    fsdem_vec3 n = fsdem__direction(d->x[i], d->x[j], fsdem_v3(1, 0, 0), &dist);
+    const fsdem_real overlap = d->r[i] + d->r[j] + d->desc.contact_offset - dist;
+    if (overlap <= 0) return count;
+    fsdem__report_contact(out, capacity, count, i, j, n, overlap);
+    return count + 1;
+}
+
 int fsdem_dem_contacts(fsdem_dem *d, fsdem_contact_info *out, int capacity) {
-    const fsdem_real off = d->desc.contact_offset;
     int i, k, nh, count = 0;
     if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    for (k = 0; k < d->inert_count; ++k) {
+        const int a = d->inert[2 * k], b = d->inert[2 * k + 1];
+        count = fsdem__report_pair(d, out, capacity, count, a < b ? a : b, a < b ? b : a);
+    }
     for (i = 0; i < d->n; ++i) {
-        for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
-            int j = FSDEM__PARTNER(d->pp.key[k]);
-            fsdem_real dist;
-            fsdem_vec3 n = fsdem__direction(d->x[i], d->x[j], fsdem_v3(1, 0, 0), &dist);
-            if (d->r[i] + d->r[j] + off - dist <= 0) continue;
-            fsdem__report_contact(out, capacity, count++, i, j, n, d->r[i] + d->r[j] + off - dist);
-        }
+        for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k)
+            count = fsdem__report_pair(d, out, capacity, count, i, FSDEM__PARTNER(d->pp.key[k]));
         nh = fsdem__wall_hits(d, i, 0);
         for (k = 0; k < nh; ++k)
             fsdem__report_contact(out, capacity, count++, i, -1 - FSDEM__WALL_OF(d->pw.key[d->hits[k].entry]),
