@@ -2938,8 +2938,9 @@ static int fsdem__find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_rea
             const int b1 = g->cell_start[cells[f] + 1];
             for (a = g->cell_start[c]; a < g->cell_start[c + 1]; ++a) {
                 const int b0 = f == 0 ? a + 1 : g->cell_start[cells[f]];
-                if (fsdem__grow(&d->allocator, (void **)&d->found, &d->found_capacity, 2 * count,
-                                2 * (count + (b1 > b0 ? b1 - b0 : 0)), sizeof(int)) != FSDEM_OK)
+                if (2 * (count + b1 - b0) > d->found_capacity &&
+                    fsdem__grow(&d->allocator, (void **)&d->found, &d->found_capacity, 2 * count, 2 * (count + b1 - b0),
+                                sizeof(int)) != FSDEM_OK)
                     return -1;
                 for (b = b0; b < b1; ++b) {
                     /* arithmetic, not branches, which would mispredict */
