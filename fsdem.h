@@ -383,7 +383,9 @@ FSDEM_API fsdem_vec3 fsdem_dem_wall_impulse(const fsdem_dem *dem, int id);
 FSDEM_API fsdem_result fsdem_dem_step(fsdem_dem *dem);
 /* Advances by an outer (fluid) step dt_outer with K = INT(dt_outer/dt) substeps of dt_outer/K, or
    one substep of dt_outer when dt > dt_outer (seed 000 Eq. 25). External forces stay fixed over
-   the substeps. K goes to *substeps (may be NULL). */
+   the substeps. K goes to *substeps (may be NULL). Verlet substeps run fused, one pass over the
+   particles each, so this is the fast way to take many steps; the state it ends in is that of K
+   calls of fsdem_dem_step, to rounding. Errors as fsdem_dem_step, at the substep that met them. */
 FSDEM_API fsdem_result fsdem_dem_advance(fsdem_dem *dem, fsdem_real dt_outer, int *substeps);
 FSDEM_API fsdem_result fsdem_dem_set_dt(fsdem_dem *dem, fsdem_real dt);
 FSDEM_API fsdem_real fsdem_dem_dt(const fsdem_dem *dem);
