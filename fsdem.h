@@ -2890,15 +2890,19 @@ static fsdem_result fsdem__list_grow(fsdem_dem *d, fsdem__list *l) {
 }
 
 /* Appends (row, partner `key`) with the history that entry `from` of list `old` holds (none for -1). */
+/* Writes entry e = (row, partner `key`) with the spring that entry `from` of list `old` holds (none
+   for -1). Without branches on the flag: the spring is copied whether held or not, as it means
+   nothing without it. */
+static void fsdem__list_set(fsdem__list *l, int e, int row, int key, const fsdem__list *old, int from) {
+    const int src = from >= 0 ? from : 0;
+    l->first[e] = row;
+    l->key[e] = key | (((from >= 0) & (old->count > 0)) ? old->key[src] & FSDEM__HELD : 0);
+    if (old->count > 0) l->history[e] = old->history[src];
+}
+
 static fsdem_result fsdem__list_append(fsdem_dem *d, fsdem__list *l, int row, int key, const fsdem__list *old, int from) {
     if (l->count == l->capacity && fsdem__list_grow(d, l) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
-    l->first[l->count] = row;
-    l->key[l->count] = key;
-    if (from >= 0 && (old->key[from] & FSDEM__HELD)) {
-        l->key[l->count] |= FSDEM__HELD;
-        l->history[l->count] = old->history[from];
-    }
-    l->count++;
+    fsdem__list_set(l, l->count++, row, key, old, from);
     return FSDEM_OK;
 }
 
@@ -2997,11 +3001,7 @@ static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
         const int a = items[d->found[2 * k]], b = items[d->found[2 * k + 1]];
         const int i0 = a < b ? a : b, j = a < b ? b : a, e = cursor[i0]++;
         const int oi = d->old_of[i0], oj = d->old_of[j], lo = oi < oj ? oi : oj, hi = oi < oj ? oj : oi;
-        const int from = lo >= 0 ? fsdem__old_entry(&d->pp_old, lo, hi) : -1, src = from >= 0 ? from : 0;
-        l->first[e] = i0;
-        /* the spring is copied whether held or not (it means nothing without the flag) */
-        l->key[e] = j | (((from >= 0) & (d->pp_old.count > 0)) ? d->pp_old.key[src] & FSDEM__HELD : 0);
-        if (d->pp_old.count > 0) l->history[e] = d->pp_old.history[src];
+        fsdem__list_set(l, e, i0, j, &d->pp_old, lo >= 0 ? fsdem__old_entry(&d->pp_old, lo, hi) : -1);
     }
     l->count = count;
     return FSDEM_OK;
