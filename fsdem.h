@@ -8,10 +8,12 @@
          #include "fsdem.h"
      Everywhere else include "fsdem.h" without the define. Link with libm (-lm). Nothing else.
 
-   TABLE OF CONTENTS (grep -n '>>' fsdem.h prints the map)
+   TABLE OF CONTENTS (grep -n '>>' fsdem.h prints the map; `make test` checks it)
      >>doc      this text
-     >>config   configuration macros
-     >>core     real type, vectors, results, allocator, logging
+     >>config   version, configuration macros, precision-suffixed symbols
+     >>core     real type, vectors, sides, results, allocator, logging, the fluid coupling sample
+     >>geom     signed distances and closest points (private; DEM walls, PIC obstacles, couplers)
+     >>kernel   interpolation weights on grids (private; PIC transfers, sampling, couplers)
      >>grid     cell grid (uniform spatial binning) shared by DEM, MPS and the couplings
      >>dem      discrete element method: particles, materials, contact laws, walls, integration
      >>linalg   CSR and MAC-grid stencil operators, preconditioned conjugate gradients (Jacobi,
@@ -21,21 +23,28 @@
      >>swe      shallow-water equations in 1D and 2D: HLL, MUSCL-Hancock, wet/dry, well-balanced
                 (seed 003)
      >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
-     >>io       CSV time series, ParaView .pvd series, DEM particle snapshots (CSV, legacy VTK)
-     >>impl     implementation, in the same order
+     >>io       CSV time series, ParaView .pvd series, DEM particle snapshots
+     >>impl     implementation, in the same order (each chapter opens with its contents)
      >>licence  MIT
 
    CONFIGURATION MACROS (define before including)
-     FSDEM_USE_FLOAT         fsdem_real is float instead of double.
+     FSDEM_USE_FLOAT         fsdem_real is float instead of double. Every public function then has
+                             an "_f" suffix at link time (fsdem_dem_create links as
+                             fsdem_dem_create_f), so objects compiled with and without it cannot
+                             be linked together silently: define it in every translation unit or
+                             in none.
      FSDEM_MALLOC(sz)        default allocator; define FSDEM_MALLOC, FSDEM_REALLOC and FSDEM_FREE
      FSDEM_REALLOC(p, sz)    all three or none. An fsdem_allocator in a desc overrides them per
-     FSDEM_FREE(p)           object.
+     FSDEM_FREE(p)           object. Read only by the implementation's translation unit.
      FSDEM_ASSERT(c)         programmer-error checks (default: assert from <assert.h>).
-     FSDEM_API               decoration of public functions (default: extern).
+     FSDEM_API               decoration of public functions (default: extern); the same in every
+                             translation unit.
      FSDEM_NO_SIMD           batched kernels (the DEM contact law) use one real per lane instead of
                              the compiler's vectors. By default they use GNU vector extensions as wide
                              as the target flags allow: 2 doubles with SSE2 (any x86-64), 4 with
-                             -mavx2, 8 with -mavx512f or -march=native on such a CPU.
+                             -mavx2, 8 with -mavx512f or -march=native on such a CPU. Read only by
+                             the implementation's translation unit.
+     FSDEM_VERSION_MAJOR/MINOR/PATCH, FSDEM_VERSION_STRING: the version of this file (read-only).
 
    CONCEPTS
      Units are SI throughout: metres, seconds, kilograms, newtons, pascals, radians.
@@ -49,20 +58,62 @@
    HELLO WORLD (a sphere dropped on a floor)
      fsdem_dem_desc d = fsdem_dem_desc_default(3);
      d.domain_min = fsdem_v3(-1, -1, 0); d.domain_max = fsdem_v3(1, 1, 2);
-     d.law = FSDEM_CONTACT_HERTZ_MINDLIN;
+     d.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
      d.dt = 1e-5;
      fsdem_dem *dem;
      if (fsdem_dem_create(&d, &dem) != FSDEM_OK) return 1;
-     fsdem_material mat = fsdem_material_default();          (2500 kg/m3, E = 1e8 Pa, e = 0.5)
+     fsdem_dem_material mat = fsdem_dem_material_default();          (2500 kg/m3, E = 1e8 Pa, e = 0.5)
      int steel; fsdem_dem_add_material(dem, &mat, &steel);
-     fsdem_wall_desc floor = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), steel);
+     fsdem_dem_wall_desc floor = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), steel);
      fsdem_dem_add_wall(dem, &floor, NULL);
-     fsdem_particle_desc p = fsdem_particle_desc_default();
+     fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
      p.position = fsdem_v3(0, 0, 0.5); p.radius = 0.01; p.material = steel;
      fsdem_dem_add_particle(dem, &p, NULL);
      for (int s = 0; s < 100000; ++s)
          if (fsdem_dem_step(dem) != FSDEM_OK) { puts(fsdem_dem_last_error(dem)); break; }
      fsdem_dem_destroy(dem);
+
+   ONE DIALECT FOR EVERY SOLVER
+     Each solver (fsdem_dem, fsdem_pic, fsdem_swe) and each coupler (fsdem_swe_dem) speaks these
+     verbs; X is the object's name. A solver adds verbs of its own (add_particle, set_bed, ...).
+       fsdem_X_desc fsdem_X_desc_default(dim)      defaults (couplers and fsdem_pcg: no argument)
+       fsdem_result fsdem_X_desc_check(desc, message, size)  validation without creating anything
+       fsdem_result fsdem_X_create(desc, &x)        *x is NULL on failure; destroy with _destroy
+       void         fsdem_X_destroy(x)              NULL is allowed
+       const char  *fsdem_X_last_error(x)           message of the last failed call ("" after success)
+       fsdem_X_desc fsdem_X_get_desc(x)             the desc in force (with values resolved)
+       fsdem_result fsdem_X_step(x)                 one step of the object's own size: the DEM's dt,
+                                                    a fluid's stable (adaptive) dt
+       fsdem_result fsdem_X_step_dt(x, dt)          one step of exactly dt (s); FSDEM_ERR_CFL, with
+                                                    nothing changed, where dt is unstable
+       fsdem_result fsdem_X_advance(x, duration, &steps)  steps until exactly `duration` (s) later;
+                                                    steps (long long, may be NULL) counts them
+       fsdem_result fsdem_X_stable_dt(x, &dt)       the stable step of the current state (s)
+       double       fsdem_X_time(x)                 simulated time (s), a double everywhere
+       fsdem_X_stats fsdem_X_get_stats(x)           counters and figures; starts with
+                                                    long long steps, double time, fsdem_real dt
+       fsdem_X_particles / fsdem_X_fields fsdem_X_get_particles / _get_fields(x)  views (SoA)
+       fsdem_result fsdem_X_write_<what>(x, path)   snapshots (FSDEM_ERR_IO)
+     Gravity is a vector (m/s^2) in every desc. A NULL object pointer is refused with
+     FSDEM_ERR_INVALID_ARG by every function that returns a result (getters return zeros, last_error
+     says which object is NULL). Messages start with the public name they concern: the function
+     (`fsdem_pic_add_obstacle: ...`), the desc field (`fsdem_swe_desc.cfl must ...`), or for failures
+     inside time stepping the object (`fsdem_dem: particle 12 (id 40) left the domain ...`).
+     Public types of a module carry its name (fsdem_dem_material, fsdem_pic_bc); enum values are
+     FSDEM_<ENUM>_<VALUE>; private names are fsdem__<module>_... (core helpers: fsdem__...).
+     "stencil" means one thing: the matrix-free MAC-grid operator fsdem_stencil of >>linalg;
+     interpolation weights are "kernels" (>>kernel).
+
+   COUPLING INTERFACE
+     A coupler is named fsdem_<fluid>_dem (fsdem_swe_dem; next fsdem_mps_dem, fsdem_pic_dem) and
+     holds non-owning pointers to a fluid and a DEM. It reaches them only through these functions:
+       DEM   fsdem_dem_get_particles (read), fsdem_dem_get_desc, fsdem_dem_get_coupling (writable
+             external loads), fsdem_dem_substep_count, fsdem_dem_advance_with (substeps with a
+             callback at every force evaluation, Verlet substeps fused)
+       fluid fsdem_<fluid>_sample (velocity, pressure gradient, volume fraction at points),
+             fsdem_<fluid>_add_force / _clear_forces (momentum sources), fsdem_<fluid>_get_coupling
+             (writable per-cell or per-face arrays), fsdem_<fluid>_get_desc, stable_dt, step_dt,
+             and for the shallow water fsdem_swe_sample_state (depth-averaged state at (x, y)).
 
    THREAD SAFETY
      No global mutable state. Distinct objects may be used from distinct threads at once; one
@@ -81,9 +132,18 @@
 #ifndef FSDEM_H_INCLUDED
 #define FSDEM_H_INCLUDED
 
-/* ===== >>config : configuration macros ============================================================ */
+/* ===== >>config : version, configuration macros, precision-suffixed symbols ======================== */
 
 #include <stddef.h>
+
+#define FSDEM_VERSION_MAJOR 0
+#define FSDEM_VERSION_MINOR 9
+#define FSDEM_VERSION_PATCH 0
+#define FSDEM_VERSION_STRING "0.9.0"
+
+/* FSDEM__SYMBOLS_BEGIN (generated by tests/map_check.sh --symbols; the check fails when a public
+   function is missing here) */
+/* FSDEM__SYMBOLS_END */
 
 #ifndef FSDEM_API
 #define FSDEM_API extern
@@ -104,6 +164,16 @@ typedef double fsdem_real;
 typedef struct fsdem_vec3 {
     fsdem_real x, y, z;
 } fsdem_vec3;
+
+/* Sides of a box domain, in the order of the axes (index into a desc's boundary arrays). */
+typedef enum fsdem_side {
+    FSDEM_SIDE_XMIN = 0,
+    FSDEM_SIDE_XMAX = 1,
+    FSDEM_SIDE_YMIN = 2,
+    FSDEM_SIDE_YMAX = 3,
+    FSDEM_SIDE_ZMIN = 4,
+    FSDEM_SIDE_ZMAX = 5
+} fsdem_side;
 
 /* Result of every fallible call. 0 is success, negative values are errors. */
 typedef enum fsdem_result {
@@ -146,6 +216,30 @@ static inline fsdem_vec3 fsdem_v3(fsdem_real x, fsdem_real y, fsdem_real z) {
     v.z = z;
     return v;
 }
+
+/* Signed distance (m) from p to a solid, positive on the open (particle or liquid) side; writes the
+   unit normal pointing to the open side (the distance gradient) to *normal. Used by DEM walls, PIC
+   obstacles and fill regions. */
+typedef fsdem_real (*fsdem_sdf_fn)(void *user, fsdem_vec3 p, fsdem_vec3 *normal);
+
+/* What a fluid solver reports at a point for a coupler (fsdem_<fluid>_sample). */
+typedef struct fsdem_fluid_sample {
+    fsdem_vec3 velocity;          /* m/s, fluid velocity (0 where there is no liquid) */
+    fsdem_vec3 pressure_gradient; /* Pa/m, gradient of the (total) pressure */
+    fsdem_real volume_fraction;   /* -, liquid fraction: 1 inside the liquid, 0 in air or dry land */
+} fsdem_fluid_sample;
+
+/* ===== >>geom : signed distances and closest points ================================================ */
+
+/* Private helpers of the implementation (>>impl_geom), one copy for every user: closest points on
+   segments and triangles, signed distances of boxes, spheres, discs, capped cylinders and polygons,
+   distance gradients by central differences. DEM walls, PIC obstacles and the couplers call them. */
+
+/* ===== >>kernel : interpolation weights ============================================================ */
+
+/* Private helpers of the implementation (>>impl_kernel): per-axis weights of the tent (linear) and
+   quadratic B-spline kernels on a uniform grid with a staggering offset, their derivatives, and
+   the clamped node indices; PIC transfers, fluid fractions, sampling and couplers use them. */
 
 /* ===== >>grid : cell grid shared by DEM, MPS and the couplings ==================================== */
 
@@ -195,30 +289,30 @@ FSDEM_API void fsdem_cellgrid_free(fsdem_cellgrid *grid);
 typedef struct fsdem_dem fsdem_dem;
 
 /* Contact law of a simulation. All laws use Coulomb friction with the material's `friction`. */
-typedef enum fsdem_contact_law {
+typedef enum fsdem_dem_law {
     /* Linear spring-dashpot of seed 000 Eq. 7-18: k from theta and dx (Eq. 10), damping from alpha
        (Eq. 11), tangential spring over one step capped by Coulomb (Eq. 8, 12-15), moment Eq. 9. */
-    FSDEM_CONTACT_LINEAR = 0,
+    FSDEM_DEM_LAW_LINEAR = 0,
     /* Hertz normal force (4/3) E* sqrt(R*) d^1.5, Mindlin tangential spring on the accumulated
        tangential displacement, Tsuji-form damping calibrated so the normal restitution equals the
        material's `restitution` exactly (see >>dem_law in the implementation). */
-    FSDEM_CONTACT_HERTZ_MINDLIN = 1,
+    FSDEM_DEM_LAW_HERTZ_MINDLIN = 1,
     /* Granule-In-Cell law of seed 004 Eq. 1a-1c: k_n = E r, viscous tangential force capped by
        |F_n| tan(phi) with tan(phi) = friction. */
-    FSDEM_CONTACT_GIC = 2
-} fsdem_contact_law;
+    FSDEM_DEM_LAW_GIC = 2
+} fsdem_dem_law;
 
-typedef enum fsdem_integrator {
+typedef enum fsdem_dem_integrator {
     /* Velocity Verlet (kick-drift-kick), one force evaluation per step: second order for elastic
        forces; dashpots see the half-step velocity, which makes damping first order in dt (resolve
        a contact with >= 50 steps, or use the predictor-corrector, whose error is far smaller). */
-    FSDEM_INTEGRATOR_VERLET = 0,
+    FSDEM_DEM_INTEGRATOR_VERLET = 0,
     /* Predictor-corrector of seed 000 Eq. 21-24, two force evaluations per step. */
-    FSDEM_INTEGRATOR_PREDICTOR_CORRECTOR = 1
-} fsdem_integrator;
+    FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR = 1
+} fsdem_dem_integrator;
 
 /* Per-material properties. Fields not used by the chosen law are ignored. */
-typedef struct fsdem_material {
+typedef struct fsdem_dem_material {
     fsdem_real density;          /* kg/m^3; default 2500 */
     fsdem_real young_modulus;    /* Pa; Hertz-Mindlin and GIC; default 1e8 */
     fsdem_real poisson_ratio;    /* -; Hertz-Mindlin, GIC, and psi of seed 000 Eq. 12-13; default 0.3 */
@@ -226,18 +320,34 @@ typedef struct fsdem_material {
     fsdem_real friction;         /* -; Coulomb sliding coefficient mu (tan phi for GIC); default 0.3 */
     fsdem_real rolling_friction; /* -; constant-torque rolling resistance mu_r; default 0 (off) */
     fsdem_real damping_alpha;    /* -; alpha of seed 000 Eq. 11, linear law; default 0.4 */
-} fsdem_material;
+} fsdem_dem_material;
 
-FSDEM_API fsdem_material fsdem_material_default(void);
+FSDEM_API fsdem_dem_material fsdem_dem_material_default(void);
+
+/* Rule of fsdem_dem_stable_dt (and of the dt warning, fsdem_dem_stats.dt_ratio). */
+typedef enum fsdem_dem_dt_rule {
+    /* the rule of the contact law: LINEAR_SEED000 for FSDEM_DEM_LAW_LINEAR, RAYLEIGH for
+       FSDEM_DEM_LAW_HERTZ_MINDLIN, GIC for FSDEM_DEM_LAW_GIC */
+    FSDEM_DEM_DT_AUTO = 0,
+    /* seed 000 Eq. 18: (2 pi / gamma) sqrt(m_ij / k), k from Eq. 10; dt_param is gamma (default 150) */
+    FSDEM_DEM_DT_LINEAR_SEED000 = 1,
+    /* seed 002 Eq. 38, the Rayleigh time pi R sqrt(2 rho (1+nu)/E) / (0.1631 nu + 0.8766) over all
+       particles, times dt_param, a safety fraction in (0, 1] (default 0.2, as LIGGGHTS advises) */
+    FSDEM_DEM_DT_RAYLEIGH = 2,
+    /* seed 004 Eq. 32: (1/2) sqrt(m / k_n), k_n = E r, times dt_param in (0, 1] (default 1) */
+    FSDEM_DEM_DT_GIC = 3
+} fsdem_dem_dt_rule;
 
 typedef struct fsdem_dem_desc {
     int dim;                        /* 2 or 3 */
     fsdem_vec3 domain_min;          /* m; particles must stay inside [domain_min, domain_max] */
     fsdem_vec3 domain_max;          /* m; default (-1,-1,-1)..(1,1,1) */
     fsdem_vec3 gravity;             /* m/s^2; default (0,-9.81,0) in 2D, (0,0,-9.81) in 3D */
-    fsdem_contact_law law;          /* default FSDEM_CONTACT_HERTZ_MINDLIN */
-    fsdem_integrator integrator;    /* default FSDEM_INTEGRATOR_VERLET */
+    fsdem_dem_law law;          /* default FSDEM_DEM_LAW_HERTZ_MINDLIN */
+    fsdem_dem_integrator integrator;    /* default FSDEM_DEM_INTEGRATOR_VERLET */
     fsdem_real dt;                  /* s; time step; default 1e-5 */
+    fsdem_dem_dt_rule dt_rule;      /* rule of fsdem_dem_stable_dt; default FSDEM_DEM_DT_AUTO */
+    fsdem_real dt_param;            /* gamma or safety fraction of the rule; 0: its default; default 0 */
     fsdem_real skin;                /* m; neighbour-list margin; < 0: 0.25 x largest radius; default -1 */
     fsdem_real contact_offset;      /* m; imaginary-boundary gap of seed 000 Eq. 19 (2 dx there): */
                                     /*    contacts start at distance r_i + r_j + offset; default 0 */
@@ -266,23 +376,23 @@ FSDEM_API void fsdem_dem_destroy(fsdem_dem *dem);
 FSDEM_API const char *fsdem_dem_last_error(const fsdem_dem *dem);
 
 /* Adds a material; its index goes to *index (may be NULL). FSDEM_ERR_INVALID_ARG names the field. */
-FSDEM_API fsdem_result fsdem_dem_add_material(fsdem_dem *dem, const fsdem_material *material,
+FSDEM_API fsdem_result fsdem_dem_add_material(fsdem_dem *dem, const fsdem_dem_material *material,
                                               int *index);
 
-typedef struct fsdem_particle_desc {
+typedef struct fsdem_dem_particle_desc {
     fsdem_vec3 position;         /* m; inside the domain */
     fsdem_vec3 velocity;         /* m/s; default 0 */
     fsdem_vec3 angular_velocity; /* rad/s; default 0 (2D: only z is used) */
     fsdem_real radius;           /* m; > 0; default 0 (must be set) */
     int material;                /* index from fsdem_dem_add_material; default 0 */
     int fixed;                   /* 1: kinematic, moves with its velocity whatever the forces */
-} fsdem_particle_desc;
+} fsdem_dem_particle_desc;
 
-FSDEM_API fsdem_particle_desc fsdem_particle_desc_default(void);
+FSDEM_API fsdem_dem_particle_desc fsdem_dem_particle_desc_default(void);
 /* Adds a particle at the end; its index goes to *index (may be NULL). Each particle also gets a
-   stable id (fsdem_particles.id) that survives removals. Errors: FSDEM_ERR_INVALID_ARG (radius,
+   stable id (fsdem_dem_particles.id) that survives removals. Errors: FSDEM_ERR_INVALID_ARG (radius,
    material, non-finite values), FSDEM_ERR_OUT_OF_DOMAIN, FSDEM_ERR_OUT_OF_MEMORY. */
-FSDEM_API fsdem_result fsdem_dem_add_particle(fsdem_dem *dem, const fsdem_particle_desc *particle,
+FSDEM_API fsdem_result fsdem_dem_add_particle(fsdem_dem *dem, const fsdem_dem_particle_desc *particle,
                                               int *index);
 /* Removes particle `index`; later particles move down one index (ids do not change), contact
    history is kept. O(n). FSDEM_ERR_NOT_FOUND for a bad index. */
@@ -294,8 +404,8 @@ FSDEM_API fsdem_result fsdem_dem_set_particle_state(fsdem_dem *dem, int index, f
 
 /* Read-only views of the particle arrays (structure of arrays), valid until particles are added or
    removed. `force` and `torque` are the contact forces of the last step (N, N m), without gravity
-   and without the external loads (fsdem_dem_external_loads), which are shown too. */
-typedef struct fsdem_particles {
+   and without the external loads (fsdem_dem_get_coupling), which are shown too. */
+typedef struct fsdem_dem_particles {
     int count;
     int dim;
     const int *id;
@@ -310,56 +420,53 @@ typedef struct fsdem_particles {
     const fsdem_real *mass;
     const int *material;
     const unsigned char *fixed;
-} fsdem_particles;
+} fsdem_dem_particles;
 
-FSDEM_API fsdem_particles fsdem_dem_particles(const fsdem_dem *dem);
+FSDEM_API fsdem_dem_particles fsdem_dem_get_particles(const fsdem_dem *dem);
 
 /* External loads of every particle, written by the caller: a force (N) and a torque (N m) at the
    centre, besides contacts and gravity, held fixed over steps (a fluid force during DEM substeps).
    They start at zero; steps read them only once this function has handed them out (or a coupler
    wrote them), so a run without them does not pay for them. Valid until particles are added or
    removed. */
-typedef struct fsdem_external_loads {
+typedef struct fsdem_dem_coupling {
     int count;
     fsdem_vec3 *force;
     fsdem_vec3 *torque;
-} fsdem_external_loads;
+} fsdem_dem_coupling;
 
-FSDEM_API fsdem_external_loads fsdem_dem_external_loads(fsdem_dem *dem);
+FSDEM_API fsdem_dem_coupling fsdem_dem_get_coupling(fsdem_dem *dem);
 
 /* ---- walls ---- */
 
-typedef enum fsdem_wall_type {
-    FSDEM_WALL_PLANE = 0,       /* infinite plane through `a` with unit normal `b` (towards particles) */
-    FSDEM_WALL_BOX_INSIDE = 1,  /* axis-aligned box [a, b] holding the particles inside */
-    FSDEM_WALL_BOX_OUTSIDE = 2, /* axis-aligned solid box [a, b]; particles stay outside */
-    FSDEM_WALL_SEGMENT = 3,     /* 2D segment a-b (both sides) */
-    FSDEM_WALL_TRIANGLE = 4,    /* 3D triangle a-b-c (both sides) */
-    FSDEM_WALL_SDF = 5          /* signed distance given by a callback (moved by it: fsdem_dem_wall_moved) */
-} fsdem_wall_type;
+typedef enum fsdem_dem_wall_type {
+    FSDEM_DEM_WALL_PLANE = 0,       /* infinite plane through `a` with unit normal `b` (towards particles) */
+    FSDEM_DEM_WALL_BOX_INSIDE = 1,  /* axis-aligned box [a, b] holding the particles inside */
+    FSDEM_DEM_WALL_BOX_OUTSIDE = 2, /* axis-aligned solid box [a, b]; particles stay outside */
+    FSDEM_DEM_WALL_SEGMENT = 3,     /* 2D segment a-b (both sides) */
+    FSDEM_DEM_WALL_TRIANGLE = 4,    /* 3D triangle a-b-c (both sides) */
+    FSDEM_DEM_WALL_SDF = 5          /* signed distance given by a callback (moved by it: fsdem_dem_wall_moved) */
+} fsdem_dem_wall_type;
 
-/* Signed distance (m) from p to a solid, positive on the particles' side; writes the unit outward
-   normal (the distance gradient) to *normal. */
-typedef fsdem_real (*fsdem_sdf_fn)(void *user, fsdem_vec3 p, fsdem_vec3 *normal);
 
-typedef struct fsdem_wall_desc {
-    fsdem_wall_type type;
+typedef struct fsdem_dem_wall_desc {
+    fsdem_dem_wall_type type;
     fsdem_vec3 a, b, c;   /* m; geometry, meaning per type above */
     fsdem_vec3 velocity;  /* m/s; the wall translates with it; default 0 */
     int material;         /* index from fsdem_dem_add_material */
-    fsdem_sdf_fn sdf;     /* FSDEM_WALL_SDF only */
+    fsdem_sdf_fn sdf;     /* FSDEM_DEM_WALL_SDF only */
     void *sdf_user;
-} fsdem_wall_desc;
+} fsdem_dem_wall_desc;
 
-FSDEM_API fsdem_wall_desc fsdem_wall_plane(fsdem_vec3 point, fsdem_vec3 normal, int material);
-FSDEM_API fsdem_wall_desc fsdem_wall_box(fsdem_vec3 lo, fsdem_vec3 hi, int inside, int material);
-FSDEM_API fsdem_wall_desc fsdem_wall_segment(fsdem_vec3 a, fsdem_vec3 b, int material);
-FSDEM_API fsdem_wall_desc fsdem_wall_triangle(fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c, int material);
-FSDEM_API fsdem_wall_desc fsdem_wall_sdf(fsdem_sdf_fn sdf, void *user, int material);
+FSDEM_API fsdem_dem_wall_desc fsdem_dem_wall_plane(fsdem_vec3 point, fsdem_vec3 normal, int material);
+FSDEM_API fsdem_dem_wall_desc fsdem_dem_wall_box(fsdem_vec3 lo, fsdem_vec3 hi, int inside, int material);
+FSDEM_API fsdem_dem_wall_desc fsdem_dem_wall_segment(fsdem_vec3 a, fsdem_vec3 b, int material);
+FSDEM_API fsdem_dem_wall_desc fsdem_dem_wall_triangle(fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c, int material);
+FSDEM_API fsdem_dem_wall_desc fsdem_dem_wall_sdf(fsdem_sdf_fn sdf, void *user, int material);
 
 /* Adds a wall; its id goes to *id (may be NULL). Ids are stable. FSDEM_ERR_INVALID_ARG names the
    problem (zero normal, degenerate triangle, missing callback, wrong dimension, bad material). */
-FSDEM_API fsdem_result fsdem_dem_add_wall(fsdem_dem *dem, const fsdem_wall_desc *wall, int *id);
+FSDEM_API fsdem_result fsdem_dem_add_wall(fsdem_dem *dem, const fsdem_dem_wall_desc *wall, int *id);
 /* Removes a wall (the id is not reused). */
 FSDEM_API fsdem_result fsdem_dem_remove_wall(fsdem_dem *dem, int id);
 FSDEM_API fsdem_result fsdem_dem_set_wall_velocity(fsdem_dem *dem, int id, fsdem_vec3 velocity);
@@ -376,49 +483,65 @@ FSDEM_API fsdem_vec3 fsdem_dem_wall_impulse(const fsdem_dem *dem, int id);
 
 /* ---- time integration ---- */
 
-/* Advances by one step of desc.dt (or the last fsdem_dem_set_dt). Errors: FSDEM_ERR_NAN,
-   FSDEM_ERR_OUT_OF_DOMAIN (the step is complete and the message names the particle),
-   FSDEM_ERR_OUT_OF_MEMORY (the neighbour lists could not grow: the step stopped part way, after the
-   drift, and is not undone; the object stays consistent and a later step rebuilds the lists). */
+/* Advances by one step of the current dt (desc.dt, or the last fsdem_dem_set_dt). Errors:
+   FSDEM_ERR_NAN, FSDEM_ERR_OUT_OF_DOMAIN (the step is complete and the message names the particle,
+   and dt when it exceeds the stable estimate), FSDEM_ERR_OUT_OF_MEMORY (the neighbour lists could
+   not grow: the step stopped part way, after the drift, and is not undone; the object stays
+   consistent and a later step rebuilds the lists). */
 FSDEM_API fsdem_result fsdem_dem_step(fsdem_dem *dem);
-/* Advances by an outer (fluid) step dt_outer with K = INT(dt_outer/dt) substeps of dt_outer/K, or
-   one substep of dt_outer when dt > dt_outer (seed 000 Eq. 25). External forces stay fixed over
-   the substeps. K goes to *substeps (may be NULL). Verlet substeps run fused, one pass over the
-   particles each, so this is the fast way to take many steps; the state it ends in is that of K
-   calls of fsdem_dem_step, to rounding. Errors as fsdem_dem_step, at the substep that met them. */
-FSDEM_API fsdem_result fsdem_dem_advance(fsdem_dem *dem, fsdem_real dt_outer, int *substeps);
+/* One step of dt (s) instead of the current dt (which does not change). FSDEM_ERR_INVALID_ARG for
+   dt <= 0 or not finite; otherwise as fsdem_dem_step. */
+FSDEM_API fsdem_result fsdem_dem_step_dt(fsdem_dem *dem, fsdem_real dt);
+/* Advances by `duration` (s, an outer fluid step) in K = fsdem_dem_substep_count substeps of
+   duration/K (seed 000 Eq. 25). External loads stay as they are over the substeps. K goes to *steps
+   (may be NULL). Verlet substeps run fused, one pass over the particles each, so this is the fast
+   way to take many steps; the state it ends in is that of K calls of fsdem_dem_step_dt, to
+   rounding. Errors as fsdem_dem_step, at the substep that met them, and FSDEM_ERR_INVALID_ARG for
+   a bad duration or more than FSDEM_DEM_MAX_SUBSTEPS substeps (nothing changes then). */
+FSDEM_API fsdem_result fsdem_dem_advance(fsdem_dem *dem, fsdem_real duration, long long *steps);
+/* Substeps of fsdem_dem_advance(dem, duration): K = INT(duration/dt) (an exact multiple counts
+   whole to a relative 1e-9), or 1 when dt > duration (seed 000 Eq. 25). FSDEM_ERR_INVALID_ARG for a
+   duration that is not > 0 and finite, or for K > FSDEM_DEM_MAX_SUBSTEPS. */
+FSDEM_API fsdem_result fsdem_dem_substep_count(const fsdem_dem *dem, fsdem_real duration, long long *count);
+#define FSDEM_DEM_MAX_SUBSTEPS 100000000LL
+/* Called by fsdem_dem_advance_with wherever the advance evaluates forces: once before the first
+   substep and after the drift of every substep, with the positions at `time` (s). It writes the
+   external loads (fsdem_dem_get_coupling) that the kicks around that time use, such as a buoyancy
+   refreshed for the new heights. Velocities are the integrator's at that point (the half-step
+   velocity with Verlet). It must not add or remove particles; an error it returns stops the
+   advance with that result (its message is the callback's to give through its own object). */
+typedef fsdem_result (*fsdem_dem_substep_fn)(void *user, fsdem_dem *dem, double time);
+/* fsdem_dem_advance with `fn` (may be NULL) called at every force evaluation. */
+FSDEM_API fsdem_result fsdem_dem_advance_with(fsdem_dem *dem, fsdem_real duration, fsdem_dem_substep_fn fn,
+                                              void *user, long long *steps);
+/* Sets the dt of later fsdem_dem_step and fsdem_dem_advance calls (s, > 0). Logs a warning when it
+   exceeds the stable estimate (fsdem_dem_stats.dt_ratio). */
 FSDEM_API fsdem_result fsdem_dem_set_dt(fsdem_dem *dem, fsdem_real dt);
-FSDEM_API fsdem_real fsdem_dem_dt(const fsdem_dem *dem);
-FSDEM_API fsdem_real fsdem_dem_time(const fsdem_dem *dem);
-
-typedef enum fsdem_dt_rule {
-    /* seed 000 Eq. 18: (2 pi / gamma) sqrt(m_ij / k), k from Eq. 10; `param` is gamma (150 there) */
-    FSDEM_DT_LINEAR_SEED000 = 0,
-    /* seed 002 Eq. 38, the Rayleigh time pi R sqrt(2 rho (1+nu)/E) / (0.1631 nu + 0.8766) over all
-       particles; multiply by a safety fraction `param` (e.g. 0.2) */
-    FSDEM_DT_RAYLEIGH = 1,
-    /* seed 004 Eq. 32: (1/2) sqrt(m / k_n), k_n = E r; `param` unused */
-    FSDEM_DT_GIC = 2
-} fsdem_dt_rule;
-
-/* Stable time step of the current particles by `rule` (smallest over particles). FSDEM_ERR_NOT_FOUND
-   when there are no particles, FSDEM_ERR_INVALID_ARG for a bad param. */
-FSDEM_API fsdem_result fsdem_dem_dt_estimate(const fsdem_dem *dem, fsdem_dt_rule rule,
-                                             fsdem_real param, fsdem_real *dt);
+/* Simulated time (s). */
+FSDEM_API double fsdem_dem_time(const fsdem_dem *dem);
+/* Stable time step (s) of the current particles by desc.dt_rule and desc.dt_param (the smallest
+   over the particles). FSDEM_ERR_NOT_FOUND when there are no particles. */
+FSDEM_API fsdem_result fsdem_dem_stable_dt(const fsdem_dem *dem, fsdem_real *dt);
+/* The desc in force: dt is the current dt, dt_rule the resolved rule, dt_param its value. */
+FSDEM_API fsdem_dem_desc fsdem_dem_get_desc(const fsdem_dem *dem);
 
 /* ---- diagnostics ---- */
 
-typedef struct fsdem_energy {
+typedef struct fsdem_dem_energy {
     fsdem_real kinetic;    /* J, translational, free particles */
     fsdem_real rotational; /* J */
     fsdem_real potential;  /* J, -m g.x summed over free particles */
     fsdem_real elastic;    /* J, stored in normal and tangential contact springs */
-} fsdem_energy;
+} fsdem_dem_energy;
 
-FSDEM_API fsdem_energy fsdem_dem_energy(const fsdem_dem *dem);
+FSDEM_API fsdem_dem_energy fsdem_dem_get_energy(const fsdem_dem *dem);
 
 typedef struct fsdem_dem_stats {
     long long steps;          /* steps taken */
+    double time;              /* s */
+    fsdem_real dt;            /* s, the current step */
+    fsdem_real stable_dt;     /* s, fsdem_dem_stable_dt at the last neighbour-list build (0: none) */
+    fsdem_real dt_ratio;      /* dt / stable_dt; above 1 the log has a warning (0: no particles) */
     long long rebuilds;       /* neighbour-list rebuilds */
     int contacts;             /* particle-particle contacts at the last force evaluation */
     int wall_contacts;        /* particle-wall contacts at the last force evaluation */
@@ -430,17 +553,17 @@ typedef struct fsdem_dem_stats {
 FSDEM_API fsdem_dem_stats fsdem_dem_get_stats(const fsdem_dem *dem);
 
 /* One geometric contact (overlap > 0) in the current positions. */
-typedef struct fsdem_contact_info {
+typedef struct fsdem_dem_contact {
     int i;              /* particle index */
     int j;              /* partner particle index (> i), or -1 - wall id for a wall contact */
     fsdem_vec3 normal;  /* unit normal from the partner towards particle i */
     fsdem_real overlap; /* m, including the contact offset */
-} fsdem_contact_info;
+} fsdem_dem_contact;
 
 /* Lists the contacts of the current positions (found through the neighbour lists, rebuilt first if
    stale). Writes up to `capacity` entries to `out` (may be NULL) and returns the total number, or
    FSDEM_ERR_OUT_OF_MEMORY (negative) when the lists cannot be rebuilt. */
-FSDEM_API int fsdem_dem_contacts(fsdem_dem *dem, fsdem_contact_info *out, int capacity);
+FSDEM_API int fsdem_dem_contacts(fsdem_dem *dem, fsdem_dem_contact *out, int capacity);
 
 /* ===== >>linalg : sparse operators and preconditioned conjugate gradients ===== */
 
@@ -557,6 +680,9 @@ typedef struct fsdem_pcg fsdem_pcg;
 
 /* Defaults (see the field comments). */
 FSDEM_API fsdem_pcg_desc fsdem_pcg_desc_default(void);
+/* Checks a desc without creating anything; the reason, naming the field, goes to `message` (may be
+   NULL). Returns FSDEM_OK or FSDEM_ERR_INVALID_ARG. */
+FSDEM_API fsdem_result fsdem_pcg_desc_check(const fsdem_pcg_desc *desc, char *message, size_t message_size);
 /* Creates a solver; nothing size-dependent is allocated until a setup call. *out is NULL on
    failure. Errors: FSDEM_ERR_INVALID_ARG (the reason goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY.
    Destroy with fsdem_pcg_destroy. */
@@ -654,15 +780,15 @@ typedef enum fsdem_pic_kernel {
     FSDEM_PIC_KERNEL_QUADRATIC = 1 /* quadratic B-spline, 3^dim faces, smoother */
 } fsdem_pic_kernel;
 
-/* Boundary condition on one side of the domain box. */
-typedef enum fsdem_pic_boundary {
+/* Boundary condition on one side of the domain box (desc.boundary, indexed by fsdem_side). */
+typedef enum fsdem_pic_bc {
     FSDEM_PIC_BC_SLIP = 0,    /* impermeable wall, free slip */
     FSDEM_PIC_BC_NO_SLIP = 1, /* impermeable wall; viscous no slip at the wall's tangential */
                               /*    velocity (a moving lid is a tangential boundary_velocity) */
     FSDEM_PIC_BC_INFLOW = 2,  /* prescribed velocity boundary_velocity (all components); the cells */
                               /*    next to it are kept filled with particles of that velocity */
     FSDEM_PIC_BC_OUTFLOW = 3  /* open: p = 0 on the boundary, particles crossing it are removed */
-} fsdem_pic_boundary;
+} fsdem_pic_bc;
 
 typedef struct fsdem_pic_desc {
     int dim;                          /* 2 or 3 */
@@ -673,7 +799,7 @@ typedef struct fsdem_pic_desc {
     fsdem_real viscosity;             /* m^2/s; kinematic viscosity nu (seed 000 Eq. 2), implicit; */
                                       /*    default 0 (inviscid) */
     fsdem_vec3 gravity;               /* m/s^2; default (0,-9.81,0) in 2D, (0,0,-9.81) in 3D */
-    fsdem_pic_boundary boundary[6];   /* sides -x,+x,-y,+y,-z,+z; default FSDEM_PIC_BC_SLIP */
+    fsdem_pic_bc boundary[6];         /* indexed by fsdem_side; default FSDEM_PIC_BC_SLIP */
     fsdem_vec3 boundary_velocity[6];  /* m/s; lid or inflow velocity per side; default 0 */
     int free_surface;                 /* 1: cells are FLUID where particles are; 0: every open cell */
                                       /*    is FLUID (a completely filled box, e.g. a cavity); default 1 */
@@ -809,17 +935,21 @@ FSDEM_API fsdem_result fsdem_pic_step(fsdem_pic *pic);
    u_max dt / dx > cfl_max (the message names the fastest particle); in both cases nothing moved.
    Otherwise as fsdem_pic_step. */
 FSDEM_API fsdem_result fsdem_pic_step_dt(fsdem_pic *pic, fsdem_real dt);
-/* Advances by `duration` (s) with adaptive steps, the last one shortened to land on the end time.
+/* Advances by `duration` (s) with adaptive steps, the last ones shortened to land on the end time.
    Stops at the first error and returns it. Steps taken go to *steps (may be NULL). */
-FSDEM_API fsdem_result fsdem_pic_advance(fsdem_pic *pic, fsdem_real duration, int *steps);
-/* The adaptive step the next fsdem_pic_step would take (s). */
-FSDEM_API fsdem_real fsdem_pic_dt_estimate(const fsdem_pic *pic);
-FSDEM_API fsdem_real fsdem_pic_time(const fsdem_pic *pic);
+FSDEM_API fsdem_result fsdem_pic_advance(fsdem_pic *pic, fsdem_real duration, long long *steps);
+/* The adaptive step the next fsdem_pic_step would take (s). FSDEM_ERR_NAN when a particle velocity
+   is not finite. */
+FSDEM_API fsdem_result fsdem_pic_stable_dt(const fsdem_pic *pic, fsdem_real *dt);
+/* Simulated time (s). */
+FSDEM_API double fsdem_pic_time(const fsdem_pic *pic);
+/* The desc in force (domain_max moved to whole cells). */
+FSDEM_API fsdem_pic_desc fsdem_pic_get_desc(const fsdem_pic *pic);
 
 /* ---- grid and coupling ---- */
 
 /* Read-only view of the grid after the last step (valid while the solver lives). */
-typedef struct fsdem_pic_grid {
+typedef struct fsdem_pic_fields {
     int dim;
     int n[3];                      /* cells per axis (n[2] = 1 in 2D) */
     int face_count[3];             /* faces per axis (0 for z in 2D) */
@@ -833,21 +963,20 @@ typedef struct fsdem_pic_grid {
     const fsdem_real *open[3];     /* -; effective face-area fraction E used by the projection */
     const fsdem_real *solid_velocity[3]; /* m/s; velocity of the solid part of each face (walls, */
                                    /*    inflow, obstacles, coupler): face flux E u + (1 - E) us */
-} fsdem_pic_grid;
+} fsdem_pic_fields;
 
-FSDEM_API fsdem_pic_grid fsdem_pic_get_grid(const fsdem_pic *pic);
+FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
 
-/* Writable per-face arrays for a coupler (layout of fsdem_pic_grid), read by every step:
+/* Writable per-face arrays for a coupler (layout of fsdem_pic_fields), read by every step; valid
+   while the solver lives:
    - open[a][f]: fraction of face f not covered by moving solids (default 1); the projection uses
      min(static obstacle fraction, open);
    - solid_velocity[a][f]: velocity component a (m/s) of the moving solid on that face (default 0),
      used where open < the static fraction;
-   - acceleration[a][f]: extra acceleration (m/s^2) added with gravity (default 0; not cleared);
-   - pressure_extra / pressure_extra_user: an optional symmetric positive semi-definite term y += K p
-     added to the pressure operator of the equation sum_f E_f (p_c - p_nb) = -(rho dx^2/dt) div
-     (p and y in Pa; e.g. the implicit solid response dt J^T M^-1 J of seed 000 Eq. 6 in these
-     units). It must write only to FLUID cells; the preconditioner does not see it. NULL: none;
-   - pressure_rhs[c]: added to the right-hand side of that equation (Pa; default 0, not cleared).
+   - acceleration[a][f]: extra acceleration (m/s^2) added with gravity (default 0; kept until
+     changed; fsdem_pic_add_force adds to it, fsdem_pic_clear_forces zeroes it);
+   - pressure_rhs[c]: added to the right-hand side of the pressure equation
+     sum_f E_f (p_c - p_nb) = -(rho dx^2/dt) div (Pa; default 0, kept until changed).
    A cell whose faces are all closed becomes SOLID. Particles are pushed out of static obstacles
    only; keeping them out of moving solids is the coupler's part. */
 typedef struct fsdem_pic_coupling {
@@ -858,24 +987,36 @@ typedef struct fsdem_pic_coupling {
     fsdem_real *solid_velocity[3];
     fsdem_real *acceleration[3];
     fsdem_real *pressure_rhs;
-    fsdem_operator_fn pressure_extra;
-    void *pressure_extra_user;
 } fsdem_pic_coupling;
 
-/* Pointer to the coupler view; edit its arrays and hooks between steps. */
-FSDEM_API fsdem_pic_coupling *fsdem_pic_coupling_view(fsdem_pic *pic);
+FSDEM_API fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *pic);
+/* An optional symmetric positive semi-definite term y += K p added to the pressure operator of the
+   equation above (p and y in Pa, vectors in the cell layout; e.g. the implicit solid response
+   dt J^T M^-1 J of seed 000 Eq. 6 in these units). It must write only to FLUID cells; the
+   preconditioner does not see it. fn = NULL removes it; `user` must stay valid while it is set. */
+FSDEM_API fsdem_result fsdem_pic_set_pressure_extra(fsdem_pic *pic, fsdem_operator_fn fn, void *user);
 
-/* Grid velocity (m/s, trilinear from the faces) and pressure (Pa, trilinear from the cells) at a
-   point (clamped into the domain). */
-FSDEM_API fsdem_vec3 fsdem_pic_sample_velocity(const fsdem_pic *pic, fsdem_vec3 p);
-FSDEM_API fsdem_real fsdem_pic_sample_pressure(const fsdem_pic *pic, fsdem_vec3 p);
+/* Samples the grid at `count` points (clamped into the domain): velocity (trilinear from the faces),
+   the gradient of the pressure (Pa/m, from the face differences) and the liquid fraction
+   clamp(1/2 - phi/dx, 0, 1) (trilinear from the cells). FSDEM_ERR_INVALID_ARG for NULL arrays. */
+FSDEM_API fsdem_result fsdem_pic_sample(const fsdem_pic *pic, int count, const fsdem_vec3 *points,
+                                       fsdem_fluid_sample *out);
+/* Adds a force exerted on the liquid at `point` (N; N/m in 2D, per unit depth) to the faces'
+   acceleration, spread by the tent kernel of half-width max(radius, dx) over the faces next to
+   FLUID cells of the last step and divided by rho dx^dim, so the grid momentum before the
+   projection gains exactly force x dt per step. *taken (may be NULL) is 0 when no face next to the
+   liquid lies within reach (the force is then dropped). FSDEM_ERR_INVALID_ARG for non-finite input. */
+FSDEM_API fsdem_result fsdem_pic_add_force(fsdem_pic *pic, fsdem_vec3 point, fsdem_real radius, fsdem_vec3 force,
+                                          int *taken);
+/* Zeroes the coupling accelerations. */
+FSDEM_API fsdem_result fsdem_pic_clear_forces(fsdem_pic *pic);
 
 /* ---- diagnostics ---- */
 
 typedef struct fsdem_pic_stats {
-    fsdem_real time;               /* s */
-    fsdem_real dt;                 /* s, last step */
     long long steps;
+    double time;                   /* s */
+    fsdem_real dt;                 /* s, last step */
     int particles;
     int fluid_cells;
     fsdem_real fluid_volume;       /* m^3 (m^2 in 2D): liquid volume the solver sees, the sum over */
@@ -945,14 +1086,7 @@ typedef enum fsdem_swe_limiter {
     FSDEM_SWE_LIMITER_SUPERBEE = 3  /* least dissipative, steepens fronts */
 } fsdem_swe_limiter;
 
-/* Sides of the domain, the index into fsdem_swe_desc.boundary. 1D uses XMIN and XMAX only. */
-typedef enum fsdem_swe_side {
-    FSDEM_SWE_XMIN = 0,
-    FSDEM_SWE_XMAX = 1,
-    FSDEM_SWE_YMIN = 2,
-    FSDEM_SWE_YMAX = 3
-} fsdem_swe_side;
-
+/* fsdem_swe_desc.boundary is indexed by fsdem_side; 1D uses XMIN and XMAX only. */
 typedef enum fsdem_swe_bc {
     FSDEM_SWE_BC_WALL = 0,         /* reflective, free slip: no mass flux, mirrored normal velocity */
     FSDEM_SWE_BC_TRANSMISSIVE = 1, /* zero gradient: waves leave (approximately) without reflection */
@@ -980,7 +1114,7 @@ typedef struct fsdem_swe_desc {
     fsdem_real x_min, x_max;         /* m; extent along x; default 0 .. 1 */
     fsdem_real y_min, y_max;         /* m; extent along y, 2D only; default 0 .. 1 */
     fsdem_real width;                /* m; 1D only: channel width for volumes, momenta, forces; default 1 */
-    fsdem_real gravity;              /* m/s^2; default 9.81 */
+    fsdem_vec3 gravity;              /* m/s^2; vertical, (0, 0, -g) with g > 0; default (0, 0, -9.81) */
     fsdem_real density;              /* kg/m^3; water density for momentum and force; default 1000 */
     fsdem_real cfl;                  /* -; Courant number of adaptive steps, in (0, 1]; default 0.5 */
     fsdem_real dt_max;               /* s; longest adaptive step (used when nothing moves); default 1 */
@@ -990,7 +1124,7 @@ typedef struct fsdem_swe_desc {
     fsdem_real manning;              /* s/m^(1/3); uniform Manning n, 0 = frictionless; default 0 */
     fsdem_real eddy_viscosity;       /* m^2/s; turbulent viscosity of S_v = div(nu h grad u); default 0 */
     fsdem_real rain_rate;            /* m/s; uniform rain on every cell; default 0 */
-    fsdem_swe_boundary boundary[4];  /* indexed by fsdem_swe_side; default all walls */
+    fsdem_swe_boundary boundary[4];  /* indexed by fsdem_side; default all walls */
     const fsdem_real *bed;           /* m; nx*ny bed elevations z_b, copied; NULL: flat at 0; default NULL */
     const fsdem_real *depth;         /* m; nx*ny initial depths >= 0, copied; NULL: dry; default NULL */
     fsdem_allocator allocator;       /* default: FSDEM_MALLOC/FSDEM_FREE */
@@ -1049,23 +1183,30 @@ typedef struct fsdem_swe_cell {
 typedef void (*fsdem_swe_init_fn)(void *user, fsdem_real x, fsdem_real y, fsdem_swe_cell *cell);
 FSDEM_API fsdem_result fsdem_swe_set_cells(fsdem_swe *swe, fsdem_swe_init_fn fn, void *user);
 
-/* Views of the state arrays (nx*ny each, index i + nx j), valid until the solver is destroyed.
-   The conserved variables are read-only; change them with the setters. `source_x/y` are the
-   coupling momentum source S_p of seed 003 Eq. 2 and 8 in m^2/s^2 (acceleration times depth,
-   i.e. force per unit plan area divided by the density): written by the caller or a coupler,
-   added to d(uh)/dt and d(vh)/dt, and held over steps until changed (zero at creation). A source in
-   a dry cell is dropped (dry cells carry no momentum). */
+/* Read-only views of the state arrays (nx*ny each, index i + nx j), valid until the solver is
+   destroyed; change them with the setters. */
 typedef struct fsdem_swe_fields {
     int nx, ny;
     const fsdem_real *eta;  /* m */
     const fsdem_real *qx;   /* m^2/s, uh */
     const fsdem_real *qy;   /* m^2/s, vh (all zero in 1D) */
     const fsdem_real *bed;  /* m */
-    fsdem_real *source_x;   /* m^2/s^2 */
-    fsdem_real *source_y;   /* m^2/s^2 (ignored in 1D) */
 } fsdem_swe_fields;
 
-FSDEM_API fsdem_swe_fields fsdem_swe_get_fields(fsdem_swe *swe);
+FSDEM_API fsdem_swe_fields fsdem_swe_get_fields(const fsdem_swe *swe);
+
+/* Writable coupling arrays (nx*ny each): the momentum source S_p of seed 003 Eq. 2 and 8 in
+   m^2/s^2 (acceleration times depth, i.e. force per unit plan area divided by the density), added to
+   d(uh)/dt and d(vh)/dt and held over steps until changed (zero at creation). A source in a dry cell
+   is dropped (dry cells carry no momentum). Steps read them once this function has handed them out
+   (or fsdem_swe_add_force wrote them). */
+typedef struct fsdem_swe_coupling {
+    int nx, ny;
+    fsdem_real *source_x;   /* m^2/s^2 */
+    fsdem_real *source_y;   /* m^2/s^2 (ignored in 1D) */
+} fsdem_swe_coupling;
+
+FSDEM_API fsdem_swe_coupling fsdem_swe_get_coupling(fsdem_swe *swe);
 
 typedef enum fsdem_swe_field {
     FSDEM_SWE_FIELD_DEPTH = 0, /* m */
@@ -1084,19 +1225,31 @@ FSDEM_API fsdem_result fsdem_swe_copy_field(const fsdem_swe *swe, fsdem_swe_fiel
 FSDEM_API int fsdem_swe_cell_at(const fsdem_swe *swe, fsdem_real x, fsdem_real y);
 /* State at a point, interpolated (bi)linearly between cell centres (clamped to the outermost centres
    near the boundary): bed, depth, eta and velocity. FSDEM_ERR_OUT_OF_DOMAIN outside the grid. */
-FSDEM_API fsdem_result fsdem_swe_sample(const fsdem_swe *swe, fsdem_real x, fsdem_real y, fsdem_swe_cell *out);
-/* Adds a force (N) exerted on the water at (x, y) to the momentum source of the cell there,
-   as F / (rho dx dy) (1D: dy = width), so over a step of dt the water gains exactly F dt of momentum
-   (unless the cell is dry). Clear the sources with fsdem_swe_clear_sources. FSDEM_ERR_OUT_OF_DOMAIN. */
-FSDEM_API fsdem_result fsdem_swe_add_force(fsdem_swe *swe, fsdem_real x, fsdem_real y, fsdem_vec3 force);
-/* Sets source_x and source_y to zero. */
-FSDEM_API void fsdem_swe_clear_sources(fsdem_swe *swe);
+FSDEM_API fsdem_result fsdem_swe_sample_state(const fsdem_swe *swe, fsdem_real x, fsdem_real y, fsdem_swe_cell *out);
+/* The coupling sample at `count` points (x, y horizontal, z vertical; 1D: y ignored): the
+   depth-averaged velocity where z is in the water column (bed <= z <= eta), the hydrostatic pressure
+   gradient rho g (deta/dx, deta/dy, -1) there, and volume fraction 1 in the column, 0 above the
+   surface, below the bed and off the grid (where velocity and gradient are 0 too).
+   FSDEM_ERR_INVALID_ARG for NULL arrays. */
+FSDEM_API fsdem_result fsdem_swe_sample(const fsdem_swe *swe, int count, const fsdem_vec3 *points,
+                                       fsdem_fluid_sample *out);
+/* Adds a horizontal force exerted on the water (N; its z is ignored) to the momentum sources: spread
+   over the wet cells under the square footprint [x - radius, x + radius] (x [y - radius, y + radius]
+   in 2D) in proportion to their overlap, or the wet cell holding the point when radius is 0; when
+   none is wet, shared equally by the wet cells of that footprint grown by one cell. Over a step of
+   dt the water then gains exactly force x dt of momentum. *taken (may be NULL) is 0 when no wet
+   cell could take it (the force is dropped). FSDEM_ERR_INVALID_ARG (non-finite input, radius < 0),
+   FSDEM_ERR_OUT_OF_DOMAIN (the point is off the grid). */
+FSDEM_API fsdem_result fsdem_swe_add_force(fsdem_swe *swe, fsdem_vec3 point, fsdem_real radius, fsdem_vec3 force,
+                                          int *taken);
+/* Sets the momentum sources (source_x, source_y) to zero. */
+FSDEM_API fsdem_result fsdem_swe_clear_forces(fsdem_swe *swe);
 
 /* ---- boundaries, friction and sources ---- */
 
 /* Replaces one side's boundary condition (the series is copied). FSDEM_ERR_INVALID_ARG for a bad
    side (Y sides in 1D), type, value or series; the old condition stays. FSDEM_ERR_OUT_OF_MEMORY. */
-FSDEM_API fsdem_result fsdem_swe_set_boundary(fsdem_swe *swe, fsdem_swe_side side, const fsdem_swe_boundary *bc);
+FSDEM_API fsdem_result fsdem_swe_set_boundary(fsdem_swe *swe, fsdem_side side, const fsdem_swe_boundary *bc);
 /* Per-cell Manning coefficients (nx*ny values, s/m^(1/3), >= 0), copied; NULL returns to the uniform
    desc.manning. FSDEM_ERR_INVALID_ARG names a negative or non-finite value. */
 FSDEM_API fsdem_result fsdem_swe_set_manning(fsdem_swe *swe, const fsdem_real *manning);
@@ -1127,18 +1280,21 @@ FSDEM_API fsdem_result fsdem_swe_remove_point_source(fsdem_swe *swe, int id);
    a = g max(|deta/dx|/dx + |deta/dy|/dy) bounds the velocity gained within the step (it matters for
    thin films on steep beds; minmod slopes, so it is 0 for a lake at rest, islands included). Capped
    by desc.dt_max and, with an eddy viscosity, by 2 nu dt (1/dx^2 + 1/dy^2) <= cfl. */
-FSDEM_API fsdem_real fsdem_swe_stable_dt(const fsdem_swe *swe);
-/* Advances by one adaptive step of min(stable dt, dt_cap) (dt_cap <= 0: no cap); the step taken goes
-   to *dt (may be NULL). Errors: FSDEM_ERR_NAN (the step is complete, the message names the first bad
-   cell; the state is then not usable), FSDEM_ERR_IO (a gauge row could not be written). */
-FSDEM_API fsdem_result fsdem_swe_step(fsdem_swe *swe, fsdem_real dt_cap, fsdem_real *dt);
+FSDEM_API fsdem_result fsdem_swe_stable_dt(const fsdem_swe *swe, fsdem_real *dt);
+/* Advances by one step of the stable dt. Errors: FSDEM_ERR_NAN (the step is complete, the message
+   names the first bad cell; the state is then not usable), FSDEM_ERR_IO (a gauge row could not be
+   written). */
+FSDEM_API fsdem_result fsdem_swe_step(fsdem_swe *swe);
 /* Advances by exactly dt (s). FSDEM_ERR_CFL, with nothing changed, when dt exceeds the stability
    limit (Courant number > 1); FSDEM_ERR_INVALID_ARG for dt <= 0; otherwise as fsdem_swe_step. */
-FSDEM_API fsdem_result fsdem_swe_step_fixed(fsdem_swe *swe, fsdem_real dt);
+FSDEM_API fsdem_result fsdem_swe_step_dt(fsdem_swe *swe, fsdem_real dt);
 /* Adaptive steps until `duration` (s) has elapsed exactly (the last step is shortened); the number
    of steps goes to *steps (may be NULL). Stops at the first error. */
 FSDEM_API fsdem_result fsdem_swe_advance(fsdem_swe *swe, fsdem_real duration, long long *steps);
-FSDEM_API fsdem_real fsdem_swe_time(const fsdem_swe *swe);
+/* Simulated time (s). */
+FSDEM_API double fsdem_swe_time(const fsdem_swe *swe);
+/* The desc in force (bed, depth and boundary series pointers are NULL: the solver keeps copies). */
+FSDEM_API fsdem_swe_desc fsdem_swe_get_desc(const fsdem_swe *swe);
 
 /* ---- diagnostics ---- */
 
@@ -1149,7 +1305,7 @@ FSDEM_API fsdem_vec3 fsdem_swe_momentum(const fsdem_swe *swe);
 
 typedef struct fsdem_swe_stats {
     long long steps;              /* steps taken */
-    fsdem_real time;              /* s */
+    double time;                  /* s */
     fsdem_real dt;                /* s, the last step */
     fsdem_real max_depth;         /* m, over the cells */
     fsdem_real max_speed;         /* m/s, largest |velocity| over wet cells */
@@ -1176,7 +1332,7 @@ FSDEM_API fsdem_result fsdem_swe_write_vtk(const fsdem_swe *swe, const char *pat
 /* Adds a gauge at (x, y) (before fsdem_swe_gauges_open); its id goes to *id (may be NULL).
    FSDEM_ERR_OUT_OF_DOMAIN, FSDEM_ERR_OUT_OF_MEMORY, FSDEM_ERR_INVALID_ARG while a file is open. */
 FSDEM_API fsdem_result fsdem_swe_add_gauge(fsdem_swe *swe, fsdem_real x, fsdem_real y, int *id);
-/* Samples gauge `id` now (as fsdem_swe_sample). FSDEM_ERR_NOT_FOUND. */
+/* Samples gauge `id` now (as fsdem_swe_sample_state). FSDEM_ERR_NOT_FOUND. */
 FSDEM_API fsdem_result fsdem_swe_gauge(const fsdem_swe *swe, int id, fsdem_swe_cell *out);
 /* Opens a gauge time series: a CSV with columns t, then h_<id>,eta_<id>,u_<id>,v_<id> per gauge.
    A row is written now and after every step that reaches the next multiple of `interval` (s; 0:
@@ -1184,6 +1340,11 @@ FSDEM_API fsdem_result fsdem_swe_gauge(const fsdem_swe *swe, int id, fsdem_swe_c
 FSDEM_API fsdem_result fsdem_swe_gauges_open(fsdem_swe *swe, const char *path, fsdem_real interval);
 /* Closes the gauge file (also done by fsdem_swe_destroy). FSDEM_ERR_IO. */
 FSDEM_API fsdem_result fsdem_swe_gauges_close(fsdem_swe *swe);
+
+/* Signed distance from p to the SWE bed surface z = z_b(x, y), for fsdem_dem_wall_sdf(fsdem_swe_bed_sdf,
+   swe, material): (z - z_b)/sqrt(1 + |grad z_b|^2) with the bed normal; exact on planar beds. `user` is
+   the fsdem_swe. Points outside the SWE grid take the nearest cell's bed. */
+FSDEM_API fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal);
 
 /* ===== >>couple_swe : SWE-DEM floating debris (seed 003) ========================================== */
 
@@ -1201,12 +1362,13 @@ FSDEM_API fsdem_result fsdem_swe_gauges_close(fsdem_swe *swe);
    source spread over the wet cells under the sphere's footprint as force per unit plan area divided by
    rho (Eq. 8 as printed, S_px = p/rho, is loose about units; this form makes the exchange exact: the
    water gains exactly -F_h dt per step while the debris gains F_h dt).
-   Each coupled step: forces from the current state, one adaptive SWE step dt, then K DEM substeps of
-   dt/K (seed 000 Eq. 25) with the horizontal forces held fixed and the buoyancy (and heave damping)
-   recomputed in every substep from the sphere's height against the held water surface: buoyancy is
-   a stiff spring, and holding it over a whole fluid step would let bobbing grow without bound. A
-   horizontal force is only applied while wet cells under (or next to) the sphere can take its
-   reaction. The coupler owns the SWE's source_x/source_y and the DEM's external_force. */
+   Each coupled step: forces from the current state, one SWE step dt, then K DEM substeps of dt/K
+   (seed 000 Eq. 25, fsdem_dem_advance_with) with the horizontal forces held fixed and the buoyancy
+   (and heave damping) recomputed at every DEM force evaluation from the sphere's height against the
+   held water surface: buoyancy is a stiff spring, and holding it over a whole fluid step would let
+   bobbing grow without bound. A horizontal force is only applied while wet cells under (or next to)
+   the sphere can take its reaction. The coupler owns the SWE's momentum sources and the DEM's
+   external forces, and reaches both solvers through their coupling functions only (>>doc). */
 
 typedef struct fsdem_swe_dem fsdem_swe_dem;
 
@@ -1217,6 +1379,8 @@ typedef struct fsdem_swe_dem_desc {
     int two_way;                  /* 1: the water feels the reaction (Eq. 8); 0: one-way; default 1 */
     fsdem_real heave_damping;     /* -; fraction of critical damping of the bobbing about the floating
                                      draft (wave radiation is not in the SWE); default 0 */
+    long long max_substeps;       /* DEM substeps one coupled step may take; a longer step is refused
+                                     before anything moves; default 100000 */
     fsdem_log_fn log;             /* optional; default NULL */
     void *log_user;
 } fsdem_swe_dem_desc;
@@ -1252,12 +1416,32 @@ FSDEM_API fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *coupler, int
 /* One coupled step: update the forces, one adaptive SWE step of at most dt_cap (<= 0: no cap), then
    the DEM over the same dt in substeps. The step goes to *dt and the substep count to *substeps (both
    may be NULL). Errors of either solver are passed on with their message. */
-FSDEM_API fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *coupler, fsdem_real dt_cap, fsdem_real *dt, int *substeps);
+/* One coupled step of the SWE's stable dt: update the forces, the SWE step, then the DEM over the
+   same dt in substeps. The substep count is checked first, so a step the DEM cannot take (more than
+   max_substeps) is refused with FSDEM_ERR_INVALID_ARG before anything moves. Errors of either
+   solver are passed on with their message. */
+FSDEM_API fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *coupler);
+/* One coupled step of dt (s); FSDEM_ERR_CFL (nothing moved) when it is unstable for the SWE. */
+FSDEM_API fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *coupler, fsdem_real dt);
+/* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
+FSDEM_API fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *coupler, fsdem_real duration, long long *steps);
+/* The SWE's stable dt (s). */
+FSDEM_API fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *coupler, fsdem_real *dt);
+/* The SWE's time (s). */
+FSDEM_API double fsdem_swe_dem_time(const fsdem_swe_dem *coupler);
+FSDEM_API fsdem_swe_dem_desc fsdem_swe_dem_get_desc(const fsdem_swe_dem *coupler);
 
-/* Signed distance from p to the SWE bed surface z = z_b(x, y), for fsdem_wall_sdf(fsdem_swe_bed_sdf,
-   swe, material): (z - z_b)/sqrt(1 + |grad z_b|^2) with the bed normal; exact on planar beds. `user` is
-   the fsdem_swe. Points outside the SWE grid take the nearest cell's bed. */
-FSDEM_API fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal);
+typedef struct fsdem_swe_dem_stats {
+    long long steps;              /* coupled steps */
+    double time;                  /* s */
+    fsdem_real dt;                /* s, the last coupled step */
+    long long substeps;           /* DEM substeps of the last coupled step */
+    long long substeps_total;     /* DEM substeps of all coupled steps */
+    int in_water;                 /* spheres in water at the last force update */
+    fsdem_vec3 impulse_to_water;  /* N s, momentum given to the water by the reactions, total */
+} fsdem_swe_dem_stats;
+
+FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupler);
 
 /* ===== >>io : CSV time series and particle snapshots =============================================== */
 
@@ -1325,7 +1509,7 @@ FSDEM_API fsdem_result fsdem_dem_write_vtk(const fsdem_dem *dem, const char *pat
 /* ===== >>impl_core : results, allocator, messages, vector algebra ================================== */
 
 #define FSDEM__PI 3.14159265358979323846
-#define FSDEM__MESSAGE_SIZE 256
+#define FSDEM__MESSAGE_SIZE 512
 
 /* Forces inlining where the compiler allows it: a kernel written once with a constant argument (a
    contact law, a limiter) is instantiated per value, so hot loops carry no switch. */
@@ -1602,6 +1786,181 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_set(fsdem_real s) {
     return fsdem__lane_load(v);
 }
 
+/* ===== >>impl_geom : signed distances and closest points =============================================
+
+   Contents: closest points (segment, triangle); the unit direction between two points; signed
+   distances (positive outside the solid) of an axis-aligned box (with its outward normal), a sphere
+   or disc, a flat-capped cylinder and a 2D polygon. */
+
+/* Closest point to p on segment a-b. */
+static fsdem_vec3 fsdem__geom_closest_on_segment(fsdem_vec3 p, fsdem_vec3 a, fsdem_vec3 b) {
+    fsdem_vec3 ab = fsdem__sub(b, a);
+    fsdem_real len2 = fsdem__dot(ab, ab), s = len2 > 0 ? fsdem__dot(fsdem__sub(p, a), ab) / len2 : 0;
+    s = s < 0 ? 0 : s > 1 ? 1 : s;
+    return fsdem__madd(a, ab, s);
+}
+
+/* Closest point to p on triangle a-b-c: the projection when it falls inside, else the closest
+   point on the nearest edge (then *on_edge is 1). */
+static fsdem_vec3 fsdem__geom_closest_on_triangle(fsdem_vec3 p, fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c, int *on_edge) {
+    fsdem_vec3 ab = fsdem__sub(b, a), ac = fsdem__sub(c, a), ap = fsdem__sub(p, a);
+    fsdem_vec3 nrm = fsdem__cross(ab, ac), q, best;
+    fsdem_real n2 = fsdem__dot(nrm, nrm), u, v, dist2, best2;
+    fsdem_vec3 edge_point[3];
+    int k;
+    /* barycentric coordinates of the projection of p */
+    v = fsdem__dot(fsdem__cross(ap, ac), nrm) / n2;
+    u = fsdem__dot(fsdem__cross(ab, ap), nrm) / n2;
+    *on_edge = !(v > 0 && u > 0 && u + v < 1);
+    if (v >= 0 && u >= 0 && u + v <= 1) return fsdem__add(a, fsdem__add(fsdem__scale(ab, v), fsdem__scale(ac, u)));
+    edge_point[0] = fsdem__geom_closest_on_segment(p, a, b);
+    edge_point[1] = fsdem__geom_closest_on_segment(p, b, c);
+    edge_point[2] = fsdem__geom_closest_on_segment(p, c, a);
+    best = edge_point[0];
+    q = fsdem__sub(p, best);
+    best2 = fsdem__dot(q, q);
+    for (k = 1; k < 3; ++k) {
+        q = fsdem__sub(p, edge_point[k]);
+        dist2 = fsdem__dot(q, q);
+        if (dist2 < best2) {
+            best2 = dist2;
+            best = edge_point[k];
+        }
+    }
+    return best;
+}
+
+/* Unit vector from q to p, or `fallback` when they coincide; their distance goes to *dist. */
+static fsdem_vec3 fsdem__geom_direction(fsdem_vec3 p, fsdem_vec3 q, fsdem_vec3 fallback, fsdem_real *dist) {
+    fsdem_vec3 dv = fsdem__sub(p, q);
+    *dist = fsdem__norm(dv);
+    return *dist > 0 ? fsdem__scale(dv, 1 / *dist) : fallback;
+}
+
+/* Signed distance from p to the box [lo, hi] over the first `dim` axes (2D: z ignored), positive
+   outside, and the unit outward normal: from the closest point of the surface towards p outside,
+   through the nearest face inside. */
+static fsdem_real fsdem__geom_box(fsdem_vec3 p, fsdem_vec3 lo, fsdem_vec3 hi, int dim, fsdem_vec3 *normal) {
+    fsdem_real q[3], e[3] = {0, 0, 0}, depth = (fsdem_real)HUGE_VAL, dist;
+    int axis, inside = 1, best_axis = 0, best_side = 0;
+    for (axis = 0; axis < 3; ++axis) {
+        const fsdem_real x = fsdem__comp(p, axis), l = fsdem__comp(lo, axis), h = fsdem__comp(hi, axis);
+        q[axis] = axis >= dim ? x : x < l ? l : x > h ? h : x;
+        if (q[axis] != x) inside = 0;
+    }
+    if (!inside) {
+        *normal = fsdem__geom_direction(p, fsdem_v3(q[0], q[1], q[2]), fsdem_v3(1, 0, 0), &dist);
+        return dist;
+    }
+    for (axis = 0; axis < dim; ++axis) {
+        const fsdem_real x = fsdem__comp(p, axis), l = fsdem__comp(lo, axis), h = fsdem__comp(hi, axis);
+        if (x - l < depth) { depth = x - l; best_axis = axis; best_side = 0; }
+        if (h - x < depth) { depth = h - x; best_axis = axis; best_side = 1; }
+    }
+    e[best_axis] = best_side ? 1 : -1;
+    *normal = fsdem_v3(e[0], e[1], e[2]);
+    return -depth;
+}
+
+/* Signed distance from p to a sphere (3D) or a disc in the x-y plane (2D). */
+static fsdem_real fsdem__geom_sphere(fsdem_vec3 p, fsdem_vec3 centre, fsdem_real radius, int dim) {
+    fsdem_vec3 q = fsdem__sub(p, centre);
+    if (dim == 2) q.z = 0;
+    return fsdem__norm(q) - radius;
+}
+
+/* Signed distance from p to the flat-capped cylinder of axis a-b (a != b) and `radius`. */
+static fsdem_real fsdem__geom_cylinder(fsdem_vec3 p, fsdem_vec3 a, fsdem_vec3 b, fsdem_real radius) {
+    fsdem_vec3 e = fsdem__sub(b, a), m = fsdem__scale(fsdem__add(a, b), (fsdem_real)0.5), q;
+    fsdem_real len = fsdem__norm(e), z, rad, dr, dz, o2;
+    e = fsdem__scale(e, 1 / len);
+    q = fsdem__sub(p, m);
+    z = fsdem__dot(q, e);
+    rad = fsdem__norm(fsdem__madd(q, e, -z));
+    dr = rad - radius;
+    dz = (fsdem_real)fabs(z) - len / 2;
+    o2 = (dr > 0 ? dr * dr : 0) + (dz > 0 ? dz * dz : 0);
+    return (dr > dz ? (dr < 0 ? dr : 0) : (dz < 0 ? dz : 0)) + (fsdem_real)sqrt(o2);
+}
+
+/* Signed distance from p (x, y) to the closed polygon of `count` vertices (x, y used), any
+   orientation: the distance to the nearest edge, negative inside (even-odd rule). */
+static fsdem_real fsdem__geom_polygon(fsdem_vec3 p, const fsdem_vec3 *v, int count) {
+    fsdem_real best = (fsdem_real)HUGE_VAL;
+    int i, j, inside = 0;
+    p.z = 0;
+    for (i = 0, j = count - 1; i < count; j = i++) {
+        const fsdem_vec3 vi = fsdem_v3(v[i].x, v[i].y, 0), vj = fsdem_v3(v[j].x, v[j].y, 0);
+        const fsdem_vec3 d = fsdem__sub(p, fsdem__geom_closest_on_segment(p, vj, vi));
+        const fsdem_real d2 = fsdem__dot(d, d);
+        if (d2 < best) best = d2;
+        if ((vi.y > p.y) != (vj.y > p.y) && p.x < (vj.x - vi.x) * (p.y - vi.y) / (vj.y - vi.y) + vi.x) inside = !inside;
+    }
+    best = (fsdem_real)sqrt(best);
+    return inside ? -best : best;
+}
+
+/* ===== >>impl_kernel : interpolation weights ==========================================================
+
+   Contents: fsdem__kernel (per-axis node range, weights, derivatives and clamped node indices) and
+   fsdem__kernel_weights, the tent (linear, 2 nodes) and quadratic B-spline (3 nodes) kernels at a
+   position given in grid units. */
+
+/* Kernel weights of one point along each axis: nodes lo[b] .. lo[b] + count[b] - 1, weights w and
+   their derivatives dw (per grid unit), and the node indices clamped into the grid (idx). */
+typedef struct fsdem__kernel {
+    int lo[3];
+    int count[3];
+    int idx[3][3];
+    fsdem_real w[3][3];
+    fsdem_real dw[3][3];
+} fsdem__kernel;
+
+/* Weights at position s[b] (grid units: node i sits at s = i) on a grid of n[b] nodes, for the first
+   `dim` axes; the others get the single node 0 with weight 1. Positions far outside (or NaN) are
+   clamped to 4 nodes beyond the grid, so the indices stay representable. */
+static void fsdem__kernel_weights(fsdem__kernel *k, int dim, const fsdem_real s[3], const int n[3], int quadratic) {
+    int b, q;
+    for (b = 0; b < 3; ++b) {
+        fsdem_real x = s[b], t;
+        int i0;
+        if (b >= dim) {
+            k->lo[b] = 0;
+            k->count[b] = 1;
+            k->idx[b][0] = 0;
+            k->w[b][0] = 1;
+            k->dw[b][0] = 0;
+            continue;
+        }
+        if (!(x > -4)) x = -4; /* also NaN */
+        if (x > (fsdem_real)n[b] + 4) x = (fsdem_real)n[b] + 4;
+        if (!quadratic) {
+            i0 = (int)(x + 8) - 8; /* floor: x > -8 here */
+            t = x - (fsdem_real)i0;
+            k->count[b] = 2;
+            k->w[b][0] = 1 - t;
+            k->w[b][1] = t;
+            k->dw[b][0] = -1;
+            k->dw[b][1] = 1;
+        } else {
+            i0 = (int)(x + (fsdem_real)7.5) - 8; /* floor(x - 1/2) */
+            t = x - (fsdem_real)i0;
+            k->count[b] = 3;
+            k->w[b][0] = (fsdem_real)0.5 * ((fsdem_real)1.5 - t) * ((fsdem_real)1.5 - t);
+            k->w[b][1] = (fsdem_real)0.75 - (t - 1) * (t - 1);
+            k->w[b][2] = (fsdem_real)0.5 * (t - (fsdem_real)0.5) * (t - (fsdem_real)0.5);
+            k->dw[b][0] = t - (fsdem_real)1.5;
+            k->dw[b][1] = -2 * (t - 1);
+            k->dw[b][2] = t - (fsdem_real)0.5;
+        }
+        k->lo[b] = i0;
+        for (q = 0; q < k->count[b]; ++q) {
+            const int i = i0 + q;
+            k->idx[b][q] = i < 0 ? 0 : i > n[b] - 1 ? n[b] - 1 : i;
+        }
+    }
+}
+
 /* ===== >>impl_grid : cell grid ===================================================================== */
 
 fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *g, const fsdem_allocator *allocator, int dim,
@@ -1738,7 +2097,7 @@ void fsdem_cellgrid_free(fsdem_cellgrid *g) {
 /* ===== >>impl_dem : discrete element method ======================================================== */
 
 /* Constants of one material pair, computed when a material is added. */
-typedef struct fsdem__pair {
+typedef struct fsdem__dem_pair {
     fsdem_real e_star;   /* Pa, 1/E* = (1-nu_i^2)/E_i + (1-nu_j^2)/E_j (Hertz) */
     fsdem_real g_star;   /* Pa, 1/G* = 2(2-nu_i)(1+nu_i)/E_i + 2(2-nu_j)(1+nu_j)/E_j (Mindlin) */
     fsdem_real e_pair;   /* Pa, 2/(1/E_i + 1/E_j): equals E for one material (GIC, k_n = E r) */
@@ -1748,61 +2107,64 @@ typedef struct fsdem__pair {
     fsdem_real rolling;  /* -, mean mu_r */
     fsdem_real restitution; /* -, mean e */
     fsdem_real tsuji;    /* -, damping coefficient giving that restitution (>>dem_law) */
-    /* The law's coefficients in the form the contact kernel evaluates (fsdem__batch_law):
+    /* The law's coefficients in the form the contact kernel evaluates (fsdem__dem_batch_law):
          law      kn                  cn                      kt                 ct
          Hertz    (4/3) E* (Pa)       tsuji^2 (4/3) E* (Pa)   8 G* (Pa)          sqrt(4 G* / E*)
          linear   ||g||/(theta dx)    2 alpha sqrt(kn)        1/(2(1+psi))       1/sqrt(2(1+psi))
                   (1/s^2)             (1/s)                   seed 000 Eq. 10-13 per unit m_ij
          GIC      2 E_pair (Pa)       0                       1/(2(1+nu))        0 */
     fsdem_real kn, cn, kt, ct;
-} fsdem__pair;
+} fsdem__dem_pair;
 
-typedef struct fsdem__wall {
-    fsdem_wall_desc d;
+typedef struct fsdem__dem_wall {
+    fsdem_dem_wall_desc d;
     int active;
     fsdem_vec3 force;   /* N, exerted by the particles on the wall at the last force evaluation */
     fsdem_vec3 impulse; /* N s, given by the wall to the particles since it was added */
     fsdem_vec3 force_a; /* N, force of the predictor evaluation (predictor-corrector) */
     fsdem_real moved;   /* m, distance travelled since the last neighbour-list build */
-} fsdem__wall;
+} fsdem__dem_wall;
 
 /* Neighbour list in compressed rows: the entries of particle i are start[i] .. start[i+1]-1, and
    first[k] = i. Entry k names a partner in key[k] (particle j > i, or wall*8+face) and keeps the
    contact's tangential spring displacement in history[k], the contact history carried across steps
-   and rebuilds. history[k] means something only while key[k] carries FSDEM__HELD (the contact
+   and rebuilds. history[k] means something only while key[k] carries FSDEM__DEM_HELD (the contact
    touched at the last committed force evaluation); without it the spring is zero. So a separation
    costs one bit and the many entries that do not touch are passed over without reading history. */
-typedef struct fsdem__list {
+typedef struct fsdem__dem_list {
     int *start;
     int start_capacity;
     int rows; /* particles the list was built for */
     int *first, *key;
     fsdem_vec3 *history; /* m */
     int count, capacity;
-} fsdem__list;
+} fsdem__dem_list;
 
-#define FSDEM__HELD (1 << 30) /* the entry's spring is live */
-#define FSDEM__PARTNER(key) ((key) & ~FSDEM__HELD)
-#define FSDEM__MAX_PARTICLES (FSDEM__HELD - 1) /* partners and wall keys stay below the flag */
+#define FSDEM__DEM_HELD (1 << 30) /* the entry's spring is live */
+#define FSDEM__DEM_PARTNER(key) ((key) & ~FSDEM__DEM_HELD)
+#define FSDEM__DEM_MAX_PARTICLES (FSDEM__DEM_HELD - 1) /* partners and wall keys stay below the flag */
 
 /* One particle-wall contact of the current positions. */
-typedef struct fsdem__wall_hit {
+typedef struct fsdem__dem_wall_hit {
     int entry;         /* index into the particle-wall list */
     fsdem_vec3 n;      /* unit normal from the wall towards the particle */
     fsdem_real delta;  /* m, overlap > 0 */
     int on_feature;    /* contact point on a triangle edge/vertex or a segment end */
-} fsdem__wall_hit;
+} fsdem__dem_wall_hit;
 
-#define FSDEM__WALL_KEY(wall, face) ((wall) * 8 + (face))
-#define FSDEM__WALL_OF(key) (FSDEM__PARTNER(key) / 8)
-#define FSDEM__FACE_OF(key) (FSDEM__PARTNER(key) % 8)
+#define FSDEM__DEM_WALL_KEY(wall, face) ((wall) * 8 + (face))
+#define FSDEM__DEM_WALL_OF(key) (FSDEM__DEM_PARTNER(key) / 8)
+#define FSDEM__DEM_FACE_OF(key) (FSDEM__DEM_PARTNER(key) % 8)
 
 struct fsdem_dem {
-    fsdem_dem_desc desc;
+    fsdem_dem_desc desc; /* dt_rule and dt_param resolved */
     fsdem__status status;
     fsdem_allocator allocator;
-    fsdem_real dt, time;
+    fsdem_real dt;
+    double time;
     long long steps, rebuilds;
+    fsdem_real stable_dt; /* fsdem_dem_stable_dt at the last rebuild (0: no particles) */
+    int dt_warned;        /* the dt warning was logged for the current dt and stable_dt */
 
     /* particles, structure of arrays */
     int n, capacity, next_id;
@@ -1812,25 +2174,25 @@ struct fsdem_dem {
     fsdem_vec3 *x0, *v0, *w0, *fa, *ta; /* predictor-corrector: start state and first forces */
     fsdem_real *r, *m, *inv_m, *inv_i;
 
-    fsdem_material *materials;
+    fsdem_dem_material *materials;
     int material_count, material_capacity;
-    fsdem__pair *pairs; /* material_count^2 */
+    fsdem__dem_pair *pairs; /* material_count^2 */
     int pair_capacity;
 
-    fsdem__wall *walls;
+    fsdem__dem_wall *walls;
     int wall_count, wall_capacity;
 
-    fsdem__list pp, pp_old, pw, pw_old;
-    struct fsdem__wall_hit *hits; /* scratch: one particle's wall contacts (fsdem__wall_hits) */
+    fsdem__dem_list pp, pp_old, pw, pw_old;
+    struct fsdem__dem_wall_hit *hits; /* scratch: one particle's wall contacts (fsdem__dem_wall_hits) */
     fsdem__arena arena;           /* per-step scratch of the force evaluation, reserved by rebuilds */
-    int *found, found_capacity;   /* scratch of the rebuild: pairs within reach (fsdem__find_pairs) */
+    int *found, found_capacity;   /* scratch of the rebuild: pairs within reach (fsdem__dem_find_pairs) */
     int *inert, inert_count, inert_capacity; /* pairs of fixed particles within reach (i, j), listed aside */
     int hit_capacity;
     fsdem_cellgrid grid;
     fsdem_real skin, r_max, max_disp2, k0_linear;
     int need_rebuild, forces_valid;
     int rolling;  /* some material pair has rolling resistance */
-    int external; /* fext/text may be nonzero (fsdem_dem_external_loads handed them out, or a coupler wrote them) */
+    int external; /* fext/text may be nonzero (fsdem_dem_get_coupling handed them out, or a coupler wrote them) */
     int forces_cleared; /* f and t were zeroed by the last Verlet pass, for the force evaluation */
     int contacts, wall_contacts;
     fsdem_real max_overlap;
@@ -1838,8 +2200,8 @@ struct fsdem_dem {
 
 /* ---- >>dem_desc : defaults and validation ---- */
 
-fsdem_material fsdem_material_default(void) {
-    fsdem_material m;
+fsdem_dem_material fsdem_dem_material_default(void) {
+    fsdem_dem_material m;
     m.density = 2500;
     m.young_modulus = 1e8;
     m.poisson_ratio = (fsdem_real)0.3;
@@ -1857,9 +2219,11 @@ fsdem_dem_desc fsdem_dem_desc_default(int dim) {
     d.domain_min = fsdem_v3(-1, -1, -1);
     d.domain_max = fsdem_v3(1, 1, 1);
     d.gravity = dim == 2 ? fsdem_v3(0, (fsdem_real)-9.81, 0) : fsdem_v3(0, 0, (fsdem_real)-9.81);
-    d.law = FSDEM_CONTACT_HERTZ_MINDLIN;
-    d.integrator = FSDEM_INTEGRATOR_VERLET;
+    d.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
+    d.integrator = FSDEM_DEM_INTEGRATOR_VERLET;
     d.dt = (fsdem_real)1e-5;
+    d.dt_rule = FSDEM_DEM_DT_AUTO;
+    d.dt_param = 0;
     d.skin = -1;
     d.contact_offset = 0;
     d.linear_theta = (fsdem_real)0.01;
@@ -1894,13 +2258,23 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
             return fsdem__reject(msg, size, "fsdem_dem_desc.domain_max must exceed domain_min on axis %d",
                                  axis);
     if (!fsdem__finite3(d->gravity)) return fsdem__reject(msg, size, "fsdem_dem_desc.gravity is not finite");
-    if (d->law != FSDEM_CONTACT_LINEAR && d->law != FSDEM_CONTACT_HERTZ_MINDLIN && d->law != FSDEM_CONTACT_GIC)
-        return fsdem__reject(msg, size, "fsdem_dem_desc.law is not a fsdem_contact_law (%d)", (int)d->law);
-    if (d->integrator != FSDEM_INTEGRATOR_VERLET && d->integrator != FSDEM_INTEGRATOR_PREDICTOR_CORRECTOR)
-        return fsdem__reject(msg, size, "fsdem_dem_desc.integrator is not a fsdem_integrator (%d)",
+    if (d->law != FSDEM_DEM_LAW_LINEAR && d->law != FSDEM_DEM_LAW_HERTZ_MINDLIN && d->law != FSDEM_DEM_LAW_GIC)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.law is not a fsdem_dem_law (%d)", (int)d->law);
+    if (d->integrator != FSDEM_DEM_INTEGRATOR_VERLET && d->integrator != FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.integrator is not a fsdem_dem_integrator (%d)",
                              (int)d->integrator);
     if (!(d->dt > 0) || !fsdem__finite(d->dt))
         return fsdem__reject(msg, size, "fsdem_dem_desc.dt must be > 0 and finite (got %g s)", (double)d->dt);
+    if ((int)d->dt_rule < (int)FSDEM_DEM_DT_AUTO || (int)d->dt_rule > (int)FSDEM_DEM_DT_GIC)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.dt_rule is not a fsdem_dem_dt_rule (%d)", (int)d->dt_rule);
+    if (!(d->dt_param >= 0) || !fsdem__finite(d->dt_param))
+        return fsdem__reject(msg, size, "fsdem_dem_desc.dt_param must be >= 0 (got %g)", (double)d->dt_param);
+    if (d->dt_param > 1 && d->dt_rule != FSDEM_DEM_DT_LINEAR_SEED000 &&
+        !(d->dt_rule == FSDEM_DEM_DT_AUTO && d->law == FSDEM_DEM_LAW_LINEAR))
+        return fsdem__reject(msg, size, "fsdem_dem_desc.dt_param: a safety fraction must be in (0, 1] (got %g)",
+                             (double)d->dt_param);
+    if (d->dt_rule == FSDEM_DEM_DT_LINEAR_SEED000 && d->law != FSDEM_DEM_LAW_LINEAR)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.dt_rule FSDEM_DEM_DT_LINEAR_SEED000 needs the linear law");
     if (!fsdem__finite(d->skin)) return fsdem__reject(msg, size, "fsdem_dem_desc.skin is not finite");
     if (!(d->contact_offset >= 0) || !fsdem__finite(d->contact_offset))
         return fsdem__reject(msg, size, "fsdem_dem_desc.contact_offset must be >= 0 (got %g m)",
@@ -1910,7 +2284,7 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
     if (d->capacity < 0) return fsdem__reject(msg, size, "fsdem_dem_desc.capacity must be >= 0");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return fsdem__reject(msg, size, "fsdem_dem_desc.allocator: set both alloc and free, or neither");
-    if (d->law == FSDEM_CONTACT_LINEAR) {
+    if (d->law == FSDEM_DEM_LAW_LINEAR) {
         fsdem_real accel = d->linear_accel > 0 ? d->linear_accel : fsdem__norm(d->gravity);
         if (!(d->linear_theta > 0) || !fsdem__finite(d->linear_theta))
             return fsdem__reject(msg, size, "fsdem_dem_desc.linear_theta must be > 0 (got %g)", (double)d->linear_theta);
@@ -1920,32 +2294,88 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
         if (!(d->linear_accel >= 0) || !fsdem__finite(d->linear_accel))
             return fsdem__reject(msg, size, "fsdem_dem_desc.linear_accel must be >= 0 (got %g)", (double)d->linear_accel);
         if (!(accel > 0))
-            return fsdem__reject(msg, size, "the linear law needs ||g|| > 0 in seed 000 Eq. 10: set "
+            return fsdem__reject(msg, size, "fsdem_dem_desc: the linear law needs ||g|| > 0 in seed 000 Eq. 10: set "
                                             "fsdem_dem_desc.linear_accel when gravity is zero");
     }
     return FSDEM_OK;
 }
 
-static fsdem_result fsdem__material_check(const fsdem_material *m, char *msg, size_t size) {
-    if (!m) return fsdem__reject(msg, size, "fsdem_material is NULL");
+static fsdem_result fsdem__dem_material_check(const fsdem_dem_material *m, char *msg, size_t size) {
+    if (!m) return fsdem__reject(msg, size, "fsdem_dem_material is NULL");
     if (!(m->density > 0) || !fsdem__finite(m->density))
-        return fsdem__reject(msg, size, "fsdem_material.density must be > 0 (got %g kg/m^3)", (double)m->density);
+        return fsdem__reject(msg, size, "fsdem_dem_material.density must be > 0 (got %g kg/m^3)", (double)m->density);
     /* An infinite modulus is allowed: a rigid wall material. */
     if (!(m->young_modulus > 0))
-        return fsdem__reject(msg, size, "fsdem_material.young_modulus must be > 0 (got %g Pa)", (double)m->young_modulus);
+        return fsdem__reject(msg, size, "fsdem_dem_material.young_modulus must be > 0 (got %g Pa)", (double)m->young_modulus);
     if (!(m->poisson_ratio > -1 && m->poisson_ratio <= (fsdem_real)0.5))
-        return fsdem__reject(msg, size, "fsdem_material.poisson_ratio must be in (-1, 0.5] (got %g)",
+        return fsdem__reject(msg, size, "fsdem_dem_material.poisson_ratio must be in (-1, 0.5] (got %g)",
                              (double)m->poisson_ratio);
     if (!(m->restitution > 0 && m->restitution <= 1))
-        return fsdem__reject(msg, size, "fsdem_material.restitution must be in (0, 1] (got %g)", (double)m->restitution);
+        return fsdem__reject(msg, size, "fsdem_dem_material.restitution must be in (0, 1] (got %g)", (double)m->restitution);
     if (!(m->friction >= 0) || !fsdem__finite(m->friction))
-        return fsdem__reject(msg, size, "fsdem_material.friction must be >= 0 (got %g)", (double)m->friction);
+        return fsdem__reject(msg, size, "fsdem_dem_material.friction must be >= 0 (got %g)", (double)m->friction);
     if (!(m->rolling_friction >= 0) || !fsdem__finite(m->rolling_friction))
-        return fsdem__reject(msg, size, "fsdem_material.rolling_friction must be >= 0 (got %g)",
+        return fsdem__reject(msg, size, "fsdem_dem_material.rolling_friction must be >= 0 (got %g)",
                              (double)m->rolling_friction);
     if (!(m->damping_alpha >= 0) || !fsdem__finite(m->damping_alpha))
-        return fsdem__reject(msg, size, "fsdem_material.damping_alpha must be >= 0 (got %g)", (double)m->damping_alpha);
+        return fsdem__reject(msg, size, "fsdem_dem_material.damping_alpha must be >= 0 (got %g)", (double)m->damping_alpha);
     return FSDEM_OK;
+}
+
+static const char *fsdem__dem_rule_name(fsdem_dem_dt_rule rule) {
+    switch (rule) {
+    case FSDEM_DEM_DT_LINEAR_SEED000: return "seed 000 Eq. 18";
+    case FSDEM_DEM_DT_RAYLEIGH: return "Rayleigh time, seed 002 Eq. 38";
+    case FSDEM_DEM_DT_GIC: return "seed 004 Eq. 32";
+    default: return "?";
+    }
+}
+
+/* The stable dt of the current particles by the resolved rule (+inf without particles). */
+static fsdem_real fsdem__dem_rule_dt(const fsdem_dem *d) {
+    fsdem_real best = (fsdem_real)HUGE_VAL;
+    const fsdem_real param = d->desc.dt_param;
+    int i;
+    switch (d->desc.dt_rule) {
+    case FSDEM_DEM_DT_LINEAR_SEED000:
+        /* Eq. 18 with Eq. 10: m_ij / k = theta dx / ||g|| whatever the masses */
+        return d->n ? (fsdem_real)(2 * FSDEM__PI) / param / (fsdem_real)sqrt(d->k0_linear) : best;
+    case FSDEM_DEM_DT_RAYLEIGH:
+        /* seed 002 Eq. 38 prints 0.01631; the Rayleigh-wave fit it cites (Thornton & Randall 1988)
+           is 0.1631 nu + 0.8766, which we use. */
+        for (i = 0; i < d->n; ++i) {
+            const fsdem_dem_material *m = &d->materials[d->material[i]];
+            fsdem_real t = (fsdem_real)FSDEM__PI * d->r[i] *
+                           (fsdem_real)sqrt(2 * m->density * (1 + m->poisson_ratio) / m->young_modulus) /
+                           ((fsdem_real)0.1631 * m->poisson_ratio + (fsdem_real)0.8766);
+            if (t < best) best = t;
+        }
+        return best * param;
+    default:
+        for (i = 0; i < d->n; ++i) {
+            fsdem_real kn = d->materials[d->material[i]].young_modulus * d->r[i]; /* Eq. 32: k_n = E r */
+            fsdem_real t = (fsdem_real)0.5 * (fsdem_real)sqrt(d->m[i] / kn);
+            if (t < best) best = t;
+        }
+        return best * param;
+    }
+}
+
+/* Refreshes stable_dt (at rebuilds and dt changes) and logs a warning once per change when dt
+   exceeds it, as LIGGGHTS' fix check/timestep/gran does: such a run loses energy conservation
+   long before a particle leaves the domain. */
+static void fsdem__dem_dt_check(fsdem_dem *d) {
+    const fsdem_real limit = fsdem__dem_rule_dt(d);
+    const fsdem_real stable = fsdem__finite(limit) ? limit : 0;
+    if (stable != d->stable_dt) d->dt_warned = 0;
+    d->stable_dt = stable;
+    if (stable > 0 && d->dt > stable && !d->dt_warned && d->status.log) {
+        char msg[FSDEM__MESSAGE_SIZE];
+        snprintf(msg, sizeof msg, "fsdem_dem: dt = %g s is %.3g times the stable dt %g s (%s)", (double)d->dt,
+                 (double)(d->dt / stable), (double)stable, fsdem__dem_rule_name(d->desc.dt_rule));
+        d->status.log(d->status.log_user, FSDEM_LOG_WARNING, msg);
+        d->dt_warned = 1;
+    }
 }
 
 /* ---- >>dem_law : contact laws ---- */
@@ -1955,27 +2385,27 @@ static fsdem_result fsdem__material_check(const fsdem_material *m, char *msg, si
    which is the contact m d'' = -k d^(3/2) - a sqrt(m k) d^(1/4) d' scaled by t0 = (m/(k v0^0.5))^0.4,
    d0 = v0 t0. The scaling removes m, k and v0, so e depends on a alone (Tsuji et al. 1992), and the
    force is clamped at zero (no adhesion) as it is in the simulation. Integrated with RK4. */
-static double fsdem__hertz_restitution(double a) {
+static double fsdem__dem_hertz_restitution(double a) {
     double x = 0, v = 1, h = 4e-3 / (1 + a); /* ~800 steps per contact: e to about 1e-6 */
     int step;
     for (step = 0; step < 100000000; ++step) {
         double k1x, k1v, k2x, k2v, k3x, k3v, k4x, k4v, xs, vs, xn, vn;
-#define FSDEM__HERTZ_ACC(X, V) (-fmax(0.0, fmax(X, 0.0) * sqrt(fmax(X, 0.0)) + a * sqrt(sqrt(fmax(X, 0.0))) * (V)))
+#define FSDEM__DEM_HERTZ_ACC(X, V) (-fmax(0.0, fmax(X, 0.0) * sqrt(fmax(X, 0.0)) + a * sqrt(sqrt(fmax(X, 0.0))) * (V)))
         k1x = v;
-        k1v = FSDEM__HERTZ_ACC(x, v);
+        k1v = FSDEM__DEM_HERTZ_ACC(x, v);
         xs = x + 0.5 * h * k1x;
         vs = v + 0.5 * h * k1v;
         k2x = vs;
-        k2v = FSDEM__HERTZ_ACC(xs, vs);
+        k2v = FSDEM__DEM_HERTZ_ACC(xs, vs);
         xs = x + 0.5 * h * k2x;
         vs = v + 0.5 * h * k2v;
         k3x = vs;
-        k3v = FSDEM__HERTZ_ACC(xs, vs);
+        k3v = FSDEM__DEM_HERTZ_ACC(xs, vs);
         xs = x + h * k3x;
         vs = v + h * k3v;
         k4x = vs;
-        k4v = FSDEM__HERTZ_ACC(xs, vs);
-#undef FSDEM__HERTZ_ACC
+        k4v = FSDEM__DEM_HERTZ_ACC(xs, vs);
+#undef FSDEM__DEM_HERTZ_ACC
         xn = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
         vn = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
         if (step > 0 && xn <= 0) {
@@ -1989,28 +2419,28 @@ static double fsdem__hertz_restitution(double a) {
 }
 
 /* Damping coefficient a whose restitution is e (bisection; e decreases monotonically with a). */
-static fsdem_real fsdem__tsuji_coefficient(fsdem_real e) {
+static fsdem_real fsdem__dem_tsuji_coefficient(fsdem_real e) {
     double lo = 0, hi = 1, mid = 0;
     int it;
     if (e >= 1) return 0;
-    while (fsdem__hertz_restitution(hi) > e && hi < 1e4) hi *= 2;
+    while (fsdem__dem_hertz_restitution(hi) > e && hi < 1e4) hi *= 2;
     for (it = 0; it < 40; ++it) {
         mid = 0.5 * (lo + hi);
-        if (fsdem__hertz_restitution(mid) > e) lo = mid;
+        if (fsdem__dem_hertz_restitution(mid) > e) lo = mid;
         else hi = mid;
     }
     return (fsdem_real)(0.5 * (lo + hi));
 }
 
-static fsdem_real fsdem__inv_or_zero(fsdem_real x) { return fsdem__finite(x) ? 1 / x : 0; }
+static fsdem_real fsdem__dem_inv_or_zero(fsdem_real x) { return fsdem__finite(x) ? 1 / x : 0; }
 
-static void fsdem__pair_setup(fsdem__pair *p, const fsdem_material *a, const fsdem_material *b, fsdem_contact_law law,
-                              fsdem_real k0_linear, const fsdem__pair *known, int known_count) {
+static void fsdem__dem_pair_setup(fsdem__dem_pair *p, const fsdem_dem_material *a, const fsdem_dem_material *b, fsdem_dem_law law,
+                              fsdem_real k0_linear, const fsdem__dem_pair *known, int known_count) {
     fsdem_real ea = a->young_modulus, eb = b->young_modulus, na = a->poisson_ratio, nb = b->poisson_ratio;
     fsdem_real e = (a->restitution + b->restitution) / 2;
-    fsdem_real inv_e = (1 - na * na) * fsdem__inv_or_zero(ea) + (1 - nb * nb) * fsdem__inv_or_zero(eb);
-    fsdem_real inv_g = 2 * (2 - na) * (1 + na) * fsdem__inv_or_zero(ea) + 2 * (2 - nb) * (1 + nb) * fsdem__inv_or_zero(eb);
-    fsdem_real inv_ep = fsdem__inv_or_zero(ea) + fsdem__inv_or_zero(eb);
+    fsdem_real inv_e = (1 - na * na) * fsdem__dem_inv_or_zero(ea) + (1 - nb * nb) * fsdem__dem_inv_or_zero(eb);
+    fsdem_real inv_g = 2 * (2 - na) * (1 + na) * fsdem__dem_inv_or_zero(ea) + 2 * (2 - nb) * (1 + nb) * fsdem__dem_inv_or_zero(eb);
+    fsdem_real inv_ep = fsdem__dem_inv_or_zero(ea) + fsdem__dem_inv_or_zero(eb);
     int k;
     p->e_star = inv_e > 0 ? 1 / inv_e : (fsdem_real)HUGE_VAL;
     p->g_star = inv_g > 0 ? 1 / inv_g : (fsdem_real)HUGE_VAL;
@@ -2021,20 +2451,20 @@ static void fsdem__pair_setup(fsdem__pair *p, const fsdem_material *a, const fsd
     p->rolling = (a->rolling_friction + b->rolling_friction) / 2;
     p->restitution = e;
     p->tsuji = 0;
-    if (law == FSDEM_CONTACT_HERTZ_MINDLIN) {
+    if (law == FSDEM_DEM_LAW_HERTZ_MINDLIN) {
         /* The calibration costs a few milliseconds; reuse it for a restitution seen before. */
         for (k = 0; k < known_count && known[k].restitution != e; ++k) {
         }
-        p->tsuji = k < known_count ? known[k].tsuji : fsdem__tsuji_coefficient(e);
+        p->tsuji = k < known_count ? known[k].tsuji : fsdem__dem_tsuji_coefficient(e);
     }
     switch (law) {
-    case FSDEM_CONTACT_LINEAR:
+    case FSDEM_DEM_LAW_LINEAR:
         p->kn = k0_linear;
         p->cn = 2 * p->alpha * (fsdem_real)sqrt(k0_linear);
         p->kt = 1 / (2 * (1 + p->nu));
         p->ct = 1 / (fsdem_real)sqrt(2 * (1 + p->nu));
         break;
-    case FSDEM_CONTACT_GIC:
+    case FSDEM_DEM_LAW_GIC:
         p->kn = 2 * p->e_pair;
         p->cn = p->ct = 0;
         p->kt = 1 / (2 * (1 + p->nu));
@@ -2049,45 +2479,45 @@ static void fsdem__pair_setup(fsdem__pair *p, const fsdem_material *a, const fsd
     }
 }
 
-/* Contacts in structure-of-arrays form, up to FSDEM__BATCH at a time, for the vector kernel below
-   (fsdem__compute_forces fills and drains them). A particle pair enters as the bodies' data, which
+/* Contacts in structure-of-arrays form, up to FSDEM__DEM_BATCH at a time, for the vector kernel below
+   (fsdem__dem_compute_forces fills and drains them). A particle pair enters as the bodies' data, which
    the kernel turns into a contact; a wall contact enters as a contact. */
-#define FSDEM__BATCH 32
+#define FSDEM__DEM_BATCH 32
 
-typedef struct fsdem__batch {
+typedef struct fsdem__dem_batch {
     int count;
-    int i[FSDEM__BATCH];     /* particle */
-    int other[FSDEM__BATCH]; /* partner particle, or wall index */
-    int entry[FSDEM__BATCH]; /* neighbour-list entry (its spring) */
-    int pair[FSDEM__BATCH];  /* material pair */
+    int i[FSDEM__DEM_BATCH];     /* particle */
+    int other[FSDEM__DEM_BATCH]; /* partner particle, or wall index */
+    int entry[FSDEM__DEM_BATCH]; /* neighbour-list entry (its spring) */
+    int pair[FSDEM__DEM_BATCH];  /* material pair */
     /* particle pairs: geometry input */
-    fsdem_real dx[3][FSDEM__BATCH];       /* m, x_i - x_j */
-    fsdem_real dv[3][FSDEM__BATCH];       /* m/s, v_i - v_j */
-    fsdem_real wi[3][FSDEM__BATCH], wj[3][FSDEM__BATCH]; /* rad/s */
-    fsdem_real ri[FSDEM__BATCH], rj[FSDEM__BATCH];       /* m */
-    fsdem_real inv_mi[FSDEM__BATCH], inv_mj[FSDEM__BATCH]; /* 1/kg */
+    fsdem_real dx[3][FSDEM__DEM_BATCH];       /* m, x_i - x_j */
+    fsdem_real dv[3][FSDEM__DEM_BATCH];       /* m/s, v_i - v_j */
+    fsdem_real wi[3][FSDEM__DEM_BATCH], wj[3][FSDEM__DEM_BATCH]; /* rad/s */
+    fsdem_real ri[FSDEM__DEM_BATCH], rj[FSDEM__DEM_BATCH];       /* m */
+    fsdem_real inv_mi[FSDEM__DEM_BATCH], inv_mj[FSDEM__DEM_BATCH]; /* 1/kg */
     /* the contact: law input */
-    fsdem_real n[3][FSDEM__BATCH];    /* unit normal from the partner to i */
-    fsdem_real delta[FSDEM__BATCH];   /* m, overlap > 0 */
-    fsdem_real vrel[3][FSDEM__BATCH]; /* m/s, velocity of i's contact point relative to the partner's */
-    fsdem_real m_eff[FSDEM__BATCH];   /* kg, reduced mass (m_i for a wall) */
-    fsdem_real m_mean[FSDEM__BATCH];  /* kg, m_ij = (m_i + m_j)/2 of seed 000 Eq. 10 (m_i for a wall) */
-    fsdem_real r_eff[FSDEM__BATCH];   /* m, R* = r_i r_j/(r_i + r_j) (r_i for a wall) */
-    fsdem_real arm_i[FSDEM__BATCH];   /* m, centre of i to the contact point */
-    fsdem_real kn[FSDEM__BATCH], cn[FSDEM__BATCH], kt[FSDEM__BATCH], ct[FSDEM__BATCH]; /* fsdem__pair */
-    fsdem_real mu[FSDEM__BATCH];      /* -, Coulomb coefficient */
-    fsdem_real spring[3][FSDEM__BATCH]; /* m, tangential spring: held value in, new value out */
+    fsdem_real n[3][FSDEM__DEM_BATCH];    /* unit normal from the partner to i */
+    fsdem_real delta[FSDEM__DEM_BATCH];   /* m, overlap > 0 */
+    fsdem_real vrel[3][FSDEM__DEM_BATCH]; /* m/s, velocity of i's contact point relative to the partner's */
+    fsdem_real m_eff[FSDEM__DEM_BATCH];   /* kg, reduced mass (m_i for a wall) */
+    fsdem_real m_mean[FSDEM__DEM_BATCH];  /* kg, m_ij = (m_i + m_j)/2 of seed 000 Eq. 10 (m_i for a wall) */
+    fsdem_real r_eff[FSDEM__DEM_BATCH];   /* m, R* = r_i r_j/(r_i + r_j) (r_i for a wall) */
+    fsdem_real arm_i[FSDEM__DEM_BATCH];   /* m, centre of i to the contact point */
+    fsdem_real kn[FSDEM__DEM_BATCH], cn[FSDEM__DEM_BATCH], kt[FSDEM__DEM_BATCH], ct[FSDEM__DEM_BATCH]; /* fsdem__dem_pair */
+    fsdem_real mu[FSDEM__DEM_BATCH];      /* -, Coulomb coefficient */
+    fsdem_real spring[3][FSDEM__DEM_BATCH]; /* m, tangential spring: held value in, new value out */
     /* output */
-    fsdem_real force[3][FSDEM__BATCH];    /* N, on i */
-    fsdem_real torque_i[3][FSDEM__BATCH]; /* N m, on i */
-    fsdem_real torque_j[3][FSDEM__BATCH]; /* N m, on the partner particle */
-    fsdem_real fn[FSDEM__BATCH];          /* N, normal force */
-} fsdem__batch;
+    fsdem_real force[3][FSDEM__DEM_BATCH];    /* N, on i */
+    fsdem_real torque_i[3][FSDEM__DEM_BATCH]; /* N m, on i */
+    fsdem_real torque_j[3][FSDEM__DEM_BATCH]; /* N m, on the partner particle */
+    fsdem_real fn[FSDEM__DEM_BATCH];          /* N, normal force */
+} fsdem__dem_batch;
 
 /* Copies contact 0 into the lanes after `count` up to a whole lane, so the kernel sees real data
    there: the pair input for a batch of particle pairs (`pairs`), the contact otherwise, and the
    coefficients unless the batch is `uniform`. */
-static void fsdem__batch_pad(fsdem__batch *b, int pairs, int uniform) {
+static void fsdem__dem_batch_pad(fsdem__dem_batch *b, int pairs, int uniform) {
     int c, a;
     for (c = b->count; c % FSDEM__LANES; ++c) {
         for (a = 0; a < 3; ++a) {
@@ -2124,11 +2554,11 @@ static void fsdem__batch_pad(fsdem__batch *b, int pairs, int uniform) {
     }
 }
 
-#define FSDEM__LOAD3(v, arr, c)                \
+#define FSDEM__DEM_LOAD3(v, arr, c)                \
     v##x = fsdem__lane_load(&(arr)[0][c]);     \
     v##y = fsdem__lane_load(&(arr)[1][c]);     \
     v##z = fsdem__lane_load(&(arr)[2][c])
-#define FSDEM__STORE3(arr, c, vx, vy, vz)      \
+#define FSDEM__DEM_STORE3(arr, c, vx, vy, vz)      \
     fsdem__lane_store(&(arr)[0][c], vx);       \
     fsdem__lane_store(&(arr)[1][c], vy);       \
     fsdem__lane_store(&(arr)[2][c], vz)
@@ -2139,8 +2569,8 @@ static void fsdem__batch_pad(fsdem__batch *b, int pairs, int uniform) {
    arms (each body's radius less half the overlap). With `uniform`, every contact has that material
    pair and the batch holds no coefficients. Written once, branch-free, and inlined with a constant
    `law` and `pairs`. h is the step the spring and seed 000's one-step tangential spring (Eq. 8) use. */
-FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_law law, fsdem_real h, const int pairs,
-                                          fsdem_real off, const fsdem__pair *uniform) {
+FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_dem_law law, fsdem_real h, const int pairs,
+                                          fsdem_real off, const fsdem__dem_pair *uniform) {
     const fsdem__lane one = fsdem__lane_set(1), zero = fsdem__lane_set(0);
     int c;
     for (c = 0; c < b->count; c += FSDEM__LANES) {
@@ -2152,10 +2582,10 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             const fsdem__lane ri = fsdem__lane_load(&b->ri[c]), rj = fsdem__lane_load(&b->rj[c]);
             const fsdem__lane inv_m = fsdem__lane_load(&b->inv_mi[c]) + fsdem__lane_load(&b->inv_mj[c]);
             fsdem__mask apart;
-            FSDEM__LOAD3(dx, b->dx, c);
-            FSDEM__LOAD3(v, b->dv, c);
-            FSDEM__LOAD3(wi, b->wi, c);
-            FSDEM__LOAD3(wj, b->wj, c);
+            FSDEM__DEM_LOAD3(dx, b->dx, c);
+            FSDEM__DEM_LOAD3(v, b->dv, c);
+            FSDEM__DEM_LOAD3(wi, b->wi, c);
+            FSDEM__DEM_LOAD3(wj, b->wj, c);
             dist = fsdem__lane_sqrt(dxx * dxx + dxy * dxy + dxz * dxz);
             /* 1/dist and 1/q, q = (1/m_i + 1/m_j)(r_i + r_j) > 0, from one division; coincident
                centres (dx = 0) take the normal (1, 0, 0) */
@@ -2183,8 +2613,8 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             fsdem__lane_store(&b->delta[c], delta);
             fsdem__lane_store(&b->r_eff[c], r_eff);
         } else {
-            FSDEM__LOAD3(n, b->n, c);
-            FSDEM__LOAD3(v, b->vrel, c);
+            FSDEM__DEM_LOAD3(n, b->n, c);
+            FSDEM__DEM_LOAD3(v, b->vrel, c);
             delta = fsdem__lane_load(&b->delta[c]);
             m_eff = fsdem__lane_load(&b->m_eff[c]);
             r_eff = fsdem__lane_load(&b->r_eff[c]);
@@ -2208,7 +2638,7 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
         vx -= vn * nx; /* tangential relative velocity */
         vy -= vn * ny;
         vz -= vn * nz;
-        if (law == FSDEM_CONTACT_LINEAR) {
+        if (law == FSDEM_DEM_LAW_LINEAR) {
             /* seed 000 Eq. 7-13 with m_ij the mean mass: k_n = m_ij ||g|| / (theta dx), c_n = 2 alpha
                sqrt(m_ij k_n), k_t = k_n/(2(1+psi)), c_t = c_n/sqrt(2(1+psi)); the tangential spring
                acts over one DEM step (Eq. 8); no tension cut-off, as printed */
@@ -2218,7 +2648,7 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             ty = g * vy;
             tz = g * vz;
             ft_max = mu * fsdem__lane_max(fn, -fn);
-        } else if (law == FSDEM_CONTACT_GIC) {
+        } else if (law == FSDEM_DEM_LAW_GIC) {
             /* seed 004 Eq. 1a-1c: k_n = E r for equal spheres (here E_pair 2 R*); the viscous
                tangential coefficient is not given in the seed: we take the critical damping of the
                tangential spring k_n/(2(1+nu)) (seed 000 Eq. 12) */
@@ -2233,12 +2663,12 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
                (2/3) S_n d = (4/3) E* s d; tangential stiffness S_t = 8 G* s on the accumulated
                tangential displacement (seed 002 Eq. 20, Coulomb sliding Eq. 22). Damping
                eta = a sqrt((2/3) m* S), Tsuji's a sqrt(m* k) d^(1/4) with a calibrated from e
-               (fsdem__tsuji_coefficient), so eta_n = sqrt(cn m* s) and eta_t = ct eta_n. */
+               (fsdem__dem_tsuji_coefficient), so eta_n = sqrt(cn m* s) and eta_t = ct eta_n. */
             const fsdem__lane s = fsdem__lane_sqrt(r_eff * delta);
             const fsdem__lane eta_n = fsdem__lane_sqrt(cn * m_eff * s), st = kt * s;
             fsdem__lane sn, len2, proj2, inv;
             /* the held spring, turned into the current tangent plane with its length kept */
-            FSDEM__LOAD3(s, b->spring, c);
+            FSDEM__DEM_LOAD3(s, b->spring, c);
             len2 = sx * sx + sy * sy + sz * sz;
             sn = sx * nx + sy * ny + sz * nz;
             sx -= sn * nx;
@@ -2268,10 +2698,10 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             ty *= scale;
             tz *= scale;
             inv = -ft2 * inv; /* -1/S_t where sliding */
-            FSDEM__STORE3(b->spring, c, fsdem__lane_select(slide, tx * inv, sx), fsdem__lane_select(slide, ty * inv, sy),
+            FSDEM__DEM_STORE3(b->spring, c, fsdem__lane_select(slide, tx * inv, sx), fsdem__lane_select(slide, ty * inv, sy),
                           fsdem__lane_select(slide, tz * inv, sz));
         }
-        if (law != FSDEM_CONTACT_HERTZ_MINDLIN) {
+        if (law != FSDEM_DEM_LAW_HERTZ_MINDLIN) {
             /* Coulomb cap (seed 000 Eq. 15, seed 004 Eq. 1b) for the laws without history */
             ft2 = tx * tx + ty * ty + tz * tz;
             slide = ft2 > ft_max * ft_max;
@@ -2280,26 +2710,26 @@ FSDEM__FORCE_INLINE void fsdem__batch_law(fsdem__batch *b, const fsdem_contact_l
             ty *= scale;
             tz *= scale;
         }
-        FSDEM__STORE3(b->force, c, tx + fn * nx, ty + fn * ny, tz + fn * nz);
+        FSDEM__DEM_STORE3(b->force, c, tx + fn * nx, ty + fn * ny, tz + fn * nz);
         fsdem__lane_store(&b->fn[c], fn);
         /* torques: the arms point along -n from i and +n from the partner, torque = arm x F, and
            n x F = n x F_t */
         mx = ny * tz - nz * ty;
         my = nz * tx - nx * tz;
         mz = nx * ty - ny * tx;
-        FSDEM__STORE3(b->torque_i, c, -arm_i * mx, -arm_i * my, -arm_i * mz);
+        FSDEM__DEM_STORE3(b->torque_i, c, -arm_i * mx, -arm_i * my, -arm_i * mz);
         if (pairs) {
-            FSDEM__STORE3(b->torque_j, c, -arm_j * mx, -arm_j * my, -arm_j * mz);
+            FSDEM__DEM_STORE3(b->torque_j, c, -arm_j * mx, -arm_j * my, -arm_j * mz);
         }
     }
 }
 
-#undef FSDEM__LOAD3
-#undef FSDEM__STORE3
+#undef FSDEM__DEM_LOAD3
+#undef FSDEM__DEM_STORE3
 
 /* Constant-torque rolling resistance on i: -mu_r R* |F_n| along the relative spin, limited so that
    it cannot reverse the relative spin within one step. */
-static fsdem_vec3 fsdem__rolling_torque(fsdem_vec3 w_rel, fsdem_real mu_r, fsdem_real r_eff, fsdem_real fn,
+static fsdem_vec3 fsdem__dem_rolling_torque(fsdem_vec3 w_rel, fsdem_real mu_r, fsdem_real r_eff, fsdem_real fn,
                                         fsdem_real inv_i_sum, fsdem_real h) {
     fsdem_real wlen = fsdem__norm(w_rel), tau = mu_r * r_eff * (fn < 0 ? -fn : fn), cap;
     if (wlen == 0 || tau == 0) return fsdem__zero3();
@@ -2311,39 +2741,39 @@ static fsdem_vec3 fsdem__rolling_torque(fsdem_vec3 w_rel, fsdem_real mu_r, fsdem
 /* ---- >>dem_object : creation, materials, particles ---- */
 
 /* Every per-particle array with its element size, so growth and removal treat them alike. */
-#define FSDEM__PARTICLE_ARRAYS 21
-static void fsdem__particle_arrays(fsdem_dem *d, void **ptr[FSDEM__PARTICLE_ARRAYS],
-                                   size_t size[FSDEM__PARTICLE_ARRAYS]) {
+#define FSDEM__DEM_PARTICLE_ARRAYS 21
+static void fsdem__dem_particle_arrays(fsdem_dem *d, void **ptr[FSDEM__DEM_PARTICLE_ARRAYS],
+                                   size_t size[FSDEM__DEM_PARTICLE_ARRAYS]) {
     int k = 0;
-#define FSDEM__ARRAY(field)          \
+#define FSDEM__DEM_ARRAY(field)          \
     ptr[k] = (void **)&d->field;     \
     size[k++] = sizeof(*d->field)
-    FSDEM__ARRAY(id); FSDEM__ARRAY(material); FSDEM__ARRAY(old_of); FSDEM__ARRAY(fixed);
-    FSDEM__ARRAY(x); FSDEM__ARRAY(v); FSDEM__ARRAY(w); FSDEM__ARRAY(f); FSDEM__ARRAY(t);
-    FSDEM__ARRAY(fext); FSDEM__ARRAY(text); FSDEM__ARRAY(x_ref);
-    FSDEM__ARRAY(x0); FSDEM__ARRAY(v0); FSDEM__ARRAY(w0); FSDEM__ARRAY(fa); FSDEM__ARRAY(ta);
-    FSDEM__ARRAY(r); FSDEM__ARRAY(m); FSDEM__ARRAY(inv_m); FSDEM__ARRAY(inv_i);
-#undef FSDEM__ARRAY
-    FSDEM_ASSERT(k == FSDEM__PARTICLE_ARRAYS);
+    FSDEM__DEM_ARRAY(id); FSDEM__DEM_ARRAY(material); FSDEM__DEM_ARRAY(old_of); FSDEM__DEM_ARRAY(fixed);
+    FSDEM__DEM_ARRAY(x); FSDEM__DEM_ARRAY(v); FSDEM__DEM_ARRAY(w); FSDEM__DEM_ARRAY(f); FSDEM__DEM_ARRAY(t);
+    FSDEM__DEM_ARRAY(fext); FSDEM__DEM_ARRAY(text); FSDEM__DEM_ARRAY(x_ref);
+    FSDEM__DEM_ARRAY(x0); FSDEM__DEM_ARRAY(v0); FSDEM__DEM_ARRAY(w0); FSDEM__DEM_ARRAY(fa); FSDEM__DEM_ARRAY(ta);
+    FSDEM__DEM_ARRAY(r); FSDEM__DEM_ARRAY(m); FSDEM__DEM_ARRAY(inv_m); FSDEM__DEM_ARRAY(inv_i);
+#undef FSDEM__DEM_ARRAY
+    FSDEM_ASSERT(k == FSDEM__DEM_PARTICLE_ARRAYS);
 }
 
-static fsdem_result fsdem__reserve_particles(fsdem_dem *d, int need) {
-    void **ptr[FSDEM__PARTICLE_ARRAYS];
-    void *fresh[FSDEM__PARTICLE_ARRAYS];
-    size_t size[FSDEM__PARTICLE_ARRAYS];
+static fsdem_result fsdem__dem_reserve_particles(fsdem_dem *d, int need) {
+    void **ptr[FSDEM__DEM_PARTICLE_ARRAYS];
+    void *fresh[FSDEM__DEM_PARTICLE_ARRAYS];
+    size_t size[FSDEM__DEM_PARTICLE_ARRAYS];
     int k, cap = d->capacity > 0 ? d->capacity : 64;
     if (need <= d->capacity) return FSDEM_OK;
-    if (need > FSDEM__MAX_PARTICLES) return FSDEM_ERR_OUT_OF_MEMORY;
-    while (cap < need) cap = cap > FSDEM__MAX_PARTICLES / 2 ? FSDEM__MAX_PARTICLES : 2 * cap;
-    fsdem__particle_arrays(d, ptr, size);
-    for (k = 0; k < FSDEM__PARTICLE_ARRAYS; ++k) {
+    if (need > FSDEM__DEM_MAX_PARTICLES) return FSDEM_ERR_OUT_OF_MEMORY;
+    while (cap < need) cap = cap > FSDEM__DEM_MAX_PARTICLES / 2 ? FSDEM__DEM_MAX_PARTICLES : 2 * cap;
+    fsdem__dem_particle_arrays(d, ptr, size);
+    for (k = 0; k < FSDEM__DEM_PARTICLE_ARRAYS; ++k) {
         fresh[k] = fsdem__alloc(&d->allocator, size[k] * (size_t)cap);
         if (!fresh[k]) {
             while (k-- > 0) fsdem__free(&d->allocator, fresh[k], size[k] * (size_t)cap);
             return FSDEM_ERR_OUT_OF_MEMORY;
         }
     }
-    for (k = 0; k < FSDEM__PARTICLE_ARRAYS; ++k) {
+    for (k = 0; k < FSDEM__DEM_PARTICLE_ARRAYS; ++k) {
         if (d->n > 0) memcpy(fresh[k], *ptr[k], size[k] * (size_t)d->n);
         fsdem__free(&d->allocator, *ptr[k], size[k] * (size_t)d->capacity);
         *ptr[k] = fresh[k];
@@ -2352,15 +2782,15 @@ static fsdem_result fsdem__reserve_particles(fsdem_dem *d, int need) {
     return FSDEM_OK;
 }
 
-static void fsdem__list_free_entries(fsdem_dem *d, fsdem__list *l) {
+static void fsdem__dem_list_free_entries(fsdem_dem *d, fsdem__dem_list *l) {
     fsdem__free(&d->allocator, l->first, sizeof(int) * (size_t)l->capacity);
     fsdem__free(&d->allocator, l->key, sizeof(int) * (size_t)l->capacity);
     fsdem__free(&d->allocator, l->history, sizeof(fsdem_vec3) * (size_t)l->capacity);
 }
 
-static void fsdem__list_free(fsdem_dem *d, fsdem__list *l) {
+static void fsdem__dem_list_free(fsdem_dem *d, fsdem__dem_list *l) {
     fsdem__free(&d->allocator, l->start, sizeof(int) * (size_t)l->start_capacity);
-    fsdem__list_free_entries(d, l);
+    fsdem__dem_list_free_entries(d, l);
     memset(l, 0, sizeof *l);
 }
 
@@ -2375,6 +2805,14 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
                                        desc ? &desc->allocator : NULL, sizeof *d, &res);
     if (!d) return res;
     d->desc = *desc;
+    if (desc->dt_rule == FSDEM_DEM_DT_AUTO)
+        d->desc.dt_rule = desc->law == FSDEM_DEM_LAW_LINEAR  ? FSDEM_DEM_DT_LINEAR_SEED000
+                          : desc->law == FSDEM_DEM_LAW_GIC ? FSDEM_DEM_DT_GIC
+                                                           : FSDEM_DEM_DT_RAYLEIGH;
+    if (desc->dt_param == 0)
+        d->desc.dt_param = d->desc.dt_rule == FSDEM_DEM_DT_LINEAR_SEED000 ? 150
+                           : d->desc.dt_rule == FSDEM_DEM_DT_RAYLEIGH   ? (fsdem_real)0.2
+                                                                        : 1;
     d->allocator = desc->allocator;
     d->status.log = desc->log;
     d->status.log_user = desc->log_user;
@@ -2383,9 +2821,9 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     d->need_rebuild = 1;
     {
         fsdem_real accel = desc->linear_accel > 0 ? desc->linear_accel : fsdem__norm(desc->gravity);
-        d->k0_linear = desc->law == FSDEM_CONTACT_LINEAR ? accel / (desc->linear_theta * desc->linear_dx) : 0;
+        d->k0_linear = desc->law == FSDEM_DEM_LAW_LINEAR ? accel / (desc->linear_theta * desc->linear_dx) : 0;
     }
-    res = fsdem__reserve_particles(d, desc->capacity > 0 ? desc->capacity : 1);
+    res = fsdem__dem_reserve_particles(d, desc->capacity > 0 ? desc->capacity : 1);
     if (res != FSDEM_OK) {
         fsdem_dem_destroy(d);
         return res;
@@ -2395,22 +2833,22 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
 }
 
 void fsdem_dem_destroy(fsdem_dem *d) {
-    void **ptr[FSDEM__PARTICLE_ARRAYS];
-    size_t size[FSDEM__PARTICLE_ARRAYS];
+    void **ptr[FSDEM__DEM_PARTICLE_ARRAYS];
+    size_t size[FSDEM__DEM_PARTICLE_ARRAYS];
     int k;
     fsdem_allocator al;
     if (!d) return;
     al = d->allocator;
-    fsdem__particle_arrays(d, ptr, size);
-    for (k = 0; k < FSDEM__PARTICLE_ARRAYS; ++k) fsdem__free(&al, *ptr[k], size[k] * (size_t)d->capacity);
-    fsdem__free(&al, d->materials, sizeof(fsdem_material) * (size_t)d->material_capacity);
-    fsdem__free(&al, d->pairs, sizeof(fsdem__pair) * (size_t)d->pair_capacity);
-    fsdem__free(&al, d->walls, sizeof(fsdem__wall) * (size_t)d->wall_capacity);
-    fsdem__list_free(d, &d->pp);
-    fsdem__list_free(d, &d->pp_old);
-    fsdem__list_free(d, &d->pw);
-    fsdem__list_free(d, &d->pw_old);
-    fsdem__free(&al, d->hits, sizeof(fsdem__wall_hit) * (size_t)d->hit_capacity);
+    fsdem__dem_particle_arrays(d, ptr, size);
+    for (k = 0; k < FSDEM__DEM_PARTICLE_ARRAYS; ++k) fsdem__free(&al, *ptr[k], size[k] * (size_t)d->capacity);
+    fsdem__free(&al, d->materials, sizeof(fsdem_dem_material) * (size_t)d->material_capacity);
+    fsdem__free(&al, d->pairs, sizeof(fsdem__dem_pair) * (size_t)d->pair_capacity);
+    fsdem__free(&al, d->walls, sizeof(fsdem__dem_wall) * (size_t)d->wall_capacity);
+    fsdem__dem_list_free(d, &d->pp);
+    fsdem__dem_list_free(d, &d->pp_old);
+    fsdem__dem_list_free(d, &d->pw);
+    fsdem__dem_list_free(d, &d->pw_old);
+    fsdem__free(&al, d->hits, sizeof(fsdem__dem_wall_hit) * (size_t)d->hit_capacity);
     fsdem__arena_free(&al, &d->arena);
     fsdem__free(&al, d->found, sizeof(int) * (size_t)d->found_capacity);
     fsdem__free(&al, d->inert, sizeof(int) * (size_t)d->inert_capacity);
@@ -2420,27 +2858,27 @@ void fsdem_dem_destroy(fsdem_dem *d) {
 
 const char *fsdem_dem_last_error(const fsdem_dem *d) { return d ? d->status.message : "fsdem_dem is NULL"; }
 
-fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_material *mat, int *index) {
+fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_dem_material *mat, int *index) {
     char msg[FSDEM__MESSAGE_SIZE];
     int nm = d->material_count + 1, a, b;
-    fsdem__pair *pairs;
-    if (fsdem__material_check(mat, msg, sizeof msg) != FSDEM_OK)
+    fsdem__dem_pair *pairs;
+    if (fsdem__dem_material_check(mat, msg, sizeof msg) != FSDEM_OK)
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "%s", msg);
     if (fsdem__grow(&d->allocator, (void **)&d->materials, &d->material_capacity, d->material_count, nm,
-                    sizeof(fsdem_material)) != FSDEM_OK)
-        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "out of memory adding a material");
-    pairs = (fsdem__pair *)fsdem__alloc(&d->allocator, sizeof(fsdem__pair) * (size_t)(nm * nm));
-    if (!pairs) return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "out of memory adding a material");
+                    sizeof(fsdem_dem_material)) != FSDEM_OK)
+        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_material: out of memory");
+    pairs = (fsdem__dem_pair *)fsdem__alloc(&d->allocator, sizeof(fsdem__dem_pair) * (size_t)(nm * nm));
+    if (!pairs) return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_material: out of memory");
     d->materials[d->material_count] = *mat;
     for (a = 0; a < nm; ++a)
         for (b = 0; b < nm; ++b) {
             if (a < nm - 1 && b < nm - 1) pairs[a * nm + b] = d->pairs[a * (nm - 1) + b];
             else if (b < a) pairs[a * nm + b] = pairs[b * nm + a];
-            else fsdem__pair_setup(&pairs[a * nm + b], &d->materials[a], &d->materials[b], d->desc.law, d->k0_linear,
+            else fsdem__dem_pair_setup(&pairs[a * nm + b], &d->materials[a], &d->materials[b], d->desc.law, d->k0_linear,
                                    pairs, a * nm + b);
         }
     /* the loop reads earlier rows only, which are already in the new table */
-    fsdem__free(&d->allocator, d->pairs, sizeof(fsdem__pair) * (size_t)d->pair_capacity);
+    fsdem__free(&d->allocator, d->pairs, sizeof(fsdem__dem_pair) * (size_t)d->pair_capacity);
     d->pairs = pairs;
     d->pair_capacity = nm * nm;
     d->material_count = nm;
@@ -2450,58 +2888,58 @@ fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_material *mat, int
     return fsdem__ok(&d->status);
 }
 
-static int fsdem__inside_domain(const fsdem_dem *d, fsdem_vec3 p) {
+static int fsdem__dem_inside_domain(const fsdem_dem *d, fsdem_vec3 p) {
     const fsdem_vec3 lo = d->desc.domain_min, hi = d->desc.domain_max;
     if (!(p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y)) return 0;
     return d->desc.dim == 2 || (p.z >= lo.z && p.z <= hi.z);
 }
 
 /* Checks a kinematic state; writes the reason and returns the code, or FSDEM_OK. */
-static fsdem_result fsdem__state_check(fsdem_dem *d, const char *what, fsdem_vec3 x, fsdem_vec3 v, fsdem_vec3 w) {
+static fsdem_result fsdem__dem_state_check(fsdem_dem *d, const char *what, fsdem_vec3 x, fsdem_vec3 v, fsdem_vec3 w) {
     if (!fsdem__finite3(x) || !fsdem__finite3(v) || !fsdem__finite3(w))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "%s: position, velocity and angular velocity must be finite",
                            what);
-    if (!fsdem__inside_domain(d, x))
+    if (!fsdem__dem_inside_domain(d, x))
         return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_DOMAIN, "%s: position (%g, %g, %g) m is outside the domain", what,
                            (double)x.x, (double)x.y, (double)x.z);
     return FSDEM_OK;
 }
 
-fsdem_particle_desc fsdem_particle_desc_default(void) {
-    fsdem_particle_desc p;
+fsdem_dem_particle_desc fsdem_dem_particle_desc_default(void) {
+    fsdem_dem_particle_desc p;
     memset(&p, 0, sizeof p);
     return p;
 }
 
 /* Keeps 2D state in the plane: z of positions and velocities, x and y of spins. */
-static void fsdem__planar(const fsdem_dem *d, fsdem_vec3 *x, fsdem_vec3 *v, fsdem_vec3 *w) {
+static void fsdem__dem_planar(const fsdem_dem *d, fsdem_vec3 *x, fsdem_vec3 *v, fsdem_vec3 *w) {
     if (d->desc.dim != 2) return;
     x->z = 0;
     v->z = 0;
     w->x = w->y = 0;
 }
 
-fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_particle_desc *p, int *index) {
+fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_dem_particle_desc *p, int *index) {
     fsdem_result res;
     int i = d->n;
     fsdem_real volume, inertia_factor, rho;
     fsdem_vec3 x, v, w;
     if (!p) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_add_particle: desc is NULL");
     if (!(p->radius > 0) || !fsdem__finite(p->radius))
-        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_particle_desc.radius must be > 0 (got %g m)",
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_particle_desc.radius must be > 0 (got %g m)",
                            (double)p->radius);
     if (p->material < 0 || p->material >= d->material_count)
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
-                           "fsdem_particle_desc.material %d is not a material of this simulation (%d added)",
+                           "fsdem_dem_particle_desc.material %d is not a material of this simulation (%d added)",
                            p->material, d->material_count);
-    res = fsdem__state_check(d, "fsdem_particle_desc", p->position, p->velocity, p->angular_velocity);
+    res = fsdem__dem_state_check(d, "fsdem_dem_particle_desc", p->position, p->velocity, p->angular_velocity);
     if (res != FSDEM_OK) return res;
-    if (fsdem__reserve_particles(d, d->n + 1) != FSDEM_OK)
-        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "out of memory adding particle %d", d->n);
+    if (fsdem__dem_reserve_particles(d, d->n + 1) != FSDEM_OK)
+        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_particle: out of memory adding particle %d", d->n);
     x = p->position;
     v = p->velocity;
     w = p->angular_velocity;
-    fsdem__planar(d, &x, &v, &w);
+    fsdem__dem_planar(d, &x, &v, &w);
     rho = d->materials[p->material].density;
     if (d->desc.dim == 2) {
         volume = (fsdem_real)FSDEM__PI * p->radius * p->radius * d->desc.disc_length;
@@ -2531,14 +2969,14 @@ fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_particle_desc *p, 
 }
 
 fsdem_result fsdem_dem_remove_particle(fsdem_dem *d, int index) {
-    void **ptr[FSDEM__PARTICLE_ARRAYS];
-    size_t size[FSDEM__PARTICLE_ARRAYS];
+    void **ptr[FSDEM__DEM_PARTICLE_ARRAYS];
+    size_t size[FSDEM__DEM_PARTICLE_ARRAYS];
     int k;
     if (index < 0 || index >= d->n)
         return fsdem__fail(&d->status, FSDEM_ERR_NOT_FOUND, "fsdem_dem_remove_particle: index %d not in [0, %d)", index,
                            d->n);
-    fsdem__particle_arrays(d, ptr, size);
-    for (k = 0; k < FSDEM__PARTICLE_ARRAYS; ++k) {
+    fsdem__dem_particle_arrays(d, ptr, size);
+    for (k = 0; k < FSDEM__DEM_PARTICLE_ARRAYS; ++k) {
         char *base = (char *)*ptr[k];
         memmove(base + size[k] * (size_t)index, base + size[k] * (size_t)(index + 1),
                 size[k] * (size_t)(d->n - index - 1));
@@ -2554,9 +2992,9 @@ fsdem_result fsdem_dem_set_particle_state(fsdem_dem *d, int index, fsdem_vec3 x,
     if (index < 0 || index >= d->n)
         return fsdem__fail(&d->status, FSDEM_ERR_NOT_FOUND, "fsdem_dem_set_particle_state: index %d not in [0, %d)",
                            index, d->n);
-    res = fsdem__state_check(d, "fsdem_dem_set_particle_state", x, v, w);
+    res = fsdem__dem_state_check(d, "fsdem_dem_set_particle_state", x, v, w);
     if (res != FSDEM_OK) return res;
-    fsdem__planar(d, &x, &v, &w);
+    fsdem__dem_planar(d, &x, &v, &w);
     d->x[index] = x;
     d->v[index] = v;
     d->w[index] = w;
@@ -2565,8 +3003,8 @@ fsdem_result fsdem_dem_set_particle_state(fsdem_dem *d, int index, fsdem_vec3 x,
     return fsdem__ok(&d->status);
 }
 
-fsdem_particles fsdem_dem_particles(const fsdem_dem *d) {
-    fsdem_particles p;
+fsdem_dem_particles fsdem_dem_get_particles(const fsdem_dem *d) {
+    fsdem_dem_particles p;
     p.count = d->n;
     p.dim = d->desc.dim;
     p.id = d->id;
@@ -2584,8 +3022,8 @@ fsdem_particles fsdem_dem_particles(const fsdem_dem *d) {
     return p;
 }
 
-fsdem_external_loads fsdem_dem_external_loads(fsdem_dem *d) {
-    fsdem_external_loads e;
+fsdem_dem_coupling fsdem_dem_get_coupling(fsdem_dem *d) {
+    fsdem_dem_coupling e;
     e.count = d->n;
     e.force = d->fext;
     e.torque = d->text;
@@ -2595,8 +3033,8 @@ fsdem_external_loads fsdem_dem_external_loads(fsdem_dem *d) {
 
 /* ---- >>dem_wall : wall geometry ---- */
 
-static fsdem_wall_desc fsdem__wall_desc(fsdem_wall_type type, fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c, int material) {
-    fsdem_wall_desc w;
+static fsdem_dem_wall_desc fsdem__dem_wall_desc(fsdem_dem_wall_type type, fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c, int material) {
+    fsdem_dem_wall_desc w;
     memset(&w, 0, sizeof w);
     w.type = type;
     w.a = a;
@@ -2606,133 +3044,67 @@ static fsdem_wall_desc fsdem__wall_desc(fsdem_wall_type type, fsdem_vec3 a, fsde
     return w;
 }
 
-fsdem_wall_desc fsdem_wall_plane(fsdem_vec3 point, fsdem_vec3 normal, int material) {
-    return fsdem__wall_desc(FSDEM_WALL_PLANE, point, normal, fsdem__zero3(), material);
+fsdem_dem_wall_desc fsdem_dem_wall_plane(fsdem_vec3 point, fsdem_vec3 normal, int material) {
+    return fsdem__dem_wall_desc(FSDEM_DEM_WALL_PLANE, point, normal, fsdem__zero3(), material);
 }
-fsdem_wall_desc fsdem_wall_box(fsdem_vec3 lo, fsdem_vec3 hi, int inside, int material) {
-    return fsdem__wall_desc(inside ? FSDEM_WALL_BOX_INSIDE : FSDEM_WALL_BOX_OUTSIDE, lo, hi, fsdem__zero3(), material);
+fsdem_dem_wall_desc fsdem_dem_wall_box(fsdem_vec3 lo, fsdem_vec3 hi, int inside, int material) {
+    return fsdem__dem_wall_desc(inside ? FSDEM_DEM_WALL_BOX_INSIDE : FSDEM_DEM_WALL_BOX_OUTSIDE, lo, hi, fsdem__zero3(), material);
 }
-fsdem_wall_desc fsdem_wall_segment(fsdem_vec3 a, fsdem_vec3 b, int material) {
-    return fsdem__wall_desc(FSDEM_WALL_SEGMENT, a, b, fsdem__zero3(), material);
+fsdem_dem_wall_desc fsdem_dem_wall_segment(fsdem_vec3 a, fsdem_vec3 b, int material) {
+    return fsdem__dem_wall_desc(FSDEM_DEM_WALL_SEGMENT, a, b, fsdem__zero3(), material);
 }
-fsdem_wall_desc fsdem_wall_triangle(fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c, int material) {
-    return fsdem__wall_desc(FSDEM_WALL_TRIANGLE, a, b, c, material);
+fsdem_dem_wall_desc fsdem_dem_wall_triangle(fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c, int material) {
+    return fsdem__dem_wall_desc(FSDEM_DEM_WALL_TRIANGLE, a, b, c, material);
 }
-fsdem_wall_desc fsdem_wall_sdf(fsdem_sdf_fn sdf, void *user, int material) {
-    fsdem_wall_desc w = fsdem__wall_desc(FSDEM_WALL_SDF, fsdem__zero3(), fsdem__zero3(), fsdem__zero3(), material);
+fsdem_dem_wall_desc fsdem_dem_wall_sdf(fsdem_sdf_fn sdf, void *user, int material) {
+    fsdem_dem_wall_desc w = fsdem__dem_wall_desc(FSDEM_DEM_WALL_SDF, fsdem__zero3(), fsdem__zero3(), fsdem__zero3(), material);
     w.sdf = sdf;
     w.sdf_user = user;
     return w;
 }
 
-static int fsdem__wall_faces(const fsdem__wall *w, int dim) {
-    return w->d.type == FSDEM_WALL_BOX_INSIDE ? 2 * dim : 1;
-}
-
-/* Closest point to p on segment a-b. */
-static fsdem_vec3 fsdem__closest_on_segment(fsdem_vec3 p, fsdem_vec3 a, fsdem_vec3 b) {
-    fsdem_vec3 ab = fsdem__sub(b, a);
-    fsdem_real len2 = fsdem__dot(ab, ab), s = len2 > 0 ? fsdem__dot(fsdem__sub(p, a), ab) / len2 : 0;
-    s = s < 0 ? 0 : s > 1 ? 1 : s;
-    return fsdem__madd(a, ab, s);
-}
-
-/* Closest point to p on triangle a-b-c: the projection when it falls inside, else the closest
-   point on the nearest edge (then *on_edge is 1). */
-static fsdem_vec3 fsdem__closest_on_triangle(fsdem_vec3 p, fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c, int *on_edge) {
-    fsdem_vec3 ab = fsdem__sub(b, a), ac = fsdem__sub(c, a), ap = fsdem__sub(p, a);
-    fsdem_vec3 nrm = fsdem__cross(ab, ac), q, best;
-    fsdem_real n2 = fsdem__dot(nrm, nrm), u, v, dist2, best2;
-    fsdem_vec3 edge_point[3];
-    int k;
-    /* barycentric coordinates of the projection of p */
-    v = fsdem__dot(fsdem__cross(ap, ac), nrm) / n2;
-    u = fsdem__dot(fsdem__cross(ab, ap), nrm) / n2;
-    *on_edge = !(v > 0 && u > 0 && u + v < 1);
-    if (v >= 0 && u >= 0 && u + v <= 1) return fsdem__add(a, fsdem__add(fsdem__scale(ab, v), fsdem__scale(ac, u)));
-    edge_point[0] = fsdem__closest_on_segment(p, a, b);
-    edge_point[1] = fsdem__closest_on_segment(p, b, c);
-    edge_point[2] = fsdem__closest_on_segment(p, c, a);
-    best = edge_point[0];
-    q = fsdem__sub(p, best);
-    best2 = fsdem__dot(q, q);
-    for (k = 1; k < 3; ++k) {
-        q = fsdem__sub(p, edge_point[k]);
-        dist2 = fsdem__dot(q, q);
-        if (dist2 < best2) {
-            best2 = dist2;
-            best = edge_point[k];
-        }
-    }
-    return best;
-}
-
-/* Unit vector from q to p, or `fallback` when they coincide. */
-static fsdem_vec3 fsdem__direction(fsdem_vec3 p, fsdem_vec3 q, fsdem_vec3 fallback, fsdem_real *dist) {
-    fsdem_vec3 dv = fsdem__sub(p, q);
-    *dist = fsdem__norm(dv);
-    return *dist > 0 ? fsdem__scale(dv, 1 / *dist) : fallback;
+static int fsdem__dem_wall_faces(const fsdem__dem_wall *w, int dim) {
+    return w->d.type == FSDEM_DEM_WALL_BOX_INSIDE ? 2 * dim : 1;
 }
 
 /* Signed distance (m) from p to face `face` of a wall, with the unit normal from the wall towards p.
    *on_feature is set when the closest point is an edge or vertex of a triangle, or an end of a
-   segment: such points are shared by neighbouring elements of a mesh (see fsdem__wall_hits). */
-static fsdem_real fsdem__wall_distance(const fsdem__wall *w, int face, fsdem_vec3 p, int dim, fsdem_vec3 *n,
+   segment: such points are shared by neighbouring elements of a mesh (see fsdem__dem_wall_hits). */
+static fsdem_real fsdem__dem_wall_distance(const fsdem__dem_wall *w, int face, fsdem_vec3 p, int dim, fsdem_vec3 *n,
                                       int *on_feature) {
-    const fsdem_wall_desc *g = &w->d;
+    const fsdem_dem_wall_desc *g = &w->d;
     fsdem_real dist;
     *on_feature = 0;
     switch (g->type) {
-    case FSDEM_WALL_PLANE:
+    case FSDEM_DEM_WALL_PLANE:
         *n = g->b;
         return fsdem__dot(fsdem__sub(p, g->a), g->b);
-    case FSDEM_WALL_BOX_INSIDE: {
+    case FSDEM_DEM_WALL_BOX_INSIDE: {
         int axis = face / 2;
         fsdem_real e[3] = {0, 0, 0};
         e[axis] = face % 2 == 0 ? 1 : -1;
         *n = fsdem_v3(e[0], e[1], e[2]);
         return face % 2 == 0 ? fsdem__comp(p, axis) - fsdem__comp(g->a, axis) : fsdem__comp(g->b, axis) - fsdem__comp(p, axis);
     }
-    case FSDEM_WALL_BOX_OUTSIDE: {
-        fsdem_real pc[3] = {p.x, p.y, p.z}, lo[3] = {g->a.x, g->a.y, g->a.z}, hi[3] = {g->b.x, g->b.y, g->b.z};
-        fsdem_real q[3], e[3] = {0, 0, 0}, depth = (fsdem_real)HUGE_VAL;
-        int axis, inside = 1, best_axis = 0, best_side = 0;
-        for (axis = 0; axis < 3; ++axis) {
-            q[axis] = pc[axis] < lo[axis] ? lo[axis] : pc[axis] > hi[axis] ? hi[axis] : pc[axis];
-            if (axis < dim && q[axis] != pc[axis]) inside = 0;
-        }
-        if (dim == 2) q[2] = pc[2];
-        if (!inside) {
-            *n = fsdem__direction(p, fsdem_v3(q[0], q[1], q[2]), fsdem_v3(1, 0, 0), &dist);
-            return dist;
-        }
-        /* centre inside the solid: push out through the nearest face */
-        for (axis = 0; axis < dim; ++axis) {
-            if (pc[axis] - lo[axis] < depth) { depth = pc[axis] - lo[axis]; best_axis = axis; best_side = 0; }
-            if (hi[axis] - pc[axis] < depth) { depth = hi[axis] - pc[axis]; best_axis = axis; best_side = 1; }
-        }
-        e[best_axis] = best_side ? 1 : -1;
-        *n = fsdem_v3(e[0], e[1], e[2]);
-        return -depth;
-    }
-    case FSDEM_WALL_SEGMENT: {
+    case FSDEM_DEM_WALL_BOX_OUTSIDE: return fsdem__geom_box(p, g->a, g->b, dim, n);
+    case FSDEM_DEM_WALL_SEGMENT: {
         fsdem_vec3 ab = fsdem__sub(g->b, g->a), perp = fsdem_v3(-ab.y, ab.x, 0);
         fsdem_real len = fsdem__norm(perp);
-        fsdem_vec3 q = fsdem__closest_on_segment(p, g->a, g->b);
+        fsdem_vec3 q = fsdem__geom_closest_on_segment(p, g->a, g->b);
         perp = len > 0 ? fsdem__scale(perp, 1 / len) : fsdem_v3(0, 1, 0);
         *on_feature = fsdem__dot(fsdem__sub(q, g->a), fsdem__sub(q, g->a)) == 0 ||
                       fsdem__dot(fsdem__sub(q, g->b), fsdem__sub(q, g->b)) == 0;
-        *n = fsdem__direction(p, q, perp, &dist);
+        *n = fsdem__geom_direction(p, q, perp, &dist);
         return dist;
     }
-    case FSDEM_WALL_TRIANGLE: {
+    case FSDEM_DEM_WALL_TRIANGLE: {
         fsdem_vec3 nrm = fsdem__cross(fsdem__sub(g->b, g->a), fsdem__sub(g->c, g->a));
-        fsdem_vec3 q = fsdem__closest_on_triangle(p, g->a, g->b, g->c, on_feature);
+        fsdem_vec3 q = fsdem__geom_closest_on_triangle(p, g->a, g->b, g->c, on_feature);
         nrm = fsdem__scale(nrm, 1 / fsdem__norm(nrm));
-        *n = fsdem__direction(p, q, nrm, &dist);
+        *n = fsdem__geom_direction(p, q, nrm, &dist);
         return dist;
     }
-    case FSDEM_WALL_SDF:
+    case FSDEM_DEM_WALL_SDF:
     default: {
         fsdem_vec3 grad = fsdem_v3(0, 0, 1);
         fsdem_real len;
@@ -2745,60 +3117,60 @@ static fsdem_real fsdem__wall_distance(const fsdem__wall *w, int face, fsdem_vec
     }
 }
 
-fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_wall_desc *desc, int *id) {
-    fsdem_wall_desc g;
-    fsdem__wall *w;
+fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_dem_wall_desc *desc, int *id) {
+    fsdem_dem_wall_desc g;
+    fsdem__dem_wall *w;
     int axis;
     if (!desc) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_add_wall: desc is NULL");
     g = *desc;
     if (g.material < 0 || g.material >= d->material_count)
-        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_desc.material %d is not a material of this simulation",
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_desc.material %d is not a material of this simulation",
                            g.material);
     if (!fsdem__finite3(g.a) || !fsdem__finite3(g.b) || !fsdem__finite3(g.c) || !fsdem__finite3(g.velocity))
-        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_desc: geometry and velocity must be finite");
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_desc: geometry and velocity must be finite");
     if (d->desc.dim == 2) {
         g.a.z = g.b.z = g.c.z = g.velocity.z = 0;
     }
     switch (g.type) {
-    case FSDEM_WALL_PLANE: {
+    case FSDEM_DEM_WALL_PLANE: {
         fsdem_real len;
         if (d->desc.dim == 2) g.b.z = 0;
         len = fsdem__norm(g.b);
-        if (!(len > 0)) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_plane: the normal is zero");
+        if (!(len > 0)) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_plane: the normal is zero");
         g.b = fsdem__scale(g.b, 1 / len);
         break;
     }
-    case FSDEM_WALL_BOX_INSIDE:
-    case FSDEM_WALL_BOX_OUTSIDE:
+    case FSDEM_DEM_WALL_BOX_INSIDE:
+    case FSDEM_DEM_WALL_BOX_OUTSIDE:
         for (axis = 0; axis < d->desc.dim; ++axis)
             if (!(fsdem__comp(g.b, axis) > fsdem__comp(g.a, axis)))
-                return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_box: hi must exceed lo on axis %d", axis);
+                return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_box: hi must exceed lo on axis %d", axis);
         break;
-    case FSDEM_WALL_SEGMENT:
+    case FSDEM_DEM_WALL_SEGMENT:
         if (!(fsdem__norm(fsdem__sub(g.b, g.a)) > 0))
-            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_segment: the end points coincide");
+            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_segment: the end points coincide");
         break;
-    case FSDEM_WALL_TRIANGLE:
+    case FSDEM_DEM_WALL_TRIANGLE:
         if (d->desc.dim != 3)
-            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_triangle: triangles need dim = 3 (use segments in 2D)");
+            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_triangle: triangles need dim = 3 (use segments in 2D)");
         if (!(fsdem__norm(fsdem__cross(fsdem__sub(g.b, g.a), fsdem__sub(g.c, g.a))) > 0))
-            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_triangle: the triangle is degenerate");
+            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_triangle: the triangle is degenerate");
         break;
-    case FSDEM_WALL_SDF:
-        if (!g.sdf) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_sdf: the callback is NULL");
+    case FSDEM_DEM_WALL_SDF:
+        if (!g.sdf) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_sdf: the callback is NULL");
         if (fsdem__norm(g.velocity) > 0)
             return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
-                               "fsdem_wall_sdf: a moving SDF wall must move inside its callback (velocity must be 0)");
+                               "fsdem_dem_wall_sdf: a moving SDF wall must move inside its callback (velocity must be 0)");
         break;
     default:
-        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_wall_desc.type %d is not a fsdem_wall_type", (int)g.type);
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_desc.type %d is not a fsdem_dem_wall_type", (int)g.type);
     }
     /* wall keys (wall * 8 + face) stay below the entry flags */
-    if (d->wall_count >= FSDEM__HELD / 8)
-        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_wall: at most %d walls", FSDEM__HELD / 8);
+    if (d->wall_count >= FSDEM__DEM_HELD / 8)
+        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_wall: at most %d walls", FSDEM__DEM_HELD / 8);
     if (fsdem__grow(&d->allocator, (void **)&d->walls, &d->wall_capacity, d->wall_count, d->wall_count + 1,
-                    sizeof(fsdem__wall)) != FSDEM_OK)
-        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "out of memory adding a wall");
+                    sizeof(fsdem__dem_wall)) != FSDEM_OK)
+        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_wall: out of memory");
     w = &d->walls[d->wall_count];
     memset(w, 0, sizeof *w);
     w->d = g;
@@ -2810,7 +3182,7 @@ fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_wall_desc *desc, int *
     return fsdem__ok(&d->status);
 }
 
-static fsdem__wall *fsdem__wall_by_id(fsdem_dem *d, int id, const char *what) {
+static fsdem__dem_wall *fsdem__dem_wall_by_id(fsdem_dem *d, int id, const char *what) {
     if (id < 0 || id >= d->wall_count || !d->walls[id].active) {
         fsdem__fail(&d->status, FSDEM_ERR_NOT_FOUND, "%s: wall %d does not exist", what, id);
         return NULL;
@@ -2819,7 +3191,7 @@ static fsdem__wall *fsdem__wall_by_id(fsdem_dem *d, int id, const char *what) {
 }
 
 fsdem_result fsdem_dem_remove_wall(fsdem_dem *d, int id) {
-    fsdem__wall *w = fsdem__wall_by_id(d, id, "fsdem_dem_remove_wall");
+    fsdem__dem_wall *w = fsdem__dem_wall_by_id(d, id, "fsdem_dem_remove_wall");
     if (!w) return FSDEM_ERR_NOT_FOUND;
     w->active = 0;
     w->force = fsdem__zero3();
@@ -2829,11 +3201,11 @@ fsdem_result fsdem_dem_remove_wall(fsdem_dem *d, int id) {
 }
 
 fsdem_result fsdem_dem_set_wall_velocity(fsdem_dem *d, int id, fsdem_vec3 velocity) {
-    fsdem__wall *w = fsdem__wall_by_id(d, id, "fsdem_dem_set_wall_velocity");
+    fsdem__dem_wall *w = fsdem__dem_wall_by_id(d, id, "fsdem_dem_set_wall_velocity");
     if (!w) return FSDEM_ERR_NOT_FOUND;
     if (!fsdem__finite3(velocity))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_set_wall_velocity: velocity must be finite");
-    if (w->d.type == FSDEM_WALL_SDF && fsdem__norm(velocity) > 0)
+    if (w->d.type == FSDEM_DEM_WALL_SDF && fsdem__norm(velocity) > 0)
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_set_wall_velocity: an SDF wall moves in its callback");
     if (d->desc.dim == 2) velocity.z = 0;
     w->d.velocity = velocity;
@@ -2841,7 +3213,7 @@ fsdem_result fsdem_dem_set_wall_velocity(fsdem_dem *d, int id, fsdem_vec3 veloci
 }
 
 fsdem_result fsdem_dem_wall_moved(fsdem_dem *d, int id, fsdem_real distance) {
-    fsdem__wall *w = fsdem__wall_by_id(d, id, "fsdem_dem_wall_moved");
+    fsdem__dem_wall *w = fsdem__dem_wall_by_id(d, id, "fsdem_dem_wall_moved");
     if (!w) return FSDEM_ERR_NOT_FOUND;
     if (!(distance >= 0) || !fsdem__finite(distance))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_moved: distance must be >= 0 (got %g m)",
@@ -2861,7 +3233,7 @@ fsdem_vec3 fsdem_dem_wall_impulse(const fsdem_dem *d, int id) {
 /* ---- >>dem_neighbours : neighbour lists with contact history ---- */
 
 /* Doubles the entry arrays of a list (all three or none). */
-static fsdem_result fsdem__list_grow(fsdem_dem *d, fsdem__list *l) {
+static fsdem_result fsdem__dem_list_grow(fsdem_dem *d, fsdem__dem_list *l) {
     const size_t n = (size_t)l->count;
     int cap = l->capacity > 0 ? 2 * l->capacity : 256;
     int *first, *key;
@@ -2881,7 +3253,7 @@ static fsdem_result fsdem__list_grow(fsdem_dem *d, fsdem__list *l) {
         memcpy(key, l->key, sizeof(int) * n);
         memcpy(history, l->history, sizeof(fsdem_vec3) * n);
     }
-    fsdem__list_free_entries(d, l);
+    fsdem__dem_list_free_entries(d, l);
     l->first = first;
     l->key = key;
     l->history = history;
@@ -2893,35 +3265,35 @@ static fsdem_result fsdem__list_grow(fsdem_dem *d, fsdem__list *l) {
 /* Writes entry e = (row, partner `key`) with the spring that entry `from` of list `old` holds (none
    for -1). Without branches on the flag: the spring is copied whether held or not, as it means
    nothing without it. */
-static void fsdem__list_set(fsdem__list *l, int e, int row, int key, const fsdem__list *old, int from) {
+static void fsdem__dem_list_set(fsdem__dem_list *l, int e, int row, int key, const fsdem__dem_list *old, int from) {
     const int src = from >= 0 ? from : 0;
     l->first[e] = row;
-    l->key[e] = key | (((from >= 0) & (old->count > 0)) ? old->key[src] & FSDEM__HELD : 0);
+    l->key[e] = key | (((from >= 0) & (old->count > 0)) ? old->key[src] & FSDEM__DEM_HELD : 0);
     if (old->count > 0) l->history[e] = old->history[src];
 }
 
-static fsdem_result fsdem__list_append(fsdem_dem *d, fsdem__list *l, int row, int key, const fsdem__list *old, int from) {
-    if (l->count == l->capacity && fsdem__list_grow(d, l) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
-    fsdem__list_set(l, l->count++, row, key, old, from);
+static fsdem_result fsdem__dem_list_append(fsdem_dem *d, fsdem__dem_list *l, int row, int key, const fsdem__dem_list *old, int from) {
+    if (l->count == l->capacity && fsdem__dem_list_grow(d, l) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    fsdem__dem_list_set(l, l->count++, row, key, old, from);
     return FSDEM_OK;
 }
 
 /* The tangential spring of entry k (zero unless held). */
-static fsdem_vec3 fsdem__spring(const fsdem__list *l, int k) {
-    return l->key[k] & FSDEM__HELD ? l->history[k] : fsdem__zero3();
+static fsdem_vec3 fsdem__dem_spring(const fsdem__dem_list *l, int k) {
+    return l->key[k] & FSDEM__DEM_HELD ? l->history[k] : fsdem__zero3();
 }
 
 /* Entry of (row, partner) in a previous list, or -1. */
-static int fsdem__old_entry(const fsdem__list *old, int row, int partner) {
+static int fsdem__dem_old_entry(const fsdem__dem_list *old, int row, int partner) {
     int k;
     if (row >= 0 && row < old->rows)
         for (k = old->start[row]; k < old->start[row + 1]; ++k)
-            if (FSDEM__PARTNER(old->key[k]) == partner) return k;
+            if (FSDEM__DEM_PARTNER(old->key[k]) == partner) return k;
     return -1;
 }
 
-static void fsdem__swap_lists(fsdem__list *a, fsdem__list *b) {
-    fsdem__list t = *a;
+static void fsdem__dem_swap_lists(fsdem__dem_list *a, fsdem__dem_list *b) {
+    fsdem__dem_list t = *a;
     *a = *b;
     *b = t;
 }
@@ -2930,7 +3302,7 @@ static void fsdem__swap_lists(fsdem__list *a, fsdem__list *b) {
    itself and its forward neighbours (fsdem_cellgrid_forward), into d->found as pairs of cell-order
    indices; xs and reach_s are the positions and radii plus half the offset and skin in cell order, so
    the scan reads them in sequence. Returns the number of pairs, or -1 when d->found cannot grow. */
-static int fsdem__find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_real *reach_s) {
+static int fsdem__dem_find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_real *reach_s) {
     const fsdem_cellgrid *g = &d->grid;
     int c, f, a, b, count = 0;
     for (c = 0; c < g->cell_count; ++c) {
@@ -2965,8 +3337,8 @@ static int fsdem__find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_rea
 /* The particle-pair list from the `count` pairs in d->found: row min(i, j), partner max(i, j), each
    carrying its history from the previous list. Pairs of fixed particles exert nothing, so they go
    to d->inert instead, where fsdem_dem_contacts still finds them. `cursor` is scratch for n rows. */
-static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
-    fsdem__list *l = &d->pp;
+static fsdem_result fsdem__dem_fill_pairs(fsdem_dem *d, int count, int *cursor) {
+    fsdem__dem_list *l = &d->pp;
     const int *items = d->grid.items;
     int k, i, inert = 0;
     for (k = 0; k < count; ++k) {
@@ -2987,7 +3359,7 @@ static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
     memcpy(d->inert, d->found + 2 * count, sizeof(int) * 2 * (size_t)inert);
     d->inert_count = inert;
     while (l->capacity < count)
-        if (fsdem__list_grow(d, l) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+        if (fsdem__dem_list_grow(d, l) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     memset(l->start, 0, sizeof(int) * (size_t)(d->n + 1));
     for (k = 0; k < count; ++k) {
         const int a = items[d->found[2 * k]], b = items[d->found[2 * k + 1]];
@@ -3001,7 +3373,7 @@ static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
         const int a = items[d->found[2 * k]], b = items[d->found[2 * k + 1]];
         const int i0 = a < b ? a : b, j = a < b ? b : a, e = cursor[i0]++;
         const int oi = d->old_of[i0], oj = d->old_of[j], lo = oi < oj ? oi : oj, hi = oi < oj ? oj : oi;
-        fsdem__list_set(l, e, i0, j, &d->pp_old, lo >= 0 ? fsdem__old_entry(&d->pp_old, lo, hi) : -1);
+        fsdem__dem_list_set(l, e, i0, j, &d->pp_old, lo >= 0 ? fsdem__dem_old_entry(&d->pp_old, lo, hi) : -1);
     }
     l->count = count;
     return FSDEM_OK;
@@ -3009,7 +3381,7 @@ static fsdem_result fsdem__fill_pairs(fsdem_dem *d, int count, int *cursor) {
 
 /* Rebuilds both lists: pairs within r_i + r_j + offset + skin, and particle-wall faces within
    r_i + offset + skin, carrying each surviving contact's history over from the previous lists. */
-static fsdem_result fsdem__rebuild(fsdem_dem *d) {
+static fsdem_result fsdem__dem_rebuild(fsdem_dem *d) {
     const fsdem_real off = d->desc.contact_offset;
     fsdem_real r_max = 0, skin, *reach_s;
     fsdem_vec3 *xs;
@@ -3039,34 +3411,34 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
         xs[k] = d->x[j];
         reach_s[k] = d->r[j] + (off + skin) / 2;
     }
-    pairs = fsdem__find_pairs(d, xs, reach_s);
+    pairs = fsdem__dem_find_pairs(d, xs, reach_s);
     if (pairs < 0) return FSDEM_ERR_OUT_OF_MEMORY;
-    fsdem__swap_lists(&d->pp, &d->pp_old);
-    fsdem__swap_lists(&d->pw, &d->pw_old);
+    fsdem__dem_swap_lists(&d->pp, &d->pp_old);
+    fsdem__dem_swap_lists(&d->pw, &d->pw_old);
     if (fsdem__grow(&d->allocator, (void **)&d->pp.start, &d->pp.start_capacity, 0, d->n + 1, sizeof(int)) != FSDEM_OK ||
         fsdem__grow(&d->allocator, (void **)&d->pw.start, &d->pw.start_capacity, 0, d->n + 1, sizeof(int)) != FSDEM_OK ||
-        fsdem__fill_pairs(d, pairs, cursor) != FSDEM_OK)
+        fsdem__dem_fill_pairs(d, pairs, cursor) != FSDEM_OK)
         res = FSDEM_ERR_OUT_OF_MEMORY;
     d->pw.count = 0;
     for (i = 0; i < d->n && res == FSDEM_OK; ++i) {
         const int oi = d->old_of[i];
         d->pw.start[i] = d->pw.count;
         for (k = 0; k < d->wall_count && res == FSDEM_OK; ++k) {
-            const fsdem__wall *w = &d->walls[k];
-            int face, faces = fsdem__wall_faces(w, dim);
+            const fsdem__dem_wall *w = &d->walls[k];
+            int face, faces = fsdem__dem_wall_faces(w, dim);
             if (!w->active) continue;
             for (face = 0; face < faces; ++face) {
                 fsdem_vec3 nrm;
-                int key = FSDEM__WALL_KEY(k, face), on_feature;
-                if (fsdem__wall_distance(w, face, d->x[i], dim, &nrm, &on_feature) >= d->r[i] + off + skin) continue;
-                res = fsdem__list_append(d, &d->pw, i, key, &d->pw_old, fsdem__old_entry(&d->pw_old, oi, key));
+                int key = FSDEM__DEM_WALL_KEY(k, face), on_feature;
+                if (fsdem__dem_wall_distance(w, face, d->x[i], dim, &nrm, &on_feature) >= d->r[i] + off + skin) continue;
+                res = fsdem__dem_list_append(d, &d->pw, i, key, &d->pw_old, fsdem__dem_old_entry(&d->pw_old, oi, key));
                 if (res != FSDEM_OK) break;
             }
         }
     }
     if (res != FSDEM_OK) {
-        fsdem__swap_lists(&d->pp, &d->pp_old);
-        fsdem__swap_lists(&d->pw, &d->pw_old);
+        fsdem__dem_swap_lists(&d->pp, &d->pp_old);
+        fsdem__dem_swap_lists(&d->pw, &d->pw_old);
         return res;
     }
     d->pw.start[d->n] = d->pw.count;
@@ -3078,19 +3450,20 @@ static fsdem_result fsdem__rebuild(fsdem_dem *d) {
     for (k = 0; k < d->wall_count; ++k) d->walls[k].moved = 0;
     d->max_disp2 = 0;
     d->rebuilds++;
-    /* scratch for the longest wall row, and the force evaluation's arena (fsdem__compute_forces) for
+    fsdem__dem_dt_check(d);
+    /* scratch for the longest wall row, and the force evaluation's arena (fsdem__dem_compute_forces) for
        the new list; the lists above are complete, so a failure here only asks for another rebuild */
     for (i = 0, k = 0; i < d->n; ++i)
         if (d->pw.start[i + 1] - d->pw.start[i] > k) k = d->pw.start[i + 1] - d->pw.start[i];
-    d->need_rebuild = fsdem__grow(&d->allocator, (void **)&d->hits, &d->hit_capacity, 0, k, sizeof(fsdem__wall_hit)) !=
+    d->need_rebuild = fsdem__grow(&d->allocator, (void **)&d->hits, &d->hit_capacity, 0, k, sizeof(fsdem__dem_wall_hit)) !=
                           FSDEM_OK ||
                       fsdem__arena_reserve(&d->allocator, &d->arena,
                                            fsdem__arena_bytes(sizeof(int) * (size_t)d->pp.count) +
-                                               fsdem__arena_bytes(sizeof(fsdem__batch))) != FSDEM_OK;
+                                               fsdem__arena_bytes(sizeof(fsdem__dem_batch))) != FSDEM_OK;
     return d->need_rebuild ? FSDEM_ERR_OUT_OF_MEMORY : FSDEM_OK;
 }
 
-static int fsdem__lists_stale(const fsdem_dem *d) {
+static int fsdem__dem_lists_stale(const fsdem_dem *d) {
     fsdem_real disp = (fsdem_real)sqrt(d->max_disp2), wall_moved = 0;
     int k;
     for (k = 0; k < d->wall_count; ++k)
@@ -3104,32 +3477,32 @@ static int fsdem__lists_stale(const fsdem_dem *d) {
    contact point lies in the plane of a face contact of the same particle (the edge belongs to that
    face), or when an edge/vertex contact kept before has the same normal (one edge seen from two
    elements). With `reset`, entries without a kept contact lose their tangential history. */
-static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
+static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
     const fsdem_real off = d->desc.contact_offset, tol = (fsdem_real)fsdem__tolerance(1e-9) * d->r[i];
     const fsdem_vec3 xi = d->x[i];
     int k, a, b, count = 0, kept = 0;
     for (k = d->pw.start[i]; k < d->pw.start[i + 1]; ++k) {
         const int key = d->pw.key[k];
-        const fsdem__wall *wall = &d->walls[FSDEM__WALL_OF(key)];
-        fsdem__wall_hit *h = &d->hits[count];
+        const fsdem__dem_wall *wall = &d->walls[FSDEM__DEM_WALL_OF(key)];
+        fsdem__dem_wall_hit *h = &d->hits[count];
         if (wall->active) {
-            h->delta = d->r[i] + off - fsdem__wall_distance(wall, FSDEM__FACE_OF(key), xi, d->desc.dim, &h->n, &h->on_feature);
+            h->delta = d->r[i] + off - fsdem__dem_wall_distance(wall, FSDEM__DEM_FACE_OF(key), xi, d->desc.dim, &h->n, &h->on_feature);
             if (h->delta > 0) {
                 h->entry = k;
                 count++;
                 continue;
             }
         }
-        if (reset) d->pw.key[k] &= ~FSDEM__HELD;
+        if (reset) d->pw.key[k] &= ~FSDEM__DEM_HELD;
     }
     for (a = 0; a < count; ++a) {
-        fsdem__wall_hit h = d->hits[a];
+        fsdem__dem_wall_hit h = d->hits[a];
         int duplicate = 0;
         if (h.on_feature) {
             /* contact point q = x - (r + off - delta) n; in face b's plane when (q - x).n_b = -(r + off - delta_b) */
             fsdem_vec3 q_rel = fsdem__scale(h.n, -(d->r[i] + off - h.delta));
             for (b = 0; b < count && !duplicate; ++b) {
-                const fsdem__wall_hit *o = &d->hits[b];
+                const fsdem__dem_wall_hit *o = &d->hits[b];
                 if (b == a) continue;
                 if (!o->on_feature)
                     duplicate = fsdem__dot(q_rel, o->n) + (d->r[i] + off - o->delta) <= tol &&
@@ -3139,7 +3512,7 @@ static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
             }
         }
         if (duplicate) {
-            if (reset) d->pw.key[h.entry] &= ~FSDEM__HELD;
+            if (reset) d->pw.key[h.entry] &= ~FSDEM__DEM_HELD;
             continue;
         }
         d->hits[kept++] = h;
@@ -3150,8 +3523,8 @@ static int fsdem__wall_hits(fsdem_dem *d, int i, int reset) {
 /* ---- >>dem_forces : contact force evaluation ---- */
 
 /* Material pair `pair`'s coefficients into lane c of a batch. */
-static void fsdem__gather_pair_coefficients(const fsdem_dem *d, fsdem__batch *b, int c, int pair) {
-    const fsdem__pair *p = d->pairs + pair;
+static void fsdem__dem_gather_pair_coefficients(const fsdem_dem *d, fsdem__dem_batch *b, int c, int pair) {
+    const fsdem__dem_pair *p = d->pairs + pair;
     b->pair[c] = pair;
     b->kn[c] = p->kn;
     b->cn[c] = p->cn;
@@ -3162,11 +3535,11 @@ static void fsdem__gather_pair_coefficients(const fsdem_dem *d, fsdem__batch *b,
 
 /* Contact `k` of the particle-pair list into lane c of a batch; the coefficients of its material
    pair unless the batch is `uniform`, the mean mass only for the law that uses it. */
-FSDEM__FORCE_INLINE void fsdem__gather_pair(const fsdem_dem *d, fsdem__batch *FSDEM__RESTRICT b, int c, int k, const fsdem_contact_law law,
+FSDEM__FORCE_INLINE void fsdem__dem_gather_pair(const fsdem_dem *d, fsdem__dem_batch *FSDEM__RESTRICT b, int c, int k, const fsdem_dem_law law,
                                             int uniform) {
-    const int i = d->pp.first[k], key = d->pp.key[k], j = FSDEM__PARTNER(key);
+    const int i = d->pp.first[k], key = d->pp.key[k], j = FSDEM__DEM_PARTNER(key);
     const fsdem_vec3 xi = d->x[i], xj = d->x[j], vi = d->v[i], vj = d->v[j], wi = d->w[i], wj = d->w[j];
-    const fsdem_vec3 spring = key & FSDEM__HELD ? d->pp.history[k] : fsdem__zero3();
+    const fsdem_vec3 spring = key & FSDEM__DEM_HELD ? d->pp.history[k] : fsdem__zero3();
     b->i[c] = i;
     b->other[c] = j;
     b->entry[c] = k;
@@ -3186,19 +3559,19 @@ FSDEM__FORCE_INLINE void fsdem__gather_pair(const fsdem_dem *d, fsdem__batch *FS
     b->rj[c] = d->r[j];
     b->inv_mi[c] = d->inv_m[i];
     b->inv_mj[c] = d->inv_m[j];
-    if (law == FSDEM_CONTACT_LINEAR) b->m_mean[c] = (d->m[i] + d->m[j]) / 2;
+    if (law == FSDEM_DEM_LAW_LINEAR) b->m_mean[c] = (d->m[i] + d->m[j]) / 2;
     b->spring[0][c] = spring.x;
     b->spring[1][c] = spring.y;
     b->spring[2][c] = spring.z;
-    if (!uniform) fsdem__gather_pair_coefficients(d, b, c, d->material[i] * d->material_count + d->material[j]);
+    if (!uniform) fsdem__dem_gather_pair_coefficients(d, b, c, d->material[i] * d->material_count + d->material[j]);
     else b->pair[c] = 0;
 }
 
-/* Wall contact `hit` of particle i into lane c of a batch (coefficients as fsdem__gather_pair). */
-static void fsdem__gather_wall(const fsdem_dem *d, fsdem__batch *b, int c, int i, const fsdem__wall_hit *hit, int uniform) {
-    const int key = d->pw.key[hit->entry], wall = FSDEM__WALL_OF(key);
+/* Wall contact `hit` of particle i into lane c of a batch (coefficients as fsdem__dem_gather_pair). */
+static void fsdem__dem_gather_wall(const fsdem_dem *d, fsdem__dem_batch *b, int c, int i, const fsdem__dem_wall_hit *hit, int uniform) {
+    const int key = d->pw.key[hit->entry], wall = FSDEM__DEM_WALL_OF(key);
     const fsdem_real arm = d->r[i] - hit->delta / 2;
-    const fsdem_vec3 n = hit->n, spring = key & FSDEM__HELD ? d->pw.history[hit->entry] : fsdem__zero3();
+    const fsdem_vec3 n = hit->n, spring = key & FSDEM__DEM_HELD ? d->pw.history[hit->entry] : fsdem__zero3();
     const fsdem_vec3 vrel = fsdem__sub(fsdem__sub(d->v[i], fsdem__scale(fsdem__cross(d->w[i], n), arm)),
                                        d->walls[wall].d.velocity);
     b->i[c] = i;
@@ -3217,34 +3590,34 @@ static void fsdem__gather_wall(const fsdem_dem *d, fsdem__batch *b, int c, int i
     b->spring[0][c] = spring.x;
     b->spring[1][c] = spring.y;
     b->spring[2][c] = spring.z;
-    if (!uniform) fsdem__gather_pair_coefficients(d, b, c, d->material[i] * d->material_count + d->walls[wall].d.material);
+    if (!uniform) fsdem__dem_gather_pair_coefficients(d, b, c, d->material[i] * d->material_count + d->walls[wall].d.material);
     else b->pair[c] = 0;
 }
 
-static fsdem_vec3 fsdem__batch_vec(const fsdem_real (*a)[FSDEM__BATCH], int c) { return fsdem_v3(a[0][c], a[1][c], a[2][c]); }
+static fsdem_vec3 fsdem__dem_batch_vec(const fsdem_real (*a)[FSDEM__DEM_BATCH], int c) { return fsdem_v3(a[0][c], a[1][c], a[2][c]); }
 
 /* Adds a batch's forces and torques to the particles (and its walls, `walls`), commits the springs
    when `commit` and the law has history, and applies rolling resistance. */
-FSDEM__FORCE_INLINE void fsdem__scatter(fsdem_dem *d, const fsdem__batch *FSDEM__RESTRICT b, const int walls, int commit,
+FSDEM__FORCE_INLINE void fsdem__dem_scatter(fsdem_dem *d, const fsdem__dem_batch *FSDEM__RESTRICT b, const int walls, int commit,
                                         fsdem_real h) {
-    fsdem__list *l = walls ? &d->pw : &d->pp;
+    fsdem__dem_list *l = walls ? &d->pw : &d->pp;
     fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t, *FSDEM__RESTRICT history = l->history;
     int *FSDEM__RESTRICT keys = l->key;
     fsdem_real max_overlap = d->max_overlap;
     int c;
     for (c = 0; c < b->count; ++c) {
         const int i = b->i[c], o = b->other[c];
-        const fsdem_vec3 force = fsdem__batch_vec(b->force, c), torque = fsdem__batch_vec(b->torque_i, c);
+        const fsdem_vec3 force = fsdem__dem_batch_vec(b->force, c), torque = fsdem__dem_batch_vec(b->torque_i, c);
         f[i] = fsdem__add(f[i], force);
         t[i] = fsdem__add(t[i], torque);
         if (walls) d->walls[o].force = fsdem__sub(d->walls[o].force, force);
         else {
             f[o] = fsdem__sub(f[o], force);
-            t[o] = fsdem__add(t[o], fsdem__batch_vec(b->torque_j, c));
+            t[o] = fsdem__add(t[o], fsdem__dem_batch_vec(b->torque_j, c));
         }
         if (commit) {
-            history[b->entry[c]] = fsdem__batch_vec(b->spring, c);
-            keys[b->entry[c]] |= FSDEM__HELD;
+            history[b->entry[c]] = fsdem__dem_batch_vec(b->spring, c);
+            keys[b->entry[c]] |= FSDEM__DEM_HELD;
         }
         if (b->delta[c] > max_overlap) max_overlap = b->delta[c];
     }
@@ -3256,7 +3629,7 @@ FSDEM__FORCE_INLINE void fsdem__scatter(fsdem_dem *d, const fsdem__batch *FSDEM_
             fsdem_vec3 w_rel, tr;
             if (!(mu_r > 0)) continue;
             w_rel = walls ? d->w[i] : fsdem__sub(d->w[i], d->w[o]);
-            tr = fsdem__rolling_torque(w_rel, mu_r, b->r_eff[c], b->fn[c], d->inv_i[i] + (walls ? 0 : d->inv_i[o]), h);
+            tr = fsdem__dem_rolling_torque(w_rel, mu_r, b->r_eff[c], b->fn[c], d->inv_i[i] + (walls ? 0 : d->inv_i[o]), h);
             t[i] = fsdem__add(t[i], tr);
             if (!walls) t[o] = fsdem__sub(t[o], tr);
         }
@@ -3265,7 +3638,7 @@ FSDEM__FORCE_INLINE void fsdem__scatter(fsdem_dem *d, const fsdem__batch *FSDEM_
 /* The entries of the particle-pair list whose pair touches, into `touching`; returns their number.
    With `commit`, the pairs that do not touch lose their spring. Branch-free, and instantiated with
    and without `commit`. */
-FSDEM__FORCE_INLINE int fsdem__touching(fsdem_dem *d, int *FSDEM__RESTRICT touching, const int commit) {
+FSDEM__FORCE_INLINE int fsdem__dem_touching(fsdem_dem *d, int *FSDEM__RESTRICT touching, const int commit) {
     const fsdem_real off = d->desc.contact_offset;
     const fsdem_vec3 *FSDEM__RESTRICT x = d->x;
     const fsdem_real *FSDEM__RESTRICT r = d->r;
@@ -3274,26 +3647,26 @@ FSDEM__FORCE_INLINE int fsdem__touching(fsdem_dem *d, int *FSDEM__RESTRICT touch
     const int pairs = d->pp.count;
     int k, count = 0;
     for (k = 0; k < pairs; ++k) {
-        const int key = keys[k], i = first[k], j = FSDEM__PARTNER(key);
+        const int key = keys[k], i = first[k], j = FSDEM__DEM_PARTNER(key);
         const fsdem_real ex = x[i].x - x[j].x, ey = x[i].y - x[j].y, ez = x[i].z - x[j].z, reach = r[i] + r[j] + off;
         const int touch = ex * ex + ey * ey + ez * ez < reach * reach;
         touching[count] = k;
         count += touch;
-        if (commit) keys[k] = key & ~((touch - 1) & FSDEM__HELD); /* arithmetic: a branch here would mispredict */
+        if (commit) keys[k] = key & ~((touch - 1) & FSDEM__DEM_HELD); /* arithmetic: a branch here would mispredict */
     }
     return count;
 }
 
 /* Runs the kernels on a filled batch (particle pairs or, with `walls`, wall contacts), applies it
    and empties it; returns the number of contacts it held. */
-FSDEM__FORCE_INLINE int fsdem__drain(fsdem_dem *d, fsdem__batch *b, int walls, const fsdem_contact_law law, fsdem_real h,
+FSDEM__FORCE_INLINE int fsdem__dem_drain(fsdem_dem *d, fsdem__dem_batch *b, int walls, const fsdem_dem_law law, fsdem_real h,
                                      int keep) {
     const int count = b->count;
-    const fsdem__pair *uniform = d->material_count == 1 ? d->pairs : NULL;
-    fsdem__batch_pad(b, !walls, uniform != NULL);
-    if (walls) fsdem__batch_law(b, law, h, 0, 0, uniform);
-    else fsdem__batch_law(b, law, h, 1, d->desc.contact_offset, uniform);
-    fsdem__scatter(d, b, walls, keep, h);
+    const fsdem__dem_pair *uniform = d->material_count == 1 ? d->pairs : NULL;
+    fsdem__dem_batch_pad(b, !walls, uniform != NULL);
+    if (walls) fsdem__dem_batch_law(b, law, h, 0, 0, uniform);
+    else fsdem__dem_batch_law(b, law, h, 1, d->desc.contact_offset, uniform);
+    fsdem__dem_scatter(d, b, walls, keep, h);
     b->count = 0;
     return count;
 }
@@ -3303,14 +3676,14 @@ FSDEM__FORCE_INLINE int fsdem__drain(fsdem_dem *d, fsdem__batch *b, int walls, c
    springs are kept when `commit` (the predictor of the predictor-corrector does not keep them).
    A pass over the whole pair list finds the touching pairs without branching; they and the wall
    contacts then go through the vector kernels a batch at a time. Written once, instantiated per
-   contact law (fsdem__compute_forces). */
-FSDEM__FORCE_INLINE void fsdem__compute_forces_law(fsdem_dem *d, fsdem_real h, int commit, const fsdem_contact_law law) {
-    const int n = d->n, keep = commit && law == FSDEM_CONTACT_HERTZ_MINDLIN, uniform = d->material_count == 1;
-    fsdem__batch *b;
+   contact law (fsdem__dem_compute_forces). */
+FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real h, int commit, const fsdem_dem_law law) {
+    const int n = d->n, keep = commit && law == FSDEM_DEM_LAW_HERTZ_MINDLIN, uniform = d->material_count == 1;
+    fsdem__dem_batch *b;
     int *touching, i, k, c, nt = 0, nw = 0;
     fsdem__arena_reset(&d->arena);
     touching = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->pp.count);
-    b = (fsdem__batch *)fsdem__arena_push(&d->arena, sizeof *b);
+    b = (fsdem__dem_batch *)fsdem__arena_push(&d->arena, sizeof *b);
     if (!d->forces_cleared) {
         memset(d->f, 0, sizeof *d->f * (size_t)n);
         memset(d->t, 0, sizeof *d->t * (size_t)n);
@@ -3318,44 +3691,44 @@ FSDEM__FORCE_INLINE void fsdem__compute_forces_law(fsdem_dem *d, fsdem_real h, i
     d->forces_cleared = 0;
     for (k = 0; k < d->wall_count; ++k) d->walls[k].force = fsdem__zero3();
     d->max_overlap = 0;
-    nt = commit ? fsdem__touching(d, touching, 1) : fsdem__touching(d, touching, 0);
+    nt = commit ? fsdem__dem_touching(d, touching, 1) : fsdem__dem_touching(d, touching, 0);
     b->count = 0;
     for (k = 0; k < nt; ++k) {
-        fsdem__gather_pair(d, b, b->count++, touching[k], law, uniform);
-        if (b->count == FSDEM__BATCH || k == nt - 1) fsdem__drain(d, b, 0, law, h, keep);
+        fsdem__dem_gather_pair(d, b, b->count++, touching[k], law, uniform);
+        if (b->count == FSDEM__DEM_BATCH || k == nt - 1) fsdem__dem_drain(d, b, 0, law, h, keep);
     }
     for (k = 0; k < d->pw.count; k = d->pw.start[i + 1]) {
         /* row to row through the particles with wall entries */
         int nh;
         i = d->pw.first[k];
         if (d->inv_m[i] == 0) continue; /* fixed: no wall force */
-        nh = fsdem__wall_hits(d, i, commit);
+        nh = fsdem__dem_wall_hits(d, i, commit);
         for (c = 0; c < nh; ++c) {
-            fsdem__gather_wall(d, b, b->count++, i, &d->hits[c], uniform);
-            if (b->count == FSDEM__BATCH) nw += fsdem__drain(d, b, 1, law, h, keep);
+            fsdem__dem_gather_wall(d, b, b->count++, i, &d->hits[c], uniform);
+            if (b->count == FSDEM__DEM_BATCH) nw += fsdem__dem_drain(d, b, 1, law, h, keep);
         }
     }
-    if (b->count) nw += fsdem__drain(d, b, 1, law, h, keep);
+    if (b->count) nw += fsdem__dem_drain(d, b, 1, law, h, keep);
     d->contacts = nt;
     d->wall_contacts = nw;
     d->forces_valid = 1;
 }
 
-static void fsdem__compute_forces(fsdem_dem *d, fsdem_real h, int commit) {
+static void fsdem__dem_compute_forces(fsdem_dem *d, fsdem_real h, int commit) {
     switch (d->desc.law) {
-    case FSDEM_CONTACT_LINEAR: fsdem__compute_forces_law(d, h, commit, FSDEM_CONTACT_LINEAR); break;
-    case FSDEM_CONTACT_GIC: fsdem__compute_forces_law(d, h, commit, FSDEM_CONTACT_GIC); break;
-    default: fsdem__compute_forces_law(d, h, commit, FSDEM_CONTACT_HERTZ_MINDLIN); break;
+    case FSDEM_DEM_LAW_LINEAR: fsdem__dem_compute_forces_law(d, h, commit, FSDEM_DEM_LAW_LINEAR); break;
+    case FSDEM_DEM_LAW_GIC: fsdem__dem_compute_forces_law(d, h, commit, FSDEM_DEM_LAW_GIC); break;
+    default: fsdem__dem_compute_forces_law(d, h, commit, FSDEM_DEM_LAW_HERTZ_MINDLIN); break;
     }
 }
 
 /* ---- >>dem_integrate : time integration ---- */
 
-static fsdem_vec3 fsdem__accel(const fsdem_dem *d, const fsdem_vec3 *f, int i) {
+static fsdem_vec3 fsdem__dem_accel(const fsdem_dem *d, const fsdem_vec3 *f, int i) {
     return fsdem__madd(d->desc.gravity, fsdem__add(f[i], d->fext[i]), d->inv_m[i]);
 }
 
-static fsdem_vec3 fsdem__spin_rate(const fsdem_dem *d, const fsdem_vec3 *t, int i) {
+static fsdem_vec3 fsdem__dem_spin_rate(const fsdem_dem *d, const fsdem_vec3 *t, int i) {
     return d->desc.rotation ? fsdem__scale(fsdem__add(t[i], d->text[i]), d->inv_i[i]) : fsdem__zero3();
 }
 
@@ -3363,10 +3736,10 @@ static fsdem_vec3 fsdem__spin_rate(const fsdem_dem *d, const fsdem_vec3 *t, int 
    particles (with the external loads when `external`), then, with `drift`, the position update
    x += h_drift v of all of them, the largest displacement since the last rebuild, and f and t
    cleared for the force evaluation that follows. Returns nonzero when the pass may have produced a
-   state that is not finite or outside the domain; fsdem__check_particles then finds and names the
+   state that is not finite or outside the domain; fsdem__dem_check_particles then finds and names the
    particle. (Positions are checked after the drift, velocities after a pass without one.) Written
    once and instantiated per flag, so each pass reads every array it needs once. */
-FSDEM__FORCE_INLINE int fsdem__verlet_pass(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift,
+FSDEM__FORCE_INLINE int fsdem__dem_verlet_pass(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift,
                                            const int external) {
     const fsdem_vec3 g = d->desc.gravity, lo = d->desc.domain_min, hi = d->desc.domain_max;
     fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t;
@@ -3421,27 +3794,27 @@ FSDEM__FORCE_INLINE int fsdem__verlet_pass(fsdem_dem *d, fsdem_real h, const int
 }
 
 /* Velocity update v += h a, w += h alpha of the free particles, and the walls' impulse. */
-static int fsdem__kick(fsdem_dem *d, fsdem_real h) {
-    return d->external ? fsdem__verlet_pass(d, h, 0, 0, 1) : fsdem__verlet_pass(d, h, 0, 0, 0);
+static int fsdem__dem_kick(fsdem_dem *d, fsdem_real h) {
+    return d->external ? fsdem__dem_verlet_pass(d, h, 0, 0, 1) : fsdem__dem_verlet_pass(d, h, 0, 0, 0);
 }
 
 /* Kick h, then drift h_drift (and clear the forces). */
-static int fsdem__kick_drift(fsdem_dem *d, fsdem_real h, fsdem_real h_drift) {
-    return d->external ? fsdem__verlet_pass(d, h, 1, h_drift, 1) : fsdem__verlet_pass(d, h, 1, h_drift, 0);
+static int fsdem__dem_kick_drift(fsdem_dem *d, fsdem_real h, fsdem_real h_drift) {
+    return d->external ? fsdem__dem_verlet_pass(d, h, 1, h_drift, 1) : fsdem__dem_verlet_pass(d, h, 1, h_drift, 0);
 }
 
-static void fsdem__track_displacement(fsdem_dem *d, int i) {
+static void fsdem__dem_track_displacement(fsdem_dem *d, int i) {
     fsdem_vec3 dd = fsdem__sub(d->x[i], d->x_ref[i]);
     fsdem_real d2 = fsdem__dot(dd, dd);
     if (d2 > d->max_disp2) d->max_disp2 = d2;
 }
 
-static void fsdem__move_walls(fsdem_dem *d, fsdem_real h) {
+static void fsdem__dem_move_walls(fsdem_dem *d, fsdem_real h) {
     int k;
     for (k = 0; k < d->wall_count; ++k) {
-        fsdem__wall *w = &d->walls[k];
+        fsdem__dem_wall *w = &d->walls[k];
         fsdem_vec3 dv = fsdem__scale(w->d.velocity, h);
-        if (w->d.type == FSDEM_WALL_PLANE) w->d.a = fsdem__add(w->d.a, dv); /* b is the normal */
+        if (w->d.type == FSDEM_DEM_WALL_PLANE) w->d.a = fsdem__add(w->d.a, dv); /* b is the normal */
         else {
             w->d.a = fsdem__add(w->d.a, dv);
             w->d.b = fsdem__add(w->d.b, dv);
@@ -3451,38 +3824,42 @@ static void fsdem__move_walls(fsdem_dem *d, fsdem_real h) {
     }
 }
 
-static fsdem_result fsdem__ensure_lists(fsdem_dem *d) {
-    if (fsdem__lists_stale(d) && fsdem__rebuild(d) != FSDEM_OK)
-        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "out of memory growing the neighbour lists (%d particles)",
+static fsdem_result fsdem__dem_ensure_lists(fsdem_dem *d) {
+    if (fsdem__dem_lists_stale(d) && fsdem__dem_rebuild(d) != FSDEM_OK)
+        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem: out of memory growing the neighbour lists (%d particles)",
                            d->n);
     return FSDEM_OK;
 }
 
 /* Names the first particle that is not finite or left the domain. */
-static fsdem_result fsdem__check_particles(fsdem_dem *d) {
+static fsdem_result fsdem__dem_check_particles(fsdem_dem *d) {
+    char hint[160] = "";
     int i;
+    if (d->stable_dt > 0 && d->dt > d->stable_dt)
+        snprintf(hint, sizeof hint, "; dt = %g s is %.3g times the stable dt %g s (%s), the likely cause", (double)d->dt,
+                 (double)(d->dt / d->stable_dt), (double)d->stable_dt, fsdem__dem_rule_name(d->desc.dt_rule));
     for (i = 0; i < d->n; ++i) {
         if (!fsdem__finite3(d->x[i]) || !fsdem__finite3(d->v[i]) || !fsdem__finite3(d->w[i]))
-            return fsdem__fail(&d->status, FSDEM_ERR_NAN, "particle %d (id %d) has a non-finite state at t = %g s", i,
-                               d->id[i], (double)d->time);
-        if (!fsdem__inside_domain(d, d->x[i]))
+            return fsdem__fail(&d->status, FSDEM_ERR_NAN, "fsdem_dem: particle %d (id %d) has a non-finite state at t = %g s%s",
+                               i, d->id[i], d->time, hint);
+        if (!fsdem__dem_inside_domain(d, d->x[i]))
             return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_DOMAIN,
-                               "particle %d (id %d) left the domain at t = %g s: position (%g, %g, %g) m", i, d->id[i],
-                               (double)d->time, (double)d->x[i].x, (double)d->x[i].y, (double)d->x[i].z);
+                               "fsdem_dem: particle %d (id %d) left the domain at t = %g s: position (%g, %g, %g) m%s", i,
+                               d->id[i], d->time, (double)d->x[i].x, (double)d->x[i].y, (double)d->x[i].z, hint);
     }
     return FSDEM_OK;
 }
 
 /* Velocity Verlet: kick h/2 and drift h (one pass), forces, kick h/2. *suspect is set when a pass
-   saw a state that fsdem__check_particles should look at. */
-static fsdem_result fsdem__step_verlet(fsdem_dem *d, fsdem_real h, int *suspect) {
-    if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
-    if (!d->forces_valid) fsdem__compute_forces(d, h, 0);
-    *suspect = fsdem__kick_drift(d, h / 2, h);
-    fsdem__move_walls(d, h);
-    if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
-    fsdem__compute_forces(d, h, 1);
-    *suspect |= fsdem__kick(d, h / 2);
+   saw a state that fsdem__dem_check_particles should look at. */
+static fsdem_result fsdem__dem_step_verlet(fsdem_dem *d, fsdem_real h, int *suspect) {
+    if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    if (!d->forces_valid) fsdem__dem_compute_forces(d, h, 0);
+    *suspect = fsdem__dem_kick_drift(d, h / 2, h);
+    fsdem__dem_move_walls(d, h);
+    if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    fsdem__dem_compute_forces(d, h, 1);
+    *suspect |= fsdem__dem_kick(d, h / 2);
     return FSDEM_OK;
 }
 
@@ -3490,10 +3867,10 @@ static fsdem_result fsdem__step_verlet(fsdem_dem *d, fsdem_real h, int *suspect)
    Eq. 22 and 24 as printed average U^n (the outer step's start) with the new velocity; we average
    the substep's own start velocity U_(k-1), which is the trapezoidal rule the scheme is built on
    and keeps positions consistent with velocities when K > 1. */
-static fsdem_result fsdem__step_predictor_corrector(fsdem_dem *d, fsdem_real h) {
+static fsdem_result fsdem__dem_step_predictor_corrector(fsdem_dem *d, fsdem_real h) {
     int i, k;
-    if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
-    fsdem__compute_forces(d, h, 0); /* F_a at X_(k-1), U_(k-1); history not committed */
+    if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    fsdem__dem_compute_forces(d, h, 0); /* F_a at X_(k-1), U_(k-1); history not committed */
     for (k = 0; k < d->wall_count; ++k) d->walls[k].force_a = d->walls[k].force;
     for (i = 0; i < d->n; ++i) {
         d->x0[i] = d->x[i];
@@ -3502,26 +3879,26 @@ static fsdem_result fsdem__step_predictor_corrector(fsdem_dem *d, fsdem_real h) 
         d->fa[i] = d->f[i];
         d->ta[i] = d->t[i];
         if (!d->fixed[i]) {
-            d->v[i] = fsdem__madd(d->v0[i], fsdem__accel(d, d->fa, i), h);            /* Eq. 21 */
-            d->w[i] = fsdem__madd(d->w0[i], fsdem__spin_rate(d, d->ta, i), h);
-            fsdem__planar(d, &d->x[i], &d->v[i], &d->w[i]);
+            d->v[i] = fsdem__madd(d->v0[i], fsdem__dem_accel(d, d->fa, i), h);            /* Eq. 21 */
+            d->w[i] = fsdem__madd(d->w0[i], fsdem__dem_spin_rate(d, d->ta, i), h);
+            fsdem__dem_planar(d, &d->x[i], &d->v[i], &d->w[i]);
         }
         d->x[i] = fsdem__madd(d->x0[i], fsdem__add(d->v0[i], d->v[i]), h / 2);       /* Eq. 22 */
-        fsdem__track_displacement(d, i);
+        fsdem__dem_track_displacement(d, i);
     }
-    fsdem__move_walls(d, h);
-    if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
-    fsdem__compute_forces(d, h, 1); /* F_b at X_a, U_a */
+    fsdem__dem_move_walls(d, h);
+    if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    fsdem__dem_compute_forces(d, h, 1); /* F_b at X_a, U_a */
     for (i = 0; i < d->n; ++i) {
         if (!d->fixed[i]) {
-            fsdem_vec3 acc = fsdem__add(fsdem__accel(d, d->fa, i), fsdem__accel(d, d->f, i));
-            fsdem_vec3 spin = fsdem__add(fsdem__spin_rate(d, d->ta, i), fsdem__spin_rate(d, d->t, i));
+            fsdem_vec3 acc = fsdem__add(fsdem__dem_accel(d, d->fa, i), fsdem__dem_accel(d, d->f, i));
+            fsdem_vec3 spin = fsdem__add(fsdem__dem_spin_rate(d, d->ta, i), fsdem__dem_spin_rate(d, d->t, i));
             d->v[i] = fsdem__madd(d->v0[i], acc, h / 2);                               /* Eq. 23 */
             d->w[i] = fsdem__madd(d->w0[i], spin, h / 2);
-            fsdem__planar(d, &d->x[i], &d->v[i], &d->w[i]);
+            fsdem__dem_planar(d, &d->x[i], &d->v[i], &d->w[i]);
         }
         d->x[i] = fsdem__madd(d->x0[i], fsdem__add(d->v0[i], d->v[i]), h / 2);       /* Eq. 24 */
-        fsdem__track_displacement(d, i);
+        fsdem__dem_track_displacement(d, i);
     }
     for (k = 0; k < d->wall_count; ++k)
         d->walls[k].impulse = fsdem__madd(d->walls[k].impulse, fsdem__add(d->walls[k].force_a, d->walls[k].force), -h / 2);
@@ -3529,136 +3906,151 @@ static fsdem_result fsdem__step_predictor_corrector(fsdem_dem *d, fsdem_real h) 
     return FSDEM_OK;
 }
 
-static fsdem_result fsdem__step(fsdem_dem *d, fsdem_real h) {
+static fsdem_result fsdem__dem_step(fsdem_dem *d, fsdem_real h) {
     int suspect = 1;
-    fsdem_result res = d->desc.integrator == FSDEM_INTEGRATOR_PREDICTOR_CORRECTOR ? fsdem__step_predictor_corrector(d, h)
-                                                                                  : fsdem__step_verlet(d, h, &suspect);
+    fsdem_result res = d->desc.integrator == FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR ? fsdem__dem_step_predictor_corrector(d, h)
+                                                                                  : fsdem__dem_step_verlet(d, h, &suspect);
     if (res != FSDEM_OK) return res;
     d->time += h;
     d->steps++;
-    return suspect ? fsdem__check_particles(d) : FSDEM_OK;
+    return suspect ? fsdem__dem_check_particles(d) : FSDEM_OK;
 }
 
 fsdem_result fsdem_dem_step(fsdem_dem *d) {
-    fsdem_result res = fsdem__step(d, d->dt);
+    fsdem_result res;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem__dem_step(d, d->dt);
+    return res == FSDEM_OK ? fsdem__ok(&d->status) : res;
+}
+
+fsdem_result fsdem_dem_step_dt(fsdem_dem *d, fsdem_real dt) {
+    fsdem_result res;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_step_dt: dt must be > 0 (got %g s)", (double)dt);
+    res = fsdem__dem_step(d, dt);
     return res == FSDEM_OK ? fsdem__ok(&d->status) : res;
 }
 
 /* Substeps of an outer step (seed 000): K = INT(dt/dt_DEM), dt_DEM = dt/K, and Eq. 25: one substep of
    dt when dt_DEM > dt. The relative tolerance (1e-9, more in float) keeps an exact multiple
    (3e-4/1e-4 = 2.9999999999999996, or 1000 dt rounded to float) from losing a step. */
-static fsdem_result fsdem__substep_count(fsdem_dem *d, fsdem_real dt_outer, int *count) {
-    double ratio = (double)dt_outer / d->dt * (1 + fsdem__tolerance(1e-9));
-    if (!(dt_outer > 0) || !fsdem__finite(dt_outer))
-        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_advance: dt_outer must be > 0 (got %g s)",
-                           (double)dt_outer);
-    if (ratio > 1e9)
-        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
-                           "fsdem_dem_advance: dt_outer / dt = %g substeps is more than 1e9", ratio);
-    *count = ratio < 1 ? 1 : (int)ratio;
+fsdem_result fsdem_dem_substep_count(const fsdem_dem *d, fsdem_real duration, long long *count) {
+    fsdem__status *st;
+    double ratio;
+    if (!d || !count) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&d->status; /* the message is the object's only mutable part here */
+    ratio = (double)duration / d->dt * (1 + fsdem__tolerance(1e-9));
+    if (!(duration > 0) || !fsdem__finite(duration))
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "fsdem_dem_advance: the duration must be > 0 (got %g s)",
+                           (double)duration);
+    if (ratio > (double)FSDEM_DEM_MAX_SUBSTEPS)
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_dem_advance: %g s / dt %g s = %g substeps is more than FSDEM_DEM_MAX_SUBSTEPS (%lld)",
+                           (double)duration, (double)d->dt, ratio, FSDEM_DEM_MAX_SUBSTEPS);
+    *count = ratio < 1 ? 1 : (long long)ratio;
     return FSDEM_OK;
 }
 
 /* `count` Verlet steps of h as leapfrog: the closing half kick of a step and the opening one of the
    next are one kick of h in the kick-drift pass, so a step costs one pass over the particles, not
-   two. The same arithmetic as `count` calls of fsdem__step_verlet (velocities in between are never
+   two. The same arithmetic as `count` calls of fsdem__dem_step_verlet (velocities in between are never
    seen); the half kick is closed at the end, and early when a pass saw a suspect state, which the
-   check then names (the substeps stop there). */
-static fsdem_result fsdem__advance_verlet(fsdem_dem *d, fsdem_real h, int count) {
-    int k, open = 0, suspect;
+   check then names (the substeps stop there), or when the callback `fn` (run after every force
+   evaluation) fails. */
+static fsdem_result fsdem__dem_advance_verlet(fsdem_dem *d, fsdem_real h, long long count, fsdem_dem_substep_fn fn,
+                                              void *user) {
+    long long k;
+    int open = 0, suspect;
     fsdem_result res;
-    if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
-    if (!d->forces_valid) fsdem__compute_forces(d, h, 0);
+    if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    if (!d->forces_valid) fsdem__dem_compute_forces(d, h, 0);
+    if (fn && (res = fn(user, d, d->time)) != FSDEM_OK) return res;
     for (k = 0; k < count; ++k) {
-        suspect = fsdem__kick_drift(d, open ? h : h / 2, h);
-        fsdem__move_walls(d, h);
-        if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
-        fsdem__compute_forces(d, h, 1);
+        fsdem_result called = FSDEM_OK;
+        suspect = fsdem__dem_kick_drift(d, open ? h : h / 2, h);
+        fsdem__dem_move_walls(d, h);
+        if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+        fsdem__dem_compute_forces(d, h, 1);
         d->time += h;
         d->steps++;
         open = 1;
-        if (k == count - 1 || suspect) {
-            suspect |= fsdem__kick(d, h / 2);
+        if (fn) called = fn(user, d, d->time);
+        if (k == count - 1 || suspect || called != FSDEM_OK) {
+            suspect |= fsdem__dem_kick(d, h / 2);
             open = 0;
-            res = suspect ? fsdem__check_particles(d) : FSDEM_OK;
+            res = suspect ? fsdem__dem_check_particles(d) : FSDEM_OK;
             if (res != FSDEM_OK) return res;
+            if (called != FSDEM_OK) return called;
         }
     }
     return FSDEM_OK;
 }
 
-fsdem_result fsdem_dem_advance(fsdem_dem *d, fsdem_real dt_outer, int *substeps) {
-    int k, count = 0;
-    fsdem_result res = fsdem__substep_count(d, dt_outer, &count);
+fsdem_result fsdem_dem_advance_with(fsdem_dem *d, fsdem_real duration, fsdem_dem_substep_fn fn, void *user,
+                                    long long *steps) {
+    long long k, count = 0;
+    fsdem_result res;
+    if (steps) *steps = 0;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem_dem_substep_count(d, duration, &count);
     if (res != FSDEM_OK) return res;
-    if (substeps) *substeps = count;
-    if (d->desc.integrator == FSDEM_INTEGRATOR_VERLET) res = fsdem__advance_verlet(d, dt_outer / count, count);
+    if (steps) *steps = count;
+    if (d->desc.integrator == FSDEM_DEM_INTEGRATOR_VERLET)
+        res = fsdem__dem_advance_verlet(d, duration / (fsdem_real)count, count, fn, user);
     else
-        for (k = 0; k < count && res == FSDEM_OK; ++k) res = fsdem__step(d, dt_outer / count);
+        for (k = 0; k < count && res == FSDEM_OK; ++k) {
+            /* the predictor-corrector holds the external loads over a substep: one call at its start */
+            if (fn) res = fn(user, d, d->time);
+            if (res == FSDEM_OK) res = fsdem__dem_step(d, duration / (fsdem_real)count);
+        }
     return res == FSDEM_OK ? fsdem__ok(&d->status) : res;
 }
 
+fsdem_result fsdem_dem_advance(fsdem_dem *d, fsdem_real duration, long long *steps) {
+    return fsdem_dem_advance_with(d, duration, NULL, NULL, steps);
+}
+
 fsdem_result fsdem_dem_set_dt(fsdem_dem *d, fsdem_real dt) {
+    if (!d) return FSDEM_ERR_INVALID_ARG;
     if (!(dt > 0) || !fsdem__finite(dt))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_set_dt: dt must be > 0 (got %g s)", (double)dt);
     d->dt = dt;
+    fsdem__dem_dt_check(d);
     return fsdem__ok(&d->status);
 }
 
-fsdem_real fsdem_dem_dt(const fsdem_dem *d) { return d->dt; }
-fsdem_real fsdem_dem_time(const fsdem_dem *d) { return d->time; }
+double fsdem_dem_time(const fsdem_dem *d) { return d ? d->time : 0; }
+
+fsdem_dem_desc fsdem_dem_get_desc(const fsdem_dem *d) {
+    fsdem_dem_desc desc;
+    if (!d) {
+        memset(&desc, 0, sizeof desc);
+        return desc;
+    }
+    desc = d->desc;
+    desc.dt = d->dt;
+    return desc;
+}
 
 /* ---- >>dem_diagnostics : time-step estimates, energy, statistics ---- */
 
-fsdem_result fsdem_dem_dt_estimate(const fsdem_dem *d, fsdem_dt_rule rule, fsdem_real param, fsdem_real *dt) {
-    fsdem__status *st = (fsdem__status *)&d->status; /* the message is the object's only mutable part here */
-    fsdem_real best = (fsdem_real)HUGE_VAL;
-    int i;
-    if (!dt) return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "fsdem_dem_dt_estimate: dt is NULL");
-    if (d->n == 0) return fsdem__fail(st, FSDEM_ERR_NOT_FOUND, "fsdem_dem_dt_estimate: there are no particles");
-    switch (rule) {
-    case FSDEM_DT_LINEAR_SEED000:
-        if (!(param > 0)) return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "FSDEM_DT_LINEAR_SEED000: gamma must be > 0");
-        if (d->desc.law != FSDEM_CONTACT_LINEAR)
-            return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "FSDEM_DT_LINEAR_SEED000 needs the linear contact law");
-        /* Eq. 18 with Eq. 10: m_ij / k = theta dx / ||g|| whatever the masses */
-        best = (fsdem_real)(2 * FSDEM__PI) / param / (fsdem_real)sqrt(d->k0_linear);
-        break;
-    case FSDEM_DT_RAYLEIGH:
-        if (!(param > 0 && param <= 1))
-            return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "FSDEM_DT_RAYLEIGH: the safety fraction must be in (0, 1]");
-        /* seed 002 Eq. 38 prints 0.01631; the Rayleigh-wave fit it cites (Thornton & Randall 1988)
-           is 0.1631 nu + 0.8766, which we use. */
-        for (i = 0; i < d->n; ++i) {
-            const fsdem_material *m = &d->materials[d->material[i]];
-            fsdem_real t = (fsdem_real)FSDEM__PI * d->r[i] *
-                           (fsdem_real)sqrt(2 * m->density * (1 + m->poisson_ratio) / m->young_modulus) /
-                           ((fsdem_real)0.1631 * m->poisson_ratio + (fsdem_real)0.8766);
-            if (t < best) best = t;
-        }
-        best *= param;
-        break;
-    case FSDEM_DT_GIC:
-        for (i = 0; i < d->n; ++i) {
-            fsdem_real kn = d->materials[d->material[i]].young_modulus * d->r[i]; /* Eq. 32: k_n = E r */
-            fsdem_real t = (fsdem_real)0.5 * (fsdem_real)sqrt(d->m[i] / kn);
-            if (t < best) best = t;
-        }
-        break;
-    default:
-        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "fsdem_dem_dt_estimate: %d is not a fsdem_dt_rule", (int)rule);
-    }
-    *dt = best;
+fsdem_result fsdem_dem_stable_dt(const fsdem_dem *d, fsdem_real *dt) {
+    fsdem__status *st;
+    if (!d || !dt) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&d->status; /* the message is the object's only mutable part here */
+    if (d->n == 0) return fsdem__fail(st, FSDEM_ERR_NOT_FOUND, "fsdem_dem_stable_dt: there are no particles");
+    *dt = fsdem__dem_rule_dt(d);
     return fsdem__ok(st);
 }
 
 /* Elastic energy (J) stored in one contact's normal and tangential springs: overlap delta, mean
-   and effective radius as the force kernels see them (fsdem__batch). */
-static fsdem_real fsdem__contact_energy(const fsdem_dem *d, const fsdem__pair *p, fsdem_real delta, fsdem_real m_mean,
+   and effective radius as the force kernels see them (fsdem__dem_batch). */
+static fsdem_real fsdem__dem_contact_energy(const fsdem_dem *d, const fsdem__dem_pair *p, fsdem_real delta, fsdem_real m_mean,
                                         fsdem_real r_eff, fsdem_vec3 history) {
     switch (d->desc.law) {
-    case FSDEM_CONTACT_LINEAR: return (fsdem_real)0.5 * m_mean * d->k0_linear * delta * delta;
-    case FSDEM_CONTACT_GIC: return (fsdem_real)0.5 * p->e_pair * 2 * r_eff * delta * delta;
+    case FSDEM_DEM_LAW_LINEAR: return (fsdem_real)0.5 * m_mean * d->k0_linear * delta * delta;
+    case FSDEM_DEM_LAW_GIC: return (fsdem_real)0.5 * p->e_pair * 2 * r_eff * delta * delta;
     default: {
         fsdem_real srd = (fsdem_real)sqrt(r_eff * delta);
         /* integral of (4/3) E* sqrt(R*) d^1.5 = (8/15) E* sqrt(R*) d^2.5, plus the Mindlin spring */
@@ -3668,8 +4060,8 @@ static fsdem_real fsdem__contact_energy(const fsdem_dem *d, const fsdem__pair *p
     }
 }
 
-fsdem_energy fsdem_dem_energy(const fsdem_dem *d) {
-    fsdem_energy e;
+fsdem_dem_energy fsdem_dem_get_energy(const fsdem_dem *d) {
+    fsdem_dem_energy e;
     const int nm = d->material_count;
     int i, k, nh;
     memset(&e, 0, sizeof e);
@@ -3682,57 +4074,62 @@ fsdem_energy fsdem_dem_energy(const fsdem_dem *d) {
     }
     if (d->need_rebuild) return e; /* lists are stale after edits; springs are counted after a step */
     for (i = 0; i < d->n; ++i) {
-        const fsdem__pair *row = d->pairs + d->material[i] * nm;
+        const fsdem__dem_pair *row = d->pairs + d->material[i] * nm;
         for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
-            int j = FSDEM__PARTNER(d->pp.key[k]);
+            int j = FSDEM__DEM_PARTNER(d->pp.key[k]);
             fsdem_real delta = d->r[i] + d->r[j] + d->desc.contact_offset - fsdem__norm(fsdem__sub(d->x[i], d->x[j]));
             if (delta <= 0) continue;
-            e.elastic += fsdem__contact_energy(d, row + d->material[j], delta, (d->m[i] + d->m[j]) / 2,
-                                               d->r[i] * d->r[j] / (d->r[i] + d->r[j]), fsdem__spring(&d->pp, k));
+            e.elastic += fsdem__dem_contact_energy(d, row + d->material[j], delta, (d->m[i] + d->m[j]) / 2,
+                                               d->r[i] * d->r[j] / (d->r[i] + d->r[j]), fsdem__dem_spring(&d->pp, k));
         }
-        nh = d->inv_m[i] > 0 ? fsdem__wall_hits((fsdem_dem *)d, i, 0) : 0; /* fixed: no wall force */
+        nh = d->inv_m[i] > 0 ? fsdem__dem_wall_hits((fsdem_dem *)d, i, 0) : 0; /* fixed: no wall force */
         for (k = 0; k < nh; ++k) {
-            const fsdem__wall_hit *hit = &d->hits[k];
-            e.elastic += fsdem__contact_energy(d, row + d->walls[FSDEM__WALL_OF(d->pw.key[hit->entry])].d.material,
-                                               hit->delta, d->m[i], d->r[i], fsdem__spring(&d->pw, hit->entry));
+            const fsdem__dem_wall_hit *hit = &d->hits[k];
+            e.elastic += fsdem__dem_contact_energy(d, row + d->walls[FSDEM__DEM_WALL_OF(d->pw.key[hit->entry])].d.material,
+                                               hit->delta, d->m[i], d->r[i], fsdem__dem_spring(&d->pw, hit->entry));
         }
     }
     return e;
 }
 
-static size_t fsdem__particle_bytes(fsdem_dem *d) {
-    void **ptr[FSDEM__PARTICLE_ARRAYS];
-    size_t size[FSDEM__PARTICLE_ARRAYS], total = 0;
+static size_t fsdem__dem_particle_bytes(fsdem_dem *d) {
+    void **ptr[FSDEM__DEM_PARTICLE_ARRAYS];
+    size_t size[FSDEM__DEM_PARTICLE_ARRAYS], total = 0;
     int k;
-    fsdem__particle_arrays(d, ptr, size);
-    for (k = 0; k < FSDEM__PARTICLE_ARRAYS; ++k) total += size[k] * (size_t)d->capacity;
+    fsdem__dem_particle_arrays(d, ptr, size);
+    for (k = 0; k < FSDEM__DEM_PARTICLE_ARRAYS; ++k) total += size[k] * (size_t)d->capacity;
     return total;
 }
 
 fsdem_dem_stats fsdem_dem_get_stats(const fsdem_dem *d) {
     fsdem_dem_stats s;
     memset(&s, 0, sizeof s);
+    if (!d) return s;
     s.steps = d->steps;
+    s.time = d->time;
+    s.dt = d->dt;
+    s.stable_dt = d->stable_dt;
+    s.dt_ratio = d->stable_dt > 0 ? d->dt / d->stable_dt : 0;
     s.rebuilds = d->rebuilds;
     s.contacts = d->contacts;
     s.wall_contacts = d->wall_contacts;
     s.neighbour_pairs = d->pp.count + d->inert_count;
     s.max_overlap = d->max_overlap;
-    s.memory_bytes = sizeof *d + fsdem__particle_bytes((fsdem_dem *)d) +
+    s.memory_bytes = sizeof *d + fsdem__dem_particle_bytes((fsdem_dem *)d) +
                      (size_t)(d->pp.capacity + d->pp_old.capacity + d->pw.capacity + d->pw_old.capacity) *
                          (2 * sizeof(int) + sizeof(fsdem_vec3)) +
                      (size_t)(d->pp.start_capacity + d->pp_old.start_capacity + d->pw.start_capacity +
                               d->pw_old.start_capacity) * sizeof(int) +
                      (size_t)(d->grid.cell_capacity + 2 * d->grid.item_capacity) * sizeof(int) +
-                     (size_t)d->pair_capacity * sizeof(fsdem__pair) + (size_t)d->wall_capacity * sizeof(fsdem__wall) +
-                     (size_t)d->material_capacity * sizeof(fsdem_material) + d->arena.size +
+                     (size_t)d->pair_capacity * sizeof(fsdem__dem_pair) + (size_t)d->wall_capacity * sizeof(fsdem__dem_wall) +
+                     (size_t)d->material_capacity * sizeof(fsdem_dem_material) + d->arena.size +
                      (size_t)(d->found_capacity + d->inert_capacity) * sizeof(int) +
-                     (size_t)d->hit_capacity * sizeof(fsdem__wall_hit);
+                     (size_t)d->hit_capacity * sizeof(fsdem__dem_wall_hit);
     return s;
 }
 
 /* Writes contact `count` to out when there is room. */
-static void fsdem__report_contact(fsdem_contact_info *out, int capacity, int count, int i, int j, fsdem_vec3 n,
+static void fsdem__dem_report_contact(fsdem_dem_contact *out, int capacity, int count, int i, int j, fsdem_vec3 n,
                                   fsdem_real overlap) {
     if (!out || count >= capacity) return;
     out[count].i = i;
@@ -3742,28 +4139,28 @@ static void fsdem__report_contact(fsdem_contact_info *out, int capacity, int cou
 }
 
 /* Reports particles i < j as contact `count` when they overlap; returns the new count. */
-static int fsdem__report_pair(const fsdem_dem *d, fsdem_contact_info *out, int capacity, int count, int i, int j) {
+static int fsdem__dem_report_pair(const fsdem_dem *d, fsdem_dem_contact *out, int capacity, int count, int i, int j) {
     fsdem_real dist;
-    fsdem_vec3 n = fsdem__direction(d->x[i], d->x[j], fsdem_v3(1, 0, 0), &dist);
+    fsdem_vec3 n = fsdem__geom_direction(d->x[i], d->x[j], fsdem_v3(1, 0, 0), &dist);
     const fsdem_real overlap = d->r[i] + d->r[j] + d->desc.contact_offset - dist;
     if (overlap <= 0) return count;
-    fsdem__report_contact(out, capacity, count, i, j, n, overlap);
+    fsdem__dem_report_contact(out, capacity, count, i, j, n, overlap);
     return count + 1;
 }
 
-int fsdem_dem_contacts(fsdem_dem *d, fsdem_contact_info *out, int capacity) {
+int fsdem_dem_contacts(fsdem_dem *d, fsdem_dem_contact *out, int capacity) {
     int i, k, nh, count = 0;
-    if (fsdem__ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     for (k = 0; k < d->inert_count; ++k) {
         const int a = d->inert[2 * k], b = d->inert[2 * k + 1];
-        count = fsdem__report_pair(d, out, capacity, count, a < b ? a : b, a < b ? b : a);
+        count = fsdem__dem_report_pair(d, out, capacity, count, a < b ? a : b, a < b ? b : a);
     }
     for (i = 0; i < d->n; ++i) {
         for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k)
-            count = fsdem__report_pair(d, out, capacity, count, i, FSDEM__PARTNER(d->pp.key[k]));
-        nh = fsdem__wall_hits(d, i, 0);
+            count = fsdem__dem_report_pair(d, out, capacity, count, i, FSDEM__DEM_PARTNER(d->pp.key[k]));
+        nh = fsdem__dem_wall_hits(d, i, 0);
         for (k = 0; k < nh; ++k)
-            fsdem__report_contact(out, capacity, count++, i, -1 - FSDEM__WALL_OF(d->pw.key[d->hits[k].entry]),
+            fsdem__dem_report_contact(out, capacity, count++, i, -1 - FSDEM__DEM_WALL_OF(d->pw.key[d->hits[k].entry]),
                                   d->hits[k].n, d->hits[k].delta);
     }
     return count;
@@ -4047,7 +4444,7 @@ fsdem_pcg_desc fsdem_pcg_desc_default(void) {
     return d;
 }
 
-static fsdem_result fsdem__pcg_desc_check(const fsdem_pcg_desc *d, char *msg, size_t size) {
+fsdem_result fsdem_pcg_desc_check(const fsdem_pcg_desc *d, char *msg, size_t size) {
     if (!d) return fsdem__reject(msg, size, "fsdem_pcg_desc is NULL");
     if ((int)d->preconditioner < (int)FSDEM_PRECOND_AUTO || (int)d->preconditioner > (int)FSDEM_PRECOND_MG)
         return fsdem__reject(msg, size, "fsdem_pcg_desc.preconditioner is not a fsdem_precond (%d)",
@@ -4073,7 +4470,7 @@ fsdem_result fsdem_pcg_create(const fsdem_pcg_desc *desc, fsdem_pcg **out) {
     fsdem_result res;
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
-    res = fsdem__pcg_desc_check(desc, msg, sizeof msg);
+    res = fsdem_pcg_desc_check(desc, msg, sizeof msg);
     s = (fsdem_pcg *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
                                        desc ? &desc->allocator : NULL, sizeof *s, &res);
     if (!s) return res;
@@ -5043,7 +5440,7 @@ fsdem_result fsdem_pcg_setup_csr(fsdem_pcg *s, const fsdem_csr *m) {
     pc = s->desc.preconditioner == FSDEM_PRECOND_AUTO ? FSDEM_PRECOND_MIC0 : s->desc.preconditioner;
     if (pc == FSDEM_PRECOND_MG)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
-                           "FSDEM_PRECOND_MG needs a stencil operator (fsdem_pcg_setup_stencil); use "
+                           "fsdem_pcg_setup_csr: FSDEM_PRECOND_MG needs a stencil operator (fsdem_pcg_setup_stencil); use "
                            "FSDEM_PRECOND_MIC0 for a CSR matrix");
     for (i = 0; i < m->rows; ++i)
         for (e = m->row_start[i]; e < m->row_start[i + 1]; ++e)
@@ -5379,16 +5776,6 @@ typedef struct fsdem__pic_obst {
     fsdem_vec3 box_lo, box_hi; /* bounding box (m), inflated by two cells */
 } fsdem__pic_obst;
 
-/* Kernel weights of one particle along each axis: nodes lo[b] .. lo[b]+cnt[b]-1 (indices are
-   clamped into the grid when used), weights w and their derivatives dw (per grid unit). */
-typedef struct fsdem__pic_st {
-    int lo[3];
-    int idx[3][3]; /* node indices clamped into the grid */
-    int cnt[3];
-    fsdem_real w[3][3];
-    fsdem_real dw[3][3];
-} fsdem__pic_st;
-
 struct fsdem_pic {
     fsdem_pic_desc desc;
     fsdem__status status;
@@ -5438,7 +5825,9 @@ struct fsdem_pic {
 
     fsdem_pcg *pcg_p;
     fsdem_pcg *pcg_v[3];
-    fsdem_pic_coupling coupling;
+    fsdem_pic_coupling coupling;     /* the coupler's arrays (fsdem_pic_get_coupling) */
+    fsdem_operator_fn pressure_extra; /* fsdem_pic_set_pressure_extra */
+    void *pressure_extra_user;
 
     /* diagnostics */
     int cells_fresh; /* frac/phi hold the current particle positions (set at the end of a step) */
@@ -5534,75 +5923,75 @@ static fsdem_result fsdem__pic_check(const fsdem_pic_desc *d, char *msg, size_t 
         return FSDEM_ERR_INVALID_ARG;                                                              \
     } while (0)
     if (msg && size) msg[0] = '\0';
-    if (d->dim != 2 && d->dim != 3) FSDEM__PIC_BAD("pic desc: dim = %d must be 2 or 3", d->dim);
+    if (d->dim != 2 && d->dim != 3) FSDEM__PIC_BAD("fsdem_pic_desc.dim = %d must be 2 or 3", d->dim);
     if (!(d->cell_size > 0) || !fsdem__finite(d->cell_size))
-        FSDEM__PIC_BAD("pic desc: cell_size = %g m must be > 0 and finite", (double)d->cell_size);
+        FSDEM__PIC_BAD("fsdem_pic_desc.cell_size = %g m must be > 0 and finite", (double)d->cell_size);
     if (!fsdem__finite3(d->domain_min) || !fsdem__finite3(d->domain_max))
-        FSDEM__PIC_BAD("pic desc: domain_min/domain_max must be finite");
+        FSDEM__PIC_BAD("fsdem_pic_desc.domain_min/domain_max must be finite");
     for (a = 0; a < d->dim; ++a)
         if (!(fsdem__comp(d->domain_max, a) > fsdem__comp(d->domain_min, a)))
-            FSDEM__PIC_BAD("pic desc: domain_max.%c = %g must exceed domain_min.%c = %g", "xyz"[a],
+            FSDEM__PIC_BAD("fsdem_pic_desc.domain_max.%c = %g must exceed domain_min.%c = %g", "xyz"[a],
                            (double)fsdem__comp(d->domain_max, a), "xyz"[a],
                            (double)fsdem__comp(d->domain_min, a));
     if (!(d->density > 0) || !fsdem__finite(d->density))
-        FSDEM__PIC_BAD("pic desc: density = %g kg/m^3 must be > 0", (double)d->density);
+        FSDEM__PIC_BAD("fsdem_pic_desc.density = %g kg/m^3 must be > 0", (double)d->density);
     if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
-        FSDEM__PIC_BAD("pic desc: viscosity = %g m^2/s must be >= 0", (double)d->viscosity);
-    if (!fsdem__finite3(d->gravity)) FSDEM__PIC_BAD("pic desc: gravity must be finite");
+        FSDEM__PIC_BAD("fsdem_pic_desc.viscosity = %g m^2/s must be >= 0", (double)d->viscosity);
+    if (!fsdem__finite3(d->gravity)) FSDEM__PIC_BAD("fsdem_pic_desc.gravity must be finite");
     for (k = 0; k < 2 * d->dim; ++k) {
         if ((int)d->boundary[k] < 0 || (int)d->boundary[k] > 3)
-            FSDEM__PIC_BAD("pic desc: boundary[%d] (%s side) = %d is not a fsdem_pic_boundary", k,
+            FSDEM__PIC_BAD("fsdem_pic_desc.boundary[%d] (%s side) = %d is not a fsdem_pic_bc", k,
                            fsdem__pic_side_name(k), (int)d->boundary[k]);
         if (!fsdem__finite3(d->boundary_velocity[k]))
-            FSDEM__PIC_BAD("pic desc: boundary_velocity[%d] must be finite", k);
+            FSDEM__PIC_BAD("fsdem_pic_desc.boundary_velocity[%d] must be finite", k);
     }
     if ((int)d->transfer < 0 || (int)d->transfer > 2)
-        FSDEM__PIC_BAD("pic desc: transfer = %d is not a fsdem_pic_transfer", (int)d->transfer);
+        FSDEM__PIC_BAD("fsdem_pic_desc.transfer = %d is not a fsdem_pic_transfer", (int)d->transfer);
     if (!(d->flip_ratio >= 0 && d->flip_ratio <= 1))
-        FSDEM__PIC_BAD("pic desc: flip_ratio = %g must be in [0, 1]", (double)d->flip_ratio);
+        FSDEM__PIC_BAD("fsdem_pic_desc.flip_ratio = %g must be in [0, 1]", (double)d->flip_ratio);
     if ((int)d->kernel < 0 || (int)d->kernel > 1)
-        FSDEM__PIC_BAD("pic desc: kernel = %d is not a fsdem_pic_kernel", (int)d->kernel);
+        FSDEM__PIC_BAD("fsdem_pic_desc.kernel = %d is not a fsdem_pic_kernel", (int)d->kernel);
     if (d->particles_per_cell < 1 || d->particles_per_cell > 64)
-        FSDEM__PIC_BAD("pic desc: particles_per_cell = %d must be in [1, 64]", d->particles_per_cell);
+        FSDEM__PIC_BAD("fsdem_pic_desc.particles_per_cell = %d must be in [1, 64]", d->particles_per_cell);
     if (!(d->jitter >= 0 && d->jitter <= 1))
-        FSDEM__PIC_BAD("pic desc: jitter = %g must be in [0, 1]", (double)d->jitter);
+        FSDEM__PIC_BAD("fsdem_pic_desc.jitter = %g must be in [0, 1]", (double)d->jitter);
     if (d->min_particles_per_cell < 0 || d->min_particles_per_cell > d->particles_per_cell)
-        FSDEM__PIC_BAD("pic desc: min_particles_per_cell = %d must be in [0, particles_per_cell = %d]",
+        FSDEM__PIC_BAD("fsdem_pic_desc.min_particles_per_cell = %d must be in [0, particles_per_cell = %d]",
                        d->min_particles_per_cell, d->particles_per_cell);
     if (d->max_particles_per_cell != 0 && d->max_particles_per_cell < d->particles_per_cell)
-        FSDEM__PIC_BAD("pic desc: max_particles_per_cell = %d must be 0 or >= particles_per_cell = %d",
+        FSDEM__PIC_BAD("fsdem_pic_desc.max_particles_per_cell = %d must be 0 or >= particles_per_cell = %d",
                        d->max_particles_per_cell, d->particles_per_cell);
     if (d->advection_order != 2 && d->advection_order != 3)
-        FSDEM__PIC_BAD("pic desc: advection_order = %d must be 2 or 3", d->advection_order);
+        FSDEM__PIC_BAD("fsdem_pic_desc.advection_order = %d must be 2 or 3", d->advection_order);
     if (!(d->cfl > 0) || !fsdem__finite(d->cfl))
-        FSDEM__PIC_BAD("pic desc: cfl = %g must be > 0", (double)d->cfl);
+        FSDEM__PIC_BAD("fsdem_pic_desc.cfl = %g must be > 0", (double)d->cfl);
     if (!(d->cfl_max >= d->cfl) || !fsdem__finite(d->cfl_max))
-        FSDEM__PIC_BAD("pic desc: cfl_max = %g must be >= cfl = %g", (double)d->cfl_max, (double)d->cfl);
+        FSDEM__PIC_BAD("fsdem_pic_desc.cfl_max = %g must be >= cfl = %g", (double)d->cfl_max, (double)d->cfl);
     if (!(d->dt_max > 0) || !fsdem__finite(d->dt_max))
-        FSDEM__PIC_BAD("pic desc: dt_max = %g s must be > 0", (double)d->dt_max);
+        FSDEM__PIC_BAD("fsdem_pic_desc.dt_max = %g s must be > 0", (double)d->dt_max);
     if (!(d->ghost_theta_min > 0 && d->ghost_theta_min <= 1))
-        FSDEM__PIC_BAD("pic desc: ghost_theta_min = %g must be in (0, 1]", (double)d->ghost_theta_min);
+        FSDEM__PIC_BAD("fsdem_pic_desc.ghost_theta_min = %g must be in (0, 1]", (double)d->ghost_theta_min);
     if (d->extrapolation_layers < 0 || d->extrapolation_layers > 1000)
-        FSDEM__PIC_BAD("pic desc: extrapolation_layers = %d must be in [0, 1000]", d->extrapolation_layers);
+        FSDEM__PIC_BAD("fsdem_pic_desc.extrapolation_layers = %d must be in [0, 1000]", d->extrapolation_layers);
     if ((int)d->pressure_precond < 0 || (int)d->pressure_precond > 5)
-        FSDEM__PIC_BAD("pic desc: pressure_precond = %d is not a fsdem_precond", (int)d->pressure_precond);
+        FSDEM__PIC_BAD("fsdem_pic_desc.pressure_precond = %d is not a fsdem_precond", (int)d->pressure_precond);
     if ((int)d->viscosity_precond < 0 || (int)d->viscosity_precond > 5)
-        FSDEM__PIC_BAD("pic desc: viscosity_precond = %d is not a fsdem_precond", (int)d->viscosity_precond);
+        FSDEM__PIC_BAD("fsdem_pic_desc.viscosity_precond = %d is not a fsdem_precond", (int)d->viscosity_precond);
     if (!(d->pressure_tolerance > 0 && d->pressure_tolerance < 1))
-        FSDEM__PIC_BAD("pic desc: pressure_tolerance = %g must be in (0, 1)", (double)d->pressure_tolerance);
+        FSDEM__PIC_BAD("fsdem_pic_desc.pressure_tolerance = %g must be in (0, 1)", (double)d->pressure_tolerance);
     if (!(d->viscosity_tolerance > 0 && d->viscosity_tolerance < 1))
-        FSDEM__PIC_BAD("pic desc: viscosity_tolerance = %g must be in (0, 1)", (double)d->viscosity_tolerance);
+        FSDEM__PIC_BAD("fsdem_pic_desc.viscosity_tolerance = %g must be in (0, 1)", (double)d->viscosity_tolerance);
     if (d->pressure_max_iterations < 1)
-        FSDEM__PIC_BAD("pic desc: pressure_max_iterations = %d must be >= 1", d->pressure_max_iterations);
+        FSDEM__PIC_BAD("fsdem_pic_desc.pressure_max_iterations = %d must be >= 1", d->pressure_max_iterations);
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
-        FSDEM__PIC_BAD("pic desc: allocator needs both alloc and free, or neither");
+        FSDEM__PIC_BAD("fsdem_pic_desc.allocator needs both alloc and free, or neither");
 #undef FSDEM__PIC_BAD
     fsdem__pic_grid_size(d, cells, &total, &bytes);
     if (total > 4e8 || cells[0] + 1 > 2e9 || cells[1] + 1 > 2e9 || cells[2] + 1 > 2e9 ||
         (d->max_memory > 0 && bytes > (double)d->max_memory) || bytes > (double)((size_t)-1) / 2) {
         if (msg && size)
             snprintf(msg, size,
-                     "pic desc: the grid of %.0f x %.0f x %.0f = %.4g cells (cell_size %g m) needs about "
+                     "fsdem_pic_desc.the grid of %.0f x %.0f x %.0f = %.4g cells (cell_size %g m) needs about "
                      "%.4g bytes, more than %s",
                      cells[0], cells[1], cells[2], total, (double)d->cell_size, bytes,
                      d->max_memory > 0 && bytes > (double)d->max_memory ? "max_memory allows"
@@ -5614,7 +6003,7 @@ static fsdem_result fsdem__pic_check(const fsdem_pic_desc *d, char *msg, size_t 
 
 fsdem_result fsdem_pic_desc_check(const fsdem_pic_desc *desc, char *message, size_t message_size) {
     if (!desc) {
-        if (message && message_size) snprintf(message, message_size, "pic desc: NULL");
+        if (message && message_size) snprintf(message, message_size, "fsdem_pic_desc is NULL");
         return FSDEM_ERR_INVALID_ARG;
     }
     return fsdem__pic_check(desc, message, message_size);
@@ -5845,7 +6234,7 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
         if (!s->fqueue) ok = 0;
     }
     if (!ok) {
-        snprintf(msg, sizeof msg, "pic create: out of memory allocating the %d x %d x %d grid", s->n[0],
+        snprintf(msg, sizeof msg, "fsdem_pic_create: out of memory allocating the %d x %d x %d grid", s->n[0],
                  s->n[1], s->n[2]);
         if (desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
         fsdem_pic_destroy(s);
@@ -5879,7 +6268,7 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
         }
     }
     if (r != FSDEM_OK) {
-        snprintf(msg, sizeof msg, "pic create: setting up the linear solvers failed (%s)",
+        snprintf(msg, sizeof msg, "fsdem_pic_create: setting up the linear solvers failed (%s)",
                  fsdem_result_string(r));
         if (desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
         fsdem_pic_destroy(s);
@@ -5915,72 +6304,18 @@ static fsdem_real fsdem__pic_rand(fsdem_pic *s) {
 
 /* ---- >>pic_geometry : obstacles, signed distances, cut-cell face fractions ---- */
 
-static fsdem_real fsdem__pic_seg_dist2(fsdem_vec3 p, fsdem_vec3 a, fsdem_vec3 b) {
-    fsdem_real ex = b.x - a.x, ey = b.y - a.y, px = p.x - a.x, py = p.y - a.y;
-    fsdem_real len2 = ex * ex + ey * ey, t = len2 > 0 ? (px * ex + py * ey) / len2 : 0;
-    if (t < 0) t = 0;
-    if (t > 1) t = 1;
-    px -= t * ex;
-    py -= t * ey;
-    return px * px + py * py;
-}
-
 /* Signed distance of one obstacle, positive outside the solid. */
 static fsdem_real fsdem__pic_obst_sdf(const fsdem_pic *s, const fsdem__pic_obst *o, fsdem_vec3 p) {
     const fsdem_pic_obstacle *d = &o->d;
-    int b;
+    fsdem_vec3 normal;
     switch (d->type) {
-    case FSDEM_PIC_OBSTACLE_BOX: {
-        fsdem_real out = 0, in = -1e30f, q;
-        for (b = 0; b < s->dim; ++b) {
-            fsdem_real c = (fsdem__comp(d->a, b) + fsdem__comp(d->b, b)) / 2;
-            fsdem_real h = (fsdem__comp(d->b, b) - fsdem__comp(d->a, b)) / 2;
-            q = (fsdem_real)fabs(fsdem__comp(p, b) - c) - h;
-            if (q > 0) out += q * q;
-            if (q > in) in = q;
-        }
-        return out > 0 ? (fsdem_real)sqrt(out) : in;
-    }
+    case FSDEM_PIC_OBSTACLE_BOX: return fsdem__geom_box(p, d->a, d->b, s->dim, &normal);
     case FSDEM_PIC_OBSTACLE_CYLINDER:
-        if (s->dim == 3) {
-            fsdem_vec3 e = fsdem__sub(d->b, d->a), m = fsdem__scale(fsdem__add(d->a, d->b), (fsdem_real)0.5);
-            fsdem_real len = fsdem__norm(e), z, rad, dr, dz, o2;
-            fsdem_vec3 q;
-            e = fsdem__scale(e, 1 / len);
-            q = fsdem__sub(p, m);
-            z = fsdem__dot(q, e);
-            rad = fsdem__norm(fsdem__madd(q, e, -z));
-            dr = rad - d->radius;
-            dz = (fsdem_real)fabs(z) - len / 2;
-            o2 = (dr > 0 ? dr * dr : 0) + (dz > 0 ? dz * dz : 0);
-            return (dr > dz ? (dr < 0 ? dr : 0) : (dz < 0 ? dz : 0)) + (fsdem_real)sqrt(o2);
-        } else { /* a disc in 2D */
-            fsdem_vec3 q = fsdem__sub(p, d->a);
-            q.z = 0;
-            return fsdem__norm(q) - d->radius;
-        }
-    case FSDEM_PIC_OBSTACLE_SPHERE: {
-        fsdem_vec3 q = fsdem__sub(p, d->a);
-        if (s->dim == 2) q.z = 0;
-        return fsdem__norm(q) - d->radius;
-    }
-    case FSDEM_PIC_OBSTACLE_POLYGON: {
-        fsdem_real best = 1e30f;
-        int i, j, inside = 0, nv = d->vertex_count;
-        for (i = 0, j = nv - 1; i < nv; j = i++) {
-            fsdem_vec3 vi = o->verts[i], vj = o->verts[j];
-            fsdem_real d2 = fsdem__pic_seg_dist2(p, vj, vi);
-            if (d2 < best) best = d2;
-            if ((vi.y > p.y) != (vj.y > p.y) && p.x < (vj.x - vi.x) * (p.y - vi.y) / (vj.y - vi.y) + vi.x)
-                inside = !inside;
-        }
-        best = (fsdem_real)sqrt(best);
-        return inside ? -best : best;
-    }
-    case FSDEM_PIC_OBSTACLE_SDF: {
-        fsdem_vec3 nrm;
-        return d->sdf(d->sdf_user, p, &nrm);
-    }
+        if (s->dim == 3) return fsdem__geom_cylinder(p, d->a, d->b, d->radius);
+        return fsdem__geom_sphere(p, d->a, d->radius, 2); /* a disc in 2D */
+    case FSDEM_PIC_OBSTACLE_SPHERE: return fsdem__geom_sphere(p, d->a, d->radius, s->dim);
+    case FSDEM_PIC_OBSTACLE_POLYGON: return fsdem__geom_polygon(p, o->verts, d->vertex_count);
+    case FSDEM_PIC_OBSTACLE_SDF: return d->sdf(d->sdf_user, p, &normal);
     }
     return 1e30f;
 }
@@ -6313,13 +6648,13 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
     const char *name;
     if (id) *id = -1;
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    if (!ob) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle: NULL obstacle");
+    if (!ob) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: NULL obstacle");
     if ((int)ob->type < 0 || (int)ob->type > 4)
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle: type %d is not a fsdem_pic_obstacle_type",
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: type %d is not a fsdem_pic_obstacle_type",
                            (int)ob->type);
     name = names[ob->type];
     if (!fsdem__finite3(ob->a) || !fsdem__finite3(ob->b) || !fsdem__finite(ob->radius) || !fsdem__finite3(ob->velocity))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (%s): non-finite geometry or velocity",
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (%s): non-finite geometry or velocity",
                            s->obst_count, name);
     memset(&o, 0, sizeof o);
     o.d = *ob;
@@ -6327,7 +6662,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
     case FSDEM_PIC_OBSTACLE_BOX:
         for (b = 0; b < s->dim; ++b)
             if (!(fsdem__comp(ob->b, b) > fsdem__comp(ob->a, b)))
-                return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (box): b.%c must exceed a.%c",
+                return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (box): b.%c must exceed a.%c",
                                    s->obst_count, "xyz"[b], "xyz"[b]);
         o.box_lo = ob->a;
         o.box_hi = ob->b;
@@ -6335,10 +6670,10 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
     case FSDEM_PIC_OBSTACLE_SPHERE:
     case FSDEM_PIC_OBSTACLE_CYLINDER:
         if (!(ob->radius > 0))
-            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (%s): radius = %g must be > 0",
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (%s): radius = %g must be > 0",
                                s->obst_count, name, (double)ob->radius);
         if (ob->type == FSDEM_PIC_OBSTACLE_CYLINDER && s->dim == 3 && !(fsdem__norm(fsdem__sub(ob->b, ob->a)) > 0))
-            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (cylinder): axis a-b has zero length",
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (cylinder): axis a-b has zero length",
                                s->obst_count);
         o.box_lo = fsdem__sub(ob->a, fsdem_v3(ob->radius, ob->radius, ob->radius));
         o.box_hi = fsdem__add(ob->a, fsdem_v3(ob->radius, ob->radius, ob->radius));
@@ -6352,16 +6687,16 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
         break;
     case FSDEM_PIC_OBSTACLE_POLYGON:
         if (s->dim != 2)
-            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (polygon): polygons are 2D only",
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (polygon): polygons are 2D only",
                                s->obst_count);
         if (!ob->vertices || ob->vertex_count < 3)
-            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (polygon): needs >= 3 vertices, has %d",
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (polygon): needs >= 3 vertices, has %d",
                                s->obst_count, ob->vertices ? ob->vertex_count : 0);
         o.box_lo = o.box_hi = ob->vertices[0];
         for (i = 0; i < ob->vertex_count; ++i) {
             fsdem_vec3 v = ob->vertices[i];
             if (!fsdem__finite3(v))
-                return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (polygon): vertex %d is not finite",
+                return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (polygon): vertex %d is not finite",
                                    s->obst_count, i);
             if (v.x < o.box_lo.x) o.box_lo.x = v.x;
             if (v.y < o.box_lo.y) o.box_lo.y = v.y;
@@ -6371,7 +6706,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
         break;
     case FSDEM_PIC_OBSTACLE_SDF:
         if (!ob->sdf)
-            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_obstacle %d (sdf): NULL callback", s->obst_count);
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (sdf): NULL callback", s->obst_count);
         o.box_lo = fsdem__sub(s->lo, fsdem_v3(1e30f, 1e30f, 1e30f));
         o.box_hi = fsdem__add(s->hi, fsdem_v3(1e30f, 1e30f, 1e30f));
         break;
@@ -6387,7 +6722,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
     }
     if (ob->type == FSDEM_PIC_OBSTACLE_POLYGON) {
         o.verts = (fsdem_vec3 *)fsdem__pic_alloc(s, sizeof(fsdem_vec3) * (size_t)ob->vertex_count);
-        if (!o.verts) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "pic add_obstacle: out of memory");
+        if (!o.verts) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_add_obstacle: out of memory");
         memcpy(o.verts, ob->vertices, sizeof(fsdem_vec3) * (size_t)ob->vertex_count);
         o.d.vertices = o.verts;
     }
@@ -6396,7 +6731,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
         fsdem__pic_obst *fresh = (fsdem__pic_obst *)fsdem__pic_alloc(s, sizeof(fsdem__pic_obst) * (size_t)cap);
         if (!fresh) {
             if (o.verts) fsdem__pic_release(s, o.verts, sizeof(fsdem_vec3) * (size_t)ob->vertex_count);
-            return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "pic add_obstacle: out of memory");
+            return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_add_obstacle: out of memory");
         }
         if (s->obst) memcpy(fresh, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_count);
         fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
@@ -6414,7 +6749,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
         s->obst_count--;
         if (o.verts) fsdem__pic_release(s, o.verts, sizeof(fsdem_vec3) * (size_t)ob->vertex_count);
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
-                           "pic add_obstacle %d (%s) covers the whole domain: no open cell is left", s->obst_count, name);
+                           "fsdem_pic_add_obstacle: obstacle %d (%s) covers the whole domain: no open cell is left", s->obst_count, name);
     }
     for (b = 0; b < s->dim; ++b) {
         memcpy(s->sopen[b], open[b], sizeof(fsdem_real) * (size_t)s->nface[b]);
@@ -6496,10 +6831,10 @@ static fsdem_result fsdem__pic_make_room(fsdem_pic *s, long need) {
 
 fsdem_result fsdem_pic_reserve(fsdem_pic *s, int count) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    if (count < 0) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic reserve: count = %d < 0", count);
+    if (count < 0) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_reserve: count = %d < 0", count);
     if (count <= s->pcap) return fsdem__ok(&s->status);
     if (fsdem__pic_set_capacity(s, count) != FSDEM_OK)
-        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "pic reserve: out of memory for %d particles", count);
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_reserve: out of memory for %d particles", count);
     return fsdem__ok(&s->status);
 }
 
@@ -6580,7 +6915,7 @@ static fsdem_result fsdem__pic_fill(fsdem_pic *s, fsdem_vec3 lo, fsdem_vec3 hi, 
         cells *= c1[b] - c0[b] + 1;
     }
     if (fsdem__pic_make_room(s, (long)s->np + cells * s->ppc) != FSDEM_OK)
-        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "pic %s: out of memory for %ld more particles", what,
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_%s: out of memory for %ld more particles", what,
                            cells * s->ppc);
     for (k = c0[2]; k <= c1[2]; ++k)
         for (j = c0[1]; j <= c1[1]; ++j)
@@ -6612,14 +6947,14 @@ fsdem_result fsdem_pic_fill_box(fsdem_pic *s, fsdem_vec3 lo, fsdem_vec3 hi, fsde
     if (added) *added = 0;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!fsdem__finite3(lo) || !fsdem__finite3(hi) || !fsdem__finite3(velocity))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic fill_box: non-finite corner or velocity");
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_box: non-finite corner or velocity");
     for (b = 0; b < s->dim; ++b) {
         if (!(fsdem__comp(hi, b) > fsdem__comp(lo, b)))
-            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic fill_box: hi.%c must exceed lo.%c", "xyz"[b], "xyz"[b]);
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_box: hi.%c must exceed lo.%c", "xyz"[b], "xyz"[b]);
         if (fsdem__comp(lo, b) < fsdem__comp(s->lo, b)) lo = fsdem__pic_axis_shift(lo, b, fsdem__comp(s->lo, b) - fsdem__comp(lo, b));
         if (fsdem__comp(hi, b) > fsdem__comp(s->hi, b)) hi = fsdem__pic_axis_shift(hi, b, fsdem__comp(s->hi, b) - fsdem__comp(hi, b));
         if (!(fsdem__comp(hi, b) > fsdem__comp(lo, b)))
-            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic fill_box: the box is outside the domain along %c",
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_box: the box is outside the domain along %c",
                                "xyz"[b]);
     }
     return fsdem__pic_fill(s, lo, hi, NULL, NULL, velocity, added, "fill_box");
@@ -6628,8 +6963,8 @@ fsdem_result fsdem_pic_fill_box(fsdem_pic *s, fsdem_vec3 lo, fsdem_vec3 hi, fsde
 fsdem_result fsdem_pic_fill_sdf(fsdem_pic *s, fsdem_sdf_fn region, void *user, fsdem_vec3 velocity, int *added) {
     if (added) *added = 0;
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    if (!region) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic fill_sdf: NULL region");
-    if (!fsdem__finite3(velocity)) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic fill_sdf: non-finite velocity");
+    if (!region) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_sdf: NULL region");
+    if (!fsdem__finite3(velocity)) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_sdf: non-finite velocity");
     return fsdem__pic_fill(s, s->lo, s->hi, region, user, velocity, added, "fill_sdf");
 }
 
@@ -6637,20 +6972,20 @@ fsdem_result fsdem_pic_add_particles(fsdem_pic *s, const fsdem_vec3 *x, const fs
     int i;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (count < 0 || (count > 0 && !x))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic add_particles: bad count %d or NULL positions", count);
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_particles: bad count %d or NULL positions", count);
     for (i = 0; i < count; ++i) {
         fsdem_vec3 p = x[i];
         if (!fsdem__finite3(p) || (v && !fsdem__finite3(v[i])))
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
-                               "pic add_particles: particle %d has a non-finite position or velocity", i);
+                               "fsdem_pic_add_particles: particle %d has a non-finite position or velocity", i);
         if (s->dim == 2) p.z = 0;
         if (!fsdem__pic_open_at(s, p))
             return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN,
-                               "pic add_particles: particle %d at (%g, %g, %g) is outside the domain or inside a solid", i,
+                               "fsdem_pic_add_particles: particle %d at (%g, %g, %g) is outside the domain or inside a solid", i,
                                (double)p.x, (double)p.y, (double)p.z);
     }
     if (fsdem__pic_make_room(s, (long)s->np + count) != FSDEM_OK)
-        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "pic add_particles: out of memory for %d particles",
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_add_particles: out of memory for %d particles",
                            s->np + count);
     for (i = 0; i < count; ++i) {
         s->px[s->np] = x[i];
@@ -6676,69 +7011,30 @@ fsdem_pic_particles fsdem_pic_get_particles(fsdem_pic *s) {
 
 /* ---- >>pic_transfer : kernels, particle-to-grid, grid-to-particle ---- */
 
-static void fsdem__pic_stencil(const fsdem_pic *s, int a, fsdem_vec3 x, int quadratic, fsdem__pic_st *st) {
+/* Kernel weights of point x on the faces of axis a (face nodes sit half a cell off along the other
+   axes). */
+static void fsdem__pic_kernel(const fsdem_pic *s, int a, fsdem_vec3 x, int quadratic, fsdem__kernel *k) {
+    fsdem_real g[3];
     int b;
-    for (b = 0; b < 3; ++b) {
-        fsdem_real sx, t;
-        int i0;
-        if (b >= s->dim) {
-            st->lo[b] = 0;
-            st->idx[b][0] = 0;
-            st->cnt[b] = 1;
-            st->w[b][0] = 1;
-            st->dw[b][0] = 0;
-            continue;
-        }
-        sx = (fsdem__comp(x, b) - fsdem__comp(s->lo, b)) * s->inv_dx - (b == a ? 0 : (fsdem_real)0.5);
-        if (!(sx > -4)) sx = -4; /* also NaN */
-        if (sx > (fsdem_real)s->n[b] + 4) sx = (fsdem_real)s->n[b] + 4;
-        if (!quadratic) {
-            i0 = (int)(sx + 8) - 8; /* floor: sx > -8 here */
-            t = sx - (fsdem_real)i0;
-            st->lo[b] = i0;
-            st->cnt[b] = 2;
-            st->w[b][0] = 1 - t;
-            st->w[b][1] = t;
-            st->dw[b][0] = -1;
-            st->dw[b][1] = 1;
-        } else {
-            i0 = (int)(sx + (fsdem_real)7.5) - 8; /* floor(sx - 1/2) */
-            t = sx - (fsdem_real)i0;
-            st->lo[b] = i0;
-            st->cnt[b] = 3;
-            st->w[b][0] = (fsdem_real)0.5 * ((fsdem_real)1.5 - t) * ((fsdem_real)1.5 - t);
-            st->w[b][1] = (fsdem_real)0.75 - (t - 1) * (t - 1);
-            st->w[b][2] = (fsdem_real)0.5 * (t - (fsdem_real)0.5) * (t - (fsdem_real)0.5);
-            st->dw[b][0] = t - (fsdem_real)1.5;
-            st->dw[b][1] = -2 * (t - 1);
-            st->dw[b][2] = t - (fsdem_real)0.5;
-        }
-        {
-            int q, nmax = s->fn[a][b] - 1;
-            for (q = 0; q < st->cnt[b]; ++q) {
-                int i = i0 + q;
-                st->idx[b][q] = i < 0 ? 0 : i > nmax ? nmax : i;
-            }
-        }
-    }
+    for (b = 0; b < 3; ++b)
+        g[b] = b < s->dim ? (fsdem__comp(x, b) - fsdem__comp(s->lo, b)) * s->inv_dx - (b == a ? 0 : (fsdem_real)0.5) : 0;
+    fsdem__kernel_weights(k, s->dim, g, s->fn[a], quadratic);
 }
-
-static int fsdem__pic_clampi(int i, int n) { return i < 0 ? 0 : i >= n ? n - 1 : i; }
 
 /* Linear interpolation of a face field of axis a at x. */
 static fsdem_real fsdem__pic_interp_face(const fsdem_pic *s, const fsdem_real *field, int a, fsdem_vec3 x) {
-    fsdem__pic_st st;
+    fsdem__kernel kw;
     fsdem_real sum = 0;
     int q0, q1, q2;
-    fsdem__pic_stencil(s, a, x, 0, &st);
-    for (q2 = 0; q2 < st.cnt[2]; ++q2) {
-        int k = st.idx[2][q2];
-        for (q1 = 0; q1 < st.cnt[1]; ++q1) {
-            int j = st.idx[1][q1];
-            fsdem_real w12 = st.w[2][q2] * st.w[1][q1];
+    fsdem__pic_kernel(s, a, x, 0, &kw);
+    for (q2 = 0; q2 < kw.count[2]; ++q2) {
+        int k = kw.idx[2][q2];
+        for (q1 = 0; q1 < kw.count[1]; ++q1) {
+            int j = kw.idx[1][q1];
+            fsdem_real w12 = kw.w[2][q2] * kw.w[1][q1];
             int row = (k * s->fn[a][1] + j) * s->fn[a][0];
-            for (q0 = 0; q0 < st.cnt[0]; ++q0)
-                sum += w12 * st.w[0][q0] * field[row + st.idx[0][q0]];
+            for (q0 = 0; q0 < kw.count[0]; ++q0)
+                sum += w12 * kw.w[0][q0] * field[row + kw.idx[0][q0]];
         }
     }
     return sum;
@@ -6756,7 +7052,7 @@ static fsdem_vec3 fsdem__pic_interp_vel(const fsdem_pic *s, fsdem_real *const f[
    received weight are marked valid. */
 static void fsdem__pic_p2g(fsdem_pic *s) {
     int a, p, q0, q1, q2, f, quad = s->desc.kernel == FSDEM_PIC_KERNEL_QUADRATIC;
-    fsdem__pic_st st;
+    fsdem__kernel kw;
     for (a = 0; a < s->dim; ++a) {
         fsdem_real *u = s->u[a], *m = s->wsum[a];
         const fsdem_vec3 *ca = s->pc[0] ? s->pc[a] : NULL;
@@ -6765,16 +7061,16 @@ static void fsdem__pic_p2g(fsdem_pic *s) {
         for (p = 0; p < s->np; ++p) {
             fsdem_vec3 x = s->px[p];
             fsdem_real va = fsdem__comp(s->pv[p], a);
-            fsdem__pic_stencil(s, a, x, quad, &st);
-            for (q2 = 0; q2 < st.cnt[2]; ++q2) {
-                int k = st.idx[2][q2];
-                for (q1 = 0; q1 < st.cnt[1]; ++q1) {
-                    int j = st.idx[1][q1];
-                    fsdem_real w12 = st.w[2][q2] * st.w[1][q1];
+            fsdem__pic_kernel(s, a, x, quad, &kw);
+            for (q2 = 0; q2 < kw.count[2]; ++q2) {
+                int k = kw.idx[2][q2];
+                for (q1 = 0; q1 < kw.count[1]; ++q1) {
+                    int j = kw.idx[1][q1];
+                    fsdem_real w12 = kw.w[2][q2] * kw.w[1][q1];
                     int row = (k * s->fn[a][1] + j) * s->fn[a][0];
-                    for (q0 = 0; q0 < st.cnt[0]; ++q0) {
-                        int i = st.idx[0][q0];
-                        fsdem_real w = w12 * st.w[0][q0], v = va;
+                    for (q0 = 0; q0 < kw.count[0]; ++q0) {
+                        int i = kw.idx[0][q0];
+                        fsdem_real w = w12 * kw.w[0][q0], v = va;
                         f = row + i;
                         if (ca) {
                             fsdem_vec3 xf = fsdem__pic_face_pos(s, a, i, j, k);
@@ -6801,22 +7097,22 @@ static int fsdem__pic_g2p(fsdem_pic *s) {
     fsdem_real ratio = s->desc.transfer == FSDEM_PIC_TRANSFER_FLIP ? s->desc.flip_ratio : 0;
     int apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC;
     fsdem_real dfac = 4 * s->inv_dx * s->inv_dx;
-    fsdem__pic_st st;
+    fsdem__kernel kw;
     for (p = 0; p < s->np; ++p) {
         fsdem_vec3 x = s->px[p];
         fsdem_real vnew[3] = {0, 0, 0};
         for (a = 0; a < s->dim; ++a) {
             fsdem_real pic = 0, flip = 0, c[3] = {0, 0, 0};
             const fsdem_real *u = s->u[a], *du = s->uold[a];
-            fsdem__pic_stencil(s, a, x, quad, &st);
-            for (q2 = 0; q2 < st.cnt[2]; ++q2) {
-                int k = st.idx[2][q2];
-                for (q1 = 0; q1 < st.cnt[1]; ++q1) {
-                    int j = st.idx[1][q1];
+            fsdem__pic_kernel(s, a, x, quad, &kw);
+            for (q2 = 0; q2 < kw.count[2]; ++q2) {
+                int k = kw.idx[2][q2];
+                for (q1 = 0; q1 < kw.count[1]; ++q1) {
+                    int j = kw.idx[1][q1];
                     int row = (k * s->fn[a][1] + j) * s->fn[a][0];
-                    for (q0 = 0; q0 < st.cnt[0]; ++q0) {
-                        int i = st.idx[0][q0], f = row + i;
-                        fsdem_real w = st.w[2][q2] * st.w[1][q1] * st.w[0][q0];
+                    for (q0 = 0; q0 < kw.count[0]; ++q0) {
+                        int i = kw.idx[0][q0], f = row + i;
+                        fsdem_real w = kw.w[2][q2] * kw.w[1][q1] * kw.w[0][q0];
                         pic += w * u[f];
                         if (ratio > 0) flip += w * du[f];
                         if (apic) {
@@ -6826,9 +7122,9 @@ static int fsdem__pic_g2p(fsdem_pic *s) {
                                 c[1] += w * u[f] * d.y * dfac;
                                 c[2] += w * u[f] * d.z * dfac;
                             } else {
-                                c[0] += st.dw[0][q0] * st.w[1][q1] * st.w[2][q2] * u[f] * s->inv_dx;
-                                c[1] += st.w[0][q0] * st.dw[1][q1] * st.w[2][q2] * u[f] * s->inv_dx;
-                                if (s->dim == 3) c[2] += st.w[0][q0] * st.w[1][q1] * st.dw[2][q2] * u[f] * s->inv_dx;
+                                c[0] += kw.dw[0][q0] * kw.w[1][q1] * kw.w[2][q2] * u[f] * s->inv_dx;
+                                c[1] += kw.w[0][q0] * kw.dw[1][q1] * kw.w[2][q2] * u[f] * s->inv_dx;
+                                if (s->dim == 3) c[2] += kw.w[0][q0] * kw.w[1][q1] * kw.dw[2][q2] * u[f] * s->inv_dx;
                             }
                         }
                     }
@@ -6866,7 +7162,7 @@ static void fsdem__pic_effective_faces(fsdem_pic *s) {
                     if (co > 1) co = 1;
                     if (coord == 0 || coord == s->n[a]) {
                         int side = 2 * a + (coord != 0);
-                        fsdem_pic_boundary bc = s->desc.boundary[side];
+                        fsdem_pic_bc bc = s->desc.boundary[side];
                         if (bc == FSDEM_PIC_BC_OUTFLOW) {
                             s->E[a][f] = so < co ? so : co;
                             s->us[a][f] = co < so ? s->cvel[a][f] : s->svel[a][f];
@@ -6890,33 +7186,22 @@ static void fsdem__pic_fraction(fsdem_pic *s) {
     fsdem_real inv_ppc = 1 / (fsdem_real)s->ppc;
     memset(s->frac, 0, sizeof(fsdem_real) * (size_t)s->ncell);
     for (p = 0; p < s->np; ++p) {
-        int i0[3];
-        fsdem_real w[3][2];
-        for (b = 0; b < 3; ++b) {
-            if (b < s->dim) {
-                fsdem_real sx = (fsdem__comp(s->px[p], b) - fsdem__comp(s->lo, b)) * s->inv_dx - (fsdem_real)0.5, t;
-                if (!(sx > -2)) sx = -2;
-                if (sx > (fsdem_real)s->n[b] + 2) sx = (fsdem_real)s->n[b] + 2;
-                i0[b] = (int)(sx + 8) - 8; /* floor: sx >= -2 here */
-                t = sx - (fsdem_real)i0[b];
-                w[b][0] = 1 - t;
-                w[b][1] = t;
-            } else {
-                i0[b] = 0;
-                w[b][0] = 1;
-                w[b][1] = 0;
-            }
-        }
-        for (q2 = 0; q2 < (s->dim == 3 ? 2 : 1); ++q2) {
-            int k = i0[2] + q2;
+        fsdem__kernel kw;
+        fsdem_real g[3];
+        for (b = 0; b < 3; ++b)
+            g[b] = b < s->dim ? (fsdem__comp(s->px[p], b) - fsdem__comp(s->lo, b)) * s->inv_dx - (fsdem_real)0.5 : 0;
+        fsdem__kernel_weights(&kw, s->dim, g, s->n, 0);
+        /* nodes outside the grid collect nothing (the reference fraction fref is truncated alike) */
+        for (q2 = 0; q2 < kw.count[2]; ++q2) {
+            int k = kw.lo[2] + q2;
             if (k < 0 || k >= s->n[2]) continue;
-            for (q1 = 0; q1 < 2; ++q1) {
-                int j = i0[1] + q1;
+            for (q1 = 0; q1 < kw.count[1]; ++q1) {
+                int j = kw.lo[1] + q1;
                 if (j < 0 || j >= s->n[1]) continue;
-                for (q0 = 0; q0 < 2; ++q0) {
-                    int i = i0[0] + q0;
+                for (q0 = 0; q0 < kw.count[0]; ++q0) {
+                    int i = kw.lo[0] + q0;
                     if (i < 0 || i >= s->n[0]) continue;
-                    s->frac[fsdem__pic_cell(s, i, j, k)] += w[0][q0] * w[1][q1] * w[2][q2];
+                    s->frac[fsdem__pic_cell(s, i, j, k)] += kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2];
                 }
             }
         }
@@ -7144,7 +7429,7 @@ static fsdem_result fsdem__pic_viscosity(fsdem_pic *s, fsdem_real dt) {
                             if (nc < 0 || nc >= fn[b]) {
                                 if (b != a) {
                                     int side = 2 * b + (sg > 0);
-                                    fsdem_pic_boundary bc = s->desc.boundary[side];
+                                    fsdem_pic_bc bc = s->desc.boundary[side];
                                     if (bc == FSDEM_PIC_BC_NO_SLIP || bc == FSDEM_PIC_BC_INFLOW) {
                                         d += 2;
                                         r0 += 2 * fsdem__comp(s->desc.boundary_velocity[side], a);
@@ -7174,7 +7459,7 @@ static fsdem_result fsdem__pic_viscosity(fsdem_pic *s, fsdem_real dt) {
         s->v_iters += info.iterations;
         if (r != FSDEM_OK && worst == FSDEM_OK) {
             worst = r;
-            fsdem__fail(&s->status, r, "pic step: viscous solve of component %c failed: %s", "xyz"[a],
+            fsdem__fail(&s->status, r, "fsdem_pic: viscous solve of component %c failed: %s", "xyz"[a],
                         fsdem_pcg_last_error(s->pcg_v[a]));
         }
     }
@@ -7266,8 +7551,8 @@ static void fsdem__pic_stencil_view(const fsdem_pic *s, fsdem_stencil *st, int w
     for (a = 0; a < s->dim; ++a) st->face[a] = s->E[a];
     st->diag = s->diag;
     if (with_extra) {
-        st->extra = s->coupling.pressure_extra;
-        st->extra_user = s->coupling.pressure_extra_user;
+        st->extra = s->pressure_extra;
+        st->extra_user = s->pressure_extra_user;
     }
 }
 
@@ -7329,7 +7614,7 @@ static fsdem_result fsdem__pic_project(fsdem_pic *s, fsdem_real dt) {
     s->p_res = info.residual;
     s->sec_pressure += (double)(clock() - t0) / CLOCKS_PER_SEC;
     if (r != FSDEM_OK)
-        fsdem__fail(&s->status, r, "pic step: pressure solve failed (%d iterations, residual %g): %s", info.iterations,
+        fsdem__fail(&s->status, r, "fsdem_pic: pressure solve failed (%d iterations, residual %g): %s", info.iterations,
                     (double)info.residual, fsdem_pcg_last_error(s->pcg_p));
     fsdem__pic_apply_grad(s, s->pres, dt / (s->desc.density * s->dx), s->u);
     for (k = 0; k < s->n[2]; ++k)
@@ -7662,7 +7947,7 @@ static fsdem_real fsdem__pic_umax(const fsdem_pic *s, int *who) {
         }
     }
     for (k = 0; k < 2 * s->dim; ++k) {
-        fsdem_pic_boundary bc = s->desc.boundary[k];
+        fsdem_pic_bc bc = s->desc.boundary[k];
         if (bc == FSDEM_PIC_BC_NO_SLIP || bc == FSDEM_PIC_BC_INFLOW) {
             fsdem_real v2 = fsdem__dot(s->desc.boundary_velocity[k], s->desc.boundary_velocity[k]);
             if (v2 > m2) {
@@ -7681,9 +7966,31 @@ static fsdem_real fsdem__pic_dt_from(const fsdem_pic *s, fsdem_real umax) {
     return dt;
 }
 
-fsdem_real fsdem_pic_dt_estimate(const fsdem_pic *s) { return fsdem__pic_dt_from(s, fsdem__pic_umax(s, NULL)); }
+fsdem_result fsdem_pic_stable_dt(const fsdem_pic *s, fsdem_real *dt) {
+    int who;
+    fsdem_real umax;
+    if (!s || !dt) return FSDEM_ERR_INVALID_ARG;
+    umax = fsdem__pic_umax(s, &who);
+    if (!fsdem__finite(umax))
+        return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_NAN, "fsdem_pic_stable_dt: particle %d has a non-finite velocity",
+                           who);
+    *dt = fsdem__pic_dt_from(s, umax);
+    return fsdem__ok((fsdem__status *)&s->status);
+}
 
-fsdem_real fsdem_pic_time(const fsdem_pic *s) { return (fsdem_real)s->time; }
+double fsdem_pic_time(const fsdem_pic *s) { return s ? s->time : 0; }
+
+fsdem_pic_desc fsdem_pic_get_desc(const fsdem_pic *s) {
+    fsdem_pic_desc d;
+    if (!s) {
+        memset(&d, 0, sizeof d);
+        return d;
+    }
+    d = s->desc;
+    d.domain_max = s->hi;
+    if (s->dim == 2) d.domain_max.z = d.domain_min.z;
+    return d;
+}
 
 static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
     fsdem_result r, worst = FSDEM_OK;
@@ -7737,7 +8044,7 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
         fsdem__pic_types(s);
         r = fsdem__pic_density_projection(s);
         if (r != FSDEM_OK && worst == FSDEM_OK)
-            worst = fsdem__fail(&s->status, r, "pic step: density projection failed: %s", fsdem_pcg_last_error(s->pcg_p));
+            worst = fsdem__fail(&s->status, r, "fsdem_pic: density projection failed: %s", fsdem_pcg_last_error(s->pcg_p));
         if (fsdem__pic_constrain(s)) {
             int before = s->np;
             fsdem__pic_remove_marked(s);
@@ -7760,10 +8067,10 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
     s->steps++;
     s->sec_total += (double)(clock() - t0) / CLOCKS_PER_SEC;
     if (bad >= 0 && worst == FSDEM_OK)
-        worst = fsdem__fail(&s->status, FSDEM_ERR_NAN, "pic step %lld: particle %d has a non-finite velocity", s->steps, bad);
+        worst = fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pic: step %lld: particle %d has a non-finite velocity", s->steps, bad);
     if (worst == FSDEM_OK && umax * dt * s->inv_dx > s->desc.cfl_max)
         worst = fsdem__fail(&s->status, FSDEM_ERR_CFL,
-                            "pic step %lld: the projected grid velocity %g m/s moves %g cells in dt = %g s (cfl_max %g)",
+                            "fsdem_pic: step %lld: the projected grid velocity %g m/s moves %g cells in dt = %g s (cfl_max %g)",
                             s->steps, (double)umax, (double)(umax * dt * s->inv_dx), (double)dt, (double)s->desc.cfl_max);
     return worst;
 }
@@ -7773,18 +8080,18 @@ fsdem_result fsdem_pic_step_dt(fsdem_pic *s, fsdem_real dt) {
     fsdem_real umax, cfl;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic step_dt: dt = %g s must be > 0 and finite", (double)dt);
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_step_dt: dt = %g s must be > 0 and finite", (double)dt);
     umax = fsdem__pic_umax(s, &who);
     if (!fsdem__finite(umax))
-        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "pic step: particle %d has a non-finite velocity", who);
+        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pic: particle %d has a non-finite velocity", who);
     cfl = umax * dt * s->inv_dx;
     if (cfl > s->desc.cfl_max) {
         if (who >= 0)
             return fsdem__fail(&s->status, FSDEM_ERR_CFL,
-                               "pic step_dt: dt = %g s gives CFL %g > cfl_max %g (particle %d at %g m/s; dt <= %g s)", (double)dt,
+                               "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (particle %d at %g m/s; dt <= %g s)", (double)dt,
                                (double)cfl, (double)s->desc.cfl_max, who, (double)umax,
                                (double)(s->desc.cfl_max * s->dx / umax));
-        return fsdem__fail(&s->status, FSDEM_ERR_CFL, "pic step_dt: dt = %g s gives CFL %g > cfl_max %g (%s side velocity %g m/s)",
+        return fsdem__fail(&s->status, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s side velocity %g m/s)",
                            (double)dt, (double)cfl, (double)s->desc.cfl_max, fsdem__pic_side_name(-2 - who), (double)umax);
     }
     return fsdem__pic_do_step(s, dt);
@@ -7796,24 +8103,24 @@ fsdem_result fsdem_pic_step(fsdem_pic *s) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
     umax = fsdem__pic_umax(s, &who);
     if (!fsdem__finite(umax))
-        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "pic step: particle %d has a non-finite velocity", who);
+        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pic: particle %d has a non-finite velocity", who);
     return fsdem__pic_do_step(s, fsdem__pic_dt_from(s, umax));
 }
 
-fsdem_result fsdem_pic_advance(fsdem_pic *s, fsdem_real duration, int *steps) {
+fsdem_result fsdem_pic_advance(fsdem_pic *s, fsdem_real duration, long long *steps) {
     double end;
-    int n = 0;
+    long long n = 0;
     fsdem_result r = FSDEM_OK;
     if (steps) *steps = 0;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!(duration >= 0) || !fsdem__finite(duration))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "pic advance: duration = %g s must be >= 0", (double)duration);
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_advance: duration = %g s must be >= 0", (double)duration);
     end = s->time + (double)duration;
     while (s->time < end - 1e-12 * (end > 1 ? end : 1)) {
         int who;
         fsdem_real umax = fsdem__pic_umax(s, &who), dt;
         if (!fsdem__finite(umax)) {
-            r = fsdem__fail(&s->status, FSDEM_ERR_NAN, "pic advance: particle %d has a non-finite velocity", who);
+            r = fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pic_advance: particle %d has a non-finite velocity", who);
             break;
         }
         dt = fsdem__pic_dt_from(s, umax);
@@ -7829,8 +8136,8 @@ fsdem_result fsdem_pic_advance(fsdem_pic *s, fsdem_real duration, int *steps) {
 
 /* ---- >>pic_views : grid, coupling, sampling, statistics ---- */
 
-fsdem_pic_grid fsdem_pic_get_grid(const fsdem_pic *s) {
-    fsdem_pic_grid g;
+fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *s) {
+    fsdem_pic_fields g;
     int a;
     memset(&g, 0, sizeof g);
     g.dim = s->dim;
@@ -7850,30 +8157,139 @@ fsdem_pic_grid fsdem_pic_get_grid(const fsdem_pic *s) {
     return g;
 }
 
-fsdem_pic_coupling *fsdem_pic_coupling_view(fsdem_pic *s) { return &s->coupling; }
+fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *s) {
+    fsdem_pic_coupling c;
+    if (s) return s->coupling;
+    memset(&c, 0, sizeof c);
+    return c;
+}
 
-fsdem_vec3 fsdem_pic_sample_velocity(const fsdem_pic *s, fsdem_vec3 p) { return fsdem__pic_interp_vel(s, s->u, p); }
+fsdem_result fsdem_pic_set_pressure_extra(fsdem_pic *s, fsdem_operator_fn fn, void *user) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    s->pressure_extra = fn;
+    s->pressure_extra_user = fn ? user : NULL;
+    return fsdem__ok(&s->status);
+}
 
-fsdem_real fsdem_pic_sample_pressure(const fsdem_pic *s, fsdem_vec3 p) {
-    fsdem_real t[3], sum = 0;
-    int i0[3], b, q0, q1, q2;
-    for (b = 0; b < 3; ++b) {
-        fsdem_real sx = b < s->dim ? (fsdem__comp(p, b) - fsdem__comp(s->lo, b)) * s->inv_dx - (fsdem_real)0.5 : 0;
-        if (!(sx > 0)) sx = 0;
-        if (sx > (fsdem_real)(s->n[b] - 1)) sx = (fsdem_real)(s->n[b] - 1);
-        i0[b] = (int)floor(sx);
-        if (i0[b] > s->n[b] - 2) i0[b] = s->n[b] > 1 ? s->n[b] - 2 : 0;
-        t[b] = sx - (fsdem_real)i0[b];
+static int fsdem__pic_fluid_cell(const fsdem_pic *s, int c) { return c >= 0 && s->ctype[c] == FSDEM_STENCIL_CELL_FLUID; }
+
+/* The cells below (lower index along a) and above face (i, j, k) of axis a; -1 off the grid. */
+static void fsdem__pic_face_cells(const fsdem_pic *s, int a, const int f3[3], int *below, int *above) {
+    const int coord = f3[a];
+    *above = coord < s->n[a] ? fsdem__pic_cell(s, f3[0], f3[1], f3[2]) : -1;
+    *below = coord > 0 ? fsdem__pic_cell(s, f3[0] - (a == 0), f3[1] - (a == 1), f3[2] - (a == 2)) : -1;
+}
+
+fsdem_result fsdem_pic_sample(const fsdem_pic *s, int count, const fsdem_vec3 *points, fsdem_fluid_sample *out) {
+    int n, a, b, q0, q1, q2;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (count < 0 || (count > 0 && (!points || !out)))
+        return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_sample: bad count %d or NULL arrays",
+                           count);
+    for (n = 0; n < count; ++n) {
+        const fsdem_vec3 x = points[n];
+        fsdem_real grad[3] = {0, 0, 0}, g[3], frac = 0;
+        fsdem__kernel kw;
+        out[n].velocity = fsdem__pic_interp_vel(s, s->u, x);
+        /* pressure gradient: the face differences (p_above - p_below)/dx, interpolated over the faces
+           between two open cells (weights renormalised) */
+        for (a = 0; a < s->dim; ++a) {
+            fsdem_real sum = 0, wsum = 0;
+            fsdem__pic_kernel(s, a, x, 0, &kw);
+            for (q2 = 0; q2 < kw.count[2]; ++q2)
+                for (q1 = 0; q1 < kw.count[1]; ++q1)
+                    for (q0 = 0; q0 < kw.count[0]; ++q0) {
+                        const int f3[3] = {kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2]};
+                        const fsdem_real w = kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2];
+                        int lo, hi;
+                        fsdem__pic_face_cells(s, a, f3, &lo, &hi);
+                        if (lo < 0 || hi < 0 || s->ctype[lo] == FSDEM_STENCIL_CELL_SOLID ||
+                            s->ctype[hi] == FSDEM_STENCIL_CELL_SOLID || !(w > 0))
+                            continue;
+                        sum += w * (s->pres[hi] - s->pres[lo]);
+                        wsum += w;
+                    }
+            grad[a] = wsum > 0 ? sum / wsum * s->inv_dx : 0;
+        }
+        out[n].pressure_gradient = fsdem_v3(grad[0], grad[1], grad[2]);
+        /* liquid fraction clamp(1/2 - phi/dx, 0, 1) between cell centres (clamped to the outer ones) */
+        for (b = 0; b < 3; ++b) {
+            fsdem_real t = b < s->dim ? (fsdem__comp(x, b) - fsdem__comp(s->lo, b)) * s->inv_dx - (fsdem_real)0.5 : 0;
+            g[b] = t < 0 ? 0 : t > (fsdem_real)(s->n[b] - 1) ? (fsdem_real)(s->n[b] - 1) : t;
+        }
+        fsdem__kernel_weights(&kw, s->dim, g, s->n, 0);
+        for (q2 = 0; q2 < kw.count[2]; ++q2)
+            for (q1 = 0; q1 < kw.count[1]; ++q1)
+                for (q0 = 0; q0 < kw.count[0]; ++q0) {
+                    const int c = fsdem__pic_cell(s, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2]);
+                    fsdem_real f = s->desc.free_surface ? (fsdem_real)0.5 - s->phi[c] * s->inv_dx : 1;
+                    if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID) f = 0;
+                    frac += kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2] * (f < 0 ? 0 : f > 1 ? 1 : f);
+                }
+        out[n].volume_fraction = frac;
     }
-    for (q2 = 0; q2 < 2; ++q2)
-        for (q1 = 0; q1 < 2; ++q1)
-            for (q0 = 0; q0 < 2; ++q0) {
-                fsdem_real w = (q0 ? t[0] : 1 - t[0]) * (q1 ? t[1] : 1 - t[1]) * (q2 ? t[2] : 1 - t[2]);
-                int i = fsdem__pic_clampi(i0[0] + q0, s->n[0]), j = fsdem__pic_clampi(i0[1] + q1, s->n[1]);
-                int k = fsdem__pic_clampi(i0[2] + q2, s->n[2]);
-                if (w != 0) sum += w * s->pres[fsdem__pic_cell(s, i, j, k)];
+    return fsdem__ok((fsdem__status *)&s->status);
+}
+
+/* Weights of the tent kernel of half-width `hw` at `point` on the faces of axis a next to FLUID
+   cells: with `add` == 0 returns their sum; otherwise adds add x weight to the coupling
+   acceleration of each. */
+static fsdem_real fsdem__pic_spread(fsdem_pic *s, int a, fsdem_vec3 point, fsdem_real hw, fsdem_real add) {
+    int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0}, f3[3], b;
+    fsdem_real sum = 0;
+    for (b = 0; b < s->dim; ++b) {
+        const fsdem_real off = b == a ? 0 : (fsdem_real)0.5, x = (fsdem__comp(point, b) - fsdem__comp(s->lo, b)) * s->inv_dx;
+        const fsdem_real reach = hw * s->inv_dx;
+        lo[b] = (int)floor(x - reach - off) + 1;
+        hi[b] = (int)ceil(x + reach - off) - 1;
+        if (lo[b] < 0) lo[b] = 0;
+        if (hi[b] > s->fn[a][b] - 1) hi[b] = s->fn[a][b] - 1;
+    }
+    for (f3[2] = lo[2]; f3[2] <= hi[2]; ++f3[2])
+        for (f3[1] = lo[1]; f3[1] <= hi[1]; ++f3[1])
+            for (f3[0] = lo[0]; f3[0] <= hi[0]; ++f3[0]) {
+                const int f = fsdem__pic_face(s, a, f3[0], f3[1], f3[2]);
+                fsdem_vec3 xf = fsdem__pic_face_pos(s, a, f3[0], f3[1], f3[2]);
+                fsdem_real w = 1;
+                int below, above;
+                fsdem__pic_face_cells(s, a, f3, &below, &above);
+                if (s->E[a][f] <= 0 || (!fsdem__pic_fluid_cell(s, below) && !fsdem__pic_fluid_cell(s, above))) continue;
+                for (b = 0; b < s->dim; ++b) {
+                    const fsdem_real t = 1 - (fsdem_real)fabs(fsdem__comp(xf, b) - fsdem__comp(point, b)) / hw;
+                    w *= t > 0 ? t : 0;
+                }
+                if (!(w > 0)) continue;
+                sum += w;
+                if (add != 0) s->cacc[a][f] += add * w;
             }
     return sum;
+}
+
+fsdem_result fsdem_pic_add_force(fsdem_pic *s, fsdem_vec3 point, fsdem_real radius, fsdem_vec3 force, int *taken) {
+    const fsdem_real hw = radius > s->dx ? radius : s->dx;
+    fsdem_real wsum[3] = {0, 0, 0};
+    int a;
+    if (taken) *taken = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!fsdem__finite3(point) || !fsdem__finite3(force) || !(radius >= 0) || !fsdem__finite(radius))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_force: point, force and radius >= 0 must be finite");
+    if (s->dim == 2) point.z = 0;
+    /* all components or none, so the momentum given is exactly force x dt */
+    for (a = 0; a < s->dim; ++a)
+        if (fsdem__comp(force, a) != 0 && !((wsum[a] = fsdem__pic_spread(s, a, point, hw, 0)) > 0)) return fsdem__ok(&s->status);
+    for (a = 0; a < s->dim; ++a)
+        if (fsdem__comp(force, a) != 0)
+            fsdem__pic_spread(s, a, point, hw,
+                              fsdem__comp(force, a) / (wsum[a] * s->desc.density * (fsdem_real)pow((double)s->dx, s->dim)));
+    if (taken) *taken = 1;
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_pic_clear_forces(fsdem_pic *s) {
+    int a;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    for (a = 0; a < s->dim; ++a) memset(s->cacc[a], 0, sizeof(fsdem_real) * (size_t)s->nface[a]);
+    return fsdem__ok(&s->status);
 }
 
 fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *s) {
@@ -8088,7 +8504,8 @@ struct fsdem_swe {
     fsdem_allocator allocator;
     int dim, nx, ny, n;
     fsdem_real dx, dy, area, g, tiny;
-    fsdem_real time, dt_last;
+    double time;
+    fsdem_real dt_last;
     long long steps, fallbacks;
     fsdem_real max_wave;  /* 1/s, max over wet cells of (|u|+c)/dx + (|v|+c)/dy of the current state */
     fsdem_real max_accel; /* 1/s^2, max over wet cells of g (|deta/dx|/dx + |deta/dy|/dy), minmod slopes */
@@ -8119,7 +8536,7 @@ struct fsdem_swe {
     fsdem_real *gauge_xy;
     int gauge_count, gauge_capacity;
     void *gauge_file;
-    fsdem_real gauge_interval, gauge_next;
+    double gauge_interval, gauge_next;
 };
 
 /* ---- >>swe_desc : defaults and validation ---- */
@@ -8136,7 +8553,7 @@ fsdem_swe_desc fsdem_swe_desc_default(int dim) {
     d.y_min = 0;
     d.y_max = 1;
     d.width = 1;
-    d.gravity = (fsdem_real)9.81;
+    d.gravity = fsdem_v3(0, 0, (fsdem_real)-9.81);
     d.density = 1000;
     d.cfl = (fsdem_real)0.5;
     d.dt_max = 1;
@@ -8215,8 +8632,9 @@ fsdem_result fsdem_swe_desc_check(const fsdem_swe_desc *d, char *msg, size_t siz
                              (double)d->y_max);
     if (d->dim == 1 && (!(d->width > 0) || !fsdem__finite(d->width)))
         return fsdem__reject(msg, size, "fsdem_swe_desc.width must be > 0 (got %g m)", (double)d->width);
-    if (!(d->gravity > 0) || !fsdem__finite(d->gravity))
-        return fsdem__reject(msg, size, "fsdem_swe_desc.gravity must be > 0 (got %g m/s^2)", (double)d->gravity);
+    if (d->gravity.x != 0 || d->gravity.y != 0 || !(d->gravity.z < 0) || !fsdem__finite(d->gravity.z))
+        return fsdem__reject(msg, size, "fsdem_swe_desc.gravity must be (0, 0, -g) with g > 0 (got (%g, %g, %g) m/s^2)",
+                             (double)d->gravity.x, (double)d->gravity.y, (double)d->gravity.z);
     if (!(d->density > 0) || !fsdem__finite(d->density))
         return fsdem__reject(msg, size, "fsdem_swe_desc.density must be > 0 (got %g kg/m^3)", (double)d->density);
     if (!(d->cfl > 0 && d->cfl <= 1))
@@ -8376,7 +8794,7 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
     s->nx = desc->nx;
     s->ny = desc->ny;
     s->n = desc->nx * desc->ny;
-    s->g = desc->gravity;
+    s->g = -desc->gravity.z;
     s->tiny = desc->dry_depth * (fsdem_real)1e-9;
     s->dx = (desc->x_max - desc->x_min) / (fsdem_real)desc->nx;
     s->dy = desc->dim == 2 ? (desc->y_max - desc->y_min) / (fsdem_real)desc->ny : desc->width;
@@ -8555,18 +8973,29 @@ fsdem_result fsdem_swe_set_cells(fsdem_swe *s, fsdem_swe_init_fn fn, void *user)
     return fsdem__ok(&s->status);
 }
 
-fsdem_swe_fields fsdem_swe_get_fields(fsdem_swe *s) {
+fsdem_swe_fields fsdem_swe_get_fields(const fsdem_swe *s) {
     fsdem_swe_fields f;
+    memset(&f, 0, sizeof f);
+    if (!s) return f;
     f.nx = s->nx;
     f.ny = s->ny;
     f.eta = s->eta;
     f.qx = s->qx;
     f.qy = s->qy;
     f.bed = s->bed;
-    f.source_x = s->sx;
-    f.source_y = s->sy;
-    s->sources_used = 1; /* the caller may write them from now on */
     return f;
+}
+
+fsdem_swe_coupling fsdem_swe_get_coupling(fsdem_swe *s) {
+    fsdem_swe_coupling c;
+    memset(&c, 0, sizeof c);
+    if (!s) return c;
+    c.nx = s->nx;
+    c.ny = s->ny;
+    c.source_x = s->sx;
+    c.source_y = s->sy;
+    s->sources_used = 1; /* the caller may write them from now on */
+    return c;
 }
 
 fsdem_result fsdem_swe_copy_field(const fsdem_swe *s, fsdem_swe_field field, fsdem_real *out) {
@@ -8599,7 +9028,7 @@ int fsdem_swe_cell_at(const fsdem_swe *s, fsdem_real x, fsdem_real y) {
     return i + s->nx * j;
 }
 
-fsdem_result fsdem_swe_sample(const fsdem_swe *s, fsdem_real x, fsdem_real y, fsdem_swe_cell *out) {
+fsdem_result fsdem_swe_sample_state(const fsdem_swe *s, fsdem_real x, fsdem_real y, fsdem_swe_cell *out) {
     fsdem_real fx, fy, wx, wy, w[4];
     int i0, j0, i1, j1, c[4], q;
     if (!out) return FSDEM_ERR_INVALID_ARG;
@@ -8638,27 +9067,103 @@ fsdem_result fsdem_swe_sample(const fsdem_swe *s, fsdem_real x, fsdem_real y, fs
     return FSDEM_OK;
 }
 
-fsdem_result fsdem_swe_add_force(fsdem_swe *s, fsdem_real x, fsdem_real y, fsdem_vec3 force) {
-    int k = fsdem_swe_cell_at(s, x, y);
-    fsdem_real scale;
-    if (k < 0)
+fsdem_result fsdem_swe_sample(const fsdem_swe *s, int count, const fsdem_vec3 *points, fsdem_fluid_sample *out) {
+    int n;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (count < 0 || (count > 0 && (!points || !out)))
+        return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_sample: bad count %d or NULL arrays",
+                           count);
+    for (n = 0; n < count; ++n) {
+        const fsdem_vec3 p = points[n];
+        const fsdem_real rg = s->desc.density * s->g, hx = s->dx / 2, hy = s->dim == 2 ? s->dy / 2 : 0;
+        fsdem_swe_cell c, e0, e1;
+        memset(&out[n], 0, sizeof out[n]);
+        if (fsdem_swe_sample_state(s, p.x, p.y, &c) != FSDEM_OK || c.depth < s->desc.dry_depth || p.z < c.bed ||
+            p.z > c.eta)
+            continue;
+        out[n].velocity = fsdem_v3(c.u, c.v, 0);
+        out[n].volume_fraction = 1;
+        /* hydrostatic p = rho g (eta - z): the surface slope over one cell around the point */
+        fsdem_swe_sample_state(s, p.x - hx, p.y, &e0);
+        fsdem_swe_sample_state(s, p.x + hx, p.y, &e1);
+        out[n].pressure_gradient.x = rg * (e1.eta - e0.eta) / s->dx;
+        if (s->dim == 2) {
+            fsdem_swe_sample_state(s, p.x, p.y - hy, &e0);
+            fsdem_swe_sample_state(s, p.x, p.y + hy, &e1);
+            out[n].pressure_gradient.y = rg * (e1.eta - e0.eta) / s->dy;
+        }
+        out[n].pressure_gradient.z = -rg;
+    }
+    return fsdem__ok((fsdem__status *)&s->status);
+}
+
+/* Wet cells of the footprint [x - r, x + r] (x [y - r, y + r] in 2D; grown by `grown` cells) with
+   their overlap weights (grown: 1 each): pass 0 sums the weights, pass 1 adds `scale` x weight x
+   (fx, fy) to the sources. Returns the sum. */
+static fsdem_real fsdem__swe_footprint(fsdem_swe *s, fsdem_vec3 p, fsdem_real r, int grown, int pass, fsdem_real scale,
+                                       fsdem_vec3 f) {
+    const fsdem_real dry = s->desc.dry_depth;
+    int lo[2], hi[2], i, j;
+    fsdem_real total = 0;
+    lo[0] = (int)floor((p.x - r - s->desc.x_min) / s->dx) - grown;
+    hi[0] = (int)floor((p.x + r - s->desc.x_min) / s->dx) + grown;
+    lo[1] = s->dim == 2 ? (int)floor((p.y - r - s->desc.y_min) / s->dy) - grown : 0;
+    hi[1] = s->dim == 2 ? (int)floor((p.y + r - s->desc.y_min) / s->dy) + grown : 0;
+    lo[0] = lo[0] < 0 ? 0 : lo[0];
+    hi[0] = hi[0] >= s->nx ? s->nx - 1 : hi[0];
+    lo[1] = lo[1] < 0 ? 0 : lo[1];
+    hi[1] = hi[1] >= s->ny ? s->ny - 1 : hi[1];
+    for (j = lo[1]; j <= hi[1]; ++j)
+        for (i = lo[0]; i <= hi[0]; ++i) {
+            const int k = i + s->nx * j;
+            fsdem_real w = 1;
+            if (!grown && r > 0) {
+                fsdem_real xa = s->desc.x_min + (fsdem_real)i * s->dx;
+                w = (p.x + r < xa + s->dx ? p.x + r : xa + s->dx) - (p.x - r > xa ? p.x - r : xa);
+                if (s->dim == 2) {
+                    fsdem_real ya = s->desc.y_min + (fsdem_real)j * s->dy;
+                    w *= (p.y + r < ya + s->dy ? p.y + r : ya + s->dy) - (p.y - r > ya ? p.y - r : ya);
+                }
+            }
+            if (!(w > 0) || s->eta[k] - s->bed[k] < dry) continue;
+            total += w;
+            if (pass) {
+                s->sx[k] += f.x * scale * w;
+                if (s->dim == 2) s->sy[k] += f.y * scale * w;
+            }
+        }
+    return total;
+}
+
+fsdem_result fsdem_swe_add_force(fsdem_swe *s, fsdem_vec3 point, fsdem_real radius, fsdem_vec3 force, int *taken) {
+    fsdem_real total = 0;
+    int grown;
+    if (taken) *taken = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!fsdem__finite3(point) || !fsdem__finite3(force) || !(radius >= 0) || !fsdem__finite(radius))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_force: point, force and radius >= 0 must be finite");
+    if (fsdem_swe_cell_at(s, point.x, point.y) < 0)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_swe_add_force: point (%g, %g) is outside the grid",
-                           (double)x, (double)y);
-    if (!fsdem__finite3(force))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_force: force is not finite");
-    scale = 1 / (s->desc.density * s->area);
-    s->sx[k] += force.x * scale;
-    if (s->dim == 2) s->sy[k] += force.y * scale;
-    s->sources_used = 1;
+                           (double)point.x, (double)point.y);
+    /* a force felt at a wet/dry edge (water sampled from a neighbouring cell while the footprint is
+       dry) goes to the wet cells one cell around, so momentum is exchanged, never created */
+    for (grown = 0; grown < 2 && total == 0; ++grown) total = fsdem__swe_footprint(s, point, radius, grown, 0, 0, force);
+    if (total > 0) {
+        fsdem__swe_footprint(s, point, radius, grown - 1, 1, 1 / (total * s->desc.density * s->area), force);
+        s->sources_used = 1;
+        if (taken) *taken = 1;
+    }
     return fsdem__ok(&s->status);
 }
 
-void fsdem_swe_clear_sources(fsdem_swe *s) {
+fsdem_result fsdem_swe_clear_forces(fsdem_swe *s) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     memset(s->sx, 0, sizeof(fsdem_real) * (size_t)s->n);
     memset(s->sy, 0, sizeof(fsdem_real) * (size_t)s->n);
+    return fsdem__ok(&s->status);
 }
 
-fsdem_result fsdem_swe_set_boundary(fsdem_swe *s, fsdem_swe_side side, const fsdem_swe_boundary *bc) {
+fsdem_result fsdem_swe_set_boundary(fsdem_swe *s, fsdem_side side, const fsdem_swe_boundary *bc) {
     char msg[FSDEM__MESSAGE_SIZE];
     if ((int)side < 0 || (int)side >= (s->dim == 2 ? 4 : 2))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_set_boundary: side %d does not exist in %dD",
@@ -8975,7 +9480,7 @@ static void fsdem__swe_load_row(const fsdem_swe *s, int src, int dst, int flip_v
     e[-1] = e[0];
     h[-1] = h[0];
     v[-1] = v[0];
-    if (s->bnd[FSDEM_SWE_XMIN].type == FSDEM_SWE_BC_WALL) u[-1] = -u[0];
+    if (s->bnd[FSDEM_SIDE_XMIN].type == FSDEM_SWE_BC_WALL) u[-1] = -u[0];
     else {
         u[-1] = u[0];
         if (nx > 1) e[-1] += bed[0] - bed[1];
@@ -8983,7 +9488,7 @@ static void fsdem__swe_load_row(const fsdem_swe *s, int src, int dst, int flip_v
     e[nx] = e[nx - 1];
     h[nx] = h[nx - 1];
     v[nx] = v[nx - 1];
-    if (s->bnd[FSDEM_SWE_XMAX].type == FSDEM_SWE_BC_WALL) u[nx] = -u[nx - 1];
+    if (s->bnd[FSDEM_SIDE_XMAX].type == FSDEM_SWE_BC_WALL) u[nx] = -u[nx - 1];
     else {
         u[nx] = u[nx - 1];
         if (nx > 1) e[nx] += bed[nx - 1] - bed[nx - 2];
@@ -9186,14 +9691,14 @@ FSDEM__FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, in
             if (c->visc > 0) fsdem__swe_viscous(s, c, j, i, &cvx, &cvy);
             /* ---- face i - 1/2 ---- */
             if (i == 0) {
-                fsdem__swe_boundary_flux(s, FSDEM_SWE_XMIN, 0, e - half * sex, h - half * shx, u - half * sux,
+                fsdem__swe_boundary_flux(s, FSDEM_SIDE_XMIN, 0, e - half * sex, h - half * shx, u - half * sux,
                                          w - half * svx, &f);
                 c->bflux += f.mass * s->dy * c->dt;
             } else {
                 fsdem__swe_riemann(g, c->tiny, Ee, Eh, Eu, Ev, e - half * sex, h - half * shx, u - half * sux, w - half * svx, &f);
             }
         } else {
-            fsdem__swe_boundary_flux(s, FSDEM_SWE_XMAX, 1, Ee, Eh, Eu, Ev, &f);
+            fsdem__swe_boundary_flux(s, FSDEM_SIDE_XMAX, 1, Ee, Eh, Eu, Ev, &f);
             c->bflux -= f.mass * s->dy * c->dt;
         }
         if (i > 0) {
@@ -9255,11 +9760,11 @@ static void fsdem__swe_yfaces(fsdem_swe *s, fsdem__swe_ctx *c, int j) {
     for (i = 0; i < nx; ++i) {
         if (j == 0) {
             const fsdem_real *R = hi[i].s;
-            fsdem__swe_boundary_flux(s, FSDEM_SWE_YMIN, 0, R[0], R[1], R[2], R[3], &f);
+            fsdem__swe_boundary_flux(s, FSDEM_SIDE_YMIN, 0, R[0], R[1], R[2], R[3], &f);
             c->bflux += f.mass * s->dx * c->dt;
         } else if (j == ny) {
             const fsdem_real *L = lo[i].n;
-            fsdem__swe_boundary_flux(s, FSDEM_SWE_YMAX, 1, L[0], L[1], L[2], L[3], &f);
+            fsdem__swe_boundary_flux(s, FSDEM_SIDE_YMAX, 1, L[0], L[1], L[2], L[3], &f);
             c->bflux -= f.mass * s->dx * c->dt;
         } else {
             const fsdem_real *L = lo[i].n, *R = hi[i].s;
@@ -9360,7 +9865,11 @@ static fsdem_real fsdem__swe_dt_for(const fsdem_swe *s, fsdem_real cfl) {
     return lim < dt ? lim : dt;
 }
 
-fsdem_real fsdem_swe_stable_dt(const fsdem_swe *s) { return fsdem__swe_dt_for(s, s->desc.cfl); }
+fsdem_result fsdem_swe_stable_dt(const fsdem_swe *s, fsdem_real *dt) {
+    if (!s || !dt) return FSDEM_ERR_INVALID_ARG;
+    *dt = fsdem__swe_dt_for(s, s->desc.cfl);
+    return FSDEM_OK;
+}
 
 /* Writes a gauge row when the time has reached the next output time. */
 static fsdem_result fsdem__swe_gauge_row(fsdem_swe *s, int force) {
@@ -9372,7 +9881,7 @@ static fsdem_result fsdem__swe_gauge_row(fsdem_swe *s, int force) {
     for (k = 0; k < s->gauge_count; ++k) {
         fsdem_swe_cell c;
         memset(&c, 0, sizeof c);
-        fsdem_swe_sample(s, s->gauge_xy[2 * k], s->gauge_xy[2 * k + 1], &c);
+        fsdem_swe_sample_state(s, s->gauge_xy[2 * k], s->gauge_xy[2 * k + 1], &c);
         fprintf(fp, ",%.10g,%.10g,%.10g,%.10g", (double)c.depth, (double)c.eta, (double)c.u, (double)c.v);
     }
     fputc('\n', fp);
@@ -9410,8 +9919,8 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
         fsdem__swe_load_row(s, 0, 0, 0, -1);
         fsdem__swe_row(s, &c, 0);
     } else {
-        int wall_lo = s->bnd[FSDEM_SWE_YMIN].type == FSDEM_SWE_BC_WALL;
-        int wall_hi = s->bnd[FSDEM_SWE_YMAX].type == FSDEM_SWE_BC_WALL;
+        int wall_lo = s->bnd[FSDEM_SIDE_YMIN].type == FSDEM_SWE_BC_WALL;
+        int wall_hi = s->bnd[FSDEM_SIDE_YMAX].type == FSDEM_SWE_BC_WALL;
         fsdem__swe_load_row(s, 0, -1, wall_lo, !wall_lo && s->ny > 1 ? 1 : -1);
         fsdem__swe_load_row(s, 0, 0, 0, -1);
         for (j = 0; j < s->ny; ++j) {
@@ -9459,36 +9968,39 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
     return fsdem__ok(&s->status);
 }
 
-fsdem_result fsdem_swe_step(fsdem_swe *s, fsdem_real dt_cap, fsdem_real *dt_out) {
-    fsdem_real dt = fsdem_swe_stable_dt(s);
-    if (dt_cap > 0 && dt_cap < dt) dt = dt_cap;
-    if (dt_out) *dt_out = dt;
-    return fsdem__swe_do_step(s, dt);
+fsdem_result fsdem_swe_step(fsdem_swe *s) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__swe_do_step(s, fsdem__swe_dt_for(s, s->desc.cfl));
 }
 
-fsdem_result fsdem_swe_step_fixed(fsdem_swe *s, fsdem_real dt) {
+fsdem_result fsdem_swe_step_dt(fsdem_swe *s, fsdem_real dt) {
     fsdem_real courant;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_step_fixed: dt must be > 0 (got %g s)", (double)dt);
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_step_dt: dt must be > 0 (got %g s)", (double)dt);
     courant = dt * fsdem__swe_rate(s) + dt * dt * s->max_accel;
     if (courant > 1)
         return fsdem__fail(&s->status, FSDEM_ERR_CFL,
-                           "fsdem_swe_step_fixed: dt = %g s gives Courant number %g > 1 (stable dt at cfl 1: %g s)",
+                           "fsdem_swe_step_dt: dt = %g s gives Courant number %g > 1 (stable dt at cfl 1: %g s)",
                            (double)dt, (double)courant, (double)fsdem__swe_dt_for(s, 1));
     return fsdem__swe_do_step(s, dt);
 }
 
 fsdem_result fsdem_swe_advance(fsdem_swe *s, fsdem_real duration, long long *steps) {
-    fsdem_real t_end = s->time + duration;
+    double t_end;
     fsdem_result res = FSDEM_OK;
     long long count = 0;
+    if (steps) *steps = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!(duration >= 0) || !fsdem__finite(duration))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_advance: duration must be >= 0 (got %g s)",
                            (double)duration);
+    t_end = s->time + (double)duration;
     while (s->time < t_end) {
-        fsdem_real dt = fsdem_swe_stable_dt(s), left = t_end - s->time;
-        int last = dt >= left;
-        res = fsdem__swe_do_step(s, last ? left : dt);
+        fsdem_real dt = fsdem__swe_dt_for(s, s->desc.cfl);
+        double left = t_end - s->time;
+        int last = (double)dt >= left;
+        res = fsdem__swe_do_step(s, last ? (fsdem_real)left : dt);
         count++;
         if (last) s->time = t_end;
         if (res != FSDEM_OK) break;
@@ -9497,7 +10009,23 @@ fsdem_result fsdem_swe_advance(fsdem_swe *s, fsdem_real duration, long long *ste
     return res;
 }
 
-fsdem_real fsdem_swe_time(const fsdem_swe *s) { return s->time; }
+double fsdem_swe_time(const fsdem_swe *s) { return s ? s->time : 0; }
+
+fsdem_swe_desc fsdem_swe_get_desc(const fsdem_swe *s) {
+    fsdem_swe_desc d;
+    int k;
+    if (!s) {
+        memset(&d, 0, sizeof d);
+        return d;
+    }
+    d = s->desc;
+    d.rain_rate = s->rain;
+    for (k = 0; k < 4; ++k) {
+        d.boundary[k].type = s->bnd[k].type;
+        d.boundary[k].value = s->bnd[k].value;
+    }
+    return d;
+}
 
 /* ---- >>swe_diag : diagnostics and output ---- */
 
@@ -9609,7 +10137,7 @@ fsdem_result fsdem_swe_add_gauge(fsdem_swe *s, fsdem_real x, fsdem_real y, int *
 
 fsdem_result fsdem_swe_gauge(const fsdem_swe *s, int id, fsdem_swe_cell *out) {
     if (id < 0 || id >= s->gauge_count || !out) return FSDEM_ERR_NOT_FOUND;
-    return fsdem_swe_sample(s, s->gauge_xy[2 * id], s->gauge_xy[2 * id + 1], out);
+    return fsdem_swe_sample_state(s, s->gauge_xy[2 * id], s->gauge_xy[2 * id + 1], out);
 }
 
 fsdem_result fsdem_swe_gauges_open(fsdem_swe *s, const char *path, fsdem_real interval) {
@@ -9643,14 +10171,48 @@ fsdem_result fsdem_swe_gauges_close(fsdem_swe *s) {
     return bad ? fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_gauges_close: write error") : fsdem__ok(&s->status);
 }
 
-/* ===== >>impl_couple_swe : SWE-DEM floating debris ================================================= */
+fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
+    const fsdem_swe *swe = (const fsdem_swe *)user;
+    const fsdem_real x0 = swe->desc.x_min + swe->dx / 2, x1 = swe->desc.x_min + (swe->nx - (fsdem_real)0.5) * swe->dx;
+    const fsdem_real y0 = swe->desc.y_min + swe->dy / 2, y1 = swe->desc.y_min + (swe->ny - (fsdem_real)0.5) * swe->dy;
+    fsdem_real x = p.x < x0 ? x0 : p.x > x1 ? x1 : p.x, y = p.y < y0 ? y0 : p.y > y1 ? y1 : p.y, gx, gy, len;
+    fsdem_swe_cell c0, cm, cp;
+    fsdem_swe_sample_state(swe, x, y, &c0);
+    /* bed slope from centred differences over one cell */
+    fsdem_swe_sample_state(swe, x - swe->dx / 2, y, &cm);
+    fsdem_swe_sample_state(swe, x + swe->dx / 2, y, &cp);
+    gx = (cp.bed - cm.bed) / swe->dx;
+    gy = 0;
+    if (swe->dim == 2) {
+        fsdem_swe_sample_state(swe, x, y - swe->dy / 2, &cm);
+        fsdem_swe_sample_state(swe, x, y + swe->dy / 2, &cp);
+        gy = (cp.bed - cm.bed) / swe->dy;
+    }
+    len = (fsdem_real)sqrt(1 + gx * gx + gy * gy);
+    *normal = fsdem_v3(-gx / len, -gy / len, 1 / len);
+    return (p.z - c0.bed) / len;
+}
+
+/* ===== >>impl_couple_swe : SWE-DEM floating debris =================================================
+
+   Contents: >>couple_swe_object (desc, creation), >>couple_swe_geometry (submerged parts of a
+   sphere), >>couple_swe_forces (seed 003 Eq. 5-8), >>couple_swe_step (coupled time stepping). The
+   coupler reaches the solvers through their coupling functions only (>>doc). */
+
+/* ---- >>couple_swe_object : desc, creation ---- */
 
 struct fsdem_swe_dem {
     fsdem_swe_dem_desc desc;
     fsdem__status status;
     fsdem_allocator allocator;
-    fsdem_swe_dem_force *force; /* one per DEM particle */
+    fsdem_real rho, g, dry;        /* the SWE's density, |g| and dry depth */
+    fsdem_swe_dem_force *force;    /* one per DEM particle */
     int force_capacity;
+    long long steps, substeps, substeps_total;
+    fsdem_real dt_last;
+    int in_water;
+    fsdem_vec3 impulse;            /* N s, given to the water */
+    fsdem_vec3 *reaction;          /* N, horizontal force on each sphere whose reaction the water took */
 };
 
 fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void) {
@@ -9659,43 +10221,54 @@ fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void) {
     d.beta = (fsdem_real)1.1;
     d.two_way = 1;
     d.heave_damping = 0;
+    d.max_substeps = 100000;
     return d;
 }
 
 fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *d, char *msg, size_t size) {
+    fsdem_dem_desc dd;
     fsdem_vec3 g;
     fsdem_real gs;
     if (!d) return fsdem__reject(msg, size, "fsdem_swe_dem_desc is NULL");
     if (!d->swe || !d->dem) return fsdem__reject(msg, size, "fsdem_swe_dem_desc.swe and .dem must both be set");
-    if (d->dem->desc.dim != 3)
-        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.dem must be 3D (spheres, z vertical); it has dim %d",
-                             d->dem->desc.dim);
-    g = d->dem->desc.gravity;
-    gs = d->swe->g;
+    dd = fsdem_dem_get_desc(d->dem);
+    if (dd.dim != 3)
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.dem must be 3D (spheres, z vertical); it has dim %d", dd.dim);
+    g = dd.gravity;
+    gs = -fsdem_swe_get_desc(d->swe).gravity.z;
     if (g.x != 0 || g.y != 0 || !(fabs(g.z + gs) <= 1e-12 * gs))
-        return fsdem__reject(msg, size,
-                             "the DEM gravity (%g, %g, %g) must be (0, 0, -g) with the SWE's g = %g m/s^2",
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc: the DEM gravity (%g, %g, %g) must be (0, 0, -g) with the SWE's g = %g m/s^2",
                              (double)g.x, (double)g.y, (double)g.z, (double)gs);
     if (!(d->beta > 0) || !fsdem__finite(d->beta))
         return fsdem__reject(msg, size, "fsdem_swe_dem_desc.beta must be > 0 (got %g)", (double)d->beta);
     if (!(d->heave_damping >= 0) || !fsdem__finite(d->heave_damping))
         return fsdem__reject(msg, size, "fsdem_swe_dem_desc.heave_damping must be >= 0 (got %g)",
                              (double)d->heave_damping);
+    if (d->max_substeps < 1)
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
     return FSDEM_OK;
 }
 
 fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out) {
     char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_allocator al;
     fsdem_swe_dem *c;
     fsdem_result res;
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_swe_dem_desc_check(desc, msg, sizeof msg);
+    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
     c = (fsdem_swe_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                           res == FSDEM_OK ? &desc->dem->allocator : NULL, sizeof *c, &res);
+                                           res == FSDEM_OK ? &al : NULL, sizeof *c, &res);
     if (!c) return res;
+    {
+        const fsdem_swe_desc sd = fsdem_swe_get_desc(desc->swe);
+        c->rho = sd.density;
+        c->g = -sd.gravity.z;
+        c->dry = sd.dry_depth;
+    }
     c->desc = *desc;
-    c->allocator = desc->dem->allocator;
+    c->allocator = al;
     c->status.log = desc->log;
     c->status.log_user = desc->log_user;
     *out = c;
@@ -9707,10 +10280,18 @@ void fsdem_swe_dem_destroy(fsdem_swe_dem *c) {
     if (!c) return;
     al = c->allocator;
     fsdem__free(&al, c->force, sizeof(fsdem_swe_dem_force) * (size_t)c->force_capacity);
+    fsdem__free(&al, c->reaction, sizeof(fsdem_vec3) * (size_t)c->force_capacity);
     fsdem__free(&al, c, sizeof *c);
 }
 
 const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *c) { return c ? c->status.message : "fsdem_swe_dem is NULL"; }
+
+fsdem_swe_dem_desc fsdem_swe_dem_get_desc(const fsdem_swe_dem *c) {
+    fsdem_swe_dem_desc d;
+    if (c) return c->desc;
+    memset(&d, 0, sizeof d);
+    return d;
+}
 
 /* ---- >>couple_swe_geometry : submerged parts of a sphere ---- */
 
@@ -9718,7 +10299,7 @@ const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *c) { return c ? c->sta
    area and its first moment M = int (eta - z) w(z) dz, so the hydrostatic force on it is rho g M.
    With z = zc - r cos(phi) and w = 2 r sin(phi) both integrals are closed forms in the angle theta of
    the waterline: area r^2 (theta - sin cos), M = 2 r^2 [(eta - zc)(theta - sin cos)/2 + r sin^3 / 3]. */
-static void fsdem__submerged_disc(fsdem_real r, fsdem_real zc, fsdem_real eta, fsdem_real *area, fsdem_real *moment) {
+static void fsdem__swe_dem_submerged_disc(fsdem_real r, fsdem_real zc, fsdem_real eta, fsdem_real *area, fsdem_real *moment) {
     fsdem_real top = eta < zc + r ? eta : zc + r, c, s, th;
     if (top <= zc - r) {
         *area = *moment = 0;
@@ -9733,7 +10314,7 @@ static void fsdem__submerged_disc(fsdem_real r, fsdem_real zc, fsdem_real eta, f
 }
 
 /* Volume of the part of a sphere (radius r, centre height zc) below the surface eta: a cap. */
-static fsdem_real fsdem__submerged_sphere(fsdem_real r, fsdem_real zc, fsdem_real eta) {
+static fsdem_real fsdem__swe_dem_submerged_sphere(fsdem_real r, fsdem_real zc, fsdem_real eta) {
     fsdem_real s = eta - (zc - r);
     if (s <= 0) return 0;
     if (s > 2 * r) s = 2 * r;
@@ -9741,71 +10322,27 @@ static fsdem_real fsdem__submerged_sphere(fsdem_real r, fsdem_real zc, fsdem_rea
 }
 
 /* Water at p shifted by `shift` along a horizontal axis (0: x, 1: y); off the grid it is `fallback`. */
-static fsdem_swe_cell fsdem__swe_water_at(const fsdem_swe *swe, fsdem_vec3 p, int axis, fsdem_real shift,
-                                          fsdem_swe_cell fallback) {
+static fsdem_swe_cell fsdem__swe_dem_water_at(const fsdem_swe *swe, fsdem_vec3 p, int axis, fsdem_real shift,
+                                              fsdem_swe_cell fallback) {
     fsdem_swe_cell cell;
     fsdem_real x = p.x + (axis == 0 ? shift : 0), y = p.y + (axis == 1 ? shift : 0);
-    return fsdem_swe_sample(swe, x, y, &cell) == FSDEM_OK ? cell : fallback;
-}
-
-/* Spreads the force -f (N, horizontal) exerted by a sphere on the water over the wet cells under its
-   footprint [x-r, x+r] (x [y-r, y+r] in 2D), weighted by overlap, as momentum sources (m^2/s^2). At a
-   wet/dry edge the sphere can feel water sampled from a neighbouring cell while its own cells are dry:
-   then the wet cells of the footprint grown by one cell share it equally. Returns 0 when no wet cell
-   can take it (the caller then drops the force, so momentum is exchanged, never created). */
-static int fsdem__swe_spread_reaction(fsdem_swe *swe, fsdem_vec3 p, fsdem_real r, fsdem_vec3 f) {
-    const fsdem_real dry = swe->desc.dry_depth;
-    int lo[2], hi[2], i, j, pass, grown;
-    fsdem_real total = 0;
-    for (grown = 0; grown < 2 && total == 0; ++grown) {
-        lo[0] = (int)floor((p.x - r - swe->desc.x_min) / swe->dx) - grown;
-        hi[0] = (int)floor((p.x + r - swe->desc.x_min) / swe->dx) + grown;
-        lo[1] = swe->dim == 2 ? (int)floor((p.y - r - swe->desc.y_min) / swe->dy) - grown : 0;
-        hi[1] = swe->dim == 2 ? (int)floor((p.y + r - swe->desc.y_min) / swe->dy) + grown : 0;
-        lo[0] = lo[0] < 0 ? 0 : lo[0];
-        hi[0] = hi[0] >= swe->nx ? swe->nx - 1 : hi[0];
-        lo[1] = lo[1] < 0 ? 0 : lo[1];
-        hi[1] = hi[1] >= swe->ny ? swe->ny - 1 : hi[1];
-        /* pass 0 sums the wet weights, pass 1 deposits -f w / (rho A) with the weights normalised */
-        for (pass = 0; pass < 2; ++pass)
-            for (j = lo[1]; j <= hi[1]; ++j)
-                for (i = lo[0]; i <= hi[0]; ++i) {
-                    const int k = i + swe->nx * j;
-                    fsdem_real w = 1;
-                    if (!grown) {
-                        fsdem_real xa = swe->desc.x_min + i * swe->dx;
-                        w = (p.x + r < xa + swe->dx ? p.x + r : xa + swe->dx) - (p.x - r > xa ? p.x - r : xa);
-                        if (swe->dim == 2) {
-                            fsdem_real ya = swe->desc.y_min + j * swe->dy;
-                            w *= (p.y + r < ya + swe->dy ? p.y + r : ya + swe->dy) - (p.y - r > ya ? p.y - r : ya);
-                        }
-                    }
-                    if (!(w > 0) || swe->eta[k] - swe->bed[k] < dry) continue;
-                    if (pass == 0) total += w;
-                    else if (total > 0) {
-                        const fsdem_real scale = -w / (total * swe->desc.density * swe->area);
-                        swe->sx[k] += f.x * scale;
-                        if (swe->dim == 2) swe->sy[k] += f.y * scale;
-                    }
-                }
-    }
-    return total > 0;
+    return fsdem_swe_sample_state(swe, x, y, &cell) == FSDEM_OK ? cell : fallback;
 }
 
 /* Buoyancy (Eq. 5) and heave damping of sphere i at its current height and vertical speed, against
    the water surface held in out->surface; updates `out` and returns the vertical force (N). */
-static fsdem_real fsdem__swe_dem_vertical(const fsdem_swe_dem *c, int i, fsdem_swe_dem_force *out) {
-    const fsdem_dem *dem = c->desc.dem;
-    const fsdem_real rho = c->desc.swe->desc.density, g = c->desc.swe->g, r = dem->r[i], z = dem->x[i].z;
-    out->submerged_volume = fsdem__submerged_sphere(r, z, out->surface);
+static fsdem_real fsdem__swe_dem_vertical(const fsdem_swe_dem *c, const fsdem_dem_particles *pv, int i,
+                                          fsdem_swe_dem_force *out) {
+    const fsdem_real rho = c->rho, g = c->g, r = pv->radius[i], z = pv->position[i].z;
+    out->submerged_volume = fsdem__swe_dem_submerged_sphere(r, z, out->surface);
     out->buoyancy = fsdem_v3(0, 0, rho * g * out->submerged_volume);
     out->heave = fsdem__zero3();
     if (c->desc.heave_damping > 0) {
         /* critical damping of the hydrostatic spring rho g A_waterplane of the bobbing */
         fsdem_real a2 = r * r - (out->surface - z) * (out->surface - z);
         if (a2 > 0)
-            out->heave.z = -2 * c->desc.heave_damping *
-                           (fsdem_real)sqrt(rho * g * (fsdem_real)FSDEM__PI * a2 * dem->m[i]) * dem->v[i].z;
+            out->heave.z = -2 * c->desc.heave_damping * (fsdem_real)sqrt(rho * g * (fsdem_real)FSDEM__PI * a2 * pv->mass[i]) *
+                           pv->velocity[i].z;
     }
     return out->buoyancy.z + out->heave.z;
 }
@@ -9813,48 +10350,64 @@ static fsdem_real fsdem__swe_dem_vertical(const fsdem_swe_dem *c, int i, fsdem_s
 /* ---- >>couple_swe_forces : seed 003 Eq. 5-8 ---- */
 
 fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
-    fsdem_swe *swe = c->desc.swe;
-    fsdem_dem *dem = c->desc.dem;
-    const fsdem_real rho = swe->desc.density, g = swe->g, beta = c->desc.beta;
-    const int axes = swe->dim;
-    int i, a;
-    if (fsdem__grow(&c->allocator, (void **)&c->force, &c->force_capacity, 0, dem->n, sizeof(fsdem_swe_dem_force)) !=
-        FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "out of memory for the forces of %d particles", dem->n);
-    if (c->desc.two_way) {
-        fsdem_swe_clear_sources(swe);
-        swe->sources_used = 1; /* the step must apply them */
+    fsdem_swe *swe;
+    fsdem_dem_particles pv;
+    fsdem_dem_coupling loads;
+    fsdem_real beta;
+    int i, a, axes, n;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    swe = c->desc.swe;
+    beta = c->desc.beta;
+    axes = fsdem_swe_get_desc(swe).dim;
+    pv = fsdem_dem_get_particles(c->desc.dem);
+    n = pv.count;
+    if (n > c->force_capacity) {
+        fsdem_swe_dem_force *force = (fsdem_swe_dem_force *)fsdem__alloc(&c->allocator, sizeof *force * (size_t)n);
+        fsdem_vec3 *reaction = (fsdem_vec3 *)fsdem__alloc(&c->allocator, sizeof *reaction * (size_t)n);
+        if (!force || !reaction) {
+            fsdem__free(&c->allocator, force, sizeof *force * (size_t)n);
+            fsdem__free(&c->allocator, reaction, sizeof *reaction * (size_t)n);
+            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_dem: out of memory for the forces of %d particles", n);
+        }
+        fsdem__free(&c->allocator, c->force, sizeof *force * (size_t)c->force_capacity);
+        fsdem__free(&c->allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
+        c->force = force;
+        c->reaction = reaction;
+        c->force_capacity = n;
     }
-    for (i = 0; i < dem->n; ++i) {
+    loads = fsdem_dem_get_coupling(c->desc.dem);
+    if (c->desc.two_way) fsdem_swe_clear_forces(swe);
+    c->in_water = 0;
+    for (i = 0; i < n; ++i) {
         fsdem_swe_dem_force *out = &c->force[i];
-        const fsdem_vec3 p = dem->x[i], w = dem->v[i];
-        const fsdem_real r = dem->r[i];
+        const fsdem_vec3 p = pv.position[i], w = pv.velocity[i];
+        const fsdem_real r = pv.radius[i];
         fsdem_swe_cell centre, back[2], front[2], flow;
         fsdem_vec3 horizontal;
         memset(out, 0, sizeof *out);
-        dem->fext[i] = fsdem__zero3();
-        dem->external = 1;
-        if (dem->fixed[i] || fsdem_swe_sample(swe, p.x, p.y, &centre) != FSDEM_OK) continue;
+        loads.force[i] = c->reaction[i] = fsdem__zero3();
+        if (pv.fixed[i] || fsdem_swe_sample_state(swe, p.x, p.y, &centre) != FSDEM_OK) continue;
         /* the water at the centre, and at the back (-r) and front (+r) along each horizontal axis; the
            flow velocity is the centre's, or that of the deepest side while a front reaches the sphere */
         flow = centre;
         for (a = 0; a < axes; ++a) {
-            back[a] = fsdem__swe_water_at(swe, p, a, -r, centre);
-            front[a] = fsdem__swe_water_at(swe, p, a, r, centre);
-            if (flow.depth < swe->desc.dry_depth && back[a].depth > flow.depth) flow = back[a];
-            if (flow.depth < swe->desc.dry_depth && front[a].depth > flow.depth) flow = front[a];
+            back[a] = fsdem__swe_dem_water_at(swe, p, a, -r, centre);
+            front[a] = fsdem__swe_dem_water_at(swe, p, a, r, centre);
+            if (flow.depth < c->dry && back[a].depth > flow.depth) flow = back[a];
+            if (flow.depth < c->dry && front[a].depth > flow.depth) flow = front[a];
         }
-        if (flow.depth < swe->desc.dry_depth) continue;
+        if (flow.depth < c->dry) continue;
         out->in_water = 1;
+        c->in_water++;
         out->surface = centre.eta;
         for (a = 0; a < axes; ++a) {
             /* Eq. 6-7 along axis a */
             fsdem_real area_b, area_f, m_b, m_f, rel, hydro, dyn;
-            fsdem__submerged_disc(r, p.z, back[a].eta, &area_b, &m_b);
-            fsdem__submerged_disc(r, p.z, front[a].eta, &area_f, &m_f);
+            fsdem__swe_dem_submerged_disc(r, p.z, back[a].eta, &area_b, &m_b);
+            fsdem__swe_dem_submerged_disc(r, p.z, front[a].eta, &area_f, &m_f);
             rel = beta * (a == 0 ? flow.u : flow.v) - (a == 0 ? w.x : w.y);
-            hydro = rho * g * (m_b - m_f);
-            dyn = rho * rel * (rel < 0 ? -rel : rel) * (rel > 0 ? area_b : area_f);
+            hydro = c->rho * c->g * (m_b - m_f);
+            dyn = c->rho * rel * (rel < 0 ? -rel : rel) * (rel > 0 ? area_b : area_f);
             if (a == 0) {
                 out->hydrostatic.x = hydro;
                 out->dynamic.x = dyn;
@@ -9865,65 +10418,124 @@ fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
             }
         }
         horizontal = fsdem__add(out->hydrostatic, out->dynamic);
-        if (c->desc.two_way && !fsdem__swe_spread_reaction(swe, p, r, horizontal)) {
-            out->hydrostatic = out->dynamic = horizontal = fsdem__zero3();
+        if (c->desc.two_way) {
+            /* Eq. 8: the reaction -F_h as a momentum source under the sphere; a force whose reaction
+               no wet cell can take is dropped, so momentum is exchanged, never created */
+            int taken = 0;
+            fsdem_swe_add_force(swe, p, r, fsdem__scale(horizontal, -1), &taken);
+            if (!taken) out->hydrostatic = out->dynamic = horizontal = fsdem__zero3();
+            c->reaction[i] = horizontal;
         }
-        horizontal.z = fsdem__swe_dem_vertical(c, i, out);
-        dem->fext[i] = horizontal;
+        horizontal.z = fsdem__swe_dem_vertical(c, &pv, i, out);
+        loads.force[i] = horizontal;
     }
     return fsdem__ok(&c->status);
 }
 
 fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *c, int index, fsdem_swe_dem_force *out) {
-    if (!out || index < 0 || index >= c->desc.dem->n || index >= c->force_capacity) return FSDEM_ERR_NOT_FOUND;
+    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
+    if (index < 0 || index >= fsdem_dem_get_particles(c->desc.dem).count || index >= c->force_capacity)
+        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_swe_dem_get_force: no particle %d", index);
     *out = c->force[index];
     return FSDEM_OK;
 }
 
-fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c, fsdem_real dt_cap, fsdem_real *dt_out, int *substeps) {
-    fsdem_real dt = 0;
-    fsdem_result res = fsdem_swe_dem_update_forces(c);
+/* ---- >>couple_swe_step : coupled time stepping ---- */
+
+/* fsdem_dem_substep_fn: buoyancy and heave damping of the spheres in water refreshed for the heights
+   of every DEM force evaluation, against the water surface held over the fluid step. */
+static fsdem_result fsdem__swe_dem_refresh(void *user, fsdem_dem *dem, double time) {
+    fsdem_swe_dem *c = (fsdem_swe_dem *)user;
+    const fsdem_dem_particles pv = fsdem_dem_get_particles(dem);
+    const fsdem_dem_coupling loads = fsdem_dem_get_coupling(dem);
+    int i;
+    (void)time;
+    for (i = 0; i < pv.count; ++i)
+        if (c->force[i].in_water) loads.force[i].z = fsdem__swe_dem_vertical(c, &pv, i, &c->force[i]);
+    return FSDEM_OK;
+}
+
+/* One coupled step of dt: the DEM substep count is checked before anything moves; `adaptive` steps
+   the water with fsdem_swe_step (whose dt is the stable dt computed by the caller), otherwise with
+   fsdem_swe_step_dt. */
+static fsdem_result fsdem__swe_dem_step(fsdem_swe_dem *c, fsdem_real dt, int adaptive) {
+    fsdem_result res;
+    long long k, substeps = 0;
+    res = fsdem_dem_substep_count(c->desc.dem, dt, &substeps);
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: %s", fsdem_dem_last_error(c->desc.dem));
+    if (substeps > c->desc.max_substeps)
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_swe_dem: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)",
+                           (double)dt, substeps, c->desc.max_substeps, (double)fsdem_dem_get_desc(c->desc.dem).dt);
+    res = fsdem_swe_dem_update_forces(c);
     if (res != FSDEM_OK) return res;
-    res = fsdem_swe_step(c->desc.swe, dt_cap, &dt);
-    if (res != FSDEM_OK)
-        return fsdem__fail(&c->status, res, "shallow-water step: %s", fsdem_swe_last_error(c->desc.swe));
-    {
-        fsdem_dem *dem = c->desc.dem;
-        int count = 0, k, i;
-        res = fsdem__substep_count(dem, dt, &count);
-        for (k = 0; k < count && res == FSDEM_OK; ++k) {
-            for (i = 0; i < dem->n; ++i)
-                if (c->force[i].in_water) dem->fext[i].z = fsdem__swe_dem_vertical(c, i, &c->force[i]);
-            res = fsdem__step(dem, dt / count);
-        }
-        if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "DEM substeps: %s", fsdem_dem_last_error(dem));
-        fsdem__ok(&dem->status);
-        if (substeps) *substeps = count;
-    }
-    if (dt_out) *dt_out = dt;
+    res = adaptive ? fsdem_swe_step(c->desc.swe) : fsdem_swe_step_dt(c->desc.swe, dt);
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: shallow-water step: %s", fsdem_swe_last_error(c->desc.swe));
+    for (k = 0; k < c->force_capacity && k < fsdem_dem_get_particles(c->desc.dem).count; ++k)
+        c->impulse = fsdem__madd(c->impulse, c->reaction[k], -dt);
+    res = fsdem_dem_advance_with(c->desc.dem, dt, fsdem__swe_dem_refresh, c, &substeps);
+    c->steps++;
+    c->dt_last = dt;
+    c->substeps = substeps;
+    c->substeps_total += substeps;
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
     return fsdem__ok(&c->status);
 }
 
-fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
-    const fsdem_swe *swe = (const fsdem_swe *)user;
-    const fsdem_real x0 = swe->desc.x_min + swe->dx / 2, x1 = swe->desc.x_min + (swe->nx - (fsdem_real)0.5) * swe->dx;
-    const fsdem_real y0 = swe->desc.y_min + swe->dy / 2, y1 = swe->desc.y_min + (swe->ny - (fsdem_real)0.5) * swe->dy;
-    fsdem_real x = p.x < x0 ? x0 : p.x > x1 ? x1 : p.x, y = p.y < y0 ? y0 : p.y > y1 ? y1 : p.y, gx, gy, len;
-    fsdem_swe_cell c0, cm, cp;
-    fsdem_swe_sample(swe, x, y, &c0);
-    /* bed slope from centred differences over one cell */
-    fsdem_swe_sample(swe, x - swe->dx / 2, y, &cm);
-    fsdem_swe_sample(swe, x + swe->dx / 2, y, &cp);
-    gx = (cp.bed - cm.bed) / swe->dx;
-    gy = 0;
-    if (swe->dim == 2) {
-        fsdem_swe_sample(swe, x, y - swe->dy / 2, &cm);
-        fsdem_swe_sample(swe, x, y + swe->dy / 2, &cp);
-        gy = (cp.bed - cm.bed) / swe->dy;
+fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c) {
+    fsdem_real dt = 0;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    fsdem_swe_stable_dt(c->desc.swe, &dt);
+    return fsdem__swe_dem_step(c, dt, 1);
+}
+
+fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *c, fsdem_real dt) {
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_dem_step_dt: dt must be > 0 (got %g s)", (double)dt);
+    return fsdem__swe_dem_step(c, dt, 0);
+}
+
+fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *c, fsdem_real duration, long long *steps) {
+    double end;
+    long long n = 0;
+    fsdem_result res = FSDEM_OK;
+    if (steps) *steps = 0;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_dem_advance: duration must be >= 0 (got %g s)",
+                           (double)duration);
+    end = fsdem_swe_time(c->desc.swe) + (double)duration;
+    while (res == FSDEM_OK && fsdem_swe_time(c->desc.swe) < end) {
+        fsdem_real dt = 0;
+        const double left = end - fsdem_swe_time(c->desc.swe);
+        fsdem_swe_stable_dt(c->desc.swe, &dt);
+        res = (double)dt >= left ? fsdem__swe_dem_step(c, (fsdem_real)left, 0) : fsdem__swe_dem_step(c, dt, 1);
+        ++n;
     }
-    len = (fsdem_real)sqrt(1 + gx * gx + gy * gy);
-    *normal = fsdem_v3(-gx / len, -gy / len, 1 / len);
-    return (p.z - c0.bed) / len;
+    if (steps) *steps = n;
+    return res;
+}
+
+fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *c, fsdem_real *dt) {
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    return fsdem_swe_stable_dt(c->desc.swe, dt);
+}
+
+double fsdem_swe_dem_time(const fsdem_swe_dem *c) { return c ? fsdem_swe_time(c->desc.swe) : 0; }
+
+fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
+    fsdem_swe_dem_stats st;
+    memset(&st, 0, sizeof st);
+    if (!c) return st;
+    st.steps = c->steps;
+    st.time = fsdem_swe_time(c->desc.swe);
+    st.dt = c->dt_last;
+    st.substeps = c->substeps;
+    st.substeps_total = c->substeps_total;
+    st.in_water = c->in_water;
+    st.impulse_to_water = c->impulse;
+    return st;
 }
 
 /* ===== >>impl_io : CSV and VTK output ============================================================== */

@@ -20,7 +20,7 @@ int main(void) {
     const double r = 0.005, dx = 0.0005, gap = 2 * dx, tank = 0.26 * 1.1, t_end = 1.0, every = 0.05;
     const double a = r + gap, s = 2 * r + gap; /* first centre, centre spacing: boundaries just touch */
     fsdem_dem_desc desc = fsdem_dem_desc_default(2);
-    fsdem_material al = fsdem_material_default();
+    fsdem_dem_material al = fsdem_dem_material_default();
     fsdem_dem *dem;
     fsdem_real dt;
     int mat, layer, k, frame = 0;
@@ -28,8 +28,8 @@ int main(void) {
 
     desc.domain_min = fsdem_v3(-0.05, -0.05, -1);
     desc.domain_max = fsdem_v3(tank + 0.05, tank + 0.2, 1);
-    desc.law = FSDEM_CONTACT_LINEAR;
-    desc.integrator = FSDEM_INTEGRATOR_PREDICTOR_CORRECTOR;
+    desc.law = FSDEM_DEM_LAW_LINEAR;
+    desc.integrator = FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR;
     desc.contact_offset = gap;
     desc.linear_theta = 0.01;
     desc.linear_dx = dx;
@@ -42,16 +42,16 @@ int main(void) {
     al.damping_alpha = 0.4;
     fsdem_dem_add_material(dem, &al, &mat);
     {
-        fsdem_wall_desc floor = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 1, 0), mat);
-        fsdem_wall_desc left = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(1, 0, 0), mat);
-        fsdem_wall_desc right = fsdem_wall_plane(fsdem_v3(tank, 0, 0), fsdem_v3(-1, 0, 0), mat);
+        fsdem_dem_wall_desc floor = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 1, 0), mat);
+        fsdem_dem_wall_desc left = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(1, 0, 0), mat);
+        fsdem_dem_wall_desc right = fsdem_dem_wall_plane(fsdem_v3(tank, 0, 0), fsdem_v3(-1, 0, 0), mat);
         fsdem_dem_add_wall(dem, &floor, NULL);
         fsdem_dem_add_wall(dem, &left, NULL);
         fsdem_dem_add_wall(dem, &right, NULL);
     }
     for (layer = 0; layer < 6; ++layer) /* 6, 5, 6, 5, 6, 5; the 5-layers sit in the grooves */
         for (k = 0; k < (layer % 2 ? 5 : 6); ++k) {
-            fsdem_particle_desc p = fsdem_particle_desc_default();
+            fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
             p.radius = r;
             p.material = mat;
             p.position = fsdem_v3(a + s * k + (layer % 2 ? s / 2 : 0), a + layer * s * sqrt(3.0) / 2, 0);
@@ -60,18 +60,18 @@ int main(void) {
                 return 1;
             }
         }
-    fsdem_dem_dt_estimate(dem, FSDEM_DT_LINEAR_SEED000, 150, &dt); /* Eq. 18, gamma = 150 */
+    fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 150, &dt); /* Eq. 18, gamma = 150 */
     fsdem_dem_set_dt(dem, dt);
     steps = (long)ceil(t_end / dt);
-    printf("cylinder collapse: %d cylinders, dt = %.3g s, %ld steps\n", fsdem_dem_particles(dem).count, (double)dt,
+    printf("cylinder collapse: %d cylinders, dt = %.3g s, %ld steps\n", fsdem_dem_get_particles(dem).count, (double)dt,
            steps);
     printf("%6s %9s %9s %12s %8s\n", "t [s]", "x_ave [m]", "z_ave [m]", "E_kin [J]", "contacts");
 
     for (step = 0; step <= steps; ++step) {
         double t = fsdem_dem_time(dem);
         if (t >= frame * every - dt / 2) { /* progress line and snapshot every 0.05 s */
-            fsdem_particles p = fsdem_dem_particles(dem);
-            fsdem_energy e = fsdem_dem_energy(dem);
+            fsdem_dem_particles p = fsdem_dem_get_particles(dem);
+            fsdem_dem_energy e = fsdem_dem_get_energy(dem);
             fsdem_dem_stats st = fsdem_dem_get_stats(dem);
             double xs = 0, zs = 0;
             char path[64];

@@ -16,16 +16,16 @@ int main(void) {
     fsdem_dem_desc d = fsdem_dem_desc_default(3);
     d.domain_min = fsdem_v3(-1, -1, 0);
     d.domain_max = fsdem_v3(1, 1, 2);
-    d.law = FSDEM_CONTACT_HERTZ_MINDLIN;
+    d.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
     d.dt = 1e-5;
     fsdem_dem *dem;
     if (fsdem_dem_create(&d, &dem) != FSDEM_OK) return 1;
-    fsdem_material mat = fsdem_material_default();
+    fsdem_dem_material mat = fsdem_dem_material_default();
     int steel;
     fsdem_dem_add_material(dem, &mat, &steel);
-    fsdem_wall_desc floor = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), steel);
+    fsdem_dem_wall_desc floor = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), steel);
     fsdem_dem_add_wall(dem, &floor, NULL);
-    fsdem_particle_desc p = fsdem_particle_desc_default();
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
     p.position = fsdem_v3(0, 0, 0.5);
     p.radius = 0.01;
     p.material = steel;
@@ -40,12 +40,12 @@ int main(void) {
     double peak = 0; /* highest point after the first rebound */
     int bounced = 0;
     for (int s = 0; s <= 100000; ++s) {
-        fsdem_particles now = fsdem_dem_particles(dem);
+        fsdem_dem_particles now = fsdem_dem_get_particles(dem);
         if (now.velocity[0].z > 0) bounced = 1;
         if (bounced && bounced < 2 && now.position[0].z > peak) peak = now.position[0].z;
         if (bounced && now.velocity[0].z < 0 && peak > 0) bounced = 2; /* falling again: first peak done */
         if (s % 10000 == 0) {
-            fsdem_particles view = fsdem_dem_particles(dem);
+            fsdem_dem_particles view = fsdem_dem_get_particles(dem);
             printf("%6.2f %10.4f %10.4f\n", (double)fsdem_dem_time(dem), (double)view.position[0].z,
                    (double)view.velocity[0].z);
         }

@@ -1,10 +1,10 @@
 /* 03_hopper_3d.c - spheres draining from a 3D hopper built of triangle walls.
 
-   What it shows: mesh-like geometry from fsdem_wall_triangle. A square funnel (top 0.2 m wide at
+   What it shows: mesh-like geometry from fsdem_dem_wall_triangle. A square funnel (top 0.2 m wide at
    z = 0.3 m, outlet 0.048 m wide at z = 0.2 m, so six particle diameters) is made of four trapezoids,
    two triangles each. About a thousand glass-like spheres (r = 4 mm, Hertz-Mindlin, mu = 0.3) start
    in a loose lattice above the funnel, fall in and drain through the outlet onto the floor of a box
-   (FSDEM_WALL_BOX_INSIDE). The program prints the number of discharged spheres (centre below the
+   (FSDEM_DEM_WALL_BOX_INSIDE). The program prints the number of discharged spheres (centre below the
    outlet) every 0.1 s; the count grows at a nearly steady rate while the funnel drains, as Beverloo's
    law expects for a hopper, and then levels off.
 
@@ -28,7 +28,7 @@ int main(void) {
     const double r = 0.004, top = 0.30, bottom = 0.20, top_half = 0.10, out_half = 0.024;
     const double t_end = 1.2, report_every = 0.1;
     fsdem_dem_desc desc = fsdem_dem_desc_default(3);
-    fsdem_material glass = fsdem_material_default();
+    fsdem_dem_material glass = fsdem_dem_material_default();
     fsdem_dem *dem;
     fsdem_real dt;
     unsigned seed = 12345u;
@@ -37,7 +37,7 @@ int main(void) {
 
     desc.domain_min = fsdem_v3(-0.3, -0.3, -0.05);
     desc.domain_max = fsdem_v3(0.3, 0.3, 0.8);
-    desc.law = FSDEM_CONTACT_HERTZ_MINDLIN;
+    desc.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
     if (fsdem_dem_create(&desc, &dem) != FSDEM_OK) return 1;
     glass.density = 2500;
     glass.young_modulus = 1e7; /* softened, as usual in DEM, for a larger time step */
@@ -50,14 +50,14 @@ int main(void) {
     for (side = 0; side < 4; ++side) {
         fsdem_vec3 b0 = turned(out_half, -out_half, bottom, side), b1 = turned(out_half, out_half, bottom, side);
         fsdem_vec3 t0 = turned(top_half, -top_half, top, side), t1 = turned(top_half, top_half, top, side);
-        fsdem_wall_desc tri0 = fsdem_wall_triangle(b0, b1, t1, mat), tri1 = fsdem_wall_triangle(b0, t1, t0, mat);
+        fsdem_dem_wall_desc tri0 = fsdem_dem_wall_triangle(b0, b1, t1, mat), tri1 = fsdem_dem_wall_triangle(b0, t1, t0, mat);
         if (fsdem_dem_add_wall(dem, &tri0, NULL) != FSDEM_OK || fsdem_dem_add_wall(dem, &tri1, NULL) != FSDEM_OK) {
             printf("%s\n", fsdem_dem_last_error(dem));
             return 1;
         }
     }
     {   /* the collecting box: floor at z = 0 and four side walls */
-        fsdem_wall_desc box = fsdem_wall_box(fsdem_v3(-0.25, -0.25, 0), fsdem_v3(0.25, 0.25, 0.75), 1, mat);
+        fsdem_dem_wall_desc box = fsdem_dem_wall_box(fsdem_v3(-0.25, -0.25, 0), fsdem_v3(0.25, 0.25, 0.75), 1, mat);
         fsdem_dem_add_wall(dem, &box, NULL);
     }
 
@@ -65,7 +65,7 @@ int main(void) {
     for (k = 0; k < 3; ++k)
         for (j = 0; j < 18; ++j)
             for (i = 0; i < 18; ++i) {
-                fsdem_particle_desc p = fsdem_particle_desc_default();
+                fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
                 double jitter[3];
                 int c;
                 for (c = 0; c < 3; ++c) {
@@ -81,16 +81,16 @@ int main(void) {
                     return 1;
                 }
             }
-    fsdem_dem_dt_estimate(dem, FSDEM_DT_RAYLEIGH, 0.2, &dt);
+    fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_RAYLEIGH, 0.2, &dt);
     fsdem_dem_set_dt(dem, dt);
     steps = (long)(t_end / dt + 0.5);
-    printf("hopper: %d spheres, 8 triangles, dt = %.3g s, %ld steps\n", fsdem_dem_particles(dem).count, (double)dt,
+    printf("hopper: %d spheres, 8 triangles, dt = %.3g s, %ld steps\n", fsdem_dem_get_particles(dem).count, (double)dt,
            steps);
     printf("%6s %11s %9s\n", "t [s]", "discharged", "in hopper");
 
     for (step = 0; step <= steps; ++step) {
         if (fsdem_dem_time(dem) >= n_report * report_every - dt / 2) {
-            fsdem_particles p = fsdem_dem_particles(dem);
+            fsdem_dem_particles p = fsdem_dem_get_particles(dem);
             int below = 0, in_hopper = 0;
             for (i = 0; i < p.count; ++i) {
                 if (p.position[i].z < bottom - r) below++;

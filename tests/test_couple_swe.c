@@ -21,8 +21,8 @@ static world world_new(double length, int n, double depth, double u, double r, d
     fsdem_swe_desc sd = fsdem_swe_desc_default(1);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     fsdem_swe_dem_desc cd = fsdem_swe_dem_desc_default();
-    fsdem_material m = fsdem_material_default();
-    fsdem_particle_desc p = fsdem_particle_desc_default();
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
     fsdem_real *h = malloc(sizeof(fsdem_real) * (size_t)n), *v = malloc(sizeof(fsdem_real) * (size_t)n);
     int k, mat;
     for (k = 0; k < n; ++k) {
@@ -83,7 +83,7 @@ START_TEST(floating_sphere_settles_at_buoyancy_equilibrium) {
         world w = world_new(4, 40, depth, 0, r, 1000 * ratios[c], 2, depth, 1.0, 1);
         double draft, expected = floating_draft(r, ratios[c]);
         for (s = 0; s < 400; ++s) ck_assert_int_eq(fsdem_swe_dem_step(w.cpl, 5e-3, NULL, NULL), FSDEM_OK);
-        draft = depth - (fsdem_dem_particles(w.dem).position[0].z - r);
+        draft = depth - (fsdem_dem_get_particles(w.dem).position[0].z - r);
         /* critically damped heave (period ~0.5 s) decays within 2 s; the still water stays flat, so
            the equilibrium is exact up to the bisection; 1e-3 relative allows for the residual decay */
         ck_assert_msg(fabs(draft / expected - 1) < 1e-3, "ratio %g: draft %g, expected %g", ratios[c], draft, expected);
@@ -143,18 +143,18 @@ START_TEST(momentum_is_exchanged_not_created) {
     int two_way, s;
     for (two_way = 0; two_way <= 1; ++two_way) {
         world w = world_new(20, 400, 0.4, 0, 0.05, 500, 10, 0.4, 0, two_way);
-        fsdem_particles p;
+        fsdem_dem_particles p;
         fsdem_vec3 pw0, pw;
         double pd0, pd;
         ck_assert_int_eq(fsdem_dem_set_particle_state(w.dem, 0, fsdem_v3(10, 0, 0.4), fsdem_v3(1, 0, 0),
                                                       fsdem_v3(0, 0, 0)),
                          FSDEM_OK);
-        p = fsdem_dem_particles(w.dem);
+        p = fsdem_dem_get_particles(w.dem);
         pw0 = fsdem_swe_momentum(w.swe);
         pd0 = p.mass[0] * p.velocity[0].x;
         for (s = 0; s < 100; ++s) ck_assert_int_eq(fsdem_swe_dem_step(w.cpl, 5e-3, NULL, NULL), FSDEM_OK);
         /* 0.5 s: waves travel sqrt(g h) t = 1 m, far from the walls 10 m away */
-        p = fsdem_dem_particles(w.dem);
+        p = fsdem_dem_get_particles(w.dem);
         pw = fsdem_swe_momentum(w.swe);
         pd = p.mass[0] * p.velocity[0].x;
         ck_assert_msg(pd < 0.9 * pd0, "the water must slow the sphere (%g -> %g)", pd0, pd);
@@ -222,7 +222,7 @@ START_TEST(undamped_bobbing_does_not_grow) {
         double offset;
         ck_assert_int_eq(fsdem_swe_dem_step(w.cpl, 0, &dt, NULL), FSDEM_OK);
         t += dt;
-        offset = fabs(fsdem_dem_particles(w.dem).position[0].z - depth);
+        offset = fabs(fsdem_dem_get_particles(w.dem).position[0].z - depth);
         if (t > 6 && offset > late_max) late_max = offset;
     }
     /* Verlet substeps keep an undamped oscillator's amplitude to O((omega dt)^2) ~ 1e-6; the water
@@ -248,16 +248,16 @@ static void half_wet(void *user, fsdem_real x, fsdem_real y, fsdem_swe_cell *cel
    both: one step moves nothing near them). */
 static double edge_step(int two_way, double *debris_gain, fsdem_swe_dem_force *f) {
     world w = world_new(1, 10, 0.1, 0, 0.02, 500, 0.53, 0.02, 0, two_way);
-    fsdem_particles p;
+    fsdem_dem_particles p;
     fsdem_vec3 pw0, pw;
     double pd0;
     ck_assert_int_eq(fsdem_swe_set_cells(w.swe, half_wet, NULL), FSDEM_OK);
-    p = fsdem_dem_particles(w.dem);
+    p = fsdem_dem_get_particles(w.dem);
     pw0 = fsdem_swe_momentum(w.swe);
     pd0 = p.mass[0] * p.velocity[0].x;
     ck_assert_int_eq(fsdem_swe_dem_step(w.cpl, 1e-3, NULL, NULL), FSDEM_OK);
     ck_assert_int_eq(fsdem_swe_dem_get_force(w.cpl, 0, f), FSDEM_OK);
-    p = fsdem_dem_particles(w.dem);
+    p = fsdem_dem_get_particles(w.dem);
     pw = fsdem_swe_momentum(w.swe);
     *debris_gain = p.mass[0] * p.velocity[0].x - pd0;
     world_free(&w);

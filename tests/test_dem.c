@@ -60,7 +60,7 @@ static fsdem_dem *dem_new(const fsdem_dem_desc *desc) {
 
 static int add_material(fsdem_dem *dem, double density, double young, double poisson, double restitution,
                         double friction, double alpha) {
-    fsdem_material m = fsdem_material_default();
+    fsdem_dem_material m = fsdem_dem_material_default();
     int index = -1;
     fsdem_result res;
     m.density = density;
@@ -81,7 +81,7 @@ static int add_plain_material(fsdem_dem *dem) { return add_material(dem, 2500, 1
 
 static int add_particle(fsdem_dem *dem, fsdem_vec3 x, fsdem_vec3 v, fsdem_vec3 w, double radius, int material,
                         int fixed) {
-    fsdem_particle_desc p = fsdem_particle_desc_default();
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
     int index = -1;
     fsdem_result res;
     p.position = x;
@@ -95,7 +95,7 @@ static int add_particle(fsdem_dem *dem, fsdem_vec3 x, fsdem_vec3 v, fsdem_vec3 w
     return index;
 }
 
-static int add_wall(fsdem_dem *dem, fsdem_wall_desc w) {
+static int add_wall(fsdem_dem *dem, fsdem_dem_wall_desc w) {
     int id = -1;
     fsdem_result res = fsdem_dem_add_wall(dem, &w, &id);
     ck_assert_msg(res == FSDEM_OK, "add_wall: %s", fsdem_dem_last_error(dem));
@@ -151,7 +151,7 @@ typedef struct nb_geometry {
 } nb_geometry;
 
 /* All contacts of the current positions by an O(n^2) scan, written independently of the library. */
-static int brute_force_contacts(const fsdem_particles *p, const nb_geometry *g, contact_rec *out) {
+static int brute_force_contacts(const fsdem_dem_particles *p, const nb_geometry *g, contact_rec *out) {
     int i, j, axis, count = 0;
     for (i = 0; i < p->count; ++i) {
         const fsdem_vec3 xi = p->position[i];
@@ -202,20 +202,20 @@ static int brute_force_contacts(const fsdem_particles *p, const nb_geometry *g, 
 /* Compares fsdem_dem_contacts with brute force: same set of (i, j) pairs and particle-wall
    contacts, same overlaps and normals. Returns the number of contacts. */
 static int compare_with_brute_force(fsdem_dem *dem, const nb_geometry *g) {
-    fsdem_particles p = fsdem_dem_particles(dem);
+    fsdem_dem_particles p = fsdem_dem_get_particles(dem);
     const int n = p.count, room = n * (n - 1) / 2 + n * (2 * g->dim + 1) + 1;
-    fsdem_contact_info *info;
+    fsdem_dem_contact *info;
     contact_rec *lib, *ref;
     int total, got, nref, k;
     total = fsdem_dem_contacts(dem, NULL, 0);
     ck_assert_int_ge(total, 0);
-    info = (fsdem_contact_info *)malloc(sizeof *info * (size_t)(total + 1));
+    info = (fsdem_dem_contact *)malloc(sizeof *info * (size_t)(total + 1));
     lib = (contact_rec *)malloc(sizeof *lib * (size_t)(total + 1));
     ref = (contact_rec *)malloc(sizeof *ref * (size_t)room);
     ck_assert(info && lib && ref);
     got = fsdem_dem_contacts(dem, info, total);
     ck_assert_int_eq(got, total);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     for (k = 0; k < total; ++k) {
         lib[k].i = info[k].i;
         lib[k].j = info[k].j;
@@ -271,8 +271,8 @@ static void neighbour_case(int dim, double offset_factor, unsigned long long see
     g.plane_point = fsdem_v3(0.8 * L, 0.8 * L, dim == 3 ? 0.8 * L : 0);
     g.plane_normal = dim == 3 ? fsdem_v3(-1 / sqrt(3.0), -1 / sqrt(3.0), -1 / sqrt(3.0))
                               : fsdem_v3(-1 / sqrt(2.0), -1 / sqrt(2.0), 0);
-    g.box_id = add_wall(dem, fsdem_wall_box(g.lo, fsdem_v3(L, L, L), 1, mat));
-    g.plane_id = add_wall(dem, fsdem_wall_plane(g.plane_point, g.plane_normal, mat));
+    g.box_id = add_wall(dem, fsdem_dem_wall_box(g.lo, fsdem_v3(L, L, L), 1, mat));
+    g.plane_id = add_wall(dem, fsdem_dem_wall_plane(g.plane_point, g.plane_normal, mat));
     for (i = 0; i < n;) {
         fsdem_vec3 x = fsdem_v3(urange(0, L), urange(0, L), dim == 3 ? urange(0, L) : 0);
         fsdem_vec3 v = fsdem_v3(urange(-vmax, vmax), urange(-vmax, vmax), dim == 3 ? urange(-vmax, vmax) : 0);
@@ -288,18 +288,18 @@ static void neighbour_case(int dim, double offset_factor, unsigned long long see
     for (s = 0; s < steps; ++s) {
         long long before = fsdem_dem_get_stats(dem).rebuilds;
         int c, k;
-        fsdem_contact_info *info;
+        fsdem_dem_contact *info;
         step_n(dem, 1);
         c = compare_with_brute_force(dem, &g);
         st = fsdem_dem_get_stats(dem);
         if (st.rebuilds == before) reused++;
         if (c < min_contacts) min_contacts = c;
-        info = (fsdem_contact_info *)malloc(sizeof *info * (size_t)(c + 1));
+        info = (fsdem_dem_contact *)malloc(sizeof *info * (size_t)(c + 1));
         ck_assert_int_eq(fsdem_dem_contacts(dem, info, c), c);
         {
             /* The forces of the step were evaluated at these same positions, so they saw the same
                contacts but those that exert nothing: two fixed particles, a fixed one and a wall. */
-            const unsigned char *fixed = fsdem_dem_particles(dem).fixed;
+            const unsigned char *fixed = fsdem_dem_get_particles(dem).fixed;
             int inert = 0;
             for (k = 0; k < c; ++k) {
                 wall_seen |= info[k].j < 0 ? (info[k].j == -1 - g.plane_id ? 2 : 1) : 0;
@@ -338,7 +338,7 @@ END_TEST
    floating-point exceptions enabled. The pairs are searched for with the library's own arithmetic
    (the difference of the stored centres, squared and summed; the root subtracted from the reach). */
 START_TEST(touching_pairs_raise_no_fp_exceptions) {
-    const fsdem_contact_law laws[3] = {FSDEM_CONTACT_HERTZ_MINDLIN, FSDEM_CONTACT_LINEAR, FSDEM_CONTACT_GIC};
+    const fsdem_dem_law laws[3] = {FSDEM_DEM_LAW_HERTZ_MINDLIN, FSDEM_DEM_LAW_LINEAR, FSDEM_DEM_LAW_GIC};
     const double r = 0.01, reach = r + r;
     fsdem_vec3 xa[8], xb[8];
     int law, k, m, pairs = 0, flags = 0, contacts = 0;
@@ -396,9 +396,9 @@ START_TEST(elastic_box_conserves_momentum_and_energy) {
     const double r0 = 0.01, rho = 2500, young = 1e7, nu = 0.3, L = 0.152, vmax = 1.0;
     fsdem_dem_desc d = fsdem_dem_desc_default(3);
     fsdem_dem *dem;
-    fsdem_particles p;
-    fsdem_energy en;
-    fsdem_contact_info *info;
+    fsdem_dem_particles p;
+    fsdem_dem_energy en;
+    fsdem_dem_contact *info;
     long *prev_keys, *cur_keys;
     int mat, box, i, j, nprev = 0, steps = 0, info_room = 8 * n;
     long collisions = 0;
@@ -415,12 +415,12 @@ START_TEST(elastic_box_conserves_momentum_and_energy) {
     d.dt = tc / 50;
     dem = dem_new(&d);
     mat = add_material(dem, rho, young, nu, 1.0, 0.0, 0.4); /* elastic, frictionless */
-    box = add_wall(dem, fsdem_wall_box(fsdem_v3(0, 0, 0), fsdem_v3(L, L, L), 1, mat));
+    box = add_wall(dem, fsdem_dem_wall_box(fsdem_v3(0, 0, 0), fsdem_v3(L, L, L), 1, mat));
     for (i = 0; i < n;) {
         const double r = r0 * urange(0.8, 1.2); /* unequal masses: momentum exchange is not symmetric */
         fsdem_vec3 x = fsdem_v3(urange(r, L - r), urange(r, L - r), urange(r, L - r));
         int ok = 1;
-        p = fsdem_dem_particles(dem);
+        p = fsdem_dem_get_particles(dem);
         for (j = 0; j < p.count && ok; ++j)
             if (vnorm(vsub(x, p.position[j])) < r + p.radius[j]) ok = 0;
         if (!ok) continue;
@@ -428,16 +428,16 @@ START_TEST(elastic_box_conserves_momentum_and_energy) {
                      fsdem_v3(urange(-50, 50), urange(-50, 50), urange(-50, 50)), r, mat, 0);
         ++i;
     }
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     for (i = 0; i < n; ++i) {
         p0 = vadd(p0, vscale(p.velocity[i], p.mass[i]));
         pscale += p.mass[i] * vnorm(p.velocity[i]);
     }
-    en = fsdem_dem_energy(dem);
+    en = fsdem_dem_get_energy(dem);
     e0 = en.kinetic + en.rotational + en.elastic;
     prev_keys = (long *)malloc(sizeof(long) * (size_t)info_room);
     cur_keys = (long *)malloc(sizeof(long) * (size_t)info_room);
-    info = (fsdem_contact_info *)malloc(sizeof *info * (size_t)info_room);
+    info = (fsdem_dem_contact *)malloc(sizeof *info * (size_t)info_room);
     ck_assert(prev_keys && cur_keys && info);
     /* Collisions are counted as contact starts: after every step the pairs in contact are listed
        (fsdem_dem_contacts) and a pair that was not in contact after the previous step is a new
@@ -461,17 +461,17 @@ START_TEST(elastic_box_conserves_momentum_and_energy) {
         nprev = ncur;
         if (steps % 20 == 0) {
             double drift;
-            en = fsdem_dem_energy(dem);
+            en = fsdem_dem_get_energy(dem);
             drift = fabs(en.kinetic + en.rotational + en.elastic - e0) / e0;
             if (drift > max_drift) max_drift = drift;
         }
     }
-    en = fsdem_dem_energy(dem);
+    en = fsdem_dem_get_energy(dem);
     {
         double drift = fabs(en.kinetic + en.rotational + en.elastic - e0) / e0;
         if (drift > max_drift) max_drift = drift;
     }
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     p1 = fsdem_v3(0, 0, 0);
     for (i = 0; i < n; ++i) p1 = vadd(p1, vscale(p.velocity[i], p.mass[i]));
     impulse = fsdem_dem_wall_impulse(dem, box);
@@ -511,11 +511,11 @@ END_TEST
 
 /* Expected restitution and contact duration of a head-on impact of sphere 1 (radius r1) on
    sphere 2 (r2, both moving at IMPACT_SPEED towards each other) or on a plane (wall = 1). */
-static double impact_expectation(fsdem_contact_law law, double theta_dx_over_g, double e, double alpha, double r1,
+static double impact_expectation(fsdem_dem_law law, double theta_dx_over_g, double e, double alpha, double r1,
                                  double r2, int wall, double *duration) {
     const double m1 = sphere_mass(IMPACT_RHO, r1), m2 = sphere_mass(IMPACT_RHO, r2);
     const double m_eff = wall ? m1 : m1 * m2 / (m1 + m2);
-    if (law == FSDEM_CONTACT_LINEAR) {
+    if (law == FSDEM_DEM_LAW_LINEAR) {
         /* seed 000 Eq. 10-11: k = m_ij ||g|| / (theta dx), c = 2 alpha sqrt(m_ij k), with
            m_ij = (m1 + m2)/2 for a pair and m1 for a wall. The two bodies form a damped oscillator
            of mass m_eff, so zeta = c / (2 sqrt(m_eff k)) (alpha sqrt 2 for equal spheres, alpha for
@@ -537,12 +537,12 @@ static double impact_expectation(fsdem_contact_law law, double theta_dx_over_g, 
    Returns the measured normal restitution (rebound / impact relative normal speed). */
 static double run_impact(fsdem_dem *dem, int mat, double r1, double r2, int wall, double dt, double duration) {
     const double v = IMPACT_SPEED, gap = IMPACT_GAP;
-    fsdem_particles p;
+    fsdem_dem_particles p;
     int a, b = -1, s, touched = 0, wall_id = -1, max_steps;
     double v_in, v_out;
     ck_assert_int_eq(fsdem_dem_set_dt(dem, dt), FSDEM_OK);
     a = add_particle(dem, fsdem_v3(-r1 - gap, 0, 0), fsdem_v3(v, 0, 0), fsdem_v3(0, 0, 0), r1, mat, 0);
-    if (wall) wall_id = add_wall(dem, fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(-1, 0, 0), mat));
+    if (wall) wall_id = add_wall(dem, fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(-1, 0, 0), mat));
     else b = add_particle(dem, fsdem_v3(r2 + gap, 0, 0), fsdem_v3(-v, 0, 0), fsdem_v3(0, 0, 0), r2, mat, 0);
     v_in = wall ? v : 2 * v;
     max_steps = (int)(10 * duration / dt + 2 * gap / (v * dt));
@@ -554,7 +554,7 @@ static double run_impact(fsdem_dem *dem, int mat, double r1, double r2, int wall
         else if (touched) break;
     }
     ck_assert_msg(touched && s < max_steps, "the impact did not complete");
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     v_out = wall ? -p.velocity[a].x : p.velocity[b].x - p.velocity[a].x;
     /* the motion stays on the x axis: no spurious tangential force or spin */
     ck_assert(fabs(p.velocity[a].y) + fabs(p.velocity[a].z) < 1e-12 * v);
@@ -573,12 +573,12 @@ START_TEST(hertz_restitution_matches_input) {
             fsdem_dem *dem;
             int mat;
             d.gravity = fsdem_v3(0, 0, 0);
-            d.integrator = integ ? FSDEM_INTEGRATOR_PREDICTOR_CORRECTOR : FSDEM_INTEGRATOR_VERLET;
+            d.integrator = integ ? FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR : FSDEM_DEM_INTEGRATOR_VERLET;
             dem = dem_new(&d);
             /* one object per e: the sphere-sphere and the sphere-wall impact share its material */
             mat = add_material(dem, IMPACT_RHO, IMPACT_YOUNG, IMPACT_NU, es[k], 0.3, 0.4);
             for (wall = 0; wall < 2; ++wall) {
-                double duration, expected = impact_expectation(FSDEM_CONTACT_HERTZ_MINDLIN, 0, es[k], 0, r, r, wall, &duration);
+                double duration, expected = impact_expectation(FSDEM_DEM_LAW_HERTZ_MINDLIN, 0, es[k], 0, r, r, wall, &duration);
                 double e = run_impact(dem, mat, r, r, wall, duration / 400, duration);
                 REPORT("Hertz-Mindlin %s %s: e = %.4f measured, %.4f input (%+.2f%%)", integ ? "PC    " : "Verlet",
                        wall ? "sphere-wall  " : "sphere-sphere", e, expected, 100 * (e / expected - 1));
@@ -602,8 +602,8 @@ START_TEST(linear_restitution_matches_damped_oscillator) {
         fsdem_dem_desc d = fsdem_dem_desc_default(3);
         fsdem_dem *dem;
         d.gravity = fsdem_v3(0, 0, 0);
-        d.law = FSDEM_CONTACT_LINEAR;
-        d.integrator = integ ? FSDEM_INTEGRATOR_PREDICTOR_CORRECTOR : FSDEM_INTEGRATOR_VERLET;
+        d.law = FSDEM_DEM_LAW_LINEAR;
+        d.integrator = integ ? FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR : FSDEM_DEM_INTEGRATOR_VERLET;
         d.linear_theta = theta;
         d.linear_dx = dx;
         d.linear_accel = G; /* ||g|| of seed 000 Eq. 10; gravity itself is off for a clean impact */
@@ -619,7 +619,7 @@ START_TEST(linear_restitution_matches_damped_oscillator) {
                    8000 steps per contact keep it below 0.4% for zeta = 0.81. The predictor-corrector
                    is second order: 400 steps give < 0.03%. */
                 const double steps_per_contact = integ ? 400 : 8000;
-                expected = impact_expectation(FSDEM_CONTACT_LINEAR, theta * dx / G, 1, alphas[k], r, r2, kind == 2, &duration);
+                expected = impact_expectation(FSDEM_DEM_LAW_LINEAR, theta * dx / G, 1, alphas[k], r, r2, kind == 2, &duration);
                 e = run_impact(dem, mats[k], r, r2, kind == 2, duration / steps_per_contact, duration);
                 REPORT("linear %s %s alpha %.1f: e = %.4f measured, %.4f damped oscillator (%+.3f%%)",
                        integ ? "PC    " : "Verlet", names[kind], alphas[k], e, expected, 100 * (e / expected - 1));
@@ -644,7 +644,7 @@ END_TEST
    speed along the slope) at t2 relative to the centre's speed. */
 static double incline_acceleration(fsdem_dem *dem, int mat, double theta, double *slip_ratio) {
     const double r = 0.01, t1 = 0.1, t2 = 0.4, dt = fsdem_dem_dt(dem);
-    fsdem_particles p = fsdem_dem_particles(dem);
+    fsdem_dem_particles p = fsdem_dem_get_particles(dem);
     const int dim = p.dim;
     fsdem_vec3 n, down, axis;
     int n1, n2, wall, index;
@@ -656,9 +656,9 @@ static double incline_acceleration(fsdem_dem *dem, int mat, double theta, double
         n = fsdem_v3(-sin(theta), cos(theta), 0);
         down = fsdem_v3(-cos(theta), -sin(theta), 0);
     }
-    wall = add_wall(dem, fsdem_wall_plane(fsdem_v3(0, 0, 0), n, mat));
+    wall = add_wall(dem, fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), n, mat));
     index = add_particle(dem, fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), r, mat, 0);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     m = p.mass[index];
     /* start at the static overlap under the normal load so that the normal bounce is small */
     delta = hertz_static_overlap(m * G * cos(theta), r, hertz_estar(INCLINE_YOUNG, INCLINE_NU));
@@ -667,10 +667,10 @@ static double incline_acceleration(fsdem_dem *dem, int mat, double theta, double
     n1 = (int)(t1 / dt + 0.5);
     n2 = (int)(t2 / dt + 0.5);
     step_n(dem, n1);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     v1 = vdot(p.velocity[index], down);
     step_n(dem, n2 - n1);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     v2 = vdot(p.velocity[index], down);
     /* rolling down the slope spins the body about n x down, at omega = v / r without slip */
     axis = fsdem_v3(n.y * down.z - n.z * down.y, n.z * down.x - n.x * down.z, n.x * down.y - n.y * down.x);
@@ -736,11 +736,11 @@ END_TEST
 /* ---- 5. static overlap ----------------------------------------------------------------------------- */
 
 /* A sphere released touching a floor settles; returns the final overlap and the expected one. */
-static double resting_overlap(fsdem_contact_law law, double linear_accel, double *expected) {
+static double resting_overlap(fsdem_dem_law law, double linear_accel, double *expected) {
     const double rho = 2500, young = 1e7, nu = 0.3, r = 0.01;
     fsdem_dem_desc d = fsdem_dem_desc_default(3);
     fsdem_dem *dem;
-    fsdem_particles p;
+    fsdem_dem_particles p;
     fsdem_real dt;
     int mat, steps;
     double overlap, m;
@@ -751,19 +751,19 @@ static double resting_overlap(fsdem_contact_law law, double linear_accel, double
     d.dt = 1e-5;
     dem = dem_new(&d);
     /* restitution only matters for Hertz-Mindlin (the linear law's damping is alpha) */
-    mat = add_material(dem, rho, young, nu, law == FSDEM_CONTACT_LINEAR ? 1.0 : 0.5, 0.3, 0.4);
-    add_wall(dem, fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), mat));
+    mat = add_material(dem, rho, young, nu, law == FSDEM_DEM_LAW_LINEAR ? 1.0 : 0.5, 0.3, 0.4);
+    add_wall(dem, fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), mat));
     add_particle(dem, fsdem_v3(0, 0, r), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), r, mat, 0);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     m = p.mass[0];
-    if (law == FSDEM_CONTACT_LINEAR) {
+    if (law == FSDEM_DEM_LAW_LINEAR) {
         /* seed 000 Eq. 10 for a wall: m_ij = m, k = m ||g|| / (theta dx), ||g|| = linear_accel
            when set, else |gravity|. The weight m g is carried by k d: d = m g / k. */
         const double accel = linear_accel > 0 ? linear_accel : G;
         const double k = m * accel / (d.linear_theta * d.linear_dx);
         *expected = m * G / k;
         /* seed 000 Eq. 18 with gamma = 150 gives ~150 steps per undamped period */
-        ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DT_LINEAR_SEED000, 150, &dt), FSDEM_OK);
+        ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 150, &dt), FSDEM_OK);
         ck_assert_int_eq(fsdem_dem_set_dt(dem, dt), FSDEM_OK);
         /* damping zeta = alpha = 0.4, omega = sqrt(k/m) >= 313 rad/s: after 0.3 s the transient
            is below e^-37 */
@@ -776,7 +776,7 @@ static double resting_overlap(fsdem_contact_law law, double linear_accel, double
         steps = (int)(0.3 / dt);
     }
     step_n(dem, steps);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     overlap = r - p.position[0].z;
     fsdem_dem_destroy(dem);
     return overlap;
@@ -784,18 +784,18 @@ static double resting_overlap(fsdem_contact_law law, double linear_accel, double
 
 START_TEST(resting_particle_settles_to_static_overlap) {
     double expected, overlap;
-    overlap = resting_overlap(FSDEM_CONTACT_LINEAR, 0, &expected);
+    overlap = resting_overlap(FSDEM_DEM_LAW_LINEAR, 0, &expected);
     REPORT("linear, ||g|| = |gravity|: overlap / (m g / k) = %.6f (m g / k = %.4g m = theta dx)", overlap / expected,
            expected);
     /* At rest the dashpot is idle and k d = m g holds exactly; the residual transient is < e^-37.
        1% is the required bound. */
     ck_assert_msg(fabs(overlap / expected - 1) < 0.01, "overlap %g, expected %g", overlap, expected);
     ck_assert(fabs(expected - 0.01 * 0.01) < 1e-12); /* theta dx, the meaning of theta in seed 000 */
-    overlap = resting_overlap(FSDEM_CONTACT_LINEAR, 2.5 * G, &expected);
+    overlap = resting_overlap(FSDEM_DEM_LAW_LINEAR, 2.5 * G, &expected);
     REPORT("linear, ||g|| = 2.5 |gravity|: overlap / (m g / k) = %.6f (m g / k = %.4g m = theta dx / 2.5)",
            overlap / expected, expected);
     ck_assert_msg(fabs(overlap / expected - 1) < 0.01, "overlap %g, expected %g", overlap, expected);
-    overlap = resting_overlap(FSDEM_CONTACT_HERTZ_MINDLIN, 0, &expected);
+    overlap = resting_overlap(FSDEM_DEM_LAW_HERTZ_MINDLIN, 0, &expected);
     REPORT("Hertz: overlap / (3 m g / (4 E* sqrt R))^(2/3) = %.6f (%.4g m)", overlap / expected, expected);
     /* Hertz damping (e = 0.5) decays the oscillation within ~0.05 s; the equilibrium is exact. */
     ck_assert_msg(fabs(overlap / expected - 1) < 0.01, "overlap %g, expected %g", overlap, expected);
@@ -806,26 +806,26 @@ END_TEST
    shared vertex of a fan of six, the joint of a 2D polyline) must be pushed once, as by a plane:
    Hertz gives the static overlap (3 m g / (4 E* sqrt R))^(2/3). Counting the shared edge once per
    element would give two (or six) springs in parallel and a smaller overlap (0.63x for two). */
-static double settle_on_mesh(int dim, const fsdem_wall_desc *walls, int nwalls, fsdem_vec3 at, double *expected) {
+static double settle_on_mesh(int dim, const fsdem_dem_wall_desc *walls, int nwalls, fsdem_vec3 at, double *expected) {
     const double rho = 2500, young = 1e7, nu = 0.3, r = 0.01;
     fsdem_dem_desc d = fsdem_dem_desc_default(dim);
     fsdem_dem *dem;
-    fsdem_particles p;
+    fsdem_dem_particles p;
     int mat, k;
     double overlap, height;
     d.dt = 5e-5; /* ~100 steps per period of the oscillation about the static overlap */
     dem = dem_new(&d);
     mat = add_material(dem, rho, young, nu, 0.5, 0.3, 0.4);
     for (k = 0; k < nwalls; ++k) {
-        fsdem_wall_desc w = walls[k];
+        fsdem_dem_wall_desc w = walls[k];
         w.material = mat;
         add_wall(dem, w);
     }
     add_particle(dem, at, fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), r, mat, 0);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     *expected = hertz_static_overlap(p.mass[0] * G, r, hertz_estar(young, nu));
     step_n(dem, 6000); /* 0.3 s: e = 0.5 damps the bounce within ~0.05 s */
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     height = dim == 2 ? p.position[0].y : p.position[0].z;
     overlap = r - height;
     fsdem_dem_destroy(dem);
@@ -834,12 +834,12 @@ static double settle_on_mesh(int dim, const fsdem_wall_desc *walls, int nwalls, 
 
 START_TEST(mesh_edges_and_vertices_push_once) {
     const double r = 0.01;
-    fsdem_wall_desc w[6];
+    fsdem_dem_wall_desc w[6];
     double expected, overlap;
     int k;
     /* two triangles sharing the diagonal (-1,-1)-(1,1); sphere on the diagonal, then near it */
-    w[0] = fsdem_wall_triangle(fsdem_v3(-1, -1, 0), fsdem_v3(1, -1, 0), fsdem_v3(1, 1, 0), 0);
-    w[1] = fsdem_wall_triangle(fsdem_v3(-1, -1, 0), fsdem_v3(1, 1, 0), fsdem_v3(-1, 1, 0), 0);
+    w[0] = fsdem_dem_wall_triangle(fsdem_v3(-1, -1, 0), fsdem_v3(1, -1, 0), fsdem_v3(1, 1, 0), 0);
+    w[1] = fsdem_dem_wall_triangle(fsdem_v3(-1, -1, 0), fsdem_v3(1, 1, 0), fsdem_v3(-1, 1, 0), 0);
     overlap = settle_on_mesh(3, w, 2, fsdem_v3(0, 0, r), &expected);
     REPORT("sphere on a shared triangle edge: overlap / Hertz = %.6f", overlap / expected);
     /* Hertz equilibrium is exact once the bounce has decayed (< 1e-6 relative after 0.3 s); 1% as
@@ -851,14 +851,14 @@ START_TEST(mesh_edges_and_vertices_push_once) {
     /* a fan of six triangles around the origin; sphere on the common vertex */
     for (k = 0; k < 6; ++k) {
         double a0 = k * PI / 3, a1 = (k + 1) * PI / 3;
-        w[k] = fsdem_wall_triangle(fsdem_v3(0, 0, 0), fsdem_v3(cos(a0), sin(a0), 0), fsdem_v3(cos(a1), sin(a1), 0), 0);
+        w[k] = fsdem_dem_wall_triangle(fsdem_v3(0, 0, 0), fsdem_v3(cos(a0), sin(a0), 0), fsdem_v3(cos(a1), sin(a1), 0), 0);
     }
     overlap = settle_on_mesh(3, w, 6, fsdem_v3(0, 0, r), &expected);
     REPORT("sphere on a vertex shared by six triangles: overlap / Hertz = %.6f", overlap / expected);
     ck_assert_msg(fabs(overlap / expected - 1) < 0.01, "overlap %g, expected %g", overlap, expected);
     /* 2D: a disc on the joint of a two-segment polyline */
-    w[0] = fsdem_wall_segment(fsdem_v3(-1, 0, 0), fsdem_v3(0, 0, 0), 0);
-    w[1] = fsdem_wall_segment(fsdem_v3(0, 0, 0), fsdem_v3(1, 0, 0), 0);
+    w[0] = fsdem_dem_wall_segment(fsdem_v3(-1, 0, 0), fsdem_v3(0, 0, 0), 0);
+    w[1] = fsdem_dem_wall_segment(fsdem_v3(0, 0, 0), fsdem_v3(1, 0, 0), 0);
     overlap = settle_on_mesh(2, w, 2, fsdem_v3(0, r, 0), &expected);
     REPORT("disc on a polyline joint: overlap / Hertz = %.6f", overlap / expected);
     ck_assert_msg(fabs(overlap / expected - 1) < 0.01, "overlap %g, expected %g", overlap, expected);
@@ -882,7 +882,7 @@ START_TEST(moving_sdf_wall_reaches_resting_particles) {
     d.dt = 1e-5;
     dem = dem_new(&d);
     mat = add_plain_material(dem);
-    wall = add_wall(dem, fsdem_wall_sdf(sdf_rising_floor, &height, mat));
+    wall = add_wall(dem, fsdem_dem_wall_sdf(sdf_rising_floor, &height, mat));
     add_particle(dem, fsdem_v3(0, 0, 0.05), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.01, mat, 0);
     for (s = 0; s < 10000; ++s) { /* the floor rises 0.1 m at 1 m/s */
         height += 1e-5;
@@ -890,8 +890,8 @@ START_TEST(moving_sdf_wall_reaches_resting_particles) {
         step_n(dem, 1);
     }
     /* the particle rides on the floor: centre at least r minus a Hertz overlap (< 1 mm here) above it */
-    ck_assert_msg(fsdem_dem_particles(dem).position[0].z > height + 0.01 - 1e-3, "particle at %g, floor at %g",
-                  (double)fsdem_dem_particles(dem).position[0].z, (double)height);
+    ck_assert_msg(fsdem_dem_get_particles(dem).position[0].z > height + 0.01 - 1e-3, "particle at %g, floor at %g",
+                  (double)fsdem_dem_get_particles(dem).position[0].z, (double)height);
     ck_assert_int_eq(fsdem_dem_wall_moved(dem, wall, -1), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_dem_wall_moved(dem, 7, 1), FSDEM_ERR_NOT_FOUND);
     fsdem_dem_destroy(dem);
@@ -939,10 +939,10 @@ static void expect_error(fsdem_dem *dem, fsdem_result res, fsdem_result code, co
 
 /* The object still works: a valid particle can be added and a step succeeds. */
 static void expect_usable(fsdem_dem *dem, int material) {
-    fsdem_particles p = fsdem_dem_particles(dem);
+    fsdem_dem_particles p = fsdem_dem_get_particles(dem);
     const int before = p.count;
     int index = -1;
-    fsdem_particle_desc pd = fsdem_particle_desc_default();
+    fsdem_dem_particle_desc pd = fsdem_dem_particle_desc_default();
     pd.position = fsdem_v3(0.5 * (before % 3) - 0.5, 0.5, 0); /* distinct, inside [-1, 1]^3 */
     pd.radius = 0.01;
     pd.material = material;
@@ -963,8 +963,8 @@ START_TEST(invalid_desc_is_rejected) {
     bad = base; bad.domain_max.x = -2; expect_bad_desc(bad, "fsdem_dem_desc.domain_max");
     bad = base; bad.gravity.z = NAN; expect_bad_desc(bad, "fsdem_dem_desc.gravity");
     bad = base; bad.contact_offset = -1e-3; expect_bad_desc(bad, "fsdem_dem_desc.contact_offset");
-    bad = base; bad.law = FSDEM_CONTACT_LINEAR; expect_bad_desc(bad, "fsdem_dem_desc.linear_dx"); /* linear_dx left at 0 */
-    bad = base; bad.law = FSDEM_CONTACT_LINEAR; bad.linear_dx = 0.01; bad.gravity = fsdem_v3(0, 0, 0);
+    bad = base; bad.law = FSDEM_DEM_LAW_LINEAR; expect_bad_desc(bad, "fsdem_dem_desc.linear_dx"); /* linear_dx left at 0 */
+    bad = base; bad.law = FSDEM_DEM_LAW_LINEAR; bad.linear_dx = 0.01; bad.gravity = fsdem_v3(0, 0, 0);
     expect_bad_desc(bad, "fsdem_dem_desc.linear_accel");
     /* the same desc with linear_accel set is valid: zero gravity is fine then */
     bad.linear_accel = G;
@@ -980,25 +980,25 @@ END_TEST
 START_TEST(invalid_material_and_particle_are_rejected) {
     fsdem_dem_desc d = fsdem_dem_desc_default(3);
     fsdem_dem *dem;
-    fsdem_material good = fsdem_material_default(), bad;
-    fsdem_particle_desc pd = fsdem_particle_desc_default(), pbad;
+    fsdem_dem_material good = fsdem_dem_material_default(), bad;
+    fsdem_dem_particle_desc pd = fsdem_dem_particle_desc_default(), pbad;
     int index = -7, mat;
     d.gravity = fsdem_v3(0, 0, 0);
     dem = dem_new(&d);
     mat = add_plain_material(dem);
     good.restitution = 1; /* see add_plain_material */
     bad = good; bad.density = 0;
-    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_material.density");
+    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_dem_material.density");
     bad = good; bad.density = -2500;
-    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_material.density");
+    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_dem_material.density");
     bad = good; bad.restitution = 0;
-    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_material.restitution");
+    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_dem_material.restitution");
     bad = good; bad.restitution = 1.5;
-    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_material.restitution");
+    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_dem_material.restitution");
     bad = good; bad.friction = -0.1;
-    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_material.friction");
+    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_dem_material.friction");
     bad = good; bad.poisson_ratio = 0.6;
-    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_material.poisson_ratio");
+    expect_error(dem, fsdem_dem_add_material(dem, &bad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_dem_material.poisson_ratio");
     ck_assert_int_eq(index, -7); /* untouched on failure */
     /* none of the rejected materials was added: the next one gets index 1 */
     ck_assert_int_eq(fsdem_dem_add_material(dem, &good, &index), FSDEM_OK);
@@ -1007,18 +1007,18 @@ START_TEST(invalid_material_and_particle_are_rejected) {
     pd.radius = 0.01;
     pd.material = mat;
     pbad = pd; pbad.radius = -0.01;
-    expect_error(dem, fsdem_dem_add_particle(dem, &pbad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_particle_desc.radius");
+    expect_error(dem, fsdem_dem_add_particle(dem, &pbad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_dem_particle_desc.radius");
     pbad = pd; pbad.radius = 0;
-    expect_error(dem, fsdem_dem_add_particle(dem, &pbad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_particle_desc.radius");
+    expect_error(dem, fsdem_dem_add_particle(dem, &pbad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_dem_particle_desc.radius");
     pbad = pd; pbad.position.y = NAN;
     expect_error(dem, fsdem_dem_add_particle(dem, &pbad, &index), FSDEM_ERR_INVALID_ARG, "position");
     pbad = pd; pbad.position.x = 1.5; /* domain is [-1, 1]^3 */
     expect_error(dem, fsdem_dem_add_particle(dem, &pbad, &index), FSDEM_ERR_OUT_OF_DOMAIN, "position");
     pbad = pd; pbad.material = 2; /* two materials exist */
-    expect_error(dem, fsdem_dem_add_particle(dem, &pbad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_particle_desc.material");
+    expect_error(dem, fsdem_dem_add_particle(dem, &pbad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_dem_particle_desc.material");
     pbad = pd; pbad.material = -1;
-    expect_error(dem, fsdem_dem_add_particle(dem, &pbad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_particle_desc.material");
-    ck_assert_int_eq(fsdem_dem_particles(dem).count, 0);
+    expect_error(dem, fsdem_dem_add_particle(dem, &pbad, &index), FSDEM_ERR_INVALID_ARG, "fsdem_dem_particle_desc.material");
+    ck_assert_int_eq(fsdem_dem_get_particles(dem).count, 0);
     expect_usable(dem, mat);
     expect_usable(dem, 1);
     fsdem_dem_destroy(dem);
@@ -1034,31 +1034,31 @@ static fsdem_real sdf_floor(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
 START_TEST(invalid_walls_and_calls_are_rejected) {
     fsdem_dem_desc d = fsdem_dem_desc_default(3), d2 = fsdem_dem_desc_default(2);
     fsdem_dem *dem, *dem2;
-    fsdem_wall_desc w;
+    fsdem_dem_wall_desc w;
     int id = -7, mat, mat2, i;
     fsdem_real t0;
-    fsdem_particles p;
+    fsdem_dem_particles p;
     d.gravity = fsdem_v3(0, 0, 0);
     dem = dem_new(&d);
     mat = add_plain_material(dem);
-    w = fsdem_wall_plane(fsdem_v3(0, 0, -0.9), fsdem_v3(0, 0, 0), mat);
+    w = fsdem_dem_wall_plane(fsdem_v3(0, 0, -0.9), fsdem_v3(0, 0, 0), mat);
     expect_error(dem, fsdem_dem_add_wall(dem, &w, &id), FSDEM_ERR_INVALID_ARG, "normal");
-    w = fsdem_wall_triangle(fsdem_v3(0, 0, 0), fsdem_v3(1, 1, 1), fsdem_v3(2, 2, 2), mat); /* collinear */
+    w = fsdem_dem_wall_triangle(fsdem_v3(0, 0, 0), fsdem_v3(1, 1, 1), fsdem_v3(2, 2, 2), mat); /* collinear */
     expect_error(dem, fsdem_dem_add_wall(dem, &w, &id), FSDEM_ERR_INVALID_ARG, "degenerate");
-    w = fsdem_wall_sdf(NULL, NULL, mat);
+    w = fsdem_dem_wall_sdf(NULL, NULL, mat);
     expect_error(dem, fsdem_dem_add_wall(dem, &w, &id), FSDEM_ERR_INVALID_ARG, "callback");
-    w = fsdem_wall_plane(fsdem_v3(0, 0, -0.9), fsdem_v3(0, 0, 1), 5);
+    w = fsdem_dem_wall_plane(fsdem_v3(0, 0, -0.9), fsdem_v3(0, 0, 1), 5);
     expect_error(dem, fsdem_dem_add_wall(dem, &w, &id), FSDEM_ERR_INVALID_ARG, "material");
     ck_assert_int_eq(id, -7);
     /* no wall was added: the first valid one gets id 0 */
-    w = fsdem_wall_sdf(sdf_floor, NULL, mat);
+    w = fsdem_dem_wall_sdf(sdf_floor, NULL, mat);
     ck_assert_int_eq(fsdem_dem_add_wall(dem, &w, &id), FSDEM_OK);
     ck_assert_int_eq(id, 0);
 
     d2.gravity = fsdem_v3(0, 0, 0);
     dem2 = dem_new(&d2);
     mat2 = add_plain_material(dem2);
-    w = fsdem_wall_triangle(fsdem_v3(0, 0, 0), fsdem_v3(1, 0, 0), fsdem_v3(0, 1, 0), mat2);
+    w = fsdem_dem_wall_triangle(fsdem_v3(0, 0, 0), fsdem_v3(1, 0, 0), fsdem_v3(0, 1, 0), mat2);
     expect_error(dem2, fsdem_dem_add_wall(dem2, &w, &id), FSDEM_ERR_INVALID_ARG, "dim");
     expect_usable(dem2, mat2);
     fsdem_dem_destroy(dem2);
@@ -1080,25 +1080,25 @@ START_TEST(invalid_walls_and_calls_are_rejected) {
                  FSDEM_ERR_NOT_FOUND, "index");
     expect_error(dem, fsdem_dem_set_particle_state(dem, -1, fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0)),
                  FSDEM_ERR_NOT_FOUND, "index");
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     {
         const fsdem_vec3 x0 = p.position[0];
         expect_error(dem, fsdem_dem_set_particle_state(dem, 0, fsdem_v3(0, 0, 0), fsdem_v3(NAN, 0, 0), fsdem_v3(0, 0, 0)),
                      FSDEM_ERR_INVALID_ARG, "velocity");
         expect_error(dem, fsdem_dem_set_particle_state(dem, 0, fsdem_v3(0, 3, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0)),
                      FSDEM_ERR_OUT_OF_DOMAIN, "position");
-        p = fsdem_dem_particles(dem);
+        p = fsdem_dem_get_particles(dem);
         ck_assert(p.position[0].x == x0.x && p.position[0].y == x0.y && p.position[0].z == x0.z);
     }
     expect_usable(dem, mat);
 
     /* a NaN external force is a result, naming the particle; removing it lets the run go on */
-    ck_assert_int_eq(fsdem_dem_external_loads(dem).count, 2);
-    fsdem_dem_external_loads(dem).force[1].x = NAN;
+    ck_assert_int_eq(fsdem_dem_get_coupling(dem).count, 2);
+    fsdem_dem_get_coupling(dem).force[1].x = NAN;
     expect_error(dem, fsdem_dem_step(dem), FSDEM_ERR_NAN, "particle 1");
     ck_assert_int_eq(fsdem_dem_remove_particle(dem, 1), FSDEM_OK);
     step_n(dem, 3);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     for (i = 0; i < p.count; ++i) ck_assert(isfinite(p.position[i].x) && isfinite(p.velocity[i].x));
     fsdem_dem_destroy(dem);
 }
@@ -1110,7 +1110,7 @@ START_TEST(particle_leaving_domain_is_reported) {
     fsdem_dem_desc d = fsdem_dem_desc_default(3);
     fsdem_dem *dem;
     fsdem_result res = FSDEM_OK;
-    fsdem_particles p;
+    fsdem_dem_particles p;
     int mat, s;
     d.dt = 1e-3;
     dem = dem_new(&d);
@@ -1122,7 +1122,7 @@ START_TEST(particle_leaving_domain_is_reported) {
        time and stay inside */
     for (s = 0; s < 1000 && res == FSDEM_OK; ++s) res = fsdem_dem_step(dem);
     expect_error(dem, res, FSDEM_ERR_OUT_OF_DOMAIN, "particle 2");
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     ck_assert(p.position[2].z > 1); /* the step completed: the particle is outside */
     ck_assert(fabs(p.position[0].z) < 1 && fabs(p.position[1].z) < 1);
     ck_assert(fabs(fsdem_dem_time(dem) - s * 1e-3) < 1e-9);
@@ -1147,7 +1147,7 @@ START_TEST(contact_history_survives_rebuilds_and_removal) {
     const double estar = hertz_estar(young, nu);
     fsdem_dem_desc d = fsdem_dem_desc_default(3);
     fsdem_dem *dem;
-    fsdem_particles p;
+    fsdem_dem_particles p;
     fsdem_vec3 n_plane = fsdem_v3(-sin(theta), 0, cos(theta)), plane_point = fsdem_v3(0, 0, -0.5);
     fsdem_vec3 big = fsdem_v3(0.3, 0, 0), s1_before, s2_before, x;
     int mat, i, i_s1, i_s2, id_s1, id_s2, i_f1;
@@ -1157,7 +1157,7 @@ START_TEST(contact_history_survives_rebuilds_and_removal) {
     d.rotation = 0;
     dem = dem_new(&d);
     mat = add_material(dem, rho, young, nu, 0.5, mu, 0.4);
-    add_wall(dem, fsdem_wall_plane(plane_point, n_plane, mat));
+    add_wall(dem, fsdem_dem_wall_plane(plane_point, n_plane, mat));
     /* 0: far fixed particle, removed later */
     add_particle(dem, fsdem_v3(0.6, 0.6, 0.6), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), r, mat, 1);
     /* 1: fixed big sphere; 2: S1 on top of it, normal tilted by beta (tan beta = 0.21 < mu) */
@@ -1172,13 +1172,13 @@ START_TEST(contact_history_survives_rebuilds_and_removal) {
     /* 4: far fixed particle moving at 1 m/s: its displacement triggers a rebuild every
        skin / (2 v dt) = 0.0075 / (2 * 5e-5) = 75 steps */
     i_f1 = add_particle(dem, fsdem_v3(-0.6, 0.6, 0.6), fsdem_v3(0, -1, 0), fsdem_v3(0, 0, 0), r, mat, 1);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     id_s1 = p.id[i_s1];
     id_s2 = p.id[i_s2];
     ck_assert_int_eq(i_f1, 4);
     /* settle: the tangential transients decay in a few ms (Tsuji damping with e = 0.5) */
     step_n(dem, 4000);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     s1_before = p.position[i_s1];
     s2_before = p.position[i_s2];
     /* at rest: the initial stick-in transient (speed ~ xi omega ~ 5e-3 m/s) has decayed by
@@ -1188,7 +1188,7 @@ START_TEST(contact_history_survives_rebuilds_and_removal) {
     rebuilds_before = fsdem_dem_get_stats(dem).rebuilds;
 
     ck_assert_int_eq(fsdem_dem_remove_particle(dem, 0), FSDEM_OK);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     i_s1 = i_s2 = -1;
     for (i = 0; i < p.count; ++i) {
         if (p.id[i] == id_s1) i_s1 = i;
@@ -1197,11 +1197,11 @@ START_TEST(contact_history_survives_rebuilds_and_removal) {
     ck_assert_int_eq(i_s1, 1); /* indices shifted down by one */
     ck_assert_int_eq(i_s2, 2);
     step_n(dem, 1500);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     ck_assert_int_eq(fsdem_dem_set_particle_state(dem, 3, fsdem_v3(-0.6, 0.5, 0.2), p.velocity[3], fsdem_v3(0, 0, 0)),
                      FSDEM_OK);
     step_n(dem, 1500);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     disp1 = vnorm(vsub(p.position[i_s1], s1_before));
     disp2 = vnorm(vsub(p.position[i_s2], s2_before));
     /* spring stretch carrying the load: S_t = 8 G* sqrt(R* d) (Mindlin, seed 002 Eq. 20) */
@@ -1230,7 +1230,7 @@ END_TEST
 static void advance_case(double dt, double dt_outer, int expected_k) {
     fsdem_dem_desc d = fsdem_dem_desc_default(3);
     fsdem_dem *dem;
-    fsdem_particles p;
+    fsdem_dem_particles p;
     fsdem_result res;
     int mat, k = -1;
     long long steps;
@@ -1241,16 +1241,16 @@ static void advance_case(double dt, double dt_outer, int expected_k) {
     mat = add_plain_material(dem);
     add_particle(dem, fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.01, mat, 0);
     step_n(dem, 3); /* start from a non-zero time */
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     m = p.mass[0];
-    fsdem_dem_external_loads(dem).force[0] = fsdem_v3(force, 0, 0);
+    fsdem_dem_get_coupling(dem).force[0] = fsdem_v3(force, 0, 0);
     t0 = fsdem_dem_time(dem);
     steps = fsdem_dem_get_stats(dem).steps;
     res = fsdem_dem_advance(dem, dt_outer, &k);
     t = fsdem_dem_time(dem) - t0;
     steps = fsdem_dem_get_stats(dem).steps - steps;
     dt_after = fsdem_dem_dt(dem);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     v = p.velocity[0].x;
     x = p.position[0].x;
     /* destroyed before the checks, so a failure does not leak under CK_FORK=no (make valgrind) */
@@ -1294,7 +1294,7 @@ static fsdem_dem *shaken_box(int *box) {
     d.dt = 2e-6;
     dem = dem_new(&d);
     mat = add_material(dem, 2500, 1e7, 0.3, 0.7, 0.4, 0.4);
-    *box = add_wall(dem, fsdem_wall_box(fsdem_v3(0, 0, 0), fsdem_v3(L, L, L), 1, mat));
+    *box = add_wall(dem, fsdem_dem_wall_box(fsdem_v3(0, 0, 0), fsdem_v3(L, L, L), 1, mat));
     rng_seed(77);
     for (k = 0; k < 5; ++k)
         for (j = 0; j < 5; ++j)
@@ -1312,7 +1312,7 @@ static fsdem_dem *shaken_box(int *box) {
    g_contact h / 2, of order 1e-2 of the scale here). */
 START_TEST(advance_equals_steps) {
     fsdem_dem *a, *b;
-    fsdem_particles pa, pb;
+    fsdem_dem_particles pa, pb;
     fsdem_vec3 ja, jb;
     int box_a, box_b, i, k, n, contacts = 0;
     double dx = 0, dv = 0, dw = 0;
@@ -1323,8 +1323,8 @@ START_TEST(advance_equals_steps) {
         contacts += fsdem_dem_get_stats(a).contacts;
     }
     ck_assert_int_eq(fsdem_dem_advance(b, 600 * 2e-6, &n), FSDEM_OK);
-    pa = fsdem_dem_particles(a);
-    pb = fsdem_dem_particles(b);
+    pa = fsdem_dem_get_particles(a);
+    pb = fsdem_dem_get_particles(b);
     for (i = 0; i < pa.count; ++i) {
         dx = fmax(dx, vnorm(vsub(pa.position[i], pb.position[i])));
         dv = fmax(dv, vnorm(vsub(pa.velocity[i], pb.velocity[i])));
@@ -1367,7 +1367,7 @@ START_TEST(advance_stops_where_a_particle_leaves) {
     ck_assert(fsdem_dem_get_stats(dem).steps >= 945 && fsdem_dem_get_stats(dem).steps <= 946);
     ck_assert_ptr_nonnull(strstr(fsdem_dem_last_error(dem), "particle 1"));
     /* the step is complete: the velocity is the full-step one, unchanged by the free flight */
-    ck_assert(fabs(fsdem_dem_particles(dem).velocity[1].z - 1) < 1e-12);
+    ck_assert(fabs(fsdem_dem_get_particles(dem).velocity[1].z - 1) < 1e-12);
     fsdem_dem_destroy(dem);
 }
 END_TEST
@@ -1377,31 +1377,31 @@ END_TEST
 START_TEST(dt_estimates_follow_their_formulas) {
     fsdem_dem_desc d = fsdem_dem_desc_default(3);
     fsdem_dem *dem;
-    fsdem_particles p;
+    fsdem_dem_particles p;
     fsdem_real dt;
     int m1, m2, i;
     double expected, best;
     /* seed 000 Eq. 18 with Eq. 10: (2 pi / gamma) sqrt(m_ij / k) = (2 pi / gamma) sqrt(theta dx / ||g||) */
-    d.law = FSDEM_CONTACT_LINEAR;
+    d.law = FSDEM_DEM_LAW_LINEAR;
     d.linear_theta = 0.01;
     d.linear_dx = 0.004;
     dem = dem_new(&d);
     m1 = add_plain_material(dem);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DT_LINEAR_SEED000, 150, &dt), FSDEM_ERR_NOT_FOUND);
+    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 150, &dt), FSDEM_ERR_NOT_FOUND);
     add_particle(dem, fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.01, m1, 0);
     add_particle(dem, fsdem_v3(0.5, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.02, m1, 0);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DT_LINEAR_SEED000, 150, &dt), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 150, &dt), FSDEM_OK);
     expected = 2 * PI / 150 * sqrt(0.01 * 0.004 / G);
     REPORT("dt LINEAR_SEED000: %.10g, expected %.10g", (double)dt, expected);
     ck_assert(fabs(dt / expected - 1) < 1e-12); /* closed form: rounding only */
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DT_LINEAR_SEED000, 0, &dt), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 0, &dt), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_nonnull(strstr(fsdem_dem_last_error(dem), "gamma"));
     fsdem_dem_destroy(dem);
     d.linear_accel = 4 * G; /* ||g|| of Eq. 10 set explicitly */
     dem = dem_new(&d);
     m1 = add_plain_material(dem);
     add_particle(dem, fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.01, m1, 0);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DT_LINEAR_SEED000, 100, &dt), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 100, &dt), FSDEM_OK);
     expected = 2 * PI / 100 * sqrt(0.01 * 0.004 / (4 * G));
     ck_assert(fabs(dt / expected - 1) < 1e-12);
     fsdem_dem_destroy(dem);
@@ -1416,8 +1416,8 @@ START_TEST(dt_estimates_follow_their_formulas) {
     add_particle(dem, fsdem_v3(0.5, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.005, m1, 0);
     add_particle(dem, fsdem_v3(-0.5, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.02, m2, 0);
     add_particle(dem, fsdem_v3(0, 0.5, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.004, m2, 0);
-    p = fsdem_dem_particles(dem);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DT_RAYLEIGH, 0.2, &dt), FSDEM_OK);
+    p = fsdem_dem_get_particles(dem);
+    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_RAYLEIGH, 0.2, &dt), FSDEM_OK);
     best = HUGE_VAL;
     for (i = 0; i < p.count; ++i) {
         const double rho = p.material[i] == m1 ? 2500 : 7800, e = p.material[i] == m1 ? 1e7 : 2e11,
@@ -1427,8 +1427,8 @@ START_TEST(dt_estimates_follow_their_formulas) {
     }
     REPORT("dt RAYLEIGH(0.2): %.10g, expected %.10g", (double)dt, 0.2 * best);
     ck_assert(fabs(dt / (0.2 * best) - 1) < 1e-12);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DT_RAYLEIGH, 1.5, &dt), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DT_GIC, 0, &dt), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_RAYLEIGH, 1.5, &dt), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_GIC, 0, &dt), FSDEM_OK);
     best = HUGE_VAL;
     for (i = 0; i < p.count; ++i) {
         const double e = p.material[i] == m1 ? 1e7 : 2e11;
@@ -1446,13 +1446,13 @@ END_TEST
 START_TEST(particle_masses) {
     fsdem_dem_desc d = fsdem_dem_desc_default(2);
     fsdem_dem *dem;
-    fsdem_particles p;
+    fsdem_dem_particles p;
     int mat;
     d.disc_length = 0.05;
     dem = dem_new(&d);
     mat = add_material(dem, 2650, 1e7, 0.3, 1.0, 0.3, 0.4);
     add_particle(dem, fsdem_v3(0, 0, 0.3), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.012, mat, 0);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     /* a disc of length disc_length: rho pi r^2 L */
     ck_assert(fabs(p.mass[0] / (2650 * PI * 0.012 * 0.012 * 0.05) - 1) < 1e-14); /* closed form: rounding only */
     ck_assert(p.position[0].z == 0); /* 2D particles live in the x-y plane */
@@ -1461,7 +1461,7 @@ START_TEST(particle_masses) {
     dem = dem_new(&d);
     mat = add_material(dem, 2650, 1e7, 0.3, 1.0, 0.3, 0.4);
     add_particle(dem, fsdem_v3(0, 0, 0.3), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.012, mat, 0);
-    p = fsdem_dem_particles(dem);
+    p = fsdem_dem_get_particles(dem);
     ck_assert(fabs(p.mass[0] / (2650 * 4.0 / 3.0 * PI * 0.012 * 0.012 * 0.012) - 1) < 1e-14);
     fsdem_dem_destroy(dem);
 }

@@ -33,7 +33,7 @@ static fsdem_pic *still_tank(int dim, fsdem_pic_transfer transfer, fsdem_pic_ker
 /* Bottom pressure averaged over the bottom cells, extrapolated from the two lowest cell centres to
    the floor. */
 static double bottom_pressure(const fsdem_pic *s) {
-    fsdem_pic_grid g = fsdem_pic_get_grid(s);
+    fsdem_pic_fields g = fsdem_pic_get_fields(s);
     int up = g.dim - 1, i, stride = up == 1 ? g.n[0] : g.n[0] * g.n[1];
     double sum = 0;
     for (i = 0; i < stride; ++i) sum += 1.5 * (double)g.pressure[i] - 0.5 * (double)g.pressure[i + stride];
@@ -77,7 +77,7 @@ START_TEST(still_water_around_obstacles_stays_still) {
         fsdem_pic_obstacle o1, o2;
         fsdem_vec3 tri[3];
         fsdem_pic_stats st;
-        fsdem_pic_grid g;
+        fsdem_pic_fields g;
         double err = 0, ref = RHO * G * 0.5;
         int c;
         d.cell_size = dim == 2 ? 0.05 : 0.1;
@@ -102,7 +102,7 @@ START_TEST(still_water_around_obstacles_stays_still) {
         ck_assert_int_eq(fsdem_pic_advance(s, 1.0, NULL), FSDEM_OK);
         st = fsdem_pic_get_stats(s);
         ck_assert_msg(st.max_speed < 1e-3, "%dD: max speed %g m/s after 1 s", dim, (double)st.max_speed);
-        g = fsdem_pic_get_grid(s);
+        g = fsdem_pic_get_fields(s);
         for (c = 0; c < g.n[0] * g.n[1] * g.n[2]; ++c) {
             int up = dim == 2 ? c / g.n[0] : c / (g.n[0] * g.n[1]);
             double y = (up + 0.5) * (double)g.cell_size;
@@ -164,14 +164,14 @@ static fsdem_pic *open_channel(double U, double H) {
 START_TEST(open_box_conserves_flux_past_obstacle) {
     fsdem_pic *s;
     fsdem_pic_obstacle disc = fsdem_pic_obstacle_sphere(fsdem_v3(0.5, 0.25, 0), 0.1);
-    fsdem_pic_grid g;
+    fsdem_pic_fields g;
     double U = 1.0, H = 0.5, vmax = 0;
     int k, i, j;
     s = open_channel(U, H);
     ck_assert_int_eq(fsdem_pic_add_obstacle(s, &disc, NULL), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(1.0, H, 0), fsdem_v3(U, 0, 0), NULL), FSDEM_OK);
     for (k = 0; k < 10; ++k) ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
-    g = fsdem_pic_get_grid(s);
+    g = fsdem_pic_get_fields(s);
     for (i = 0; i <= g.n[0]; ++i) {
         double flux = 0;
         for (j = 0; j < g.n[1]; ++j) {
@@ -239,7 +239,7 @@ START_TEST(particles_stay_out_of_solids) {
     fsdem_vec3 tri[3];
     fsdem_pic_obstacle wedge;
     fsdem_pic_particles p;
-    fsdem_pic_grid g;
+    fsdem_pic_fields g;
     int k, i, *count;
     tri[0] = fsdem_v3(0.45, 0.0, 0);
     tri[1] = fsdem_v3(0.9, 0.0, 0);
@@ -252,7 +252,7 @@ START_TEST(particles_stay_out_of_solids) {
     ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(0.3, 0.5, 0), fsdem_v3(1, 0, 0), NULL), FSDEM_OK);
     for (k = 0; k < 30; ++k) ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
     p = fsdem_pic_get_particles(s);
-    g = fsdem_pic_get_grid(s);
+    g = fsdem_pic_get_fields(s);
     count = (int *)calloc((size_t)(g.n[0] * g.n[1]), sizeof(int));
     for (i = 0; i < p.count; ++i) {
         fsdem_vec3 x = p.position[i];
@@ -463,7 +463,7 @@ END_TEST
 START_TEST(coupler_faces_carry_solid_flux) {
     fsdem_pic *s;
     fsdem_pic_coupling *cp;
-    fsdem_pic_grid g;
+    fsdem_pic_fields g;
     double U = 0.5, H = 0.5;
     int k, i, j, col = 20;
     s = open_channel(U, H);
@@ -475,7 +475,7 @@ START_TEST(coupler_faces_carry_solid_flux) {
         cp->solid_velocity[0][j * (cp->n[0] + 1) + col] = (fsdem_real)U;
     }
     for (k = 0; k < 5; ++k) ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
-    g = fsdem_pic_get_grid(s);
+    g = fsdem_pic_get_fields(s);
     for (i = 0; i <= g.n[0]; ++i) {
         double flux = 0;
         for (j = 0; j < g.n[1]; ++j) {
@@ -510,7 +510,7 @@ START_TEST(sdf_callback_matches_builtin_obstacle) {
     fsdem_real disc[3] = {(fsdem_real)0.51, (fsdem_real)0.47, (fsdem_real)0.23};
     fsdem_pic_obstacle o1 = fsdem_pic_obstacle_sphere(fsdem_v3(disc[0], disc[1], 0), disc[2]);
     fsdem_pic_obstacle o2 = fsdem_pic_obstacle_sdf(disc_sdf, disc);
-    fsdem_pic_grid ga, gb;
+    fsdem_pic_fields ga, gb;
     int ax, f, partial = 0;
     double open = 0;
     d.cell_size = 0.05;
@@ -518,8 +518,8 @@ START_TEST(sdf_callback_matches_builtin_obstacle) {
     ck_assert_int_eq(fsdem_pic_create(&d, &b), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_add_obstacle(a, &o1, NULL), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_add_obstacle(b, &o2, NULL), FSDEM_OK);
-    ga = fsdem_pic_get_grid(a);
-    gb = fsdem_pic_get_grid(b);
+    ga = fsdem_pic_get_fields(a);
+    gb = fsdem_pic_get_fields(b);
     for (ax = 0; ax < 2; ++ax)
         for (f = 0; f < ga.face_count[ax]; ++f) {
             ck_assert_msg(fabs((double)ga.open[ax][f] - (double)gb.open[ax][f]) < 1e-12, "axis %d face %d: %g vs %g", ax, f,
@@ -546,7 +546,7 @@ START_TEST(reseeding_moves_particles_into_sparse_cells) {
     fsdem_pic_desc d = fsdem_pic_desc_default(2);
     fsdem_pic *s;
     fsdem_pic_particles p;
-    fsdem_pic_grid g;
+    fsdem_pic_fields g;
     int *count, i, before;
     d.cell_size = 0.1;
     d.domain_max = fsdem_v3(1.0, 0.5, 0);
@@ -562,7 +562,7 @@ START_TEST(reseeding_moves_particles_into_sparse_cells) {
     ck_assert_int_eq(before, 8 * 45);
     ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
     p = fsdem_pic_get_particles(s);
-    g = fsdem_pic_get_grid(s);
+    g = fsdem_pic_get_fields(s);
     ck_assert_int_eq(p.count, before);
     ck_assert_int_gt((int)fsdem_pic_get_stats(s).moved, 0);
     count = (int *)calloc((size_t)(g.n[0] * g.n[1]), sizeof(int));

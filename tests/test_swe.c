@@ -80,8 +80,8 @@ static double dambreak_l1(int n, double hr, int order, fsdem_swe_limiter lim, do
     d.x_max = 7;
     d.order = order;
     d.limiter = lim;
-    d.boundary[FSDEM_SWE_XMIN].type = FSDEM_SWE_BC_TRANSMISSIVE;
-    d.boundary[FSDEM_SWE_XMAX].type = FSDEM_SWE_BC_TRANSMISSIVE;
+    d.boundary[FSDEM_SIDE_XMIN].type = FSDEM_SWE_BC_TRANSMISSIVE;
+    d.boundary[FSDEM_SIDE_XMAX].type = FSDEM_SWE_BC_TRANSMISSIVE;
     for (i = 0; i < n; ++i) h[i] = -4 + (i + 0.5) * dx < 0 ? 1 : hr;
     d.depth = h;
     s = swe_make(&d);
@@ -373,10 +373,10 @@ START_TEST(swe_inflow_and_stage_keep_uniform_flow) {
     int i;
     d.nx = 100;
     d.x_max = 10;
-    d.boundary[FSDEM_SWE_XMIN].type = FSDEM_SWE_BC_DISCHARGE;
-    d.boundary[FSDEM_SWE_XMIN].value = 0.2;
-    d.boundary[FSDEM_SWE_XMAX].type = FSDEM_SWE_BC_STAGE;
-    d.boundary[FSDEM_SWE_XMAX].value = 0.4;
+    d.boundary[FSDEM_SIDE_XMIN].type = FSDEM_SWE_BC_DISCHARGE;
+    d.boundary[FSDEM_SIDE_XMIN].value = 0.2;
+    d.boundary[FSDEM_SIDE_XMAX].type = FSDEM_SWE_BC_STAGE;
+    d.boundary[FSDEM_SIDE_XMAX].value = 0.4;
     for (i = 0; i < 100; ++i) {
         depth[i] = 0.4;
         q[i] = 0.5;
@@ -392,8 +392,8 @@ START_TEST(swe_inflow_and_stage_keep_uniform_flow) {
         ck_assert_double_eq_tol(q[i], 0.2, 1e-12);
         ck_assert_double_eq_tol(h[i], 0.4, 1e-12);
     }
-    d.boundary[FSDEM_SWE_XMIN].value = 0.4;
-    ck_assert_int_eq(fsdem_swe_set_boundary(s, FSDEM_SWE_XMIN, &d.boundary[FSDEM_SWE_XMIN]), FSDEM_OK);
+    d.boundary[FSDEM_SIDE_XMIN].value = 0.4;
+    ck_assert_int_eq(fsdem_swe_set_boundary(s, FSDEM_SIDE_XMIN, &d.boundary[FSDEM_SIDE_XMIN]), FSDEM_OK);
     ck_assert_int_eq(fsdem_swe_advance(s, 10, NULL), FSDEM_OK);
     ck_assert_double_gt(fsdem_swe_volume(s), v0 * 1.01);
     st = fsdem_swe_get_stats(s);
@@ -415,10 +415,10 @@ START_TEST(swe_hydrograph_volume) {
     d.nx = 50;
     d.x_max = 20;
     d.width = 2;
-    d.boundary[FSDEM_SWE_XMIN].type = FSDEM_SWE_BC_DISCHARGE;
-    d.boundary[FSDEM_SWE_XMIN].series_time = ts;
-    d.boundary[FSDEM_SWE_XMIN].series_value = qs;
-    d.boundary[FSDEM_SWE_XMIN].series_count = 3;
+    d.boundary[FSDEM_SIDE_XMIN].type = FSDEM_SWE_BC_DISCHARGE;
+    d.boundary[FSDEM_SIDE_XMIN].series_time = ts;
+    d.boundary[FSDEM_SIDE_XMIN].series_value = qs;
+    d.boundary[FSDEM_SIDE_XMIN].series_count = 3;
     for (i = 0; i < 50; ++i) depth[i] = 0.2;
     d.depth = depth;
     s = swe_make(&d);
@@ -488,9 +488,9 @@ START_TEST(swe_manning_normal_depth) {
     d.nx = 100;
     d.x_max = 20;
     d.manning = 0.03;
-    d.boundary[FSDEM_SWE_XMIN].type = FSDEM_SWE_BC_DISCHARGE;
-    d.boundary[FSDEM_SWE_XMIN].value = 0.1;
-    d.boundary[FSDEM_SWE_XMAX].type = FSDEM_SWE_BC_TRANSMISSIVE;
+    d.boundary[FSDEM_SIDE_XMIN].type = FSDEM_SWE_BC_DISCHARGE;
+    d.boundary[FSDEM_SIDE_XMIN].value = 0.1;
+    d.boundary[FSDEM_SIDE_XMAX].type = FSDEM_SWE_BC_TRANSMISSIVE;
     for (i = 0; i < 100; ++i) {
         bed[i] = -0.01 * (i + 0.5) * 0.2;
         depth[i] = 0.05;
@@ -595,8 +595,8 @@ static double shear_decay_rate(double nu) {
     d.ny = 4;
     d.y_max = 4.0 / 64;
     d.eddy_viscosity = nu;
-    d.boundary[FSDEM_SWE_YMIN].type = FSDEM_SWE_BC_TRANSMISSIVE;
-    d.boundary[FSDEM_SWE_YMAX].type = FSDEM_SWE_BC_TRANSMISSIVE;
+    d.boundary[FSDEM_SIDE_YMIN].type = FSDEM_SWE_BC_TRANSMISSIVE;
+    d.boundary[FSDEM_SIDE_YMAX].type = FSDEM_SWE_BC_TRANSMISSIVE;
     for (k = 0; k < 64 * 4; ++k) {
         depth[k] = 1;
         zero[k] = 0;
@@ -774,23 +774,23 @@ START_TEST(swe_bad_input_gives_codes) {
     ck_assert_int_eq(fsdem_swe_set_surface(s, eta), FSDEM_ERR_INVALID_ARG);
     ck_assert_double_eq(fsdem_swe_volume(s), v0);
     /* a fixed step over the stability limit is refused with FSDEM_ERR_CFL and changes nothing */
-    ck_assert_int_eq(fsdem_swe_step_fixed(s, 10.0), FSDEM_ERR_CFL);
+    ck_assert_int_eq(fsdem_swe_step_dt(s, 10.0), FSDEM_ERR_CFL);
     ck_assert_ptr_nonnull(strstr(fsdem_swe_last_error(s), "Courant"));
     ck_assert_double_eq(fsdem_swe_time(s), 0);
-    ck_assert_int_eq(fsdem_swe_step_fixed(s, -1.0), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_swe_step_fixed(s, 0.5 * fsdem_swe_stable_dt(s)), FSDEM_OK);
+    ck_assert_int_eq(fsdem_swe_step_dt(s, -1.0), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_swe_step_dt(s, 0.5 * fsdem_swe_stable_dt(s)), FSDEM_OK);
     ck_assert_str_eq(fsdem_swe_last_error(s), "");
     /* boundaries: negative inflow, a y side in 1D, a non-increasing series */
     memset(&bc, 0, sizeof bc);
     bc.type = FSDEM_SWE_BC_DISCHARGE;
     bc.value = -0.1;
-    ck_assert_int_eq(fsdem_swe_set_boundary(s, FSDEM_SWE_XMIN, &bc), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_swe_set_boundary(s, FSDEM_SIDE_XMIN, &bc), FSDEM_ERR_INVALID_ARG);
     bc.value = 0.1;
-    ck_assert_int_eq(fsdem_swe_set_boundary(s, FSDEM_SWE_YMIN, &bc), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_swe_set_boundary(s, FSDEM_SIDE_YMIN, &bc), FSDEM_ERR_INVALID_ARG);
     bc.series_time = ts;
     bc.series_value = ts;
     bc.series_count = 2;
-    ck_assert_int_eq(fsdem_swe_set_boundary(s, FSDEM_SWE_XMIN, &bc), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_swe_set_boundary(s, FSDEM_SIDE_XMIN, &bc), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_nonnull(strstr(fsdem_swe_last_error(s), "increase"));
     ck_assert_int_eq(fsdem_swe_set_rain(s, -1), FSDEM_ERR_INVALID_ARG);
     depth[0] = -0.5;
@@ -811,7 +811,7 @@ START_TEST(swe_bad_input_gives_codes) {
     d.dry_depth = 0;
     ck_assert_int_eq(fsdem_swe_desc_check(&d, NULL, 0), FSDEM_ERR_INVALID_ARG);
     d = fsdem_swe_desc_default(2);
-    d.boundary[FSDEM_SWE_YMAX].type = (fsdem_swe_bc)9;
+    d.boundary[FSDEM_SIDE_YMAX].type = (fsdem_swe_bc)9;
     ck_assert_int_eq(fsdem_swe_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_nonnull(strstr(msg, "YMAX"));
     ck_assert_int_eq(fsdem_swe_desc_check(NULL, NULL, 0), FSDEM_ERR_INVALID_ARG);
@@ -946,10 +946,10 @@ START_TEST(swe_allocator_and_1d_output) {
     d.nx = 20;
     d.allocator.alloc = swe_counting_alloc;
     d.allocator.free = swe_counting_free;
-    d.boundary[FSDEM_SWE_XMAX].type = FSDEM_SWE_BC_STAGE;
-    d.boundary[FSDEM_SWE_XMAX].series_time = ts;
-    d.boundary[FSDEM_SWE_XMAX].series_value = vs;
-    d.boundary[FSDEM_SWE_XMAX].series_count = 2;
+    d.boundary[FSDEM_SIDE_XMAX].type = FSDEM_SWE_BC_STAGE;
+    d.boundary[FSDEM_SIDE_XMAX].series_time = ts;
+    d.boundary[FSDEM_SIDE_XMAX].series_value = vs;
+    d.boundary[FSDEM_SIDE_XMAX].series_count = 2;
     swe_live_bytes = 0;
     s = swe_make(&d);
     ck_assert_uint_gt(swe_live_bytes, 0);

@@ -25,7 +25,7 @@ typedef struct db_series {
    (of the middle slice in 3D) plus the interface fraction of the ghost-fluid method, and the
    topmost fluid cell of the first column likewise. */
 static void db_measure(const fsdem_pic *s, double *front, double *hcol) {
-    fsdem_pic_grid g = fsdem_pic_get_grid(s);
+    fsdem_pic_fields g = fsdem_pic_get_fields(s);
     int up = g.dim - 1, i, j, nx = g.n[0], mid = g.dim == 3 ? g.n[1] / 2 : 0;
     int sx = 1, sup = up == 1 ? nx : nx * g.n[1], base = g.dim == 3 ? mid * nx : 0, nup = g.n[up];
     double dx = g.cell_size;

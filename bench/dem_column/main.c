@@ -60,7 +60,7 @@ static double now_seconds(void) {
 }
 
 static double front_x(fsdem_dem *dem) {
-    fsdem_particles p = fsdem_dem_particles(dem);
+    fsdem_dem_particles p = fsdem_dem_get_particles(dem);
     double xmax = -HUGE_VAL;
     int i;
     for (i = 0; i < p.count; ++i)
@@ -79,10 +79,10 @@ int main(int argc, char **argv) {
     long steps = argc > 1 ? strtol(argv[1], NULL, 10) : STEPS;
     long trace = argc > 2 ? strtol(argv[2], NULL, 10) : 0;
     fsdem_dem_desc desc = fsdem_dem_desc_default(3);
-    fsdem_material mat = fsdem_material_default();
+    fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_dem *dem = NULL;
     fsdem_result res;
-    fsdem_energy energy;
+    fsdem_dem_energy energy;
     fsdem_dem_stats stats;
     struct rusage usage;
     uint64_t rng = SEED;
@@ -94,8 +94,8 @@ int main(int argc, char **argv) {
     desc.domain_min = fsdem_v3(0, 0, 0);
     desc.domain_max = fsdem_v3(BOX_X, BOX_Y, BOX_TOP);
     desc.gravity = fsdem_v3(0, 0, -9.81);
-    desc.law = FSDEM_CONTACT_HERTZ_MINDLIN;
-    desc.integrator = FSDEM_INTEGRATOR_VERLET;
+    desc.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
+    desc.integrator = FSDEM_DEM_INTEGRATOR_VERLET;
     desc.dt = DT;
     desc.skin = 0.4e-3;
     desc.capacity = NX * NY * NZ;
@@ -112,12 +112,12 @@ int main(int argc, char **argv) {
     if (res != FSDEM_OK) return fail(dem, "fsdem_dem_add_material", res);
 
     {
-        fsdem_wall_desc walls[5];
-        walls[0] = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(1, 0, 0), material);
-        walls[1] = fsdem_wall_plane(fsdem_v3(BOX_X, 0, 0), fsdem_v3(-1, 0, 0), material);
-        walls[2] = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 1, 0), material);
-        walls[3] = fsdem_wall_plane(fsdem_v3(0, BOX_Y, 0), fsdem_v3(0, -1, 0), material);
-        walls[4] = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), material);
+        fsdem_dem_wall_desc walls[5];
+        walls[0] = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(1, 0, 0), material);
+        walls[1] = fsdem_dem_wall_plane(fsdem_v3(BOX_X, 0, 0), fsdem_v3(-1, 0, 0), material);
+        walls[2] = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 1, 0), material);
+        walls[3] = fsdem_dem_wall_plane(fsdem_v3(0, BOX_Y, 0), fsdem_v3(0, -1, 0), material);
+        walls[4] = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), material);
         for (i = 0; i < 5; ++i) {
             res = fsdem_dem_add_wall(dem, &walls[i], NULL);
             if (res != FSDEM_OK) return fail(dem, "fsdem_dem_add_wall", res);
@@ -128,7 +128,7 @@ int main(int argc, char **argv) {
     for (k = 0; k < NZ; ++k)
         for (j = 0; j < NY; ++j)
             for (i = 0; i < NX; ++i) {
-                fsdem_particle_desc p = fsdem_particle_desc_default();
+                fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
                 double x = FIRST + i * SPACING + rng_uniform(&rng, -JITTER, JITTER);
                 double y = FIRST + j * SPACING + rng_uniform(&rng, -JITTER, JITTER);
                 double z = FIRST + k * SPACING + rng_uniform(&rng, -JITTER, JITTER);
@@ -151,7 +151,7 @@ int main(int argc, char **argv) {
         s += chunk;
         if (trace > 0) {
             loop_time += now_seconds() - t0;
-            energy = fsdem_dem_energy(dem);
+            energy = fsdem_dem_get_energy(dem);
             stats = fsdem_dem_get_stats(dem);
             printf("TRACE %ld %.9g %.9g %.9g %d\n", s, (double)energy.kinetic, (double)energy.rotational,
                    front_x(dem), stats.contacts);
@@ -161,13 +161,13 @@ int main(int argc, char **argv) {
     }
     loop_time += now_seconds() - t0;
 
-    energy = fsdem_dem_energy(dem);
+    energy = fsdem_dem_get_energy(dem);
     stats = fsdem_dem_get_stats(dem);
     getrusage(RUSAGE_SELF, &usage);
-    printf("BENCH dem_column particles=%d 1\n", fsdem_dem_particles(dem).count);
+    printf("BENCH dem_column particles=%d 1\n", fsdem_dem_get_particles(dem).count);
     printf("BENCH dem_column steps=%ld 1\n", steps);
     printf("BENCH dem_column particle_steps_per_s=%.4g 1/s\n",
-           loop_time > 0 ? (double)fsdem_dem_particles(dem).count * (double)steps / loop_time : 0.0);
+           loop_time > 0 ? (double)fsdem_dem_get_particles(dem).count * (double)steps / loop_time : 0.0);
     printf("BENCH dem_column wall_time=%.3f s\n", loop_time);
     printf("BENCH dem_column kinetic_energy=%.9g J\n", (double)energy.kinetic);
     printf("BENCH dem_column rotational_energy=%.9g J\n", (double)energy.rotational);

@@ -39,9 +39,9 @@ static double hertz_contact_time(const material *m, int two, double v_rel) {
 
 static void run_impact(impact *im, int two) {
     fsdem_dem_desc desc = fsdem_dem_desc_default(3);
-    fsdem_material mat = fsdem_material_default(), rigid;
-    fsdem_particle_desc p = fsdem_particle_desc_default();
-    fsdem_particles view;
+    fsdem_dem_material mat = fsdem_dem_material_default(), rigid;
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    fsdem_dem_particles view;
     fsdem_dem *dem = NULL;
     double R = im->m.R, d_prev = 0, t_prev = 0, t_end = -1;
     int sphere, plane_mat, step, after = 0;
@@ -49,7 +49,7 @@ static void run_impact(impact *im, int two) {
     im->f_max = im->d_max = 0;
     im->t_contact = NAN;
     desc.gravity = fsdem_v3(0, 0, 0); /* the benchmark has no gravity */
-    desc.law = FSDEM_CONTACT_HERTZ_MINDLIN;
+    desc.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
     desc.dt = im->dt;
     desc.domain_min = fsdem_v3(-1, -1, -1);
     desc.domain_max = fsdem_v3(1, 1, 1);
@@ -73,7 +73,7 @@ static void run_impact(impact *im, int two) {
         p.velocity = fsdem_v3(-im->vn, 0, 0);
         fsdem_dem_add_particle(dem, &p, NULL);
     } else { /* touching the plane at t = 0 */
-        fsdem_wall_desc floor = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), plane_mat);
+        fsdem_dem_wall_desc floor = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), plane_mat);
         if (fsdem_dem_add_wall(dem, &floor, NULL) != FSDEM_OK) { fsdem_dem_destroy(dem); return; }
         p.position = fsdem_v3(0, 0, R);
         p.velocity = fsdem_v3(im->vt, 0, -im->vn);
@@ -86,7 +86,7 @@ static void run_impact(impact *im, int two) {
             fsdem_dem_destroy(dem);
             return;
         }
-        view = fsdem_dem_particles(dem);
+        view = fsdem_dem_get_particles(dem);
         t = fsdem_dem_time(dem);
         if (two) d = 2 * R - (view.position[1].x - view.position[0].x);
         else d = R - view.position[0].z;
@@ -102,7 +102,7 @@ static void run_impact(impact *im, int two) {
         d_prev = d;
         t_prev = t;
     }
-    view = fsdem_dem_particles(dem);
+    view = fsdem_dem_get_particles(dem);
     im->v_after = view.velocity[0];
     im->w_after = view.angular_velocity[0];
     im->t_contact = t_end;

@@ -24,7 +24,7 @@ typedef struct result {
 } result;
 
 static void mass_centre(fsdem_dem *dem, double *x_ave, double *z_ave) {
-    fsdem_particles p = fsdem_dem_particles(dem);
+    fsdem_dem_particles p = fsdem_dem_get_particles(dem);
     double sx = 0, sz = 0;
     int i;
     for (i = 0; i < p.count; ++i) {
@@ -37,26 +37,26 @@ static void mass_centre(fsdem_dem *dem, double *x_ave, double *z_ave) {
 
 /* Particles whose centre is outside the tank (x in [0, tank], y in [0, tank]). */
 static int outside_tank(fsdem_dem *dem) {
-    fsdem_particles p = fsdem_dem_particles(dem);
+    fsdem_dem_particles p = fsdem_dem_get_particles(dem);
     int i, n = 0;
     for (i = 0; i < p.count; ++i)
         if (!(p.position[i].x > 0 && p.position[i].x < tank && p.position[i].y > 0 && p.position[i].y < tank)) n++;
     return n;
 }
 
-static int run(fsdem_contact_law law, const char *tag, result *res) {
+static int run(fsdem_dem_law law, const char *tag, result *res) {
     static const double snap[6] = {0, 0.1, 0.2, 0.3, 0.5, 1.0};
     fsdem_dem_desc desc = fsdem_dem_desc_default(2);
-    fsdem_material al = fsdem_material_default();
+    fsdem_dem_material al = fsdem_dem_material_default();
     fsdem_dem *dem;
     fsdem_csv mc, en;
-    fsdem_energy e;
+    fsdem_dem_energy e;
     double gap = 2 * dx, a = radius + gap, s = 2 * radius + gap, dt, pe0, e_min, rise = 0, max_overlap = 0, settled_overlap = 0;
     double e_total, ke;
     int mat, layer, k, outside = 0, next_snap = 0, every, failed = 0;
     long step, steps;
     char path[128], metric[128];
-    const char *suffix = law == FSDEM_CONTACT_LINEAR ? "" : "_hertz";
+    const char *suffix = law == FSDEM_DEM_LAW_LINEAR ? "" : "_hertz";
 
     desc.domain_min = fsdem_v3(-0.05, -0.05, -1);
     desc.domain_max = fsdem_v3(tank + 0.05, tank + 0.2, 1);
@@ -66,7 +66,7 @@ static int run(fsdem_contact_law law, const char *tag, result *res) {
     desc.linear_dx = dx;
     desc.disc_length = length;
     /* the seed's predictor-corrector (Eq. 21-24) for the seed's law; velocity Verlet for Hertz */
-    desc.integrator = law == FSDEM_CONTACT_LINEAR ? FSDEM_INTEGRATOR_PREDICTOR_CORRECTOR : FSDEM_INTEGRATOR_VERLET;
+    desc.integrator = law == FSDEM_DEM_LAW_LINEAR ? FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR : FSDEM_DEM_INTEGRATOR_VERLET;
     if (fsdem_dem_create(&desc, &dem) != FSDEM_OK) return -1;
     al.density = density;
     al.poisson_ratio = psi;
@@ -76,10 +76,10 @@ static int run(fsdem_contact_law law, const char *tag, result *res) {
     al.restitution = 0.5;
     fsdem_dem_add_material(dem, &al, &mat);
     {
-        fsdem_wall_desc w[3];
-        w[0] = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 1, 0), mat);     /* floor */
-        w[1] = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(1, 0, 0), mat);     /* left wall */
-        w[2] = fsdem_wall_plane(fsdem_v3(tank, 0, 0), fsdem_v3(-1, 0, 0), mat); /* right wall */
+        fsdem_dem_wall_desc w[3];
+        w[0] = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 1, 0), mat);     /* floor */
+        w[1] = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(1, 0, 0), mat);     /* left wall */
+        w[2] = fsdem_dem_wall_plane(fsdem_v3(tank, 0, 0), fsdem_v3(-1, 0, 0), mat); /* right wall */
         for (k = 0; k < 3; ++k) fsdem_dem_add_wall(dem, &w[k], NULL);
     }
     /* six layers, 6 and 5 alternately, the 5-layers in the grooves; neighbours 2r + 2dx apart so the
@@ -87,26 +87,26 @@ static int run(fsdem_contact_law law, const char *tag, result *res) {
     for (layer = 0; layer < 6; ++layer) {
         int count = layer % 2 ? 5 : 6;
         for (k = 0; k < count; ++k) {
-            fsdem_particle_desc p = fsdem_particle_desc_default();
+            fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
             p.radius = radius;
             p.material = mat;
             p.position = fsdem_v3(a + s * k + (layer % 2 ? s / 2 : 0), a + layer * s * sqrt(3.0) / 2, 0);
             if (fsdem_dem_add_particle(dem, &p, NULL) != FSDEM_OK) return -1;
         }
     }
-    if (law == FSDEM_CONTACT_LINEAR) fsdem_dem_dt_estimate(dem, FSDEM_DT_LINEAR_SEED000, gamma_dt, &dt);
-    else fsdem_dem_dt_estimate(dem, FSDEM_DT_RAYLEIGH, 0.2, &dt);
+    if (law == FSDEM_DEM_LAW_LINEAR) fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, gamma_dt, &dt);
+    else fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_RAYLEIGH, 0.2, &dt);
     fsdem_dem_set_dt(dem, dt);
     steps = (long)ceil(t_end / dt - 1e-9);
     every = (int)(1e-3 / dt + 0.5);
     if (every < 1) every = 1;
-    vc_info(CASE, "%s: %d cylinders, dt = %.4g s, %ld steps", tag, fsdem_dem_particles(dem).count, dt, steps);
+    vc_info(CASE, "%s: %d cylinders, dt = %.4g s, %ld steps", tag, fsdem_dem_get_particles(dem).count, dt, steps);
 
     snprintf(path, sizeof path, "mass_centre%s.csv", suffix);
     fsdem_csv_open(&mc, path, "t,x_ave,z_ave");
     snprintf(path, sizeof path, "energy%s.csv", suffix);
     fsdem_csv_open(&en, path, "t,kinetic,rotational,potential,elastic,total");
-    e = fsdem_dem_energy(dem);
+    e = fsdem_dem_get_energy(dem);
     pe0 = e.potential; /* from the floor: -m g.x with the floor at y = 0 */
     e_min = e.kinetic + e.rotational + e.potential + e.elastic;
     res->ke_peak = 0;
@@ -114,7 +114,7 @@ static int run(fsdem_contact_law law, const char *tag, result *res) {
     for (step = 0;; ++step) {
         double t = fsdem_dem_time(dem);
         fsdem_dem_stats st = fsdem_dem_get_stats(dem);
-        e = fsdem_dem_energy(dem);
+        e = fsdem_dem_get_energy(dem);
         e_total = e.kinetic + e.rotational + e.potential + e.elastic;
         ke = e.kinetic + e.rotational;
         if (e_total - e_min > rise) rise = e_total - e_min; /* rise above the lowest energy so far */
@@ -161,7 +161,7 @@ static int run(fsdem_contact_law law, const char *tag, result *res) {
     fsdem_csv_close(&mc);
     fsdem_csv_close(&en);
     {
-        fsdem_contact_info c[512];
+        fsdem_dem_contact c[512];
         int n = fsdem_dem_contacts(dem, c, 512);
         for (k = 0; k < n && k < 512; ++k)
             if (c[k].overlap > settled_overlap) settled_overlap = c[k].overlap;
@@ -205,7 +205,7 @@ int main(int argc, char **argv) {
     (void)argv;
     memset(&lin, 0, sizeof lin);
     memset(&hertz, 0, sizeof hertz);
-    run(FSDEM_CONTACT_LINEAR, "linear", &lin);
-    run(FSDEM_CONTACT_HERTZ_MINDLIN, "hertz", &hertz);
+    run(FSDEM_DEM_LAW_LINEAR, "linear", &lin);
+    run(FSDEM_DEM_LAW_HERTZ_MINDLIN, "hertz", &hertz);
     return vc_exit_code();
 }

@@ -23,7 +23,7 @@ static outcome run(int dim, double dx, double jitter, const char *tag) {
     fsdem_pic *s;
     fsdem_csv ts, pf;
     fsdem_pic_stats st;
-    fsdem_pic_grid gr;
+    fsdem_pic_fields gr;
     outcome o = {0, 0, 0, 0};
     double v0, ref = rho * g * depth;
     int up = dim - 1, i, j, k, c, steps = 0;
@@ -65,7 +65,7 @@ static outcome run(int dim, double dx, double jitter, const char *tag) {
         fsdem_csv_row(&ts, row, 5);
     }
     fsdem_csv_close(&ts);
-    gr = fsdem_pic_get_grid(s);
+    gr = fsdem_pic_get_fields(s);
     snprintf(path, sizeof path, "profile_%s.csv", tag);
     fsdem_csv_open(&pf, path, "y,p,p_ref");
     for (k = 0; k < gr.n[2]; ++k)

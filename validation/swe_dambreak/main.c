@@ -66,8 +66,8 @@ static int run_case(const dambreak *c) {
     d.x_min = x_min;
     d.x_max = x_max;
     d.gravity = c->g;
-    d.boundary[FSDEM_SWE_XMIN].type = FSDEM_SWE_BC_TRANSMISSIVE;
-    d.boundary[FSDEM_SWE_XMAX].type = FSDEM_SWE_BC_TRANSMISSIVE;
+    d.boundary[FSDEM_SIDE_XMIN].type = FSDEM_SWE_BC_TRANSMISSIVE;
+    d.boundary[FSDEM_SIDE_XMAX].type = FSDEM_SWE_BC_TRANSMISSIVE;
     for (i = 0; i < NX; ++i) h[i] = x_min + (i + 0.5) * dx < c->x0 ? c->hl : c->hr;
     d.depth = h;
     if (fsdem_swe_create(&d, &s) != FSDEM_OK || fsdem_swe_advance(s, c->t, &steps) != FSDEM_OK) {

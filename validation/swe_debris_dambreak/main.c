@@ -47,9 +47,9 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
     fsdem_swe_desc sd = fsdem_swe_desc_default(1);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     fsdem_swe_dem_desc cd = fsdem_swe_dem_desc_default();
-    fsdem_material wood = fsdem_material_default();
-    fsdem_particle_desc debris = fsdem_particle_desc_default();
-    fsdem_wall_desc bed;
+    fsdem_dem_material wood = fsdem_dem_material_default();
+    fsdem_dem_particle_desc debris = fsdem_dem_particle_desc_default();
+    fsdem_dem_wall_desc bed;
     fsdem_swe *swe;
     fsdem_dem *dem;
     fsdem_swe_dem *cpl;
@@ -70,14 +70,14 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
 
     dd.domain_min = fsdem_v3(0, -0.5, -0.5);
     dd.domain_max = fsdem_v3(length, 0.5, 1.5);
-    dd.law = FSDEM_CONTACT_HERTZ_MINDLIN;
+    dd.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
     if (fsdem_dem_create(&dd, &dem) != FSDEM_OK) return 2;
     wood.density = rho_s;
     wood.young_modulus = 1e8;
     wood.restitution = 0.5;
     wood.friction = 0.3;
     fsdem_dem_add_material(dem, &wood, &mat);
-    bed = fsdem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), mat); /* the flat flume bed */
+    bed = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), mat); /* the flat flume bed */
     fsdem_dem_add_wall(dem, &bed, NULL);
     /* resting on the bed when dry; floating at its draft when wet (cap volume = 0.6 sphere volume,
        s = 0.0456 m for r = 0.04, found by bisection below) */
@@ -95,7 +95,7 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
     debris.radius = r;
     debris.material = mat;
     fsdem_dem_add_particle(dem, &debris, NULL);
-    fsdem_dem_dt_estimate(dem, FSDEM_DT_RAYLEIGH, 0.2, &dt_dem);
+    fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_RAYLEIGH, 0.2, &dt_dem);
     fsdem_dem_set_dt(dem, dt_dem);
 
     cd.swe = swe;
@@ -114,7 +114,7 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
         double next_out = 0;
         while (t < t_end) {
             fsdem_swe_cell at_gate, at_back, a20, a25;
-            fsdem_particles p = fsdem_dem_particles(dem);
+            fsdem_dem_particles p = fsdem_dem_get_particles(dem);
             fsdem_real dt;
             fsdem_swe_sample(swe, x_gate, 0, &at_gate);
             fsdem_swe_sample(swe, x_debris - r, 0, &at_back);
@@ -153,7 +153,7 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
     vc_info(CASE, "%s (%s limiter): front at the debris t = %.3f s, debris moves from t = %.3f s (0.1 mm at %.3f s), "
                   "start delay %+.3f s, x(end) = %.3f m; exact gate depth %.4f m, front/shock speed %.3f m/s",
             name, limiter == FSDEM_SWE_LIMITER_MC ? "MC" : "minmod", t_front, t_move, t_visible, t_move - t_front,
-            (double)fsdem_dem_particles(dem).position[0].x, h_gate_exact, speed);
+            (double)fsdem_dem_get_particles(dem).position[0].x, h_gate_exact, speed);
     if (checked) {
         char metric[64];
         /* moving within the front's transit time over one cell, dx / speed */

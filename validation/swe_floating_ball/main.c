@@ -19,8 +19,8 @@ int main(void) {
     fsdem_dem *dem;
     fsdem_swe_dem *cpl;
     fsdem_swe_dem_desc cd = fsdem_swe_dem_desc_default();
-    fsdem_material wood = fsdem_material_default();
-    fsdem_particle_desc ball = fsdem_particle_desc_default();
+    fsdem_dem_material wood = fsdem_dem_material_default();
+    fsdem_dem_particle_desc ball = fsdem_dem_particle_desc_default();
     fsdem_csv csv;
     fsdem_real *depth, *vel;
     double t = 0, next_out = 0, err_x = 0, err_w = 0, err_a = 0;
@@ -30,10 +30,10 @@ int main(void) {
     sd.nx = 400;
     sd.x_min = 0;
     sd.x_max = length;
-    sd.boundary[FSDEM_SWE_XMIN].type = FSDEM_SWE_BC_DISCHARGE;
-    sd.boundary[FSDEM_SWE_XMIN].value = h0 * u0;
-    sd.boundary[FSDEM_SWE_XMAX].type = FSDEM_SWE_BC_STAGE;
-    sd.boundary[FSDEM_SWE_XMAX].value = h0;
+    sd.boundary[FSDEM_SIDE_XMIN].type = FSDEM_SWE_BC_DISCHARGE;
+    sd.boundary[FSDEM_SIDE_XMIN].value = h0 * u0;
+    sd.boundary[FSDEM_SIDE_XMAX].type = FSDEM_SWE_BC_STAGE;
+    sd.boundary[FSDEM_SIDE_XMAX].value = h0;
     depth = malloc(sizeof(fsdem_real) * 400);
     vel = malloc(sizeof(fsdem_real) * 400);
     for (k = 0; k < 400; ++k) {
@@ -63,7 +63,7 @@ int main(void) {
     if (fsdem_csv_open(&csv, "ball.csv", "t,x,w,a,x_exact,w_exact,a_exact") != FSDEM_OK) return 2;
 
     for (;;) {
-        fsdem_particles p = fsdem_dem_particles(dem);
+        fsdem_dem_particles p = fsdem_dem_get_particles(dem);
         fsdem_swe_dem_force f;
         fsdem_real dt;
         double x, w, a, den = beta * u0 * area * rho * t + m;
@@ -94,7 +94,7 @@ int main(void) {
     }
     fsdem_csv_close(&csv);
     vc_info(CASE, "ball at t = %.1f s: x = %.5f m, w = %.5f m/s (exact %.5f, %.5f)", t_end,
-            (double)fsdem_dem_particles(dem).position[0].x, (double)fsdem_dem_particles(dem).velocity[0].x,
+            (double)fsdem_dem_get_particles(dem).position[0].x, (double)fsdem_dem_get_particles(dem).velocity[0].x,
             beta * u0 * t_end - m / (area * rho) * log(area * rho * beta * u0 / m * t_end + 1) + s0,
             beta * u0 - beta * u0 * m / (beta * u0 * area * rho * t_end + m));
     /* The coupling holds the fluid force over each outer step, a first-order lag: the errors halve
