@@ -60,7 +60,7 @@ int main(void) {
                 return 1;
             }
         }
-    fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 150, &dt); /* Eq. 18, gamma = 150 */
+    fsdem_dem_stable_dt(dem, &dt); /* the linear law's rule: seed 000 Eq. 18, gamma = 150 */
     fsdem_dem_set_dt(dem, dt);
     steps = (long)ceil(t_end / dt);
     printf("cylinder collapse: %d cylinders, dt = %.3g s, %ld steps\n", fsdem_dem_get_particles(dem).count, (double)dt,

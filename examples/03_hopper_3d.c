@@ -81,7 +81,7 @@ int main(void) {
                     return 1;
                 }
             }
-    fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_RAYLEIGH, 0.2, &dt);
+    fsdem_dem_stable_dt(dem, &dt); /* Hertz: 0.2 x the Rayleigh time (seed 002 Eq. 38) */
     fsdem_dem_set_dt(dem, dt);
     steps = (long)(t_end / dt + 0.5);
     printf("hopper: %d spheres, 8 triangles, dt = %.3g s, %ld steps\n", fsdem_dem_get_particles(dem).count, (double)dt,

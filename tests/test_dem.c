@@ -643,7 +643,7 @@ END_TEST
    along the slope from the velocity change between t1 and t2, and the slip speed (contact-point
    speed along the slope) at t2 relative to the centre's speed. */
 static double incline_acceleration(fsdem_dem *dem, int mat, double theta, double *slip_ratio) {
-    const double r = 0.01, t1 = 0.1, t2 = 0.4, dt = fsdem_dem_dt(dem);
+    const double r = 0.01, t1 = 0.1, t2 = 0.4, dt = fsdem_dem_get_stats(dem).dt;
     fsdem_dem_particles p = fsdem_dem_get_particles(dem);
     const int dim = p.dim;
     fsdem_vec3 n, down, axis;
@@ -763,7 +763,7 @@ static double resting_overlap(fsdem_dem_law law, double linear_accel, double *ex
         const double k = m * accel / (d.linear_theta * d.linear_dx);
         *expected = m * G / k;
         /* seed 000 Eq. 18 with gamma = 150 gives ~150 steps per undamped period */
-        ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 150, &dt), FSDEM_OK);
+        ck_assert_int_eq(fsdem_dem_stable_dt(dem, &dt), FSDEM_OK); /* the law's rule: Eq. 18, gamma 150 */
         ck_assert_int_eq(fsdem_dem_set_dt(dem, dt), FSDEM_OK);
         /* damping zeta = alpha = 0.4, omega = sqrt(k/m) >= 313 rad/s: after 0.3 s the transient
            is below e^-37 */
@@ -1067,10 +1067,13 @@ START_TEST(invalid_walls_and_calls_are_rejected) {
     expect_usable(dem, mat);
     expect_error(dem, fsdem_dem_set_dt(dem, 0), FSDEM_ERR_INVALID_ARG, "dt must be > 0");
     expect_error(dem, fsdem_dem_set_dt(dem, -1e-5), FSDEM_ERR_INVALID_ARG, "dt must be > 0");
-    ck_assert(fsdem_dem_dt(dem) == d.dt);
+    ck_assert(fsdem_dem_get_stats(dem).dt == d.dt);
+    ck_assert(fsdem_dem_get_desc(dem).dt == d.dt);
     t0 = fsdem_dem_time(dem);
-    expect_error(dem, fsdem_dem_advance(dem, 0, NULL), FSDEM_ERR_INVALID_ARG, "dt_outer");
-    expect_error(dem, fsdem_dem_advance(dem, -1e-3, NULL), FSDEM_ERR_INVALID_ARG, "dt_outer");
+    expect_error(dem, fsdem_dem_advance(dem, 0, NULL), FSDEM_ERR_INVALID_ARG, "duration");
+    expect_error(dem, fsdem_dem_advance(dem, -1e-3, NULL), FSDEM_ERR_INVALID_ARG, "duration");
+    expect_error(dem, fsdem_dem_advance(dem, 1e9, NULL), FSDEM_ERR_INVALID_ARG, "FSDEM_DEM_MAX_SUBSTEPS");
+    expect_error(dem, fsdem_dem_step_dt(dem, -1), FSDEM_ERR_INVALID_ARG, "dt must be > 0");
     ck_assert(fsdem_dem_time(dem) == t0);
 
     /* indices */
@@ -1232,8 +1235,8 @@ static void advance_case(double dt, double dt_outer, int expected_k) {
     fsdem_dem *dem;
     fsdem_dem_particles p;
     fsdem_result res;
-    int mat, k = -1;
-    long long steps;
+    int mat;
+    long long steps, k = -1;
     double t0, m, force = 0.5, t, dt_after, v, x;
     d.gravity = fsdem_v3(0, 0, 0);
     d.dt = dt;
@@ -1249,16 +1252,16 @@ static void advance_case(double dt, double dt_outer, int expected_k) {
     res = fsdem_dem_advance(dem, dt_outer, &k);
     t = fsdem_dem_time(dem) - t0;
     steps = fsdem_dem_get_stats(dem).steps - steps;
-    dt_after = fsdem_dem_dt(dem);
+    dt_after = fsdem_dem_get_stats(dem).dt;
     p = fsdem_dem_get_particles(dem);
     v = p.velocity[0].x;
     x = p.position[0].x;
     /* destroyed before the checks, so a failure does not leak under CK_FORK=no (make valgrind) */
     fsdem_dem_destroy(dem);
-    REPORT("advance dt_outer = %g with dt = %g: K = %d (expected %d), %lld steps, time advanced %.17g", dt_outer, dt, k,
+    REPORT("advance dt_outer = %g with dt = %g: K = %lld (expected %d), %lld steps, time advanced %.17g", dt_outer, dt, k,
            expected_k, steps, t);
     ck_assert_int_eq(res, FSDEM_OK);
-    ck_assert_msg(k == expected_k, "dt_outer/dt = %g: K = %d, expected INT(%g) = %d", dt_outer / dt, k, dt_outer / dt,
+    ck_assert_msg(k == expected_k, "dt_outer/dt = %g: K = %lld, expected INT(%g) = %d", dt_outer / dt, k, dt_outer / dt,
                   expected_k);
     ck_assert_int_eq(steps, expected_k);
     /* K additions of dt_outer/K to the clock: exact up to K roundings of the sum */
@@ -1314,7 +1317,8 @@ START_TEST(advance_equals_steps) {
     fsdem_dem *a, *b;
     fsdem_dem_particles pa, pb;
     fsdem_vec3 ja, jb;
-    int box_a, box_b, i, k, n, contacts = 0;
+    int box_a, box_b, i, k, contacts = 0;
+    long long n;
     double dx = 0, dv = 0, dw = 0;
     a = shaken_box(&box_a);
     b = shaken_box(&box_b);
@@ -1332,7 +1336,7 @@ START_TEST(advance_equals_steps) {
     }
     ja = fsdem_dem_wall_impulse(a, box_a);
     jb = fsdem_dem_wall_impulse(b, box_b);
-    REPORT("advance vs steps: %d substeps, %d contact-steps; max |dx| %.2e m, |dv| %.2e m/s, |dw| %.2e rad/s, "
+    REPORT("advance vs steps: %lld substeps, %d contact-steps; max |dx| %.2e m, |dv| %.2e m/s, |dw| %.2e rad/s, "
            "wall impulse %.2e of %.2e N s",
            n, contacts, dx, dv, dw, vnorm(vsub(ja, jb)), vnorm(ja));
     ck_assert_int_eq(n, 600);
@@ -1374,70 +1378,73 @@ END_TEST
 
 /* ---- 9. time-step estimates ---------------------------------------------------------------------- */
 
+/* A DEM of desc `d` with one material (density, E, nu) and particles of the given radii; the
+   stable dt of its rule goes to *dt. */
+static fsdem_result rule_dt(fsdem_dem_desc d, const double *radii, const int *steel, int n, fsdem_real *dt) {
+    fsdem_dem *dem = dem_new(&d);
+    int m1 = add_plain_material(dem), m2 = add_material(dem, 7800, 2e11, 0.28, 1.0, 0.3, 0.4), i;
+    fsdem_result res;
+    for (i = 0; i < n; ++i)
+        add_particle(dem, fsdem_v3(-0.5 + 0.1 * i, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), radii[i],
+                     steel && steel[i] ? m2 : m1, 0);
+    res = fsdem_dem_stable_dt(dem, dt);
+    fsdem_dem_destroy(dem);
+    return res;
+}
+
 START_TEST(dt_estimates_follow_their_formulas) {
+    const double radii[4] = {0.01, 0.005, 0.02, 0.004};
+    const int steel[4] = {0, 0, 1, 1};
     fsdem_dem_desc d = fsdem_dem_desc_default(3);
-    fsdem_dem *dem;
-    fsdem_dem_particles p;
+    char msg[256];
     fsdem_real dt;
-    int m1, m2, i;
+    int i;
     double expected, best;
     /* seed 000 Eq. 18 with Eq. 10: (2 pi / gamma) sqrt(m_ij / k) = (2 pi / gamma) sqrt(theta dx / ||g||) */
     d.law = FSDEM_DEM_LAW_LINEAR;
     d.linear_theta = 0.01;
     d.linear_dx = 0.004;
-    dem = dem_new(&d);
-    m1 = add_plain_material(dem);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 150, &dt), FSDEM_ERR_NOT_FOUND);
-    add_particle(dem, fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.01, m1, 0);
-    add_particle(dem, fsdem_v3(0.5, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.02, m1, 0);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 150, &dt), FSDEM_OK);
+    ck_assert_int_eq(rule_dt(d, radii, NULL, 0, &dt), FSDEM_ERR_NOT_FOUND);
+    ck_assert_int_eq(rule_dt(d, radii, NULL, 2, &dt), FSDEM_OK); /* AUTO: Eq. 18 with gamma = 150 */
     expected = 2 * PI / 150 * sqrt(0.01 * 0.004 / G);
     REPORT("dt LINEAR_SEED000: %.10g, expected %.10g", (double)dt, expected);
     ck_assert(fabs(dt / expected - 1) < 1e-12); /* closed form: rounding only */
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 0, &dt), FSDEM_ERR_INVALID_ARG);
-    ck_assert_ptr_nonnull(strstr(fsdem_dem_last_error(dem), "gamma"));
-    fsdem_dem_destroy(dem);
     d.linear_accel = 4 * G; /* ||g|| of Eq. 10 set explicitly */
-    dem = dem_new(&d);
-    m1 = add_plain_material(dem);
-    add_particle(dem, fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.01, m1, 0);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, 100, &dt), FSDEM_OK);
+    d.dt_rule = FSDEM_DEM_DT_LINEAR_SEED000;
+    d.dt_param = 100;
+    ck_assert_int_eq(rule_dt(d, radii, NULL, 1, &dt), FSDEM_OK);
     expected = 2 * PI / 100 * sqrt(0.01 * 0.004 / (4 * G));
     ck_assert(fabs(dt / expected - 1) < 1e-12);
-    fsdem_dem_destroy(dem);
 
     /* Rayleigh (seed 002 Eq. 38 with the Thornton-Randall coefficient) and GIC (seed 004 Eq. 32),
        minimum over particles of two materials and several radii */
     d = fsdem_dem_desc_default(3);
-    dem = dem_new(&d);
-    m1 = add_plain_material(dem);
-    m2 = add_material(dem, 7800, 2e11, 0.28, 1.0, 0.3, 0.4);
-    add_particle(dem, fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.01, m1, 0);
-    add_particle(dem, fsdem_v3(0.5, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.005, m1, 0);
-    add_particle(dem, fsdem_v3(-0.5, 0, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.02, m2, 0);
-    add_particle(dem, fsdem_v3(0, 0.5, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0.004, m2, 0);
-    p = fsdem_dem_get_particles(dem);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_RAYLEIGH, 0.2, &dt), FSDEM_OK);
+    ck_assert_int_eq(rule_dt(d, radii, steel, 4, &dt), FSDEM_OK); /* AUTO for Hertz: Rayleigh x 0.2 */
     best = HUGE_VAL;
-    for (i = 0; i < p.count; ++i) {
-        const double rho = p.material[i] == m1 ? 2500 : 7800, e = p.material[i] == m1 ? 1e7 : 2e11,
-                     nu = p.material[i] == m1 ? 0.3 : 0.28;
-        const double t = PI * p.radius[i] * sqrt(2 * rho * (1 + nu) / e) / (0.1631 * nu + 0.8766);
+    for (i = 0; i < 4; ++i) {
+        const double rho = steel[i] ? 7800 : 2500, e = steel[i] ? 2e11 : 1e7, nu = steel[i] ? 0.28 : 0.3;
+        const double t = PI * radii[i] * sqrt(2 * rho * (1 + nu) / e) / (0.1631 * nu + 0.8766);
         if (t < best) best = t;
     }
     REPORT("dt RAYLEIGH(0.2): %.10g, expected %.10g", (double)dt, 0.2 * best);
     ck_assert(fabs(dt / (0.2 * best) - 1) < 1e-12);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_RAYLEIGH, 1.5, &dt), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_GIC, 0, &dt), FSDEM_OK);
+    d.dt_param = 1.5;
+    ck_assert_int_eq(fsdem_dem_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(msg, "dt_param"));
+    d.dt_rule = FSDEM_DEM_DT_LINEAR_SEED000;
+    d.dt_param = 0;
+    ck_assert_int_eq(fsdem_dem_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(msg, "linear law"));
+    d.dt_rule = FSDEM_DEM_DT_GIC;
+    ck_assert_int_eq(rule_dt(d, radii, steel, 4, &dt), FSDEM_OK);
     best = HUGE_VAL;
-    for (i = 0; i < p.count; ++i) {
-        const double e = p.material[i] == m1 ? 1e7 : 2e11;
-        const double t = 0.5 * sqrt(p.mass[i] / (e * p.radius[i]));
+    for (i = 0; i < 4; ++i) {
+        const double e = steel[i] ? 2e11 : 1e7, rho = steel[i] ? 7800 : 2500;
+        const double t = 0.5 * sqrt(rho * 4.0 / 3.0 * PI * pow(radii[i], 3) / (e * radii[i]));
         if (t < best) best = t;
     }
     REPORT("dt GIC: %.10g, expected %.10g", (double)dt, best);
     ck_assert(fabs(dt / best - 1) < 1e-12);
-    fsdem_dem_destroy(dem);
 }
 END_TEST
 

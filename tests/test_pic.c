@@ -462,17 +462,17 @@ END_TEST
    leaves the uniform flow U untouched: flux U H through every section, no vertical velocity. */
 START_TEST(coupler_faces_carry_solid_flux) {
     fsdem_pic *s;
-    fsdem_pic_coupling *cp;
+    fsdem_pic_coupling cp;
     fsdem_pic_fields g;
     double U = 0.5, H = 0.5;
     int k, i, j, col = 20;
     s = open_channel(U, H);
     ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(1.0, H, 0), fsdem_v3(U, 0, 0), NULL), FSDEM_OK);
-    cp = fsdem_pic_coupling_view(s);
-    ck_assert_int_eq(cp->face_count[0], (cp->n[0] + 1) * cp->n[1]);
-    for (j = 0; j < cp->n[1]; ++j) {
-        cp->open[0][j * (cp->n[0] + 1) + col] = 0;
-        cp->solid_velocity[0][j * (cp->n[0] + 1) + col] = (fsdem_real)U;
+    cp = fsdem_pic_get_coupling(s);
+    ck_assert_int_eq(cp.face_count[0], (cp.n[0] + 1) * cp.n[1]);
+    for (j = 0; j < cp.n[1]; ++j) {
+        cp.open[0][j * (cp.n[0] + 1) + col] = 0;
+        cp.solid_velocity[0][j * (cp.n[0] + 1) + col] = (fsdem_real)U;
     }
     for (k = 0; k < 5; ++k) ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
     g = fsdem_pic_get_fields(s);

@@ -65,6 +65,7 @@ static int run(fsdem_dem_law law, const char *tag, result *res) {
     desc.linear_theta = theta;
     desc.linear_dx = dx;
     desc.disc_length = length;
+    desc.dt_param = law == FSDEM_DEM_LAW_LINEAR ? gamma_dt : 0.2; /* Eq. 18 gamma; Rayleigh fraction */
     /* the seed's predictor-corrector (Eq. 21-24) for the seed's law; velocity Verlet for Hertz */
     desc.integrator = law == FSDEM_DEM_LAW_LINEAR ? FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR : FSDEM_DEM_INTEGRATOR_VERLET;
     if (fsdem_dem_create(&desc, &dem) != FSDEM_OK) return -1;
@@ -94,9 +95,12 @@ static int run(fsdem_dem_law law, const char *tag, result *res) {
             if (fsdem_dem_add_particle(dem, &p, NULL) != FSDEM_OK) return -1;
         }
     }
-    if (law == FSDEM_DEM_LAW_LINEAR) fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_LINEAR_SEED000, gamma_dt, &dt);
-    else fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_RAYLEIGH, 0.2, &dt);
-    fsdem_dem_set_dt(dem, dt);
+    {
+        fsdem_real stable;
+        fsdem_dem_stable_dt(dem, &stable);
+        dt = stable;
+    }
+    fsdem_dem_set_dt(dem, (fsdem_real)dt);
     steps = (long)ceil(t_end / dt - 1e-9);
     every = (int)(1e-3 / dt + 0.5);
     if (every < 1) every = 1;

@@ -65,7 +65,7 @@ static int run_case(const dambreak *c) {
     d.nx = NX;
     d.x_min = x_min;
     d.x_max = x_max;
-    d.gravity = c->g;
+    d.gravity = fsdem_v3(0, 0, (fsdem_real)-c->g);
     d.boundary[FSDEM_SIDE_XMIN].type = FSDEM_SWE_BC_TRANSMISSIVE;
     d.boundary[FSDEM_SIDE_XMAX].type = FSDEM_SWE_BC_TRANSMISSIVE;
     for (i = 0; i < NX; ++i) h[i] = x_min + (i + 0.5) * dx < c->x0 ? c->hl : c->hr;

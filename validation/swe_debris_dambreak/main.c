@@ -95,7 +95,7 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
     debris.radius = r;
     debris.material = mat;
     fsdem_dem_add_particle(dem, &debris, NULL);
-    fsdem_dem_dt_estimate(dem, FSDEM_DEM_DT_RAYLEIGH, 0.2, &dt_dem);
+    fsdem_dem_stable_dt(dem, &dt_dem); /* Hertz: 0.2 x the Rayleigh time */
     fsdem_dem_set_dt(dem, dt_dem);
 
     cd.swe = swe;
@@ -115,9 +115,8 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
         while (t < t_end) {
             fsdem_swe_cell at_gate, at_back, a20, a25;
             fsdem_dem_particles p = fsdem_dem_get_particles(dem);
-            fsdem_real dt;
-            fsdem_swe_sample(swe, x_gate, 0, &at_gate);
-            fsdem_swe_sample(swe, x_debris - r, 0, &at_back);
+            fsdem_swe_sample_state(swe, x_gate, 0, &at_gate);
+            fsdem_swe_sample_state(swe, x_debris - r, 0, &at_back);
             /* the front reaches the debris's back when the depth there first rises 1e-3 h_L above its
                initial value (the issue's front threshold, on a dry or a wet bed alike) */
             if (t_front < 0 && at_back.depth > hr + 1e-3 * hl) t_front = t;
@@ -133,19 +132,19 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
             }
             if (t >= next_out) {
                 fsdem_real g[6], d[4];
-                fsdem_swe_sample(swe, 20, 0, &a20);
-                fsdem_swe_sample(swe, 25, 0, &a25);
+                fsdem_swe_sample_state(swe, 20, 0, &a20);
+                fsdem_swe_sample_state(swe, 25, 0, &a25);
                 g[0] = t; g[1] = at_gate.depth; g[2] = h_gate_exact; g[3] = at_back.depth; g[4] = a20.depth; g[5] = a25.depth;
                 fsdem_csv_row(&gauges, g, 6);
                 d[0] = t; d[1] = p.position[0].x; d[2] = p.position[0].z; d[3] = p.velocity[0].x;
                 fsdem_csv_row(&track, d, 4);
                 next_out += 0.02;
             }
-            if (fsdem_swe_dem_step(cpl, 0, &dt, NULL) != FSDEM_OK) {
+            if (fsdem_swe_dem_step(cpl) != FSDEM_OK) {
                 printf("case %s: %s\n", name, fsdem_swe_dem_last_error(cpl));
                 return 2;
             }
-            t += dt;
+            t += fsdem_swe_dem_get_stats(cpl).dt;
         }
     }
     fsdem_csv_close(&gauges);

@@ -86,7 +86,9 @@ int main(void) {
             next_out += dt_out;
         }
         if (t >= t_end - 1e-12) break;
-        if (fsdem_swe_dem_step(cpl, fmin(dt_cap, t_end - t), &dt, NULL) != FSDEM_OK) {
+        fsdem_swe_dem_stable_dt(cpl, &dt);
+        dt = (fsdem_real)fmin(fmin((double)dt, dt_cap), t_end - t);
+        if (fsdem_swe_dem_step_dt(cpl, dt) != FSDEM_OK) {
             printf("step failed: %s\n", fsdem_swe_dem_last_error(cpl));
             return 2;
         }

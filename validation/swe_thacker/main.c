@@ -57,7 +57,7 @@ static int run(int n, int out, result *res) {
     d.nx = d.ny = n;
     d.x_min = d.y_min = 0;
     d.x_max = d.y_max = L;
-    d.gravity = G;
+    d.gravity = fsdem_v3(0, 0, (fsdem_real)-G);
     if (fsdem_swe_create(&d, &s) != FSDEM_OK || fsdem_swe_set_cells(s, initial, NULL) != FSDEM_OK) return 1;
     v0 = fsdem_swe_volume(s);
     res->hmin = 1e300;
