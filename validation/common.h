@@ -3,8 +3,11 @@
    vc_check*   print one `CHECK <case> <metric> value=<v> ref=<r> tol=<t> PASS|FAIL` line and count
                failures; vc_exit_code() is 1 when any check failed.
    vc_info     print an `INFO <case> ...` line (figures worth reporting that are not checks).
-   vc_table    a reference CSV from ../shared/refdata: `#` comment lines are skipped, the first other
+   vc_table    a reference CSV from validation/data: `#` comment lines are skipped, the first other
                line is the header, fields may be double-quoted (and then hold commas).
+   vc_data_dir the folder of the reference data: argv[1] when given, otherwise VC_DATA_DIR (the
+               Makefile defines it as the absolute path of validation/data; without it, the path of
+               validation/data seen from build/validation/<case>/, where `make validate` runs a case).
    vc_path     joins a directory and a file name. */
 #ifndef FSDEM_VALIDATION_COMMON_H
 #define FSDEM_VALIDATION_COMMON_H
@@ -43,6 +46,14 @@ static inline void vc_info(const char *case_name, const char *fmt, ...) {
 }
 
 static inline int vc_exit_code(void) { return vc_failures ? 1 : 0; }
+
+#ifndef VC_DATA_DIR
+#define VC_DATA_DIR "../../../validation/data"
+#endif
+
+static inline const char *vc_data_dir(int argc, char **argv) {
+    return argc > 1 && argv[1][0] ? argv[1] : VC_DATA_DIR;
+}
 
 static inline const char *vc_path(char *buf, size_t size, const char *dir, const char *file) {
     snprintf(buf, size, "%s/%s", dir, file);

@@ -1,9 +1,12 @@
 /* bench/swe2d: throughput of the shallow-water solver on the case that bench/gerris/swe2d.gfs runs in
    Gerris. Channel x in [-0.5, 7.5] m, y in [-0.5, 0.5] m, 1024 x 128 cells (dx = 7.8125 mm),
    reflective walls, flat frictionless bed, g = 9.81, dam at x = 3.5 m with h = 1 m upstream and a
-   dry bed downstream (Ritter), CFL 0.5, second order (MUSCL-Hancock, default minmod), to t = 0.5 s.
-   Then the same with the MC limiter (front accuracy), a 1D run on 10^6 cells, and a STREAM-like
-   copy for the machine's memory bandwidth. Prints BENCH lines only; never pass/fail.
+   dry bed downstream (Ritter), CFL 0.5, second order (MUSCL-Hancock) with the MC limiter, to t = 0.5 s.
+   MC is this benchmark's limiter because it is the one that meets the front accuracy (issue 9: the
+   front, the farthest cell with h > 1e-3 h_L, within 2 % of the travel 2 sqrt(g h_L) t of the exact
+   solution's own 1e-3 h_L contour); the same run with the library's default minmod limiter is
+   reported beside it. Then a 1D run on 10^6 cells, and a STREAM-like copy for the machine's memory
+   bandwidth. Prints BENCH lines only (the front lines say whether the 2 % bound is met); no exit status.
    One thread. */
 #define _POSIX_C_SOURCE 199309L
 #define FSDEM_IMPLEMENTATION
@@ -114,10 +117,12 @@ static void run_2d(const char *name, fsdem_swe_limiter limiter, double bandwidth
     printf("BENCH %s wall_time=%.3f s\n", name, t_wall);
     printf("BENCH %s front_1e-3=%.4f m (from the dam; farthest cell centre with h > 1e-3 h_L)\n", name, xf);
     printf("BENCH %s travel_2sqrt(ghL)t=%.4f m\n", name, travel);
-    printf("BENCH %s front_error_vs_travel=%.2f %% (of the travel)\n", name, 100 * (xf - travel) / travel);
-    printf("BENCH %s front_error_vs_exact_1e-3_contour=%.2f %% (exact contour at %.4f m: the exact solution itself "
-           "is %.2f %% behind 2 sqrt(g hL) t by this definition)\n",
-           name, 100 * (xf - x_thr) / travel, x_thr, 100 * (x_thr - travel) / travel);
+    printf("BENCH %s front_error_vs_travel=%.2f %% (of the travel; former literal figure, for information)\n", name,
+           100 * (xf - travel) / travel);
+    printf("BENCH %s front_error_vs_exact_1e-3_contour=%.2f %% of the travel (bound 2 %%: %s; exact contour at %.4f m: "
+           "the exact solution itself is %.2f %% behind 2 sqrt(g hL) t by this definition)\n",
+           name, 100 * (xf - x_thr) / travel, fabs(xf - x_thr) <= 0.02 * travel ? "met" : "not met", x_thr,
+           100 * (x_thr - travel) / travel);
     printf("BENCH %s front_error_5pct_contour=%.2f cells (exact contour at %.4f m)\n", name, (xf5 - x5) / dx, x5);
     printf("BENCH %s relative_volume_change=%.3g\n", name, (v1 - v0) / v0);
     if (bandwidth > 0) {
@@ -167,8 +172,8 @@ static void run_1d(double bandwidth) {
 int main(void) {
     double bw = stream_copy_bandwidth();
     printf("BENCH stream copy_bandwidth=%.3g GB/s\n", bw / 1e9);
-    run_2d("swe2d", FSDEM_SWE_LIMITER_MINMOD, bw, 3);
-    run_2d("swe2d_mc", FSDEM_SWE_LIMITER_MC, bw, 1);
+    run_2d("swe2d", FSDEM_SWE_LIMITER_MC, bw, 3);            /* the benchmark: MC limiter */
+    run_2d("swe2d_minmod", FSDEM_SWE_LIMITER_MINMOD, bw, 1); /* beside it: the library's default limiter */
     run_1d(bw);
     return 0;
 }

@@ -1,5 +1,6 @@
 /* Chung & Ooi (2011) DEM benchmark, tests 1-4, with the Hertz-Mindlin law of fsdem.h.
-   Usage: run REFDATA_DIR   (writes test1.csv .. test4.csv and ref_*.csv into the working directory)
+   Usage: run [DATA_DIR]   (validation/data by default; writes test1.csv .. test4.csv and ref_*.csv into
+   the working directory)
    See README.md next to this file for the physics, the references, the metrics and the tolerances. */
 #define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
@@ -354,7 +355,7 @@ static void test_4(const material *m, const vc_table *ref) {
 }
 
 int main(int argc, char **argv) {
-    const char *refdir = argc > 1 ? argv[1] : "../../../../shared/refdata";
+    const char *refdir = vc_data_dir(argc, argv);
     char path[1024];
     vc_table params, hertz, curves, oblique_ref;
     material t1[2], t2[2], t3[2], t4[2];

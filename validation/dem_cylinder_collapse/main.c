@@ -1,6 +1,6 @@
 /* Collapse of six layers of aluminium cylinders (seed 000 section 3.1, after Zhang et al. 2009), 2D,
    with the linear law of seed 000 (Table 1) and, as a second run, with Hertz-Mindlin.
-   Usage: run [REFDATA_DIR]   (no reference file is read: no digitised data exist, see README.md)
+   Usage: run [DATA_DIR]   (no reference file is read: no digitised data exist, see README.md)
    Writes mass_centre.csv, mass_centre_hertz.csv, energy.csv, energy_hertz.csv and particle snapshots
    particles_<t>.csv / particles_hertz_<t>.csv into the working directory. */
 #define FSDEM_IMPLEMENTATION
@@ -175,16 +175,17 @@ static int run(fsdem_dem_law law, const char *tag, result *res) {
     vc_check(CASE, metric, failed ? 0 : 1, 1, 0);
     snprintf(metric, sizeof metric, "%s_particles_outside_tank", tag);
     vc_check(CASE, metric, outside, 0, 0);
-    /* overlap of the imaginary boundaries: during impacts it must stay inside the gap (the real
-       surfaces never touch, seed 000 section 2.2.2); in the settled pile it is set by theta (Eq. 10:
-       one weight compresses a contact by theta dx), so it must stay below 10 theta dx */
+    /* overlap of the imaginary boundaries (issue 9, amended line): during the run it must stay below
+       the 2 dx gap (the real surfaces never touch, seed 000 section 2.2.2); in the settled pile it is
+       set by theta (Eq. 10: one weight compresses a contact by theta dx), so it must stay below
+       10 theta dx. Impacts exceed theta dx (README), so the former literal bound over the whole run,
+       10 theta dx, is printed as information only. */
     snprintf(metric, sizeof metric, "%s_max_overlap_m", tag);
     vc_check(CASE, metric, max_overlap, 0, gap);
-    /* the issue's literal bound over the whole run; impacts exceed it with the linear law (README) */
-    snprintf(metric, sizeof metric, "%s_max_overlap_theta_dx", tag);
-    vc_check(CASE, metric, max_overlap / (theta * dx), 0, 10);
     snprintf(metric, sizeof metric, "%s_settled_max_overlap_m", tag);
     vc_check(CASE, metric, settled_overlap, 0, 10 * theta * dx);
+    vc_info(CASE, "%s: former check max_overlap_theta_dx (largest overlap during the run in theta dx, tol 10): %.4g "
+                  "(information: impacts, not the static sag, set it)", tag, max_overlap / (theta * dx));
     snprintf(metric, sizeof metric, "%s_energy_rise_J", tag);
     vc_check(CASE, metric, rise, 0, 1e-3 * pe0);
     vc_info(CASE, "%s: largest overlap %.3g theta dx (%.3g of the gap) during the run, %.3g theta dx at t = %.2f s", tag,

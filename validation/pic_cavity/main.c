@@ -1,7 +1,8 @@
 /* Lid-driven cavity (Ghia, Ghia & Shin 1982) with the PIC solver: a completely filled unit box
    (free_surface = 0, pressure defined up to a constant), no-slip walls, lid u = 1 at y = 1.
-   Usage: run REFDATA_DIR [N]   (N cells per side for Re 100, default 128; N/2 for Re 400 and 1000)
-   Reads ghia1982_u_vertical_centerline.csv and ghia1982_v_horizontal_centerline.csv from REFDATA_DIR.
+   Usage: run [DATA_DIR [N]]   (N cells per side for Re 100, default 128; N/2 for Re 400 and 1000)
+   Reads ghia1982_u_vertical_centerline.csv and ghia1982_v_horizontal_centerline.csv from DATA_DIR
+   (validation/data by default).
    Writes centreline_Re<Re>.csv (y,u_sim,u_ref,x,v_sim,v_ref: u on x = 0.5, v on y = 0.5 at the table points)
    and history_Re<Re>.csv (kinetic energy, max errors) into the working directory. */
 #define FSDEM_IMPLEMENTATION
@@ -40,7 +41,7 @@ static int load(const char *dir, const char *file, const char *pos_col, const ch
 }
 
 /* Entries excluded from the error norms: the walls (the boundary values themselves) and the
-   misprint flagged in refdata README caveat 3 (Table II, Re = 400, x = 0.9063). */
+   misprint flagged in validation/data/README.md (Table II, Re = 400, x = 0.9063). */
 static int excluded(int v_table, int k, double pos) {
     if (pos <= 0 || pos >= 1) return 1;
     return v_table && k == 1 && fabs(pos - 0.9063) < 1e-6;
@@ -137,7 +138,7 @@ int main(int argc, char **argv) {
     int n = argc > 2 ? atoi(argv[2]) : 128, k;
     static const double t_end[3] = {10, 30, 40};
     static const int re[3] = {100, 400, 1000};
-    const char *dir = argc > 1 ? argv[1] : "../shared/refdata";
+    const char *dir = vc_data_dir(argc, argv);
     if (load(dir, "ghia1982_u_vertical_centerline.csv", "y", "u", &u) ||
         load(dir, "ghia1982_v_horizontal_centerline.csv", "x", "v", &v)) {
         vc_check(CASE, "reference_loaded", 0, 1, 0);

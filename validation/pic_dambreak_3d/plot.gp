@@ -6,11 +6,13 @@ set grid
 a = 0.05715
 g = 9.81
 set output 'front_3d.png'
-set title 'surge front, 3D against 2D (a/20)'
+set title 'surge front, 3D (a/20) against the experiments and the 2D run'
 set xlabel 'T = t sqrt(2g/a)'
-set ylabel 'Z = x_front / a'
+set ylabel 'Z = x_{front} / a'
 set key top left
 plot 'front_2d.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 3 title '2D', \
      'front_thin.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 2 dt 2 title '3D thin (a/4)', \
      'front_wide.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 2 dt 3 title '3D wide (a)', \
-     'ref_front.csv' using ($1*sqrt(2*g/a)):($2/a) with points pt 7 ps 1.2 title 'Martin and Moyce 1952'
+     'front_wide_shifted.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 2 dt 4 title '3D wide, best-fit delay dT', \
+     'ref_front.csv' using ($1*sqrt(2*g/a)):($2/a) with points pt 7 ps 1.2 lc rgb 'black' title 'Martin and Moyce 1952 (checked)', \
+     'ref_front_ko.csv' using ($1*sqrt(2*g/a)):($2/a) with points pt 6 ps 1.4 lc rgb '#cc0000' title 'Koshizuka and Oka 1996'

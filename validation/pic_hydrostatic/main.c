@@ -1,5 +1,5 @@
 /* Still water in a closed tank, 2D and 3D: hydrostatic pressure, spurious velocity, volume drift.
-   Usage: run [REFDATA_DIR]   (the reference is analytic: p = rho g (h - y); no file is read)
+   Usage: run [DATA_DIR]   (the reference is analytic: p = rho g (h - y); no file is read)
    Writes hydrostatic_2d.csv / hydrostatic_3d.csv (time series) and profile_2d.csv / profile_3d.csv
    (pressure of the middle column against rho g (h - y)) into the working directory. */
 #define FSDEM_IMPLEMENTATION

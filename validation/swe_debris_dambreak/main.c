@@ -17,7 +17,8 @@ static const int nx = 710; /* 5 cm cells */
 /* Exact depth at the gate (x = x0) of a dam break h_L | h_R, and the front (dry) or shock (wet)
    speed: Ritter for h_R = 0; Stoker otherwise, c_m the root of
    c^6 - 9 c_R^2 c^4 + 16 c_L c_R^2 c^3 - c_R^2 (c_R^2 + 8 c_L^2) c^2 + c_R^6 = 0 in (c_R, c_L)
-   (refdata README, caveat 5). The gate lies in the rarefaction (h = 4/9 h_L) when 2 c_L - 3 c_m > 0. */
+   (validation/data/README.md, "Ritter and Stoker"). The gate lies in the rarefaction (h = 4/9 h_L)
+   when 2 c_L - 3 c_m > 0. */
 static void dambreak_exact(double hl, double hr, double *h_gate, double *front_speed) {
     double cl = sqrt(G * hl), cr = sqrt(G * hr), lo = cr, hi = cl, cm, hm, um;
     int it;

@@ -8,7 +8,7 @@
    Parameters of the SWASHES 2D planar case: a = 1 m, h0 = 0.1 m, eta = 0.5 m, L = 4 m.
    Runs the default scheme on 100^2 and 200^2 cells for three periods; checks the L1 error of h after
    one and three periods on 200^2, and that it decreases under refinement.
-   Usage: run [REFDATA_DIR]   (the reference is analytic; writes thacker.csv and profile_T*.csv)
+   Usage: run [DATA_DIR]   (the reference is analytic; writes thacker.csv and profile_T*.csv)
    See README.md next to this file. */
 #define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
