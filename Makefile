@@ -8,30 +8,35 @@ CFLAGS  ?= -O2 -g
 STD     := -std=c99
 LDLIBS  := -lm
 BUILD   := build
-SHARED  ?= ../shared
+# reference data of the validation cases, shipped in the repository (validation/data/README.md)
+VALIDATION_DATA ?= validation/data
 
 CHECK_CFLAGS = $(shell pkg-config --cflags check 2>/dev/null)
 CHECK_LIBS   = $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -lsubunit -lrt -lpthread -lm)
 
 # one file per suite registered in tests/check_main.c
-TEST_SRC   := tests/test_core.c tests/test_dem.c tests/test_linalg.c tests/test_pic.c tests/test_swe.c tests/test_couple_swe.c tests/check_main.c tests/fsdem_impl.c
+TEST_SRC   := tests/test_core.c tests/test_dem.c tests/test_linalg.c tests/test_pic.c tests/test_swe.c tests/test_couple_swe.c \
+              tests/test_interface.c tests/check_main.c tests/fsdem_impl.c
 EXAMPLES   := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
 VALIDATION := $(patsubst validation/%/main.c,%,$(wildcard validation/*/main.c))
 BENCHES    := $(patsubst bench/%/main.c,%,$(wildcard bench/*/main.c))
 
-.PHONY: all help test check-deps compile-checks valgrind sanitize examples demo validate bench install clean
+.PHONY: all help test check-deps gnuplot-deps compile-checks valgrind sanitize examples demo validate bench install clean
 
 all: $(BUILD)/check_fsdem examples
 
 help:
 	@echo "make test       Check suite (installs Check with apt-get when missing and run as root)"
+	@echo "make test-float the Check suite with fsdem_real = float (-DFSDEM_USE_FLOAT)"
 	@echo "make valgrind   the suite under Valgrind (no errors, no leaks)"
 	@echo "make sanitize   the suite with AddressSanitizer and UndefinedBehaviorSanitizer"
 	@echo "make demo       the headline example (cylinder-layer collapse) in under a minute"
 	@echo "make examples   all examples"
-	@echo "make validate   every validation case; report in build/validation/REPORT.md"
+	@echo "make validate   every validation case; report and plots in build/validation/REPORT.md"
+	@echo "                 (installs gnuplot-nox with apt-get when missing and run as root)"
 	@echo "make bench      throughput benchmarks (BENCH lines); BENCH_FLAGS=-march=native for this CPU"
-	@echo "make install    copy fsdem.h to PREFIX/include (PREFIX=/usr/local)"
+	@echo "make install    fsdem.h, pkg-config file, CMake package to PREFIX (/usr/local); DESTDIR stages"
+	@echo "make install-check  install to a temporary prefix, build via pkg-config and CMake, run"
 
 $(BUILD):
 	@mkdir -p $(BUILD)/examples $(BUILD)/validation $(BUILD)/bench
@@ -63,6 +68,14 @@ compile-checks: | $(BUILD)
 test: compile-checks $(BUILD)/check_fsdem
 	$(BUILD)/check_fsdem
 
+# The same suite with fsdem_real = float; its tolerances follow the precision (tests/fsdem_tests.h).
+.PHONY: test-float
+$(BUILD)/check_fsdem_float: $(TEST_SRC) tests/fsdem_tests.h fsdem.h | $(BUILD) check-deps
+	$(CC) $(STD) $(WARN) $(CFLAGS) -DFSDEM_USE_FLOAT $(CHECK_CFLAGS) -I. $(TEST_SRC) -o $@ $(CHECK_LIBS) $(LDLIBS)
+
+test-float: $(BUILD)/check_fsdem_float
+	$(BUILD)/check_fsdem_float
+
 valgrind: $(BUILD)/check_fsdem
 	CK_FORK=no valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=all -q $(BUILD)/check_fsdem
 
@@ -80,15 +93,28 @@ examples: $(EXAMPLES)
 demo: $(BUILD)/examples/01_cylinder_collapse
 	cd $(BUILD)/examples && ./01_cylinder_collapse
 
-$(BUILD)/validation/%/run: validation/%/main.c fsdem.h | $(BUILD)
+# gnuplot draws the validation plots. Install it when we can, otherwise say exactly how; the cases
+# still run without it and validation/report.sh says that the plots were not drawn.
+gnuplot-deps:
+	@if ! command -v gnuplot >/dev/null 2>&1; then \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	    echo "installing gnuplot: apt-get install -y gnuplot-nox"; \
+	    (apt-get install -y gnuplot-nox >/dev/null 2>&1 || (apt-get update >/dev/null && apt-get install -y gnuplot-nox >/dev/null)) \
+	      || echo "could not install gnuplot; the report will have no plots; run: sudo apt-get install -y gnuplot-nox"; \
+	  else echo "gnuplot is missing; the report will have no plots; run: sudo apt-get install -y gnuplot-nox"; fi; \
+	fi
+
+# The cases read their reference data from VALIDATION_DATA (passed as the first argument; compiled in
+# as the default, so build/validation/<case>/run works on its own).
+$(BUILD)/validation/%/run: validation/%/main.c validation/common.h validation/pic_dambreak.h fsdem.h | $(BUILD)
 	@mkdir -p $(dir $@)
-	$(CC) $(STD) $(WARN) -O2 -I. -Ivalidation $< -o $@ $(LDLIBS)
+	$(CC) $(STD) $(WARN) -O2 -I. -Ivalidation -DVC_DATA_DIR='"$(abspath $(VALIDATION_DATA))"' $< -o $@ $(LDLIBS)
 
 validate: SHELL := /bin/bash
-validate: $(foreach v,$(VALIDATION),$(BUILD)/validation/$(v)/run)
+validate: $(foreach v,$(VALIDATION),$(BUILD)/validation/$(v)/run) | gnuplot-deps
 	@status=0; for v in $(VALIDATION); do \
 	  echo "== validation/$$v"; \
-	  (cd $(BUILD)/validation/$$v && ./run $(abspath $(SHARED))/refdata) | tee $(BUILD)/validation/$$v/checks.txt; \
+	  (cd $(BUILD)/validation/$$v && ./run $(abspath $(VALIDATION_DATA))) | tee $(BUILD)/validation/$$v/checks.txt; \
 	  [ $${PIPESTATUS[0]} -eq 0 ] || status=1; \
 	done; sh validation/report.sh $(BUILD)/validation; exit $$status
 
@@ -102,10 +128,40 @@ $(BUILD)/bench/%: bench/%/main.c fsdem.h | $(BUILD)
 bench: $(foreach b,$(BENCHES),$(BUILD)/bench/$(b))
 	@for b in $(BENCHES); do echo "== bench/$$b"; (cd $(BUILD)/bench && ./$$b) || exit 1; done
 
-PREFIX ?= /usr/local
+# ---- install and packaging ----
+# `make install [PREFIX=/usr/local] [DESTDIR=stage]` installs the header, a pkg-config file and a
+# CMake package (INTERFACE target fsdem::fsdem) from packaging/*.in, with the version taken from
+# FSDEM_VERSION_STRING in fsdem.h when installing. The files name the final PREFIX (not DESTDIR).
+# `make install-check` installs into a temporary prefix and builds and runs a program through
+# pkg-config and through find_package (packaging/install-check.sh).
+PREFIX       ?= /usr/local
+INCLUDEDIR   ?= $(PREFIX)/include
+LIBDIR       ?= $(PREFIX)/lib
+PKGCONFIGDIR ?= $(LIBDIR)/pkgconfig
+CMAKEDIR     ?= $(LIBDIR)/cmake/fsdem
+FSDEM_VERSION = $(shell sed -n 's/^\#define FSDEM_VERSION_STRING "\(.*\)"$$/\1/p' fsdem.h)
+PKG_SUBST     = sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@VERSION@|$(FSDEM_VERSION)|g' \
+                    -e 's|@INCLUDEDIR@|$(patsubst $(PREFIX)/%,$${prefix}/%,$(INCLUDEDIR))|g'
+CMAKE_SUBST   = sed -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|g' -e 's|@VERSION@|$(FSDEM_VERSION)|g'
+
+.PHONY: install-check uninstall
 install:
-	install -d $(DESTDIR)$(PREFIX)/include
-	install -m 644 fsdem.h $(DESTDIR)$(PREFIX)/include/fsdem.h
+	@test -n "$(FSDEM_VERSION)" || { echo "install: no FSDEM_VERSION_STRING in fsdem.h"; exit 1; }
+	install -d "$(DESTDIR)$(INCLUDEDIR)" "$(DESTDIR)$(PKGCONFIGDIR)" "$(DESTDIR)$(CMAKEDIR)"
+	install -m 644 fsdem.h "$(DESTDIR)$(INCLUDEDIR)/fsdem.h"
+	$(PKG_SUBST) packaging/fsdem.pc.in > "$(DESTDIR)$(PKGCONFIGDIR)/fsdem.pc"
+	$(CMAKE_SUBST) packaging/fsdemConfig.cmake.in > "$(DESTDIR)$(CMAKEDIR)/fsdemConfig.cmake"
+	$(CMAKE_SUBST) packaging/fsdemConfigVersion.cmake.in > "$(DESTDIR)$(CMAKEDIR)/fsdemConfigVersion.cmake"
+	chmod 644 "$(DESTDIR)$(PKGCONFIGDIR)/fsdem.pc" "$(DESTDIR)$(CMAKEDIR)/fsdemConfig.cmake" \
+	  "$(DESTDIR)$(CMAKEDIR)/fsdemConfigVersion.cmake"
+
+uninstall:
+	rm -f "$(DESTDIR)$(INCLUDEDIR)/fsdem.h" "$(DESTDIR)$(PKGCONFIGDIR)/fsdem.pc" \
+	  "$(DESTDIR)$(CMAKEDIR)/fsdemConfig.cmake" "$(DESTDIR)$(CMAKEDIR)/fsdemConfigVersion.cmake"
+	-rmdir "$(DESTDIR)$(CMAKEDIR)" 2>/dev/null
+
+install-check:
+	MAKE="$(MAKE)" CC="$(CC)" sh packaging/install-check.sh
 
 clean:
 	rm -rf $(BUILD)
