@@ -1508,6 +1508,10 @@ FSDEM_API fsdem_result fsdem_dem_write_vtk(const fsdem_dem *dem, const char *pat
 
 /* ===== >>impl_core : results, allocator, messages, vector algebra ================================== */
 
+/* Contents: results and messages, the allocator and growth, the per-step scratch arena, the status
+   every object keeps, finite-value checks, 3-vector algebra, and >>core_lane (short vectors for the
+   batched kernels). */
+
 #define FSDEM__PI 3.14159265358979323846
 #define FSDEM__MESSAGE_SIZE 512
 
@@ -1963,6 +1967,9 @@ static void fsdem__kernel_weights(fsdem__kernel *k, int dim, const fsdem_real s[
 
 /* ===== >>impl_grid : cell grid ===================================================================== */
 
+/* Contents: setup (cell size enlarged to bound the cell count), binning by counting sort, cell
+   lookup, the 3^dim neighbourhood and the half (forward) neighbourhood. */
+
 fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *g, const fsdem_allocator *allocator, int dim,
                                   fsdem_vec3 lo, fsdem_vec3 hi, fsdem_real cell_size, int max_cells) {
     double extent[3], cells = 1;
@@ -2095,6 +2102,13 @@ void fsdem_cellgrid_free(fsdem_cellgrid *g) {
 }
 
 /* ===== >>impl_dem : discrete element method ======================================================== */
+
+/* Contents: the object and its private types; >>dem_desc (defaults, validation, the time-step
+   rule), >>dem_law (contact laws: pair constants, the batched law kernel, rolling resistance),
+   >>dem_object (creation, materials, particles), >>dem_wall (wall geometry and distances),
+   >>dem_neighbours (neighbour lists with contact history), >>dem_forces (force evaluation),
+   >>dem_integrate (Verlet, predictor-corrector, advance), >>dem_diagnostics (stable dt, energy,
+   statistics, contacts). */
 
 /* Constants of one material pair, computed when a material is added. */
 typedef struct fsdem__dem_pair {
@@ -2860,8 +2874,10 @@ const char *fsdem_dem_last_error(const fsdem_dem *d) { return d ? d->status.mess
 
 fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_dem_material *mat, int *index) {
     char msg[FSDEM__MESSAGE_SIZE];
-    int nm = d->material_count + 1, a, b;
+    int nm, a, b;
     fsdem__dem_pair *pairs;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    nm = d->material_count + 1;
     if (fsdem__dem_material_check(mat, msg, sizeof msg) != FSDEM_OK)
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "%s", msg);
     if (fsdem__grow(&d->allocator, (void **)&d->materials, &d->material_capacity, d->material_count, nm,
@@ -2921,9 +2937,11 @@ static void fsdem__dem_planar(const fsdem_dem *d, fsdem_vec3 *x, fsdem_vec3 *v, 
 
 fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_dem_particle_desc *p, int *index) {
     fsdem_result res;
-    int i = d->n;
+    int i;
     fsdem_real volume, inertia_factor, rho;
     fsdem_vec3 x, v, w;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    i = d->n;
     if (!p) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_add_particle: desc is NULL");
     if (!(p->radius > 0) || !fsdem__finite(p->radius))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_particle_desc.radius must be > 0 (got %g m)",
@@ -2972,6 +2990,7 @@ fsdem_result fsdem_dem_remove_particle(fsdem_dem *d, int index) {
     void **ptr[FSDEM__DEM_PARTICLE_ARRAYS];
     size_t size[FSDEM__DEM_PARTICLE_ARRAYS];
     int k;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
     if (index < 0 || index >= d->n)
         return fsdem__fail(&d->status, FSDEM_ERR_NOT_FOUND, "fsdem_dem_remove_particle: index %d not in [0, %d)", index,
                            d->n);
@@ -2989,6 +3008,7 @@ fsdem_result fsdem_dem_remove_particle(fsdem_dem *d, int index) {
 
 fsdem_result fsdem_dem_set_particle_state(fsdem_dem *d, int index, fsdem_vec3 x, fsdem_vec3 v, fsdem_vec3 w) {
     fsdem_result res;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
     if (index < 0 || index >= d->n)
         return fsdem__fail(&d->status, FSDEM_ERR_NOT_FOUND, "fsdem_dem_set_particle_state: index %d not in [0, %d)",
                            index, d->n);
@@ -3005,6 +3025,8 @@ fsdem_result fsdem_dem_set_particle_state(fsdem_dem *d, int index, fsdem_vec3 x,
 
 fsdem_dem_particles fsdem_dem_get_particles(const fsdem_dem *d) {
     fsdem_dem_particles p;
+    memset(&p, 0, sizeof p);
+    if (!d) return p;
     p.count = d->n;
     p.dim = d->desc.dim;
     p.id = d->id;
@@ -3024,6 +3046,8 @@ fsdem_dem_particles fsdem_dem_get_particles(const fsdem_dem *d) {
 
 fsdem_dem_coupling fsdem_dem_get_coupling(fsdem_dem *d) {
     fsdem_dem_coupling e;
+    memset(&e, 0, sizeof e);
+    if (!d) return e;
     e.count = d->n;
     e.force = d->fext;
     e.torque = d->text;
@@ -3121,6 +3145,7 @@ fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_dem_wall_desc *desc, i
     fsdem_dem_wall_desc g;
     fsdem__dem_wall *w;
     int axis;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
     if (!desc) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_add_wall: desc is NULL");
     g = *desc;
     if (g.material < 0 || g.material >= d->material_count)
@@ -3191,8 +3216,8 @@ static fsdem__dem_wall *fsdem__dem_wall_by_id(fsdem_dem *d, int id, const char *
 }
 
 fsdem_result fsdem_dem_remove_wall(fsdem_dem *d, int id) {
-    fsdem__dem_wall *w = fsdem__dem_wall_by_id(d, id, "fsdem_dem_remove_wall");
-    if (!w) return FSDEM_ERR_NOT_FOUND;
+    fsdem__dem_wall *w = d ? fsdem__dem_wall_by_id(d, id, "fsdem_dem_remove_wall") : NULL;
+    if (!w) return d ? FSDEM_ERR_NOT_FOUND : FSDEM_ERR_INVALID_ARG;
     w->active = 0;
     w->force = fsdem__zero3();
     d->need_rebuild = 1;
@@ -3201,8 +3226,8 @@ fsdem_result fsdem_dem_remove_wall(fsdem_dem *d, int id) {
 }
 
 fsdem_result fsdem_dem_set_wall_velocity(fsdem_dem *d, int id, fsdem_vec3 velocity) {
-    fsdem__dem_wall *w = fsdem__dem_wall_by_id(d, id, "fsdem_dem_set_wall_velocity");
-    if (!w) return FSDEM_ERR_NOT_FOUND;
+    fsdem__dem_wall *w = d ? fsdem__dem_wall_by_id(d, id, "fsdem_dem_set_wall_velocity") : NULL;
+    if (!w) return d ? FSDEM_ERR_NOT_FOUND : FSDEM_ERR_INVALID_ARG;
     if (!fsdem__finite3(velocity))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_set_wall_velocity: velocity must be finite");
     if (w->d.type == FSDEM_DEM_WALL_SDF && fsdem__norm(velocity) > 0)
@@ -3213,8 +3238,8 @@ fsdem_result fsdem_dem_set_wall_velocity(fsdem_dem *d, int id, fsdem_vec3 veloci
 }
 
 fsdem_result fsdem_dem_wall_moved(fsdem_dem *d, int id, fsdem_real distance) {
-    fsdem__dem_wall *w = fsdem__dem_wall_by_id(d, id, "fsdem_dem_wall_moved");
-    if (!w) return FSDEM_ERR_NOT_FOUND;
+    fsdem__dem_wall *w = d ? fsdem__dem_wall_by_id(d, id, "fsdem_dem_wall_moved") : NULL;
+    if (!w) return d ? FSDEM_ERR_NOT_FOUND : FSDEM_ERR_INVALID_ARG;
     if (!(distance >= 0) || !fsdem__finite(distance))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_moved: distance must be >= 0 (got %g m)",
                            (double)distance);
@@ -3223,11 +3248,11 @@ fsdem_result fsdem_dem_wall_moved(fsdem_dem *d, int id, fsdem_real distance) {
 }
 
 fsdem_vec3 fsdem_dem_wall_force(const fsdem_dem *d, int id) {
-    return id >= 0 && id < d->wall_count ? d->walls[id].force : fsdem__zero3();
+    return d && id >= 0 && id < d->wall_count ? d->walls[id].force : fsdem__zero3();
 }
 
 fsdem_vec3 fsdem_dem_wall_impulse(const fsdem_dem *d, int id) {
-    return id >= 0 && id < d->wall_count ? d->walls[id].impulse : fsdem__zero3();
+    return d && id >= 0 && id < d->wall_count ? d->walls[id].impulse : fsdem__zero3();
 }
 
 /* ---- >>dem_neighbours : neighbour lists with contact history ---- */
@@ -4062,9 +4087,10 @@ static fsdem_real fsdem__dem_contact_energy(const fsdem_dem *d, const fsdem__dem
 
 fsdem_dem_energy fsdem_dem_get_energy(const fsdem_dem *d) {
     fsdem_dem_energy e;
-    const int nm = d->material_count;
-    int i, k, nh;
+    int i, k, nh, nm;
     memset(&e, 0, sizeof e);
+    if (!d) return e;
+    nm = d->material_count;
     for (i = 0; i < d->n; ++i) {
         fsdem_real iner = d->inv_i[i] > 0 ? 1 / d->inv_i[i] : 0;
         if (d->fixed[i]) continue;
@@ -4150,6 +4176,7 @@ static int fsdem__dem_report_pair(const fsdem_dem *d, fsdem_dem_contact *out, in
 
 int fsdem_dem_contacts(fsdem_dem *d, fsdem_dem_contact *out, int capacity) {
     int i, k, nh, count = 0;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
     if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     for (k = 0; k < d->inert_count; ++k) {
         const int a = d->inert[2 * k], b = d->inert[2 * k + 1];
@@ -4167,6 +4194,11 @@ int fsdem_dem_contacts(fsdem_dem *d, fsdem_dem_contact *out, int capacity) {
 }
 
 /* ===== >>impl_linalg : sparse operators and preconditioned conjugate gradients ===== */
+
+/* Contents: the padded layout and multigrid notes below; >>linalg_check (operator validation),
+   >>linalg_object (creation, memory), >>linalg_grid (padded MAC-grid levels), >>linalg_kernels
+   (stencil kernels), >>linalg_mg (V-cycle), >>linalg_ic (incomplete Cholesky), >>linalg_setup
+   (setup for stencils and CSR), >>linalg_solve (preconditioned conjugate gradients). */
 
 /* Layout. A stencil is solved on padded arrays: one ghost cell on each side of every axis (none
    along z in 2D), so the kernels need no bounds tests. Cell (i, j, k) sits at
@@ -5766,6 +5798,13 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
 
 /* ===== >>impl_pic : PIC/FLIP solver ===== */
 
+/* Contents: >>pic_types (the object), >>pic_desc (defaults, validation, creation), >>pic_geometry
+   (obstacles, cut-cell face fractions), >>pic_particles (storage, seeding), >>pic_transfer (P2G,
+   G2P), >>pic_cells (effective faces, fluid fraction, level set, cell types), >>pic_extrapolate,
+   >>pic_viscosity, >>pic_projection (pressure and density projection), >>pic_advection,
+   >>pic_reseed, >>pic_step (time stepping), >>pic_views (fields, coupling, sampling, statistics),
+   >>pic_output. */
+
 #include <time.h>
 
 /* ---- >>pic_types : the solver object ---- */
@@ -6384,7 +6423,10 @@ static fsdem_vec3 fsdem__pic_obst_normal(const fsdem_pic *s, fsdem_vec3 p) {
 }
 
 fsdem_real fsdem_pic_solid_distance(const fsdem_pic *s, fsdem_vec3 p, fsdem_vec3 *normal) {
-    fsdem_real d = fsdem__pic_solid_sdf(s, p);
+    fsdem_real d;
+    if (normal) *normal = fsdem__zero3();
+    if (!s) return 0;
+    d = fsdem__pic_solid_sdf(s, p);
     if (normal) {
         fsdem_real h = s->dx * (fsdem_real)1e-3, g[3] = {0, 0, 0}, len;
         int b;
@@ -7001,6 +7043,8 @@ fsdem_result fsdem_pic_add_particles(fsdem_pic *s, const fsdem_vec3 *x, const fs
 
 fsdem_pic_particles fsdem_pic_get_particles(fsdem_pic *s) {
     fsdem_pic_particles v;
+    memset(&v, 0, sizeof v);
+    if (!s) return v;
     v.count = s->np;
     v.dim = s->dim;
     v.volume = s->pvol;
@@ -8140,6 +8184,7 @@ fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *s) {
     fsdem_pic_fields g;
     int a;
     memset(&g, 0, sizeof g);
+    if (!s) return g;
     g.dim = s->dim;
     for (a = 0; a < 3; ++a) {
         g.n[a] = s->n[a];
@@ -8295,8 +8340,10 @@ fsdem_result fsdem_pic_clear_forces(fsdem_pic *s) {
 fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *s) {
     fsdem_pic_stats st;
     int c, p, a;
-    double vol = 0, ke = 0, cellv = pow((double)s->dx, (double)s->dim);
+    double vol = 0, ke = 0, cellv;
     memset(&st, 0, sizeof st);
+    if (!s) return st;
+    cellv = pow((double)s->dx, (double)s->dim);
     for (c = 0; c < s->ncell; ++c) {
         double f;
         if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID) continue;
@@ -8428,6 +8475,11 @@ fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *s, const char *path) {
 }
 
 /* ===== >>impl_swe : shallow-water solver ========================================================== */
+
+/* Contents: the scheme below and the object; >>swe_desc (defaults, validation), >>swe_object
+   (creation, series, state, coupling), >>swe_riemann (face fluxes), >>swe_row (reconstruction,
+   predictor and x faces of a row), >>swe_step (y faces, repair, stable dt, stepping), >>swe_diag
+   (diagnostics, output, gauges, bed SDF). */
 
 /* Scheme (one step of dt, >>swe_step):
      1. MUSCL reconstruction of eta, h, u, v per cell with the limiter (slopes per cell width); z_b at
@@ -8859,6 +8911,8 @@ const char *fsdem_swe_last_error(const fsdem_swe *s) { return s ? s->status.mess
 
 fsdem_swe_grid fsdem_swe_get_grid(const fsdem_swe *s) {
     fsdem_swe_grid g;
+    memset(&g, 0, sizeof g);
+    if (!s) return g;
     g.dim = s->dim;
     g.nx = s->nx;
     g.ny = s->ny;
@@ -8874,6 +8928,7 @@ fsdem_swe_grid fsdem_swe_get_grid(const fsdem_swe *s) {
 static fsdem_result fsdem__swe_array_check(fsdem_swe *s, const fsdem_real *a, int non_negative, const char *what,
                                            const char *unit) {
     int k;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!a) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: array is NULL", what);
     k = fsdem__swe_first_bad(a, s->n, non_negative);
     if (k >= 0)
@@ -8938,6 +8993,7 @@ static void fsdem__swe_centre(const fsdem_swe *s, int k, fsdem_real *x, fsdem_re
 
 fsdem_result fsdem_swe_set_cells(fsdem_swe *s, fsdem_swe_init_fn fn, void *user) {
     int k, pass;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!fn) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_set_cells: fn is NULL");
     /* pass 0 validates everything, pass 1 writes, so a bad cell leaves the state unchanged */
     for (pass = 0; pass < 2; ++pass)
@@ -9018,8 +9074,11 @@ fsdem_result fsdem_swe_copy_field(const fsdem_swe *s, fsdem_swe_field field, fsd
 }
 
 int fsdem_swe_cell_at(const fsdem_swe *s, fsdem_real x, fsdem_real y) {
-    fsdem_real fx = (x - s->desc.x_min) / s->dx, fy = s->dim == 2 ? (y - s->desc.y_min) / s->dy : 0;
+    fsdem_real fx, fy;
     int i, j;
+    if (!s) return -1;
+    fx = (x - s->desc.x_min) / s->dx;
+    fy = s->dim == 2 ? (y - s->desc.y_min) / s->dy : 0;
     if (!(fx >= 0 && fx <= (fsdem_real)s->nx) || !(fy >= 0 && fy <= (fsdem_real)s->ny)) return -1;
     i = (int)fx;
     j = (int)fy;
@@ -9031,7 +9090,7 @@ int fsdem_swe_cell_at(const fsdem_swe *s, fsdem_real x, fsdem_real y) {
 fsdem_result fsdem_swe_sample_state(const fsdem_swe *s, fsdem_real x, fsdem_real y, fsdem_swe_cell *out) {
     fsdem_real fx, fy, wx, wy, w[4];
     int i0, j0, i1, j1, c[4], q;
-    if (!out) return FSDEM_ERR_INVALID_ARG;
+    if (!s || !out) return FSDEM_ERR_INVALID_ARG;
     if (fsdem_swe_cell_at(s, x, y) < 0) return FSDEM_ERR_OUT_OF_DOMAIN;
     /* (bi)linear between the centres around the point, clamped at the outermost centres */
     fx = (x - s->desc.x_min) / s->dx - (fsdem_real)0.5;
@@ -9165,6 +9224,7 @@ fsdem_result fsdem_swe_clear_forces(fsdem_swe *s) {
 
 fsdem_result fsdem_swe_set_boundary(fsdem_swe *s, fsdem_side side, const fsdem_swe_boundary *bc) {
     char msg[FSDEM__MESSAGE_SIZE];
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((int)side < 0 || (int)side >= (s->dim == 2 ? 4 : 2))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_set_boundary: side %d does not exist in %dD",
                            (int)side, s->dim);
@@ -9176,6 +9236,7 @@ fsdem_result fsdem_swe_set_boundary(fsdem_swe *s, fsdem_side side, const fsdem_s
 }
 
 fsdem_result fsdem_swe_set_manning(fsdem_swe *s, const fsdem_real *manning) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!manning) {
         fsdem__free(&s->allocator, s->manning, sizeof(fsdem_real) * (size_t)s->n);
         s->manning = NULL;
@@ -9192,6 +9253,7 @@ fsdem_result fsdem_swe_set_manning(fsdem_swe *s, const fsdem_real *manning) {
 }
 
 fsdem_result fsdem_swe_set_rain(fsdem_swe *s, fsdem_real rate) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!(rate >= 0) || !fsdem__finite(rate))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_set_rain: rate must be >= 0 (got %g m/s)",
                            (double)rate);
@@ -9203,6 +9265,7 @@ fsdem_result fsdem_swe_add_point_source(fsdem_swe *s, const fsdem_swe_point_sour
     char msg[FSDEM__MESSAGE_SIZE];
     fsdem__swe_src *q;
     int k;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!p) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_point_source: source is NULL");
     if (!fsdem__finite(p->discharge))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_point_source: discharge is not finite");
@@ -9232,6 +9295,7 @@ fsdem_result fsdem_swe_add_point_source(fsdem_swe *s, const fsdem_swe_point_sour
 
 fsdem_result fsdem_swe_remove_point_source(fsdem_swe *s, int id) {
     int k;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     for (k = 0; k < s->src_count; ++k)
         if (s->src[k].active && s->src[k].id == id) {
             s->src[k].active = 0;
@@ -9495,6 +9559,14 @@ static void fsdem__swe_load_row(const fsdem_swe *s, int src, int dst, int flip_v
     }
 }
 
+/* Factor by which Manning friction scales a unit discharge of magnitude qm (m^2/s) at depth h over
+   `dt`, by backward Euler of dq/dt = -C |q| q with C = g n^2 / h^(7/3), solved exactly:
+   |q| = 2 |q*| / (1 + sqrt(1 + 4 dt C |q*|)). It never reverses the flow and is stable at any depth. */
+static inline fsdem_real fsdem__swe_manning_factor(fsdem_real g, fsdem_real n, fsdem_real h, fsdem_real qm, fsdem_real dt) {
+    const fsdem_real C = g * n * n / (h * h * (fsdem_real)cbrt(h));
+    return 2 / (1 + (fsdem_real)sqrt(1 + 4 * dt * C * qm));
+}
+
 /* Completes cell k: adds the increments, the sources and friction, writes the state back and
    updates the step's statistics. */
 static inline void fsdem__swe_finish(fsdem_swe *s, fsdem__swe_ctx *c, int k, fsdem_real de, fsdem_real dqx,
@@ -9518,8 +9590,7 @@ static inline void fsdem__swe_finish(fsdem_swe *s, fsdem__swe_ctx *c, int k, fsd
         if (n > 0) {
             fsdem_real qm = (fsdem_real)sqrt(qx * qx + qy * qy);
             if (qm > 0) {
-                fsdem_real C = c->g * n * n / (h * h * (fsdem_real)cbrt(h));
-                fsdem_real fac = 2 / (1 + (fsdem_real)sqrt(1 + 4 * c->dt * C * qm));
+                const fsdem_real fac = fsdem__swe_manning_factor(c->g, n, h, qm, c->dt);
                 qx *= fac;
                 qy *= fac;
             }
@@ -9561,142 +9632,163 @@ static void fsdem__swe_viscous(const fsdem_swe *s, const fsdem__swe_ctx *c, int 
     *dqy = fy;
 }
 
+/* The primitive rows around row j (eta, h, u, v of rows j, j - 1 and j + 1; the outer ones only
+   in 2D), each offset past its ghost cell so index -1 and nx are the ghosts. */
+typedef struct fsdem__swe_rows {
+    const fsdem_real *e, *h, *u, *v;     /* row j */
+    const fsdem_real *se, *sh, *su, *sv; /* row j - 1 (south) */
+    const fsdem_real *ne, *nh, *nu, *nv; /* row j + 1 (north) */
+} fsdem__swe_rows;
+
+/* A cell's reconstruction: its centre values after the Hancock predictor, and the limited slopes
+   per cell width along x and y, each in the order eta, h, u, v. */
+typedef struct fsdem__swe_recon {
+    fsdem_real e, h, u, v;
+    fsdem_real sx[4], sy[4];
+} fsdem__swe_recon;
+
+/* Hancock predictor of a wet cell (>>impl_swe item 2): advances r's centre values by dt/2 with its
+   own face fluxes, the pressure/bed-slope pair g h deta, the momentum source (sx, sy) and half a
+   step of Manning friction n; skipped (counted as a fallback) where it would make a face depth
+   negative. */
+FSDEM__FORCE_INLINE void fsdem__swe_hancock(fsdem__swe_ctx *c, fsdem__swe_recon *r, const int two_d, fsdem_real srcx,
+                                            fsdem_real srcy, fsdem_real n) {
+    const fsdem_real g = c->g, half = (fsdem_real)0.5, hlx = half * c->lx, hly = half * c->ly, hdt = half * c->dt;
+    const fsdem_real h = r->h, u = r->u, w = r->v;
+    const fsdem_real hE = h + half * r->sx[1], hW = h - half * r->sx[1], uE = u + half * r->sx[2], uW = u - half * r->sx[2];
+    const fsdem_real qE = hE * uE, qW = hW * uW, shx = (fsdem_real)fabs(r->sx[1]), shy = (fsdem_real)fabs(r->sy[1]);
+    fsdem_real de, dqx, dqy, hp;
+    de = -hlx * (qE - qW);
+    dqx = -hlx * (qE * uE - qW * uW + g * h * r->sx[0]);
+    dqy = -hlx * (qE * (w + half * r->sx[3]) - qW * (w - half * r->sx[3]));
+    if (two_d) {
+        const fsdem_real hN = h + half * r->sy[1], hS = h - half * r->sy[1], vN = w + half * r->sy[3], vS = w - half * r->sy[3];
+        const fsdem_real rN = hN * vN, rS = hS * vS;
+        de -= hly * (rN - rS);
+        dqx -= hly * (rN * (u + half * r->sy[2]) - rS * (u - half * r->sy[2]));
+        dqy -= hly * (rN * vN - rS * vS + g * h * r->sy[0]);
+    }
+    dqx += hdt * srcx;
+    dqy += hdt * srcy;
+    hp = h + de;
+    if (n > 0 && hp >= c->dry) {
+        /* half-step friction, as in the corrector (>>impl_swe item 5), so a steady frictional flow
+           has face velocities equal to its cell velocities */
+        const fsdem_real fx = h * u + dqx, fy = two_d ? h * w + dqy : 0, qm = (fsdem_real)sqrt(fx * fx + fy * fy);
+        if (qm > 0) {
+            const fsdem_real fac = fsdem__swe_manning_factor(g, n, hp, qm, hdt) - 1;
+            dqx += fx * fac;
+            dqy += fy * fac;
+        }
+    }
+    if (!(hp >= half * (shx > shy ? shx : shy) && hp > 0)) {
+        c->fallbacks++;
+        return;
+    }
+    if (hp >= c->dry) {
+        const fsdem_real inv = 1 / hp;
+        r->u = (h * u + dqx) * inv;
+        r->v = two_d ? (h * w + dqy) * inv : 0;
+    } else {
+        r->u = r->v = 0;
+    }
+    r->e += de;
+    r->h = hp;
+}
+
+/* Reconstruction of cell i of the rows `p`: limited slopes (first order: none), the Hancock
+   predictor, and the cell's contribution to the acceleration bound of the next dt. */
+FSDEM__FORCE_INLINE void fsdem__swe_reconstruct(const fsdem_swe *s, fsdem__swe_ctx *c, const fsdem__swe_rows *p, int j,
+                                                int i, const int limiter, const int two_d, fsdem__swe_recon *r) {
+    const int k = j * s->nx + i;
+    int a;
+    r->e = p->e[i];
+    r->h = p->h[i];
+    r->u = p->u[i];
+    r->v = p->v[i];
+    for (a = 0; a < 4; ++a) r->sx[a] = r->sy[a] = 0;
+    /* a dry cell among dry neighbours has nothing to reconstruct or predict */
+    if (c->order == 2 && !(r->h < c->tiny && p->h[i - 1] < c->tiny && p->h[i + 1] < c->tiny &&
+                           (!two_d || (p->sh[i] < c->tiny && p->nh[i] < c->tiny)))) {
+        const fsdem_real *row[4] = {p->e, p->h, p->u, p->v};
+        const fsdem_real *south[4] = {p->se, p->sh, p->su, p->sv}, *north[4] = {p->ne, p->nh, p->nu, p->nv};
+        for (a = 0; a < 4; ++a) {
+            r->sx[a] = fsdem__swe_limit(limiter, row[a][i] - row[a][i - 1], row[a][i + 1] - row[a][i]);
+            if (two_d) r->sy[a] = fsdem__swe_limit(limiter, row[a][i] - south[a][i], north[a][i] - row[a][i]);
+        }
+        if (r->h >= c->dry)
+            fsdem__swe_hancock(c, r, two_d, c->sources ? s->sx[k] : 0, c->sources ? s->sy[k] : 0,
+                               c->friction ? (s->manning ? s->manning[k] : c->manning) : 0);
+    }
+    if (r->h >= c->dry) {
+        /* acceleration bound for the next step's dt (g |grad eta| with minmod slopes, which vanish
+           at a lake's shore and at a dam; a thin film on a slope feels the slope) */
+        const int reuse = limiter == FSDEM_SWE_LIMITER_MINMOD && c->order == 2;
+        const fsdem_real ax = reuse ? r->sx[0] : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, p->e[i] - p->e[i - 1], p->e[i + 1] - p->e[i]);
+        fsdem_real acc = (ax < 0 ? -ax : ax) * c->idx * c->idx;
+        if (two_d) {
+            const fsdem_real ay = reuse ? r->sy[0] : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, p->e[i] - p->se[i], p->ne[i] - p->e[i]);
+            acc += (ay < 0 ? -ay : ay) * c->idy * c->idy;
+        }
+        if (acc > c->accel) c->accel = acc;
+    }
+}
+
 /* Row j: reconstruction and predictor of every cell (stored for the y faces in 2D), the x faces, and
    the x-direction increments (2D: into the accumulator row; 1D: the cells are finished here). */
 FSDEM__FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, int j, const int limiter,
                                                   const int two_d) {
-    const int nx = s->nx, order2 = c->order == 2;
-    const fsdem_real *pe = fsdem__swe_prim(s, j, 0) + 1, *ph = fsdem__swe_prim(s, j, 1) + 1;
-    const fsdem_real *pu = fsdem__swe_prim(s, j, 2) + 1, *pv = fsdem__swe_prim(s, j, 3) + 1;
-    const fsdem_real *se = NULL, *sh = NULL, *su = NULL, *sv = NULL, *ne = NULL, *nh = NULL, *nu = NULL, *nv = NULL;
-    fsdem__swe_rowcell *rc = NULL;
-    const fsdem_real *srcx = s->sx + (size_t)j * (size_t)nx, *srcy = s->sy + (size_t)j * (size_t)nx;
-    const fsdem_real g = c->g, dry = c->dry, hlx = (fsdem_real)0.5 * c->lx, hly = (fsdem_real)0.5 * c->ly;
-    const fsdem_real hdt = (fsdem_real)0.5 * c->dt, lx = c->lx, half = (fsdem_real)0.5;
+    const int nx = s->nx;
+    const fsdem_real g = c->g, lx = c->lx, half = (fsdem_real)0.5;
     fsdem_real Ee = 0, Eh = 0, Eu = 0, Ev = 0; /* east state of the previous cell */
     fsdem_real Wm = 0, Wa = 0, Wt = 0, Wh = 0, We = 0; /* west-face data of the previous cell */
     fsdem_real vx = 0, vy = 0; /* viscous increment of the previous cell */
+    fsdem__swe_rowcell *rc = two_d ? fsdem__swe_rowcells(s, j) : NULL;
+    fsdem__swe_rows p;
     fsdem__swe_flux f;
     int i;
-    if (two_d) {
-        se = fsdem__swe_prim(s, j - 1, 0) + 1;
-        sh = fsdem__swe_prim(s, j - 1, 1) + 1;
-        su = fsdem__swe_prim(s, j - 1, 2) + 1;
-        sv = fsdem__swe_prim(s, j - 1, 3) + 1;
-        ne = fsdem__swe_prim(s, j + 1, 0) + 1;
-        nh = fsdem__swe_prim(s, j + 1, 1) + 1;
-        nu = fsdem__swe_prim(s, j + 1, 2) + 1;
-        nv = fsdem__swe_prim(s, j + 1, 3) + 1;
-        rc = fsdem__swe_rowcells(s, j);
-    }
+    p.e = fsdem__swe_prim(s, j, 0) + 1;
+    p.h = fsdem__swe_prim(s, j, 1) + 1;
+    p.u = fsdem__swe_prim(s, j, 2) + 1;
+    p.v = fsdem__swe_prim(s, j, 3) + 1;
+    p.se = fsdem__swe_prim(s, j - 1, 0) + 1;
+    p.sh = fsdem__swe_prim(s, j - 1, 1) + 1;
+    p.su = fsdem__swe_prim(s, j - 1, 2) + 1;
+    p.sv = fsdem__swe_prim(s, j - 1, 3) + 1;
+    p.ne = fsdem__swe_prim(s, j + 1, 0) + 1;
+    p.nh = fsdem__swe_prim(s, j + 1, 1) + 1;
+    p.nu = fsdem__swe_prim(s, j + 1, 2) + 1;
+    p.nv = fsdem__swe_prim(s, j + 1, 3) + 1;
     for (i = 0; i <= nx; ++i) {
-        fsdem_real e = 0, h = 0, u = 0, w = 0;
-        fsdem_real sex = 0, shx = 0, sux = 0, svx = 0, sey = 0, shy = 0, suy = 0, svy = 0;
+        fsdem__swe_recon r;
         fsdem_real cvx = 0, cvy = 0;
         if (i < nx) {
-            /* ---- reconstruction and predictor of cell i ---- */
-            e = pe[i];
-            h = ph[i];
-            u = pu[i];
-            w = pv[i];
-            /* a dry cell among dry neighbours: nothing to reconstruct or predict */
-            if (h < c->tiny && ph[i - 1] < c->tiny && ph[i + 1] < c->tiny &&
-                (!two_d || (sh[i] < c->tiny && nh[i] < c->tiny))) {
-                /* slopes stay 0 */
-            } else if (order2) {
-                sex = fsdem__swe_limit(limiter, e - pe[i - 1], pe[i + 1] - e);
-                shx = fsdem__swe_limit(limiter, h - ph[i - 1], ph[i + 1] - h);
-                sux = fsdem__swe_limit(limiter, u - pu[i - 1], pu[i + 1] - u);
-                svx = fsdem__swe_limit(limiter, w - pv[i - 1], pv[i + 1] - w);
-                if (two_d) {
-                    sey = fsdem__swe_limit(limiter, e - se[i], ne[i] - e);
-                    shy = fsdem__swe_limit(limiter, h - sh[i], nh[i] - h);
-                    suy = fsdem__swe_limit(limiter, u - su[i], nu[i] - u);
-                    svy = fsdem__swe_limit(limiter, w - sv[i], nv[i] - w);
-                }
-                if (h >= dry) {
-                    fsdem_real hE = h + half * shx, hW = h - half * shx, uE = u + half * sux, uW = u - half * sux;
-                    fsdem_real qE = hE * uE, qW = hW * uW, de, dqx, dqy, hp, need;
-                    de = -hlx * (qE - qW);
-                    dqx = -hlx * (qE * uE - qW * uW + g * h * sex);
-                    dqy = -hlx * (qE * (w + half * svx) - qW * (w - half * svx));
-                    if (two_d) {
-                        fsdem_real hN = h + half * shy, hS = h - half * shy, vN = w + half * svy, vS = w - half * svy;
-                        fsdem_real rN = hN * vN, rS = hS * vS;
-                        de -= hly * (rN - rS);
-                        dqx -= hly * (rN * (u + half * suy) - rS * (u - half * suy));
-                        dqy -= hly * (rN * vN - rS * vS + g * h * sey);
-                    }
-                    if (c->sources) {
-                        dqx += hdt * srcx[i];
-                        dqy += hdt * srcy[i];
-                    }
-                    hp = h + de;
-                    if (c->friction && hp >= dry) {
-                        /* half-step friction, as in the corrector (>>impl_swe item 5), so a steady
-                           frictional flow has face velocities equal to its cell velocities */
-                        fsdem_real n = s->manning ? s->manning[(size_t)j * (size_t)nx + (size_t)i] : c->manning;
-                        fsdem_real fx = h * u + dqx, fy = two_d ? h * w + dqy : 0;
-                        fsdem_real qm = (fsdem_real)sqrt(fx * fx + fy * fy);
-                        if (n > 0 && qm > 0) {
-                            fsdem_real C = g * n * n / (hp * hp * (fsdem_real)cbrt(hp));
-                            fsdem_real fac = 2 / (1 + (fsdem_real)sqrt(1 + 4 * hdt * C * qm)) - 1;
-                            dqx += fx * fac;
-                            dqy += fy * fac;
-                        }
-                    }
-                    need = half * ((shx < 0 ? -shx : shx) > (shy < 0 ? -shy : shy) ? (shx < 0 ? -shx : shx)
-                                                                                    : (shy < 0 ? -shy : shy));
-                    if (hp >= need && hp > 0) {
-                        if (hp >= dry) {
-                            fsdem_real inv = 1 / hp;
-                            u = (h * u + dqx) * inv;
-                            w = two_d ? (h * w + dqy) * inv : 0;
-                        } else {
-                            u = w = 0;
-                        }
-                        e += de;
-                        h = hp;
-                    } else {
-                        c->fallbacks++;
-                    }
-                }
-            }
-            if (h >= dry) {
-                /* acceleration bound for the next step's dt (g |grad eta| with minmod slopes, which
-                   vanish at a lake's shore and at a dam; a thin film on a slope feels the slope) */
-                fsdem_real ax = limiter == FSDEM_SWE_LIMITER_MINMOD && order2
-                                    ? sex
-                                    : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, pe[i] - pe[i - 1], pe[i + 1] - pe[i]);
-                fsdem_real a = (ax < 0 ? -ax : ax) * c->idx * c->idx;
-                if (two_d) {
-                    fsdem_real ay = limiter == FSDEM_SWE_LIMITER_MINMOD && order2
-                                        ? sey
-                                        : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, pe[i] - se[i], ne[i] - pe[i]);
-                    a += (ay < 0 ? -ay : ay) * c->idy * c->idy;
-                }
-                if (a > c->accel) c->accel = a;
-            }
+            fsdem__swe_reconstruct(s, c, &p, j, i, limiter, two_d, &r);
             if (two_d) {
                 fsdem__swe_rowcell *q = rc + i;
-                q->n[0] = e + half * sey;
-                q->n[1] = h + half * shy;
-                q->n[2] = w + half * svy;
-                q->n[3] = u + half * suy;
-                q->s[0] = e - half * sey;
-                q->s[1] = h - half * shy;
-                q->s[2] = w - half * svy;
-                q->s[3] = u - half * suy;
+                q->n[0] = r.e + half * r.sy[0];
+                q->n[1] = r.h + half * r.sy[1];
+                q->n[2] = r.v + half * r.sy[3];
+                q->n[3] = r.u + half * r.sy[2];
+                q->s[0] = r.e - half * r.sy[0];
+                q->s[1] = r.h - half * r.sy[1];
+                q->s[2] = r.v - half * r.sy[3];
+                q->s[3] = r.u - half * r.sy[2];
             }
             if (c->visc > 0) fsdem__swe_viscous(s, c, j, i, &cvx, &cvy);
             /* ---- face i - 1/2 ---- */
             if (i == 0) {
-                fsdem__swe_boundary_flux(s, FSDEM_SIDE_XMIN, 0, e - half * sex, h - half * shx, u - half * sux,
-                                         w - half * svx, &f);
+                fsdem__swe_boundary_flux(s, FSDEM_SIDE_XMIN, 0, r.e - half * r.sx[0], r.h - half * r.sx[1], r.u - half * r.sx[2],
+                                         r.v - half * r.sx[3], &f);
                 c->bflux += f.mass * s->dy * c->dt;
             } else {
-                fsdem__swe_riemann(g, c->tiny, Ee, Eh, Eu, Ev, e - half * sex, h - half * shx, u - half * sux, w - half * svx, &f);
+                fsdem__swe_riemann(g, c->tiny, Ee, Eh, Eu, Ev, r.e - half * r.sx[0], r.h - half * r.sx[1], r.u - half * r.sx[2],
+                                   r.v - half * r.sx[3], &f);
             }
+            Ee = r.e + half * r.sx[0]; /* the east face state, for face i + 1/2 */
+            Eh = r.h + half * r.sx[1];
+            Eu = r.u + half * r.sx[2];
+            Ev = r.v + half * r.sx[3];
         } else {
             fsdem__swe_boundary_flux(s, FSDEM_SIDE_XMAX, 1, Ee, Eh, Eu, Ev, &f);
             c->bflux -= f.mass * s->dy * c->dt;
@@ -9719,10 +9811,6 @@ FSDEM__FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, in
         Wt = f.tan;
         Wh = f.hR;
         We = f.eR;
-        Ee = e + half * sex;
-        Eh = h + half * shx;
-        Eu = u + half * sux;
-        Ev = w + half * svx;
         vx = cvx;
         vy = cvy;
     }
@@ -10032,13 +10120,16 @@ fsdem_swe_desc fsdem_swe_get_desc(const fsdem_swe *s) {
 fsdem_real fsdem_swe_volume(const fsdem_swe *s) {
     double sum = 0;
     int k;
+    if (!s) return 0;
     for (k = 0; k < s->n; ++k) sum += (double)(s->eta[k] - s->bed[k]);
     return (fsdem_real)(sum * (double)s->area);
 }
 
 fsdem_vec3 fsdem_swe_momentum(const fsdem_swe *s) {
-    double mx = 0, my = 0, scale = (double)s->desc.density * (double)s->area;
+    double mx = 0, my = 0, scale;
     int k;
+    if (!s) return fsdem__zero3();
+    scale = (double)s->desc.density * (double)s->area;
     for (k = 0; k < s->n; ++k) {
         mx += (double)s->qx[k];
         my += (double)s->qy[k];
@@ -10050,6 +10141,7 @@ fsdem_swe_stats fsdem_swe_get_stats(const fsdem_swe *s) {
     fsdem_swe_stats st;
     int k;
     memset(&st, 0, sizeof st);
+    if (!s) return st;
     st.steps = s->steps;
     st.time = s->time;
     st.dt = s->dt_last;
@@ -10120,6 +10212,7 @@ fsdem_result fsdem_swe_write_vtk(const fsdem_swe *s, const char *path) {
 }
 
 fsdem_result fsdem_swe_add_gauge(fsdem_swe *s, fsdem_real x, fsdem_real y, int *id) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if (s->gauge_file)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_gauge: close the gauge file first");
     if (fsdem_swe_cell_at(s, x, y) < 0)
@@ -10136,13 +10229,15 @@ fsdem_result fsdem_swe_add_gauge(fsdem_swe *s, fsdem_real x, fsdem_real y, int *
 }
 
 fsdem_result fsdem_swe_gauge(const fsdem_swe *s, int id, fsdem_swe_cell *out) {
-    if (id < 0 || id >= s->gauge_count || !out) return FSDEM_ERR_NOT_FOUND;
+    if (!s || !out) return FSDEM_ERR_INVALID_ARG;
+    if (id < 0 || id >= s->gauge_count) return FSDEM_ERR_NOT_FOUND;
     return fsdem_swe_sample_state(s, s->gauge_xy[2 * id], s->gauge_xy[2 * id + 1], out);
 }
 
 fsdem_result fsdem_swe_gauges_open(fsdem_swe *s, const char *path, fsdem_real interval) {
     FILE *fp;
     int k;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if (s->gauge_count == 0)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_gauges_open: add gauges first");
     if (!(interval >= 0) || !fsdem__finite(interval))
@@ -10164,6 +10259,7 @@ fsdem_result fsdem_swe_gauges_open(fsdem_swe *s, const char *path, fsdem_real in
 
 fsdem_result fsdem_swe_gauges_close(fsdem_swe *s) {
     int bad;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!s->gauge_file) return FSDEM_OK;
     bad = ferror((FILE *)s->gauge_file);
     bad |= fclose((FILE *)s->gauge_file) != 0;
@@ -10539,6 +10635,8 @@ fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
 }
 
 /* ===== >>impl_io : CSV and VTK output ============================================================== */
+
+/* Contents: CSV time series, ParaView .pvd series, DEM particle snapshots. */
 
 fsdem_result fsdem_csv_open(fsdem_csv *csv, const char *path, const char *header) {
     FILE *fp;
