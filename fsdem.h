@@ -2162,7 +2162,7 @@ fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *g, const fsdem_allocator *allo
     return FSDEM_OK;
 }
 
-static int fsdem__cell_coord(const fsdem_cellgrid *g, fsdem_real x, int axis) {
+static int fsdem__cellgrid_coord(const fsdem_cellgrid *g, fsdem_real x, int axis) {
     fsdem_real s = (x - fsdem__comp(g->origin, axis)) * g->inv_cell_size;
     int c;
     if (!(s > 0)) return 0; /* also catches NaN */
@@ -2172,9 +2172,9 @@ static int fsdem__cell_coord(const fsdem_cellgrid *g, fsdem_real x, int axis) {
 
 int fsdem_cellgrid_cell(const fsdem_cellgrid *g, fsdem_vec3 p, int coord[3]) {
     int c[3];
-    c[0] = fsdem__cell_coord(g, p.x, 0);
-    c[1] = fsdem__cell_coord(g, p.y, 1);
-    c[2] = g->dim == 3 ? fsdem__cell_coord(g, p.z, 2) : 0;
+    c[0] = fsdem__cellgrid_coord(g, p.x, 0);
+    c[1] = fsdem__cellgrid_coord(g, p.y, 1);
+    c[2] = g->dim == 3 ? fsdem__cellgrid_coord(g, p.z, 2) : 0;
     if (coord) {
         coord[0] = c[0];
         coord[1] = c[1];
@@ -4714,13 +4714,13 @@ fsdem_result fsdem_pcg_set_tolerance(fsdem_pcg *s, fsdem_real tolerance, int max
 }
 
 /* Carves arrays out of one block: a first pass with base = NULL measures, a second assigns. */
-typedef struct fsdem__carver {
+typedef struct fsdem__pcg_carver {
     char *base;
     size_t used;
     int overflow;
-} fsdem__carver;
+} fsdem__pcg_carver;
 
-static void *fsdem__carve(fsdem__carver *cv, size_t count, size_t elem) {
+static void *fsdem__pcg_carve(fsdem__pcg_carver *cv, size_t count, size_t elem) {
     size_t off = (cv->used + 63) & ~(size_t)63;
     if (elem && count > ((size_t)-1 - off) / elem / 2) {
         cv->overflow = 1;
@@ -4964,7 +4964,7 @@ static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim
     fsdem__level_ghosts(C, dim);
 }
 
-/* Marks fine fluid cells whose interpolation stencil (from level C) contains a solid cell. */
+/* Marks fine fluid cells whose interpolation kernel (from level C) contains a solid cell. */
 static void fsdem__level_mark_near_solid(fsdem__level *F, const fsdem__level *C, int dim) {
     int i, j, k;
     for (k = 0; k < F->n[2]; ++k)
@@ -5017,7 +5017,7 @@ static void fsdem__level_apply(const fsdem__level *L, int dim, const fsdem_real 
 /* Gauss-Seidel on the cells of one colour ((i + j + k) % 2 == colour) of row (j, k). With
    `from_zero` the row is treated as if x were 0 before the sweep: cells of this colour get
    b / d and the others 0 (so no clearing pass is needed). */
-static void fsdem__smooth_row(const fsdem__level *L, int dim, const fsdem_real *b, fsdem_real *x, int colour, int j,
+static void fsdem__mg_smooth_row(const fsdem__level *L, int dim, const fsdem_real *b, fsdem_real *x, int colour, int j,
                               int k, int from_zero) {
     int i, sy = L->sy, sz = L->sz, n0 = L->n[0], c0 = fsdem__level_index(L, dim, 0, j, k);
     int i0 = (j + k + colour) & 1;
@@ -5045,7 +5045,7 @@ static void fsdem__smooth_row(const fsdem__level *L, int dim, const fsdem_real *
 /* Interpolation along one axis for fine index i and coarsening ratio r (1 or 2): the parent's
    coarse index *I, the offset *o (index step) to the other coarse cell, and the weights of the
    parent (*a) and of the other cell (*b). */
-static void fsdem__axis_weights(int i, int r, int stride, int *I, int *o, fsdem_real *a, fsdem_real *b) {
+static void fsdem__mg_axis_weights(int i, int r, int stride, int *I, int *o, fsdem_real *a, fsdem_real *b) {
     if (r == 2) {
         *I = i >> 1;
         *o = (i & 1) ? stride : -stride;
@@ -5060,8 +5060,8 @@ static void fsdem__axis_weights(int i, int r, int stride, int *I, int *o, fsdem_
 }
 
 /* 1 / (sum of the interpolation weights of the non-solid coarse cells) for a fine cell whose
-   stencil has parent pc, offsets o[] and weights a[], b[]. */
-static fsdem_real fsdem__interp_inv_norm(const fsdem__level *C, int pc, const int o[3], const fsdem_real a[3],
+   kernel has parent pc, offsets o[] and weights a[], b[]. */
+static fsdem_real fsdem__mg_interp_inv_norm(const fsdem__level *C, int pc, const int o[3], const fsdem_real a[3],
                                          const fsdem_real b[3]) {
     fsdem_real norm = 0;
     int u, v, w;
@@ -5075,7 +5075,7 @@ static fsdem_real fsdem__interp_inv_norm(const fsdem__level *C, int pc, const in
     return norm > 0 ? 1 / norm : 0;
 }
 
-static fsdem_real fsdem__interp_inv_norm1(const fsdem__level *C, int pc, int ox, int oy, int oz, fsdem_real ax,
+static fsdem_real fsdem__mg_interp_inv_norm1(const fsdem__level *C, int pc, int ox, int oy, int oz, fsdem_real ax,
                                           fsdem_real bx, fsdem_real ay, fsdem_real by, fsdem_real az, fsdem_real bz) {
     int o[3];
     fsdem_real a[3], b[3];
@@ -5088,7 +5088,7 @@ static fsdem_real fsdem__interp_inv_norm1(const fsdem__level *C, int pc, int ox,
     b[0] = bx;
     b[1] = by;
     b[2] = bz;
-    return fsdem__interp_inv_norm(C, pc, o, a, b);
+    return fsdem__mg_interp_inv_norm(C, pc, o, a, b);
 }
 
 /* P and P^T are tensor products of one-dimensional stencils (3/4 to the parent, 1/4 to the next
@@ -5097,15 +5097,15 @@ static fsdem_real fsdem__interp_inv_norm1(const fsdem__level *C, int pc, int ox,
    vectorises. `buf` holds two rows of the fine level (n[0] + 4 each). */
 
 /* xf += P xc at the fluid cells of row (j, k) of F. */
-static void fsdem__prolong_row(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *xc,
+static void fsdem__mg_prolong_row(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *xc,
                                fsdem_real *xf, int j, int k, fsdem_real *buf) {
     int i, I, J, K, oy, oz, crow, f0, nI = C->n[0];
     fsdem_real ay, by, az, bz, w00, w10, w01, w11;
     fsdem_real *cx = buf + 1; /* coarse row, indices -1 .. nI */
     const fsdem_real *x00, *x10, *x01, *x11;
     const unsigned char *type;
-    fsdem__axis_weights(j, C->ratio[1], C->sy, &J, &oy, &ay, &by);
-    fsdem__axis_weights(k, C->ratio[2], C->sz, &K, &oz, &az, &bz);
+    fsdem__mg_axis_weights(j, C->ratio[1], C->sy, &J, &oy, &ay, &by);
+    fsdem__mg_axis_weights(k, C->ratio[2], C->sz, &K, &oz, &az, &bz);
     if (dim == 2) {
         az = 1;
         bz = 0;
@@ -5133,14 +5133,14 @@ static void fsdem__prolong_row(const fsdem__level *F, const fsdem__level *C, int
             v = q * cx[I] + e * cx[(i & 1) ? I + 1 : I - 1];
             if (t == FSDEM_STENCIL_CELL_FLUID) xf[f0 + i] += v;
             else if (FSDEM__TYPE(t) == FSDEM_STENCIL_CELL_FLUID)
-                xf[f0 + i] += v * fsdem__interp_inv_norm1(C, crow + I, (i & 1) ? 1 : -1, oy, oz, q, e, ay, by, az, bz);
+                xf[f0 + i] += v * fsdem__mg_interp_inv_norm1(C, crow + I, (i & 1) ? 1 : -1, oy, oz, q, e, ay, by, az, bz);
         }
     } else {
         for (i = 0; i < F->n[0]; ++i) {
             unsigned char t = type[i];
             if (t == FSDEM_STENCIL_CELL_FLUID) xf[f0 + i] += cx[i];
             else if (FSDEM__TYPE(t) == FSDEM_STENCIL_CELL_FLUID)
-                xf[f0 + i] += cx[i] * fsdem__interp_inv_norm1(C, crow + i, 0, oy, oz, 1, 0, ay, by, az, bz);
+                xf[f0 + i] += cx[i] * fsdem__mg_interp_inv_norm1(C, crow + i, 0, oy, oz, 1, 0, ay, by, az, bz);
         }
     }
 }
@@ -5148,15 +5148,15 @@ static void fsdem__prolong_row(const fsdem__level *F, const fsdem__level *C, int
 /* bc += P^T (b - A x) over row (j, k) of F, the residual formed on the fly. b is 0 off fluid cells
    on every level, so the residual is too (d and the couplings vanish there). Coarse ghost and
    non-fluid entries receive values that fsdem__mg_clean clears. */
-static void fsdem__restrict_row(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *b,
+static void fsdem__mg_restrict_row(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *b,
                                 const fsdem_real *x, fsdem_real *bc, int j, int k, fsdem_real *buf) {
     int i, I, J, K, oy, oz, crow, f0, n0 = F->n[0], nI = C->n[0], sy = F->sy, sz = F->sz;
     fsdem_real ay, by, az, bz;
     fsdem_real *r = buf + 2, *cr = buf + F->n[0] + 6;
     const fsdem_real *d, *w0, *w1, *w2, *bb, *xx;
     const unsigned char *type;
-    fsdem__axis_weights(j, C->ratio[1], C->sy, &J, &oy, &ay, &by);
-    fsdem__axis_weights(k, C->ratio[2], C->sz, &K, &oz, &az, &bz);
+    fsdem__mg_axis_weights(j, C->ratio[1], C->sy, &J, &oy, &ay, &by);
+    fsdem__mg_axis_weights(k, C->ratio[2], C->sz, &K, &oz, &az, &bz);
     if (dim == 2) {
         az = 1;
         bz = 0;
@@ -5183,7 +5183,7 @@ static void fsdem__restrict_row(const fsdem__level *F, const fsdem__level *C, in
         if (type[i] & FSDEM__NEAR_SOLID) {
             int ox = C->ratio[0] == 2 ? ((i & 1) ? 1 : -1) : 0;
             fsdem_real ax = C->ratio[0] == 2 ? (fsdem_real)0.75 : 1, bx = C->ratio[0] == 2 ? (fsdem_real)0.25 : 0;
-            r[i] *= fsdem__interp_inv_norm1(C, crow + (C->ratio[0] == 2 ? i >> 1 : i), ox, oy, oz, ax, bx, ay, by, az,
+            r[i] *= fsdem__mg_interp_inv_norm1(C, crow + (C->ratio[0] == 2 ? i >> 1 : i), ox, oy, oz, ax, bx, ay, by, az,
                                             bz);
         }
     /* x: coarse I gathers 1/4, 3/4, 3/4, 1/4 from fine 2I-1 .. 2I+2 (zero beyond the row) */
@@ -5225,12 +5225,12 @@ static void fsdem__mg_clean(const fsdem__level *L, fsdem_real *b) {
    the memory traffic. */
 enum { FSDEM__STAGE_SMOOTH, FSDEM__STAGE_SMOOTH_FROM_ZERO, FSDEM__STAGE_RESTRICT, FSDEM__STAGE_PROLONG };
 
-typedef struct fsdem__stage {
+typedef struct fsdem__mg_stage {
     int kind, colour;
-} fsdem__stage;
+} fsdem__mg_stage;
 
 static void fsdem__mg_pipeline(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b,
-                               fsdem_real *x, fsdem_real *xc_or_bc, const fsdem__stage *stage, int stages,
+                               fsdem_real *x, fsdem_real *xc_or_bc, const fsdem__mg_stage *stage, int stages,
                                fsdem_real *buf) {
     int slabs = dim == 3 ? L->n[2] : L->n[1], t, s, j;
     for (t = 0; t < slabs + stages - 1; ++t)
@@ -5238,10 +5238,10 @@ static void fsdem__mg_pipeline(const fsdem__level *L, const fsdem__level *C, int
             int p = t - s, jb = dim == 3 ? 0 : p, je = dim == 3 ? L->n[1] : p + 1, k = dim == 3 ? p : 0;
             if (p < 0 || p >= slabs) continue;
             for (j = jb; j < je; ++j) switch (stage[s].kind) {
-                case FSDEM__STAGE_SMOOTH: fsdem__smooth_row(L, dim, b, x, stage[s].colour, j, k, 0); break;
-                case FSDEM__STAGE_SMOOTH_FROM_ZERO: fsdem__smooth_row(L, dim, b, x, stage[s].colour, j, k, 1); break;
-                case FSDEM__STAGE_RESTRICT: fsdem__restrict_row(L, C, dim, b, x, xc_or_bc, j, k, buf); break;
-                default: fsdem__prolong_row(L, C, dim, xc_or_bc, x, j, k, buf); break;
+                case FSDEM__STAGE_SMOOTH: fsdem__mg_smooth_row(L, dim, b, x, stage[s].colour, j, k, 0); break;
+                case FSDEM__STAGE_SMOOTH_FROM_ZERO: fsdem__mg_smooth_row(L, dim, b, x, stage[s].colour, j, k, 1); break;
+                case FSDEM__STAGE_RESTRICT: fsdem__mg_restrict_row(L, C, dim, b, x, xc_or_bc, j, k, buf); break;
+                default: fsdem__mg_prolong_row(L, C, dim, xc_or_bc, x, j, k, buf); break;
                 }
         }
 }
@@ -5249,7 +5249,7 @@ static void fsdem__mg_pipeline(const fsdem__level *L, const fsdem__level *C, int
 /* Pre-smoothing from x = 0 (red first), then (when C is given) bc = P^T (b - A x). */
 static void fsdem__mg_down(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b, fsdem_real *x,
                            fsdem_real *bc, int sweeps, fsdem_real *buf) {
-    fsdem__stage stage[2 * 64 + 2];
+    fsdem__mg_stage stage[2 * 64 + 2];
     int n = 0, s;
     for (s = 0; s < 2 * sweeps; ++s) {
         stage[n].kind = s == 0 ? FSDEM__STAGE_SMOOTH_FROM_ZERO : FSDEM__STAGE_SMOOTH;
@@ -5267,7 +5267,7 @@ static void fsdem__mg_down(const fsdem__level *L, const fsdem__level *C, int dim
 /* (When C is given) x += P xc, then post-smoothing (black first: the adjoint of the pre-smoother). */
 static void fsdem__mg_up(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b, fsdem_real *x,
                          fsdem_real *xc, int sweeps, fsdem_real *buf) {
-    fsdem__stage stage[2 * 64 + 2];
+    fsdem__mg_stage stage[2 * 64 + 2];
     int n = 0, s;
     if (C) {
         stage[n].kind = FSDEM__STAGE_PROLONG;
@@ -5423,7 +5423,7 @@ static void fsdem__csr_ic_apply(const fsdem_pcg *s, const fsdem_real *r, fsdem_r
 /* ---- >>linalg_setup : setup for stencils and CSR matrices ---- */
 
 /* Carves the stencil workspace; `levels` = number of multigrid levels to hold (1 without MG). */
-static void fsdem__stencil_carve(fsdem_pcg *s, fsdem__carver *cv, int levels, int want_ic, int cells,
+static void fsdem__stencil_carve(fsdem_pcg *s, fsdem__pcg_carver *cv, int levels, int want_ic, int cells,
                                  int with_extra) {
     int l, a, N = s->level[0].count;
     fsdem_real **vec[4];
@@ -5431,29 +5431,29 @@ static void fsdem__stencil_carve(fsdem_pcg *s, fsdem__carver *cv, int levels, in
     vec[1] = &s->r;
     vec[2] = &s->z;
     vec[3] = &s->p;
-    for (a = 0; a < 4; ++a) *vec[a] = (fsdem_real *)fsdem__carve(cv, (size_t)N, sizeof(fsdem_real));
+    for (a = 0; a < 4; ++a) *vec[a] = (fsdem_real *)fsdem__pcg_carve(cv, (size_t)N, sizeof(fsdem_real));
     s->ux = s->uy = NULL;
     if (with_extra) {
-        s->ux = (fsdem_real *)fsdem__carve(cv, (size_t)cells, sizeof(fsdem_real));
-        s->uy = (fsdem_real *)fsdem__carve(cv, (size_t)cells, sizeof(fsdem_real));
+        s->ux = (fsdem_real *)fsdem__pcg_carve(cv, (size_t)cells, sizeof(fsdem_real));
+        s->uy = (fsdem_real *)fsdem__pcg_carve(cv, (size_t)cells, sizeof(fsdem_real));
     }
-    s->ic = want_ic ? (fsdem_real *)fsdem__carve(cv, (size_t)N, sizeof(fsdem_real)) : NULL;
-    s->rowbuf = levels > 1 ? (fsdem_real *)fsdem__carve(cv, 2 * ((size_t)s->level[0].n[0] + 8), sizeof(fsdem_real)) : NULL;
-    s->mark = (unsigned char *)fsdem__carve(cv, (size_t)N, 1);
-    s->ns_cell = (int *)fsdem__carve(cv, (size_t)N, sizeof(int));
+    s->ic = want_ic ? (fsdem_real *)fsdem__pcg_carve(cv, (size_t)N, sizeof(fsdem_real)) : NULL;
+    s->rowbuf = levels > 1 ? (fsdem_real *)fsdem__pcg_carve(cv, 2 * ((size_t)s->level[0].n[0] + 8), sizeof(fsdem_real)) : NULL;
+    s->mark = (unsigned char *)fsdem__pcg_carve(cv, (size_t)N, 1);
+    s->ns_cell = (int *)fsdem__pcg_carve(cv, (size_t)N, sizeof(int));
     for (l = 0; l < levels; ++l) {
         fsdem__level *L = &s->level[l];
         size_t n = (size_t)L->count;
-        L->type = (unsigned char *)fsdem__carve(cv, n, 1);
-        L->d = (fsdem_real *)fsdem__carve(cv, n, sizeof(fsdem_real));
-        L->inv_d = (fsdem_real *)fsdem__carve(cv, n, sizeof(fsdem_real));
+        L->type = (unsigned char *)fsdem__pcg_carve(cv, n, 1);
+        L->d = (fsdem_real *)fsdem__pcg_carve(cv, n, sizeof(fsdem_real));
+        L->inv_d = (fsdem_real *)fsdem__pcg_carve(cv, n, sizeof(fsdem_real));
         for (a = 0; a < 3; ++a)
-            L->w[a] = a < s->dim ? (fsdem_real *)fsdem__carve(cv, n, sizeof(fsdem_real)) : NULL;
+            L->w[a] = a < s->dim ? (fsdem_real *)fsdem__pcg_carve(cv, n, sizeof(fsdem_real)) : NULL;
         if (s->dim == 2) L->w[2] = L->w[1]; /* never read in 2D; keeps the kernels' pointers valid */
         L->x = L->b = NULL;
         if (l > 0) {
-            L->x = (fsdem_real *)fsdem__carve(cv, n, sizeof(fsdem_real));
-            L->b = (fsdem_real *)fsdem__carve(cv, n, sizeof(fsdem_real));
+            L->x = (fsdem_real *)fsdem__pcg_carve(cv, n, sizeof(fsdem_real));
+            L->b = (fsdem_real *)fsdem__pcg_carve(cv, n, sizeof(fsdem_real));
         }
     }
 }
@@ -5532,7 +5532,7 @@ static void fsdem__stencil_nullspace(fsdem_pcg *s, const fsdem_real *extra) {
 fsdem_result fsdem_pcg_setup_stencil(fsdem_pcg *s, const fsdem_stencil *st) {
     char msg[FSDEM__MESSAGE_SIZE];
     fsdem__level plan[FSDEM__MG_MAX_LEVELS];
-    fsdem__carver cv;
+    fsdem__pcg_carver cv;
     fsdem_precond pc;
     fsdem_result res;
     int n[3], levels, l, cells;
@@ -5616,29 +5616,29 @@ fsdem_result fsdem_pcg_setup_stencil(fsdem_pcg *s, const fsdem_stencil *st) {
     return fsdem__ok(&s->status);
 }
 
-static void fsdem__csr_carve(fsdem_pcg *s, fsdem__carver *cv, int n, int upper, fsdem_precond pc) {
+static void fsdem__csr_carve(fsdem_pcg *s, fsdem__pcg_carver *cv, int n, int upper, fsdem_precond pc) {
     fsdem_real **vec[4];
     int a;
     vec[0] = &s->x;
     vec[1] = &s->r;
     vec[2] = &s->z;
     vec[3] = &s->p;
-    for (a = 0; a < 4; ++a) *vec[a] = (fsdem_real *)fsdem__carve(cv, (size_t)n, sizeof(fsdem_real));
+    for (a = 0; a < 4; ++a) *vec[a] = (fsdem_real *)fsdem__pcg_carve(cv, (size_t)n, sizeof(fsdem_real));
     s->ux = s->uy = NULL;
-    s->ic = pc != FSDEM_PRECOND_NONE ? (fsdem_real *)fsdem__carve(cv, (size_t)n, sizeof(fsdem_real)) : NULL;
+    s->ic = pc != FSDEM_PRECOND_NONE ? (fsdem_real *)fsdem__pcg_carve(cv, (size_t)n, sizeof(fsdem_real)) : NULL;
     s->u_start = s->u_col = s->u_pos = NULL;
     s->u_val = NULL;
     if (pc == FSDEM_PRECOND_IC0 || pc == FSDEM_PRECOND_MIC0) {
-        s->u_start = (int *)fsdem__carve(cv, (size_t)n + 1, sizeof(int));
-        s->u_pos = (int *)fsdem__carve(cv, (size_t)n, sizeof(int));
-        s->u_col = (int *)fsdem__carve(cv, (size_t)upper, sizeof(int));
-        s->u_val = (fsdem_real *)fsdem__carve(cv, (size_t)upper, sizeof(fsdem_real));
+        s->u_start = (int *)fsdem__pcg_carve(cv, (size_t)n + 1, sizeof(int));
+        s->u_pos = (int *)fsdem__pcg_carve(cv, (size_t)n, sizeof(int));
+        s->u_col = (int *)fsdem__pcg_carve(cv, (size_t)upper, sizeof(int));
+        s->u_val = (fsdem_real *)fsdem__pcg_carve(cv, (size_t)upper, sizeof(fsdem_real));
     }
 }
 
 fsdem_result fsdem_pcg_setup_csr(fsdem_pcg *s, const fsdem_csr *m) {
     char msg[FSDEM__MESSAGE_SIZE];
-    fsdem__carver cv;
+    fsdem__pcg_carver cv;
     fsdem_precond pc;
     fsdem_result res;
     int i, e, upper = 0;
@@ -5801,7 +5801,7 @@ static void fsdem__pcg_store(const fsdem_pcg *s, const fsdem_real *src, fsdem_re
     }
 }
 
-static double fsdem__vdot(const fsdem_real *a, const fsdem_real *b, int n) {
+static double fsdem__pcg_vdot(const fsdem_real *a, const fsdem_real *b, int n) {
     double s0 = 0, s1 = 0;
     int i;
     for (i = 0; i + 1 < n; i += 2) {
@@ -5812,7 +5812,7 @@ static double fsdem__vdot(const fsdem_real *a, const fsdem_real *b, int n) {
     return s0 + s1;
 }
 
-static int fsdem__finite_d(double v) { return v == v && v - v == 0; }
+static int fsdem__pcg_finite_d(double v) { return v == v && v - v == 0; }
 
 /* True residual b - A x into `out` (uses z as scratch); returns its squared norm. */
 static double fsdem__pcg_true_residual(fsdem_pcg *s, const fsdem_real *b, fsdem_real *out) {
@@ -5821,12 +5821,12 @@ static double fsdem__pcg_true_residual(fsdem_pcg *s, const fsdem_real *b, fsdem_
     fsdem__pcg_project(s, out);
     fsdem__pcg_apply(s, s->x, s->z);
     for (i = 0; i < s->length; ++i) out[i] -= s->z[i];
-    return fsdem__vdot(out, out, s->length);
+    return fsdem__pcg_vdot(out, out, s->length);
 }
 
 /* r.z must be positive and finite for a symmetric positive definite preconditioner and operator. */
 static fsdem_result fsdem__pcg_check_rz(fsdem_pcg *s, double rz, int it) {
-    if (!fsdem__finite_d(rz))
+    if (!fsdem__pcg_finite_d(rz))
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: r.z is NaN/Inf at iteration %d", it);
     if (rz <= 0)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
@@ -5863,11 +5863,11 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: initial guess x[%d] = %g is not finite", bad,
                            (double)x[bad]);
     }
-    bb = fsdem__vdot(s->r, s->r, n);
+    bb = fsdem__pcg_vdot(s->r, s->r, n);
     removed = fsdem__pcg_project(s, s->r);
     inf.incompatibility = bb > 0 ? (fsdem_real)sqrt(removed / bb) : 0;
-    bb = fsdem__vdot(s->r, s->r, n);
-    if (!fsdem__finite_d(bb)) {
+    bb = fsdem__pcg_vdot(s->r, s->r, n);
+    if (!fsdem__pcg_finite_d(bb)) {
         if (info) *info = inf;
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: ||b|| overflows");
     }
@@ -5883,10 +5883,10 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
     fsdem__pcg_project(s, s->x);
     fsdem__pcg_apply(s, s->x, s->z);
     for (i = 0; i < n; ++i) s->r[i] -= s->z[i];
-    rr = fsdem__vdot(s->r, s->r, n);
+    rr = fsdem__pcg_vdot(s->r, s->r, n);
     for (;;) {
         double pq, alpha, rz_new, beta;
-        if (!fsdem__finite_d(rr)) {
+        if (!fsdem__pcg_finite_d(rr)) {
             res = fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: the residual became NaN/Inf at iteration %d", it);
             break;
         }
@@ -5910,15 +5910,15 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
         if (restart) {
             fsdem__pcg_precondition(s, s->r, s->z);
             fsdem__pcg_project(s, s->z);
-            rz = fsdem__vdot(s->r, s->z, n);
+            rz = fsdem__pcg_vdot(s->r, s->z, n);
             res = fsdem__pcg_check_rz(s, rz, it);
             if (res != FSDEM_OK) break;
             memcpy(s->p, s->z, sizeof(fsdem_real) * (size_t)n);
             restart = 0;
         }
         fsdem__pcg_apply(s, s->p, s->z); /* z is free until the next preconditioning */
-        pq = fsdem__vdot(s->p, s->z, n);
-        if (!fsdem__finite_d(pq)) {
+        pq = fsdem__pcg_vdot(s->p, s->z, n);
+        if (!fsdem__pcg_finite_d(pq)) {
             res = fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: p.Ap is NaN/Inf at iteration %d", it);
             break;
         }
@@ -5943,10 +5943,10 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
         }
         ++it;
         r_is_true = 0;
-        if (!fsdem__finite_d(rr) || rr <= tol2) continue;
+        if (!fsdem__pcg_finite_d(rr) || rr <= tol2) continue;
         fsdem__pcg_precondition(s, s->r, s->z);
         fsdem__pcg_project(s, s->z);
-        rz_new = fsdem__vdot(s->r, s->z, n);
+        rz_new = fsdem__pcg_vdot(s->r, s->z, n);
         res = fsdem__pcg_check_rz(s, rz_new, it);
         if (res != FSDEM_OK) break;
         beta = rz_new / rz;
@@ -5960,7 +5960,7 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
     }
     inf.iterations = it;
     if (res == FSDEM_ERR_NAN) { /* x is left as it was */
-        inf.residual = (fsdem_real)(fsdem__finite_d(rr) ? sqrt(rr / bb) : rr);
+        inf.residual = (fsdem_real)(fsdem__pcg_finite_d(rr) ? sqrt(rr / bb) : rr);
         if (info) *info = inf;
         return res;
     }
@@ -10891,7 +10891,7 @@ fsdem_result fsdem_dem_write_csv(const fsdem_dem *d, const char *path) {
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
-static void fsdem__vtk_vectors(FILE *fp, const char *name, const fsdem_vec3 *v, int n) {
+static void fsdem__io_vtk_vectors(FILE *fp, const char *name, const fsdem_vec3 *v, int n) {
     int i;
     fprintf(fp, "VECTORS %s double\n", name);
     for (i = 0; i < n; ++i) fprintf(fp, "%.10g %.10g %.10g\n", (double)v[i].x, (double)v[i].y, (double)v[i].z);
@@ -10910,8 +10910,8 @@ fsdem_result fsdem_dem_write_vtk(const fsdem_dem *d, const char *path) {
     for (i = 0; i < d->n; ++i) fprintf(fp, "%.10g\n", (double)d->r[i]);
     fprintf(fp, "SCALARS id int 1\nLOOKUP_TABLE default\n");
     for (i = 0; i < d->n; ++i) fprintf(fp, "%d\n", d->id[i]);
-    fsdem__vtk_vectors(fp, "velocity", d->v, d->n);
-    fsdem__vtk_vectors(fp, "angular_velocity", d->w, d->n);
+    fsdem__io_vtk_vectors(fp, "velocity", d->v, d->n);
+    fsdem__io_vtk_vectors(fp, "angular_velocity", d->w, d->n);
     bad = ferror(fp);
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
 }
