@@ -422,7 +422,8 @@ typedef struct fsdem_cellgrid {
 FSDEM_API fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *grid, const fsdem_allocator *allocator,
                                             int dim, fsdem_vec3 lo, fsdem_vec3 hi,
                                             fsdem_real cell_size, int max_cells);
-/* Bin `count` points. Returns FSDEM_ERR_OUT_OF_MEMORY. */
+/* Bin `count` (>= 0) points. FSDEM_ERR_INVALID_ARG before a successful setup, for a negative count or
+   NULL points; FSDEM_ERR_OUT_OF_MEMORY. */
 FSDEM_API fsdem_result fsdem_cellgrid_build(fsdem_cellgrid *grid, const fsdem_vec3 *points,
                                             int count);
 /* Cell holding a point (clamped into the grid) and its integer coordinates. */
@@ -1660,6 +1661,14 @@ FSDEM_API fsdem_result fsdem_dem_write_vtk(const fsdem_dem *dem, const char *pat
 #define FSDEM_ASSERT(c) assert(c)
 #endif
 
+/* Results must not depend on the compiler fusing a * b + c into one rounding (it changes the last
+   bits, and a chaotic run then diverges), so the implementation forbids the contraction where the
+   compiler honours the standard pragma (clang). GCC contracts only in its GNU modes: build with
+   -std=c99 (or -ffp-contract=off) for results that are the same bit for bit across compilers. */
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
+
 /* ===== >>impl_core : results, allocator, messages, vector algebra ================================== */
 
 /* Contents: results and messages, the allocator and growth, the per-step scratch arena, the status
@@ -1810,6 +1819,15 @@ static fsdem_result fsdem__fail(fsdem__status *s, fsdem_result code, const char 
     return code;
 }
 
+/* Logs an allocation failure of `bytes` in the function `what` (at creation, where no object exists
+   yet to keep the message). */
+static void fsdem__log_oom(fsdem_log_fn log, void *log_user, const char *what, size_t bytes) {
+    char msg[128];
+    if (!log) return;
+    snprintf(msg, sizeof msg, "%s: out of memory (%lu bytes)", what, (unsigned long)bytes);
+    log(log_user, FSDEM_LOG_ERROR, msg);
+}
+
 static fsdem_result fsdem__ok(fsdem__status *s) {
     s->message[0] = '\0';
     return FSDEM_OK;
@@ -1817,9 +1835,10 @@ static fsdem_result fsdem__ok(fsdem__status *s) {
 
 /* The common start of every fsdem_<object>_create: `checked` is the result of the desc check and `why`
    its reason, which goes to the desc's log on failure; otherwise a zeroed object of `size` bytes is
-   allocated with `al`. Returns it, or NULL with *res set. */
+   allocated with `al` (a failure is logged as one of `name`, the create function). Returns it, or
+   NULL with *res set. */
 static void *fsdem__object_new(fsdem_result checked, const char *why, fsdem_log_fn log, void *log_user,
-                               const fsdem_allocator *al, size_t size, fsdem_result *res) {
+                               const fsdem_allocator *al, size_t size, const char *name, fsdem_result *res) {
     void *obj;
     if (checked != FSDEM_OK) {
         if (log) log(log_user, FSDEM_LOG_ERROR, why);
@@ -1829,6 +1848,7 @@ static void *fsdem__object_new(fsdem_result checked, const char *why, fsdem_log_
     obj = fsdem__alloc(al, size);
     *res = obj ? FSDEM_OK : FSDEM_ERR_OUT_OF_MEMORY;
     if (obj) memset(obj, 0, size);
+    else fsdem__log_oom(log, log_user, name, size);
     return obj;
 }
 
@@ -2127,7 +2147,8 @@ static void fsdem__kernel_weights(fsdem__kernel *k, int dim, const fsdem_real s[
 fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *g, const fsdem_allocator *allocator, int dim,
                                   fsdem_vec3 lo, fsdem_vec3 hi, fsdem_real cell_size, int max_cells) {
     double extent[3], cells = 1;
-    int axis;
+    int axis, tries;
+    if (!g) return FSDEM_ERR_INVALID_ARG;
     if (allocator) g->allocator = *allocator;
     if ((dim != 2 && dim != 3) || !(cell_size > 0) || !fsdem__finite(cell_size) ||
         !fsdem__finite3(lo) || !fsdem__finite3(hi))
@@ -2135,13 +2156,16 @@ fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *g, const fsdem_allocator *allo
     if (max_cells <= 0) max_cells = 1 << 24;
     for (axis = 0; axis < 3; ++axis) {
         extent[axis] = axis < dim ? (double)fsdem__comp(hi, axis) - fsdem__comp(lo, axis) : 0;
-        if (axis < dim && !(extent[axis] > 0)) return FSDEM_ERR_INVALID_ARG;
+        /* finite, or the cell count below never fits (a box of +-1e308 overflows to infinity) */
+        if (axis < dim && !(extent[axis] > 0 && extent[axis] < HUGE_VAL)) return FSDEM_ERR_INVALID_ARG;
     }
-    /* Enlarge the cell until the cell count fits: a coarse grid is slower, never wrong. */
-    for (;;) {
+    /* Enlarge the cell until the cell count fits: a coarse grid is slower, never wrong. Each try
+       grows it by 1.25, so 400 tries cover any finite extent over any positive size. */
+    for (tries = 0;; ++tries) {
         cells = 1;
         for (axis = 0; axis < dim; ++axis) cells *= floor(extent[axis] / cell_size) + 1;
         if (cells <= max_cells) break;
+        if (tries == 400 || !fsdem__finite(cell_size * (fsdem_real)1.25)) return FSDEM_ERR_INVALID_ARG;
         cell_size *= (fsdem_real)1.25;
     }
     g->dim = dim;
@@ -2185,6 +2209,7 @@ int fsdem_cellgrid_cell(const fsdem_cellgrid *g, fsdem_vec3 p, int coord[3]) {
 
 fsdem_result fsdem_cellgrid_build(fsdem_cellgrid *g, const fsdem_vec3 *points, int count) {
     int i, c, sum = 0;
+    if (!g || !g->cell_start || count < 0 || (count > 0 && !points)) return FSDEM_ERR_INVALID_ARG; /* set up first */
     if (count > g->item_capacity) {
         int cap = count + count / 4 + 16;
         int *items = (int *)fsdem__alloc(&g->allocator, sizeof(int) * (size_t)cap);
@@ -2422,8 +2447,9 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
     if (!fsdem__finite3(d->domain_min) || !fsdem__finite3(d->domain_max))
         return fsdem__reject(msg, size, "fsdem_dem_desc.domain_min/domain_max must be finite");
     for (axis = 0; axis < d->dim; ++axis)
-        if (!(fsdem__comp(d->domain_max, axis) > fsdem__comp(d->domain_min, axis)))
-            return fsdem__reject(msg, size, "fsdem_dem_desc.domain_max must exceed domain_min on axis %d",
+        if (!(fsdem__comp(d->domain_max, axis) > fsdem__comp(d->domain_min, axis)) ||
+            !fsdem__finite(fsdem__comp(d->domain_max, axis) - fsdem__comp(d->domain_min, axis)))
+            return fsdem__reject(msg, size, "fsdem_dem_desc.domain_max must exceed domain_min by a finite extent on axis %d",
                                  axis);
     if (!fsdem__finite3(d->gravity)) return fsdem__reject(msg, size, "fsdem_dem_desc.gravity is not finite");
     if (d->law != FSDEM_DEM_LAW_LINEAR && d->law != FSDEM_DEM_LAW_HERTZ_MINDLIN && d->law != FSDEM_DEM_LAW_GIC)
@@ -2478,8 +2504,8 @@ static fsdem_result fsdem__dem_material_check(const fsdem_dem_material *m, char 
     if (!(m->poisson_ratio > -1 && m->poisson_ratio <= (fsdem_real)0.5))
         return fsdem__reject(msg, size, "fsdem_dem_material.poisson_ratio must be in (-1, 0.5] (got %g)",
                              (double)m->poisson_ratio);
-    if (!(m->restitution > 0 && m->restitution <= 1))
-        return fsdem__reject(msg, size, "fsdem_dem_material.restitution must be in (0, 1] (got %g)", (double)m->restitution);
+    if (!(m->restitution >= 1e-6 && m->restitution <= 1))
+        return fsdem__reject(msg, size, "fsdem_dem_material.restitution must be in [1e-6, 1] (got %g)", (double)m->restitution);
     if (!(m->friction >= 0) || !fsdem__finite(m->friction))
         return fsdem__reject(msg, size, "fsdem_dem_material.friction must be >= 0 (got %g)", (double)m->friction);
     if (!(m->rolling_friction >= 0) || !fsdem__finite(m->rolling_friction))
@@ -2576,17 +2602,20 @@ static double fsdem__dem_hertz_restitution(double a) {
 #undef FSDEM__DEM_HERTZ_ACC
         xn = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x);
         vn = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
-        if (step > 0 && xn <= 0) {
-            double s = x / (x - xn); /* linear interpolation to the crossing */
-            return -(v + s * (vn - v));
-        }
+        /* Once the clamped force vanishes on the way out (v < 0) it stays zero (the elastic term
+           falls faster than the damping one as x shrinks at constant v): the particle coasts off
+           at -vn. Stopping here, not at x = 0, bounds the work for heavy damping, where the
+           coasting tail would take ever longer. */
+        if (step > 0 && vn < 0 && (xn <= 0 || xn * sqrt(xn) + a * sqrt(sqrt(xn)) * vn <= 0)) return -vn;
         x = xn;
         v = vn;
     }
     return 0;
 }
 
-/* Damping coefficient a whose restitution is e (bisection; e decreases monotonically with a). */
+/* Damping coefficient a whose restitution is e (bisection; e decreases monotonically with a): a
+   bracket [0, hi <= 1e4] and 40 halvings, each an integration of at most ~1e5 steps (a = 1e4 gives
+   e ~ 1e-8), so it takes milliseconds for any e in the accepted range [1e-6, 1]. */
 static fsdem_real fsdem__dem_tsuji_coefficient(fsdem_real e) {
     double lo = 0, hi = 1, mid = 0;
     int it;
@@ -2947,6 +2976,16 @@ static void fsdem__dem_particle_arrays(fsdem_dem *d, void **ptr[FSDEM__DEM_PARTI
     FSDEM_ASSERT(k == FSDEM__DEM_PARTICLE_ARRAYS);
 }
 
+/* Bytes of the per-particle arrays for `count` particles. */
+static size_t fsdem__dem_particle_bytes(fsdem_dem *d, int count) {
+    void **ptr[FSDEM__DEM_PARTICLE_ARRAYS];
+    size_t size[FSDEM__DEM_PARTICLE_ARRAYS], total = 0;
+    int k;
+    fsdem__dem_particle_arrays(d, ptr, size);
+    for (k = 0; k < FSDEM__DEM_PARTICLE_ARRAYS; ++k) total += size[k] * (size_t)count;
+    return total;
+}
+
 static fsdem_result fsdem__dem_reserve_particles(fsdem_dem *d, int need) {
     void **ptr[FSDEM__DEM_PARTICLE_ARRAYS];
     void *fresh[FSDEM__DEM_PARTICLE_ARRAYS];
@@ -2992,7 +3031,7 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_dem_desc_check(desc, msg, sizeof msg);
     d = (fsdem_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                       desc ? &desc->allocator : NULL, sizeof *d, &res);
+                                       desc ? &desc->allocator : NULL, sizeof *d, "fsdem_dem_create", &res);
     if (!d) return res;
     d->desc = *desc;
     if (desc->dt_rule == FSDEM_DEM_DT_AUTO)
@@ -3015,6 +3054,7 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     }
     res = fsdem__dem_reserve_particles(d, desc->capacity > 0 ? desc->capacity : 1);
     if (res != FSDEM_OK) {
+        fsdem__log_oom(desc->log, desc->log_user, "fsdem_dem_create", fsdem__dem_particle_bytes(d, desc->capacity));
         fsdem_dem_destroy(d);
         return res;
     }
@@ -3114,7 +3154,7 @@ static void fsdem__dem_planar(const fsdem_dem *d, fsdem_vec3 *x, fsdem_vec3 *v, 
 fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_dem_particle_desc *p, int *index) {
     fsdem_result res;
     int i;
-    fsdem_real volume, inertia_factor, rho;
+    fsdem_real volume, inertia_factor, mass, inertia;
     fsdem_vec3 x, v, w;
     if (!d) return FSDEM_ERR_INVALID_ARG;
     i = d->n;
@@ -3128,13 +3168,6 @@ fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_dem_particle_desc 
                            p->material, d->material_count);
     res = fsdem__dem_state_check(d, "fsdem_dem_particle_desc", p->position, p->velocity, p->angular_velocity);
     if (res != FSDEM_OK) return res;
-    if (fsdem__dem_reserve_particles(d, d->n + 1) != FSDEM_OK)
-        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_particle: out of memory adding particle %d", d->n);
-    x = p->position;
-    v = p->velocity;
-    w = p->angular_velocity;
-    fsdem__dem_planar(d, &x, &v, &w);
-    rho = d->materials[p->material].density;
     if (d->desc.dim == 2) {
         volume = (fsdem_real)FSDEM__PI * p->radius * p->radius * d->desc.disc_length;
         inertia_factor = (fsdem_real)0.5; /* disc about its axis: m r^2 / 2 */
@@ -3142,6 +3175,21 @@ fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_dem_particle_desc 
         volume = (fsdem_real)(4.0 / 3.0 * FSDEM__PI) * p->radius * p->radius * p->radius;
         inertia_factor = (fsdem_real)0.4; /* solid sphere: 2 m r^2 / 5 */
     }
+    mass = d->materials[p->material].density * volume;
+    inertia = inertia_factor * mass * p->radius * p->radius;
+    /* a radius of 1e120 overflows the mass (the particle would act as fixed), one of 1e-120 rounds
+       it to zero (NaN at the next step): both are refused */
+    if (!(mass > 0 && inertia > 0) || !fsdem__finite(inertia) || !fsdem__finite(1 / inertia))
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_dem_particle_desc.radius %g m gives mass %g kg and moment of inertia %g kg m^2, "
+                           "which are not positive finite numbers",
+                           (double)p->radius, (double)mass, (double)inertia);
+    if (fsdem__dem_reserve_particles(d, d->n + 1) != FSDEM_OK)
+        return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_particle: out of memory adding particle %d", d->n);
+    x = p->position;
+    v = p->velocity;
+    w = p->angular_velocity;
+    fsdem__dem_planar(d, &x, &v, &w);
     d->id[i] = d->next_id++;
     d->material[i] = p->material;
     d->old_of[i] = -1;
@@ -3152,9 +3200,9 @@ fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_dem_particle_desc 
     d->f[i] = d->t[i] = d->fext[i] = d->text[i] = fsdem__zero3();
     d->x_ref[i] = x;
     d->r[i] = p->radius;
-    d->m[i] = rho * volume;
-    d->inv_m[i] = p->fixed ? 0 : 1 / d->m[i];
-    d->inv_i[i] = p->fixed ? 0 : 1 / (inertia_factor * d->m[i] * p->radius * p->radius);
+    d->m[i] = mass;
+    d->inv_m[i] = p->fixed ? 0 : 1 / mass;
+    d->inv_i[i] = p->fixed ? 0 : 1 / inertia;
     d->n++;
     d->need_rebuild = 1;
     d->forces_valid = 0;
@@ -3334,28 +3382,42 @@ fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_dem_wall_desc *desc, i
     }
     switch (g.type) {
     case FSDEM_DEM_WALL_PLANE: {
-        fsdem_real len;
+        fsdem_real len, big;
         if (d->desc.dim == 2) g.b.z = 0;
+        /* scaled by its largest component first, so a normal of (1e300, 1e300, 1e300) does not
+           overflow to a zero unit vector */
+        big = (fsdem_real)fmax(fmax(fabs(g.b.x), fabs(g.b.y)), fabs(g.b.z));
+        if (!(big > 0)) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_plane: the normal is zero");
+        g.b = fsdem__scale(g.b, 1 / big);
         len = fsdem__norm(g.b);
-        if (!(len > 0)) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_plane: the normal is zero");
         g.b = fsdem__scale(g.b, 1 / len);
         break;
     }
     case FSDEM_DEM_WALL_BOX_INSIDE:
     case FSDEM_DEM_WALL_BOX_OUTSIDE:
         for (axis = 0; axis < d->desc.dim; ++axis)
-            if (!(fsdem__comp(g.b, axis) > fsdem__comp(g.a, axis)))
-                return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_box: hi must exceed lo on axis %d", axis);
+            if (!(fsdem__comp(g.b, axis) > fsdem__comp(g.a, axis)) || !fsdem__finite(fsdem__comp(g.b, axis) - fsdem__comp(g.a, axis)))
+                return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
+                                   "fsdem_dem_wall_box: hi must exceed lo by a finite extent on axis %d", axis);
         break;
     case FSDEM_DEM_WALL_SEGMENT:
-        if (!(fsdem__norm(fsdem__sub(g.b, g.a)) > 0))
-            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_segment: the end points coincide");
+        if (d->desc.dim != 2)
+            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_segment: segments need dim = 2 (use triangles in 3D)");
+        if (!(fsdem__norm(fsdem__sub(g.b, g.a)) > 0) || !fsdem__finite(fsdem__norm(fsdem__sub(g.b, g.a))))
+            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
+                               "fsdem_dem_wall_segment: the end points must be distinct at a finite distance");
         break;
     case FSDEM_DEM_WALL_TRIANGLE:
         if (d->desc.dim != 3)
             return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_triangle: triangles need dim = 3 (use segments in 2D)");
-        if (!(fsdem__norm(fsdem__cross(fsdem__sub(g.b, g.a), fsdem__sub(g.c, g.a))) > 0))
-            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_triangle: the triangle is degenerate");
+        {
+            /* twice the area; not finite when coordinates of 1e200 overflow it */
+            const fsdem_real area2 = fsdem__norm(fsdem__cross(fsdem__sub(g.b, g.a), fsdem__sub(g.c, g.a)));
+            if (!(area2 > 0) || !fsdem__finite(area2) || !fsdem__finite(1 / area2))
+                return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
+                                   "fsdem_dem_wall_triangle: the triangle is degenerate or too large (twice its area: %g m^2)",
+                                   (double)area2);
+        }
         break;
     case FSDEM_DEM_WALL_SDF:
         if (!g.sdf) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_sdf: the callback is NULL");
@@ -3557,7 +3619,7 @@ static fsdem_result fsdem__dem_fill_pairs(fsdem_dem *d, int count, int *cursor) 
     }
     if (fsdem__grow(&d->allocator, (void **)&d->inert, &d->inert_capacity, 0, 2 * inert, sizeof(int)) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
-    memcpy(d->inert, d->found + 2 * count, sizeof(int) * 2 * (size_t)inert);
+    if (inert) memcpy(d->inert, d->found + 2 * count, sizeof(int) * 2 * (size_t)inert); /* found may be NULL */
     d->inert_count = inert;
     while (l->capacity < count)
         if (fsdem__dem_list_grow(d, l) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
@@ -4294,15 +4356,6 @@ fsdem_dem_energy fsdem_dem_get_energy(const fsdem_dem *d) {
     return e;
 }
 
-static size_t fsdem__dem_particle_bytes(fsdem_dem *d) {
-    void **ptr[FSDEM__DEM_PARTICLE_ARRAYS];
-    size_t size[FSDEM__DEM_PARTICLE_ARRAYS], total = 0;
-    int k;
-    fsdem__dem_particle_arrays(d, ptr, size);
-    for (k = 0; k < FSDEM__DEM_PARTICLE_ARRAYS; ++k) total += size[k] * (size_t)d->capacity;
-    return total;
-}
-
 fsdem_dem_stats fsdem_dem_get_stats(const fsdem_dem *d) {
     fsdem_dem_stats s;
     memset(&s, 0, sizeof s);
@@ -4317,7 +4370,7 @@ fsdem_dem_stats fsdem_dem_get_stats(const fsdem_dem *d) {
     s.wall_contacts = d->wall_contacts;
     s.neighbour_pairs = d->pp.count + d->inert_count;
     s.max_overlap = d->max_overlap;
-    s.memory_bytes = sizeof *d + fsdem__dem_particle_bytes((fsdem_dem *)d) +
+    s.memory_bytes = sizeof *d + fsdem__dem_particle_bytes((fsdem_dem *)d, d->capacity) +
                      (size_t)(d->pp.capacity + d->pp_old.capacity + d->pw.capacity + d->pw_old.capacity) *
                          (2 * sizeof(int) + sizeof(fsdem_vec3)) +
                      (size_t)(d->pp.start_capacity + d->pp_old.start_capacity + d->pw.start_capacity +
@@ -4680,7 +4733,7 @@ fsdem_result fsdem_pcg_create(const fsdem_pcg_desc *desc, fsdem_pcg **out) {
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_pcg_desc_check(desc, msg, sizeof msg);
     s = (fsdem_pcg *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                       desc ? &desc->allocator : NULL, sizeof *s, &res);
+                                       desc ? &desc->allocator : NULL, sizeof *s, "fsdem_pcg_create", &res);
     if (!s) return res;
     s->desc = *desc;
     s->allocator = desc->allocator;
@@ -6202,6 +6255,15 @@ static fsdem_result fsdem__pic_check(const fsdem_pic_desc *d, char *msg, size_t 
         FSDEM__PIC_BAD("fsdem_pic_desc.allocator needs both alloc and free, or neither");
 #undef FSDEM__PIC_BAD
     fsdem__pic_grid_size(d, cells, &total, &bytes);
+    for (a = 0; a < d->dim; ++a) {
+        /* whole cells move domain_max by at most half a cell, unless the extent is below half a cell */
+        const double extent = (double)fsdem__comp(d->domain_max, a) - (double)fsdem__comp(d->domain_min, a);
+        if (fabs(cells[a] * (double)d->cell_size - extent) > 0.5 * (double)d->cell_size * (1 + 1e-9))
+            return fsdem__reject(msg, size,
+                                 "fsdem_pic_desc.cell_size = %g m exceeds twice the extent %g m along %c: the grid would "
+                                 "change the domain by more than half a cell",
+                                 (double)d->cell_size, extent, "xyz"[a]);
+    }
     if (total > 4e8 || cells[0] + 1 > 2e9 || cells[1] + 1 > 2e9 || cells[2] + 1 > 2e9 ||
         (d->max_memory > 0 && bytes > (double)d->max_memory) || bytes > (double)((size_t)-1) / 2) {
         if (msg && size)
@@ -6464,7 +6526,7 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
     if (out) *out = NULL;
     if (!desc || !out) return FSDEM_ERR_INVALID_ARG;
     r = fsdem__pic_check(desc, msg, sizeof msg);
-    s = (fsdem_pic *)fsdem__object_new(r, msg, desc->log, desc->log_user, &desc->allocator, sizeof *s, &r);
+    s = (fsdem_pic *)fsdem__object_new(r, msg, desc->log, desc->log_user, &desc->allocator, sizeof *s, "fsdem_pic_create", &r);
     if (!s) return r;
     s->desc = *desc;
     s->allocator = desc->allocator;
@@ -6472,6 +6534,13 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
     s->status.log = desc->log;
     s->status.log_user = desc->log_user;
     fsdem__pic_layout(s, desc);
+    for (a = 0; a < s->dim && desc->log; ++a)
+        if (fsdem__comp(s->hi, a) != fsdem__comp(desc->domain_max, a)) {
+            snprintf(msg, sizeof msg, "fsdem_pic_create: domain_max.%c rounded from %.9g to %.9g m (%d cells of %g m)",
+                     "xyz"[a], (double)fsdem__comp(desc->domain_max, a), (double)fsdem__comp(s->hi, a), s->n[a],
+                     (double)s->dx);
+            desc->log(desc->log_user, FSDEM_LOG_INFO, msg);
+        }
     if (fsdem__pic_allocate(s) != FSDEM_OK) {
         snprintf(msg, sizeof msg, "fsdem_pic_create: out of memory allocating the %d x %d x %d grid", s->n[0], s->n[1],
                  s->n[2]);
@@ -6916,10 +6985,30 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
             if (v.x > o.box_hi.x) o.box_hi.x = v.x;
             if (v.y > o.box_hi.y) o.box_hi.y = v.y;
         }
+        {
+            /* shoelace area: coincident or collinear vertices enclose nothing */
+            double area = 0;
+            int j;
+            for (i = 0, j = ob->vertex_count - 1; i < ob->vertex_count; j = i++)
+                area += (double)ob->vertices[j].x * ob->vertices[i].y - (double)ob->vertices[i].x * ob->vertices[j].y;
+            if (!(fabs(area) > 0) || !(fabs(area) < HUGE_VAL))
+                return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                                   "fsdem_pic_add_obstacle: obstacle %d (polygon): the vertices enclose no area", s->obst_count);
+        }
         break;
     case FSDEM_PIC_OBSTACLE_SDF:
         if (!ob->sdf)
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (sdf): NULL callback", s->obst_count);
+        for (i = 0; i < s->ncell; ++i) {
+            /* a distance that is not a number would be ignored silently by the union below */
+            const fsdem_vec3 c = fsdem__pic_cell_pos(s, i % s->n[0], i / s->n[0] % s->n[1], i / (s->n[0] * s->n[1]));
+            fsdem_vec3 nrm;
+            const fsdem_real dist = ob->sdf(ob->sdf_user, c, &nrm);
+            if (!fsdem__finite(dist))
+                return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                                   "fsdem_pic_add_obstacle: obstacle %d (sdf): the callback returned %g at (%g, %g, %g)",
+                                   s->obst_count, (double)dist, (double)c.x, (double)c.y, (double)c.z);
+        }
         o.box_lo = fsdem__sub(s->lo, fsdem_v3(1e30f, 1e30f, 1e30f));
         o.box_hi = fsdem__add(s->hi, fsdem_v3(1e30f, 1e30f, 1e30f));
         break;
@@ -8042,9 +8131,11 @@ static int fsdem__pic_append(fsdem_pic *s, fsdem_vec3 x, fsdem_vec3 v) {
 static int fsdem__pic_random_in_cell(fsdem_pic *s, int i, int j, int k, fsdem_vec3 *out) {
     int t;
     for (t = 0; t < 8; ++t) {
-        fsdem_vec3 p = fsdem_v3(s->lo.x + s->dx * ((fsdem_real)i + fsdem__pic_rand(s)),
-                                s->lo.y + s->dx * ((fsdem_real)j + fsdem__pic_rand(s)),
-                                s->dim == 3 ? s->lo.z + s->dx * ((fsdem_real)k + fsdem__pic_rand(s)) : 0);
+        /* one draw per statement: C leaves the order of a function's arguments unspecified, so
+           draws in one argument list would give different runs with different compilers */
+        const fsdem_real rx = fsdem__pic_rand(s), ry = fsdem__pic_rand(s), rz = s->dim == 3 ? fsdem__pic_rand(s) : 0;
+        fsdem_vec3 p = fsdem_v3(s->lo.x + s->dx * ((fsdem_real)i + rx), s->lo.y + s->dx * ((fsdem_real)j + ry),
+                                s->dim == 3 ? s->lo.z + s->dx * ((fsdem_real)k + rz) : 0);
         if (fsdem__pic_open_at(s, p)) {
             *out = p;
             return 1;
@@ -8855,6 +8946,16 @@ fsdem_result fsdem_swe_desc_check(const fsdem_swe_desc *d, char *msg, size_t siz
                              (double)d->y_max);
     if (d->dim == 1 && (!(d->width > 0) || !fsdem__finite(d->width)))
         return fsdem__reject(msg, size, "fsdem_swe_desc.width must be > 0 (got %g m)", (double)d->width);
+    {
+        /* cells of a finite, normal size: a range of +-1e308 overflows dx, one of 1e-308 underflows
+           the cell area */
+        const fsdem_real dx = (d->x_max - d->x_min) / (fsdem_real)d->nx;
+        const fsdem_real dy = d->dim == 2 ? (d->y_max - d->y_min) / (fsdem_real)d->ny : d->width, area = dx * dy;
+        if (!fsdem__finite(dx) || !fsdem__finite(dy) || !fsdem__finite(area) || !(area > 0) || !fsdem__finite(1 / area) ||
+            !fsdem__finite(1 / dx) || !fsdem__finite(1 / dy) || area < (fsdem_real)FLT_MIN)
+            return fsdem__reject(msg, size, "fsdem_swe_desc: cells of %g x %g m (extent / cell count) are not of a finite, "
+                                            "representable size", (double)dx, (double)dy);
+    }
     if (d->gravity.x != 0 || d->gravity.y != 0 || !(d->gravity.z < 0) || !fsdem__finite(d->gravity.z))
         return fsdem__reject(msg, size, "fsdem_swe_desc.gravity must be (0, 0, -g) with g > 0 (got (%g, %g, %g) m/s^2)",
                              (double)d->gravity.x, (double)d->gravity.y, (double)d->gravity.z);
@@ -9005,7 +9106,7 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_swe_desc_check(desc, msg, sizeof msg);
     s = (fsdem_swe *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                       desc ? &desc->allocator : NULL, sizeof *s, &res);
+                                       desc ? &desc->allocator : NULL, sizeof *s, "fsdem_swe_create", &res);
     if (!s) return res;
     al = desc->allocator;
     s->desc = *desc;
@@ -9032,6 +9133,7 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
     s->block_bytes = reals * sizeof(fsdem_real);
     s->block = (fsdem_real *)fsdem__alloc(&al, s->block_bytes);
     if (!s->block) {
+        fsdem__log_oom(desc->log, desc->log_user, "fsdem_swe_create", s->block_bytes);
         fsdem__free(&al, s, sizeof *s);
         return FSDEM_ERR_OUT_OF_MEMORY;
     }
@@ -10528,7 +10630,7 @@ fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem 
     res = fsdem_swe_dem_desc_check(desc, msg, sizeof msg);
     if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
     c = (fsdem_swe_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                           res == FSDEM_OK ? &al : NULL, sizeof *c, &res);
+                                           res == FSDEM_OK ? &al : NULL, sizeof *c, "fsdem_swe_dem_create", &res);
     if (!c) return res;
     {
         const fsdem_swe_desc sd = fsdem_swe_get_desc(desc->swe);
