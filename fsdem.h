@@ -1342,10 +1342,11 @@ FSDEM_API fsdem_result fsdem_swe_set_cells(fsdem_swe *swe, fsdem_swe_init_fn fn,
    destroyed; change them with the setters. */
 typedef struct fsdem_swe_fields {
     int nx, ny;
-    const fsdem_real *eta;  /* m */
-    const fsdem_real *qx;   /* m^2/s, uh */
-    const fsdem_real *qy;   /* m^2/s, vh (all zero in 1D) */
-    const fsdem_real *bed;  /* m */
+    const fsdem_real *eta;           /* m */
+    const fsdem_real *qx;            /* m^2/s, uh */
+    const fsdem_real *qy;            /* m^2/s, vh (all zero in 1D) */
+    const fsdem_real *bed;           /* m */
+    const unsigned char *blocked;    /* 1 for blocked cells (fsdem_swe_set_blocked); NULL when none */
 } fsdem_swe_fields;
 
 FSDEM_API fsdem_swe_fields fsdem_swe_get_fields(const fsdem_swe *swe);
@@ -1379,7 +1380,8 @@ FSDEM_API fsdem_result fsdem_swe_copy_field(const fsdem_swe *swe, fsdem_swe_fiel
 /* Cell holding the point (x, y) (y ignored in 1D): its index k = i + nx j, or -1 outside. */
 FSDEM_API int fsdem_swe_cell_at(const fsdem_swe *swe, fsdem_real x, fsdem_real y);
 /* State at a point, interpolated (bi)linearly between cell centres (clamped to the outermost centres
-   near the boundary): bed, depth, eta and velocity. FSDEM_ERR_OUT_OF_DOMAIN outside the grid. */
+   near the boundary; blocked cells leave the interpolation, the others share their weight): bed,
+   depth, eta and velocity. FSDEM_ERR_OUT_OF_DOMAIN outside the grid or in a blocked cell. */
 FSDEM_API fsdem_result fsdem_swe_sample_state(const fsdem_swe *swe, fsdem_real x, fsdem_real y, fsdem_swe_cell *out);
 /* The coupling sample at `count` points (x, y horizontal, z vertical; 1D: y ignored): the
    depth-averaged velocity where z is in the water column (bed <= z <= eta), the hydrostatic pressure
@@ -1410,6 +1412,20 @@ FSDEM_API fsdem_result fsdem_swe_set_boundary(fsdem_swe *swe, fsdem_side side, c
 FSDEM_API fsdem_result fsdem_swe_set_manning(fsdem_swe *swe, const fsdem_real *manning);
 /* Uniform rain rate (m/s, >= 0) from now on. */
 FSDEM_API fsdem_result fsdem_swe_set_rain(fsdem_swe *swe, fsdem_real rate);
+
+/* Blocked cells: solids inside the domain (buildings, walls, piers). Their faces reflect like a
+   FSDEM_SWE_BC_WALL side (no mass flux, the normal velocity mirrored in the reconstruction), they
+   hold no water, and gauges, sampling and point sources never reach into them. `blocked` has nx*ny
+   values (nonzero: blocked) and replaces the mask; NULL unblocks every cell. Water in a cell that
+   becomes blocked is removed and counted in stats.source_volume (negative), so the volume balance
+   still holds. FSDEM_ERR_INVALID_ARG (with nothing changed) when a point source or gauge would be
+   in a blocked cell; FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_swe_set_blocked(fsdem_swe *swe, const unsigned char *blocked);
+/* Adds to the mask the cells whose centres lie in the box [x0, x1] x [y0, y1] (1D: y ignored). */
+FSDEM_API fsdem_result fsdem_swe_block_box(fsdem_swe *swe, fsdem_real x0, fsdem_real y0, fsdem_real x1, fsdem_real y1);
+/* Adds to the mask the cells whose centres lie inside the closed polygon of `count` >= 3 vertices
+   (x, y used; a building footprint; 2D only). */
+FSDEM_API fsdem_result fsdem_swe_block_polygon(fsdem_swe *swe, const fsdem_vec3 *vertices, int count);
 
 /* A point source (Q > 0) or sink (Q < 0) of discharge Q (m^3/s; 1D: the whole channel width) in the
    cell holding (x, y); with a series, Q follows it in time like a boundary series. A sink takes no
@@ -8797,6 +8813,7 @@ typedef struct fsdem__swe_sface {
    inner loop has neither a limiter switch nor 2D branches in 1D. */
 
 /* m^2/s: unit discharges below this are set to zero (no physical meaning; see fsdem__swe_finish) */
+#define FSDEM__SWE_GAUGE 6 /* reals per gauge: x, y, h, eta, u, v */
 #define FSDEM__SWE_QTINY ((fsdem_real)(sizeof(fsdem_real) < sizeof(double) ? 1e-12 : 1e-100))
 
 typedef struct fsdem__swe_bnd {
@@ -8833,6 +8850,8 @@ struct fsdem_swe {
     size_t block_bytes;
     fsdem_real *eta, *qx, *qy, *bed, *sx, *sy;
     fsdem_real *manning; /* NULL: uniform desc.manning */
+    unsigned char *blocked; /* n flags (1: solid cell), NULL when no cell is blocked */
+    int blocked_count;
     int sources_used;
 
     /* work rows */
@@ -8847,7 +8866,7 @@ struct fsdem_swe {
     fsdem__swe_src *src;
     int src_count, src_capacity, src_next_id;
 
-    fsdem_real *gauge_xy;
+    fsdem_real *gauge; /* per gauge: x, y, then h, eta, u, v at the start of the step in flight */
     int gauge_count, gauge_capacity;
     void *gauge_file;
     double gauge_interval, gauge_next;
@@ -9062,6 +9081,18 @@ static void fsdem__swe_velocity(const fsdem_swe *s, int k, fsdem_real *u, fsdem_
     *v = s->qy[k] / h;
 }
 
+static int fsdem__swe_is_blocked(const fsdem_swe *s, int k) { return s->blocked && k >= 0 && s->blocked[k]; }
+
+/* Keeps blocked cells dry (after a setter wrote depths). */
+static void fsdem__swe_dry_blocked(fsdem_swe *s) {
+    int k;
+    for (k = 0; s->blocked && k < s->n; ++k)
+        if (s->blocked[k]) {
+            s->eta[k] = s->bed[k];
+            s->qx[k] = s->qy[k] = 0;
+        }
+}
+
 /* Recomputes the wave-speed bound and the statistics of the current state (after a setter). */
 static void fsdem__swe_scan(fsdem_swe *s) {
     int k, wet = 0;
@@ -9162,6 +9193,9 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
         s->bed[k] = desc->bed ? desc->bed[k] : 0;
         s->eta[k] = s->bed[k] + (desc->depth ? desc->depth[k] : 0);
     }
+    fsdem__swe_dry_blocked(s);
+    fsdem__swe_dry_blocked(s);
+    fsdem__swe_dry_blocked(s);
     fsdem__swe_scan(s);
     *out = s;
     return FSDEM_OK;
@@ -9174,8 +9208,9 @@ void fsdem_swe_destroy(fsdem_swe *s) {
     for (k = 0; k < 4; ++k) fsdem__swe_free_series(s, &s->bnd[k].t, &s->bnd[k].v, &s->bnd[k].n);
     for (k = 0; k < s->src_count; ++k) fsdem__swe_free_series(s, &s->src[k].t, &s->src[k].v, &s->src[k].n);
     fsdem__free(&s->allocator, s->src, sizeof(fsdem__swe_src) * (size_t)s->src_capacity);
-    fsdem__free(&s->allocator, s->gauge_xy, 2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+    fsdem__free(&s->allocator, s->gauge, FSDEM__SWE_GAUGE * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
     fsdem__free(&s->allocator, s->manning, sizeof(fsdem_real) * (size_t)s->n);
+    fsdem__free(&s->allocator, s->blocked, (size_t)s->n);
     fsdem__free(&s->allocator, s->block, s->block_bytes);
     fsdem__free(&s->allocator, s, sizeof *s);
 }
@@ -9312,6 +9347,7 @@ fsdem_swe_fields fsdem_swe_get_fields(const fsdem_swe *s) {
     f.qx = s->qx;
     f.qy = s->qy;
     f.bed = s->bed;
+    f.blocked = s->blocked;
     return f;
 }
 
@@ -9361,10 +9397,11 @@ int fsdem_swe_cell_at(const fsdem_swe *s, fsdem_real x, fsdem_real y) {
 }
 
 fsdem_result fsdem_swe_sample_state(const fsdem_swe *s, fsdem_real x, fsdem_real y, fsdem_swe_cell *out) {
-    fsdem_real fx, fy, wx, wy, w[4];
+    fsdem_real fx, fy, wx, wy, w[4], wsum = 0;
     int i0, j0, i1, j1, c[4], q;
     if (!s || !out) return FSDEM_ERR_INVALID_ARG;
-    if (fsdem_swe_cell_at(s, x, y) < 0) return FSDEM_ERR_OUT_OF_DOMAIN;
+    q = fsdem_swe_cell_at(s, x, y);
+    if (q < 0 || fsdem__swe_is_blocked(s, q)) return FSDEM_ERR_OUT_OF_DOMAIN;
     /* (bi)linear between the centres around the point, clamped at the outermost centres */
     fx = (x - s->desc.x_min) / s->dx - (fsdem_real)0.5;
     fy = s->dim == 2 ? (y - s->desc.y_min) / s->dy - (fsdem_real)0.5 : 0;
@@ -9386,9 +9423,17 @@ fsdem_result fsdem_swe_sample_state(const fsdem_swe *s, fsdem_real x, fsdem_real
     w[1] = wx * (1 - wy);
     w[2] = (1 - wx) * wy;
     w[3] = wx * wy;
+    /* never across a wall: blocked cells leave the stencil and the others share their weight */
+    for (q = 0; s->blocked && q < 4; ++q) {
+        if (s->blocked[c[q]]) w[q] = 0;
+        wsum += w[q];
+    }
+    if (s->blocked)
+        for (q = 0; q < 4; ++q) w[q] = wsum > 0 ? w[q] / wsum : (c[q] == fsdem_swe_cell_at(s, x, y));
     out->bed = out->depth = out->u = out->v = 0;
     for (q = 0; q < 4; ++q) {
         fsdem_real u, v;
+        if (w[q] == 0) continue;
         fsdem__swe_velocity(s, c[q], &u, &v);
         out->bed += w[q] * s->bed[c[q]];
         out->depth += w[q] * (s->eta[c[q]] - s->bed[c[q]]);
@@ -9534,6 +9579,104 @@ fsdem_result fsdem_swe_set_rain(fsdem_swe *s, fsdem_real rate) {
     return fsdem__ok(&s->status);
 }
 
+/* Replaces the mask by `mask` (n flags, or NULL for none) after checking sources and gauges; the
+   water of newly blocked cells is removed and booked as a source. */
+static fsdem_result fsdem__swe_apply_blocked(fsdem_swe *s, const unsigned char *mask, const char *what) {
+    int k, count = 0;
+    for (k = 0; mask && k < s->src_count; ++k)
+        if (s->src[k].active && mask[s->src[k].cell])
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: point source %d would be in a blocked cell", what,
+                               s->src[k].id);
+    for (k = 0; mask && k < s->gauge_count; ++k)
+        if (mask[fsdem_swe_cell_at(s, s->gauge[FSDEM__SWE_GAUGE * k], s->gauge[FSDEM__SWE_GAUGE * k + 1])])
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: gauge %d would be in a blocked cell", what, k);
+    if (mask && !s->blocked) {
+        s->blocked = (unsigned char *)fsdem__alloc(&s->allocator, (size_t)s->n);
+        if (!s->blocked) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory", what);
+    }
+    for (k = 0; mask && k < s->n; ++k) {
+        const int b = mask[k] != 0;
+        if (b && !s->blocked[k]) s->vol_source -= (s->eta[k] - s->bed[k]) * s->area;
+        s->blocked[k] = (unsigned char)b;
+        count += b;
+    }
+    if (!count) {
+        fsdem__free(&s->allocator, s->blocked, (size_t)s->n);
+        s->blocked = NULL;
+    }
+    s->blocked_count = count;
+    fsdem__swe_dry_blocked(s);
+    fsdem__swe_scan(s);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_swe_set_blocked(fsdem_swe *s, const unsigned char *blocked) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__swe_apply_blocked(s, blocked, "fsdem_swe_set_blocked");
+}
+
+/* Blocks the cells whose centre p makes inside(p) true, on top of the current mask. */
+static fsdem_result fsdem__swe_block_where(fsdem_swe *s, int (*inside)(const void *shape, fsdem_real x, fsdem_real y),
+                                           const void *shape, const char *what) {
+    unsigned char *mask = (unsigned char *)fsdem__alloc(&s->allocator, (size_t)s->n);
+    fsdem_result res;
+    int k;
+    if (!mask) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory", what);
+    for (k = 0; k < s->n; ++k) {
+        fsdem_real x, y;
+        fsdem__swe_centre(s, k, &x, &y);
+        mask[k] = (unsigned char)(fsdem__swe_is_blocked(s, k) || inside(shape, x, y));
+    }
+    res = fsdem__swe_apply_blocked(s, mask, what);
+    fsdem__free(&s->allocator, mask, (size_t)s->n);
+    return res;
+}
+
+static int fsdem__swe_in_box(const void *shape, fsdem_real x, fsdem_real y) {
+    const fsdem_real *b = (const fsdem_real *)shape; /* x0, y0, x1, y1, dim */
+    return x >= b[0] && x <= b[2] && (b[4] == 1 || (y >= b[1] && y <= b[3]));
+}
+
+fsdem_result fsdem_swe_block_box(fsdem_swe *s, fsdem_real x0, fsdem_real y0, fsdem_real x1, fsdem_real y1) {
+    fsdem_real box[5];
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!fsdem__finite(x0) || !fsdem__finite(x1) || !(x1 >= x0) ||
+        (s->dim == 2 && (!fsdem__finite(y0) || !fsdem__finite(y1) || !(y1 >= y0))))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_block_box: the corners must be finite with x1 >= x0, y1 >= y0");
+    box[0] = x0;
+    box[1] = y0;
+    box[2] = x1;
+    box[3] = y1;
+    box[4] = (fsdem_real)s->dim;
+    return fsdem__swe_block_where(s, fsdem__swe_in_box, box, "fsdem_swe_block_box");
+}
+
+typedef struct fsdem__swe_polygon {
+    const fsdem_vec3 *v;
+    int count;
+} fsdem__swe_polygon;
+
+static int fsdem__swe_in_polygon(const void *shape, fsdem_real x, fsdem_real y) {
+    const fsdem__swe_polygon *poly = (const fsdem__swe_polygon *)shape;
+    return fsdem__geom_polygon(fsdem_v3(x, y, 0), poly->v, poly->count) < 0;
+}
+
+fsdem_result fsdem_swe_block_polygon(fsdem_swe *s, const fsdem_vec3 *vertices, int count) {
+    fsdem__swe_polygon poly;
+    int k;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (s->dim != 2) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_block_polygon: polygons need dim = 2");
+    if (!vertices || count < 3)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_block_polygon: needs >= 3 vertices (got %d)",
+                           vertices ? count : 0);
+    for (k = 0; k < count; ++k)
+        if (!fsdem__finite(vertices[k].x) || !fsdem__finite(vertices[k].y))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_block_polygon: vertex %d is not finite", k);
+    poly.v = vertices;
+    poly.count = count;
+    return fsdem__swe_block_where(s, fsdem__swe_in_polygon, &poly, "fsdem_swe_block_polygon");
+}
+
 fsdem_result fsdem_swe_add_point_source(fsdem_swe *s, const fsdem_swe_point_source *p, int *id) {
     char msg[FSDEM__MESSAGE_SIZE];
     fsdem__swe_src *q;
@@ -9549,6 +9692,9 @@ fsdem_result fsdem_swe_add_point_source(fsdem_swe *s, const fsdem_swe_point_sour
     if (k < 0)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN,
                            "fsdem_swe_add_point_source: point (%g, %g) is outside the grid", (double)p->x, (double)p->y);
+    if (fsdem__swe_is_blocked(s, k))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_point_source: point (%g, %g) is in a blocked cell",
+                           (double)p->x, (double)p->y);
     if (fsdem__grow(&s->allocator, (void **)&s->src, &s->src_capacity, s->src_count, s->src_count + 1,
                     sizeof(fsdem__swe_src)) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_add_point_source: out of memory");
@@ -9700,6 +9846,17 @@ static fsdem_real fsdem__swe_inflow_depth(fsdem_real g, fsdem_real q, fsdem_real
     return (fsdem_real)(s * s);
 }
 
+/* Flux through a reflecting face (a WALL side or the face of a blocked cell) seen from the interior
+   state e, h, un (normal velocity), ut; `upper` is 1 when the wall is on the upper side (the
+   interior is then the L side): the Riemann problem against the mirror state, with no mass or
+   tangential flux. */
+static void fsdem__swe_wall_flux(const fsdem_swe *s, int upper, fsdem_real e, fsdem_real h, fsdem_real un, fsdem_real ut,
+                                 fsdem__swe_flux *f) {
+    if (upper) fsdem__swe_riemann(s->g, s->tiny, e, h, un, ut, e, h, -un, ut, f);
+    else fsdem__swe_riemann(s->g, s->tiny, e, h, -un, ut, e, h, un, ut, f);
+    f->mass = f->tan = 0;
+}
+
 /* Flux through a boundary face. `in_*` is the interior state; `upper` is 1 when the boundary is at the
    upper end of the axis (the interior is then the L side). Returns the fluxes in f, with the interior
    side's aL/aR, hL/hR, eL/eR filled. */
@@ -9709,7 +9866,7 @@ static void fsdem__swe_boundary_flux(const fsdem_swe *s, int side, int upper, fs
     fsdem_real value = s->bvalue[side], g = s->g, sgn = upper ? 1 : -1;
     fsdem_real zin = ein - hin, eex = ein, hex = hin, unex = unin, utex = utin;
     switch (b->type) {
-    case FSDEM_SWE_BC_WALL: unex = -unin; break;
+    case FSDEM_SWE_BC_WALL: fsdem__swe_wall_flux(s, upper, ein, hin, unin, utin, f); return;
     case FSDEM_SWE_BC_TRANSMISSIVE: break;
     case FSDEM_SWE_BC_STAGE: {
         /* outgoing invariant w + 2c (w = outward normal velocity) carried from the interior */
@@ -9736,7 +9893,6 @@ static void fsdem__swe_boundary_flux(const fsdem_swe *s, int side, int upper, fs
     }
     if (upper) fsdem__swe_riemann(g, s->tiny, ein, hin, unin, utin, eex, hex, unex, utex, f);
     else fsdem__swe_riemann(g, s->tiny, eex, hex, unex, utex, ein, hin, unin, utin, f);
-    if (b->type == FSDEM_SWE_BC_WALL) f->mass = f->tan = 0;
 }
 
 /* ---- >>swe_row : reconstruction, predictor and x faces of a row ---- */
@@ -9845,6 +10001,7 @@ static inline fsdem_real fsdem__swe_manning_factor(fsdem_real g, fsdem_real n, f
 static inline void fsdem__swe_finish(fsdem_swe *s, fsdem__swe_ctx *c, int k, fsdem_real de, fsdem_real dqx,
                                      fsdem_real dqy) {
     fsdem_real e = s->eta[k] + de + c->rain_dt, qx = s->qx[k] + dqx, qy = s->qy[k] + dqy, h;
+    if (s->blocked && s->blocked[k]) return; /* a solid: no water, no update */
     if (c->sources) {
         qx += c->dt * s->sx[k];
         qy += c->dt * s->sy[k];
@@ -9911,6 +10068,7 @@ typedef struct fsdem__swe_rows {
     const fsdem_real *e, *h, *u, *v;     /* row j */
     const fsdem_real *se, *sh, *su, *sv; /* row j - 1 (south) */
     const fsdem_real *ne, *nh, *nu, *nv; /* row j + 1 (north) */
+    const unsigned char *b, *sb, *nb;    /* blocked flags of rows j, j - 1, j + 1 (NULL: none there) */
 } fsdem__swe_rows;
 
 /* A cell's reconstruction: its centre values after the Hancock predictor, and the limited slopes
@@ -9970,24 +10128,43 @@ FSDEM__FORCE_INLINE void fsdem__swe_hancock(fsdem__swe_ctx *c, fsdem__swe_recon 
 }
 
 /* Reconstruction of cell i of the rows `p`: limited slopes (first order: none), the Hancock
-   predictor, and the cell's contribution to the acceleration bound of the next dt. */
+   predictor, and the cell's contribution to the acceleration bound of the next dt. A blocked
+   neighbour enters as the mirror image of the cell (normal velocity reversed), as the ghost cell
+   beyond a WALL side does, so a wall of blocked cells and a WALL side give the same flow. */
 FSDEM__FORCE_INLINE void fsdem__swe_reconstruct(const fsdem_swe *s, fsdem__swe_ctx *c, const fsdem__swe_rows *p, int j,
                                                 int i, const int limiter, const int two_d, fsdem__swe_recon *r) {
     const int k = j * s->nx + i;
+    const fsdem_real *row[4] = {p->e, p->h, p->u, p->v};
+    const fsdem_real *srow[4] = {p->se, p->sh, p->su, p->sv}, *nrow[4] = {p->ne, p->nh, p->nu, p->nv};
+    fsdem_real w[4], e[4], so[4], no[4];
     int a;
+    for (a = 0; a < 4; ++a) {
+        w[a] = row[a][i - 1];
+        e[a] = row[a][i + 1];
+        so[a] = two_d ? srow[a][i] : 0;
+        no[a] = two_d ? nrow[a][i] : 0;
+        r->sx[a] = r->sy[a] = 0;
+    }
     r->e = p->e[i];
     r->h = p->h[i];
     r->u = p->u[i];
     r->v = p->v[i];
-    for (a = 0; a < 4; ++a) r->sx[a] = r->sy[a] = 0;
-    /* a dry cell among dry neighbours has nothing to reconstruct or predict */
-    if (c->order == 2 && !(r->h < c->tiny && p->h[i - 1] < c->tiny && p->h[i + 1] < c->tiny &&
-                           (!two_d || (p->sh[i] < c->tiny && p->nh[i] < c->tiny)))) {
-        const fsdem_real *row[4] = {p->e, p->h, p->u, p->v};
-        const fsdem_real *south[4] = {p->se, p->sh, p->su, p->sv}, *north[4] = {p->ne, p->nh, p->nu, p->nv};
+    if (p->b) {
+        const fsdem_real mirror_x[4] = {r->e, r->h, -r->u, r->v}, mirror_y[4] = {r->e, r->h, r->u, -r->v};
         for (a = 0; a < 4; ++a) {
-            r->sx[a] = fsdem__swe_limit(limiter, row[a][i] - row[a][i - 1], row[a][i + 1] - row[a][i]);
-            if (two_d) r->sy[a] = fsdem__swe_limit(limiter, row[a][i] - south[a][i], north[a][i] - row[a][i]);
+            if (i > 0 && p->b[i - 1]) w[a] = mirror_x[a];
+            if (i < s->nx - 1 && p->b[i + 1]) e[a] = mirror_x[a];
+            if (p->sb && p->sb[i]) so[a] = mirror_y[a];
+            if (p->nb && p->nb[i]) no[a] = mirror_y[a];
+        }
+    }
+    /* a dry cell among dry neighbours has nothing to reconstruct or predict */
+    if (c->order == 2 &&
+        !(r->h < c->tiny && w[1] < c->tiny && e[1] < c->tiny && (!two_d || (so[1] < c->tiny && no[1] < c->tiny)))) {
+        const fsdem_real centre[4] = {r->e, r->h, r->u, r->v};
+        for (a = 0; a < 4; ++a) {
+            r->sx[a] = fsdem__swe_limit(limiter, centre[a] - w[a], e[a] - centre[a]);
+            if (two_d) r->sy[a] = fsdem__swe_limit(limiter, centre[a] - so[a], no[a] - centre[a]);
         }
         if (r->h >= c->dry)
             fsdem__swe_hancock(c, r, two_d, c->sources ? s->sx[k] : 0, c->sources ? s->sy[k] : 0,
@@ -9997,10 +10174,10 @@ FSDEM__FORCE_INLINE void fsdem__swe_reconstruct(const fsdem_swe *s, fsdem__swe_c
         /* acceleration bound for the next step's dt (g |grad eta| with minmod slopes, which vanish
            at a lake's shore and at a dam; a thin film on a slope feels the slope) */
         const int reuse = limiter == FSDEM_SWE_LIMITER_MINMOD && c->order == 2;
-        const fsdem_real ax = reuse ? r->sx[0] : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, p->e[i] - p->e[i - 1], p->e[i + 1] - p->e[i]);
+        const fsdem_real ax = reuse ? r->sx[0] : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, p->e[i] - w[0], e[0] - p->e[i]);
         fsdem_real acc = (ax < 0 ? -ax : ax) * c->idx * c->idx;
         if (two_d) {
-            const fsdem_real ay = reuse ? r->sy[0] : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, p->e[i] - p->se[i], p->ne[i] - p->e[i]);
+            const fsdem_real ay = reuse ? r->sy[0] : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, p->e[i] - so[0], no[0] - p->e[i]);
             acc += (ay < 0 ? -ay : ay) * c->idy * c->idy;
         }
         if (acc > c->accel) c->accel = acc;
@@ -10032,6 +10209,9 @@ FSDEM__FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, in
     p.nh = fsdem__swe_prim(s, j + 1, 1) + 1;
     p.nu = fsdem__swe_prim(s, j + 1, 2) + 1;
     p.nv = fsdem__swe_prim(s, j + 1, 3) + 1;
+    p.b = s->blocked ? s->blocked + (size_t)j * (size_t)nx : NULL;
+    p.sb = p.b && j > 0 ? p.b - nx : NULL;
+    p.nb = p.b && j < s->ny - 1 ? p.b + nx : NULL;
     for (i = 0; i <= nx; ++i) {
         fsdem__swe_recon r;
         fsdem_real cvx = 0, cvy = 0;
@@ -10054,6 +10234,12 @@ FSDEM__FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, in
                 fsdem__swe_boundary_flux(s, FSDEM_SIDE_XMIN, 0, r.e - half * r.sx[0], r.h - half * r.sx[1], r.u - half * r.sx[2],
                                          r.v - half * r.sx[3], &f);
                 c->bflux += f.mass * s->dy * c->dt;
+            } else if (p.b && (p.b[i - 1] || p.b[i])) {
+                /* a face of a blocked cell reflects; between two blocked cells nothing moves */
+                if (!p.b[i]) fsdem__swe_wall_flux(s, 0, r.e - half * r.sx[0], r.h - half * r.sx[1], r.u - half * r.sx[2],
+                                                  r.v - half * r.sx[3], &f);
+                else if (!p.b[i - 1]) fsdem__swe_wall_flux(s, 1, Ee, Eh, Eu, Ev, &f);
+                else memset(&f, 0, sizeof f);
             } else {
                 fsdem__swe_riemann(g, c->tiny, Ee, Eh, Eu, Ev, r.e - half * r.sx[0], r.h - half * r.sx[1], r.u - half * r.sx[2],
                                    r.v - half * r.sx[3], &f);
@@ -10129,6 +10315,11 @@ static void fsdem__swe_yfaces(fsdem_swe *s, fsdem__swe_ctx *c, int j) {
             const fsdem_real *L = lo[i].n;
             fsdem__swe_boundary_flux(s, FSDEM_SIDE_YMAX, 1, L[0], L[1], L[2], L[3], &f);
             c->bflux -= f.mass * s->dx * c->dt;
+        } else if (s->blocked && (s->blocked[row + i] || s->blocked[row + nx + i])) {
+            const fsdem_real *L = lo[i].n, *R = hi[i].s;
+            if (!s->blocked[row + nx + i]) fsdem__swe_wall_flux(s, 0, R[0], R[1], R[2], R[3], &f);
+            else if (!s->blocked[row + i]) fsdem__swe_wall_flux(s, 1, L[0], L[1], L[2], L[3], &f);
+            else memset(&f, 0, sizeof f);
         } else {
             const fsdem_real *L = lo[i].n, *R = hi[i].s;
             fsdem__swe_riemann(g, c->tiny, L[0], L[1], L[2], L[3], R[0], R[1], R[2], R[3], &f);
@@ -10234,22 +10425,42 @@ fsdem_result fsdem_swe_stable_dt(const fsdem_swe *s, fsdem_real *dt) {
     return FSDEM_OK;
 }
 
-/* Writes a gauge row when the time has reached the next output time. */
-static fsdem_result fsdem__swe_gauge_row(fsdem_swe *s, int force) {
+/* The gauge values h, eta, u, v now (as fsdem_swe_sample_state; 0 where it fails). */
+static void fsdem__swe_gauge_sample(const fsdem_swe *s, int k, fsdem_real out[4]) {
+    fsdem_swe_cell c;
+    memset(&c, 0, sizeof c);
+    fsdem_swe_sample_state(s, s->gauge[FSDEM__SWE_GAUGE * k], s->gauge[FSDEM__SWE_GAUGE * k + 1], &c);
+    out[0] = c.depth;
+    out[1] = c.eta;
+    out[2] = c.u;
+    out[3] = c.v;
+}
+
+/* Writes the gauge row of time t: the values now, or with `prev_time` >= 0 those interpolated
+   linearly between the start of the step just taken (kept in the gauges) and now. */
+static void fsdem__swe_gauge_write(fsdem_swe *s, double t, double prev_time) {
     FILE *fp = (FILE *)s->gauge_file;
-    int k;
-    if (!fp) return FSDEM_OK;
-    if (!force && s->time < s->gauge_next * (1 - 1e-12)) return FSDEM_OK;
-    fprintf(fp, "%.10g", (double)s->time);
+    const double w = prev_time >= 0 && s->time > prev_time ? (t - prev_time) / (s->time - prev_time) : 1;
+    int k, q;
+    fprintf(fp, "%.10g", t);
     for (k = 0; k < s->gauge_count; ++k) {
-        fsdem_swe_cell c;
-        memset(&c, 0, sizeof c);
-        fsdem_swe_sample_state(s, s->gauge_xy[2 * k], s->gauge_xy[2 * k + 1], &c);
-        fprintf(fp, ",%.10g,%.10g,%.10g,%.10g", (double)c.depth, (double)c.eta, (double)c.u, (double)c.v);
+        const fsdem_real *before = s->gauge + FSDEM__SWE_GAUGE * k + 2;
+        fsdem_real now[4];
+        fsdem__swe_gauge_sample(s, k, now);
+        for (q = 0; q < 4; ++q) fprintf(fp, ",%.10g", prev_time >= 0 ? (1 - w) * before[q] + w * now[q] : (double)now[q]);
     }
     fputc('\n', fp);
+}
+
+/* After a step from prev_time: the rows of every multiple of the interval passed (interpolated to
+   it exactly), or one row at the step's time when the interval is 0. */
+static fsdem_result fsdem__swe_gauge_rows(fsdem_swe *s, double prev_time) {
+    FILE *fp = (FILE *)s->gauge_file;
+    if (!fp) return FSDEM_OK;
     if (s->gauge_interval > 0)
-        while (s->gauge_next <= s->time * (1 + 1e-12)) s->gauge_next += s->gauge_interval;
+        for (; s->gauge_next <= s->time * (1 + 1e-12); s->gauge_next += s->gauge_interval)
+            fsdem__swe_gauge_write(s, s->gauge_next, prev_time);
+    else fsdem__swe_gauge_write(s, s->time, -1);
     return ferror(fp) ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
@@ -10258,6 +10469,9 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
     fsdem__swe_ctx c;
     int j, k, side;
     fsdem_real tm = s->time + (fsdem_real)0.5 * dt;
+    const double t0 = s->time;
+    if (s->gauge_file && s->gauge_interval > 0) /* the start values, for rows between steps */
+        for (k = 0; k < s->gauge_count; ++k) fsdem__swe_gauge_sample(s, k, s->gauge + FSDEM__SWE_GAUGE * k + 2);
     memset(&c, 0, sizeof c);
     c.dt = dt;
     c.lx = dt / s->dx;
@@ -10295,7 +10509,7 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
         fsdem__swe_yfaces(s, &c, s->ny);
     }
     s->vol_boundary += c.bflux;
-    s->vol_source += c.rain_dt * s->area * (fsdem_real)s->n;
+    s->vol_source += c.rain_dt * s->area * (fsdem_real)(s->n - s->blocked_count);
     for (k = 0; k < s->src_count; ++k) {
         fsdem__swe_src *p = &s->src[k];
         fsdem_real dh, h;
@@ -10326,8 +10540,8 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
     if (c.bad >= 0)
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_swe_step: non-finite state in cell %d (i=%d, j=%d) at t=%g s",
                            c.bad, c.bad % s->nx, c.bad / s->nx, (double)s->time);
-    if (fsdem__swe_gauge_row(s, 0) != FSDEM_OK)
-        return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_step: could not write the gauge file");
+    if (fsdem__swe_gauge_rows(s, t0) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe: could not write the gauge file");
     return fsdem__ok(&s->status);
 }
 
@@ -10429,7 +10643,7 @@ fsdem_swe_stats fsdem_swe_get_stats(const fsdem_swe *s) {
     st.predictor_fallbacks = s->fallbacks;
     st.memory_bytes = sizeof *s + s->block_bytes + (s->manning ? sizeof(fsdem_real) * (size_t)s->n : 0) +
                       sizeof(fsdem__swe_src) * (size_t)s->src_capacity +
-                      2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity;
+                      FSDEM__SWE_GAUGE * sizeof(fsdem_real) * (size_t)s->gauge_capacity;
     for (k = 0; k < 4; ++k) st.memory_bytes += 2 * sizeof(fsdem_real) * (size_t)s->bnd[k].n;
     for (k = 0; k < s->src_count; ++k) st.memory_bytes += 2 * sizeof(fsdem_real) * (size_t)s->src[k].n;
     return st;
@@ -10493,11 +10707,15 @@ fsdem_result fsdem_swe_add_gauge(fsdem_swe *s, fsdem_real x, fsdem_real y, int *
     if (fsdem_swe_cell_at(s, x, y) < 0)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_swe_add_gauge: point (%g, %g) is outside the grid",
                            (double)x, (double)y);
-    if (fsdem__grow(&s->allocator, (void **)&s->gauge_xy, &s->gauge_capacity, s->gauge_count, s->gauge_count + 1,
-                    2 * sizeof(fsdem_real)) != FSDEM_OK)
+    if (s->blocked && s->blocked[fsdem_swe_cell_at(s, x, y)])
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_gauge: point (%g, %g) is in a blocked cell",
+                           (double)x, (double)y);
+    if (fsdem__grow(&s->allocator, (void **)&s->gauge, &s->gauge_capacity, s->gauge_count, s->gauge_count + 1,
+                    FSDEM__SWE_GAUGE * sizeof(fsdem_real)) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_add_gauge: out of memory");
-    s->gauge_xy[2 * s->gauge_count] = x;
-    s->gauge_xy[2 * s->gauge_count + 1] = y;
+    memset(s->gauge + FSDEM__SWE_GAUGE * s->gauge_count, 0, FSDEM__SWE_GAUGE * sizeof(fsdem_real));
+    s->gauge[FSDEM__SWE_GAUGE * s->gauge_count] = x;
+    s->gauge[FSDEM__SWE_GAUGE * s->gauge_count + 1] = y;
     if (id) *id = s->gauge_count;
     s->gauge_count++;
     return fsdem__ok(&s->status);
@@ -10506,7 +10724,7 @@ fsdem_result fsdem_swe_add_gauge(fsdem_swe *s, fsdem_real x, fsdem_real y, int *
 fsdem_result fsdem_swe_gauge(const fsdem_swe *s, int id, fsdem_swe_cell *out) {
     if (!s || !out) return FSDEM_ERR_INVALID_ARG;
     if (id < 0 || id >= s->gauge_count) return FSDEM_ERR_NOT_FOUND;
-    return fsdem_swe_sample_state(s, s->gauge_xy[2 * id], s->gauge_xy[2 * id + 1], out);
+    return fsdem_swe_sample_state(s, s->gauge[FSDEM__SWE_GAUGE * id], s->gauge[FSDEM__SWE_GAUGE * id + 1], out);
 }
 
 fsdem_result fsdem_swe_gauges_open(fsdem_swe *s, const char *path, fsdem_real interval) {
@@ -10526,9 +10744,9 @@ fsdem_result fsdem_swe_gauges_open(fsdem_swe *s, const char *path, fsdem_real in
     fputc('\n', fp);
     s->gauge_file = fp;
     s->gauge_interval = interval;
-    s->gauge_next = s->time;
-    if (fsdem__swe_gauge_row(s, 1) != FSDEM_OK)
-        return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_gauges_open: cannot write '%s'", path);
+    s->gauge_next = s->time + interval;
+    fsdem__swe_gauge_write(s, s->time, -1);
+    if (ferror(fp)) return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_gauges_open: cannot write '%s'", path);
     return fsdem__ok(&s->status);
 }
 
