@@ -1166,6 +1166,33 @@ FSDEM_API fsdem_result fsdem_pic_add_force(fsdem_pic *pic, fsdem_vec3 point, fsd
 /* Zeroes the coupling accelerations. */
 FSDEM_API fsdem_result fsdem_pic_clear_forces(fsdem_pic *pic);
 
+/* ---- gauges ---- */
+
+typedef enum fsdem_pic_gauge_kind {
+    /* water level: the elevation (m, the coordinate along -gravity) of the highest free surface
+       above the point's column of cells (the cell column holding x in 2D, x-y in 3D), where phi
+       crosses 0 between two cell centres; the bottom of the domain when the column is dry */
+    FSDEM_PIC_GAUGE_LEVEL = 0,
+    /* pressure (Pa): at the point (trilinear between cell centres) for radius 0, else the mean over
+       the non-solid cells whose centres lie within `radius` of it (a sensor patch on a wall) */
+    FSDEM_PIC_GAUGE_PRESSURE = 1
+} fsdem_pic_gauge_kind;
+
+/* Adds a gauge (before fsdem_pic_gauges_open); its id goes to *id (may be NULL). The level gauge
+   needs gravity along one axis. FSDEM_ERR_OUT_OF_DOMAIN, FSDEM_ERR_INVALID_ARG (bad kind, radius
+   < 0, non-finite input, gravity not along an axis for a level gauge, a file is open),
+   FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_pic_add_gauge(fsdem_pic *pic, fsdem_pic_gauge_kind kind, fsdem_vec3 position,
+                                          fsdem_real radius, int *id);
+/* Gauge `id` now (m or Pa). FSDEM_ERR_NOT_FOUND. */
+FSDEM_API fsdem_result fsdem_pic_gauge(const fsdem_pic *pic, int id, fsdem_real *value);
+/* Opens a gauge time series: a CSV with columns t, then level_<id> or p_<id> per gauge, written as
+   fsdem_swe_gauges_open does (rows at multiples of `interval`, interpolated within a step; 0: every
+   step). FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (no gauges, interval < 0). */
+FSDEM_API fsdem_result fsdem_pic_gauges_open(fsdem_pic *pic, const char *path, fsdem_real interval);
+/* Closes the gauge file (also done by fsdem_pic_destroy). FSDEM_ERR_IO. */
+FSDEM_API fsdem_result fsdem_pic_gauges_close(fsdem_pic *pic);
+
 /* ---- diagnostics ---- */
 
 typedef struct fsdem_pic_stats {
@@ -1177,7 +1204,9 @@ typedef struct fsdem_pic_stats {
     fsdem_real fluid_volume;       /* m^3 (m^2 in 2D): liquid volume the solver sees, the sum over */
                                    /*    open cells of clamp(1/2 - phi/dx, 0, 1) dx^dim (all open */
                                    /*    cells when free_surface = 0); cut cells count whole */
-    fsdem_real particle_volume;    /* m^3 (m^2 in 2D): particles x particle volume */
+    fsdem_real particle_volume;    /* m^3 (m^2 in 2D): particles x particle volume, the volume the */
+                                   /*    particles carry (exact at seeding; fluid_volume, from the */
+                                   /*    grid's level set, reads up to a few % lower on coarse grids) */
     fsdem_real kinetic_energy;     /* J (J/m in 2D): sum of rho V_p |v_p|^2 / 2 */
     fsdem_real max_speed;          /* m/s, particles */
     fsdem_real max_divergence;     /* 1/s; largest |div u| over fluid cells after the projection */
@@ -1506,8 +1535,9 @@ FSDEM_API fsdem_result fsdem_swe_add_gauge(fsdem_swe *swe, fsdem_real x, fsdem_r
 /* Samples gauge `id` now (as fsdem_swe_sample_state). FSDEM_ERR_NOT_FOUND. */
 FSDEM_API fsdem_result fsdem_swe_gauge(const fsdem_swe *swe, int id, fsdem_swe_cell *out);
 /* Opens a gauge time series: a CSV with columns t, then h_<id>,eta_<id>,u_<id>,v_<id> per gauge.
-   A row is written now and after every step that reaches the next multiple of `interval` (s; 0:
-   every step). FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (no gauges, interval < 0). */
+   A row is written now and at every later multiple of `interval` (s) after the opening time, the
+   values interpolated linearly within the step that passes it; interval 0: one row per step at the
+   step's time. FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (no gauges, interval < 0). */
 FSDEM_API fsdem_result fsdem_swe_gauges_open(fsdem_swe *swe, const char *path, fsdem_real interval);
 /* Closes the gauge file (also done by fsdem_swe_destroy). FSDEM_ERR_IO. */
 FSDEM_API fsdem_result fsdem_swe_gauges_close(fsdem_swe *swe);
@@ -1870,6 +1900,76 @@ static void *fsdem__object_new(fsdem_result checked, const char *why, fsdem_log_
 
 static int fsdem__finite(fsdem_real x) { return x == x && x - x == 0; }
 
+/* A CSV time series of probe values written by a solver as it steps (SWE and PIC gauges): a header,
+   then rows at the exact multiples of `interval`, the values interpolated linearly between the
+   start and the end of the step that passed each one (interval 0: one row per step). `before` holds
+   the values at the start of the step in flight, `now` is scratch for those at its end. */
+typedef struct fsdem__series {
+    void *file;            /* FILE*, NULL when closed */
+    double interval, next; /* s */
+    int columns;           /* values per row after t */
+    fsdem_real *before, *now;
+} fsdem__series;
+
+/* Opens `path`, writes `header`, and allocates the rows with `al`; the caller then samples its
+   values into ser->now and writes the first row with fsdem__series_row. FSDEM_ERR_IO,
+   FSDEM_ERR_OUT_OF_MEMORY. */
+static fsdem_result fsdem__series_open(fsdem__series *ser, const fsdem_allocator *al, const char *path, const char *header,
+                                       int columns, double t, double interval) {
+    FILE *fp;
+    fsdem_real *rows = (fsdem_real *)fsdem__alloc(al, sizeof(fsdem_real) * 2 * (size_t)columns);
+    if (!rows) return FSDEM_ERR_OUT_OF_MEMORY;
+    fp = path ? fopen(path, "w") : NULL;
+    if (!fp) {
+        fsdem__free(al, rows, sizeof(fsdem_real) * 2 * (size_t)columns);
+        return FSDEM_ERR_IO;
+    }
+    ser->file = fp;
+    ser->interval = interval;
+    ser->next = t + interval;
+    ser->columns = columns;
+    ser->before = rows;
+    ser->now = rows + columns;
+    fputs(header, fp);
+    return FSDEM_OK;
+}
+
+/* Writes the row of time t with the values in ser->now. */
+static void fsdem__series_row(fsdem__series *ser, double t) {
+    int k;
+    fprintf((FILE *)ser->file, "\n%.10g", t);
+    for (k = 0; k < ser->columns; ++k) fprintf((FILE *)ser->file, ",%.10g", (double)ser->now[k]);
+}
+
+/* After a step from t0 to t1 whose end values are in ser->now: the rows it passed. */
+static fsdem_result fsdem__series_step(fsdem__series *ser, double t0, double t1) {
+    FILE *fp = (FILE *)ser->file;
+    int k;
+    if (!fp) return FSDEM_OK;
+    if (ser->interval <= 0) fsdem__series_row(ser, t1);
+    for (; ser->interval > 0 && ser->next <= t1 * (1 + 1e-12); ser->next += ser->interval) {
+        const double w = t1 > t0 ? (ser->next - t0) / (t1 - t0) : 1;
+        fprintf(fp, "\n%.10g", ser->next);
+        for (k = 0; k < ser->columns; ++k) fprintf(fp, ",%.10g", (1 - w) * ser->before[k] + w * ser->now[k]);
+    }
+    fflush(fp);
+    return ferror(fp) ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+/* Closes the file (a last newline) and frees the rows. FSDEM_ERR_IO when writing failed. */
+static fsdem_result fsdem__series_close(fsdem__series *ser, const fsdem_allocator *al) {
+    int bad;
+    if (!ser->file) return FSDEM_OK;
+    fputc('\n', (FILE *)ser->file);
+    bad = ferror((FILE *)ser->file);
+    bad |= fclose((FILE *)ser->file) != 0;
+    fsdem__free(al, ser->before, sizeof(fsdem_real) * 2 * (size_t)ser->columns);
+    memset(ser, 0, sizeof *ser);
+    return bad ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
+
+
 /* A relative tolerance of at least `floor` and of 100 roundings of fsdem_real, so a test written for
    double still holds in float. */
 static double fsdem__tolerance(double floor) {
@@ -2118,12 +2218,14 @@ static void fsdem__kernel_weights(fsdem__kernel *k, int dim, const fsdem_real s[
     for (b = 0; b < 3; ++b) {
         fsdem_real x = s[b], t;
         int i0;
+        for (q = 0; q < 3; ++q) { /* every entry set, also those past count (compilers cannot see the bound) */
+            k->idx[b][q] = 0;
+            k->w[b][q] = k->dw[b][q] = 0;
+        }
         if (b >= dim) {
             k->lo[b] = 0;
             k->count[b] = 1;
-            k->idx[b][0] = 0;
             k->w[b][0] = 1;
-            k->dw[b][0] = 0;
             continue;
         }
         if (!(x > -4)) x = -4; /* also NaN */
@@ -6112,6 +6214,11 @@ struct fsdem_pic {
     fsdem_pic_coupling coupling;     /* the coupler's arrays (fsdem_pic_get_coupling) */
     fsdem_operator_fn pressure_extra; /* fsdem_pic_set_pressure_extra */
     void *pressure_extra_user;
+    fsdem_vec3 *gauge_at;             /* gauges: position, with kind and radius */
+    int *gauge_kind;
+    fsdem_real *gauge_radius;
+    int gauge_count, gauge_capacity;
+    fsdem__series gauges;
 
     /* diagnostics */
     int cells_fresh; /* frac/phi hold the current particle positions (set at the end of a step) */
@@ -6415,6 +6522,10 @@ void fsdem_pic_destroy(fsdem_pic *s) {
             fsdem__pic_release(s, s->obst[a].verts, sizeof(fsdem_vec3) * (size_t)s->obst[a].d.vertex_count);
     fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
     if (s->pcg_p) fsdem_pcg_destroy(s->pcg_p);
+    fsdem__series_close(&s->gauges, &s->allocator);
+    fsdem__pic_release(s, s->gauge_at, sizeof(fsdem_vec3) * (size_t)s->gauge_capacity);
+    fsdem__pic_release(s, s->gauge_kind, sizeof(int) * (size_t)s->gauge_capacity);
+    fsdem__pic_release(s, s->gauge_radius, sizeof(fsdem_real) * (size_t)s->gauge_capacity);
     al = s->allocator;
     fsdem__free(&al, s, sizeof *s);
 }
@@ -8615,6 +8726,164 @@ fsdem_result fsdem_pic_clear_forces(fsdem_pic *s) {
     return fsdem__ok(&s->status);
 }
 
+/* ---- gauges ---- */
+
+/* The axis of gravity and the sign of "up" along it; -1 when gravity is not along one axis. */
+static int fsdem__pic_up_axis(const fsdem_pic *s, fsdem_real *up) {
+    int a, best = -1, others = 0;
+    for (a = 0; a < s->dim; ++a)
+        if (fsdem__comp(s->desc.gravity, a) != 0) {
+            best = a;
+            others++;
+        }
+    if (others != 1) return -1;
+    *up = fsdem__comp(s->desc.gravity, best) < 0 ? 1 : -1;
+    return best;
+}
+
+/* Elevation of the highest free surface above p's column (FSDEM_PIC_GAUGE_LEVEL). */
+static fsdem_real fsdem__pic_level(const fsdem_pic *s, fsdem_vec3 p) {
+    fsdem_real up = 1, g[3];
+    const int u = fsdem__pic_up_axis(s, &up);
+    int c3[3], b, k, top, step;
+    for (b = 0; b < 3; ++b) {
+        g[b] = b < s->dim ? (fsdem__comp(p, b) - fsdem__comp(s->lo, b)) * s->inv_dx : 0;
+        c3[b] = g[b] < 0 ? 0 : g[b] >= (fsdem_real)s->n[b] ? s->n[b] - 1 : (int)g[b];
+    }
+    top = up > 0 ? s->n[u] - 1 : 0;
+    step = up > 0 ? -1 : 1;
+    for (k = top; k >= 0 && k < s->n[u]; k += step) {
+        int c, above;
+        c3[u] = k;
+        c = fsdem__pic_cell(s, c3[0], c3[1], c3[2]);
+        if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID || !(s->phi[c] < 0)) continue;
+        /* the centre of cell c is in water; the surface is where phi crosses 0 towards the cell above */
+        if (k == top) return up > 0 ? fsdem__comp(s->hi, u) : fsdem__comp(s->lo, u);
+        c3[u] = k - step;
+        above = fsdem__pic_cell(s, c3[0], c3[1], c3[2]);
+        c3[u] = k;
+        {
+            const fsdem_real centre = fsdem__comp(s->lo, u) + ((fsdem_real)k + (fsdem_real)0.5) * s->dx;
+            const fsdem_real pa = s->ctype[above] == FSDEM_STENCIL_CELL_SOLID ? s->dx : s->phi[above];
+            const fsdem_real t = pa > 0 ? s->phi[c] / (s->phi[c] - pa) : (fsdem_real)0.5;
+            return centre + up * t * s->dx;
+        }
+    }
+    return up > 0 ? fsdem__comp(s->lo, u) : fsdem__comp(s->hi, u);
+}
+
+/* Pressure at p (FSDEM_PIC_GAUGE_PRESSURE): trilinear between cell centres, or the mean over the
+   non-solid cells within `radius`. */
+static fsdem_real fsdem__pic_pressure_at(const fsdem_pic *s, fsdem_vec3 p, fsdem_real radius) {
+    fsdem_real g[3], sum = 0;
+    int b, q0, q1, q2, count = 0, c;
+    if (radius > 0) {
+        for (c = 0; c < s->ncell; ++c) {
+            const fsdem_vec3 x = fsdem__pic_cell_pos(s, c % s->n[0], c / s->n[0] % s->n[1], c / (s->n[0] * s->n[1]));
+            if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID || fsdem__norm(fsdem__sub(x, p)) > radius) continue;
+            sum += s->pres[c];
+            count++;
+        }
+        return count ? sum / (fsdem_real)count : 0;
+    } else {
+        fsdem__kernel kw;
+        for (b = 0; b < 3; ++b) {
+            const fsdem_real t = b < s->dim ? (fsdem__comp(p, b) - fsdem__comp(s->lo, b)) * s->inv_dx - (fsdem_real)0.5 : 0;
+            g[b] = t < 0 ? 0 : t > (fsdem_real)(s->n[b] - 1) ? (fsdem_real)(s->n[b] - 1) : t;
+        }
+        fsdem__kernel_weights(&kw, s->dim, g, s->n, 0);
+        for (q2 = 0; q2 < kw.count[2]; ++q2)
+            for (q1 = 0; q1 < kw.count[1]; ++q1)
+                for (q0 = 0; q0 < kw.count[0]; ++q0)
+                    sum += kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2] *
+                           s->pres[fsdem__pic_cell(s, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])];
+        return sum;
+    }
+}
+
+static fsdem_real fsdem__pic_gauge_value(const fsdem_pic *s, int k) {
+    return s->gauge_kind[k] == FSDEM_PIC_GAUGE_LEVEL ? fsdem__pic_level(s, s->gauge_at[k])
+                                                     : fsdem__pic_pressure_at(s, s->gauge_at[k], s->gauge_radius[k]);
+}
+
+static void fsdem__pic_gauge_values(const fsdem_pic *s, fsdem_real *out) {
+    int k;
+    for (k = 0; k < s->gauge_count; ++k) out[k] = fsdem__pic_gauge_value(s, k);
+}
+
+fsdem_result fsdem_pic_add_gauge(fsdem_pic *s, fsdem_pic_gauge_kind kind, fsdem_vec3 position, fsdem_real radius, int *id) {
+    fsdem_real up;
+    int b, n, cap;
+    if (id) *id = -1;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (s->gauges.file) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_gauge: close the gauge file first");
+    if ((int)kind < 0 || (int)kind > 1 || !fsdem__finite3(position) || !(radius >= 0) || !fsdem__finite(radius))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_pic_add_gauge: the kind must be a fsdem_pic_gauge_kind, the position finite, the radius >= 0");
+    if (kind == FSDEM_PIC_GAUGE_LEVEL && fsdem__pic_up_axis(s, &up) < 0)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_gauge: a level gauge needs gravity along one axis");
+    for (b = 0; b < s->dim; ++b)
+        if (!(fsdem__comp(position, b) >= fsdem__comp(s->lo, b) && fsdem__comp(position, b) <= fsdem__comp(s->hi, b)))
+            return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_pic_add_gauge: (%g, %g, %g) is outside the domain",
+                               (double)position.x, (double)position.y, (double)position.z);
+    n = s->gauge_count;
+    if (n == s->gauge_capacity) {
+        cap = s->gauge_capacity;
+        if (fsdem__grow(&s->allocator, (void **)&s->gauge_at, &cap, n, n + 1, sizeof(fsdem_vec3)) != FSDEM_OK ||
+            (cap = s->gauge_capacity, fsdem__grow(&s->allocator, (void **)&s->gauge_kind, &cap, n, n + 1, sizeof(int))) != FSDEM_OK ||
+            (cap = s->gauge_capacity, fsdem__grow(&s->allocator, (void **)&s->gauge_radius, &cap, n, n + 1, sizeof(fsdem_real))) !=
+                FSDEM_OK)
+            return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_add_gauge: out of memory");
+        s->gauge_capacity = cap;
+    }
+    s->gauge_at[n] = position;
+    s->gauge_kind[n] = (int)kind;
+    s->gauge_radius[n] = radius;
+    s->gauge_count++;
+    if (id) *id = n;
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_pic_gauge(const fsdem_pic *s, int id, fsdem_real *value) {
+    if (!s || !value) return FSDEM_ERR_INVALID_ARG;
+    if (id < 0 || id >= s->gauge_count) return FSDEM_ERR_NOT_FOUND;
+    *value = fsdem__pic_gauge_value(s, id);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_pic_gauges_open(fsdem_pic *s, const char *path, fsdem_real interval) {
+    char *header;
+    size_t size;
+    int k, n = 1;
+    fsdem_result res;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (s->gauge_count == 0) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_gauges_open: add gauges first");
+    if (!(interval >= 0) || !fsdem__finite(interval))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_gauges_open: interval must be >= 0 (got %g s)",
+                           (double)interval);
+    if (s->gauges.file) fsdem_pic_gauges_close(s);
+    size = 2 + 24 * (size_t)s->gauge_count;
+    header = (char *)fsdem__alloc(&s->allocator, size);
+    if (!header) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_gauges_open: out of memory");
+    header[0] = 't';
+    header[1] = '\0';
+    for (k = 0; k < s->gauge_count; ++k)
+        n += snprintf(header + n, size - (size_t)n, s->gauge_kind[k] == FSDEM_PIC_GAUGE_LEVEL ? ",level_%d" : ",p_%d", k);
+    res = fsdem__series_open(&s->gauges, &s->allocator, path, header, s->gauge_count, s->time, interval);
+    fsdem__free(&s->allocator, header, size);
+    if (res != FSDEM_OK) return fsdem__fail(&s->status, res, "fsdem_pic_gauges_open: cannot open '%s'", path ? path : "(null)");
+    fsdem__pic_gauge_values(s, s->gauges.now);
+    fsdem__series_row(&s->gauges, s->time);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_pic_gauges_close(fsdem_pic *s) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__series_close(&s->gauges, &s->allocator) == FSDEM_OK
+               ? fsdem__ok(&s->status)
+               : fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_pic_gauges_close: write error");
+}
+
 fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *s) {
     fsdem_pic_stats st;
     int c, p, a;
@@ -8813,7 +9082,6 @@ typedef struct fsdem__swe_sface {
    inner loop has neither a limiter switch nor 2D branches in 1D. */
 
 /* m^2/s: unit discharges below this are set to zero (no physical meaning; see fsdem__swe_finish) */
-#define FSDEM__SWE_GAUGE 6 /* reals per gauge: x, y, h, eta, u, v */
 #define FSDEM__SWE_QTINY ((fsdem_real)(sizeof(fsdem_real) < sizeof(double) ? 1e-12 : 1e-100))
 
 typedef struct fsdem__swe_bnd {
@@ -8866,10 +9134,9 @@ struct fsdem_swe {
     fsdem__swe_src *src;
     int src_count, src_capacity, src_next_id;
 
-    fsdem_real *gauge; /* per gauge: x, y, then h, eta, u, v at the start of the step in flight */
+    fsdem_real *gauge; /* x, y of each gauge */
     int gauge_count, gauge_capacity;
-    void *gauge_file;
-    double gauge_interval, gauge_next;
+    fsdem__series gauges; /* the gauge file, h, eta, u, v per gauge */
 };
 
 /* ---- >>swe_desc : defaults and validation ---- */
@@ -9204,11 +9471,11 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
 void fsdem_swe_destroy(fsdem_swe *s) {
     int k;
     if (!s) return;
-    if (s->gauge_file) fclose((FILE *)s->gauge_file);
+    fsdem__series_close(&s->gauges, &s->allocator);
     for (k = 0; k < 4; ++k) fsdem__swe_free_series(s, &s->bnd[k].t, &s->bnd[k].v, &s->bnd[k].n);
     for (k = 0; k < s->src_count; ++k) fsdem__swe_free_series(s, &s->src[k].t, &s->src[k].v, &s->src[k].n);
     fsdem__free(&s->allocator, s->src, sizeof(fsdem__swe_src) * (size_t)s->src_capacity);
-    fsdem__free(&s->allocator, s->gauge, FSDEM__SWE_GAUGE * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+    fsdem__free(&s->allocator, s->gauge, 2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
     fsdem__free(&s->allocator, s->manning, sizeof(fsdem_real) * (size_t)s->n);
     fsdem__free(&s->allocator, s->blocked, (size_t)s->n);
     fsdem__free(&s->allocator, s->block, s->block_bytes);
@@ -9588,7 +9855,7 @@ static fsdem_result fsdem__swe_apply_blocked(fsdem_swe *s, const unsigned char *
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: point source %d would be in a blocked cell", what,
                                s->src[k].id);
     for (k = 0; mask && k < s->gauge_count; ++k)
-        if (mask[fsdem_swe_cell_at(s, s->gauge[FSDEM__SWE_GAUGE * k], s->gauge[FSDEM__SWE_GAUGE * k + 1])])
+        if (mask[fsdem_swe_cell_at(s, s->gauge[2 * k], s->gauge[2 * k + 1])])
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: gauge %d would be in a blocked cell", what, k);
     if (mask && !s->blocked) {
         s->blocked = (unsigned char *)fsdem__alloc(&s->allocator, (size_t)s->n);
@@ -10425,43 +10692,18 @@ fsdem_result fsdem_swe_stable_dt(const fsdem_swe *s, fsdem_real *dt) {
     return FSDEM_OK;
 }
 
-/* The gauge values h, eta, u, v now (as fsdem_swe_sample_state; 0 where it fails). */
-static void fsdem__swe_gauge_sample(const fsdem_swe *s, int k, fsdem_real out[4]) {
-    fsdem_swe_cell c;
-    memset(&c, 0, sizeof c);
-    fsdem_swe_sample_state(s, s->gauge[FSDEM__SWE_GAUGE * k], s->gauge[FSDEM__SWE_GAUGE * k + 1], &c);
-    out[0] = c.depth;
-    out[1] = c.eta;
-    out[2] = c.u;
-    out[3] = c.v;
-}
-
-/* Writes the gauge row of time t: the values now, or with `prev_time` >= 0 those interpolated
-   linearly between the start of the step just taken (kept in the gauges) and now. */
-static void fsdem__swe_gauge_write(fsdem_swe *s, double t, double prev_time) {
-    FILE *fp = (FILE *)s->gauge_file;
-    const double w = prev_time >= 0 && s->time > prev_time ? (t - prev_time) / (s->time - prev_time) : 1;
-    int k, q;
-    fprintf(fp, "%.10g", t);
+/* The gauge values h, eta, u, v of every gauge now (as fsdem_swe_sample_state; 0 where it fails). */
+static void fsdem__swe_gauge_values(const fsdem_swe *s, fsdem_real *out) {
+    int k;
     for (k = 0; k < s->gauge_count; ++k) {
-        const fsdem_real *before = s->gauge + FSDEM__SWE_GAUGE * k + 2;
-        fsdem_real now[4];
-        fsdem__swe_gauge_sample(s, k, now);
-        for (q = 0; q < 4; ++q) fprintf(fp, ",%.10g", prev_time >= 0 ? (1 - w) * before[q] + w * now[q] : (double)now[q]);
+        fsdem_swe_cell c;
+        memset(&c, 0, sizeof c);
+        fsdem_swe_sample_state(s, s->gauge[2 * k], s->gauge[2 * k + 1], &c);
+        out[4 * k] = c.depth;
+        out[4 * k + 1] = c.eta;
+        out[4 * k + 2] = c.u;
+        out[4 * k + 3] = c.v;
     }
-    fputc('\n', fp);
-}
-
-/* After a step from prev_time: the rows of every multiple of the interval passed (interpolated to
-   it exactly), or one row at the step's time when the interval is 0. */
-static fsdem_result fsdem__swe_gauge_rows(fsdem_swe *s, double prev_time) {
-    FILE *fp = (FILE *)s->gauge_file;
-    if (!fp) return FSDEM_OK;
-    if (s->gauge_interval > 0)
-        for (; s->gauge_next <= s->time * (1 + 1e-12); s->gauge_next += s->gauge_interval)
-            fsdem__swe_gauge_write(s, s->gauge_next, prev_time);
-    else fsdem__swe_gauge_write(s, s->time, -1);
-    return ferror(fp) ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
 /* One step of exactly dt (already validated). */
@@ -10470,8 +10712,7 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
     int j, k, side;
     fsdem_real tm = s->time + (fsdem_real)0.5 * dt;
     const double t0 = s->time;
-    if (s->gauge_file && s->gauge_interval > 0) /* the start values, for rows between steps */
-        for (k = 0; k < s->gauge_count; ++k) fsdem__swe_gauge_sample(s, k, s->gauge + FSDEM__SWE_GAUGE * k + 2);
+    if (s->gauges.file && s->gauges.interval > 0) fsdem__swe_gauge_values(s, s->gauges.before); /* rows between steps */
     memset(&c, 0, sizeof c);
     c.dt = dt;
     c.lx = dt / s->dx;
@@ -10540,7 +10781,8 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
     if (c.bad >= 0)
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_swe_step: non-finite state in cell %d (i=%d, j=%d) at t=%g s",
                            c.bad, c.bad % s->nx, c.bad / s->nx, (double)s->time);
-    if (fsdem__swe_gauge_rows(s, t0) != FSDEM_OK)
+    if (s->gauges.file) fsdem__swe_gauge_values(s, s->gauges.now);
+    if (fsdem__series_step(&s->gauges, t0, s->time) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe: could not write the gauge file");
     return fsdem__ok(&s->status);
 }
@@ -10643,7 +10885,7 @@ fsdem_swe_stats fsdem_swe_get_stats(const fsdem_swe *s) {
     st.predictor_fallbacks = s->fallbacks;
     st.memory_bytes = sizeof *s + s->block_bytes + (s->manning ? sizeof(fsdem_real) * (size_t)s->n : 0) +
                       sizeof(fsdem__swe_src) * (size_t)s->src_capacity +
-                      FSDEM__SWE_GAUGE * sizeof(fsdem_real) * (size_t)s->gauge_capacity;
+                      2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity;
     for (k = 0; k < 4; ++k) st.memory_bytes += 2 * sizeof(fsdem_real) * (size_t)s->bnd[k].n;
     for (k = 0; k < s->src_count; ++k) st.memory_bytes += 2 * sizeof(fsdem_real) * (size_t)s->src[k].n;
     return st;
@@ -10702,7 +10944,7 @@ fsdem_result fsdem_swe_write_vtk(const fsdem_swe *s, const char *path) {
 
 fsdem_result fsdem_swe_add_gauge(fsdem_swe *s, fsdem_real x, fsdem_real y, int *id) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    if (s->gauge_file)
+    if (s->gauges.file)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_gauge: close the gauge file first");
     if (fsdem_swe_cell_at(s, x, y) < 0)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_swe_add_gauge: point (%g, %g) is outside the grid",
@@ -10711,11 +10953,10 @@ fsdem_result fsdem_swe_add_gauge(fsdem_swe *s, fsdem_real x, fsdem_real y, int *
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_gauge: point (%g, %g) is in a blocked cell",
                            (double)x, (double)y);
     if (fsdem__grow(&s->allocator, (void **)&s->gauge, &s->gauge_capacity, s->gauge_count, s->gauge_count + 1,
-                    FSDEM__SWE_GAUGE * sizeof(fsdem_real)) != FSDEM_OK)
+                    2 * sizeof(fsdem_real)) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_add_gauge: out of memory");
-    memset(s->gauge + FSDEM__SWE_GAUGE * s->gauge_count, 0, FSDEM__SWE_GAUGE * sizeof(fsdem_real));
-    s->gauge[FSDEM__SWE_GAUGE * s->gauge_count] = x;
-    s->gauge[FSDEM__SWE_GAUGE * s->gauge_count + 1] = y;
+    s->gauge[2 * s->gauge_count] = x;
+    s->gauge[2 * s->gauge_count + 1] = y;
     if (id) *id = s->gauge_count;
     s->gauge_count++;
     return fsdem__ok(&s->status);
@@ -10724,40 +10965,42 @@ fsdem_result fsdem_swe_add_gauge(fsdem_swe *s, fsdem_real x, fsdem_real y, int *
 fsdem_result fsdem_swe_gauge(const fsdem_swe *s, int id, fsdem_swe_cell *out) {
     if (!s || !out) return FSDEM_ERR_INVALID_ARG;
     if (id < 0 || id >= s->gauge_count) return FSDEM_ERR_NOT_FOUND;
-    return fsdem_swe_sample_state(s, s->gauge[FSDEM__SWE_GAUGE * id], s->gauge[FSDEM__SWE_GAUGE * id + 1], out);
+    return fsdem_swe_sample_state(s, s->gauge[2 * id], s->gauge[2 * id + 1], out);
 }
 
 fsdem_result fsdem_swe_gauges_open(fsdem_swe *s, const char *path, fsdem_real interval) {
-    FILE *fp;
-    int k;
+    char *header;
+    size_t size;
+    int k, n = 1;
+    fsdem_result res;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (s->gauge_count == 0)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_gauges_open: add gauges first");
     if (!(interval >= 0) || !fsdem__finite(interval))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_gauges_open: interval must be >= 0 (got %g s)",
                            (double)interval);
-    if (s->gauge_file) fsdem_swe_gauges_close(s);
-    fp = path ? fopen(path, "w") : NULL;
-    if (!fp) return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_gauges_open: cannot open '%s'", path ? path : "(null)");
-    fprintf(fp, "t");
-    for (k = 0; k < s->gauge_count; ++k) fprintf(fp, ",h_%d,eta_%d,u_%d,v_%d", k, k, k, k);
-    fputc('\n', fp);
-    s->gauge_file = fp;
-    s->gauge_interval = interval;
-    s->gauge_next = s->time + interval;
-    fsdem__swe_gauge_write(s, s->time, -1);
-    if (ferror(fp)) return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_gauges_open: cannot write '%s'", path);
+    if (s->gauges.file) fsdem_swe_gauges_close(s);
+    size = 2 + 48 * (size_t)s->gauge_count;
+    header = (char *)fsdem__alloc(&s->allocator, size);
+    if (!header) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_gauges_open: out of memory");
+    header[0] = 't';
+    header[1] = '\0';
+    for (k = 0; k < s->gauge_count; ++k)
+        n += snprintf(header + n, size - (size_t)n, ",h_%d,eta_%d,u_%d,v_%d", k, k, k, k);
+    res = fsdem__series_open(&s->gauges, &s->allocator, path, header, 4 * s->gauge_count, s->time, interval);
+    fsdem__free(&s->allocator, header, size);
+    if (res != FSDEM_OK)
+        return fsdem__fail(&s->status, res, "fsdem_swe_gauges_open: cannot open '%s'", path ? path : "(null)");
+    fsdem__swe_gauge_values(s, s->gauges.now);
+    fsdem__series_row(&s->gauges, s->time);
     return fsdem__ok(&s->status);
 }
 
 fsdem_result fsdem_swe_gauges_close(fsdem_swe *s) {
-    int bad;
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    if (!s->gauge_file) return FSDEM_OK;
-    bad = ferror((FILE *)s->gauge_file);
-    bad |= fclose((FILE *)s->gauge_file) != 0;
-    s->gauge_file = NULL;
-    return bad ? fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_gauges_close: write error") : fsdem__ok(&s->status);
+    return fsdem__series_close(&s->gauges, &s->allocator) == FSDEM_OK
+               ? fsdem__ok(&s->status)
+               : fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe_gauges_close: write error");
 }
 
 fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
