@@ -1,0 +1,93 @@
+#!/bin/sh
+# The map of fsdem.h is exact: `grep -n '>>' fsdem.h` is the table of contents, so this check (run by
+# `make test`) fails when
+#   - a >>tag banner is defined twice;
+#   - a header chapter has no implementation chapter >>impl_<tag>, or the implementation chapters
+#     are not in the order of the header chapters;
+#   - a >>tag named anywhere (a reference such as "(>>dem_law)") names no banner;
+#   - an implementation chapter does not open with a contents comment naming its subsections;
+#   - a subsection (or a chapter without subsections) runs over MAX_LINES lines;
+#   - the float build's precision-suffixed symbol list (>>config) differs from the FSDEM_API functions.
+# Usage: sh tests/map_check.sh [fsdem.h]          check
+#        sh tests/map_check.sh --symbols [fsdem.h] print the symbol block for >>config
+set -u
+mode=check
+if [ "${1:-}" = "--symbols" ]; then mode=symbols; shift; fi
+file=${1:-fsdem.h}
+[ -r "$file" ] || { echo "map_check: cannot read $file"; exit 1; }
+
+# public functions: the name before "(" on each FSDEM_API declaration
+api=$(awk '/^FSDEM_API / { line = $0; while (line !~ /\(/) { getline nxt; line = line " " nxt }
+            sub(/\(.*/, "", line); n = split(line, w, /[ *]+/); print w[n] }' "$file" | sort)
+if [ "$mode" = symbols ]; then
+    echo "#ifdef FSDEM_USE_FLOAT"
+    for f in $api; do echo "#define $f ${f}_f"; done
+    echo "#endif"
+    exit 0
+fi
+
+awk -v MAX_LINES=600 -v api="$api" '
+function fail(msg) { print "map_check: " msg; bad = 1 }
+/^(\/\*|  ) *(=====|----) >>[a-z_]+ :/ {
+    match($0, />>[a-z_]+/); tag = substr($0, RSTART + 2, RLENGTH - 2)
+    if (tag in line_of) fail("tag >>" tag " defined twice (lines " line_of[tag] " and " NR ")")
+    line_of[tag] = NR
+    chapter_banner = ($0 ~ /=====/)
+    # length of the previous section
+    if (prev_tag != "" && NR - prev_line > MAX_LINES && !(prev_tag in has_sub))
+        fail("section >>" prev_tag " (line " prev_line ") runs " NR - prev_line " lines, more than " MAX_LINES)
+    if (chapter_banner) {
+        if (tag == "impl") in_impl = 1
+        else if (!in_impl) { header[++nh] = tag }
+        else if (tag ~ /^impl_/) { impl[++ni] = substr(tag, 6); cur_impl = tag; contents[tag] = "" }
+        else cur_impl = ""
+        collecting = (tag ~ /^impl_/)
+    } else {
+        if (cur_impl != "") { sub_of[tag] = cur_impl; has_sub[cur_impl] = 1 }
+        collecting = 0
+    }
+    prev_tag = tag; prev_line = NR
+    next
+}
+# the opening comment of an implementation chapter, up to its first code or subsection
+collecting && /^[^\/ #]/ { collecting = 0 }
+collecting { contents[cur_impl] = contents[cur_impl] " " $0 }
+{
+    # references: every >>tag in the file
+    s = $0
+    while (match(s, />>[a-z_]+/)) { ref[substr(s, RSTART + 2, RLENGTH - 2)] = NR; s = substr(s, RSTART + RLENGTH) }
+}
+END {
+    for (r in ref) if (!(r in line_of)) fail("reference >>" r " (line " ref[r] ") names no banner")
+    k = 0
+    for (h = 1; h <= nh; ++h) {
+        t = header[h]
+        if (t == "doc" || t == "config" || t == "licence") continue
+        ++k
+        if (!(("impl_" t) in line_of)) { fail("header chapter >>" t " has no >>impl_" t); continue }
+        if (impl[k] != t) fail("implementation chapter " k " is >>impl_" impl[k] ", the header order wants >>impl_" t)
+    }
+    for (i = 1; i <= ni; ++i) {
+        c = "impl_" impl[i]
+        if (contents[c] !~ /Contents/) fail(">>" c " does not open with a contents comment")
+    }
+    for (t in sub_of) {
+        c = sub_of[t]
+        if (index(contents[c], ">>" t) == 0) fail("the contents of >>" c " do not list >>" t)
+    }
+    if (bad) exit 1
+}' "$file" || exit 1
+
+# the symbol block of >>config against the public functions
+listed=$(awk '/FSDEM__SYMBOLS_BEGIN/ { on = 1 } /FSDEM__SYMBOLS_END/ { on = 0 }
+              on && /^#define fsdem_/ { print $2 }' "$file" | sort)
+if [ "$listed" != "$api" ]; then
+    echo "map_check: the symbol block of >>config differs from the FSDEM_API functions:"
+    printf '%s\n' "$api" > /tmp/map_check_api.$$
+    printf '%s\n' "$listed" > /tmp/map_check_listed.$$
+    diff /tmp/map_check_api.$$ /tmp/map_check_listed.$$ | sed 's/^/  /'
+    rm -f /tmp/map_check_api.$$ /tmp/map_check_listed.$$
+    echo "  regenerate it with: sh tests/map_check.sh --symbols"
+    exit 1
+fi
+echo "map check: $(grep -c '>>' "$file") map lines, banners unique, order and references resolve, contents listed, symbols complete"
