@@ -2,6 +2,10 @@
 #ifndef FSDEM_TESTS_H
 #define FSDEM_TESTS_H
 #include <check.h>
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include "fsdem.h"
 
 Suite *core_suite(void);
@@ -10,5 +14,53 @@ Suite *linalg_suite(void);
 Suite *pic_suite(void);
 Suite *swe_suite(void);
 Suite *couple_swe_suite(void);
+Suite *interface_suite(void);
+
+/* ---- tolerances that follow the precision of fsdem_real ----
+
+   The suite runs in double (`make test`) and in float (`make test-float`, -DFSDEM_USE_FLOAT). A
+   tolerance is either physics or method (a discretisation error, a convergence order, a bound on
+   a transient), which does not depend on the precision, or rounding, which does. Rounding bounds
+   are written as
+       TOL(tol, k) = max(tol, k * TEST_EPS)
+   where `tol` is the bound of the double build and k * TEST_EPS the same kind of bound in units of
+   the machine epsilon of fsdem_real: k counts the roundings that accumulate in the checked value,
+   relative to its scale (for an absolute bound k carries the scale: TOL(1e-14, 4 * 0.3) is 4 eps of
+   a 0.3 m depth), with the reason next to each use. In double TOL returns `tol` unchanged
+   (the check below fails the test if k * DBL_EPSILON would exceed it, so no double tolerance is
+   ever loosened by this helper); in float k * FLT_EPSILON (1.2e-7 per unit of k) usually wins.
+   A check whose only error is rounding in both builds writes k * TEST_EPS directly. Tolerances of a
+   solver (a relative residual) follow the precision through the solver's own float defaults (the
+   pressure and pcg tolerances are 1e-5 in float). */
+#ifdef FSDEM_USE_FLOAT
+#define TEST_FLOAT 1
+#define TEST_EPS ((double)FLT_EPSILON)
+#else
+#define TEST_FLOAT 0
+#define TEST_EPS DBL_EPSILON
+#endif
+
+static inline double test_tol(double tol, double k, const char *file, int line) {
+    const double e = k * TEST_EPS;
+    ck_assert_msg(TEST_FLOAT || e <= tol, "%s:%d: TOL(%g, %g): %g eps exceeds the double tolerance", file, line, tol,
+                  k, k);
+    return e > tol ? e : tol;
+}
+#define TOL(tol, k) test_tol((tol), (k), __FILE__, __LINE__)
+
+/* Prints the measured figures of a test when FSDEM_TEST_VERBOSE is set (and not "0"). */
+#define TEST_REPORT(...)                                                                           \
+    do {                                                                                           \
+        const char *test_verbose_ = getenv("FSDEM_TEST_VERBOSE");                                  \
+        if (test_verbose_ && test_verbose_[0] && test_verbose_[0] != '0') {                        \
+            printf("  [%s] ", __func__);                                                           \
+            printf(__VA_ARGS__);                                                                   \
+            putchar('\n');                                                                         \
+            fflush(stdout);                                                                        \
+        }                                                                                          \
+    } while (0)
+
+/* True when every component is finite. */
+static inline int test_finite3(fsdem_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 
 #endif
