@@ -10891,11 +10891,11 @@ static void *fsdem__restart_block(fsdem__restart *io, const fsdem_allocator *al,
 /* ---- >>restart_dem : discrete elements ---- */
 
 /* One neighbour list: its rows and entries, the row offsets, the row of each entry, the partner keys
-   with their HELD bits and the tangential springs, all exactly, since the order of the entries and
-   the springs decide the next steps (a rebuild would carry the springs over, but its order comes
-   from the cell grid of the current positions, not of the ones the list was built at). While the
-   lists are current (not `stale`) they have one row per particle. *entries gets the saved number of
-   entries; returns the longest saved row. */
+   with their HELD bits and the tangential springs (zero where not HELD: they mean nothing there and
+   may be uninitialised), exactly as they are: the entries, their order and their springs decide the
+   next steps, and a rebuild forced at the restore would rebuild at other positions than the
+   uninterrupted run does. While the lists are current (not `stale`) they have one row per particle.
+   *entries gets the saved number of entries; returns the longest saved row. */
 static int fsdem__restart_dem_list(fsdem__restart *io, fsdem_dem *d, fsdem__dem_list *l, int pairs, int n, int stale,
                                    int walls, int *entries) {
     const char *name = pairs ? "particle-pair list" : "particle-wall list";
@@ -10944,7 +10944,13 @@ static int fsdem__restart_dem_list(fsdem__restart *io, fsdem_dem *d, fsdem__dem_
     }
     fsdem__restart_data(io, l->first, sizeof(int) * (size_t)count);
     fsdem__restart_data(io, l->key, sizeof(int) * (size_t)count);
-    fsdem__restart_data(io, l->history, sizeof(fsdem_vec3) * (size_t)count);
+    if (io->mode == FSDEM__RESTART_WRITE) /* a spring without its HELD bit means nothing: saved as 0 */
+        for (k = 0; k < count; ++k) {
+            fsdem_vec3 spring = fsdem__dem_spring(l, k);
+            fsdem__restart_data(io, &spring, sizeof spring);
+        }
+    else
+        fsdem__restart_data(io, l->history, sizeof(fsdem_vec3) * (size_t)count);
     if (io->mode == FSDEM__RESTART_COMMIT) {
         l->rows = rows;
         l->count = count;
