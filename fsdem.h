@@ -1455,6 +1455,10 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
    a run continued from a restored state is the uninterrupted run bit for bit. The format is for the
    same build: the precision of fsdem_real and the byte order are recorded and a mismatch is refused.
 
+   Use: fsdem_dem_save(dem, "run.chk") now and then; to go on later, fsdem_dem_create(&desc, &dem)
+   with the desc of the run, add its SDF walls again (below), fsdem_dem_restore(dem, "run.chk"), and
+   step on.
+
    Model. Create the object from the desc it was saved with (the allocator, log and callbacks are
    yours), then restore the state into it. What can change after creation comes from the save and
    replaces what the object holds:
@@ -1485,8 +1489,9 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
    (fsdem_pic_set_pressure_extra) stays as set on the object.
    Not restored: the SWE gauge file (restore refuses while one is open; open it again afterwards,
    its rows then start at the restored time), CPU-time figures of the statistics, last_error.
-   Views and coupling arrays of the DEM, and the PIC's particle views, obtained before a restore
-   are invalid after it; the PIC's grid and coupling arrays and the SWE's arrays stay in place.
+   The DEM's views and coupling arrays and the PIC's particle views obtained before a restore may
+   be invalid after it (take them again); the PIC's grid and coupling arrays and the SWE's fields
+   and coupling arrays stay where they are.
 
    Errors. Save: FSDEM_ERR_IO (the file cannot be written), FSDEM_ERR_INVALID_ARG (a NULL argument;
    a buffer too small, *size then holding the size needed), FSDEM_ERR_OUT_OF_MEMORY. Restore:
@@ -1494,7 +1499,9 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
    data, another format version, precision, byte order, dimension or object kind, or a desc that
    differs; the message says which), FSDEM_ERR_OUT_OF_MEMORY. A failed restore leaves the object
    exactly as it was: everything is validated and allocated before anything changes. A restore
-   needs memory for the file's contents and for the parts it replaces while both are held.
+   needs memory for the file's contents and for the parts it replaces while both are held. A file
+   is written in place: one cut short by a crash is refused by its checksum, so alternate between
+   two paths to always keep a good checkpoint.
 
    Format (version 1): a 64-byte header, then the payload.
      offset  bytes  field
@@ -10692,7 +10699,8 @@ typedef struct fsdem__restart {
 
 typedef void (*fsdem__restart_visit_fn)(fsdem__restart *io, void *object);
 
-/* 64-bit FNV-1a of `n` bytes, continuing from `h`: catches any flipped byte and costs little next to
+/* 64-bit FNV-1a of `n` bytes, continuing from `h`: each step (xor a byte, multiply by an odd prime)
+   is a bijection of the state, so any one changed byte changes the sum; and it costs little next to
    writing the data. */
 static unsigned long long fsdem__restart_fnv(unsigned long long h, const unsigned char *p, size_t n) {
     size_t k;
@@ -11794,8 +11802,11 @@ static fsdem_result fsdem__restart_load_file(const fsdem__restart_object *o, con
     return res;
 }
 
-/* The public functions: save and restore, to files and to memory, for each of the four objects. A
-   NULL object is refused with FSDEM_ERR_INVALID_ARG (there is no message to write to). */
+/* The public functions: save and restore, to files and to memory, for each of the four objects (a
+   few lines each around the helpers above). A NULL object is refused with FSDEM_ERR_INVALID_ARG
+   without a message (there is no object to hold it). */
+
+/* fsdem_dem (>>restart): the discrete elements. */
 fsdem_result fsdem_dem_save(const fsdem_dem *dem, const char *path) {
     fsdem__restart_object o;
     if (!dem) return FSDEM_ERR_INVALID_ARG;
@@ -11824,6 +11835,7 @@ fsdem_result fsdem_dem_restore_memory(fsdem_dem *dem, const void *buffer, size_t
     return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
 }
 
+/* fsdem_pic (>>restart): the PIC/FLIP solver. */
 fsdem_result fsdem_pic_save(const fsdem_pic *pic, const char *path) {
     fsdem__restart_object o;
     if (!pic) return FSDEM_ERR_INVALID_ARG;
@@ -11852,6 +11864,7 @@ fsdem_result fsdem_pic_restore_memory(fsdem_pic *pic, const void *buffer, size_t
     return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
 }
 
+/* fsdem_swe (>>restart): the shallow-water solver. */
 fsdem_result fsdem_swe_save(const fsdem_swe *swe, const char *path) {
     fsdem__restart_object o;
     if (!swe) return FSDEM_ERR_INVALID_ARG;
@@ -11880,6 +11893,7 @@ fsdem_result fsdem_swe_restore_memory(fsdem_swe *swe, const void *buffer, size_t
     return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
 }
 
+/* fsdem_swe_dem (>>restart): the SWE-DEM coupler with its two solvers. */
 fsdem_result fsdem_swe_dem_save(const fsdem_swe_dem *coupler, const char *path) {
     fsdem__restart_object o;
     if (!coupler) return FSDEM_ERR_INVALID_ARG;
