@@ -511,6 +511,42 @@ START_TEST(swe_dem_continues_bit_exact) {
 }
 END_TEST
 
+/* A coupler's save refused by one of its solvers (the water's grid differs) names that solver and
+   leaves all three objects as they were. */
+START_TEST(swe_dem_refusal_names_the_solver) {
+    world a = world_new(0), c = world_new(1);
+    fsdem_swe_desc sd = fsdem_swe_desc_default(1);
+    fsdem_swe *coarse = NULL;
+    fsdem_swe_dem *cpl = NULL;
+    fsdem_swe_dem_desc cd = fsdem_swe_dem_desc_default();
+    unsigned char *A, *before, *after;
+    size_t na, n0, n1;
+    world_run(&a, 3, 1);
+    A = save_swe_dem(a.cpl, &na);
+    sd.nx = 20;
+    sd.x_max = 2;
+    ck_assert_int_eq(fsdem_swe_create(&sd, &coarse), FSDEM_OK);
+    cd.swe = coarse;
+    cd.dem = c.dem;
+    cd.heave_damping = 0.1;
+    ck_assert_int_eq(fsdem_swe_dem_create(&cd, &cpl), FSDEM_OK);
+    before = save_swe_dem(cpl, &n0);
+    ck_assert_int_eq(fsdem_swe_dem_restore_memory(cpl, A, na), FSDEM_ERR_INVALID_ARG);
+    ck_assert_str_eq(fsdem_swe_dem_last_error(cpl),
+                     "fsdem_swe_dem_restore_memory: shallow water: the grid has 40 x 1 cells in the save and 20 x 1 in "
+                     "the object (create the object from the desc it was saved with)");
+    after = save_swe_dem(cpl, &n1);
+    same_bytes(before, n0, after, n1, "coupler after a refused restore");
+    free(A);
+    free(before);
+    free(after);
+    fsdem_swe_dem_destroy(cpl);
+    fsdem_swe_destroy(coarse);
+    world_free(&a);
+    world_free(&c);
+}
+END_TEST
+
 /* ---- bad data ---- */
 
 /* Restoring `bad` (n bytes) into d fails with `code` and a message holding `words`, and leaves d
@@ -742,6 +778,7 @@ Suite *restart_suite(void) {
     tcase_add_test(tc, pic_apic_continues_bit_exact);
     tcase_add_test(tc, swe_continues_bit_exact);
     tcase_add_test(tc, swe_dem_continues_bit_exact);
+    tcase_add_test(tc, swe_dem_refusal_names_the_solver);
     tcase_add_test(tc, bad_data_is_refused_and_changes_nothing);
     tcase_add_test(tc, out_of_memory_changes_nothing);
     tcase_add_test(tc, swe_gauge_file_blocks_restore);
