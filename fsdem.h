@@ -23,6 +23,8 @@
      >>swe      shallow-water equations in 1D and 2D: HLL, MUSCL-Hancock, wet/dry, well-balanced
                 (seed 003)
      >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
+     >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
+                to memory, bit-exact continuation (versioned binary format with a checksum)
      >>io       CSV time series, ParaView .pvd series, DEM particle snapshots
      >>impl     implementation, in the same order (each chapter opens with its contents)
      >>licence  MIT
@@ -94,6 +96,10 @@
                                                     long long steps, double time, fsdem_real dt
        fsdem_X_particles / fsdem_X_fields fsdem_X_get_particles / _get_fields(x)  views (SoA)
        fsdem_result fsdem_X_write_<what>(x, path)   snapshots (FSDEM_ERR_IO)
+       fsdem_result fsdem_X_save / _restore(x, path)  checkpoint and restart (>>restart): the whole
+                                                    state to a file and back into an object made
+                                                    from the same desc, the run going on bit for bit;
+                                                    _save_memory / _restore_memory with a buffer
      Gravity is a vector (m/s^2) in every desc. A NULL object pointer is refused with
      FSDEM_ERR_INVALID_ARG by every function that returns a result (getters return zeros, last_error
      says which object is NULL). Messages start with the public name they concern: the function
@@ -175,6 +181,10 @@
 #define fsdem_dem_particle_desc_default fsdem_dem_particle_desc_default_f
 #define fsdem_dem_remove_particle fsdem_dem_remove_particle_f
 #define fsdem_dem_remove_wall fsdem_dem_remove_wall_f
+#define fsdem_dem_restore fsdem_dem_restore_f
+#define fsdem_dem_restore_memory fsdem_dem_restore_memory_f
+#define fsdem_dem_save fsdem_dem_save_f
+#define fsdem_dem_save_memory fsdem_dem_save_memory_f
 #define fsdem_dem_set_dt fsdem_dem_set_dt_f
 #define fsdem_dem_set_particle_state fsdem_dem_set_particle_state_f
 #define fsdem_dem_set_wall_velocity fsdem_dem_set_wall_velocity_f
@@ -203,6 +213,7 @@
 #define fsdem_pcg_setup_stencil fsdem_pcg_setup_stencil_f
 #define fsdem_pcg_solve fsdem_pcg_solve_f
 #define fsdem_pic_add_force fsdem_pic_add_force_f
+#define fsdem_pic_add_gauge fsdem_pic_add_gauge_f
 #define fsdem_pic_add_obstacle fsdem_pic_add_obstacle_f
 #define fsdem_pic_add_particles fsdem_pic_add_particles_f
 #define fsdem_pic_advance fsdem_pic_advance_f
@@ -213,6 +224,9 @@
 #define fsdem_pic_destroy fsdem_pic_destroy_f
 #define fsdem_pic_fill_box fsdem_pic_fill_box_f
 #define fsdem_pic_fill_sdf fsdem_pic_fill_sdf_f
+#define fsdem_pic_gauge fsdem_pic_gauge_f
+#define fsdem_pic_gauges_close fsdem_pic_gauges_close_f
+#define fsdem_pic_gauges_open fsdem_pic_gauges_open_f
 #define fsdem_pic_get_coupling fsdem_pic_get_coupling_f
 #define fsdem_pic_get_desc fsdem_pic_get_desc_f
 #define fsdem_pic_get_fields fsdem_pic_get_fields_f
@@ -225,7 +239,11 @@
 #define fsdem_pic_obstacle_sdf fsdem_pic_obstacle_sdf_f
 #define fsdem_pic_obstacle_sphere fsdem_pic_obstacle_sphere_f
 #define fsdem_pic_reserve fsdem_pic_reserve_f
+#define fsdem_pic_restore fsdem_pic_restore_f
+#define fsdem_pic_restore_memory fsdem_pic_restore_memory_f
 #define fsdem_pic_sample fsdem_pic_sample_f
+#define fsdem_pic_save fsdem_pic_save_f
+#define fsdem_pic_save_memory fsdem_pic_save_memory_f
 #define fsdem_pic_set_pressure_extra fsdem_pic_set_pressure_extra_f
 #define fsdem_pic_solid_distance fsdem_pic_solid_distance_f
 #define fsdem_pic_stable_dt fsdem_pic_stable_dt_f
@@ -247,6 +265,8 @@
 #define fsdem_swe_add_point_source fsdem_swe_add_point_source_f
 #define fsdem_swe_advance fsdem_swe_advance_f
 #define fsdem_swe_bed_sdf fsdem_swe_bed_sdf_f
+#define fsdem_swe_block_box fsdem_swe_block_box_f
+#define fsdem_swe_block_polygon fsdem_swe_block_polygon_f
 #define fsdem_swe_cell_at fsdem_swe_cell_at_f
 #define fsdem_swe_clear_forces fsdem_swe_clear_forces_f
 #define fsdem_swe_copy_field fsdem_swe_copy_field_f
@@ -260,6 +280,10 @@
 #define fsdem_swe_dem_get_force fsdem_swe_dem_get_force_f
 #define fsdem_swe_dem_get_stats fsdem_swe_dem_get_stats_f
 #define fsdem_swe_dem_last_error fsdem_swe_dem_last_error_f
+#define fsdem_swe_dem_restore fsdem_swe_dem_restore_f
+#define fsdem_swe_dem_restore_memory fsdem_swe_dem_restore_memory_f
+#define fsdem_swe_dem_save fsdem_swe_dem_save_f
+#define fsdem_swe_dem_save_memory fsdem_swe_dem_save_memory_f
 #define fsdem_swe_dem_stable_dt fsdem_swe_dem_stable_dt_f
 #define fsdem_swe_dem_step fsdem_swe_dem_step_f
 #define fsdem_swe_dem_step_dt fsdem_swe_dem_step_dt_f
@@ -279,9 +303,14 @@
 #define fsdem_swe_last_error fsdem_swe_last_error_f
 #define fsdem_swe_momentum fsdem_swe_momentum_f
 #define fsdem_swe_remove_point_source fsdem_swe_remove_point_source_f
+#define fsdem_swe_restore fsdem_swe_restore_f
+#define fsdem_swe_restore_memory fsdem_swe_restore_memory_f
 #define fsdem_swe_sample fsdem_swe_sample_f
 #define fsdem_swe_sample_state fsdem_swe_sample_state_f
+#define fsdem_swe_save fsdem_swe_save_f
+#define fsdem_swe_save_memory fsdem_swe_save_memory_f
 #define fsdem_swe_set_bed fsdem_swe_set_bed_f
+#define fsdem_swe_set_blocked fsdem_swe_set_blocked_f
 #define fsdem_swe_set_boundary fsdem_swe_set_boundary_f
 #define fsdem_swe_set_cells fsdem_swe_set_cells_f
 #define fsdem_swe_set_depth fsdem_swe_set_depth_f
@@ -1643,6 +1672,105 @@ typedef struct fsdem_swe_dem_stats {
 } fsdem_swe_dem_stats;
 
 FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupler);
+
+/* ===== >>restart : checkpoint and restart ========================================================= */
+
+/* Saves the complete state of a solver or coupler to a file or to memory, and restores it, so that
+   a run continued from a restored state is the uninterrupted run bit for bit. The format is for the
+   same build: the precision of fsdem_real and the byte order are recorded and a mismatch is refused.
+
+   Use: fsdem_dem_save(dem, "run.chk") now and then; to go on later, fsdem_dem_create(&desc, &dem)
+   with the desc of the run, add its SDF walls again (below), fsdem_dem_restore(dem, "run.chk"), and
+   step on.
+
+   Model. Create the object from the desc it was saved with (the allocator, log and callbacks are
+   yours), then restore the state into it. What can change after creation comes from the save and
+   replaces what the object holds:
+     fsdem_dem      materials, walls (positions, velocities, forces, impulses), particles (ids,
+                    kinematics, the contact forces of the last evaluation, external loads), the
+                    neighbour lists with their tangential springs, dt, time, counters;
+     fsdem_pic      particles (APIC matrices too) and their capacity, the random-number state,
+                    obstacles and their face fractions, the grid fields that views and the next
+                    step read (face velocities, pressure, level set, fractions, cell types), the
+                    coupling arrays, time, counters;
+     fsdem_swe      surface and discharges, bed, per-cell Manning, rain, boundaries with their
+                    series, point sources, gauge positions, momentum sources, time, counters;
+     fsdem_swe_dem  the states of its fsdem_swe and fsdem_dem, restored into the solvers it was
+                    created with, and its own counters and per-particle force records (one file
+                    holds the coupled run).
+   What must match (else FSDEM_ERR_INVALID_ARG naming the field): the desc fields that steps read.
+   DEM: dim, domain, gravity, law, integrator, dt_rule, dt_param, skin, contact_offset, linear_*,
+   disc_length, rotation. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,
+   viscosity, gravity, boundaries, transfer, kernel, seeding and reseeding, advection, cfl,
+   dt_max, ghost-fluid, extrapolation and solver settings. SWE: dim, nx, ny, extent, width,
+   gravity, density, cfl, dt_max, order, limiter, dry_depth, manning, eddy_viscosity. Coupler:
+   beta, two_way, heave_damping, max_substeps (and its solvers' fields above). Not compared:
+   allocator, log, DEM dt and capacity, PIC seed and max_memory, SWE rain_rate, boundary, bed and
+   depth (all restored or irrelevant once the state is restored).
+   Callbacks cannot be saved. An SDF wall (DEM) or SDF obstacle (PIC) of the save takes the
+   callback of the object's wall or obstacle with the same index, which must be of that type: add
+   them again, in the same order, before restoring. A pressure-extra operator
+   (fsdem_pic_set_pressure_extra) stays as set on the object.
+   Not restored: the SWE gauge file (restore refuses while one is open; open it again afterwards,
+   its rows then start at the restored time), CPU-time figures of the statistics, last_error.
+   The DEM's views and coupling arrays and the PIC's particle views obtained before a restore may
+   be invalid after it (take them again); the PIC's grid and coupling arrays and the SWE's fields
+   and coupling arrays stay where they are.
+
+   Errors. Save: FSDEM_ERR_IO (the file cannot be written), FSDEM_ERR_INVALID_ARG (a NULL argument;
+   a buffer too small, *size then holding the size needed), FSDEM_ERR_OUT_OF_MEMORY. Restore:
+   FSDEM_ERR_IO (the file cannot be opened or read), FSDEM_ERR_INVALID_ARG (truncated or corrupted
+   data, another format version, precision, byte order, dimension or object kind, or a desc that
+   differs; the message says which), FSDEM_ERR_OUT_OF_MEMORY. A failed restore leaves the object
+   exactly as it was: everything is validated and allocated before anything changes. A restore
+   needs memory for the file's contents and for the parts it replaces while both are held. A file
+   is written in place: one cut short by a crash is refused by its checksum, so alternate between
+   two paths to always keep a good checkpoint.
+
+   Format (version 1): a 64-byte header, then the payload.
+     offset  bytes  field
+          0      8  magic "FSDEMRST"
+          8      4  format version (unsigned)
+         12      4  byte-order mark 0x01020304 as the saving machine stores it
+         16      4  precision: sizeof(fsdem_real), 4 (FSDEM_USE_FLOAT) or 8
+         20      4  object kind: 1 fsdem_dem, 2 fsdem_pic, 3 fsdem_swe, 4 fsdem_swe_dem
+         24      4  dimension of the object (the SWE's for fsdem_swe_dem)
+         28      4  reserved (0)
+         32     16  four sizes (int) for tools: DEM particles, materials, walls, pair-list entries;
+                    PIC cells along x, y, z and particles; SWE nx, ny, point sources, gauges;
+                    SWE-DEM nx, ny, DEM particles, force records
+         48      8  payload bytes (unsigned)
+         56      8  checksum: 64-bit FNV-1a over bytes 0 to 55 and the payload
+   The payload holds tagged sections of integers and reals as the saving machine stores them. */
+
+/* Saves the state to the file `path` (created or replaced). Errors above. */
+FSDEM_API fsdem_result fsdem_dem_save(const fsdem_dem *dem, const char *path);
+/* Restores the state saved in the file `path` into `dem`. Errors above. */
+FSDEM_API fsdem_result fsdem_dem_restore(fsdem_dem *dem, const char *path);
+/* Saves the state to `buffer` (`capacity` bytes); *size gets the bytes written, or with a NULL
+   buffer the bytes needed (nothing is written). */
+FSDEM_API fsdem_result fsdem_dem_save_memory(const fsdem_dem *dem, void *buffer, size_t capacity, size_t *size);
+/* Restores the state held in `buffer` (`size` bytes, as fsdem_dem_save_memory wrote them). */
+FSDEM_API fsdem_result fsdem_dem_restore_memory(fsdem_dem *dem, const void *buffer, size_t size);
+
+/* The same four for the PIC/FLIP solver. */
+FSDEM_API fsdem_result fsdem_pic_save(const fsdem_pic *pic, const char *path);
+FSDEM_API fsdem_result fsdem_pic_restore(fsdem_pic *pic, const char *path);
+FSDEM_API fsdem_result fsdem_pic_save_memory(const fsdem_pic *pic, void *buffer, size_t capacity, size_t *size);
+FSDEM_API fsdem_result fsdem_pic_restore_memory(fsdem_pic *pic, const void *buffer, size_t size);
+
+/* The same four for the shallow-water solver. */
+FSDEM_API fsdem_result fsdem_swe_save(const fsdem_swe *swe, const char *path);
+FSDEM_API fsdem_result fsdem_swe_restore(fsdem_swe *swe, const char *path);
+FSDEM_API fsdem_result fsdem_swe_save_memory(const fsdem_swe *swe, void *buffer, size_t capacity, size_t *size);
+FSDEM_API fsdem_result fsdem_swe_restore_memory(fsdem_swe *swe, const void *buffer, size_t size);
+
+/* The same four for the SWE-DEM coupler: its solvers' states are saved and restored with it. */
+FSDEM_API fsdem_result fsdem_swe_dem_save(const fsdem_swe_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_swe_dem_restore(fsdem_swe_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_swe_dem_save_memory(const fsdem_swe_dem *coupler, void *buffer, size_t capacity,
+                                                 size_t *size);
+FSDEM_API fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *buffer, size_t size);
 
 /* ===== >>io : CSV time series and particle snapshots =============================================== */
 
@@ -6523,9 +6651,9 @@ void fsdem_pic_destroy(fsdem_pic *s) {
     fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
     if (s->pcg_p) fsdem_pcg_destroy(s->pcg_p);
     fsdem__series_close(&s->gauges, &s->allocator);
-    fsdem__pic_release(s, s->gauge_at, sizeof(fsdem_vec3) * (size_t)s->gauge_capacity);
-    fsdem__pic_release(s, s->gauge_kind, sizeof(int) * (size_t)s->gauge_capacity);
-    fsdem__pic_release(s, s->gauge_radius, sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+    fsdem__free(&s->allocator, s->gauge_at, sizeof(fsdem_vec3) * (size_t)s->gauge_capacity);
+    fsdem__free(&s->allocator, s->gauge_kind, sizeof(int) * (size_t)s->gauge_capacity);
+    fsdem__free(&s->allocator, s->gauge_radius, sizeof(fsdem_real) * (size_t)s->gauge_capacity);
     al = s->allocator;
     fsdem__free(&al, s, sizeof *s);
 }
@@ -9024,7 +9152,8 @@ fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *s, const char *path) {
 /* ===== >>impl_swe : shallow-water solver ========================================================== */
 
 /* Contents: the scheme below and the object; >>swe_desc (defaults, validation), >>swe_object
-   (creation, series, state, coupling), >>swe_riemann (face fluxes), >>swe_row (reconstruction,
+   (creation, series, state, coupling), >>swe_sources (boundaries, friction, rain, blocked cells,
+   point sources), >>swe_riemann (face fluxes), >>swe_row (reconstruction,
    predictor and x faces of a row), >>swe_step (y faces, repair, stable dt, stepping), >>swe_diag
    (diagnostics, output, gauges, bed SDF). */
 
@@ -9806,6 +9935,8 @@ fsdem_result fsdem_swe_clear_forces(fsdem_swe *s) {
     memset(s->sy, 0, sizeof(fsdem_real) * (size_t)s->n);
     return fsdem__ok(&s->status);
 }
+
+/* ---- >>swe_sources : boundaries, friction, rain, blocked cells, point sources ---- */
 
 fsdem_result fsdem_swe_set_boundary(fsdem_swe *s, fsdem_side side, const fsdem_swe_boundary *bc) {
     char msg[FSDEM__MESSAGE_SIZE];
@@ -11368,6 +11499,1320 @@ fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
     st.in_water = c->in_water;
     st.impulse_to_water = c->impulse;
     return st;
+}
+
+/* ===== >>impl_restart : checkpoint and restart =======================================================
+
+   Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
+   every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_swe_dem (one visitor per
+   object lists what it saves, in order, and serves saving and restoring alike), >>restart_api
+   (memory and files). A restore runs the visitor three times over the payload: CHECK validates
+   everything and compares the desc, RESERVE allocates, COMMIT writes into the object. Only COMMIT
+   changes the object, and it cannot fail. */
+
+/* ---- >>restart_format : header, checksum, cursor ---- */
+
+#define FSDEM__RESTART_VERSION 1u
+#define FSDEM__RESTART_HEADER 64
+#define FSDEM__RESTART_BOM 0x01020304u
+#define FSDEM__RESTART_FNV_BASIS 0xcbf29ce484222325ull
+#define FSDEM__RESTART_FNV_PRIME 0x100000001b3ull
+#define FSDEM__RESTART_INT_MAX 2147483647
+
+/* The header stores its fields as unsigned int (4 bytes) and unsigned long long (8 bytes). */
+typedef char fsdem__restart_int_sizes[sizeof(unsigned int) == 4 && sizeof(unsigned long long) == 8 ? 1 : -1];
+
+enum { FSDEM__RESTART_DEM = 1, FSDEM__RESTART_PIC = 2, FSDEM__RESTART_SWE = 3, FSDEM__RESTART_SWE_DEM = 4 };
+
+typedef enum fsdem__restart_mode {
+    FSDEM__RESTART_WRITE = 0,   /* object to payload (to memory, to a file, or only measured) */
+    FSDEM__RESTART_CHECK = 1,   /* payload validated and compared with the object; nothing stored */
+    FSDEM__RESTART_RESERVE = 2, /* the memory the payload needs is allocated; nothing stored */
+    FSDEM__RESTART_COMMIT = 3   /* payload to object; cannot fail */
+} fsdem__restart_mode;
+
+/* A block RESERVE allocated for COMMIT to hand over to the object. */
+typedef struct fsdem__restart_held {
+    void *ptr;
+    size_t bytes;
+    const fsdem_allocator *allocator;
+} fsdem__restart_held;
+
+/* The cursor of a save or a restore. */
+typedef struct fsdem__restart {
+    fsdem__restart_mode mode;
+    unsigned char *out;          /* WRITE to memory: where the payload goes (NULL: a file, or measuring) */
+    FILE *file;                  /* WRITE to a file */
+    const unsigned char *in;     /* reading: the payload */
+    size_t pos, size;            /* cursor; bytes of the payload (WRITE to memory: room for it) */
+    unsigned long long hash;     /* FNV-1a of the header and of the bytes written so far */
+    fsdem_result res;            /* the first failure, FSDEM_OK so far */
+    char fn[48];                 /* public function, first in every message */
+    const char *section;         /* the solver being read in a coupler's file, or NULL */
+    char message[FSDEM__MESSAGE_SIZE];
+    const fsdem_allocator *allocator; /* of `blocks` */
+    fsdem__restart_held *blocks;
+    int block_count, block_capacity, block_next;
+} fsdem__restart;
+
+typedef void (*fsdem__restart_visit_fn)(fsdem__restart *io, void *object);
+
+/* 64-bit FNV-1a of `n` bytes, continuing from `h`: each step (xor a byte, multiply by an odd prime)
+   is a bijection of the state, so any one changed byte changes the sum; and it costs little next to
+   writing the data. */
+static unsigned long long fsdem__restart_fnv(unsigned long long h, const unsigned char *p, size_t n) {
+    size_t k;
+    for (k = 0; k < n; ++k) h = (h ^ p[k]) * FSDEM__RESTART_FNV_PRIME;
+    return h;
+}
+
+/* Records the first failure and its message (the public function first, then the solver section of
+   a coupler's file); later failures keep the first, so a message names the root cause. */
+static void fsdem__restart_fail(fsdem__restart *io, fsdem_result code, const char *fmt, ...) {
+    char detail[384];
+    va_list ap;
+    if (io->res != FSDEM_OK) return;
+    va_start(ap, fmt);
+    vsnprintf(detail, sizeof detail, fmt, ap);
+    va_end(ap);
+    snprintf(io->message, sizeof io->message, "%s: %s%s%s", io->fn, io->section ? io->section : "",
+             io->section ? ": " : "", detail);
+    io->res = code;
+}
+
+/* The next `bytes` of the payload when restoring (a failure and NULL when they run past its end);
+   NULL when saving. Lets a check read arrays in place. */
+static const unsigned char *fsdem__restart_peek(fsdem__restart *io, size_t bytes) {
+    if (io->mode == FSDEM__RESTART_WRITE || io->res != FSDEM_OK) return NULL;
+    if (bytes > io->size - io->pos) {
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the data end early at byte %llu of %llu (corrupted data)",
+                            (unsigned long long)io->pos, (unsigned long long)io->size);
+        return NULL;
+    }
+    return io->in + io->pos;
+}
+
+/* Object data: WRITE appends `bytes` from p (to memory or to the file, or only counts them), COMMIT
+   copies them into p, CHECK and RESERVE step over them. The one place bytes move. */
+static void fsdem__restart_data(fsdem__restart *io, void *p, size_t bytes) {
+    if (io->res != FSDEM_OK || bytes == 0) return;
+    if (io->mode == FSDEM__RESTART_WRITE) {
+        if (io->out) {
+            FSDEM_ASSERT(bytes <= io->size - io->pos);
+            memcpy(io->out + io->pos, p, bytes);
+        } else if (io->file)
+            fwrite(p, 1, bytes, io->file); /* errors: ferror at the end (fsdem__restart_save_file) */
+        if (io->out || io->file) io->hash = fsdem__restart_fnv(io->hash, (const unsigned char *)p, bytes);
+        io->pos += bytes;
+        return;
+    }
+    if (!fsdem__restart_peek(io, bytes)) return;
+    if (io->mode == FSDEM__RESTART_COMMIT) memcpy(p, io->in + io->pos, bytes);
+    io->pos += bytes;
+}
+
+/* A value the visitor itself looks at (a count, a type, a flag): written like data, and read into p
+   in every reading mode, so CHECK can validate it before anything depends on it. */
+static void fsdem__restart_value(fsdem__restart *io, void *p, size_t bytes) {
+    if (io->mode == FSDEM__RESTART_WRITE) {
+        fsdem__restart_data(io, p, bytes);
+        return;
+    }
+    if (!fsdem__restart_peek(io, bytes)) return;
+    memcpy(p, io->in + io->pos, bytes);
+    io->pos += bytes;
+}
+
+/* The int at index k of payload bytes (which need not be aligned). */
+static int fsdem__restart_int_at(const unsigned char *p, long k) {
+    int v;
+    memcpy(&v, p + (size_t)k * sizeof v, sizeof v);
+    return v;
+}
+
+/* An int that must lie in [lo, hi]: written, or read into *v and checked. */
+static void fsdem__restart_int_in(fsdem__restart *io, int *v, int lo, int hi, const char *what) {
+    fsdem__restart_value(io, v, sizeof *v);
+    if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && (*v < lo || *v > hi))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s is %d, outside [%d, %d] (corrupted data)", what, *v, lo, hi);
+}
+
+/* A count: written, or read and checked to lie in [0, max] with at least `item_bytes` of payload left
+   per item, so that a corrupted count can neither run long loops nor ask for a huge allocation.
+   Returns 1 when it may be used. */
+static int fsdem__restart_count(fsdem__restart *io, int *n, int max, size_t item_bytes, const char *what) {
+    fsdem__restart_int_in(io, n, 0, max, what);
+    if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && (size_t)*n * item_bytes > io->size - io->pos)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s is %d, more than the data can hold (corrupted data)", what, *n);
+    return io->res == FSDEM_OK;
+}
+
+/* `count` ints of object data, each in [lo, hi] (checked in CHECK): indices that steps follow. */
+static void fsdem__restart_ints(fsdem__restart *io, int *a, int count, int lo, int hi, const char *what) {
+    const unsigned char *p = io->mode == FSDEM__RESTART_CHECK ? fsdem__restart_peek(io, sizeof(int) * (size_t)count) : NULL;
+    int k, v;
+    for (k = 0; p && k < count; ++k)
+        if ((v = fsdem__restart_int_at(p, k)) < lo || v > hi) {
+            fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s %d is %d, outside [%d, %d] (corrupted data)", what, k, v, lo, hi);
+            return;
+        }
+    fsdem__restart_data(io, a, sizeof(int) * (size_t)count);
+}
+
+/* `count` bytes of object data, each at most hi (checked in CHECK): flags and cell types. */
+static void fsdem__restart_flags(fsdem__restart *io, unsigned char *a, int count, int hi, const char *what) {
+    const unsigned char *p = io->mode == FSDEM__RESTART_CHECK ? fsdem__restart_peek(io, (size_t)count) : NULL;
+    int k;
+    for (k = 0; p && k < count; ++k)
+        if (p[k] > hi) {
+            fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s %d is %d, more than %d (corrupted data)", what, k, p[k], hi);
+            return;
+        }
+    fsdem__restart_data(io, a, (size_t)count);
+}
+
+/* A desc field the object must share with the save: written, or read and compared (bit for bit for
+   reals). A difference is refused naming the field and both values: the object was not created
+   from the desc of the save. */
+static void fsdem__restart_same_int(fsdem__restart *io, int mine, const char *what) {
+    int saved = mine;
+    fsdem__restart_value(io, &saved, sizeof saved);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && saved != mine)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "desc.%s is %d in the save and %d in the object (create the object from the desc it was saved with)",
+                            what, saved, mine);
+}
+
+static void fsdem__restart_same_ll(fsdem__restart *io, long long mine, const char *what) {
+    long long saved = mine;
+    fsdem__restart_value(io, &saved, sizeof saved);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && saved != mine)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "desc.%s is %lld in the save and %lld in the object (create the object from the desc it was saved with)",
+                            what, saved, mine);
+}
+
+static void fsdem__restart_same_vec3(fsdem__restart *io, fsdem_vec3 mine, const char *what) {
+    fsdem_vec3 saved = mine;
+    fsdem__restart_value(io, &saved, sizeof saved);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && memcmp(&saved, &mine, sizeof saved) != 0)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "desc.%s is (%.17g, %.17g, %.17g) in the save and (%.17g, %.17g, %.17g) in the object "
+                            "(create the object from the desc it was saved with)",
+                            what, (double)saved.x, (double)saved.y, (double)saved.z, (double)mine.x, (double)mine.y,
+                            (double)mine.z);
+}
+
+static void fsdem__restart_same_real(fsdem__restart *io, fsdem_real mine, const char *what) {
+    fsdem_real saved = mine;
+    fsdem__restart_value(io, &saved, sizeof saved);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && memcmp(&saved, &mine, sizeof saved) != 0)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "desc.%s is %.17g in the save and %.17g in the object (create the object from the desc it was saved with)",
+                            what, (double)saved, (double)mine);
+}
+
+/* A section tag of four characters: written, or read and checked, so that data out of place are
+   caught at the section where they start. */
+static void fsdem__restart_tag(fsdem__restart *io, const char *tag) {
+    char got[4];
+    memcpy(got, tag, 4);
+    fsdem__restart_value(io, got, 4);
+    if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && memcmp(got, tag, 4) != 0)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "section '%.4s' expected at byte %llu (corrupted data)", tag,
+                            (unsigned long long)(io->pos - 4));
+}
+
+/* RESERVE: a failed allocation becomes the restore's result. */
+static void fsdem__restart_need(fsdem__restart *io, fsdem_result res, const char *what) {
+    if (res != FSDEM_OK) fsdem__restart_fail(io, FSDEM_ERR_OUT_OF_MEMORY, "out of memory for %s", what);
+}
+
+/* A fresh block of `bytes` for the object: RESERVE allocates it with the object's allocator and keeps
+   it, COMMIT hands the blocks over in the order RESERVE made them (the visitor asks for them in the
+   same order both times). NULL in the other modes and for 0 bytes. Blocks not handed over are freed
+   when the restore fails. */
+static void *fsdem__restart_block(fsdem__restart *io, const fsdem_allocator *al, size_t bytes) {
+    fsdem__restart_held *b;
+    if (io->res != FSDEM_OK || bytes == 0) return NULL;
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        FSDEM_ASSERT(io->block_next < io->block_count && io->blocks[io->block_next].bytes == bytes);
+        return io->blocks[io->block_next++].ptr;
+    }
+    if (io->mode != FSDEM__RESTART_RESERVE) return NULL;
+    if (fsdem__grow(io->allocator, (void **)&io->blocks, &io->block_capacity, io->block_count, io->block_count + 1,
+                    sizeof *io->blocks) != FSDEM_OK) {
+        fsdem__restart_need(io, FSDEM_ERR_OUT_OF_MEMORY, "the restore's bookkeeping");
+        return NULL;
+    }
+    b = &io->blocks[io->block_count];
+    b->ptr = fsdem__alloc(al, bytes);
+    b->bytes = bytes;
+    b->allocator = al;
+    if (!b->ptr) fsdem__restart_need(io, FSDEM_ERR_OUT_OF_MEMORY, "the restored state");
+    else io->block_count++;
+    return NULL;
+}
+
+/* ---- >>restart_dem : discrete elements ---- */
+
+/* One neighbour list: its rows and entries, the row offsets, the row of each entry, the partner keys
+   with their HELD bits and the tangential springs (zero where not HELD: they mean nothing there and
+   may be uninitialised), exactly as they are: the entries, their order and their springs decide the
+   next steps, and a rebuild forced at the restore would rebuild at other positions than the
+   uninterrupted run does. While the lists are current (not `stale`) they have one row per particle.
+   *entries gets the saved number of entries; returns the longest saved row. */
+static int fsdem__restart_dem_list(fsdem__restart *io, fsdem_dem *d, fsdem__dem_list *l, int pairs, int n, int stale,
+                                   int walls, int *entries) {
+    const char *name = pairs ? "particle-pair list" : "particle-wall list";
+    const unsigned char *start = NULL;
+    int rows = l->rows, count = l->count, longest = 0, i, k;
+    fsdem__restart_count(io, &rows, FSDEM__DEM_MAX_PARTICLES, sizeof(int), pairs ? "pair-list rows" : "wall-list rows");
+    fsdem__restart_count(io, &count, 1 << 30, 2 * sizeof(int) + sizeof(fsdem_vec3),
+                         pairs ? "pair-list entries" : "wall-list entries");
+    *entries = count;
+    if (io->res != FSDEM_OK) return 0;
+    if (io->mode == FSDEM__RESTART_CHECK && ((!stale && rows != n) || (rows == 0 && count != 0)))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the %s has %d rows and %d entries for %d particles (corrupted data)",
+                            name, rows, count, n);
+    if (io->mode == FSDEM__RESTART_RESERVE) {
+        if (rows > 0)
+            fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&l->start, &l->start_capacity,
+                                                l->rows > 0 ? l->rows + 1 : 0, rows + 1, sizeof(int)), name);
+        while (io->res == FSDEM_OK && l->capacity < count) fsdem__restart_need(io, fsdem__dem_list_grow(d, l), name);
+    }
+    if (rows > 0) {
+        start = fsdem__restart_peek(io, sizeof(int) * (size_t)(rows + 1));
+        for (i = 0; start && i < rows; ++i) {
+            const int a = fsdem__restart_int_at(start, i), b = fsdem__restart_int_at(start, i + 1);
+            if (io->mode == FSDEM__RESTART_CHECK && (a > b || (i == 0 && a != 0) || (i == rows - 1 && b != count))) {
+                fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the %s has bad row offsets at row %d (corrupted data)", name, i);
+                start = NULL;
+            } else if (b - a > longest)
+                longest = b - a;
+        }
+        fsdem__restart_data(io, l->start, sizeof(int) * (size_t)(rows + 1));
+    }
+    if (io->mode == FSDEM__RESTART_CHECK && start) {
+        /* each entry in its row; pairs name a later particle, wall entries a wall and a face */
+        const unsigned char *first = fsdem__restart_peek(io, 2 * sizeof(int) * (size_t)count);
+        for (i = 0; first && i < rows; ++i)
+            for (k = fsdem__restart_int_at(start, i); k < fsdem__restart_int_at(start, i + 1); ++k) {
+                const int key = fsdem__restart_int_at(first, (long)count + k), partner = FSDEM__DEM_PARTNER(key);
+                const int bad = pairs ? partner <= i || partner >= rows
+                                      : partner / 8 >= walls || partner % 8 >= 2 * d->desc.dim;
+                if (fsdem__restart_int_at(first, k) != i || key < 0 || bad) {
+                    fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the %s has a bad entry %d (corrupted data)", name, k);
+                    first = NULL;
+                    break;
+                }
+            }
+    }
+    fsdem__restart_data(io, l->first, sizeof(int) * (size_t)count);
+    fsdem__restart_data(io, l->key, sizeof(int) * (size_t)count);
+    if (io->mode == FSDEM__RESTART_WRITE) /* a spring without its HELD bit means nothing: saved as 0 */
+        for (k = 0; k < count; ++k) {
+            fsdem_vec3 spring = fsdem__dem_spring(l, k);
+            fsdem__restart_data(io, &spring, sizeof spring);
+        }
+    else
+        fsdem__restart_data(io, l->history, sizeof(fsdem_vec3) * (size_t)count);
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        l->rows = rows;
+        l->count = count;
+    }
+    return longest;
+}
+
+/* Everything of a DEM, in order. State: time, dt, counters, the neighbour-list bookkeeping (x_ref,
+   max_disp2, need_rebuild, skin, r_max, walls' `moved`), forces_valid and forces_cleared with the
+   forces and torques of the last evaluation (the next Verlet kick uses them), external loads,
+   materials with their pair table (the Hertz damping calibration is costly and its result must be
+   the same bits), walls, particles, both neighbour lists and the inert pairs. Configuration: the
+   desc fields that steps read, compared. Not saved, rebuilt or rewritten before use: the cell grid,
+   the pair scratch (found), the wall-hit scratch and the arena (reserved here for the next force
+   evaluation), the previous lists pp_old and pw_old (storage the next rebuild fills), the
+   predictor-corrector's x0, v0, w0, fa, ta and the walls' force_a (written at the start of each
+   such step), capacities, the allocator, log and message. SDF walls keep the object's callbacks. */
+static void fsdem__restart_dem(fsdem__restart *io, void *object) {
+    fsdem_dem *d = (fsdem_dem *)object;
+    const fsdem_dem_desc *dd = &d->desc;
+    const int reserve = io->mode == FSDEM__RESTART_RESERVE, commit = io->mode == FSDEM__RESTART_COMMIT;
+    int nm = d->material_count, nw = d->wall_count, n = d->n, stale = d->need_rebuild, inert = d->inert_count;
+    int k, longest, pairs = 0, wall_entries = 0;
+    fsdem__restart_tag(io, "DEM1");
+    fsdem__restart_same_int(io, dd->dim, "dim");
+    fsdem__restart_same_vec3(io, dd->domain_min, "domain_min");
+    fsdem__restart_same_vec3(io, dd->domain_max, "domain_max");
+    fsdem__restart_same_vec3(io, dd->gravity, "gravity");
+    fsdem__restart_same_int(io, (int)dd->law, "law");
+    fsdem__restart_same_int(io, (int)dd->integrator, "integrator");
+    fsdem__restart_same_int(io, (int)dd->dt_rule, "dt_rule");
+    fsdem__restart_same_real(io, dd->dt_param, "dt_param");
+    fsdem__restart_same_real(io, dd->skin, "skin");
+    fsdem__restart_same_real(io, dd->contact_offset, "contact_offset");
+    fsdem__restart_same_real(io, dd->linear_theta, "linear_theta");
+    fsdem__restart_same_real(io, dd->linear_dx, "linear_dx");
+    fsdem__restart_same_real(io, dd->linear_accel, "linear_accel");
+    fsdem__restart_same_real(io, dd->disc_length, "disc_length");
+    fsdem__restart_same_int(io, dd->rotation, "rotation");
+
+    fsdem__restart_data(io, &d->dt, sizeof d->dt);
+    fsdem__restart_data(io, &d->time, sizeof d->time);
+    fsdem__restart_data(io, &d->steps, sizeof d->steps);
+    fsdem__restart_data(io, &d->rebuilds, sizeof d->rebuilds);
+    fsdem__restart_data(io, &d->stable_dt, sizeof d->stable_dt);
+    fsdem__restart_data(io, &d->dt_warned, sizeof d->dt_warned);
+    fsdem__restart_data(io, &d->next_id, sizeof d->next_id);
+    fsdem__restart_data(io, &d->skin, sizeof d->skin);
+    fsdem__restart_data(io, &d->r_max, sizeof d->r_max);
+    fsdem__restart_data(io, &d->max_disp2, sizeof d->max_disp2);
+    fsdem__restart_int_in(io, &stale, 0, 1, "need_rebuild");
+    fsdem__restart_data(io, &d->forces_valid, sizeof d->forces_valid);
+    fsdem__restart_data(io, &d->rolling, sizeof d->rolling);
+    fsdem__restart_data(io, &d->external, sizeof d->external);
+    fsdem__restart_data(io, &d->forces_cleared, sizeof d->forces_cleared);
+    fsdem__restart_data(io, &d->contacts, sizeof d->contacts);
+    fsdem__restart_data(io, &d->wall_contacts, sizeof d->wall_contacts);
+    fsdem__restart_data(io, &d->max_overlap, sizeof d->max_overlap);
+    if (commit) d->need_rebuild = stale;
+
+    /* materials and their pair table */
+    fsdem__restart_count(io, &nm, 46340, sizeof(fsdem_dem_material), "material count");
+    if (reserve && nm > 0) {
+        fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&d->materials, &d->material_capacity, d->material_count,
+                                            nm, sizeof(fsdem_dem_material)), "the materials");
+        fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&d->pairs, &d->pair_capacity,
+                                            d->material_count * d->material_count, nm * nm, sizeof(fsdem__dem_pair)),
+                            "the materials");
+    }
+    fsdem__restart_data(io, d->materials, sizeof(fsdem_dem_material) * (size_t)nm);
+    fsdem__restart_data(io, d->pairs, sizeof(fsdem__dem_pair) * (size_t)nm * (size_t)nm);
+    if (commit) d->material_count = nm;
+
+    /* walls: geometry where it has moved to, velocity, forces and impulses */
+    fsdem__restart_count(io, &nw, FSDEM__DEM_HELD / 8, 4 * sizeof(int) + 6 * sizeof(fsdem_vec3), "wall count");
+    if (reserve && nw > 0)
+        fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&d->walls, &d->wall_capacity, d->wall_count, nw,
+                                            sizeof(fsdem__dem_wall)), "the walls");
+    for (k = 0; k < nw && io->res == FSDEM_OK; ++k) {
+        fsdem__dem_wall w;
+        int type, material;
+        if (io->mode == FSDEM__RESTART_WRITE) w = d->walls[k];
+        else memset(&w, 0, sizeof w);
+        type = (int)w.d.type;
+        material = w.d.material;
+        fsdem__restart_int_in(io, &type, 0, FSDEM_DEM_WALL_SDF, "wall type");
+        fsdem__restart_value(io, &w.d.a, sizeof w.d.a);
+        fsdem__restart_value(io, &w.d.b, sizeof w.d.b);
+        fsdem__restart_value(io, &w.d.c, sizeof w.d.c);
+        fsdem__restart_value(io, &w.d.velocity, sizeof w.d.velocity);
+        fsdem__restart_int_in(io, &material, 0, nm - 1, "wall material");
+        fsdem__restart_int_in(io, &w.active, 0, 1, "wall active flag");
+        fsdem__restart_value(io, &w.force, sizeof w.force);
+        fsdem__restart_value(io, &w.impulse, sizeof w.impulse);
+        fsdem__restart_value(io, &w.moved, sizeof w.moved);
+        if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_DEM_WALL_SDF) {
+            if (k >= d->wall_count || d->walls[k].d.type != FSDEM_DEM_WALL_SDF)
+                fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                                    "wall %d is an SDF wall in the save: add the same SDF walls (fsdem_dem_wall_sdf), in the "
+                                    "same order, to the object before restoring",
+                                    k);
+            else {
+                w.d.sdf = d->walls[k].d.sdf; /* wall k of the object is overwritten only below */
+                w.d.sdf_user = d->walls[k].d.sdf_user;
+            }
+        }
+        if (commit) {
+            w.d.type = (fsdem_dem_wall_type)type;
+            w.d.material = material;
+            d->walls[k] = w;
+        }
+    }
+    if (commit) d->wall_count = nw;
+
+    /* particles */
+    fsdem__restart_count(io, &n, FSDEM__DEM_MAX_PARTICLES, 8 * sizeof(fsdem_vec3) + 4 * sizeof(fsdem_real),
+                          "particle count");
+    if (reserve) fsdem__restart_need(io, fsdem__dem_reserve_particles(d, n > 0 ? n : 1), "the particles");
+    fsdem__restart_data(io, d->id, sizeof(int) * (size_t)n);
+    fsdem__restart_ints(io, d->material, n, 0, nm - 1, "material of particle");
+    fsdem__restart_ints(io, d->old_of, n, -1, FSDEM__RESTART_INT_MAX, "previous row of particle");
+    fsdem__restart_flags(io, d->fixed, n, 1, "fixed flag of particle");
+    fsdem__restart_data(io, d->x, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->v, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->w, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->f, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->t, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->fext, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->text, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->x_ref, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->r, sizeof(fsdem_real) * (size_t)n);
+    fsdem__restart_data(io, d->m, sizeof(fsdem_real) * (size_t)n);
+    fsdem__restart_data(io, d->inv_m, sizeof(fsdem_real) * (size_t)n);
+    fsdem__restart_data(io, d->inv_i, sizeof(fsdem_real) * (size_t)n);
+    if (commit) d->n = n;
+
+    /* neighbour lists with contact history, and the pairs of fixed particles listed aside */
+    fsdem__restart_dem_list(io, d, &d->pp, 1, n, stale, nw, &pairs);
+    longest = fsdem__restart_dem_list(io, d, &d->pw, 0, n, stale, nw, &wall_entries);
+    fsdem__restart_count(io, &inert, 1 << 29, 2 * sizeof(int), "inert pair count");
+    if (reserve && inert > 0)
+        fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&d->inert, &d->inert_capacity, 2 * d->inert_count,
+                                            2 * inert, sizeof(int)), "the inert pairs");
+    fsdem__restart_ints(io, d->inert, 2 * inert, 0, stale ? FSDEM__RESTART_INT_MAX : n - 1, "inert pair entry");
+    if (commit) d->inert_count = inert;
+    /* scratch of a force evaluation before the next rebuild, as fsdem__dem_rebuild reserves it */
+    if (reserve && io->res == FSDEM_OK) {
+        if (longest > 0)
+            fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&d->hits, &d->hit_capacity, 0, longest,
+                                                sizeof(fsdem__dem_wall_hit)), "the wall contacts");
+        fsdem__restart_need(io, fsdem__arena_reserve(&d->allocator, &d->arena,
+                                                     fsdem__arena_bytes(sizeof(int) * (size_t)pairs) +
+                                                         fsdem__arena_bytes(sizeof(fsdem__dem_batch))),
+                            "the force evaluation");
+    }
+    fsdem__restart_tag(io, "DEM.");
+}
+
+/* ---- >>restart_pic : PIC/FLIP ---- */
+
+/* Everything of a PIC solver, in order. State: time, last dt, steps (they pick the sorting steps),
+   the random-number state, particles with their capacity (a full capacity refuses inflow seeds) and
+   APIC matrices, obstacles (polygons with their vertices) with the static face fractions, solid
+   velocities and cell flags derived from them (recomputing them samples SDF callbacks), the
+   coupler's arrays, cells_fresh with the fractions and level set it vouches for, the pressure (the
+   initial guess of the next solve), the face velocities, effective faces and cell types (views,
+   sampling and fsdem_pic_add_force read them between steps), counters and the last step's figures.
+   Configuration: the grid and the desc fields that steps read, compared. Not saved, rewritten
+   before use: uold, wsum, ftmp, the valid-face marks, the extrapolation queue, rhs, diag, ctmp,
+   cstart and the particle scratch (ptmp, pcell, pidx; pflag is zeroed), the viscous face grids, the
+   linear solvers (set up at every use), CPU times, the allocator, log and message. SDF obstacles
+   keep the object's callbacks; a pressure-extra operator stays as set. */
+/* The gauges of a PIC solver (positions, kinds, radii); their file is not part of the state. */
+static void fsdem__restart_pic_gauges(fsdem__restart *io, fsdem_pic *s) {
+    const fsdem_allocator *al = &s->allocator;
+    int ng = s->gauge_count;
+    fsdem_vec3 *at;
+    int *kind;
+    fsdem_real *radius;
+    if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the object has a gauge file open: close it (fsdem_pic_gauges_close) before restoring and "
+                            "open it again afterwards");
+    fsdem__restart_count(io, &ng, 1 << 24, sizeof(fsdem_vec3) + sizeof(int) + sizeof(fsdem_real), "gauge count");
+    at = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)ng);
+    kind = (int *)fsdem__restart_block(io, al, sizeof(int) * (size_t)ng);
+    radius = (fsdem_real *)fsdem__restart_block(io, al, sizeof(fsdem_real) * (size_t)ng);
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        fsdem__free(al, s->gauge_at, sizeof(fsdem_vec3) * (size_t)s->gauge_capacity);
+        fsdem__free(al, s->gauge_kind, sizeof(int) * (size_t)s->gauge_capacity);
+        fsdem__free(al, s->gauge_radius, sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+        s->gauge_at = at;
+        s->gauge_kind = kind;
+        s->gauge_radius = radius;
+        s->gauge_count = s->gauge_capacity = ng;
+    }
+    fsdem__restart_data(io, s->gauge_at, sizeof(fsdem_vec3) * (size_t)ng);
+    fsdem__restart_ints(io, s->gauge_kind, ng, FSDEM_PIC_GAUGE_LEVEL, FSDEM_PIC_GAUGE_PRESSURE, "gauge kind");
+    fsdem__restart_data(io, s->gauge_radius, sizeof(fsdem_real) * (size_t)ng);
+}
+
+static void fsdem__restart_pic(fsdem__restart *io, void *object) {
+    fsdem_pic *s = (fsdem_pic *)object;
+    const fsdem_pic_desc *pd = &s->desc;
+    const fsdem_allocator *al = &s->allocator;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT, apic = pd->transfer == FSDEM_PIC_TRANSFER_APIC;
+    static const char *bc_names[6] = {"boundary[0]", "boundary[1]", "boundary[2]",
+                                      "boundary[3]", "boundary[4]", "boundary[5]"};
+    static const char *bv_names[6] = {"boundary_velocity[0]", "boundary_velocity[1]", "boundary_velocity[2]",
+                                      "boundary_velocity[3]", "boundary_velocity[4]", "boundary_velocity[5]"};
+    int grid[3], no = s->obst_count, np = s->np, pcap = s->pcap, a, k;
+    fsdem__pic_obst *obst;
+    size_t cells = sizeof(fsdem_real) * (size_t)s->ncell;
+    fsdem__restart_tag(io, "PIC1");
+    for (a = 0; a < 3; ++a) grid[a] = s->n[a];
+    fsdem__restart_value(io, grid, sizeof grid);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK &&
+        (grid[0] != s->n[0] || grid[1] != s->n[1] || grid[2] != s->n[2]))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the grid has %d x %d x %d cells in the save and %d x %d x %d in the object (create the "
+                            "object from the desc it was saved with)",
+                            grid[0], grid[1], grid[2], s->n[0], s->n[1], s->n[2]);
+    fsdem__restart_same_int(io, pd->dim, "dim");
+    fsdem__restart_same_vec3(io, pd->domain_min, "domain_min");
+    fsdem__restart_same_real(io, pd->cell_size, "cell_size");
+    fsdem__restart_same_real(io, pd->density, "density");
+    fsdem__restart_same_real(io, pd->viscosity, "viscosity");
+    fsdem__restart_same_vec3(io, pd->gravity, "gravity");
+    for (k = 0; k < 6; ++k) {
+        fsdem__restart_same_int(io, (int)pd->boundary[k], bc_names[k]);
+        fsdem__restart_same_vec3(io, pd->boundary_velocity[k], bv_names[k]);
+    }
+    fsdem__restart_same_int(io, pd->free_surface, "free_surface");
+    fsdem__restart_same_int(io, (int)pd->transfer, "transfer");
+    fsdem__restart_same_real(io, pd->flip_ratio, "flip_ratio");
+    fsdem__restart_same_int(io, (int)pd->kernel, "kernel");
+    fsdem__restart_same_int(io, pd->particles_per_cell, "particles_per_cell");
+    fsdem__restart_same_real(io, pd->jitter, "jitter");
+    fsdem__restart_same_int(io, pd->min_particles_per_cell, "min_particles_per_cell");
+    fsdem__restart_same_int(io, pd->max_particles_per_cell, "max_particles_per_cell");
+    fsdem__restart_same_int(io, pd->advection_order, "advection_order");
+    fsdem__restart_same_real(io, pd->cfl, "cfl");
+    fsdem__restart_same_real(io, pd->cfl_max, "cfl_max");
+    fsdem__restart_same_real(io, pd->dt_max, "dt_max");
+    fsdem__restart_same_int(io, pd->density_projection, "density_projection");
+    fsdem__restart_same_real(io, pd->ghost_theta_min, "ghost_theta_min");
+    fsdem__restart_same_int(io, pd->extrapolation_layers, "extrapolation_layers");
+    fsdem__restart_same_int(io, (int)pd->pressure_precond, "pressure_precond");
+    fsdem__restart_same_real(io, pd->pressure_tolerance, "pressure_tolerance");
+    fsdem__restart_same_int(io, pd->pressure_max_iterations, "pressure_max_iterations");
+    fsdem__restart_same_int(io, (int)pd->viscosity_precond, "viscosity_precond");
+    fsdem__restart_same_real(io, pd->viscosity_tolerance, "viscosity_tolerance");
+
+    fsdem__restart_data(io, &s->time, sizeof s->time);
+    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
+    fsdem__restart_data(io, &s->steps, sizeof s->steps);
+    fsdem__restart_data(io, &s->rng, sizeof s->rng);
+    fsdem__restart_data(io, &s->cells_fresh, sizeof s->cells_fresh);
+    fsdem__restart_data(io, &s->fluid_cells, sizeof s->fluid_cells);
+    fsdem__restart_data(io, &s->p_iters, sizeof s->p_iters);
+    fsdem__restart_data(io, &s->v_iters, sizeof s->v_iters);
+    fsdem__restart_data(io, &s->d_iters, sizeof s->d_iters);
+    fsdem__restart_data(io, &s->p_res, sizeof s->p_res);
+    fsdem__restart_data(io, &s->max_div, sizeof s->max_div);
+    fsdem__restart_data(io, &s->div_before, sizeof s->div_before);
+    fsdem__restart_data(io, &s->reseeded, sizeof s->reseeded);
+    fsdem__restart_data(io, &s->removed, sizeof s->removed);
+    fsdem__restart_data(io, &s->refused, sizeof s->refused);
+    fsdem__restart_data(io, &s->moved, sizeof s->moved);
+
+    /* obstacles, into a fresh array (polygons own their vertices) */
+    fsdem__restart_count(io, &no, 1 << 20, 2 * sizeof(int) + 5 * sizeof(fsdem_vec3) + sizeof(fsdem_real), "obstacle count");
+    obst = (fsdem__pic_obst *)fsdem__restart_block(io, al, sizeof(fsdem__pic_obst) * (size_t)no);
+    for (k = 0; k < no && io->res == FSDEM_OK; ++k) {
+        fsdem__pic_obst o;
+        fsdem_vec3 *verts;
+        int type, nv;
+        if (io->mode == FSDEM__RESTART_WRITE) o = s->obst[k];
+        else memset(&o, 0, sizeof o);
+        type = (int)o.d.type;
+        nv = o.d.type == FSDEM_PIC_OBSTACLE_POLYGON ? o.d.vertex_count : 0;
+        fsdem__restart_int_in(io, &type, 0, FSDEM_PIC_OBSTACLE_SDF, "obstacle type");
+        fsdem__restart_value(io, &o.d.a, sizeof o.d.a);
+        fsdem__restart_value(io, &o.d.b, sizeof o.d.b);
+        fsdem__restart_value(io, &o.d.radius, sizeof o.d.radius);
+        fsdem__restart_value(io, &o.d.velocity, sizeof o.d.velocity);
+        fsdem__restart_value(io, &o.box_lo, sizeof o.box_lo);
+        fsdem__restart_value(io, &o.box_hi, sizeof o.box_hi);
+        fsdem__restart_count(io, &nv, 1 << 24, sizeof(fsdem_vec3), "polygon vertex count");
+        if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && (type == FSDEM_PIC_OBSTACLE_POLYGON) != (nv >= 3))
+            fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "obstacle %d has %d vertices (corrupted data)", k, nv);
+        verts = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)nv);
+        fsdem__restart_data(io, io->mode == FSDEM__RESTART_WRITE ? o.verts : verts, sizeof(fsdem_vec3) * (size_t)nv);
+        if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_PIC_OBSTACLE_SDF) {
+            if (k >= s->obst_count || s->obst[k].d.type != FSDEM_PIC_OBSTACLE_SDF)
+                fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                                    "obstacle %d is an SDF obstacle in the save: add the same SDF obstacles "
+                                    "(fsdem_pic_obstacle_sdf), in the same order, to the object before restoring",
+                                    k);
+            else {
+                o.d.sdf = s->obst[k].d.sdf;
+                o.d.sdf_user = s->obst[k].d.sdf_user;
+            }
+        }
+        if (commit) {
+            o.d.type = (fsdem_pic_obstacle_type)type;
+            o.d.vertex_count = nv;
+            o.d.vertices = o.verts = verts;
+            obst[k] = o;
+        }
+    }
+    if (commit) {
+        for (k = 0; k < s->obst_count; ++k)
+            if (s->obst[k].verts) fsdem__pic_release(s, s->obst[k].verts, sizeof(fsdem_vec3) * (size_t)s->obst[k].d.vertex_count);
+        fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
+        s->obst = obst;
+        s->obst_count = s->obst_capacity = no;
+        s->bytes += sizeof(fsdem__pic_obst) * (size_t)no;
+        for (k = 0; k < no; ++k) s->bytes += sizeof(fsdem_vec3) * (size_t)obst[k].d.vertex_count;
+    }
+
+    /* particles, into fresh arrays of the saved capacity */
+    fsdem__restart_count(io, &pcap, 1 << 29, 0, "particle capacity");
+    fsdem__restart_count(io, &np, pcap, 2 * sizeof(fsdem_vec3), "particle count");
+    if (io->res == FSDEM_OK) {
+        const size_t vb = sizeof(fsdem_vec3) * (size_t)pcap, ib = sizeof(int) * (size_t)pcap;
+        fsdem_vec3 *px = (fsdem_vec3 *)fsdem__restart_block(io, al, vb), *pv = (fsdem_vec3 *)fsdem__restart_block(io, al, vb);
+        fsdem_vec3 *pt = (fsdem_vec3 *)fsdem__restart_block(io, al, vb), *pc[3] = {NULL, NULL, NULL};
+        int *pcell, *pidx;
+        unsigned char *pflag;
+        for (a = 0; a < 3 && apic; ++a) pc[a] = (fsdem_vec3 *)fsdem__restart_block(io, al, vb);
+        pcell = (int *)fsdem__restart_block(io, al, ib);
+        pidx = (int *)fsdem__restart_block(io, al, ib);
+        pflag = (unsigned char *)fsdem__restart_block(io, al, (size_t)pcap);
+        if (commit) {
+            fsdem__pic_free_particles(s);
+            s->px = px;
+            s->pv = pv;
+            s->ptmp = pt;
+            for (a = 0; a < 3; ++a) s->pc[a] = pc[a];
+            s->pcell = pcell;
+            s->pidx = pidx;
+            s->pflag = pflag;
+            if (pflag) memset(pflag, 0, (size_t)pcap);
+            s->pcap = pcap;
+            s->np = np;
+            s->bytes += (apic ? 6 : 3) * vb + 2 * ib + (size_t)pcap;
+        }
+    }
+    fsdem__restart_data(io, s->px, sizeof(fsdem_vec3) * (size_t)np);
+    fsdem__restart_data(io, s->pv, sizeof(fsdem_vec3) * (size_t)np);
+    for (a = 0; a < 3 && apic; ++a) fsdem__restart_data(io, s->pc[a], sizeof(fsdem_vec3) * (size_t)np);
+
+    /* grid fields, in place (the grid matches) */
+    for (a = 0; a < s->dim; ++a) {
+        const size_t fb = sizeof(fsdem_real) * (size_t)s->nface[a];
+        fsdem__restart_data(io, s->u[a], fb);
+        fsdem__restart_data(io, s->sopen[a], fb);
+        fsdem__restart_data(io, s->svel[a], fb);
+        fsdem__restart_data(io, s->copen[a], fb);
+        fsdem__restart_data(io, s->cvel[a], fb);
+        fsdem__restart_data(io, s->cacc[a], fb);
+        fsdem__restart_data(io, s->E[a], fb);
+        fsdem__restart_data(io, s->us[a], fb);
+    }
+    fsdem__restart_data(io, s->frac, cells);
+    fsdem__restart_data(io, s->phi, cells);
+    fsdem__restart_data(io, s->pres, cells);
+    fsdem__restart_data(io, s->crhs, cells);
+    fsdem__restart_data(io, s->fref, cells);
+    fsdem__restart_flags(io, s->ctype, s->ncell, FSDEM_STENCIL_CELL_SOLID, "type of cell");
+    fsdem__restart_flags(io, s->cnear, s->ncell, 1, "near-solid flag of cell");
+    fsdem__restart_flags(io, s->csolid, s->ncell, 1, "solid flag of cell");
+    fsdem__restart_pic_gauges(io, s);
+    fsdem__restart_tag(io, "PIC.");
+}
+
+/* ---- >>restart_swe : shallow water ---- */
+
+/* The per-cell masks of the SWE: the blocked cells, when there are any (nx*ny flags); `masks`
+   counts them, so data with a mask this build does not know are refused. */
+static void fsdem__restart_swe_masks(fsdem__restart *io, fsdem_swe *s) {
+    int masks = s->blocked ? 1 : 0, k, count = 0;
+    unsigned char *blocked;
+    fsdem__restart_int_in(io, &masks, 0, 1, "the number of per-cell masks (data of a newer build)");
+    blocked = masks ? (unsigned char *)fsdem__restart_block(io, &s->allocator, (size_t)s->n) : NULL;
+    if (masks) fsdem__restart_flags(io, io->mode == FSDEM__RESTART_WRITE ? s->blocked : blocked, s->n, 1, "blocked flag of cell");
+    if (io->mode != FSDEM__RESTART_COMMIT) return;
+    fsdem__free(&s->allocator, s->blocked, (size_t)s->n);
+    s->blocked = blocked;
+    for (k = 0; blocked && k < s->n; ++k) count += blocked[k];
+    s->blocked_count = count;
+}
+
+/* A series of n points (times and values): written, or read into fresh arrays that COMMIT hands to
+   *t and *v after freeing the old ones. */
+static void fsdem__restart_swe_series(fsdem__restart *io, fsdem_swe *s, fsdem_real **t, fsdem_real **v, int *n,
+                                      const char *what) {
+    int count = *n;
+    fsdem_real *ft, *fv;
+    fsdem__restart_count(io, &count, 1 << 28, 2 * sizeof(fsdem_real), what);
+    ft = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
+    fv = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        fsdem__swe_free_series(s, t, v, n);
+        *t = ft;
+        *v = fv;
+        *n = count;
+    }
+    fsdem__restart_data(io, *t, sizeof(fsdem_real) * (size_t)count);
+    fsdem__restart_data(io, *v, sizeof(fsdem_real) * (size_t)count);
+}
+
+/* Everything of a shallow-water solver, in order. State: time, last dt, counters, the bound of the
+   wave speed and of the acceleration (the next adaptive dt reads them) and the other figures of the
+   last step, the volume budget, rain, the surface, discharges and bed exactly, the momentum sources
+   and whether they are in use, the per-cell masks (merge point above), per-cell Manning, the four
+   boundaries with their series, point sources with their series, ids and states, gauge positions.
+   Configuration: the grid and the desc fields that steps read, compared. Not saved: the work rows
+   (prim, rows, south) and the boundary values of the step in flight (bvalue), rewritten by every
+   step; the gauge file, its interval and next output time (restore refuses while a file is open);
+   capacities, the allocator, log and message. */
+static void fsdem__restart_swe(fsdem__restart *io, void *object) {
+    fsdem_swe *s = (fsdem_swe *)object;
+    const fsdem_swe_desc *sd = &s->desc;
+    const fsdem_allocator *al = &s->allocator;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    const size_t cells = sizeof(fsdem_real) * (size_t)s->n;
+    int grid[2], has_manning = s->manning != NULL, ns = s->src_count, next_id = s->src_next_id, ng = s->gauge_count;
+    int side, k;
+    fsdem__swe_src *src;
+    fsdem_real *manning, *xy;
+    fsdem__restart_tag(io, "SWE1");
+    grid[0] = s->nx;
+    grid[1] = s->ny;
+    fsdem__restart_value(io, grid, sizeof grid);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && (grid[0] != s->nx || grid[1] != s->ny))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the grid has %d x %d cells in the save and %d x %d in the object (create the object from "
+                            "the desc it was saved with)",
+                            grid[0], grid[1], s->nx, s->ny);
+    fsdem__restart_same_int(io, sd->dim, "dim");
+    fsdem__restart_same_real(io, sd->x_min, "x_min");
+    fsdem__restart_same_real(io, sd->x_max, "x_max");
+    fsdem__restart_same_real(io, sd->y_min, "y_min");
+    fsdem__restart_same_real(io, sd->y_max, "y_max");
+    fsdem__restart_same_real(io, sd->width, "width");
+    fsdem__restart_same_vec3(io, sd->gravity, "gravity");
+    fsdem__restart_same_real(io, sd->density, "density");
+    fsdem__restart_same_real(io, sd->cfl, "cfl");
+    fsdem__restart_same_real(io, sd->dt_max, "dt_max");
+    fsdem__restart_same_int(io, sd->order, "order");
+    fsdem__restart_same_int(io, (int)sd->limiter, "limiter");
+    fsdem__restart_same_real(io, sd->dry_depth, "dry_depth");
+    fsdem__restart_same_real(io, sd->manning, "manning");
+    fsdem__restart_same_real(io, sd->eddy_viscosity, "eddy_viscosity");
+    if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the object has a gauge file open: close it (fsdem_swe_gauges_close) before restoring and "
+                            "open it again afterwards");
+
+    fsdem__restart_data(io, &s->time, sizeof s->time);
+    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
+    fsdem__restart_data(io, &s->steps, sizeof s->steps);
+    fsdem__restart_data(io, &s->fallbacks, sizeof s->fallbacks);
+    fsdem__restart_data(io, &s->max_wave, sizeof s->max_wave);
+    fsdem__restart_data(io, &s->max_accel, sizeof s->max_accel);
+    fsdem__restart_data(io, &s->max_speed, sizeof s->max_speed);
+    fsdem__restart_data(io, &s->max_depth, sizeof s->max_depth);
+    fsdem__restart_data(io, &s->wet_cells, sizeof s->wet_cells);
+    fsdem__restart_data(io, &s->vol_boundary, sizeof s->vol_boundary);
+    fsdem__restart_data(io, &s->vol_source, sizeof s->vol_source);
+    fsdem__restart_data(io, &s->vol_clipped, sizeof s->vol_clipped);
+    fsdem__restart_data(io, &s->rain, sizeof s->rain);
+    fsdem__restart_data(io, &s->sources_used, sizeof s->sources_used);
+
+    /* the state, exactly, in place */
+    fsdem__restart_data(io, s->eta, cells);
+    fsdem__restart_data(io, s->qx, cells);
+    fsdem__restart_data(io, s->qy, cells);
+    fsdem__restart_data(io, s->bed, cells);
+    fsdem__restart_data(io, s->sx, cells);
+    fsdem__restart_data(io, s->sy, cells);
+    fsdem__restart_swe_masks(io, s);
+
+    /* per-cell Manning: kept in place when the object has the array, else a fresh one */
+    fsdem__restart_int_in(io, &has_manning, 0, 1, "per-cell Manning flag");
+    manning = has_manning && !s->manning ? (fsdem_real *)fsdem__restart_block(io, al, cells) : NULL;
+    if (commit && !has_manning) {
+        fsdem__free(al, s->manning, cells);
+        s->manning = NULL;
+    } else if (commit && manning)
+        s->manning = manning;
+    if (has_manning) fsdem__restart_data(io, s->manning, cells);
+
+    for (side = 0; side < 4 && io->res == FSDEM_OK; ++side) {
+        fsdem__swe_bnd *b = &s->bnd[side];
+        int type = (int)b->type;
+        fsdem_real value = b->value;
+        fsdem__restart_int_in(io, &type, 0, FSDEM_SWE_BC_STAGE, "boundary type");
+        fsdem__restart_value(io, &value, sizeof value);
+        fsdem__restart_swe_series(io, s, &b->t, &b->v, &b->n, "boundary series length");
+        if (commit) {
+            b->type = (fsdem_swe_bc)type;
+            b->value = value;
+        }
+    }
+
+    /* point sources, into a fresh array */
+    fsdem__restart_count(io, &ns, 1 << 24, sizeof(fsdem_real) + 4 * sizeof(int), "point source count");
+    fsdem__restart_value(io, &next_id, sizeof next_id);
+    src = (fsdem__swe_src *)fsdem__restart_block(io, al, sizeof(fsdem__swe_src) * (size_t)ns);
+    for (k = 0; k < ns && io->res == FSDEM_OK; ++k) {
+        fsdem__swe_src q;
+        if (io->mode == FSDEM__RESTART_WRITE) q = s->src[k];
+        else memset(&q, 0, sizeof q);
+        fsdem__restart_value(io, &q.discharge, sizeof q.discharge);
+        fsdem__restart_int_in(io, &q.cell, 0, s->n - 1, "point source cell");
+        fsdem__restart_value(io, &q.id, sizeof q.id);
+        fsdem__restart_int_in(io, &q.active, 0, 1, "point source active flag");
+        fsdem__restart_swe_series(io, s, &q.t, &q.v, &q.n, "point source series length");
+        if (commit) src[k] = q;
+    }
+    if (commit) {
+        for (k = 0; k < s->src_count; ++k) fsdem__swe_free_series(s, &s->src[k].t, &s->src[k].v, &s->src[k].n);
+        fsdem__free(al, s->src, sizeof(fsdem__swe_src) * (size_t)s->src_capacity);
+        s->src = src;
+        s->src_count = s->src_capacity = ns;
+        s->src_next_id = next_id;
+    }
+
+    /* gauge positions (the file is not part of the state) */
+    fsdem__restart_count(io, &ng, 1 << 24, 2 * sizeof(fsdem_real), "gauge count");
+    xy = (fsdem_real *)fsdem__restart_block(io, al, 2 * sizeof(fsdem_real) * (size_t)ng);
+    if (commit) {
+        fsdem__free(al, s->gauge, 2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+        s->gauge = xy;
+        s->gauge_count = s->gauge_capacity = ng;
+    }
+    fsdem__restart_data(io, s->gauge, 2 * sizeof(fsdem_real) * (size_t)ng);
+    fsdem__restart_tag(io, "SWE.");
+}
+
+/* ---- >>restart_swe_dem : SWE-DEM coupler ---- */
+
+/* A coupler's file holds the coupled run: the SWE, then the DEM (restored into the solvers the
+   coupler was created with), then the coupler's own state: counters, the last step, the impulse
+   given to the water and the per-particle force records and reactions (fsdem_swe_dem_get_force and
+   the next step's impulse read them). Configuration: beta, two_way, heave_damping, max_substeps and
+   the water's density, gravity and dry depth taken at creation, compared. Not saved: the solver
+   pointers, the allocator, log and message. */
+static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
+    fsdem_swe_dem *c = (fsdem_swe_dem *)object;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    int count = c->force_capacity, k;
+    fsdem_swe_dem_force *force;
+    fsdem_vec3 *reaction;
+    fsdem__restart_tag(io, "SWD1");
+    io->section = "shallow water";
+    fsdem__restart_swe(io, c->desc.swe);
+    io->section = "debris (DEM)";
+    fsdem__restart_dem(io, c->desc.dem);
+    io->section = NULL;
+    fsdem__restart_same_real(io, c->desc.beta, "beta");
+    fsdem__restart_same_int(io, c->desc.two_way, "two_way");
+    fsdem__restart_same_real(io, c->desc.heave_damping, "heave_damping");
+    fsdem__restart_same_ll(io, c->desc.max_substeps, "max_substeps");
+    fsdem__restart_same_real(io, c->rho, "swe.density");
+    fsdem__restart_same_real(io, c->g, "swe.gravity");
+    fsdem__restart_same_real(io, c->dry, "swe.dry_depth");
+    fsdem__restart_data(io, &c->steps, sizeof c->steps);
+    fsdem__restart_data(io, &c->substeps, sizeof c->substeps);
+    fsdem__restart_data(io, &c->substeps_total, sizeof c->substeps_total);
+    fsdem__restart_data(io, &c->dt_last, sizeof c->dt_last);
+    fsdem__restart_data(io, &c->in_water, sizeof c->in_water);
+    fsdem__restart_data(io, &c->impulse, sizeof c->impulse);
+    fsdem__restart_count(io, &count, 1 << 29, 5 * sizeof(fsdem_vec3) + 3 * sizeof(fsdem_real), "force record count");
+    force = (fsdem_swe_dem_force *)fsdem__restart_block(io, &c->allocator, sizeof *force * (size_t)count);
+    reaction = (fsdem_vec3 *)fsdem__restart_block(io, &c->allocator, sizeof *reaction * (size_t)count);
+    if (commit) {
+        fsdem__free(&c->allocator, c->force, sizeof *force * (size_t)c->force_capacity);
+        fsdem__free(&c->allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
+        c->force = force;
+        c->reaction = reaction;
+        c->force_capacity = count;
+        if (force) memset(force, 0, sizeof *force * (size_t)count);
+    }
+    for (k = 0; k < count && io->res == FSDEM_OK; ++k) {
+        fsdem_swe_dem_force scratch, *f = io->mode == FSDEM__RESTART_WRITE || commit ? &c->force[k] : &scratch;
+        fsdem__restart_data(io, &f->buoyancy, sizeof f->buoyancy);
+        fsdem__restart_data(io, &f->hydrostatic, sizeof f->hydrostatic);
+        fsdem__restart_data(io, &f->dynamic, sizeof f->dynamic);
+        fsdem__restart_data(io, &f->heave, sizeof f->heave);
+        fsdem__restart_data(io, &f->submerged_volume, sizeof f->submerged_volume);
+        fsdem__restart_data(io, &f->frontal_area, sizeof f->frontal_area);
+        fsdem__restart_data(io, &f->surface, sizeof f->surface);
+        fsdem__restart_data(io, &f->in_water, sizeof f->in_water);
+    }
+    fsdem__restart_data(io, c->reaction, sizeof(fsdem_vec3) * (size_t)count);
+    fsdem__restart_tag(io, "SWD.");
+}
+
+/* ---- >>restart_api : memory and files ---- */
+
+/* What the API needs to know of one object. */
+typedef struct fsdem__restart_object {
+    unsigned int kind;
+    int dim, sizes[4];
+    void *object;
+    fsdem__restart_visit_fn visit;
+    const fsdem_allocator *allocator;
+    fsdem__status *status; /* the message is the only part of a saved (const) object that changes */
+    const char *name;
+} fsdem__restart_object;
+
+static const char *fsdem__restart_kind_name(unsigned int kind) {
+    switch (kind) {
+    case FSDEM__RESTART_DEM: return "fsdem_dem";
+    case FSDEM__RESTART_PIC: return "fsdem_pic";
+    case FSDEM__RESTART_SWE: return "fsdem_swe";
+    case FSDEM__RESTART_SWE_DEM: return "fsdem_swe_dem";
+    }
+    return "unknown object";
+}
+
+static fsdem__restart_object fsdem__restart_of_dem(const fsdem_dem *d) {
+    fsdem__restart_object o;
+    o.kind = FSDEM__RESTART_DEM;
+    o.dim = d->desc.dim;
+    o.sizes[0] = d->n;
+    o.sizes[1] = d->material_count;
+    o.sizes[2] = d->wall_count;
+    o.sizes[3] = d->pp.count;
+    o.object = (void *)d;
+    o.visit = fsdem__restart_dem;
+    o.allocator = &d->allocator;
+    o.status = (fsdem__status *)&d->status;
+    o.name = "fsdem_dem";
+    return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_pic(const fsdem_pic *s) {
+    fsdem__restart_object o;
+    o.kind = FSDEM__RESTART_PIC;
+    o.dim = s->dim;
+    o.sizes[0] = s->n[0];
+    o.sizes[1] = s->n[1];
+    o.sizes[2] = s->n[2];
+    o.sizes[3] = s->np;
+    o.object = (void *)s;
+    o.visit = fsdem__restart_pic;
+    o.allocator = &s->allocator;
+    o.status = (fsdem__status *)&s->status;
+    o.name = "fsdem_pic";
+    return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_swe(const fsdem_swe *s) {
+    fsdem__restart_object o;
+    o.kind = FSDEM__RESTART_SWE;
+    o.dim = s->dim;
+    o.sizes[0] = s->nx;
+    o.sizes[1] = s->ny;
+    o.sizes[2] = s->src_count;
+    o.sizes[3] = s->gauge_count;
+    o.object = (void *)s;
+    o.visit = fsdem__restart_swe;
+    o.allocator = &s->allocator;
+    o.status = (fsdem__status *)&s->status;
+    o.name = "fsdem_swe";
+    return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_swe_dem(const fsdem_swe_dem *c) {
+    fsdem__restart_object o;
+    o.kind = FSDEM__RESTART_SWE_DEM;
+    o.dim = c->desc.swe->dim;
+    o.sizes[0] = c->desc.swe->nx;
+    o.sizes[1] = c->desc.swe->ny;
+    o.sizes[2] = c->desc.dem->n;
+    o.sizes[3] = c->force_capacity;
+    o.object = (void *)c;
+    o.visit = fsdem__restart_swe_dem;
+    o.allocator = &c->allocator;
+    o.status = (fsdem__status *)&c->status;
+    o.name = "fsdem_swe_dem";
+    return o;
+}
+
+/* A cursor for `verb` of object o ("save", "restore_memory", ...). */
+static void fsdem__restart_begin(fsdem__restart *io, const fsdem__restart_object *o, const char *verb,
+                                 fsdem__restart_mode mode) {
+    memset(io, 0, sizeof *io);
+    io->mode = mode;
+    io->res = FSDEM_OK;
+    io->allocator = o->allocator;
+    snprintf(io->fn, sizeof io->fn, "%s_%s", o->name, verb);
+}
+
+/* Hands the cursor's result to the object: its message on failure, an empty one on success. */
+static fsdem_result fsdem__restart_end(fsdem__restart *io, const fsdem__restart_object *o) {
+    int k;
+    for (k = io->block_next; k < io->block_count; ++k)
+        fsdem__free(io->blocks[k].allocator, io->blocks[k].ptr, io->blocks[k].bytes);
+    fsdem__free(io->allocator, io->blocks, sizeof *io->blocks * (size_t)io->block_capacity);
+    io->blocks = NULL;
+    io->block_count = io->block_capacity = io->block_next = 0;
+    return io->res == FSDEM_OK ? fsdem__ok(o->status) : fsdem__fail(o->status, io->res, "%s", io->message);
+}
+
+/* The header of o with a payload of `payload` bytes, and the checksum of its first 56 bytes. */
+static unsigned long long fsdem__restart_header(unsigned char h[FSDEM__RESTART_HEADER], const fsdem__restart_object *o,
+                                                unsigned long long payload) {
+    const unsigned int u[6] = {FSDEM__RESTART_VERSION, FSDEM__RESTART_BOM, (unsigned int)sizeof(fsdem_real), o->kind,
+                               (unsigned int)o->dim, 0u};
+    memset(h, 0, FSDEM__RESTART_HEADER);
+    memcpy(h, "FSDEMRST", 8);
+    memcpy(h + 8, u, sizeof u);
+    memcpy(h + 32, o->sizes, sizeof o->sizes);
+    memcpy(h + 48, &payload, 8);
+    return fsdem__restart_fnv(FSDEM__RESTART_FNV_BASIS, h, 56);
+}
+
+static unsigned int fsdem__restart_u32(const unsigned char *p) {
+    unsigned int v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+
+/* Measures the payload of o and fills the header; the cursor is then ready to write the payload. */
+static void fsdem__restart_prepare(fsdem__restart *io, const fsdem__restart_object *o,
+                                   unsigned char header[FSDEM__RESTART_HEADER]) {
+    o->visit(io, o->object);
+    io->hash = fsdem__restart_header(header, o, (unsigned long long)io->pos);
+    io->size = io->pos;
+    io->pos = 0;
+}
+
+/* Saves o to `buffer` (`capacity` bytes; NULL: only the size). The payload is measured first, so a
+   buffer too small is refused before anything is written. */
+static fsdem_result fsdem__restart_save_memory(const fsdem__restart_object *o, void *buffer, size_t capacity,
+                                               size_t *size) {
+    fsdem__restart io;
+    unsigned char header[FSDEM__RESTART_HEADER];
+    fsdem__restart_begin(&io, o, "save_memory", FSDEM__RESTART_WRITE);
+    if (!size) {
+        fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "size is NULL");
+        return fsdem__restart_end(&io, o);
+    }
+    fsdem__restart_prepare(&io, o, header);
+    *size = FSDEM__RESTART_HEADER + io.size;
+    if (buffer && capacity < *size)
+        fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "the buffer of %llu bytes is too small: %llu are needed",
+                            (unsigned long long)capacity, (unsigned long long)*size);
+    if (buffer && io.res == FSDEM_OK) {
+        io.out = (unsigned char *)buffer + FSDEM__RESTART_HEADER;
+        o->visit(&io, o->object);
+        FSDEM_ASSERT(io.pos == io.size);
+        memcpy(header + 56, &io.hash, 8);
+        memcpy(buffer, header, FSDEM__RESTART_HEADER);
+    }
+    return fsdem__restart_end(&io, o);
+}
+
+/* Saves o to the file `path` in one pass: header, payload, then the checksum into the header. */
+static fsdem_result fsdem__restart_save_file(const fsdem__restart_object *o, const char *path) {
+    fsdem__restart io;
+    unsigned char header[FSDEM__RESTART_HEADER];
+    FILE *fp;
+    int bad;
+    fsdem__restart_begin(&io, o, "save", FSDEM__RESTART_WRITE);
+    if (!path) {
+        fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "path is NULL");
+        return fsdem__restart_end(&io, o);
+    }
+    fp = fopen(path, "wb");
+    if (!fp) {
+        fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot open '%s' for writing", path);
+        return fsdem__restart_end(&io, o);
+    }
+    fsdem__restart_prepare(&io, o, header);
+    bad = fwrite(header, 1, FSDEM__RESTART_HEADER, fp) != FSDEM__RESTART_HEADER;
+    io.file = fp;
+    o->visit(&io, o->object);
+    memcpy(header + 56, &io.hash, 8);
+    bad |= ferror(fp) || fseek(fp, 56, SEEK_SET) != 0 || fwrite(header + 56, 1, 8, fp) != 8;
+    bad |= fclose(fp) != 0;
+    if (bad) fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot write '%s'", path);
+    return fsdem__restart_end(&io, o);
+}
+
+/* Checks the header of `size` bytes at `data` against o: magic, version, byte order, precision,
+   kind, dimension, the announced size, then the checksum. */
+static void fsdem__restart_check_header(fsdem__restart *io, const fsdem__restart_object *o, const unsigned char *data,
+                                        size_t size) {
+    unsigned long long payload, sum;
+    unsigned int precision, kind, dim;
+    if (!data) {
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "buffer is NULL");
+        return;
+    }
+    if (size < FSDEM__RESTART_HEADER || memcmp(data, "FSDEMRST", 8) != 0) {
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "not a fsdem restart file (%s)",
+                            size < FSDEM__RESTART_HEADER ? "shorter than the 64-byte header" : "no FSDEMRST magic");
+        return;
+    }
+    precision = fsdem__restart_u32(data + 16);
+    kind = fsdem__restart_u32(data + 20);
+    dim = fsdem__restart_u32(data + 24);
+    memcpy(&payload, data + 48, 8);
+    memcpy(&sum, data + 56, 8);
+    if (fsdem__restart_u32(data + 8) != FSDEM__RESTART_VERSION)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "format version %u; this build reads version %u",
+                            fsdem__restart_u32(data + 8), FSDEM__RESTART_VERSION);
+    else if (fsdem__restart_u32(data + 12) != FSDEM__RESTART_BOM)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "written on a machine of another byte order");
+    else if (precision != sizeof(fsdem_real))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "precision: written with %u-byte reals, this build's fsdem_real has %u (%s)",
+                            precision, (unsigned int)sizeof(fsdem_real), sizeof(fsdem_real) == 4 ? "FSDEM_USE_FLOAT" : "double");
+    else if (kind != o->kind)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the data hold the state of a %s, not of a %s",
+                            fsdem__restart_kind_name(kind), fsdem__restart_kind_name(o->kind));
+    else if (dim != (unsigned int)o->dim)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "dimension: the data hold a %uD state, the object is %dD", dim, o->dim);
+    else if (payload != (unsigned long long)(size - FSDEM__RESTART_HEADER))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s: %llu bytes after the header, %llu announced",
+                            payload > (unsigned long long)(size - FSDEM__RESTART_HEADER) ? "truncated" : "trailing bytes",
+                            (unsigned long long)(size - FSDEM__RESTART_HEADER), payload);
+    else if (fsdem__restart_fnv(fsdem__restart_fnv(FSDEM__RESTART_FNV_BASIS, data, 56), data + FSDEM__RESTART_HEADER,
+                                (size_t)payload) != sum)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "checksum mismatch: the data are corrupted");
+}
+
+/* Restores o from `size` bytes at `data`: the header, then the visitor's CHECK, RESERVE and COMMIT
+   passes over the payload. */
+static fsdem_result fsdem__restart_load(const fsdem__restart_object *o, const char *verb, const unsigned char *data,
+                                        size_t size) {
+    fsdem__restart io;
+    static const fsdem__restart_mode passes[3] = {FSDEM__RESTART_CHECK, FSDEM__RESTART_RESERVE, FSDEM__RESTART_COMMIT};
+    int pass;
+    fsdem__restart_begin(&io, o, verb, FSDEM__RESTART_CHECK);
+    fsdem__restart_check_header(&io, o, data, size);
+    for (pass = 0; pass < 3 && io.res == FSDEM_OK; ++pass) {
+        io.mode = passes[pass];
+        io.in = data + FSDEM__RESTART_HEADER;
+        io.size = size - FSDEM__RESTART_HEADER;
+        io.pos = 0;
+        o->visit(&io, o->object);
+        if (io.res == FSDEM_OK && io.pos != io.size)
+            fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "%llu bytes left unread (corrupted data)",
+                                (unsigned long long)(io.size - io.pos));
+    }
+    FSDEM_ASSERT(io.res != FSDEM_OK || io.block_next == io.block_count);
+    return fsdem__restart_end(&io, o);
+}
+
+/* Restores o from the file `path`, read whole into memory (FSDEM_ERR_IO when it cannot be). */
+static fsdem_result fsdem__restart_load_file(const fsdem__restart_object *o, const char *path) {
+    fsdem__restart io;
+    FILE *fp = path ? fopen(path, "rb") : NULL;
+    unsigned char *data = NULL;
+    long length = -1;
+    fsdem_result res;
+    fsdem__restart_begin(&io, o, "restore", FSDEM__RESTART_CHECK);
+    if (!path) fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "path is NULL");
+    else if (!fp) fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot open '%s'", path);
+    else if (fseek(fp, 0, SEEK_END) != 0 || (length = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET) != 0)
+        fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot read '%s'", path);
+    else if (!(data = (unsigned char *)fsdem__alloc(o->allocator, (size_t)length)))
+        fsdem__restart_fail(&io, FSDEM_ERR_OUT_OF_MEMORY, "out of memory for the %ld bytes of '%s'", length, path);
+    else if (fread(data, 1, (size_t)length, fp) != (size_t)length)
+        fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot read '%s'", path);
+    if (fp) fclose(fp);
+    res = io.res == FSDEM_OK ? fsdem__restart_load(o, "restore", data, (size_t)length) : fsdem__restart_end(&io, o);
+    fsdem__free(o->allocator, data, length > 0 ? (size_t)length : 1);
+    return res;
+}
+
+/* The public functions: save and restore, to files and to memory, for each of the four objects (a
+   few lines each around the helpers above). A NULL object is refused with FSDEM_ERR_INVALID_ARG
+   without a message (there is no object to hold it). */
+
+/* fsdem_dem (>>restart): the discrete elements. */
+fsdem_result fsdem_dem_save(const fsdem_dem *dem, const char *path) {
+    fsdem__restart_object o;
+    if (!dem) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_dem(dem);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_dem_restore(fsdem_dem *dem, const char *path) {
+    fsdem__restart_object o;
+    if (!dem) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_dem(dem);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_dem_save_memory(const fsdem_dem *dem, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o;
+    if (!dem) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_dem(dem);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_dem_restore_memory(fsdem_dem *dem, const void *buffer, size_t size) {
+    fsdem__restart_object o;
+    if (!dem) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_dem(dem);
+    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+}
+
+/* fsdem_pic (>>restart): the PIC/FLIP solver. */
+fsdem_result fsdem_pic_save(const fsdem_pic *pic, const char *path) {
+    fsdem__restart_object o;
+    if (!pic) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_pic(pic);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_pic_restore(fsdem_pic *pic, const char *path) {
+    fsdem__restart_object o;
+    if (!pic) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_pic(pic);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_pic_save_memory(const fsdem_pic *pic, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o;
+    if (!pic) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_pic(pic);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_pic_restore_memory(fsdem_pic *pic, const void *buffer, size_t size) {
+    fsdem__restart_object o;
+    if (!pic) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_pic(pic);
+    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+}
+
+/* fsdem_swe (>>restart): the shallow-water solver. */
+fsdem_result fsdem_swe_save(const fsdem_swe *swe, const char *path) {
+    fsdem__restart_object o;
+    if (!swe) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe(swe);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_swe_restore(fsdem_swe *swe, const char *path) {
+    fsdem__restart_object o;
+    if (!swe) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe(swe);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_swe_save_memory(const fsdem_swe *swe, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o;
+    if (!swe) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe(swe);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_swe_restore_memory(fsdem_swe *swe, const void *buffer, size_t size) {
+    fsdem__restart_object o;
+    if (!swe) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe(swe);
+    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+}
+
+/* fsdem_swe_dem (>>restart): the SWE-DEM coupler with its two solvers. */
+fsdem_result fsdem_swe_dem_save(const fsdem_swe_dem *coupler, const char *path) {
+    fsdem__restart_object o;
+    if (!coupler) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe_dem(coupler);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_swe_dem_restore(fsdem_swe_dem *coupler, const char *path) {
+    fsdem__restart_object o;
+    if (!coupler) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe_dem(coupler);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_swe_dem_save_memory(const fsdem_swe_dem *coupler, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o;
+    if (!coupler) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe_dem(coupler);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *buffer, size_t size) {
+    fsdem__restart_object o;
+    if (!coupler) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe_dem(coupler);
+    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
 }
 
 /* ===== >>impl_io : CSV and VTK output ============================================================== */
