@@ -9991,6 +9991,7 @@ static fsdem_result fsdem__swe_apply_blocked(fsdem_swe *s, const unsigned char *
     if (mask && !s->blocked) {
         s->blocked = (unsigned char *)fsdem__alloc(&s->allocator, (size_t)s->n);
         if (!s->blocked) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory", what);
+        memset(s->blocked, 0, (size_t)s->n);
     }
     for (k = 0; mask && k < s->n; ++k) {
         const int b = mask[k] != 0;

@@ -11,5 +11,6 @@ Suite *pic_suite(void);
 Suite *swe_suite(void);
 Suite *couple_swe_suite(void);
 Suite *restart_suite(void);
+Suite *robustness_suite(void);
 
 #endif
