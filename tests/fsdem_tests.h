@@ -10,5 +10,6 @@ Suite *linalg_suite(void);
 Suite *pic_suite(void);
 Suite *swe_suite(void);
 Suite *couple_swe_suite(void);
+Suite *io_suite(void);
 
 #endif
