@@ -1477,9 +1477,9 @@ typedef enum fsdem_vtk_format {
     FSDEM_VTK_ASCII = 0,
     /* format="binary": inline base64 (RFC 4648 alphabet, '=' padding, no line breaks). Each array
        is one base64 stream of a UInt64 byte count (the number of data bytes that follow, not
-       counting itself) followed by the data, as VTK's own writer encodes uncompressed data (the
-       count is base64-encoded separately from the data only in compressed files). Exact, 4/3 of
-       the raw size, and the file is well-formed XML. */
+       counting itself) followed by the data, as VTK's own writer encodes uncompressed data (it
+       encodes the header separately only in compressed files; VTK 9.1's reader takes either).
+       Exact, 4/3 of the raw size, and the file is well-formed XML. */
     FSDEM_VTK_BASE64 = 1,
     /* format="appended": each <DataArray> carries offset="N" and no content; after the dataset,
        <AppendedData encoding="raw"> holds '_' and then, array after array in the order of the
@@ -1506,8 +1506,8 @@ FSDEM_API fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path);
    VTK XML file by its extension: .vtp, .vtu, .vti, .vts or .vtr; a legacy .vtk file, which
    ParaView's series reader cannot take, any other name, a name with a control character, and a
    NaN or infinite time are refused with FSDEM_ERR_INVALID_ARG (the file is unchanged). The
-   characters & < > " ' in the name are written as XML entities, so the name reads back as given.
-   FSDEM_ERR_IO on a write error. */
+   characters & < > " ' in the name are written as XML entities, so the name (UTF-8) reads back as
+   given. The time is written with 17 significant digits. FSDEM_ERR_IO on a write error. */
 FSDEM_API fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, double time, const char *file);
 /* Closes the file (it is already complete). FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (not open). */
 FSDEM_API fsdem_result fsdem_pvd_close(fsdem_pvd *pvd);
@@ -1527,11 +1527,12 @@ FSDEM_API fsdem_result fsdem_dem_write_csv(const fsdem_dem *dem, const char *pat
    velocity; ParaView: Glyph filter, sphere, scale by "radius" with factor 2 (the sphere source has
    diameter 1). */
 FSDEM_API fsdem_result fsdem_dem_write_vtp(const fsdem_dem *dem, const char *path, fsdem_vtk_format format);
-/* DEM walls as PolyData (.vtp), one or more cells per wall, in wall order: in 3D polygons (a plane
-   as its intersection with the domain box [domain_min, domain_max], a convex polygon, none when
-   the plane misses the box; a box, inside or outside, as its six faces; a triangle), in 2D lines
-   (a plane as its chord of the domain rectangle; a box as its four edges; a segment), at z = 0 in
-   2D. Polygons are ordered so that their normal points to the particles' side (a box's faces:
+/* DEM walls as PolyData (.vtp), one or more cells per wall: in 3D polygons (a plane as its
+   intersection with the domain box [domain_min, domain_max], a convex polygon, none when the plane
+   misses the box; a box, inside or outside, as its six faces; a triangle), in 2D lines at z = 0 (a
+   plane as its chord of the domain rectangle; a box as its four edges; a segment); a segment is a
+   line in 3D too. Line cells come first, then polygons (VTK's order), each in wall order.
+   Polygons are ordered so that their normal points to the particles' side (a box's faces:
    inwards for an inside box, outwards for an outside one). Cell data: wall_id (Int32, the id from
    fsdem_dem_add_wall), type (UInt8, fsdem_dem_wall_type), force (N, exerted by the particles on
    the whole wall at the last force evaluation, fsdem_dem_wall_force; every cell of a wall carries
@@ -10666,7 +10667,7 @@ typedef struct fsdem__vtk_array {
     long long first, step; /* FSDEM__VTK_FROM_RAMP */
 } fsdem__vtk_array;
 
-#define FSDEM__VTK_MAX_ARRAYS 24 /* arrays of one file (the most any writer has is 15) */
+#define FSDEM__VTK_MAX_ARRAYS 24 /* arrays of one file (the most any writer has is 14) */
 
 typedef struct fsdem__vtk_writer {
     FILE *fp;
@@ -10991,7 +10992,7 @@ static fsdem_result fsdem__vtk_close(fsdem__vtk_writer *w) {
 /* ---- >>io_pvd : ParaView series ---- */
 
 /* The closing tags, at the current position. */
-static fsdem_result fsdem__pvd_finish(FILE *fp) {
+static fsdem_result fsdem__io_pvd_finish(FILE *fp) {
     fputs("</Collection>\n</VTKFile>\n", fp);
     fflush(fp);
     return ferror(fp) ? FSDEM_ERR_IO : FSDEM_OK;
@@ -11008,7 +11009,7 @@ fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path) {
     if (!fp) return FSDEM_ERR_IO;
     fputs("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n", fp);
     tail = ftell(fp);
-    if (tail < 0 || fsdem__pvd_finish(fp) != FSDEM_OK) {
+    if (tail < 0 || fsdem__io_pvd_finish(fp) != FSDEM_OK) {
         fclose(fp);
         return FSDEM_ERR_IO;
     }
@@ -11018,7 +11019,7 @@ fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path) {
 }
 
 /* A piece the series reader can take: a serial VTK XML file by its extension, no control character. */
-static int fsdem__pvd_piece_ok(const char *file) {
+static int fsdem__io_pvd_piece_ok(const char *file) {
     static const char *const ext[5] = {".vtp", ".vtu", ".vti", ".vts", ".vtr"};
     const char *c;
     size_t n = strlen(file);
@@ -11034,7 +11035,7 @@ fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, double time, const char *file) {
     FILE *fp;
     const char *c;
     long tail;
-    if (!pvd || !pvd->file || !file || !(time == time && time - time == 0) || !fsdem__pvd_piece_ok(file))
+    if (!pvd || !pvd->file || !file || !(time == time && time - time == 0) || !fsdem__io_pvd_piece_ok(file))
         return FSDEM_ERR_INVALID_ARG;
     fp = (FILE *)pvd->file;
     if (fseek(fp, pvd->tail, SEEK_SET) != 0) return FSDEM_ERR_IO;
@@ -11049,7 +11050,7 @@ fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, double time, const char *file) {
         }
     fputs("\"/>\n", fp);
     tail = ftell(fp);
-    if (tail < 0 || fsdem__pvd_finish(fp) != FSDEM_OK) return FSDEM_ERR_IO;
+    if (tail < 0 || fsdem__io_pvd_finish(fp) != FSDEM_OK) return FSDEM_ERR_IO;
     pvd->tail = tail;
     pvd->count++;
     return FSDEM_OK;
@@ -11061,7 +11062,7 @@ fsdem_result fsdem_pvd_close(fsdem_pvd *pvd) {
     if (!pvd || !pvd->file) return FSDEM_ERR_INVALID_ARG;
     fp = (FILE *)pvd->file;
     /* the tags are there already; written again in case an add failed part way */
-    bad = fseek(fp, pvd->tail, SEEK_SET) != 0 || fsdem__pvd_finish(fp) != FSDEM_OK;
+    bad = fseek(fp, pvd->tail, SEEK_SET) != 0 || fsdem__io_pvd_finish(fp) != FSDEM_OK;
     bad |= fclose(fp) != 0;
     pvd->file = NULL;
     return bad ? FSDEM_ERR_IO : FSDEM_OK;
@@ -11109,13 +11110,18 @@ fsdem_result fsdem_dem_write_vtp(const fsdem_dem *d, const char *path, fsdem_vtk
     return fsdem__vtk_close(&w);
 }
 
-/* Wall geometry for the writer: points, cells (connectivity, offsets) and per-cell wall data. */
+/* Wall geometry for the writer: points, cells (connectivity, offsets) and per-cell wall data, the
+   line cells (two points) first and then the polygons, as VTK orders PolyData cells. Points are not
+   shared, so the connectivity of point k is k; offsets count from the start of their section. */
 typedef struct fsdem__io_walls {
     fsdem_vec3 *points;
     int *connectivity, *offsets, *wall_id;
     unsigned char *type;
     fsdem_vec3 *force;
-    int points_count, cells_count; /* connectivity has one entry per point */
+    int points_count, cells_count;
+    int lines;                     /* the pass: 1 takes line cells, 0 polygons */
+    int section_start;             /* points before the current section */
+    int line_cells, line_points;   /* the line section, after the build */
 } fsdem__io_walls;
 
 #define FSDEM__IO_WALL_POINTS 24 /* the most points of one wall: a 3D box's six faces of four */
@@ -11123,11 +11129,12 @@ typedef struct fsdem__io_walls {
 
 static void fsdem__io_walls_cell(fsdem__io_walls *g, const fsdem_vec3 *v, int n, int id, const fsdem__dem_wall *w) {
     int k;
+    if ((n == 2) != g->lines) return; /* the other pass's */
     for (k = 0; k < n; ++k) {
         g->connectivity[g->points_count] = g->points_count;
         g->points[g->points_count++] = v[k];
     }
-    g->offsets[g->cells_count] = g->points_count;
+    g->offsets[g->cells_count] = g->points_count - g->section_start;
     g->wall_id[g->cells_count] = id;
     g->type[g->cells_count] = (unsigned char)w->d.type;
     g->force[g->cells_count++] = w->force;
@@ -11209,14 +11216,13 @@ static int fsdem__io_plane_patch(fsdem_vec3 p, fsdem_vec3 n, fsdem_vec3 lo, fsde
     }
 }
 
-/* The cells of every drawable wall into g (room for FSDEM__IO_WALL_POINTS points and
-   FSDEM__IO_WALL_CELLS cells per wall). */
-static void fsdem__io_walls_build(const fsdem_dem *d, fsdem__io_walls *g) {
+/* The cells of the drawable walls of the pass g->lines into g (room for FSDEM__IO_WALL_POINTS points
+   and FSDEM__IO_WALL_CELLS cells per wall). */
+static void fsdem__io_walls_pass(const fsdem_dem *d, fsdem__io_walls *g) {
     /* a 3D box's faces as corners (bit 0: x at hi, bit 1: y, bit 2: z), counter-clockwise seen from outside */
     static const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
     const int dim = d->desc.dim;
     int id, f, k;
-    g->points_count = g->cells_count = 0;
     for (id = 0; id < d->wall_count; ++id) {
         const fsdem__dem_wall *w = &d->walls[id];
         const fsdem_dem_wall_desc *gd = &w->d;
@@ -11263,9 +11269,20 @@ static void fsdem__io_walls_build(const fsdem_dem *d, fsdem__io_walls *g) {
     }
 }
 
+/* Every drawable wall: the line cells (2D walls, segments), then the polygons (3D walls). */
+static void fsdem__io_walls_build(const fsdem_dem *d, fsdem__io_walls *g) {
+    g->points_count = g->cells_count = g->section_start = 0;
+    g->lines = 1;
+    fsdem__io_walls_pass(d, g);
+    g->line_cells = g->cells_count;
+    g->line_points = g->section_start = g->points_count;
+    g->lines = 0;
+    fsdem__io_walls_pass(d, g);
+}
+
 fsdem_result fsdem_dem_write_walls_vtp(const fsdem_dem *d, const char *path, fsdem_vtk_format format) {
     static const char *const who = "fsdem_dem_write_walls_vtp";
-    const size_t walls = d ? (size_t)d->wall_count : 0;
+    const size_t walls = d && d->wall_count > 0 ? (size_t)d->wall_count : 1; /* no allocation of 0 bytes */
     const size_t np = FSDEM__IO_WALL_POINTS * walls, nc = FSDEM__IO_WALL_CELLS * walls;
     fsdem__status *st;
     fsdem__io_walls g;
@@ -11284,11 +11301,11 @@ fsdem_result fsdem_dem_write_walls_vtp(const fsdem_dem *d, const char *path, fsd
     if (!g.points || !g.connectivity || !g.offsets || !g.wall_id || !g.type || !g.force)
         res = fsdem__fail(st, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory (%d walls)", who, d->wall_count);
     else {
-        const int lines = d->desc.dim == 2;
         fsdem__io_walls_build(d, &g);
         res = fsdem__vtk_open(&w, st, who, path, format, "PolyData");
         if (res == FSDEM_OK) {
-            fsdem__vtk_polydata(&w, d->time, g.points_count, 0, lines ? g.cells_count : 0, lines ? 0 : g.cells_count);
+            const int polys = g.cells_count - g.line_cells;
+            fsdem__vtk_polydata(&w, d->time, g.points_count, 0, g.line_cells, polys);
             fsdem__vtk_section(&w, "CellData", "wall_id", "force");
             fsdem__vtk_write(&w, fsdem__vtk_ints("wall_id", g.wall_id, g.cells_count));
             fsdem__vtk_write(&w, fsdem__vtk_bytes("type", g.type, g.cells_count));
@@ -11297,8 +11314,12 @@ fsdem_result fsdem_dem_write_walls_vtp(const fsdem_dem *d, const char *path, fsd
             fsdem__vtk_section(&w, "Points", NULL, NULL);
             fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", g.points, g.points_count));
             fsdem__vtk_section_end(&w, "Points");
-            fsdem__vtk_cells(&w, lines ? "Lines" : "Polys", fsdem__vtk_ints("connectivity", g.connectivity, g.points_count),
-                             fsdem__vtk_ints("offsets", g.offsets, g.cells_count));
+            if (g.line_cells)
+                fsdem__vtk_cells(&w, "Lines", fsdem__vtk_ints("connectivity", g.connectivity, g.line_points),
+                                 fsdem__vtk_ints("offsets", g.offsets, g.line_cells));
+            if (polys)
+                fsdem__vtk_cells(&w, "Polys", fsdem__vtk_ints("connectivity", g.connectivity + g.line_points, g.points_count - g.line_points),
+                                 fsdem__vtk_ints("offsets", g.offsets + g.line_cells, polys));
             res = fsdem__vtk_close(&w);
         }
     }
@@ -11404,7 +11425,7 @@ fsdem_result fsdem_dem_write_contacts_vtp(const fsdem_dem *d, const char *path, 
     fsdem__io_contacts c;
     fsdem__dem_batch *b = NULL;
     fsdem__dem_wall_hit *hits = NULL;
-    size_t row_max = 0, n = 0;
+    size_t row_max = 1, n = 1; /* room for the longest wall row and the contacts (no allocation of 0 bytes) */
     fsdem_result res;
     int i;
     if (!d) return FSDEM_ERR_INVALID_ARG;
@@ -11420,6 +11441,7 @@ fsdem_result fsdem_dem_write_contacts_vtp(const fsdem_dem *d, const char *path, 
         hits = (fsdem__dem_wall_hit *)fsdem__alloc(&d->allocator, sizeof *hits * row_max);
         if (b && hits) {
             n = (size_t)fsdem__io_dem_contacts(d, b, hits, NULL);
+            if (n == 0) n = 1;
             c.points = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * 2 * n);
             c.force = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * n);
             c.normal_force = (fsdem_real *)fsdem__alloc(&d->allocator, sizeof(fsdem_real) * n);

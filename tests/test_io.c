@@ -127,7 +127,6 @@ static int xdoc_read(xdoc *d, const char *path) {
         if (pos >= d->size) break;
         if (s[pos] != '<') {
             /* character data: only inside an element, and well-formed */
-            size_t start = pos;
             char tmp[64];
             if (depth == 0) return x_fail(d, "text outside the root", pos);
             while (pos < d->size && s[pos] != '<') {
@@ -140,7 +139,6 @@ static int xdoc_read(xdoc *d, const char *path) {
                 }
                 ++pos;
             }
-            (void)start;
             continue;
         }
         if (strncmp(s + pos, "<!--", 4) == 0) {
