@@ -25,7 +25,9 @@
      >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
      >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
                 to memory, bit-exact continuation (versioned binary format with a checksum)
-     >>io       CSV time series, ParaView .pvd series, DEM particle snapshots
+     >>io       CSV time series; ParaView .pvd series, valid after every entry; VTK XML snapshots
+                of every solver (ascii, inline base64 or appended raw): DEM particles, walls and
+                contacts (.vtp), PIC particles (.vtp) and grid (.vti), shallow-water fields (.vti)
      >>impl     implementation, in the same order (each chapter opens with its contents)
      >>licence  MIT
 
@@ -95,7 +97,8 @@
        fsdem_X_stats fsdem_X_get_stats(x)           counters and figures; starts with
                                                     long long steps, double time, fsdem_real dt
        fsdem_X_particles / fsdem_X_fields fsdem_X_get_particles / _get_fields(x)  views (SoA)
-       fsdem_result fsdem_X_write_<what>(x, path)   snapshots (FSDEM_ERR_IO)
+       fsdem_result fsdem_X_write_<what>(x, path)   snapshots: CSV, and VTK XML (.vtp, .vti) with a
+                                                    last argument fsdem_vtk_format (>>io); FSDEM_ERR_IO
        fsdem_result fsdem_X_save / _restore(x, path)  checkpoint and restart (>>restart): the whole
                                                     state to a file and back into an object made
                                                     from the same desc, the run going on bit for bit;
@@ -201,8 +204,10 @@
 #define fsdem_dem_wall_sdf fsdem_dem_wall_sdf_f
 #define fsdem_dem_wall_segment fsdem_dem_wall_segment_f
 #define fsdem_dem_wall_triangle fsdem_dem_wall_triangle_f
+#define fsdem_dem_write_contacts_vtp fsdem_dem_write_contacts_vtp_f
 #define fsdem_dem_write_csv fsdem_dem_write_csv_f
-#define fsdem_dem_write_vtk fsdem_dem_write_vtk_f
+#define fsdem_dem_write_vtp fsdem_dem_write_vtp_f
+#define fsdem_dem_write_walls_vtp fsdem_dem_write_walls_vtp_f
 #define fsdem_pcg_create fsdem_pcg_create_f
 #define fsdem_pcg_desc_check fsdem_pcg_desc_check_f
 #define fsdem_pcg_desc_default fsdem_pcg_desc_default_f
@@ -324,7 +329,7 @@
 #define fsdem_swe_time fsdem_swe_time_f
 #define fsdem_swe_volume fsdem_swe_volume_f
 #define fsdem_swe_write_csv fsdem_swe_write_csv_f
-#define fsdem_swe_write_vtk fsdem_swe_write_vtk_f
+#define fsdem_swe_write_vti fsdem_swe_write_vti_f
 #endif
 /* FSDEM__SYMBOLS_END */
 
@@ -1258,14 +1263,12 @@ FSDEM_API fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *pic);
 
 /* ---- output ---- */
 
-/* Particles as CSV (x,y,z,vx,vy,vz) or as VTK XML polydata (.vtp, ASCII) with a velocity vector.
-   FSDEM_ERR_IO. */
+/* Particles as CSV (x,y,z,vx,vy,vz). FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (NULL). VTK XML output
+   (fsdem_pic_write_particles_vtp, fsdem_pic_write_grid_vti) is in >>io. */
 FSDEM_API fsdem_result fsdem_pic_write_particles_csv(const fsdem_pic *pic, const char *path);
-FSDEM_API fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *pic, const char *path);
-/* Grid cells as CSV (i,j,k,x,y,z,type,p,phi,fraction,u,v,w with cell-centred velocity) or as VTK
-   XML image data (.vti, ASCII) with the same cell data. FSDEM_ERR_IO. */
+/* Grid cells as CSV (i,j,k,x,y,z,type,p,phi,fraction,u,v,w with cell-centred velocity).
+   FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (NULL). */
 FSDEM_API fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *pic, const char *path);
-FSDEM_API fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *pic, const char *path);
 
 
 /* ===== >>swe : shallow-water equations (seed 003) ================================================= */
@@ -1552,11 +1555,9 @@ FSDEM_API fsdem_swe_stats fsdem_swe_get_stats(const fsdem_swe *swe);
 
 /* ---- output ---- */
 
-/* Field snapshot as CSV, one row per cell: x,y,bed,h,eta,u,v (1D: x,bed,h,eta,u). FSDEM_ERR_IO. */
+/* Field snapshot as CSV, one row per cell: x,y,bed,h,eta,u,v (1D: x,bed,h,eta,u). FSDEM_ERR_IO,
+   FSDEM_ERR_INVALID_ARG (NULL). The VTK XML snapshot (fsdem_swe_write_vti) is in >>io. */
 FSDEM_API fsdem_result fsdem_swe_write_csv(const fsdem_swe *swe, const char *path);
-/* Field snapshot as legacy VTK image data (STRUCTURED_POINTS, cell data h, eta, bed, velocity) for
-   ParaView. FSDEM_ERR_IO. */
-FSDEM_API fsdem_result fsdem_swe_write_vtk(const fsdem_swe *swe, const char *path);
 
 /* Adds a gauge at (x, y) (before fsdem_swe_gauges_open); its id goes to *id (may be NULL).
    FSDEM_ERR_OUT_OF_DOMAIN, FSDEM_ERR_OUT_OF_MEMORY, FSDEM_ERR_INVALID_ARG while a file is open. */
@@ -1772,7 +1773,7 @@ FSDEM_API fsdem_result fsdem_swe_dem_save_memory(const fsdem_swe_dem *coupler, v
                                                  size_t *size);
 FSDEM_API fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *buffer, size_t size);
 
-/* ===== >>io : CSV time series and particle snapshots =============================================== */
+/* ===== >>io : CSV time series, ParaView series, VTK XML snapshots ================================== */
 
 /* A CSV time series: a header row, then one row of numbers per call. Owned by the caller. */
 typedef struct fsdem_csv {
@@ -1787,21 +1788,123 @@ FSDEM_API fsdem_result fsdem_csv_open(fsdem_csv *csv, const char *path, const ch
 FSDEM_API fsdem_result fsdem_csv_row(fsdem_csv *csv, const fsdem_real *values, int count);
 FSDEM_API fsdem_result fsdem_csv_close(fsdem_csv *csv);
 
-/* A ParaView time series (.pvd collection): open, add one entry per written file (its name as
-   seen from the .pvd's folder), close. Owned by the caller. */
+/* ---- VTK XML snapshots ----
+
+   Every VTK file the library writes is a serial VTK XML file that VTK (>= 6) and ParaView read
+   completely: PolyData (.vtp) for particles, walls and contacts, ImageData (.vti) for grids. The
+   root element is <VTKFile type="PolyData|ImageData" version="1.0" byte_order="LittleEndian" (or
+   "BigEndian": the machine's own order, in which every binary number is written)
+   header_type="UInt64">. The dataset element holds <FieldData> with "TimeValue" (Float64, one
+   tuple: the object's time in s), then one <Piece>. Arrays are Float64 (Float32 with
+   FSDEM_USE_FLOAT), Int32 or UInt8, of 1 or 3 components; a 3-component array is stored tuple by
+   tuple (x0 y0 z0 x1 y1 z1 ...). Polygonal cells are described by Int32 "connectivity" and
+   "offsets" arrays; cell data follow the cell order of VTK PolyData (Verts, Lines, Strips, Polys).
+   How the numbers are stored is the caller's choice, the last argument of every VTK writer: */
+typedef enum fsdem_vtk_format {
+    /* format="ascii": decimal text, 17 significant digits for Float64 and 9 for Float32, which
+       read back to the same bits; the largest files, readable in an editor. A NaN or infinite
+       value is written as nan/inf, which VTK's ascii parser stops at: look at a failed state in a
+       binary format. */
+    FSDEM_VTK_ASCII = 0,
+    /* format="binary": inline base64 (RFC 4648 alphabet, '=' padding, no line breaks). Each array
+       is one base64 stream of a UInt64 byte count (the number of data bytes that follow, not
+       counting itself) followed by the data, as VTK's own writer encodes uncompressed data (it
+       encodes the header separately only in compressed files; VTK 9.1's reader takes either).
+       Exact, 4/3 of the raw size, and the file is well-formed XML. */
+    FSDEM_VTK_BASE64 = 1,
+    /* format="appended": each <DataArray> carries offset="N" and no content; after the dataset,
+       <AppendedData encoding="raw"> holds '_' and then, array after array in the order of the
+       file, a UInt64 byte count and the raw bytes. N counts bytes from the first byte after the
+       '_' to the array's count. Exact, the smallest and fastest to write and read; the raw bytes
+       make the file not well-formed XML, as VTK's reader expects of appended raw data. */
+    FSDEM_VTK_APPENDED = 2
+} fsdem_vtk_format;
+
+/* A ParaView time series (.pvd collection): open, add one entry per written file, close. The file
+   is complete, valid XML after open and after every add (the closing tags are rewritten after each
+   entry and the file is flushed), so a run that is still going, was killed or crashed leaves a
+   series ParaView can open. Owned by the caller. */
 typedef struct fsdem_pvd {
-    void *file; /* FILE*, NULL when closed */
+    void *file;     /* FILE*, NULL when closed */
+    long tail;      /* file position of the closing tags, overwritten by the next add */
+    int count;      /* entries added */
 } fsdem_pvd;
 
-/* FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG for NULL arguments. */
+/* Creates (truncates) `path` and writes an empty collection. FSDEM_ERR_INVALID_ARG for NULL
+   arguments, FSDEM_ERR_IO when the file cannot be written or is not seekable (a pipe). */
 FSDEM_API fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path);
-FSDEM_API fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file);
+/* Adds the piece `file` (its name as seen from the .pvd's folder) at `time` (s). The piece must be a
+   VTK XML file by its extension: .vtp, .vtu, .vti, .vts or .vtr; a legacy .vtk file, which
+   ParaView's series reader cannot take, any other name, a name with a control character, and a
+   NaN or infinite time are refused with FSDEM_ERR_INVALID_ARG (the file is unchanged). The
+   characters & < > " ' in the name are written as XML entities, so the name (UTF-8) reads back as
+   given. The time is written with 17 significant digits. FSDEM_ERR_IO on a write error. */
+FSDEM_API fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, double time, const char *file);
+/* Closes the file (it is already complete). FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (not open). */
 FSDEM_API fsdem_result fsdem_pvd_close(fsdem_pvd *pvd);
 
-/* Particle snapshot as CSV: id,x,y,z,vx,vy,vz,wx,wy,wz,radius,material. */
+/* Common to the writers below: `path` is created or truncated; the object is not changed (its
+   last_error names the path on failure). FSDEM_ERR_INVALID_ARG for a NULL object or path or a
+   `format` that is not a fsdem_vtk_format, FSDEM_ERR_IO when the file cannot be opened or written,
+   FSDEM_ERR_OUT_OF_MEMORY where a writer needs scratch memory (walls, contacts). */
+
+/* DEM particle snapshot as CSV: id,x,y,z,vx,vy,vz,wx,wy,wz,radius,material. FSDEM_ERR_IO,
+   FSDEM_ERR_INVALID_ARG (NULL). */
 FSDEM_API fsdem_result fsdem_dem_write_csv(const fsdem_dem *dem, const char *path);
-/* Particle snapshot as legacy VTK polydata (ParaView: Glyph filter, scale by "radius"). */
-FSDEM_API fsdem_result fsdem_dem_write_vtk(const fsdem_dem *dem, const char *path);
+/* DEM particles as PolyData (.vtp): one point and one vertex per particle (in 2D, z = 0), with
+   point data id (Int32, the stable id), radius (m), mass (kg), material (Int32), fixed (UInt8),
+   velocity (m/s), angular_velocity (rad/s), force and torque (N, N m: contacts at the last force
+   evaluation, as fsdem_dem_particles), external_force (N). Active scalars radius, active vectors
+   velocity; ParaView: Glyph filter, sphere, scale by "radius" with factor 2 (the sphere source has
+   diameter 1). */
+FSDEM_API fsdem_result fsdem_dem_write_vtp(const fsdem_dem *dem, const char *path, fsdem_vtk_format format);
+/* DEM walls as PolyData (.vtp), one or more cells per wall: in 3D polygons (a plane as its
+   intersection with the domain box [domain_min, domain_max], a convex polygon, none when the plane
+   misses the box; a box, inside or outside, as its six faces; a triangle), in 2D lines at z = 0 (a
+   plane as its chord of the domain rectangle; a box as its four edges; a segment); a segment is a
+   line in 3D too. Line cells come first, then polygons (VTK's order), each in wall order.
+   Polygons are ordered so that their normal points to the particles' side (a box's faces:
+   inwards for an inside box, outwards for an outside one). Cell data: wall_id (Int32, the id from
+   fsdem_dem_add_wall), type (UInt8, fsdem_dem_wall_type), force (N, exerted by the particles on
+   the whole wall at the last force evaluation, fsdem_dem_wall_force; every cell of a wall carries
+   it). Removed walls are left out, and so are SDF walls, whose surface is known only through their
+   callback and cannot be drawn. */
+FSDEM_API fsdem_result fsdem_dem_write_walls_vtp(const fsdem_dem *dem, const char *path, fsdem_vtk_format format);
+/* DEM contacts as PolyData (.vtp): one line cell per touching particle pair (centre of particle i
+   to centre of its partner j) and per wall contact (centre to the closest point of the wall), pairs
+   first in neighbour-list order, then wall contacts by particle; the same contacts as the last force
+   evaluation (fsdem_dem_stats.contacts + wall_contacts after a Verlet step): pairs that are both
+   fixed exert nothing and are left out, as are wall contacts of fixed particles. Cell data: force
+   (N, on particle i, from the partner; normal plus tangential), normal_force (N, the normal part
+   along the unit normal from the partner to i, positive in compression), overlap (m, contact offset
+   included), particle (Int32, id of i) and partner (Int32, id of j, or -1 - wall id).
+   The forces come from the contact law evaluated on the current state, as the step evaluates it,
+   without changing anything: positions, velocities and the tangential springs the last step
+   committed, with no further spring increment (Hertz-Mindlin) and the current dt for the linear
+   law's one-step spring. After a Verlet step the positions are exactly those of the last force
+   evaluation and so are the elastic forces, normal and tangential; dashpots see the final
+   velocities instead of the half-step ones (a difference of dt/2 times the acceleration), and the
+   per-particle sums equal fsdem_dem_particles.force to that difference (to rounding without
+   damping). After a predictor-corrector step they are the forces of the final state. The file holds
+   no contacts while the neighbour lists are out of date, that is after particles or walls were
+   added, removed or set and before the next step (or fsdem_dem_contacts). */
+FSDEM_API fsdem_result fsdem_dem_write_contacts_vtp(const fsdem_dem *dem, const char *path, fsdem_vtk_format format);
+
+/* PIC marker particles as PolyData (.vtp): one point and vertex per particle (z = 0 in 2D), point
+   data velocity (m/s). */
+FSDEM_API fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *pic, const char *path, fsdem_vtk_format format);
+/* PIC grid as ImageData (.vti), extent 0..n[0] x 0..n[1] x 0..n[2] points (0..0 in z in 2D),
+   origin the lower corner, spacing the cell size, with cell data pressure (Pa), phi (m), fraction,
+   type (UInt8, fsdem_stencil_cell) and velocity (m/s, cell-centred: the mean of the two faces along
+   each axis; z = 0 in 2D), as fsdem_pic_get_fields. */
+FSDEM_API fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *pic, const char *path, fsdem_vtk_format format);
+
+/* Shallow-water fields as ImageData (.vti): extent 0..nx x 0..ny x 0..0 points, origin (x_min,
+   y_min, 0), spacing (dx, dy, 1); a 1D channel is one cell high, 0..nx x 0..1, origin (x_min, 0, 0),
+   spacing (dx, width, 1). Cell data h (m, eta - bed), eta (m), bed (m), velocity (m/s, (u, v, 0) as
+   fsdem_swe_copy_field gives them, 0 in dry cells) and, when per-cell coefficients were set
+   (fsdem_swe_set_manning), manning (s/m^(1/3)). Active scalars h, active vectors velocity. */
+FSDEM_API fsdem_result fsdem_swe_write_vti(const fsdem_swe *swe, const char *path, fsdem_vtk_format format);
 
 #ifdef __cplusplus
 }
@@ -3980,20 +4083,22 @@ static int fsdem__dem_lists_stale(const fsdem_dem *d) {
     return d->need_rebuild || 2 * disp > d->skin || disp + wall_moved > d->skin;
 }
 
-/* Wall contacts (overlap > 0) of particle i into d->hits; returns their number. A mesh of
+/* Wall contacts (overlap > 0) of particle i into `hits`; returns their number. A mesh of
    triangles or a polyline shares edges and vertices between elements, and a particle touching a
    shared edge would be pushed once per element. So an edge/vertex contact is dropped when its
    contact point lies in the plane of a face contact of the same particle (the edge belongs to that
    face), or when an edge/vertex contact kept before has the same normal (one edge seen from two
-   elements). With `reset`, entries without a kept contact lose their tangential history. */
-static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
+   elements). `hits` has room for the particle's row of the particle-wall list. With `keys` (the
+   list's keys; NULL: nothing changes), entries without a kept contact lose their tangential
+   history. */
+static int fsdem__dem_wall_hits_into(const fsdem_dem *d, int i, fsdem__dem_wall_hit *hits, int *keys) {
     const fsdem_real off = d->desc.contact_offset, tol = (fsdem_real)fsdem__tolerance(1e-9) * d->r[i];
     const fsdem_vec3 xi = d->x[i];
     int k, a, b, count = 0, kept = 0;
     for (k = d->pw.start[i]; k < d->pw.start[i + 1]; ++k) {
         const int key = d->pw.key[k];
         const fsdem__dem_wall *wall = &d->walls[FSDEM__DEM_WALL_OF(key)];
-        fsdem__dem_wall_hit *h = &d->hits[count];
+        fsdem__dem_wall_hit *h = &hits[count];
         if (wall->active) {
             h->delta = d->r[i] + off - fsdem__dem_wall_distance(wall, FSDEM__DEM_FACE_OF(key), xi, d->desc.dim, &h->n, &h->on_feature);
             if (h->delta > 0) {
@@ -4002,16 +4107,16 @@ static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
                 continue;
             }
         }
-        if (reset) d->pw.key[k] &= ~FSDEM__DEM_HELD;
+        if (keys) keys[k] &= ~FSDEM__DEM_HELD;
     }
     for (a = 0; a < count; ++a) {
-        fsdem__dem_wall_hit h = d->hits[a];
+        fsdem__dem_wall_hit h = hits[a];
         int duplicate = 0;
         if (h.on_feature) {
             /* contact point q = x - (r + off - delta) n; in face b's plane when (q - x).n_b = -(r + off - delta_b) */
             fsdem_vec3 q_rel = fsdem__scale(h.n, -(d->r[i] + off - h.delta));
             for (b = 0; b < count && !duplicate; ++b) {
-                const fsdem__dem_wall_hit *o = &d->hits[b];
+                const fsdem__dem_wall_hit *o = &hits[b];
                 if (b == a) continue;
                 if (!o->on_feature)
                     duplicate = fsdem__dot(q_rel, o->n) + (d->r[i] + off - o->delta) <= tol &&
@@ -4021,12 +4126,18 @@ static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
             }
         }
         if (duplicate) {
-            if (reset) d->pw.key[h.entry] &= ~FSDEM__DEM_HELD;
+            if (keys) keys[h.entry] &= ~FSDEM__DEM_HELD;
             continue;
         }
-        d->hits[kept++] = h;
+        hits[kept++] = h;
     }
     return kept;
+}
+
+/* Wall contacts of particle i into d->hits (fsdem__dem_wall_hits_into); with `reset`, entries
+   without a kept contact lose their tangential history. */
+static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
+    return fsdem__dem_wall_hits_into(d, i, d->hits, reset ? d->pw.key : NULL);
 }
 
 /* ---- >>dem_forces : contact force evaluation ---- */
@@ -9056,37 +9167,17 @@ fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *s) {
     return st;
 }
 
-/* ---- >>pic_output : CSV, VTK XML, PVD ---- */
+/* ---- >>pic_output : CSV (VTK XML: >>impl_io) ---- */
 
 fsdem_result fsdem_pic_write_particles_csv(const fsdem_pic *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
+    FILE *fp;
     int p, bad;
-    if (!fp) return FSDEM_ERR_IO;
+    if (!s || !path) return FSDEM_ERR_INVALID_ARG;
+    if (!(fp = fopen(path, "w"))) return FSDEM_ERR_IO;
     fprintf(fp, "x,y,z,vx,vy,vz\n");
     for (p = 0; p < s->np; ++p)
         fprintf(fp, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", (double)s->px[p].x, (double)s->px[p].y, (double)s->px[p].z,
                 (double)s->pv[p].x, (double)s->pv[p].y, (double)s->pv[p].z);
-    bad = ferror(fp);
-    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
-}
-
-fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
-    int p, bad;
-    if (!fp) return FSDEM_ERR_IO;
-    fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-                "<PolyData>\n<Piece NumberOfPoints=\"%d\" NumberOfVerts=\"%d\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
-                "NumberOfPolys=\"0\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
-            s->np, s->np);
-    for (p = 0; p < s->np; ++p) fprintf(fp, "%.9g %.9g %.9g\n", (double)s->px[p].x, (double)s->px[p].y, (double)s->px[p].z);
-    fprintf(fp, "</DataArray>\n</Points>\n<Verts>\n<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n");
-    for (p = 0; p < s->np; ++p) fprintf(fp, "%d\n", p);
-    fprintf(fp, "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n");
-    for (p = 0; p < s->np; ++p) fprintf(fp, "%d\n", p + 1);
-    fprintf(fp, "</DataArray>\n</Verts>\n<PointData Vectors=\"velocity\">\n"
-                "<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for (p = 0; p < s->np; ++p) fprintf(fp, "%.9g %.9g %.9g\n", (double)s->pv[p].x, (double)s->pv[p].y, (double)s->pv[p].z);
-    fprintf(fp, "</DataArray>\n</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
     bad = ferror(fp);
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
 }
@@ -9103,9 +9194,10 @@ static fsdem_vec3 fsdem__pic_cell_velocity(const fsdem_pic *s, int i, int j, int
 }
 
 fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
+    FILE *fp;
     int i, j, k, bad;
-    if (!fp) return FSDEM_ERR_IO;
+    if (!s || !path) return FSDEM_ERR_INVALID_ARG;
+    if (!(fp = fopen(path, "w"))) return FSDEM_ERR_IO;
     fprintf(fp, "i,j,k,x,y,z,type,p,phi,fraction,u,v,w\n");
     for (k = 0; k < s->n[2]; ++k)
         for (j = 0; j < s->n[1]; ++j)
@@ -9116,35 +9208,6 @@ fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *s, const char *path) {
                         (double)x.z, (int)s->ctype[c], (double)s->pres[c], (double)s->phi[c], (double)s->frac[c], (double)v.x,
                         (double)v.y, (double)v.z);
             }
-    bad = ferror(fp);
-    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
-}
-
-fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
-    int i, j, k, c, bad, nz = s->dim == 3 ? s->n[2] : 0;
-    if (!fp) return FSDEM_ERR_IO;
-    fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-                "<ImageData WholeExtent=\"0 %d 0 %d 0 %d\" Origin=\"%.9g %.9g %.9g\" Spacing=\"%.9g %.9g %.9g\">\n"
-                "<Piece Extent=\"0 %d 0 %d 0 %d\">\n<CellData Scalars=\"pressure\" Vectors=\"velocity\">\n",
-            s->n[0], s->n[1], nz, (double)s->lo.x, (double)s->lo.y, (double)s->lo.z, (double)s->dx, (double)s->dx,
-            (double)s->dx, s->n[0], s->n[1], nz);
-    fprintf(fp, "<DataArray type=\"Float64\" Name=\"pressure\" format=\"ascii\">\n");
-    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%.9g\n", (double)s->pres[c]);
-    fprintf(fp, "</DataArray>\n<DataArray type=\"Float64\" Name=\"phi\" format=\"ascii\">\n");
-    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%.9g\n", (double)s->phi[c]);
-    fprintf(fp, "</DataArray>\n<DataArray type=\"Float64\" Name=\"fraction\" format=\"ascii\">\n");
-    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%.9g\n", (double)s->frac[c]);
-    fprintf(fp, "</DataArray>\n<DataArray type=\"UInt8\" Name=\"type\" format=\"ascii\">\n");
-    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%d\n", (int)s->ctype[c]);
-    fprintf(fp, "</DataArray>\n<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for (k = 0; k < s->n[2]; ++k)
-        for (j = 0; j < s->n[1]; ++j)
-            for (i = 0; i < s->n[0]; ++i) {
-                fsdem_vec3 v = fsdem__pic_cell_velocity(s, i, j, k);
-                fprintf(fp, "%.9g %.9g %.9g\n", (double)v.x, (double)v.y, (double)v.z);
-            }
-    fprintf(fp, "</DataArray>\n</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n");
     bad = ferror(fp);
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
 }
@@ -11024,9 +11087,10 @@ fsdem_swe_stats fsdem_swe_get_stats(const fsdem_swe *s) {
 }
 
 fsdem_result fsdem_swe_write_csv(const fsdem_swe *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
+    FILE *fp;
     int k, bad;
-    if (!fp) return FSDEM_ERR_IO;
+    if (!s || !path) return FSDEM_ERR_INVALID_ARG;
+    if (!(fp = fopen(path, "w"))) return FSDEM_ERR_IO;
     fprintf(fp, s->dim == 2 ? "x,y,bed,h,eta,u,v\n" : "x,bed,h,eta,u\n");
     for (k = 0; k < s->n; ++k) {
         fsdem_real x, y, u, v;
@@ -11038,37 +11102,6 @@ fsdem_result fsdem_swe_write_csv(const fsdem_swe *s, const char *path) {
         else
             fprintf(fp, "%.10g,%.10g,%.10g,%.10g,%.10g\n", (double)x, (double)s->bed[k],
                     (double)(s->eta[k] - s->bed[k]), (double)s->eta[k], (double)u);
-    }
-    bad = ferror(fp);
-    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
-}
-
-static void fsdem__swe_vtk_scalars(FILE *fp, const fsdem_swe *s, const char *name, int field) {
-    int k;
-    fprintf(fp, "SCALARS %s double 1\nLOOKUP_TABLE default\n", name);
-    for (k = 0; k < s->n; ++k) {
-        double v = field == 0 ? (double)(s->eta[k] - s->bed[k]) : field == 1 ? (double)s->eta[k] : (double)s->bed[k];
-        fprintf(fp, "%.10g\n", v);
-    }
-}
-
-fsdem_result fsdem_swe_write_vtk(const fsdem_swe *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
-    int k, bad;
-    if (!fp) return FSDEM_ERR_IO;
-    fprintf(fp, "# vtk DataFile Version 3.0\nfsdem shallow water t=%.10g s\nASCII\nDATASET STRUCTURED_POINTS\n",
-            (double)s->time);
-    fprintf(fp, "DIMENSIONS %d %d 1\nORIGIN %.10g %.10g 0\nSPACING %.10g %.10g 1\nCELL_DATA %d\n", s->nx + 1,
-            s->dim == 2 ? s->ny + 1 : 1, (double)s->desc.x_min, (double)(s->dim == 2 ? s->desc.y_min : 0),
-            (double)s->dx, (double)(s->dim == 2 ? s->dy : 1), s->n);
-    fsdem__swe_vtk_scalars(fp, s, "h", 0);
-    fsdem__swe_vtk_scalars(fp, s, "eta", 1);
-    fsdem__swe_vtk_scalars(fp, s, "bed", 2);
-    fprintf(fp, "VECTORS velocity double\n");
-    for (k = 0; k < s->n; ++k) {
-        fsdem_real u, v;
-        fsdem__swe_velocity(s, k, &u, &v);
-        fprintf(fp, "%.10g %.10g 0\n", (double)u, (double)v);
     }
     bad = ferror(fp);
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
@@ -12816,9 +12849,14 @@ fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *bu
     return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
 }
 
-/* ===== >>impl_io : CSV and VTK output ============================================================== */
+/* ===== >>impl_io : CSV, ParaView series, VTK XML ====================================================
 
-/* Contents: CSV time series, ParaView .pvd series, DEM particle snapshots. */
+   Contents: >>io_csv (CSV time series), >>io_vtk (the VTK XML writer core, through which every VTK
+   file of the library is written), >>io_pvd (ParaView series), >>io_dem (particles, walls,
+   contacts), >>io_pic (particles, grid), >>io_swe (fields). */
+
+/* ---- >>io_csv : CSV time series ---- */
+
 
 fsdem_result fsdem_csv_open(fsdem_csv *csv, const char *path, const char *header) {
     FILE *fp;
@@ -12855,42 +12893,469 @@ fsdem_result fsdem_csv_close(fsdem_csv *csv) {
     return bad ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
+/* ---- >>io_vtk : the VTK XML writer core ----
+
+   A writer opens the file (fsdem__vtk_open), starts the dataset (fsdem__vtk_polydata or
+   fsdem__vtk_imagedata: the dataset element, FieldData TimeValue, <Piece>), writes sections of
+   arrays in VTK's order (fsdem__vtk_section, fsdem__vtk_write, fsdem__vtk_section_end; PolyData:
+   PointData, CellData, Points, Verts, Lines, Polys) and closes (fsdem__vtk_close: </Piece>, the
+   appended data, </VTKFile>). An array is a description (fsdem__vtk_array), not a copy: its values
+   are read through it when they are written, which for FSDEM_VTK_APPENDED is at the close, so the
+   data it points to must live until then (the description itself is copied). Each value goes
+   through a double, which holds every Float32, Float64, Int32 and UInt8 value exactly. Binary
+   numbers are written in the machine's byte order, which the root element names. The rules of the
+   three formats are those of fsdem_vtk_format (>>io). */
+
+typedef enum fsdem__vtk_type {
+    FSDEM__VTK_FLOAT32 = 0,
+    FSDEM__VTK_FLOAT64 = 1,
+    FSDEM__VTK_INT32 = 2,
+    FSDEM__VTK_UINT8 = 3
+} fsdem__vtk_type;
+
+#ifdef FSDEM_USE_FLOAT
+#define FSDEM__VTK_REAL FSDEM__VTK_FLOAT32
+#else
+#define FSDEM__VTK_REAL FSDEM__VTK_FLOAT64
+#endif
+
+/* Int32 values are written from an int and byte counts from an unsigned long long. */
+typedef char fsdem__vtk_int_is_32_bits[sizeof(int) == 4 ? 1 : -1];
+typedef char fsdem__vtk_ull_is_64_bits[sizeof(unsigned long long) == 8 ? 1 : -1];
+
+/* Where an array's values come from. */
+typedef enum fsdem__vtk_source {
+    FSDEM__VTK_FROM_REALS = 0,  /* const fsdem_real[count] */
+    FSDEM__VTK_FROM_VEC3S = 1,  /* const fsdem_vec3[count] (3 components) */
+    FSDEM__VTK_FROM_INTS = 2,   /* const int[count] */
+    FSDEM__VTK_FROM_BYTES = 3,  /* const unsigned char[count] */
+    FSDEM__VTK_FROM_RAMP = 4,   /* first + step * index (Int32) */
+    FSDEM__VTK_FROM_DOUBLE = 5, /* one const double, repeated */
+    FSDEM__VTK_FROM_FN = 6      /* a callback per tuple */
+} fsdem__vtk_source;
+
+/* Tuple `index` of a computed array into out[0 .. components - 1]. */
+typedef void (*fsdem__vtk_tuple_fn)(const void *user, long long index, double out[3]);
+
+typedef struct fsdem__vtk_array {
+    const char *name;
+    fsdem__vtk_type type;
+    int components; /* 1 or 3 */
+    long long count; /* tuples */
+    fsdem__vtk_source source;
+    const void *data; /* the values, or the callback's user */
+    fsdem__vtk_tuple_fn fn;
+    long long first, step; /* FSDEM__VTK_FROM_RAMP */
+} fsdem__vtk_array;
+
+#define FSDEM__VTK_MAX_ARRAYS 24 /* arrays of one file (the most any writer has is 14) */
+
+typedef struct fsdem__vtk_writer {
+    FILE *fp;
+    fsdem_vtk_format format;
+    const char *type;      /* "PolyData" or "ImageData" */
+    fsdem__status *status; /* the object's, for the message (may be NULL) */
+    const char *who, *path;
+    double time;           /* s, the TimeValue field */
+    unsigned long long appended; /* FSDEM_VTK_APPENDED: bytes of the blocks announced so far */
+    fsdem__vtk_array queue[FSDEM__VTK_MAX_ARRAYS]; /* FSDEM_VTK_APPENDED: the blocks to write */
+    int queued;
+} fsdem__vtk_writer;
+
+static fsdem__vtk_array fsdem__vtk_from(const char *name, fsdem__vtk_type type, int components, long long count,
+                                       fsdem__vtk_source source, const void *data) {
+    fsdem__vtk_array a;
+    memset(&a, 0, sizeof a);
+    a.name = name;
+    a.type = type;
+    a.components = components;
+    a.count = count;
+    a.source = source;
+    a.data = data;
+    return a;
+}
+static fsdem__vtk_array fsdem__vtk_reals(const char *name, const fsdem_real *p, long long n) {
+    return fsdem__vtk_from(name, FSDEM__VTK_REAL, 1, n, FSDEM__VTK_FROM_REALS, p);
+}
+static fsdem__vtk_array fsdem__vtk_vec3s(const char *name, const fsdem_vec3 *p, long long n) {
+    return fsdem__vtk_from(name, FSDEM__VTK_REAL, 3, n, FSDEM__VTK_FROM_VEC3S, p);
+}
+static fsdem__vtk_array fsdem__vtk_ints(const char *name, const int *p, long long n) {
+    return fsdem__vtk_from(name, FSDEM__VTK_INT32, 1, n, FSDEM__VTK_FROM_INTS, p);
+}
+static fsdem__vtk_array fsdem__vtk_bytes(const char *name, const unsigned char *p, long long n) {
+    return fsdem__vtk_from(name, FSDEM__VTK_UINT8, 1, n, FSDEM__VTK_FROM_BYTES, p);
+}
+/* Int32 values first, first + step, ... (connectivity and offsets of regular cells). */
+static fsdem__vtk_array fsdem__vtk_ramp(const char *name, long long n, long long first, long long step) {
+    fsdem__vtk_array a = fsdem__vtk_from(name, FSDEM__VTK_INT32, 1, n, FSDEM__VTK_FROM_RAMP, NULL);
+    a.first = first;
+    a.step = step;
+    return a;
+}
+static fsdem__vtk_array fsdem__vtk_computed(const char *name, fsdem__vtk_type type, int components, long long n,
+                                           fsdem__vtk_tuple_fn fn, const void *user) {
+    fsdem__vtk_array a = fsdem__vtk_from(name, type, components, n, FSDEM__VTK_FROM_FN, user);
+    a.fn = fn;
+    return a;
+}
+
+static const char *fsdem__vtk_type_name(fsdem__vtk_type t) {
+    switch (t) {
+    case FSDEM__VTK_FLOAT32: return "Float32";
+    case FSDEM__VTK_FLOAT64: return "Float64";
+    case FSDEM__VTK_INT32: return "Int32";
+    default: return "UInt8";
+    }
+}
+
+static size_t fsdem__vtk_type_size(fsdem__vtk_type t) {
+    return t == FSDEM__VTK_FLOAT64 ? 8 : t == FSDEM__VTK_UINT8 ? 1 : 4;
+}
+
+static int fsdem__vtk_little_endian(void) {
+    const unsigned int one = 1;
+    unsigned char first;
+    memcpy(&first, &one, 1);
+    return first == 1;
+}
+
+static void fsdem__vtk_tuple(const fsdem__vtk_array *a, long long i, double v[3]) {
+    switch (a->source) {
+    case FSDEM__VTK_FROM_REALS: v[0] = (double)((const fsdem_real *)a->data)[i]; break;
+    case FSDEM__VTK_FROM_VEC3S: {
+        const fsdem_vec3 p = ((const fsdem_vec3 *)a->data)[i];
+        v[0] = (double)p.x;
+        v[1] = (double)p.y;
+        v[2] = (double)p.z;
+        break;
+    }
+    case FSDEM__VTK_FROM_INTS: v[0] = (double)((const int *)a->data)[i]; break;
+    case FSDEM__VTK_FROM_BYTES: v[0] = (double)((const unsigned char *)a->data)[i]; break;
+    case FSDEM__VTK_FROM_RAMP: v[0] = (double)(a->first + a->step * i); break;
+    case FSDEM__VTK_FROM_DOUBLE: v[0] = *(const double *)a->data; break;
+    default: a->fn(a->data, i, v); break;
+    }
+}
+
+/* One value in the array's type, in the machine's byte order, into out; returns its size. */
+static size_t fsdem__vtk_pack(fsdem__vtk_type t, double v, unsigned char *out) {
+    switch (t) {
+    case FSDEM__VTK_FLOAT32: {
+        const float f = (float)v;
+        memcpy(out, &f, 4);
+        return 4;
+    }
+    case FSDEM__VTK_FLOAT64: memcpy(out, &v, 8); return 8;
+    case FSDEM__VTK_INT32: {
+        const int k = (int)v;
+        memcpy(out, &k, 4);
+        return 4;
+    }
+    default: out[0] = (unsigned char)v; return 1;
+    }
+}
+
+/* Binary output: raw bytes (appended), or base64 (inline) kept as one stream across calls. */
+typedef struct fsdem__vtk_sink {
+    fsdem__vtk_writer *w;
+    unsigned char pending[3];
+    int npending;
+    char text[4096];
+    int ntext;
+} fsdem__vtk_sink;
+
+static void fsdem__vtk_sink_put(fsdem__vtk_sink *s, const unsigned char *p, size_t n) {
+    static const char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    if (s->w->format == FSDEM_VTK_APPENDED) {
+        fwrite(p, 1, n, s->w->fp);
+        return;
+    }
+    while (n--) {
+        s->pending[s->npending++] = *p++;
+        if (s->npending < 3) continue;
+        if (s->ntext + 4 > (int)sizeof s->text) {
+            fwrite(s->text, 1, (size_t)s->ntext, s->w->fp);
+            s->ntext = 0;
+        }
+        s->text[s->ntext++] = digits[s->pending[0] >> 2];
+        s->text[s->ntext++] = digits[((s->pending[0] & 3) << 4) | (s->pending[1] >> 4)];
+        s->text[s->ntext++] = digits[((s->pending[1] & 15) << 2) | (s->pending[2] >> 6)];
+        s->text[s->ntext++] = digits[s->pending[2] & 63];
+        s->npending = 0;
+    }
+}
+
+/* Ends a base64 stream: the last one or two bytes with '=' padding. */
+static void fsdem__vtk_sink_end(fsdem__vtk_sink *s) {
+    static const char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    if (s->w->format == FSDEM_VTK_APPENDED) return;
+    if (s->npending) {
+        const unsigned char b0 = s->pending[0], b1 = s->npending > 1 ? s->pending[1] : 0;
+        char quad[4];
+        quad[0] = digits[b0 >> 2];
+        quad[1] = digits[((b0 & 3) << 4) | (b1 >> 4)];
+        quad[2] = s->npending > 1 ? digits[(b1 & 15) << 2] : '=';
+        quad[3] = '=';
+        fwrite(s->text, 1, (size_t)s->ntext, s->w->fp);
+        s->ntext = 0;
+        fwrite(quad, 1, 4, s->w->fp);
+        s->npending = 0;
+    }
+    fwrite(s->text, 1, (size_t)s->ntext, s->w->fp);
+    s->ntext = 0;
+}
+
+static unsigned long long fsdem__vtk_bytes_of(const fsdem__vtk_array *a) {
+    return (unsigned long long)a->count * (unsigned long long)a->components * fsdem__vtk_type_size(a->type);
+}
+
+/* The values of an array in the writer's format: text, or the byte count and the data in binary. */
+static void fsdem__vtk_values(fsdem__vtk_writer *w, const fsdem__vtk_array *a) {
+    long long i;
+    int c;
+    double v[3];
+    if (w->format == FSDEM_VTK_ASCII) {
+        for (i = 0; i < a->count; ++i) {
+            fsdem__vtk_tuple(a, i, v);
+            for (c = 0; c < a->components; ++c) {
+                const char sep = c + 1 < a->components ? ' ' : '\n';
+                switch (a->type) {
+                case FSDEM__VTK_FLOAT32: fprintf(w->fp, "%.9g%c", (double)(float)v[c], sep); break;
+                case FSDEM__VTK_FLOAT64: fprintf(w->fp, "%.17g%c", v[c], sep); break;
+                case FSDEM__VTK_INT32: fprintf(w->fp, "%d%c", (int)v[c], sep); break;
+                default: fprintf(w->fp, "%u%c", (unsigned)(unsigned char)v[c], sep); break;
+                }
+            }
+        }
+    } else {
+        /* whole tuples of up to 3 x 8 bytes fill the buffer; flushed at 3072 - 24 */
+        unsigned char buf[3072];
+        const unsigned long long bytes = fsdem__vtk_bytes_of(a);
+        fsdem__vtk_sink sink;
+        size_t used;
+        sink.w = w;
+        sink.npending = sink.ntext = 0;
+        memcpy(buf, &bytes, 8);
+        used = 8;
+        for (i = 0; i < a->count; ++i) {
+            if (used + 24 > sizeof buf) {
+                fsdem__vtk_sink_put(&sink, buf, used);
+                used = 0;
+            }
+            fsdem__vtk_tuple(a, i, v);
+            for (c = 0; c < a->components; ++c) used += fsdem__vtk_pack(a->type, v[c], buf + used);
+        }
+        fsdem__vtk_sink_put(&sink, buf, used);
+        fsdem__vtk_sink_end(&sink);
+    }
+}
+
+/* A <DataArray>: inline with its values (ascii, base64), or announced with its offset and queued for
+   the appended data. `field`: a FieldData array, which also names its number of tuples. */
+static void fsdem__vtk_write_array(fsdem__vtk_writer *w, fsdem__vtk_array a, int field) {
+    static const char *const formats[3] = {"ascii", "binary", "appended"};
+    fprintf(w->fp, "<DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" format=\"%s\"", fsdem__vtk_type_name(a.type),
+            a.name, a.components, formats[w->format]);
+    if (field) fprintf(w->fp, " NumberOfTuples=\"%lld\"", a.count);
+    if (w->format == FSDEM_VTK_APPENDED) {
+        FSDEM_ASSERT(w->queued < FSDEM__VTK_MAX_ARRAYS);
+        fprintf(w->fp, " offset=\"%llu\"/>\n", w->appended);
+        w->queue[w->queued++] = a;
+        w->appended += 8 + fsdem__vtk_bytes_of(&a);
+        return;
+    }
+    fputs(">\n", w->fp);
+    fsdem__vtk_values(w, &a);
+    fputs(w->format == FSDEM_VTK_BASE64 ? "\n</DataArray>\n" : "</DataArray>\n", w->fp);
+}
+
+static void fsdem__vtk_write(fsdem__vtk_writer *w, fsdem__vtk_array a) { fsdem__vtk_write_array(w, a, 0); }
+
+/* Checks the arguments every writer shares; the message goes to `status` (may be NULL). */
+static fsdem_result fsdem__vtk_check(fsdem__status *status, const char *who, const char *path, fsdem_vtk_format format) {
+    fsdem__status scratch;
+    fsdem__status *st = status ? status : &scratch;
+    if (!status) scratch.log = NULL;
+    if (!path) return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: path is NULL", who);
+    if ((int)format < (int)FSDEM_VTK_ASCII || (int)format > (int)FSDEM_VTK_APPENDED)
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: format %d is not a fsdem_vtk_format", who, (int)format);
+    return FSDEM_OK;
+}
+
+/* Checks the arguments, creates the file and writes the root element of a dataset `type`. */
+static fsdem_result fsdem__vtk_open(fsdem__vtk_writer *w, fsdem__status *status, const char *who, const char *path,
+                                    fsdem_vtk_format format, const char *type) {
+    fsdem_result res = fsdem__vtk_check(status, who, path, format);
+    memset(w, 0, sizeof *w);
+    if (res != FSDEM_OK) return res;
+    w->format = format;
+    w->type = type;
+    w->status = status;
+    w->who = who;
+    w->path = path;
+    w->fp = fopen(path, "wb");
+    if (!w->fp) {
+        if (status) fsdem__fail(status, FSDEM_ERR_IO, "%s: cannot open '%s' for writing", who, path);
+        return FSDEM_ERR_IO;
+    }
+    fprintf(w->fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"%s\" version=\"1.0\" byte_order=\"%s\" header_type=\"UInt64\">\n",
+            type, fsdem__vtk_little_endian() ? "LittleEndian" : "BigEndian");
+    return FSDEM_OK;
+}
+
+/* The FieldData of the dataset: TimeValue (s). */
+static void fsdem__vtk_time(fsdem__vtk_writer *w, double time) {
+    w->time = time;
+    fputs("<FieldData>\n", w->fp);
+    fsdem__vtk_write_array(w, fsdem__vtk_from("TimeValue", FSDEM__VTK_FLOAT64, 1, 1, FSDEM__VTK_FROM_DOUBLE, &w->time), 1);
+    fputs("</FieldData>\n", w->fp);
+}
+
+/* <PolyData>, the time, and the piece's counts (strips are never written). */
+static void fsdem__vtk_polydata(fsdem__vtk_writer *w, double time, long long points, long long verts, long long lines,
+                                long long polys) {
+    fputs("<PolyData>\n", w->fp);
+    fsdem__vtk_time(w, time);
+    fprintf(w->fp,
+            "<Piece NumberOfPoints=\"%lld\" NumberOfVerts=\"%lld\" NumberOfLines=\"%lld\" NumberOfStrips=\"0\" "
+            "NumberOfPolys=\"%lld\">\n",
+            points, verts, lines, polys);
+}
+
+/* <ImageData> of cells[0] x cells[1] x cells[2] cells (0 for a flat axis: one layer of points), the
+   time, and the piece, which is the whole extent. */
+static void fsdem__vtk_imagedata(fsdem__vtk_writer *w, double time, const int cells[3], const double origin[3],
+                                 const double spacing[3]) {
+    fprintf(w->fp, "<ImageData WholeExtent=\"0 %d 0 %d 0 %d\" Origin=\"%.17g %.17g %.17g\" Spacing=\"%.17g %.17g %.17g\">\n",
+            cells[0], cells[1], cells[2], origin[0], origin[1], origin[2], spacing[0], spacing[1], spacing[2]);
+    fsdem__vtk_time(w, time);
+    fprintf(w->fp, "<Piece Extent=\"0 %d 0 %d 0 %d\">\n", cells[0], cells[1], cells[2]);
+}
+
+/* Opens a section (PointData, CellData, Points, Verts, Lines, Polys) with its active scalars and
+   vectors (may be NULL). */
+static void fsdem__vtk_section(fsdem__vtk_writer *w, const char *tag, const char *scalars, const char *vectors) {
+    fprintf(w->fp, "<%s", tag);
+    if (scalars) fprintf(w->fp, " Scalars=\"%s\"", scalars);
+    if (vectors) fprintf(w->fp, " Vectors=\"%s\"", vectors);
+    fputs(">\n", w->fp);
+}
+
+static void fsdem__vtk_section_end(fsdem__vtk_writer *w, const char *tag) { fprintf(w->fp, "</%s>\n", tag); }
+
+/* A cell section (Verts, Lines, Polys) from its connectivity and offsets (Int32). */
+static void fsdem__vtk_cells(fsdem__vtk_writer *w, const char *tag, fsdem__vtk_array connectivity, fsdem__vtk_array offsets) {
+    fsdem__vtk_section(w, tag, NULL, NULL);
+    fsdem__vtk_write(w, connectivity);
+    fsdem__vtk_write(w, offsets);
+    fsdem__vtk_section_end(w, tag);
+}
+
+/* Closes the piece and the dataset, writes the appended data and closes the file. The object's
+   message names the path on failure, and is cleared on success. */
+static fsdem_result fsdem__vtk_close(fsdem__vtk_writer *w) {
+    int k, bad;
+    fprintf(w->fp, "</Piece>\n</%s>\n", w->type);
+    if (w->format == FSDEM_VTK_APPENDED) {
+        fputs("<AppendedData encoding=\"raw\">\n_", w->fp);
+        for (k = 0; k < w->queued; ++k) fsdem__vtk_values(w, &w->queue[k]);
+        fputs("\n</AppendedData>\n", w->fp);
+    }
+    fputs("</VTKFile>\n", w->fp);
+    bad = ferror(w->fp) != 0;
+    bad |= fclose(w->fp) != 0;
+    w->fp = NULL;
+    if (bad) return w->status ? fsdem__fail(w->status, FSDEM_ERR_IO, "%s: write error on '%s'", w->who, w->path) : FSDEM_ERR_IO;
+    return w->status ? fsdem__ok(w->status) : FSDEM_OK;
+}
+
+/* ---- >>io_pvd : ParaView series ---- */
+
+/* The closing tags, at the current position. */
+static fsdem_result fsdem__io_pvd_finish(FILE *fp) {
+    fputs("</Collection>\n</VTKFile>\n", fp);
+    fflush(fp);
+    return ferror(fp) ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
 fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path) {
     FILE *fp;
+    long tail;
     if (!pvd || !path) return FSDEM_ERR_INVALID_ARG;
     pvd->file = NULL;
+    pvd->tail = 0;
+    pvd->count = 0;
     fp = fopen(path, "w");
     if (!fp) return FSDEM_ERR_IO;
-    if (fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n") < 0) {
+    fputs("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n", fp);
+    tail = ftell(fp);
+    if (tail < 0 || fsdem__io_pvd_finish(fp) != FSDEM_OK) {
         fclose(fp);
         return FSDEM_ERR_IO;
     }
     pvd->file = fp;
-    fflush(fp);
+    pvd->tail = tail;
     return FSDEM_OK;
 }
 
-fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file) {
-    if (!pvd || !pvd->file || !file) return FSDEM_ERR_INVALID_ARG;
-    if (fprintf((FILE *)pvd->file, "<DataSet timestep=\"%.9g\" part=\"0\" file=\"%s\"/>\n", (double)time, file) < 0)
-        return FSDEM_ERR_IO;
-    fflush((FILE *)pvd->file);
+/* A piece the series reader can take: a serial VTK XML file by its extension, no control character. */
+static int fsdem__io_pvd_piece_ok(const char *file) {
+    static const char *const ext[5] = {".vtp", ".vtu", ".vti", ".vts", ".vtr"};
+    const char *c;
+    size_t n = strlen(file);
+    int k;
+    for (c = file; *c; ++c)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f) return 0;
+    for (k = 0; k < 5; ++k)
+        if (n > 4 && strcmp(file + n - 4, ext[k]) == 0) return 1;
+    return 0;
+}
+
+fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, double time, const char *file) {
+    FILE *fp;
+    const char *c;
+    long tail;
+    if (!pvd || !pvd->file || !file || !(time == time && time - time == 0) || !fsdem__io_pvd_piece_ok(file))
+        return FSDEM_ERR_INVALID_ARG;
+    fp = (FILE *)pvd->file;
+    if (fseek(fp, pvd->tail, SEEK_SET) != 0) return FSDEM_ERR_IO;
+    fprintf(fp, "<DataSet timestep=\"%.17g\" part=\"0\" file=\"", time);
+    for (c = file; *c; ++c) switch (*c) {
+        case '&': fputs("&amp;", fp); break;
+        case '<': fputs("&lt;", fp); break;
+        case '>': fputs("&gt;", fp); break;
+        case '"': fputs("&quot;", fp); break;
+        case '\'': fputs("&apos;", fp); break;
+        default: fputc(*c, fp); break;
+        }
+    fputs("\"/>\n", fp);
+    tail = ftell(fp);
+    if (tail < 0 || fsdem__io_pvd_finish(fp) != FSDEM_OK) return FSDEM_ERR_IO;
+    pvd->tail = tail;
+    pvd->count++;
     return FSDEM_OK;
 }
 
 fsdem_result fsdem_pvd_close(fsdem_pvd *pvd) {
+    FILE *fp;
     int bad;
     if (!pvd || !pvd->file) return FSDEM_ERR_INVALID_ARG;
-    bad = fprintf((FILE *)pvd->file, "</Collection>\n</VTKFile>\n") < 0;
-    bad |= fclose((FILE *)pvd->file) != 0;
+    fp = (FILE *)pvd->file;
+    /* the tags are there already; written again in case an add failed part way */
+    bad = fseek(fp, pvd->tail, SEEK_SET) != 0 || fsdem__io_pvd_finish(fp) != FSDEM_OK;
+    bad |= fclose(fp) != 0;
     pvd->file = NULL;
     return bad ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
+/* ---- >>io_dem : particles, walls, contacts ---- */
+
 fsdem_result fsdem_dem_write_csv(const fsdem_dem *d, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
+    FILE *fp;
     int i, bad;
-    if (!fp) return FSDEM_ERR_IO;
+    if (!d || !path) return FSDEM_ERR_INVALID_ARG;
+    if (!(fp = fopen(path, "w"))) return FSDEM_ERR_IO;
     fprintf(fp, "id,x,y,z,vx,vy,vz,wx,wy,wz,radius,material\n");
     for (i = 0; i < d->n; ++i)
         fprintf(fp, "%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d\n", d->id[i], (double)d->x[i].x,
@@ -12900,29 +13365,500 @@ fsdem_result fsdem_dem_write_csv(const fsdem_dem *d, const char *path) {
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
-static void fsdem__io_vtk_vectors(FILE *fp, const char *name, const fsdem_vec3 *v, int n) {
-    int i;
-    fprintf(fp, "VECTORS %s double\n", name);
-    for (i = 0; i < n; ++i) fprintf(fp, "%.10g %.10g %.10g\n", (double)v[i].x, (double)v[i].y, (double)v[i].z);
+fsdem_result fsdem_dem_write_vtp(const fsdem_dem *d, const char *path, fsdem_vtk_format format) {
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem__vtk_open(&w, (fsdem__status *)&d->status, "fsdem_dem_write_vtp", path, format, "PolyData");
+    if (res != FSDEM_OK) return res;
+    fsdem__vtk_polydata(&w, d->time, d->n, d->n, 0, 0);
+    fsdem__vtk_section(&w, "PointData", "radius", "velocity");
+    fsdem__vtk_write(&w, fsdem__vtk_ints("id", d->id, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("radius", d->r, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("mass", d->m, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_ints("material", d->material, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_bytes("fixed", d->fixed, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("velocity", d->v, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("angular_velocity", d->w, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("force", d->f, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("torque", d->t, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("external_force", d->fext, d->n));
+    fsdem__vtk_section_end(&w, "PointData");
+    fsdem__vtk_section(&w, "Points", NULL, NULL);
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", d->x, d->n));
+    fsdem__vtk_section_end(&w, "Points");
+    fsdem__vtk_cells(&w, "Verts", fsdem__vtk_ramp("connectivity", d->n, 0, 1), fsdem__vtk_ramp("offsets", d->n, 1, 1));
+    return fsdem__vtk_close(&w);
 }
 
-fsdem_result fsdem_dem_write_vtk(const fsdem_dem *d, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
-    int i, bad;
-    if (!fp) return FSDEM_ERR_IO;
-    fprintf(fp, "# vtk DataFile Version 3.0\nfsdem particles t=%.10g s\nASCII\nDATASET POLYDATA\n", (double)d->time);
-    fprintf(fp, "POINTS %d double\n", d->n);
-    for (i = 0; i < d->n; ++i) fprintf(fp, "%.10g %.10g %.10g\n", (double)d->x[i].x, (double)d->x[i].y, (double)d->x[i].z);
-    fprintf(fp, "VERTICES %d %d\n", d->n, 2 * d->n);
-    for (i = 0; i < d->n; ++i) fprintf(fp, "1 %d\n", i);
-    fprintf(fp, "POINT_DATA %d\nSCALARS radius double 1\nLOOKUP_TABLE default\n", d->n);
-    for (i = 0; i < d->n; ++i) fprintf(fp, "%.10g\n", (double)d->r[i]);
-    fprintf(fp, "SCALARS id int 1\nLOOKUP_TABLE default\n");
-    for (i = 0; i < d->n; ++i) fprintf(fp, "%d\n", d->id[i]);
-    fsdem__io_vtk_vectors(fp, "velocity", d->v, d->n);
-    fsdem__io_vtk_vectors(fp, "angular_velocity", d->w, d->n);
-    bad = ferror(fp);
-    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
+/* Wall geometry for the writer: points, cells (connectivity, offsets) and per-cell wall data, the
+   line cells (two points) first and then the polygons, as VTK orders PolyData cells. Points are not
+   shared, so the connectivity of point k is k; offsets count from the start of their section. */
+typedef struct fsdem__io_walls {
+    fsdem_vec3 *points;
+    int *connectivity, *offsets, *wall_id;
+    unsigned char *type;
+    fsdem_vec3 *force;
+    int points_count, cells_count;
+    int lines;                     /* the pass: 1 takes line cells, 0 polygons */
+    int section_start;             /* points before the current section */
+    int line_cells, line_points;   /* the line section, after the build */
+} fsdem__io_walls;
+
+#define FSDEM__IO_WALL_POINTS 24 /* the most points of one wall: a 3D box's six faces of four */
+#define FSDEM__IO_WALL_CELLS 6
+
+static void fsdem__io_walls_cell(fsdem__io_walls *g, const fsdem_vec3 *v, int n, int id, const fsdem__dem_wall *w) {
+    int k;
+    if ((n == 2) != g->lines) return; /* the other pass's */
+    for (k = 0; k < n; ++k) {
+        g->connectivity[g->points_count] = g->points_count;
+        g->points[g->points_count++] = v[k];
+    }
+    g->offsets[g->cells_count] = g->points_count - g->section_start;
+    g->wall_id[g->cells_count] = id;
+    g->type[g->cells_count] = (unsigned char)w->d.type;
+    g->force[g->cells_count++] = w->force;
+}
+
+/* Keeps the part of a convex polygon where sign (x_axis - bound) >= 0 (Sutherland-Hodgman). */
+static int fsdem__io_clip(const fsdem_vec3 *in, int n, fsdem_vec3 *out, int axis, fsdem_real bound, fsdem_real sign) {
+    int k, m = 0;
+    for (k = 0; k < n; ++k) {
+        const fsdem_vec3 cur = in[k], prev = in[(k + n - 1) % n];
+        const fsdem_real dc = sign * (fsdem__comp(cur, axis) - bound), dp = sign * (fsdem__comp(prev, axis) - bound);
+        if ((dc >= 0) != (dp >= 0)) {
+            fsdem_vec3 q = fsdem__madd(prev, fsdem__sub(cur, prev), dp / (dp - dc));
+            if (axis == 0) q.x = bound;
+            else if (axis == 1) q.y = bound;
+            else q.z = bound;
+            out[m++] = q;
+        }
+        if (dc >= 0) out[m++] = cur;
+    }
+    return m;
+}
+
+/* A plane (through p, unit normal n) drawn inside the box [lo, hi]: in 3D the convex polygon where
+   they meet, ordered counter-clockwise about n (up to 10 vertices), in 2D the chord of the line
+   through the rectangle (2 vertices, z = 0). Returns the number of vertices; fewer than 3 in 3D or
+   2 in 2D: the plane misses the box. */
+static int fsdem__io_plane_patch(fsdem_vec3 p, fsdem_vec3 n, fsdem_vec3 lo, fsdem_vec3 hi, int dim, fsdem_vec3 *out) {
+    const fsdem_vec3 mid = fsdem__scale(fsdem__add(lo, hi), (fsdem_real)0.5);
+    const fsdem_vec3 c = fsdem__madd(mid, n, -fsdem__dot(fsdem__sub(mid, p), n)); /* mid projected on the plane */
+    fsdem_vec3 diag = fsdem__sub(hi, lo);
+    fsdem_real half;
+    int axis, count;
+    if (dim == 2) diag.z = 0;
+    half = fsdem__norm(diag); /* every point of the box projects within half of c */
+    if (dim == 2) {
+        const fsdem_vec3 t = fsdem_v3(-n.y, n.x, 0);
+        fsdem_real t0 = -half, t1 = half;
+        for (axis = 0; axis < 2; ++axis) {
+            const fsdem_real ta = fsdem__comp(t, axis), ca = fsdem__comp(c, axis);
+            const fsdem_real la = fsdem__comp(lo, axis), ha = fsdem__comp(hi, axis);
+            if (ta == 0) {
+                if (ca < la || ca > ha) return 0;
+            } else {
+                fsdem_real a = (la - ca) / ta, b = (ha - ca) / ta;
+                if (a > b) {
+                    const fsdem_real s = a;
+                    a = b;
+                    b = s;
+                }
+                if (a > t0) t0 = a;
+                if (b < t1) t1 = b;
+            }
+        }
+        if (!(t0 < t1)) return 0;
+        out[0] = fsdem__madd(c, t, t0);
+        out[1] = fsdem__madd(c, t, t1);
+        out[0].z = out[1].z = 0;
+        return 2;
+    } else {
+        /* u, v = n x u: an orthonormal basis of the plane with u x v = n */
+        const fsdem_real ax = n.x < 0 ? -n.x : n.x, ay = n.y < 0 ? -n.y : n.y, az = n.z < 0 ? -n.z : n.z;
+        const fsdem_vec3 e = ax <= ay && ax <= az ? fsdem_v3(1, 0, 0) : ay <= az ? fsdem_v3(0, 1, 0) : fsdem_v3(0, 0, 1);
+        fsdem_vec3 u = fsdem__cross(e, n), v, a[12], b[12];
+        u = fsdem__scale(u, half / fsdem__norm(u));
+        v = fsdem__cross(n, u);
+        a[0] = fsdem__sub(fsdem__sub(c, u), v);
+        a[1] = fsdem__sub(fsdem__add(c, u), v);
+        a[2] = fsdem__add(fsdem__add(c, u), v);
+        a[3] = fsdem__add(fsdem__sub(c, u), v);
+        count = 4;
+        for (axis = 0; axis < 3 && count >= 3; ++axis) {
+            count = fsdem__io_clip(a, count, b, axis, fsdem__comp(lo, axis), 1);
+            count = fsdem__io_clip(b, count, a, axis, fsdem__comp(hi, axis), -1);
+        }
+        if (count < 3) return 0;
+        memcpy(out, a, sizeof *a * (size_t)count);
+        return count;
+    }
+}
+
+/* The cells of the drawable walls of the pass g->lines into g (room for FSDEM__IO_WALL_POINTS points
+   and FSDEM__IO_WALL_CELLS cells per wall). */
+static void fsdem__io_walls_pass(const fsdem_dem *d, fsdem__io_walls *g) {
+    /* a 3D box's faces as corners (bit 0: x at hi, bit 1: y, bit 2: z), counter-clockwise seen from outside */
+    static const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    const int dim = d->desc.dim;
+    int id, f, k;
+    for (id = 0; id < d->wall_count; ++id) {
+        const fsdem__dem_wall *w = &d->walls[id];
+        const fsdem_dem_wall_desc *gd = &w->d;
+        fsdem_vec3 v[12];
+        if (!w->active) continue;
+        switch (gd->type) {
+        case FSDEM_DEM_WALL_PLANE:
+            k = fsdem__io_plane_patch(gd->a, gd->b, d->desc.domain_min, d->desc.domain_max, dim, v);
+            if (k >= (dim == 2 ? 2 : 3)) fsdem__io_walls_cell(g, v, k, id, w);
+            break;
+        case FSDEM_DEM_WALL_BOX_INSIDE:
+        case FSDEM_DEM_WALL_BOX_OUTSIDE:
+            if (dim == 2) {
+                const fsdem_vec3 r[4] = {fsdem_v3(gd->a.x, gd->a.y, 0), fsdem_v3(gd->b.x, gd->a.y, 0), fsdem_v3(gd->b.x, gd->b.y, 0),
+                                         fsdem_v3(gd->a.x, gd->b.y, 0)};
+                for (f = 0; f < 4; ++f) {
+                    v[0] = r[f];
+                    v[1] = r[(f + 1) % 4];
+                    fsdem__io_walls_cell(g, v, 2, id, w);
+                }
+            } else
+                for (f = 0; f < 6; ++f) {
+                    for (k = 0; k < 4; ++k) {
+                        /* an inside box holds the particles: its faces face inwards */
+                        const int corner = faces[f][gd->type == FSDEM_DEM_WALL_BOX_INSIDE ? 3 - k : k];
+                        v[k] = fsdem_v3(corner & 1 ? gd->b.x : gd->a.x, corner & 2 ? gd->b.y : gd->a.y, corner & 4 ? gd->b.z : gd->a.z);
+                    }
+                    fsdem__io_walls_cell(g, v, 4, id, w);
+                }
+            break;
+        case FSDEM_DEM_WALL_SEGMENT:
+            v[0] = gd->a;
+            v[1] = gd->b;
+            fsdem__io_walls_cell(g, v, 2, id, w);
+            break;
+        case FSDEM_DEM_WALL_TRIANGLE:
+            v[0] = gd->a;
+            v[1] = gd->b;
+            v[2] = gd->c;
+            fsdem__io_walls_cell(g, v, 3, id, w);
+            break;
+        default: break; /* SDF: known only through its callback */
+        }
+    }
+}
+
+/* Every drawable wall: the line cells (2D walls, segments), then the polygons (3D walls). */
+static void fsdem__io_walls_build(const fsdem_dem *d, fsdem__io_walls *g) {
+    g->points_count = g->cells_count = g->section_start = 0;
+    g->lines = 1;
+    fsdem__io_walls_pass(d, g);
+    g->line_cells = g->cells_count;
+    g->line_points = g->section_start = g->points_count;
+    g->lines = 0;
+    fsdem__io_walls_pass(d, g);
+}
+
+fsdem_result fsdem_dem_write_walls_vtp(const fsdem_dem *d, const char *path, fsdem_vtk_format format) {
+    static const char *const who = "fsdem_dem_write_walls_vtp";
+    const size_t walls = d && d->wall_count > 0 ? (size_t)d->wall_count : 1; /* no allocation of 0 bytes */
+    const size_t np = FSDEM__IO_WALL_POINTS * walls, nc = FSDEM__IO_WALL_CELLS * walls;
+    fsdem__status *st;
+    fsdem__io_walls g;
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&d->status; /* the message is the object's only mutable part here */
+    res = fsdem__vtk_check(st, who, path, format);
+    if (res != FSDEM_OK) return res;
+    g.points = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * np);
+    g.connectivity = (int *)fsdem__alloc(&d->allocator, sizeof(int) * np);
+    g.offsets = (int *)fsdem__alloc(&d->allocator, sizeof(int) * nc);
+    g.wall_id = (int *)fsdem__alloc(&d->allocator, sizeof(int) * nc);
+    g.type = (unsigned char *)fsdem__alloc(&d->allocator, nc);
+    g.force = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * nc);
+    if (!g.points || !g.connectivity || !g.offsets || !g.wall_id || !g.type || !g.force)
+        res = fsdem__fail(st, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory (%d walls)", who, d->wall_count);
+    else {
+        fsdem__io_walls_build(d, &g);
+        res = fsdem__vtk_open(&w, st, who, path, format, "PolyData");
+        if (res == FSDEM_OK) {
+            const int polys = g.cells_count - g.line_cells;
+            fsdem__vtk_polydata(&w, d->time, g.points_count, 0, g.line_cells, polys);
+            fsdem__vtk_section(&w, "CellData", "wall_id", "force");
+            fsdem__vtk_write(&w, fsdem__vtk_ints("wall_id", g.wall_id, g.cells_count));
+            fsdem__vtk_write(&w, fsdem__vtk_bytes("type", g.type, g.cells_count));
+            fsdem__vtk_write(&w, fsdem__vtk_vec3s("force", g.force, g.cells_count));
+            fsdem__vtk_section_end(&w, "CellData");
+            fsdem__vtk_section(&w, "Points", NULL, NULL);
+            fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", g.points, g.points_count));
+            fsdem__vtk_section_end(&w, "Points");
+            if (g.line_cells)
+                fsdem__vtk_cells(&w, "Lines", fsdem__vtk_ints("connectivity", g.connectivity, g.line_points),
+                                 fsdem__vtk_ints("offsets", g.offsets, g.line_cells));
+            if (polys)
+                fsdem__vtk_cells(&w, "Polys", fsdem__vtk_ints("connectivity", g.connectivity + g.line_points, g.points_count - g.line_points),
+                                 fsdem__vtk_ints("offsets", g.offsets + g.line_cells, polys));
+            res = fsdem__vtk_close(&w);
+        }
+    }
+    fsdem__free(&d->allocator, g.points, sizeof(fsdem_vec3) * np);
+    fsdem__free(&d->allocator, g.connectivity, sizeof(int) * np);
+    fsdem__free(&d->allocator, g.offsets, sizeof(int) * nc);
+    fsdem__free(&d->allocator, g.wall_id, sizeof(int) * nc);
+    fsdem__free(&d->allocator, g.type, nc);
+    fsdem__free(&d->allocator, g.force, sizeof(fsdem_vec3) * nc);
+    return res;
+}
+
+/* Contacts for the writer: two points and the cell data of each. */
+typedef struct fsdem__io_contacts {
+    fsdem_vec3 *points; /* 2 per contact */
+    fsdem_vec3 *force;
+    fsdem_real *normal_force, *overlap;
+    int *particle, *partner;
+    int count;
+} fsdem__io_contacts;
+
+/* The contact law on a filled batch, as fsdem__dem_drain runs it, with the law chosen at run time
+   (one more instantiation of the kernel; the step's are per law). */
+static void fsdem__io_dem_batch_law(fsdem__dem_batch *b, fsdem_dem_law law, fsdem_real h, int pairs, fsdem_real off,
+                                    const fsdem__dem_pair *uniform) {
+    fsdem__dem_batch_law(b, law, h, pairs, off, uniform);
+}
+
+/* Runs the law on a batch of particle pairs or (`walls`) wall contacts and appends its contacts to
+   c, leaving the object as it is (nothing is scattered, no spring is committed); empties the batch. */
+static void fsdem__io_dem_drain(const fsdem_dem *d, fsdem__dem_batch *batch, int walls, fsdem_real h, fsdem__io_contacts *c) {
+    const fsdem__dem_pair *uniform = d->material_count == 1 ? d->pairs : NULL;
+    const fsdem__dem_batch *b = batch; /* read only after the law */
+    const fsdem_real off = d->desc.contact_offset;
+    int k;
+    fsdem__dem_batch_pad(batch, !walls, uniform != NULL);
+    fsdem__io_dem_batch_law(batch, d->desc.law, h, !walls, walls ? 0 : off, uniform);
+    for (k = 0; k < b->count; ++k) {
+        const int i = b->i[k], e = c->count++;
+        c->points[2 * e] = d->x[i];
+        if (walls) {
+            /* the wall's closest point: r_i + offset - overlap from the centre, along -n */
+            const fsdem_vec3 n = fsdem__dem_batch_vec(b->n, k);
+            c->points[2 * e + 1] = fsdem__madd(d->x[i], n, -(d->r[i] + off - b->delta[k]));
+            c->partner[e] = -1 - b->other[k];
+        } else {
+            c->points[2 * e + 1] = d->x[b->other[k]];
+            c->partner[e] = d->id[b->other[k]];
+        }
+        c->force[e] = fsdem__dem_batch_vec(b->force, k);
+        c->normal_force[e] = b->fn[k];
+        c->overlap[e] = b->delta[k];
+        c->particle[e] = d->id[i];
+    }
+    batch->count = 0;
+}
+
+/* The contacts of the last force evaluation with their forces (fsdem_dem_write_contacts_vtp), into c
+   (NULL: only counted); `hits` has room for the longest row of the particle-wall list. Returns
+   their number. */
+static int fsdem__io_dem_contacts(const fsdem_dem *d, fsdem__dem_batch *b, fsdem__dem_wall_hit *hits, fsdem__io_contacts *c) {
+    const fsdem_real off = d->desc.contact_offset;
+    /* Hertz-Mindlin: the held springs as committed, not advanced again; linear: its one-step spring */
+    const fsdem_real h = d->desc.law == FSDEM_DEM_LAW_LINEAR ? d->dt : 0;
+    const int uniform = d->material_count == 1;
+    int i, k, nh, count = 0;
+    if (c) {
+        c->count = 0;
+        b->count = 0;
+    }
+    /* touching pairs, as fsdem__dem_touching finds them */
+    for (k = 0; k < d->pp.count; ++k) {
+        const int key = d->pp.key[k];
+        const int p = d->pp.first[k], q = FSDEM__DEM_PARTNER(key);
+        const fsdem_real ex = d->x[p].x - d->x[q].x, ey = d->x[p].y - d->x[q].y, ez = d->x[p].z - d->x[q].z;
+        const fsdem_real reach = d->r[p] + d->r[q] + off;
+        if (!(ex * ex + ey * ey + ez * ez < reach * reach)) continue;
+        count++;
+        if (!c) continue;
+        fsdem__dem_gather_pair(d, b, b->count++, k, d->desc.law, uniform);
+        if (b->count == FSDEM__DEM_BATCH) fsdem__io_dem_drain(d, b, 0, h, c);
+    }
+    if (c && b->count) fsdem__io_dem_drain(d, b, 0, h, c);
+    /* wall contacts of the free particles, as fsdem__dem_compute_forces_law finds them */
+    for (i = 0; i < d->n; ++i) {
+        if (d->inv_m[i] == 0 || d->pw.start[i] == d->pw.start[i + 1]) continue;
+        nh = fsdem__dem_wall_hits_into(d, i, hits, NULL);
+        count += nh;
+        if (!c) continue;
+        for (k = 0; k < nh; ++k) {
+            fsdem__dem_gather_wall(d, b, b->count++, i, &hits[k], uniform);
+            if (b->count == FSDEM__DEM_BATCH) fsdem__io_dem_drain(d, b, 1, h, c);
+        }
+    }
+    if (c && b->count) fsdem__io_dem_drain(d, b, 1, h, c);
+    return count;
+}
+
+fsdem_result fsdem_dem_write_contacts_vtp(const fsdem_dem *d, const char *path, fsdem_vtk_format format) {
+    static const char *const who = "fsdem_dem_write_contacts_vtp";
+    fsdem__status *st;
+    fsdem__vtk_writer w;
+    fsdem__io_contacts c;
+    fsdem__dem_batch *b = NULL;
+    fsdem__dem_wall_hit *hits = NULL;
+    size_t row_max = 1, n = 1; /* room for the longest wall row and the contacts (no allocation of 0 bytes) */
+    fsdem_result res;
+    int i;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&d->status; /* the message is the object's only mutable part here */
+    res = fsdem__vtk_check(st, who, path, format);
+    if (res != FSDEM_OK) return res;
+    memset(&c, 0, sizeof c);
+    /* the lists describe the particles of the last step unless they were edited since */
+    if (!d->need_rebuild && d->pp.rows == d->n && d->pw.rows == d->n && d->n > 0) {
+        for (i = 0; i < d->n; ++i)
+            if ((size_t)(d->pw.start[i + 1] - d->pw.start[i]) > row_max) row_max = (size_t)(d->pw.start[i + 1] - d->pw.start[i]);
+        b = (fsdem__dem_batch *)fsdem__alloc(&d->allocator, sizeof *b);
+        hits = (fsdem__dem_wall_hit *)fsdem__alloc(&d->allocator, sizeof *hits * row_max);
+        if (b && hits) {
+            n = (size_t)fsdem__io_dem_contacts(d, b, hits, NULL);
+            if (n == 0) n = 1;
+            c.points = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * 2 * n);
+            c.force = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * n);
+            c.normal_force = (fsdem_real *)fsdem__alloc(&d->allocator, sizeof(fsdem_real) * n);
+            c.overlap = (fsdem_real *)fsdem__alloc(&d->allocator, sizeof(fsdem_real) * n);
+            c.particle = (int *)fsdem__alloc(&d->allocator, sizeof(int) * n);
+            c.partner = (int *)fsdem__alloc(&d->allocator, sizeof(int) * n);
+        }
+        if (!b || !hits || !c.points || !c.force || !c.normal_force || !c.overlap || !c.particle || !c.partner)
+            res = fsdem__fail(st, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory (%lu contacts)", who, (unsigned long)n);
+        else
+            fsdem__io_dem_contacts(d, b, hits, &c);
+    }
+    if (res == FSDEM_OK) res = fsdem__vtk_open(&w, st, who, path, format, "PolyData");
+    if (res == FSDEM_OK) {
+        fsdem__vtk_polydata(&w, d->time, 2 * (long long)c.count, 0, c.count, 0);
+        fsdem__vtk_section(&w, "CellData", "normal_force", "force");
+        fsdem__vtk_write(&w, fsdem__vtk_vec3s("force", c.force, c.count));
+        fsdem__vtk_write(&w, fsdem__vtk_reals("normal_force", c.normal_force, c.count));
+        fsdem__vtk_write(&w, fsdem__vtk_reals("overlap", c.overlap, c.count));
+        fsdem__vtk_write(&w, fsdem__vtk_ints("particle", c.particle, c.count));
+        fsdem__vtk_write(&w, fsdem__vtk_ints("partner", c.partner, c.count));
+        fsdem__vtk_section_end(&w, "CellData");
+        fsdem__vtk_section(&w, "Points", NULL, NULL);
+        fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", c.points, 2 * (long long)c.count));
+        fsdem__vtk_section_end(&w, "Points");
+        fsdem__vtk_cells(&w, "Lines", fsdem__vtk_ramp("connectivity", 2 * (long long)c.count, 0, 1),
+                         fsdem__vtk_ramp("offsets", c.count, 2, 2));
+        res = fsdem__vtk_close(&w);
+    }
+    fsdem__free(&d->allocator, b, sizeof *b);
+    fsdem__free(&d->allocator, hits, sizeof *hits * row_max);
+    fsdem__free(&d->allocator, c.points, sizeof(fsdem_vec3) * 2 * n);
+    fsdem__free(&d->allocator, c.force, sizeof(fsdem_vec3) * n);
+    fsdem__free(&d->allocator, c.normal_force, sizeof(fsdem_real) * n);
+    fsdem__free(&d->allocator, c.overlap, sizeof(fsdem_real) * n);
+    fsdem__free(&d->allocator, c.particle, sizeof(int) * n);
+    fsdem__free(&d->allocator, c.partner, sizeof(int) * n);
+    return res;
+}
+
+/* ---- >>io_pic : particles, grid ---- */
+
+fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *s, const char *path, fsdem_vtk_format format) {
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem__vtk_open(&w, (fsdem__status *)&s->status, "fsdem_pic_write_particles_vtp", path, format, "PolyData");
+    if (res != FSDEM_OK) return res;
+    fsdem__vtk_polydata(&w, s->time, s->np, s->np, 0, 0);
+    fsdem__vtk_section(&w, "PointData", NULL, "velocity");
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("velocity", s->pv, s->np));
+    fsdem__vtk_section_end(&w, "PointData");
+    fsdem__vtk_section(&w, "Points", NULL, NULL);
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", s->px, s->np));
+    fsdem__vtk_section_end(&w, "Points");
+    fsdem__vtk_cells(&w, "Verts", fsdem__vtk_ramp("connectivity", s->np, 0, 1), fsdem__vtk_ramp("offsets", s->np, 1, 1));
+    return fsdem__vtk_close(&w);
+}
+
+static void fsdem__io_pic_velocity(const void *user, long long c, double out[3]) {
+    const fsdem_pic *s = (const fsdem_pic *)user;
+    const int i = (int)(c % s->n[0]), j = (int)(c / s->n[0] % s->n[1]), k = (int)(c / ((long long)s->n[0] * s->n[1]));
+    const fsdem_vec3 v = fsdem__pic_cell_velocity(s, i, j, k);
+    out[0] = (double)v.x;
+    out[1] = (double)v.y;
+    out[2] = (double)v.z;
+}
+
+fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *s, const char *path, fsdem_vtk_format format) {
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    int cells[3];
+    double origin[3], spacing[3];
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem__vtk_open(&w, (fsdem__status *)&s->status, "fsdem_pic_write_grid_vti", path, format, "ImageData");
+    if (res != FSDEM_OK) return res;
+    cells[0] = s->n[0];
+    cells[1] = s->n[1];
+    cells[2] = s->dim == 3 ? s->n[2] : 0;
+    origin[0] = (double)s->lo.x;
+    origin[1] = (double)s->lo.y;
+    origin[2] = s->dim == 3 ? (double)s->lo.z : 0;
+    spacing[0] = spacing[1] = spacing[2] = (double)s->dx;
+    fsdem__vtk_imagedata(&w, s->time, cells, origin, spacing);
+    fsdem__vtk_section(&w, "CellData", "pressure", "velocity");
+    fsdem__vtk_write(&w, fsdem__vtk_reals("pressure", s->pres, s->ncell));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("phi", s->phi, s->ncell));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("fraction", s->frac, s->ncell));
+    fsdem__vtk_write(&w, fsdem__vtk_bytes("type", s->ctype, s->ncell));
+    fsdem__vtk_write(&w, fsdem__vtk_computed("velocity", FSDEM__VTK_REAL, 3, s->ncell, fsdem__io_pic_velocity, s));
+    fsdem__vtk_section_end(&w, "CellData");
+    return fsdem__vtk_close(&w);
+}
+
+/* ---- >>io_swe : fields ---- */
+
+static void fsdem__io_swe_depth(const void *user, long long k, double out[3]) {
+    const fsdem_swe *s = (const fsdem_swe *)user;
+    const fsdem_real h = s->eta[k] - s->bed[k];
+    out[0] = (double)h;
+}
+
+static void fsdem__io_swe_velocity(const void *user, long long k, double out[3]) {
+    fsdem_real u, v;
+    fsdem__swe_velocity((const fsdem_swe *)user, (int)k, &u, &v);
+    out[0] = (double)u;
+    out[1] = (double)v;
+    out[2] = 0;
+}
+
+fsdem_result fsdem_swe_write_vti(const fsdem_swe *s, const char *path, fsdem_vtk_format format) {
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    int cells[3];
+    double origin[3], spacing[3];
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem__vtk_open(&w, (fsdem__status *)&s->status, "fsdem_swe_write_vti", path, format, "ImageData");
+    if (res != FSDEM_OK) return res;
+    cells[0] = s->nx;
+    cells[1] = s->ny; /* 1 in 1D: one cell of the channel's width */
+    cells[2] = 0;
+    origin[0] = (double)s->desc.x_min;
+    origin[1] = s->dim == 2 ? (double)s->desc.y_min : 0;
+    origin[2] = 0;
+    spacing[0] = (double)s->dx;
+    spacing[1] = (double)s->dy;
+    spacing[2] = 1;
+    fsdem__vtk_imagedata(&w, s->time, cells, origin, spacing);
+    fsdem__vtk_section(&w, "CellData", "h", "velocity");
+    fsdem__vtk_write(&w, fsdem__vtk_computed("h", FSDEM__VTK_REAL, 1, s->n, fsdem__io_swe_depth, s));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("eta", s->eta, s->n));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("bed", s->bed, s->n));
+    fsdem__vtk_write(&w, fsdem__vtk_computed("velocity", FSDEM__VTK_REAL, 3, s->n, fsdem__io_swe_velocity, s));
+    if (s->manning) fsdem__vtk_write(&w, fsdem__vtk_reals("manning", s->manning, s->n));
+    fsdem__vtk_section_end(&w, "CellData");
+    return fsdem__vtk_close(&w);
 }
 
 #endif /* FSDEM_IMPLEMENTATION_DONE */

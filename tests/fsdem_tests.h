@@ -12,5 +12,6 @@ Suite *swe_suite(void);
 Suite *couple_swe_suite(void);
 Suite *restart_suite(void);
 Suite *robustness_suite(void);
+Suite *io_suite(void);
 
 #endif
