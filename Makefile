@@ -15,8 +15,8 @@ CHECK_CFLAGS = $(shell pkg-config --cflags check 2>/dev/null)
 CHECK_LIBS   = $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -lsubunit -lrt -lpthread -lm)
 
 # one file per suite registered in tests/check_main.c
-TEST_SRC   := tests/test_core.c tests/test_dem.c tests/test_linalg.c tests/test_pic.c tests/test_swe.c tests/test_couple_swe.c \
-              tests/test_interface.c tests/check_main.c tests/fsdem_impl.c
+# every tests/test_<module>.c is a suite registered in tests/check_main.c
+TEST_SRC   := $(sort $(wildcard tests/test_*.c)) tests/check_main.c tests/fsdem_impl.c
 EXAMPLES   := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
 VALIDATION := $(patsubst validation/%/main.c,%,$(wildcard validation/*/main.c))
 BENCHES    := $(patsubst bench/%/main.c,%,$(wildcard bench/*/main.c))

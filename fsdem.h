@@ -23,7 +23,11 @@
      >>swe      shallow-water equations in 1D and 2D: HLL, MUSCL-Hancock, wet/dry, well-balanced
                 (seed 003)
      >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
-     >>io       CSV time series, ParaView .pvd series, DEM particle snapshots
+     >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
+                to memory, bit-exact continuation (versioned binary format with a checksum)
+     >>io       CSV time series; ParaView .pvd series, valid after every entry; VTK XML snapshots
+                of every solver (ascii, inline base64 or appended raw): DEM particles, walls and
+                contacts (.vtp), PIC particles (.vtp) and grid (.vti), shallow-water fields (.vti)
      >>impl     implementation, in the same order (each chapter opens with its contents)
      >>licence  MIT
 
@@ -93,7 +97,12 @@
        fsdem_X_stats fsdem_X_get_stats(x)           counters and figures; starts with
                                                     long long steps, double time, fsdem_real dt
        fsdem_X_particles / fsdem_X_fields fsdem_X_get_particles / _get_fields(x)  views (SoA)
-       fsdem_result fsdem_X_write_<what>(x, path)   snapshots (FSDEM_ERR_IO)
+       fsdem_result fsdem_X_write_<what>(x, path)   snapshots: CSV, and VTK XML (.vtp, .vti) with a
+                                                    last argument fsdem_vtk_format (>>io); FSDEM_ERR_IO
+       fsdem_result fsdem_X_save / _restore(x, path)  checkpoint and restart (>>restart): the whole
+                                                    state to a file and back into an object made
+                                                    from the same desc, the run going on bit for bit;
+                                                    _save_memory / _restore_memory with a buffer
      Gravity is a vector (m/s^2) in every desc. A NULL object pointer is refused with
      FSDEM_ERR_INVALID_ARG by every function that returns a result (getters return zeros, last_error
      says which object is NULL). Messages start with the public name they concern: the function
@@ -175,6 +184,10 @@
 #define fsdem_dem_particle_desc_default fsdem_dem_particle_desc_default_f
 #define fsdem_dem_remove_particle fsdem_dem_remove_particle_f
 #define fsdem_dem_remove_wall fsdem_dem_remove_wall_f
+#define fsdem_dem_restore fsdem_dem_restore_f
+#define fsdem_dem_restore_memory fsdem_dem_restore_memory_f
+#define fsdem_dem_save fsdem_dem_save_f
+#define fsdem_dem_save_memory fsdem_dem_save_memory_f
 #define fsdem_dem_set_dt fsdem_dem_set_dt_f
 #define fsdem_dem_set_particle_state fsdem_dem_set_particle_state_f
 #define fsdem_dem_set_wall_velocity fsdem_dem_set_wall_velocity_f
@@ -191,8 +204,10 @@
 #define fsdem_dem_wall_sdf fsdem_dem_wall_sdf_f
 #define fsdem_dem_wall_segment fsdem_dem_wall_segment_f
 #define fsdem_dem_wall_triangle fsdem_dem_wall_triangle_f
+#define fsdem_dem_write_contacts_vtp fsdem_dem_write_contacts_vtp_f
 #define fsdem_dem_write_csv fsdem_dem_write_csv_f
-#define fsdem_dem_write_vtk fsdem_dem_write_vtk_f
+#define fsdem_dem_write_vtp fsdem_dem_write_vtp_f
+#define fsdem_dem_write_walls_vtp fsdem_dem_write_walls_vtp_f
 #define fsdem_pcg_create fsdem_pcg_create_f
 #define fsdem_pcg_desc_check fsdem_pcg_desc_check_f
 #define fsdem_pcg_desc_default fsdem_pcg_desc_default_f
@@ -203,6 +218,7 @@
 #define fsdem_pcg_setup_stencil fsdem_pcg_setup_stencil_f
 #define fsdem_pcg_solve fsdem_pcg_solve_f
 #define fsdem_pic_add_force fsdem_pic_add_force_f
+#define fsdem_pic_add_gauge fsdem_pic_add_gauge_f
 #define fsdem_pic_add_obstacle fsdem_pic_add_obstacle_f
 #define fsdem_pic_add_particles fsdem_pic_add_particles_f
 #define fsdem_pic_advance fsdem_pic_advance_f
@@ -213,6 +229,9 @@
 #define fsdem_pic_destroy fsdem_pic_destroy_f
 #define fsdem_pic_fill_box fsdem_pic_fill_box_f
 #define fsdem_pic_fill_sdf fsdem_pic_fill_sdf_f
+#define fsdem_pic_gauge fsdem_pic_gauge_f
+#define fsdem_pic_gauges_close fsdem_pic_gauges_close_f
+#define fsdem_pic_gauges_open fsdem_pic_gauges_open_f
 #define fsdem_pic_get_coupling fsdem_pic_get_coupling_f
 #define fsdem_pic_get_desc fsdem_pic_get_desc_f
 #define fsdem_pic_get_fields fsdem_pic_get_fields_f
@@ -225,7 +244,11 @@
 #define fsdem_pic_obstacle_sdf fsdem_pic_obstacle_sdf_f
 #define fsdem_pic_obstacle_sphere fsdem_pic_obstacle_sphere_f
 #define fsdem_pic_reserve fsdem_pic_reserve_f
+#define fsdem_pic_restore fsdem_pic_restore_f
+#define fsdem_pic_restore_memory fsdem_pic_restore_memory_f
 #define fsdem_pic_sample fsdem_pic_sample_f
+#define fsdem_pic_save fsdem_pic_save_f
+#define fsdem_pic_save_memory fsdem_pic_save_memory_f
 #define fsdem_pic_set_pressure_extra fsdem_pic_set_pressure_extra_f
 #define fsdem_pic_solid_distance fsdem_pic_solid_distance_f
 #define fsdem_pic_stable_dt fsdem_pic_stable_dt_f
@@ -247,6 +270,8 @@
 #define fsdem_swe_add_point_source fsdem_swe_add_point_source_f
 #define fsdem_swe_advance fsdem_swe_advance_f
 #define fsdem_swe_bed_sdf fsdem_swe_bed_sdf_f
+#define fsdem_swe_block_box fsdem_swe_block_box_f
+#define fsdem_swe_block_polygon fsdem_swe_block_polygon_f
 #define fsdem_swe_cell_at fsdem_swe_cell_at_f
 #define fsdem_swe_clear_forces fsdem_swe_clear_forces_f
 #define fsdem_swe_copy_field fsdem_swe_copy_field_f
@@ -260,6 +285,10 @@
 #define fsdem_swe_dem_get_force fsdem_swe_dem_get_force_f
 #define fsdem_swe_dem_get_stats fsdem_swe_dem_get_stats_f
 #define fsdem_swe_dem_last_error fsdem_swe_dem_last_error_f
+#define fsdem_swe_dem_restore fsdem_swe_dem_restore_f
+#define fsdem_swe_dem_restore_memory fsdem_swe_dem_restore_memory_f
+#define fsdem_swe_dem_save fsdem_swe_dem_save_f
+#define fsdem_swe_dem_save_memory fsdem_swe_dem_save_memory_f
 #define fsdem_swe_dem_stable_dt fsdem_swe_dem_stable_dt_f
 #define fsdem_swe_dem_step fsdem_swe_dem_step_f
 #define fsdem_swe_dem_step_dt fsdem_swe_dem_step_dt_f
@@ -279,9 +308,14 @@
 #define fsdem_swe_last_error fsdem_swe_last_error_f
 #define fsdem_swe_momentum fsdem_swe_momentum_f
 #define fsdem_swe_remove_point_source fsdem_swe_remove_point_source_f
+#define fsdem_swe_restore fsdem_swe_restore_f
+#define fsdem_swe_restore_memory fsdem_swe_restore_memory_f
 #define fsdem_swe_sample fsdem_swe_sample_f
 #define fsdem_swe_sample_state fsdem_swe_sample_state_f
+#define fsdem_swe_save fsdem_swe_save_f
+#define fsdem_swe_save_memory fsdem_swe_save_memory_f
 #define fsdem_swe_set_bed fsdem_swe_set_bed_f
+#define fsdem_swe_set_blocked fsdem_swe_set_blocked_f
 #define fsdem_swe_set_boundary fsdem_swe_set_boundary_f
 #define fsdem_swe_set_cells fsdem_swe_set_cells_f
 #define fsdem_swe_set_depth fsdem_swe_set_depth_f
@@ -295,7 +329,7 @@
 #define fsdem_swe_time fsdem_swe_time_f
 #define fsdem_swe_volume fsdem_swe_volume_f
 #define fsdem_swe_write_csv fsdem_swe_write_csv_f
-#define fsdem_swe_write_vtk fsdem_swe_write_vtk_f
+#define fsdem_swe_write_vti fsdem_swe_write_vti_f
 #endif
 /* FSDEM__SYMBOLS_END */
 
@@ -1229,14 +1263,12 @@ FSDEM_API fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *pic);
 
 /* ---- output ---- */
 
-/* Particles as CSV (x,y,z,vx,vy,vz) or as VTK XML polydata (.vtp, ASCII) with a velocity vector.
-   FSDEM_ERR_IO. */
+/* Particles as CSV (x,y,z,vx,vy,vz). FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (NULL). VTK XML output
+   (fsdem_pic_write_particles_vtp, fsdem_pic_write_grid_vti) is in >>io. */
 FSDEM_API fsdem_result fsdem_pic_write_particles_csv(const fsdem_pic *pic, const char *path);
-FSDEM_API fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *pic, const char *path);
-/* Grid cells as CSV (i,j,k,x,y,z,type,p,phi,fraction,u,v,w with cell-centred velocity) or as VTK
-   XML image data (.vti, ASCII) with the same cell data. FSDEM_ERR_IO. */
+/* Grid cells as CSV (i,j,k,x,y,z,type,p,phi,fraction,u,v,w with cell-centred velocity).
+   FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (NULL). */
 FSDEM_API fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *pic, const char *path);
-FSDEM_API fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *pic, const char *path);
 
 
 /* ===== >>swe : shallow-water equations (seed 003) ================================================= */
@@ -1523,11 +1555,9 @@ FSDEM_API fsdem_swe_stats fsdem_swe_get_stats(const fsdem_swe *swe);
 
 /* ---- output ---- */
 
-/* Field snapshot as CSV, one row per cell: x,y,bed,h,eta,u,v (1D: x,bed,h,eta,u). FSDEM_ERR_IO. */
+/* Field snapshot as CSV, one row per cell: x,y,bed,h,eta,u,v (1D: x,bed,h,eta,u). FSDEM_ERR_IO,
+   FSDEM_ERR_INVALID_ARG (NULL). The VTK XML snapshot (fsdem_swe_write_vti) is in >>io. */
 FSDEM_API fsdem_result fsdem_swe_write_csv(const fsdem_swe *swe, const char *path);
-/* Field snapshot as legacy VTK image data (STRUCTURED_POINTS, cell data h, eta, bed, velocity) for
-   ParaView. FSDEM_ERR_IO. */
-FSDEM_API fsdem_result fsdem_swe_write_vtk(const fsdem_swe *swe, const char *path);
 
 /* Adds a gauge at (x, y) (before fsdem_swe_gauges_open); its id goes to *id (may be NULL).
    FSDEM_ERR_OUT_OF_DOMAIN, FSDEM_ERR_OUT_OF_MEMORY, FSDEM_ERR_INVALID_ARG while a file is open. */
@@ -1644,7 +1674,106 @@ typedef struct fsdem_swe_dem_stats {
 
 FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupler);
 
-/* ===== >>io : CSV time series and particle snapshots =============================================== */
+/* ===== >>restart : checkpoint and restart ========================================================= */
+
+/* Saves the complete state of a solver or coupler to a file or to memory, and restores it, so that
+   a run continued from a restored state is the uninterrupted run bit for bit. The format is for the
+   same build: the precision of fsdem_real and the byte order are recorded and a mismatch is refused.
+
+   Use: fsdem_dem_save(dem, "run.chk") now and then; to go on later, fsdem_dem_create(&desc, &dem)
+   with the desc of the run, add its SDF walls again (below), fsdem_dem_restore(dem, "run.chk"), and
+   step on.
+
+   Model. Create the object from the desc it was saved with (the allocator, log and callbacks are
+   yours), then restore the state into it. What can change after creation comes from the save and
+   replaces what the object holds:
+     fsdem_dem      materials, walls (positions, velocities, forces, impulses), particles (ids,
+                    kinematics, the contact forces of the last evaluation, external loads), the
+                    neighbour lists with their tangential springs, dt, time, counters;
+     fsdem_pic      particles (APIC matrices too) and their capacity, the random-number state,
+                    obstacles and their face fractions, the grid fields that views and the next
+                    step read (face velocities, pressure, level set, fractions, cell types), the
+                    coupling arrays, time, counters;
+     fsdem_swe      surface and discharges, bed, per-cell Manning, rain, boundaries with their
+                    series, point sources, gauge positions, momentum sources, time, counters;
+     fsdem_swe_dem  the states of its fsdem_swe and fsdem_dem, restored into the solvers it was
+                    created with, and its own counters and per-particle force records (one file
+                    holds the coupled run).
+   What must match (else FSDEM_ERR_INVALID_ARG naming the field): the desc fields that steps read.
+   DEM: dim, domain, gravity, law, integrator, dt_rule, dt_param, skin, contact_offset, linear_*,
+   disc_length, rotation. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,
+   viscosity, gravity, boundaries, transfer, kernel, seeding and reseeding, advection, cfl,
+   dt_max, ghost-fluid, extrapolation and solver settings. SWE: dim, nx, ny, extent, width,
+   gravity, density, cfl, dt_max, order, limiter, dry_depth, manning, eddy_viscosity. Coupler:
+   beta, two_way, heave_damping, max_substeps (and its solvers' fields above). Not compared:
+   allocator, log, DEM dt and capacity, PIC seed and max_memory, SWE rain_rate, boundary, bed and
+   depth (all restored or irrelevant once the state is restored).
+   Callbacks cannot be saved. An SDF wall (DEM) or SDF obstacle (PIC) of the save takes the
+   callback of the object's wall or obstacle with the same index, which must be of that type: add
+   them again, in the same order, before restoring. A pressure-extra operator
+   (fsdem_pic_set_pressure_extra) stays as set on the object.
+   Not restored: the SWE gauge file (restore refuses while one is open; open it again afterwards,
+   its rows then start at the restored time), CPU-time figures of the statistics, last_error.
+   The DEM's views and coupling arrays and the PIC's particle views obtained before a restore may
+   be invalid after it (take them again); the PIC's grid and coupling arrays and the SWE's fields
+   and coupling arrays stay where they are.
+
+   Errors. Save: FSDEM_ERR_IO (the file cannot be written), FSDEM_ERR_INVALID_ARG (a NULL argument;
+   a buffer too small, *size then holding the size needed), FSDEM_ERR_OUT_OF_MEMORY. Restore:
+   FSDEM_ERR_IO (the file cannot be opened or read), FSDEM_ERR_INVALID_ARG (truncated or corrupted
+   data, another format version, precision, byte order, dimension or object kind, or a desc that
+   differs; the message says which), FSDEM_ERR_OUT_OF_MEMORY. A failed restore leaves the object
+   exactly as it was: everything is validated and allocated before anything changes. A restore
+   needs memory for the file's contents and for the parts it replaces while both are held. A file
+   is written in place: one cut short by a crash is refused by its checksum, so alternate between
+   two paths to always keep a good checkpoint.
+
+   Format (version 1): a 64-byte header, then the payload.
+     offset  bytes  field
+          0      8  magic "FSDEMRST"
+          8      4  format version (unsigned)
+         12      4  byte-order mark 0x01020304 as the saving machine stores it
+         16      4  precision: sizeof(fsdem_real), 4 (FSDEM_USE_FLOAT) or 8
+         20      4  object kind: 1 fsdem_dem, 2 fsdem_pic, 3 fsdem_swe, 4 fsdem_swe_dem
+         24      4  dimension of the object (the SWE's for fsdem_swe_dem)
+         28      4  reserved (0)
+         32     16  four sizes (int) for tools: DEM particles, materials, walls, pair-list entries;
+                    PIC cells along x, y, z and particles; SWE nx, ny, point sources, gauges;
+                    SWE-DEM nx, ny, DEM particles, force records
+         48      8  payload bytes (unsigned)
+         56      8  checksum: 64-bit FNV-1a over bytes 0 to 55 and the payload
+   The payload holds tagged sections of integers and reals as the saving machine stores them. */
+
+/* Saves the state to the file `path` (created or replaced). Errors above. */
+FSDEM_API fsdem_result fsdem_dem_save(const fsdem_dem *dem, const char *path);
+/* Restores the state saved in the file `path` into `dem`. Errors above. */
+FSDEM_API fsdem_result fsdem_dem_restore(fsdem_dem *dem, const char *path);
+/* Saves the state to `buffer` (`capacity` bytes); *size gets the bytes written, or with a NULL
+   buffer the bytes needed (nothing is written). */
+FSDEM_API fsdem_result fsdem_dem_save_memory(const fsdem_dem *dem, void *buffer, size_t capacity, size_t *size);
+/* Restores the state held in `buffer` (`size` bytes, as fsdem_dem_save_memory wrote them). */
+FSDEM_API fsdem_result fsdem_dem_restore_memory(fsdem_dem *dem, const void *buffer, size_t size);
+
+/* The same four for the PIC/FLIP solver. */
+FSDEM_API fsdem_result fsdem_pic_save(const fsdem_pic *pic, const char *path);
+FSDEM_API fsdem_result fsdem_pic_restore(fsdem_pic *pic, const char *path);
+FSDEM_API fsdem_result fsdem_pic_save_memory(const fsdem_pic *pic, void *buffer, size_t capacity, size_t *size);
+FSDEM_API fsdem_result fsdem_pic_restore_memory(fsdem_pic *pic, const void *buffer, size_t size);
+
+/* The same four for the shallow-water solver. */
+FSDEM_API fsdem_result fsdem_swe_save(const fsdem_swe *swe, const char *path);
+FSDEM_API fsdem_result fsdem_swe_restore(fsdem_swe *swe, const char *path);
+FSDEM_API fsdem_result fsdem_swe_save_memory(const fsdem_swe *swe, void *buffer, size_t capacity, size_t *size);
+FSDEM_API fsdem_result fsdem_swe_restore_memory(fsdem_swe *swe, const void *buffer, size_t size);
+
+/* The same four for the SWE-DEM coupler: its solvers' states are saved and restored with it. */
+FSDEM_API fsdem_result fsdem_swe_dem_save(const fsdem_swe_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_swe_dem_restore(fsdem_swe_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_swe_dem_save_memory(const fsdem_swe_dem *coupler, void *buffer, size_t capacity,
+                                                 size_t *size);
+FSDEM_API fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *buffer, size_t size);
+
+/* ===== >>io : CSV time series, ParaView series, VTK XML snapshots ================================== */
 
 /* A CSV time series: a header row, then one row of numbers per call. Owned by the caller. */
 typedef struct fsdem_csv {
@@ -1659,21 +1788,123 @@ FSDEM_API fsdem_result fsdem_csv_open(fsdem_csv *csv, const char *path, const ch
 FSDEM_API fsdem_result fsdem_csv_row(fsdem_csv *csv, const fsdem_real *values, int count);
 FSDEM_API fsdem_result fsdem_csv_close(fsdem_csv *csv);
 
-/* A ParaView time series (.pvd collection): open, add one entry per written file (its name as
-   seen from the .pvd's folder), close. Owned by the caller. */
+/* ---- VTK XML snapshots ----
+
+   Every VTK file the library writes is a serial VTK XML file that VTK (>= 6) and ParaView read
+   completely: PolyData (.vtp) for particles, walls and contacts, ImageData (.vti) for grids. The
+   root element is <VTKFile type="PolyData|ImageData" version="1.0" byte_order="LittleEndian" (or
+   "BigEndian": the machine's own order, in which every binary number is written)
+   header_type="UInt64">. The dataset element holds <FieldData> with "TimeValue" (Float64, one
+   tuple: the object's time in s), then one <Piece>. Arrays are Float64 (Float32 with
+   FSDEM_USE_FLOAT), Int32 or UInt8, of 1 or 3 components; a 3-component array is stored tuple by
+   tuple (x0 y0 z0 x1 y1 z1 ...). Polygonal cells are described by Int32 "connectivity" and
+   "offsets" arrays; cell data follow the cell order of VTK PolyData (Verts, Lines, Strips, Polys).
+   How the numbers are stored is the caller's choice, the last argument of every VTK writer: */
+typedef enum fsdem_vtk_format {
+    /* format="ascii": decimal text, 17 significant digits for Float64 and 9 for Float32, which
+       read back to the same bits; the largest files, readable in an editor. A NaN or infinite
+       value is written as nan/inf, which VTK's ascii parser stops at: look at a failed state in a
+       binary format. */
+    FSDEM_VTK_ASCII = 0,
+    /* format="binary": inline base64 (RFC 4648 alphabet, '=' padding, no line breaks). Each array
+       is one base64 stream of a UInt64 byte count (the number of data bytes that follow, not
+       counting itself) followed by the data, as VTK's own writer encodes uncompressed data (it
+       encodes the header separately only in compressed files; VTK 9.1's reader takes either).
+       Exact, 4/3 of the raw size, and the file is well-formed XML. */
+    FSDEM_VTK_BASE64 = 1,
+    /* format="appended": each <DataArray> carries offset="N" and no content; after the dataset,
+       <AppendedData encoding="raw"> holds '_' and then, array after array in the order of the
+       file, a UInt64 byte count and the raw bytes. N counts bytes from the first byte after the
+       '_' to the array's count. Exact, the smallest and fastest to write and read; the raw bytes
+       make the file not well-formed XML, as VTK's reader expects of appended raw data. */
+    FSDEM_VTK_APPENDED = 2
+} fsdem_vtk_format;
+
+/* A ParaView time series (.pvd collection): open, add one entry per written file, close. The file
+   is complete, valid XML after open and after every add (the closing tags are rewritten after each
+   entry and the file is flushed), so a run that is still going, was killed or crashed leaves a
+   series ParaView can open. Owned by the caller. */
 typedef struct fsdem_pvd {
-    void *file; /* FILE*, NULL when closed */
+    void *file;     /* FILE*, NULL when closed */
+    long tail;      /* file position of the closing tags, overwritten by the next add */
+    int count;      /* entries added */
 } fsdem_pvd;
 
-/* FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG for NULL arguments. */
+/* Creates (truncates) `path` and writes an empty collection. FSDEM_ERR_INVALID_ARG for NULL
+   arguments, FSDEM_ERR_IO when the file cannot be written or is not seekable (a pipe). */
 FSDEM_API fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path);
-FSDEM_API fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file);
+/* Adds the piece `file` (its name as seen from the .pvd's folder) at `time` (s). The piece must be a
+   VTK XML file by its extension: .vtp, .vtu, .vti, .vts or .vtr; a legacy .vtk file, which
+   ParaView's series reader cannot take, any other name, a name with a control character, and a
+   NaN or infinite time are refused with FSDEM_ERR_INVALID_ARG (the file is unchanged). The
+   characters & < > " ' in the name are written as XML entities, so the name (UTF-8) reads back as
+   given. The time is written with 17 significant digits. FSDEM_ERR_IO on a write error. */
+FSDEM_API fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, double time, const char *file);
+/* Closes the file (it is already complete). FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (not open). */
 FSDEM_API fsdem_result fsdem_pvd_close(fsdem_pvd *pvd);
 
-/* Particle snapshot as CSV: id,x,y,z,vx,vy,vz,wx,wy,wz,radius,material. */
+/* Common to the writers below: `path` is created or truncated; the object is not changed (its
+   last_error names the path on failure). FSDEM_ERR_INVALID_ARG for a NULL object or path or a
+   `format` that is not a fsdem_vtk_format, FSDEM_ERR_IO when the file cannot be opened or written,
+   FSDEM_ERR_OUT_OF_MEMORY where a writer needs scratch memory (walls, contacts). */
+
+/* DEM particle snapshot as CSV: id,x,y,z,vx,vy,vz,wx,wy,wz,radius,material. FSDEM_ERR_IO,
+   FSDEM_ERR_INVALID_ARG (NULL). */
 FSDEM_API fsdem_result fsdem_dem_write_csv(const fsdem_dem *dem, const char *path);
-/* Particle snapshot as legacy VTK polydata (ParaView: Glyph filter, scale by "radius"). */
-FSDEM_API fsdem_result fsdem_dem_write_vtk(const fsdem_dem *dem, const char *path);
+/* DEM particles as PolyData (.vtp): one point and one vertex per particle (in 2D, z = 0), with
+   point data id (Int32, the stable id), radius (m), mass (kg), material (Int32), fixed (UInt8),
+   velocity (m/s), angular_velocity (rad/s), force and torque (N, N m: contacts at the last force
+   evaluation, as fsdem_dem_particles), external_force (N). Active scalars radius, active vectors
+   velocity; ParaView: Glyph filter, sphere, scale by "radius" with factor 2 (the sphere source has
+   diameter 1). */
+FSDEM_API fsdem_result fsdem_dem_write_vtp(const fsdem_dem *dem, const char *path, fsdem_vtk_format format);
+/* DEM walls as PolyData (.vtp), one or more cells per wall: in 3D polygons (a plane as its
+   intersection with the domain box [domain_min, domain_max], a convex polygon, none when the plane
+   misses the box; a box, inside or outside, as its six faces; a triangle), in 2D lines at z = 0 (a
+   plane as its chord of the domain rectangle; a box as its four edges; a segment); a segment is a
+   line in 3D too. Line cells come first, then polygons (VTK's order), each in wall order.
+   Polygons are ordered so that their normal points to the particles' side (a box's faces:
+   inwards for an inside box, outwards for an outside one). Cell data: wall_id (Int32, the id from
+   fsdem_dem_add_wall), type (UInt8, fsdem_dem_wall_type), force (N, exerted by the particles on
+   the whole wall at the last force evaluation, fsdem_dem_wall_force; every cell of a wall carries
+   it). Removed walls are left out, and so are SDF walls, whose surface is known only through their
+   callback and cannot be drawn. */
+FSDEM_API fsdem_result fsdem_dem_write_walls_vtp(const fsdem_dem *dem, const char *path, fsdem_vtk_format format);
+/* DEM contacts as PolyData (.vtp): one line cell per touching particle pair (centre of particle i
+   to centre of its partner j) and per wall contact (centre to the closest point of the wall), pairs
+   first in neighbour-list order, then wall contacts by particle; the same contacts as the last force
+   evaluation (fsdem_dem_stats.contacts + wall_contacts after a Verlet step): pairs that are both
+   fixed exert nothing and are left out, as are wall contacts of fixed particles. Cell data: force
+   (N, on particle i, from the partner; normal plus tangential), normal_force (N, the normal part
+   along the unit normal from the partner to i, positive in compression), overlap (m, contact offset
+   included), particle (Int32, id of i) and partner (Int32, id of j, or -1 - wall id).
+   The forces come from the contact law evaluated on the current state, as the step evaluates it,
+   without changing anything: positions, velocities and the tangential springs the last step
+   committed, with no further spring increment (Hertz-Mindlin) and the current dt for the linear
+   law's one-step spring. After a Verlet step the positions are exactly those of the last force
+   evaluation and so are the elastic forces, normal and tangential; dashpots see the final
+   velocities instead of the half-step ones (a difference of dt/2 times the acceleration), and the
+   per-particle sums equal fsdem_dem_particles.force to that difference (to rounding without
+   damping). After a predictor-corrector step they are the forces of the final state. The file holds
+   no contacts while the neighbour lists are out of date, that is after particles or walls were
+   added, removed or set and before the next step (or fsdem_dem_contacts). */
+FSDEM_API fsdem_result fsdem_dem_write_contacts_vtp(const fsdem_dem *dem, const char *path, fsdem_vtk_format format);
+
+/* PIC marker particles as PolyData (.vtp): one point and vertex per particle (z = 0 in 2D), point
+   data velocity (m/s). */
+FSDEM_API fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *pic, const char *path, fsdem_vtk_format format);
+/* PIC grid as ImageData (.vti), extent 0..n[0] x 0..n[1] x 0..n[2] points (0..0 in z in 2D),
+   origin the lower corner, spacing the cell size, with cell data pressure (Pa), phi (m), fraction,
+   type (UInt8, fsdem_stencil_cell) and velocity (m/s, cell-centred: the mean of the two faces along
+   each axis; z = 0 in 2D), as fsdem_pic_get_fields. */
+FSDEM_API fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *pic, const char *path, fsdem_vtk_format format);
+
+/* Shallow-water fields as ImageData (.vti): extent 0..nx x 0..ny x 0..0 points, origin (x_min,
+   y_min, 0), spacing (dx, dy, 1); a 1D channel is one cell high, 0..nx x 0..1, origin (x_min, 0, 0),
+   spacing (dx, width, 1). Cell data h (m, eta - bed), eta (m), bed (m), velocity (m/s, (u, v, 0) as
+   fsdem_swe_copy_field gives them, 0 in dry cells) and, when per-cell coefficients were set
+   (fsdem_swe_set_manning), manning (s/m^(1/3)). Active scalars h, active vectors velocity. */
+FSDEM_API fsdem_result fsdem_swe_write_vti(const fsdem_swe *swe, const char *path, fsdem_vtk_format format);
 
 #ifdef __cplusplus
 }
@@ -3852,20 +4083,22 @@ static int fsdem__dem_lists_stale(const fsdem_dem *d) {
     return d->need_rebuild || 2 * disp > d->skin || disp + wall_moved > d->skin;
 }
 
-/* Wall contacts (overlap > 0) of particle i into d->hits; returns their number. A mesh of
+/* Wall contacts (overlap > 0) of particle i into `hits`; returns their number. A mesh of
    triangles or a polyline shares edges and vertices between elements, and a particle touching a
    shared edge would be pushed once per element. So an edge/vertex contact is dropped when its
    contact point lies in the plane of a face contact of the same particle (the edge belongs to that
    face), or when an edge/vertex contact kept before has the same normal (one edge seen from two
-   elements). With `reset`, entries without a kept contact lose their tangential history. */
-static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
+   elements). `hits` has room for the particle's row of the particle-wall list. With `keys` (the
+   list's keys; NULL: nothing changes), entries without a kept contact lose their tangential
+   history. */
+static int fsdem__dem_wall_hits_into(const fsdem_dem *d, int i, fsdem__dem_wall_hit *hits, int *keys) {
     const fsdem_real off = d->desc.contact_offset, tol = (fsdem_real)fsdem__tolerance(1e-9) * d->r[i];
     const fsdem_vec3 xi = d->x[i];
     int k, a, b, count = 0, kept = 0;
     for (k = d->pw.start[i]; k < d->pw.start[i + 1]; ++k) {
         const int key = d->pw.key[k];
         const fsdem__dem_wall *wall = &d->walls[FSDEM__DEM_WALL_OF(key)];
-        fsdem__dem_wall_hit *h = &d->hits[count];
+        fsdem__dem_wall_hit *h = &hits[count];
         if (wall->active) {
             h->delta = d->r[i] + off - fsdem__dem_wall_distance(wall, FSDEM__DEM_FACE_OF(key), xi, d->desc.dim, &h->n, &h->on_feature);
             if (h->delta > 0) {
@@ -3874,16 +4107,16 @@ static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
                 continue;
             }
         }
-        if (reset) d->pw.key[k] &= ~FSDEM__DEM_HELD;
+        if (keys) keys[k] &= ~FSDEM__DEM_HELD;
     }
     for (a = 0; a < count; ++a) {
-        fsdem__dem_wall_hit h = d->hits[a];
+        fsdem__dem_wall_hit h = hits[a];
         int duplicate = 0;
         if (h.on_feature) {
             /* contact point q = x - (r + off - delta) n; in face b's plane when (q - x).n_b = -(r + off - delta_b) */
             fsdem_vec3 q_rel = fsdem__scale(h.n, -(d->r[i] + off - h.delta));
             for (b = 0; b < count && !duplicate; ++b) {
-                const fsdem__dem_wall_hit *o = &d->hits[b];
+                const fsdem__dem_wall_hit *o = &hits[b];
                 if (b == a) continue;
                 if (!o->on_feature)
                     duplicate = fsdem__dot(q_rel, o->n) + (d->r[i] + off - o->delta) <= tol &&
@@ -3893,12 +4126,18 @@ static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
             }
         }
         if (duplicate) {
-            if (reset) d->pw.key[h.entry] &= ~FSDEM__DEM_HELD;
+            if (keys) keys[h.entry] &= ~FSDEM__DEM_HELD;
             continue;
         }
-        d->hits[kept++] = h;
+        hits[kept++] = h;
     }
     return kept;
+}
+
+/* Wall contacts of particle i into d->hits (fsdem__dem_wall_hits_into); with `reset`, entries
+   without a kept contact lose their tangential history. */
+static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
+    return fsdem__dem_wall_hits_into(d, i, d->hits, reset ? d->pw.key : NULL);
 }
 
 /* ---- >>dem_forces : contact force evaluation ---- */
@@ -6523,9 +6762,9 @@ void fsdem_pic_destroy(fsdem_pic *s) {
     fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
     if (s->pcg_p) fsdem_pcg_destroy(s->pcg_p);
     fsdem__series_close(&s->gauges, &s->allocator);
-    fsdem__pic_release(s, s->gauge_at, sizeof(fsdem_vec3) * (size_t)s->gauge_capacity);
-    fsdem__pic_release(s, s->gauge_kind, sizeof(int) * (size_t)s->gauge_capacity);
-    fsdem__pic_release(s, s->gauge_radius, sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+    fsdem__free(&s->allocator, s->gauge_at, sizeof(fsdem_vec3) * (size_t)s->gauge_capacity);
+    fsdem__free(&s->allocator, s->gauge_kind, sizeof(int) * (size_t)s->gauge_capacity);
+    fsdem__free(&s->allocator, s->gauge_radius, sizeof(fsdem_real) * (size_t)s->gauge_capacity);
     al = s->allocator;
     fsdem__free(&al, s, sizeof *s);
 }
@@ -8928,37 +9167,17 @@ fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *s) {
     return st;
 }
 
-/* ---- >>pic_output : CSV, VTK XML, PVD ---- */
+/* ---- >>pic_output : CSV (VTK XML: >>impl_io) ---- */
 
 fsdem_result fsdem_pic_write_particles_csv(const fsdem_pic *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
+    FILE *fp;
     int p, bad;
-    if (!fp) return FSDEM_ERR_IO;
+    if (!s || !path) return FSDEM_ERR_INVALID_ARG;
+    if (!(fp = fopen(path, "w"))) return FSDEM_ERR_IO;
     fprintf(fp, "x,y,z,vx,vy,vz\n");
     for (p = 0; p < s->np; ++p)
         fprintf(fp, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", (double)s->px[p].x, (double)s->px[p].y, (double)s->px[p].z,
                 (double)s->pv[p].x, (double)s->pv[p].y, (double)s->pv[p].z);
-    bad = ferror(fp);
-    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
-}
-
-fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
-    int p, bad;
-    if (!fp) return FSDEM_ERR_IO;
-    fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-                "<PolyData>\n<Piece NumberOfPoints=\"%d\" NumberOfVerts=\"%d\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
-                "NumberOfPolys=\"0\">\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
-            s->np, s->np);
-    for (p = 0; p < s->np; ++p) fprintf(fp, "%.9g %.9g %.9g\n", (double)s->px[p].x, (double)s->px[p].y, (double)s->px[p].z);
-    fprintf(fp, "</DataArray>\n</Points>\n<Verts>\n<DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">\n");
-    for (p = 0; p < s->np; ++p) fprintf(fp, "%d\n", p);
-    fprintf(fp, "</DataArray>\n<DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">\n");
-    for (p = 0; p < s->np; ++p) fprintf(fp, "%d\n", p + 1);
-    fprintf(fp, "</DataArray>\n</Verts>\n<PointData Vectors=\"velocity\">\n"
-                "<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for (p = 0; p < s->np; ++p) fprintf(fp, "%.9g %.9g %.9g\n", (double)s->pv[p].x, (double)s->pv[p].y, (double)s->pv[p].z);
-    fprintf(fp, "</DataArray>\n</PointData>\n</Piece>\n</PolyData>\n</VTKFile>\n");
     bad = ferror(fp);
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
 }
@@ -8975,9 +9194,10 @@ static fsdem_vec3 fsdem__pic_cell_velocity(const fsdem_pic *s, int i, int j, int
 }
 
 fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
+    FILE *fp;
     int i, j, k, bad;
-    if (!fp) return FSDEM_ERR_IO;
+    if (!s || !path) return FSDEM_ERR_INVALID_ARG;
+    if (!(fp = fopen(path, "w"))) return FSDEM_ERR_IO;
     fprintf(fp, "i,j,k,x,y,z,type,p,phi,fraction,u,v,w\n");
     for (k = 0; k < s->n[2]; ++k)
         for (j = 0; j < s->n[1]; ++j)
@@ -8992,39 +9212,11 @@ fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *s, const char *path) {
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
-fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
-    int i, j, k, c, bad, nz = s->dim == 3 ? s->n[2] : 0;
-    if (!fp) return FSDEM_ERR_IO;
-    fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-                "<ImageData WholeExtent=\"0 %d 0 %d 0 %d\" Origin=\"%.9g %.9g %.9g\" Spacing=\"%.9g %.9g %.9g\">\n"
-                "<Piece Extent=\"0 %d 0 %d 0 %d\">\n<CellData Scalars=\"pressure\" Vectors=\"velocity\">\n",
-            s->n[0], s->n[1], nz, (double)s->lo.x, (double)s->lo.y, (double)s->lo.z, (double)s->dx, (double)s->dx,
-            (double)s->dx, s->n[0], s->n[1], nz);
-    fprintf(fp, "<DataArray type=\"Float64\" Name=\"pressure\" format=\"ascii\">\n");
-    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%.9g\n", (double)s->pres[c]);
-    fprintf(fp, "</DataArray>\n<DataArray type=\"Float64\" Name=\"phi\" format=\"ascii\">\n");
-    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%.9g\n", (double)s->phi[c]);
-    fprintf(fp, "</DataArray>\n<DataArray type=\"Float64\" Name=\"fraction\" format=\"ascii\">\n");
-    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%.9g\n", (double)s->frac[c]);
-    fprintf(fp, "</DataArray>\n<DataArray type=\"UInt8\" Name=\"type\" format=\"ascii\">\n");
-    for (c = 0; c < s->ncell; ++c) fprintf(fp, "%d\n", (int)s->ctype[c]);
-    fprintf(fp, "</DataArray>\n<DataArray type=\"Float64\" Name=\"velocity\" NumberOfComponents=\"3\" format=\"ascii\">\n");
-    for (k = 0; k < s->n[2]; ++k)
-        for (j = 0; j < s->n[1]; ++j)
-            for (i = 0; i < s->n[0]; ++i) {
-                fsdem_vec3 v = fsdem__pic_cell_velocity(s, i, j, k);
-                fprintf(fp, "%.9g %.9g %.9g\n", (double)v.x, (double)v.y, (double)v.z);
-            }
-    fprintf(fp, "</DataArray>\n</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n");
-    bad = ferror(fp);
-    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
-}
-
 /* ===== >>impl_swe : shallow-water solver ========================================================== */
 
 /* Contents: the scheme below and the object; >>swe_desc (defaults, validation), >>swe_object
-   (creation, series, state, coupling), >>swe_riemann (face fluxes), >>swe_row (reconstruction,
+   (creation, series, state, coupling), >>swe_sources (boundaries, friction, rain, blocked cells,
+   point sources), >>swe_riemann (face fluxes), >>swe_row (reconstruction,
    predictor and x faces of a row), >>swe_step (y faces, repair, stable dt, stepping), >>swe_diag
    (diagnostics, output, gauges, bed SDF). */
 
@@ -9807,6 +9999,8 @@ fsdem_result fsdem_swe_clear_forces(fsdem_swe *s) {
     return fsdem__ok(&s->status);
 }
 
+/* ---- >>swe_sources : boundaries, friction, rain, blocked cells, point sources ---- */
+
 fsdem_result fsdem_swe_set_boundary(fsdem_swe *s, fsdem_side side, const fsdem_swe_boundary *bc) {
     char msg[FSDEM__MESSAGE_SIZE];
     if (!s) return FSDEM_ERR_INVALID_ARG;
@@ -9860,6 +10054,7 @@ static fsdem_result fsdem__swe_apply_blocked(fsdem_swe *s, const unsigned char *
     if (mask && !s->blocked) {
         s->blocked = (unsigned char *)fsdem__alloc(&s->allocator, (size_t)s->n);
         if (!s->blocked) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory", what);
+        memset(s->blocked, 0, (size_t)s->n);
     }
     for (k = 0; mask && k < s->n; ++k) {
         const int b = mask[k] != 0;
@@ -10892,9 +11087,10 @@ fsdem_swe_stats fsdem_swe_get_stats(const fsdem_swe *s) {
 }
 
 fsdem_result fsdem_swe_write_csv(const fsdem_swe *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
+    FILE *fp;
     int k, bad;
-    if (!fp) return FSDEM_ERR_IO;
+    if (!s || !path) return FSDEM_ERR_INVALID_ARG;
+    if (!(fp = fopen(path, "w"))) return FSDEM_ERR_IO;
     fprintf(fp, s->dim == 2 ? "x,y,bed,h,eta,u,v\n" : "x,bed,h,eta,u\n");
     for (k = 0; k < s->n; ++k) {
         fsdem_real x, y, u, v;
@@ -10906,37 +11102,6 @@ fsdem_result fsdem_swe_write_csv(const fsdem_swe *s, const char *path) {
         else
             fprintf(fp, "%.10g,%.10g,%.10g,%.10g,%.10g\n", (double)x, (double)s->bed[k],
                     (double)(s->eta[k] - s->bed[k]), (double)s->eta[k], (double)u);
-    }
-    bad = ferror(fp);
-    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
-}
-
-static void fsdem__swe_vtk_scalars(FILE *fp, const fsdem_swe *s, const char *name, int field) {
-    int k;
-    fprintf(fp, "SCALARS %s double 1\nLOOKUP_TABLE default\n", name);
-    for (k = 0; k < s->n; ++k) {
-        double v = field == 0 ? (double)(s->eta[k] - s->bed[k]) : field == 1 ? (double)s->eta[k] : (double)s->bed[k];
-        fprintf(fp, "%.10g\n", v);
-    }
-}
-
-fsdem_result fsdem_swe_write_vtk(const fsdem_swe *s, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
-    int k, bad;
-    if (!fp) return FSDEM_ERR_IO;
-    fprintf(fp, "# vtk DataFile Version 3.0\nfsdem shallow water t=%.10g s\nASCII\nDATASET STRUCTURED_POINTS\n",
-            (double)s->time);
-    fprintf(fp, "DIMENSIONS %d %d 1\nORIGIN %.10g %.10g 0\nSPACING %.10g %.10g 1\nCELL_DATA %d\n", s->nx + 1,
-            s->dim == 2 ? s->ny + 1 : 1, (double)s->desc.x_min, (double)(s->dim == 2 ? s->desc.y_min : 0),
-            (double)s->dx, (double)(s->dim == 2 ? s->dy : 1), s->n);
-    fsdem__swe_vtk_scalars(fp, s, "h", 0);
-    fsdem__swe_vtk_scalars(fp, s, "eta", 1);
-    fsdem__swe_vtk_scalars(fp, s, "bed", 2);
-    fprintf(fp, "VECTORS velocity double\n");
-    for (k = 0; k < s->n; ++k) {
-        fsdem_real u, v;
-        fsdem__swe_velocity(s, k, &u, &v);
-        fprintf(fp, "%.10g %.10g 0\n", (double)u, (double)v);
     }
     bad = ferror(fp);
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
@@ -11370,9 +11535,1328 @@ fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
     return st;
 }
 
-/* ===== >>impl_io : CSV and VTK output ============================================================== */
+/* ===== >>impl_restart : checkpoint and restart =======================================================
 
-/* Contents: CSV time series, ParaView .pvd series, DEM particle snapshots. */
+   Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
+   every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_swe_dem (one visitor per
+   object lists what it saves, in order, and serves saving and restoring alike), >>restart_api
+   (memory and files). A restore runs the visitor three times over the payload: CHECK validates
+   everything and compares the desc, RESERVE allocates, COMMIT writes into the object. Only COMMIT
+   changes the object, and it cannot fail. */
+
+/* ---- >>restart_format : header, checksum, cursor ---- */
+
+#define FSDEM__RESTART_VERSION 1u
+#define FSDEM__RESTART_HEADER 64
+#define FSDEM__RESTART_BOM 0x01020304u
+#define FSDEM__RESTART_FNV_BASIS 0xcbf29ce484222325ull
+#define FSDEM__RESTART_FNV_PRIME 0x100000001b3ull
+#define FSDEM__RESTART_INT_MAX 2147483647
+
+/* The header stores its fields as unsigned int (4 bytes) and unsigned long long (8 bytes). */
+typedef char fsdem__restart_int_sizes[sizeof(unsigned int) == 4 && sizeof(unsigned long long) == 8 ? 1 : -1];
+
+enum { FSDEM__RESTART_DEM = 1, FSDEM__RESTART_PIC = 2, FSDEM__RESTART_SWE = 3, FSDEM__RESTART_SWE_DEM = 4 };
+
+typedef enum fsdem__restart_mode {
+    FSDEM__RESTART_WRITE = 0,   /* object to payload (to memory, to a file, or only measured) */
+    FSDEM__RESTART_CHECK = 1,   /* payload validated and compared with the object; nothing stored */
+    FSDEM__RESTART_RESERVE = 2, /* the memory the payload needs is allocated; nothing stored */
+    FSDEM__RESTART_COMMIT = 3   /* payload to object; cannot fail */
+} fsdem__restart_mode;
+
+/* A block RESERVE allocated for COMMIT to hand over to the object. */
+typedef struct fsdem__restart_held {
+    void *ptr;
+    size_t bytes;
+    const fsdem_allocator *allocator;
+} fsdem__restart_held;
+
+/* The cursor of a save or a restore. */
+typedef struct fsdem__restart {
+    fsdem__restart_mode mode;
+    unsigned char *out;          /* WRITE to memory: where the payload goes (NULL: a file, or measuring) */
+    FILE *file;                  /* WRITE to a file */
+    const unsigned char *in;     /* reading: the payload */
+    size_t pos, size;            /* cursor; bytes of the payload (WRITE to memory: room for it) */
+    unsigned long long hash;     /* FNV-1a of the header and of the bytes written so far */
+    fsdem_result res;            /* the first failure, FSDEM_OK so far */
+    char fn[48];                 /* public function, first in every message */
+    const char *section;         /* the solver being read in a coupler's file, or NULL */
+    char message[FSDEM__MESSAGE_SIZE];
+    const fsdem_allocator *allocator; /* of `blocks` */
+    fsdem__restart_held *blocks;
+    int block_count, block_capacity, block_next;
+} fsdem__restart;
+
+typedef void (*fsdem__restart_visit_fn)(fsdem__restart *io, void *object);
+
+/* 64-bit FNV-1a of `n` bytes, continuing from `h`: each step (xor a byte, multiply by an odd prime)
+   is a bijection of the state, so any one changed byte changes the sum; and it costs little next to
+   writing the data. */
+static unsigned long long fsdem__restart_fnv(unsigned long long h, const unsigned char *p, size_t n) {
+    size_t k;
+    for (k = 0; k < n; ++k) h = (h ^ p[k]) * FSDEM__RESTART_FNV_PRIME;
+    return h;
+}
+
+/* Records the first failure and its message (the public function first, then the solver section of
+   a coupler's file); later failures keep the first, so a message names the root cause. */
+static void fsdem__restart_fail(fsdem__restart *io, fsdem_result code, const char *fmt, ...) {
+    char detail[384];
+    va_list ap;
+    if (io->res != FSDEM_OK) return;
+    va_start(ap, fmt);
+    vsnprintf(detail, sizeof detail, fmt, ap);
+    va_end(ap);
+    snprintf(io->message, sizeof io->message, "%s: %s%s%s", io->fn, io->section ? io->section : "",
+             io->section ? ": " : "", detail);
+    io->res = code;
+}
+
+/* The next `bytes` of the payload when restoring (a failure and NULL when they run past its end);
+   NULL when saving. Lets a check read arrays in place. */
+static const unsigned char *fsdem__restart_peek(fsdem__restart *io, size_t bytes) {
+    if (io->mode == FSDEM__RESTART_WRITE || io->res != FSDEM_OK) return NULL;
+    if (bytes > io->size - io->pos) {
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the data end early at byte %llu of %llu (corrupted data)",
+                            (unsigned long long)io->pos, (unsigned long long)io->size);
+        return NULL;
+    }
+    return io->in + io->pos;
+}
+
+/* Object data: WRITE appends `bytes` from p (to memory or to the file, or only counts them), COMMIT
+   copies them into p, CHECK and RESERVE step over them. The one place bytes move. */
+static void fsdem__restart_data(fsdem__restart *io, void *p, size_t bytes) {
+    if (io->res != FSDEM_OK || bytes == 0) return;
+    if (io->mode == FSDEM__RESTART_WRITE) {
+        if (io->out) {
+            FSDEM_ASSERT(bytes <= io->size - io->pos);
+            memcpy(io->out + io->pos, p, bytes);
+        } else if (io->file)
+            fwrite(p, 1, bytes, io->file); /* errors: ferror at the end (fsdem__restart_save_file) */
+        if (io->out || io->file) io->hash = fsdem__restart_fnv(io->hash, (const unsigned char *)p, bytes);
+        io->pos += bytes;
+        return;
+    }
+    if (!fsdem__restart_peek(io, bytes)) return;
+    if (io->mode == FSDEM__RESTART_COMMIT) memcpy(p, io->in + io->pos, bytes);
+    io->pos += bytes;
+}
+
+/* A value the visitor itself looks at (a count, a type, a flag): written like data, and read into p
+   in every reading mode, so CHECK can validate it before anything depends on it. */
+static void fsdem__restart_value(fsdem__restart *io, void *p, size_t bytes) {
+    if (io->mode == FSDEM__RESTART_WRITE) {
+        fsdem__restart_data(io, p, bytes);
+        return;
+    }
+    if (!fsdem__restart_peek(io, bytes)) return;
+    memcpy(p, io->in + io->pos, bytes);
+    io->pos += bytes;
+}
+
+/* The int at index k of payload bytes (which need not be aligned). */
+static int fsdem__restart_int_at(const unsigned char *p, long k) {
+    int v;
+    memcpy(&v, p + (size_t)k * sizeof v, sizeof v);
+    return v;
+}
+
+/* An int that must lie in [lo, hi]: written, or read into *v and checked. */
+static void fsdem__restart_int_in(fsdem__restart *io, int *v, int lo, int hi, const char *what) {
+    fsdem__restart_value(io, v, sizeof *v);
+    if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && (*v < lo || *v > hi))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s is %d, outside [%d, %d] (corrupted data)", what, *v, lo, hi);
+}
+
+/* A count: written, or read and checked to lie in [0, max] with at least `item_bytes` of payload left
+   per item, so that a corrupted count can neither run long loops nor ask for a huge allocation.
+   Returns 1 when it may be used. */
+static int fsdem__restart_count(fsdem__restart *io, int *n, int max, size_t item_bytes, const char *what) {
+    fsdem__restart_int_in(io, n, 0, max, what);
+    if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && (size_t)*n * item_bytes > io->size - io->pos)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s is %d, more than the data can hold (corrupted data)", what, *n);
+    return io->res == FSDEM_OK;
+}
+
+/* `count` ints of object data, each in [lo, hi] (checked in CHECK): indices that steps follow. */
+static void fsdem__restart_ints(fsdem__restart *io, int *a, int count, int lo, int hi, const char *what) {
+    const unsigned char *p = io->mode == FSDEM__RESTART_CHECK ? fsdem__restart_peek(io, sizeof(int) * (size_t)count) : NULL;
+    int k, v;
+    for (k = 0; p && k < count; ++k)
+        if ((v = fsdem__restart_int_at(p, k)) < lo || v > hi) {
+            fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s %d is %d, outside [%d, %d] (corrupted data)", what, k, v, lo, hi);
+            return;
+        }
+    fsdem__restart_data(io, a, sizeof(int) * (size_t)count);
+}
+
+/* `count` bytes of object data, each at most hi (checked in CHECK): flags and cell types. */
+static void fsdem__restart_flags(fsdem__restart *io, unsigned char *a, int count, int hi, const char *what) {
+    const unsigned char *p = io->mode == FSDEM__RESTART_CHECK ? fsdem__restart_peek(io, (size_t)count) : NULL;
+    int k;
+    for (k = 0; p && k < count; ++k)
+        if (p[k] > hi) {
+            fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s %d is %d, more than %d (corrupted data)", what, k, p[k], hi);
+            return;
+        }
+    fsdem__restart_data(io, a, (size_t)count);
+}
+
+/* A desc field the object must share with the save: written, or read and compared (bit for bit for
+   reals). A difference is refused naming the field and both values: the object was not created
+   from the desc of the save. */
+static void fsdem__restart_same_int(fsdem__restart *io, int mine, const char *what) {
+    int saved = mine;
+    fsdem__restart_value(io, &saved, sizeof saved);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && saved != mine)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "desc.%s is %d in the save and %d in the object (create the object from the desc it was saved with)",
+                            what, saved, mine);
+}
+
+static void fsdem__restart_same_ll(fsdem__restart *io, long long mine, const char *what) {
+    long long saved = mine;
+    fsdem__restart_value(io, &saved, sizeof saved);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && saved != mine)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "desc.%s is %lld in the save and %lld in the object (create the object from the desc it was saved with)",
+                            what, saved, mine);
+}
+
+static void fsdem__restart_same_vec3(fsdem__restart *io, fsdem_vec3 mine, const char *what) {
+    fsdem_vec3 saved = mine;
+    fsdem__restart_value(io, &saved, sizeof saved);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && memcmp(&saved, &mine, sizeof saved) != 0)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "desc.%s is (%.17g, %.17g, %.17g) in the save and (%.17g, %.17g, %.17g) in the object "
+                            "(create the object from the desc it was saved with)",
+                            what, (double)saved.x, (double)saved.y, (double)saved.z, (double)mine.x, (double)mine.y,
+                            (double)mine.z);
+}
+
+static void fsdem__restart_same_real(fsdem__restart *io, fsdem_real mine, const char *what) {
+    fsdem_real saved = mine;
+    fsdem__restart_value(io, &saved, sizeof saved);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && memcmp(&saved, &mine, sizeof saved) != 0)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "desc.%s is %.17g in the save and %.17g in the object (create the object from the desc it was saved with)",
+                            what, (double)saved, (double)mine);
+}
+
+/* A section tag of four characters: written, or read and checked, so that data out of place are
+   caught at the section where they start. */
+static void fsdem__restart_tag(fsdem__restart *io, const char *tag) {
+    char got[4];
+    memcpy(got, tag, 4);
+    fsdem__restart_value(io, got, 4);
+    if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && memcmp(got, tag, 4) != 0)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "section '%.4s' expected at byte %llu (corrupted data)", tag,
+                            (unsigned long long)(io->pos - 4));
+}
+
+/* RESERVE: a failed allocation becomes the restore's result. */
+static void fsdem__restart_need(fsdem__restart *io, fsdem_result res, const char *what) {
+    if (res != FSDEM_OK) fsdem__restart_fail(io, FSDEM_ERR_OUT_OF_MEMORY, "out of memory for %s", what);
+}
+
+/* A fresh block of `bytes` for the object: RESERVE allocates it with the object's allocator and keeps
+   it, COMMIT hands the blocks over in the order RESERVE made them (the visitor asks for them in the
+   same order both times). NULL in the other modes and for 0 bytes. Blocks not handed over are freed
+   when the restore fails. */
+static void *fsdem__restart_block(fsdem__restart *io, const fsdem_allocator *al, size_t bytes) {
+    fsdem__restart_held *b;
+    if (io->res != FSDEM_OK || bytes == 0) return NULL;
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        FSDEM_ASSERT(io->block_next < io->block_count && io->blocks[io->block_next].bytes == bytes);
+        return io->blocks[io->block_next++].ptr;
+    }
+    if (io->mode != FSDEM__RESTART_RESERVE) return NULL;
+    if (fsdem__grow(io->allocator, (void **)&io->blocks, &io->block_capacity, io->block_count, io->block_count + 1,
+                    sizeof *io->blocks) != FSDEM_OK) {
+        fsdem__restart_need(io, FSDEM_ERR_OUT_OF_MEMORY, "the restore's bookkeeping");
+        return NULL;
+    }
+    b = &io->blocks[io->block_count];
+    b->ptr = fsdem__alloc(al, bytes);
+    b->bytes = bytes;
+    b->allocator = al;
+    if (!b->ptr) fsdem__restart_need(io, FSDEM_ERR_OUT_OF_MEMORY, "the restored state");
+    else io->block_count++;
+    return NULL;
+}
+
+/* ---- >>restart_dem : discrete elements ---- */
+
+/* One neighbour list: its rows and entries, the row offsets, the row of each entry, the partner keys
+   with their HELD bits and the tangential springs (zero where not HELD: they mean nothing there and
+   may be uninitialised), exactly as they are: the entries, their order and their springs decide the
+   next steps, and a rebuild forced at the restore would rebuild at other positions than the
+   uninterrupted run does. While the lists are current (not `stale`) they have one row per particle.
+   *entries gets the saved number of entries; returns the longest saved row. */
+static int fsdem__restart_dem_list(fsdem__restart *io, fsdem_dem *d, fsdem__dem_list *l, int pairs, int n, int stale,
+                                   int walls, int *entries) {
+    const char *name = pairs ? "particle-pair list" : "particle-wall list";
+    const unsigned char *start = NULL;
+    int rows = l->rows, count = l->count, longest = 0, i, k;
+    fsdem__restart_count(io, &rows, FSDEM__DEM_MAX_PARTICLES, sizeof(int), pairs ? "pair-list rows" : "wall-list rows");
+    fsdem__restart_count(io, &count, 1 << 30, 2 * sizeof(int) + sizeof(fsdem_vec3),
+                         pairs ? "pair-list entries" : "wall-list entries");
+    *entries = count;
+    if (io->res != FSDEM_OK) return 0;
+    if (io->mode == FSDEM__RESTART_CHECK && ((!stale && rows != n) || (rows == 0 && count != 0)))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the %s has %d rows and %d entries for %d particles (corrupted data)",
+                            name, rows, count, n);
+    if (io->mode == FSDEM__RESTART_RESERVE) {
+        if (rows > 0)
+            fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&l->start, &l->start_capacity,
+                                                l->rows > 0 ? l->rows + 1 : 0, rows + 1, sizeof(int)), name);
+        while (io->res == FSDEM_OK && l->capacity < count) fsdem__restart_need(io, fsdem__dem_list_grow(d, l), name);
+    }
+    if (rows > 0) {
+        start = fsdem__restart_peek(io, sizeof(int) * (size_t)(rows + 1));
+        for (i = 0; start && i < rows; ++i) {
+            const int a = fsdem__restart_int_at(start, i), b = fsdem__restart_int_at(start, i + 1);
+            if (io->mode == FSDEM__RESTART_CHECK && (a > b || (i == 0 && a != 0) || (i == rows - 1 && b != count))) {
+                fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the %s has bad row offsets at row %d (corrupted data)", name, i);
+                start = NULL;
+            } else if (b - a > longest)
+                longest = b - a;
+        }
+        fsdem__restart_data(io, l->start, sizeof(int) * (size_t)(rows + 1));
+    }
+    if (io->mode == FSDEM__RESTART_CHECK && start) {
+        /* each entry in its row; pairs name a later particle, wall entries a wall and a face */
+        const unsigned char *first = fsdem__restart_peek(io, 2 * sizeof(int) * (size_t)count);
+        for (i = 0; first && i < rows; ++i)
+            for (k = fsdem__restart_int_at(start, i); k < fsdem__restart_int_at(start, i + 1); ++k) {
+                const int key = fsdem__restart_int_at(first, (long)count + k), partner = FSDEM__DEM_PARTNER(key);
+                const int bad = pairs ? partner <= i || partner >= rows
+                                      : partner / 8 >= walls || partner % 8 >= 2 * d->desc.dim;
+                if (fsdem__restart_int_at(first, k) != i || key < 0 || bad) {
+                    fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the %s has a bad entry %d (corrupted data)", name, k);
+                    first = NULL;
+                    break;
+                }
+            }
+    }
+    fsdem__restart_data(io, l->first, sizeof(int) * (size_t)count);
+    fsdem__restart_data(io, l->key, sizeof(int) * (size_t)count);
+    if (io->mode == FSDEM__RESTART_WRITE) /* a spring without its HELD bit means nothing: saved as 0 */
+        for (k = 0; k < count; ++k) {
+            fsdem_vec3 spring = fsdem__dem_spring(l, k);
+            fsdem__restart_data(io, &spring, sizeof spring);
+        }
+    else
+        fsdem__restart_data(io, l->history, sizeof(fsdem_vec3) * (size_t)count);
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        l->rows = rows;
+        l->count = count;
+    }
+    return longest;
+}
+
+/* Everything of a DEM, in order. State: time, dt, counters, the neighbour-list bookkeeping (x_ref,
+   max_disp2, need_rebuild, skin, r_max, walls' `moved`), forces_valid and forces_cleared with the
+   forces and torques of the last evaluation (the next Verlet kick uses them), external loads,
+   materials with their pair table (the Hertz damping calibration is costly and its result must be
+   the same bits), walls, particles, both neighbour lists and the inert pairs. Configuration: the
+   desc fields that steps read, compared. Not saved, rebuilt or rewritten before use: the cell grid,
+   the pair scratch (found), the wall-hit scratch and the arena (reserved here for the next force
+   evaluation), the previous lists pp_old and pw_old (storage the next rebuild fills), the
+   predictor-corrector's x0, v0, w0, fa, ta and the walls' force_a (written at the start of each
+   such step), capacities, the allocator, log and message. SDF walls keep the object's callbacks. */
+static void fsdem__restart_dem(fsdem__restart *io, void *object) {
+    fsdem_dem *d = (fsdem_dem *)object;
+    const fsdem_dem_desc *dd = &d->desc;
+    const int reserve = io->mode == FSDEM__RESTART_RESERVE, commit = io->mode == FSDEM__RESTART_COMMIT;
+    int nm = d->material_count, nw = d->wall_count, n = d->n, stale = d->need_rebuild, inert = d->inert_count;
+    int k, longest, pairs = 0, wall_entries = 0;
+    fsdem__restart_tag(io, "DEM1");
+    fsdem__restart_same_int(io, dd->dim, "dim");
+    fsdem__restart_same_vec3(io, dd->domain_min, "domain_min");
+    fsdem__restart_same_vec3(io, dd->domain_max, "domain_max");
+    fsdem__restart_same_vec3(io, dd->gravity, "gravity");
+    fsdem__restart_same_int(io, (int)dd->law, "law");
+    fsdem__restart_same_int(io, (int)dd->integrator, "integrator");
+    fsdem__restart_same_int(io, (int)dd->dt_rule, "dt_rule");
+    fsdem__restart_same_real(io, dd->dt_param, "dt_param");
+    fsdem__restart_same_real(io, dd->skin, "skin");
+    fsdem__restart_same_real(io, dd->contact_offset, "contact_offset");
+    fsdem__restart_same_real(io, dd->linear_theta, "linear_theta");
+    fsdem__restart_same_real(io, dd->linear_dx, "linear_dx");
+    fsdem__restart_same_real(io, dd->linear_accel, "linear_accel");
+    fsdem__restart_same_real(io, dd->disc_length, "disc_length");
+    fsdem__restart_same_int(io, dd->rotation, "rotation");
+
+    fsdem__restart_data(io, &d->dt, sizeof d->dt);
+    fsdem__restart_data(io, &d->time, sizeof d->time);
+    fsdem__restart_data(io, &d->steps, sizeof d->steps);
+    fsdem__restart_data(io, &d->rebuilds, sizeof d->rebuilds);
+    fsdem__restart_data(io, &d->stable_dt, sizeof d->stable_dt);
+    fsdem__restart_data(io, &d->dt_warned, sizeof d->dt_warned);
+    fsdem__restart_data(io, &d->next_id, sizeof d->next_id);
+    fsdem__restart_data(io, &d->skin, sizeof d->skin);
+    fsdem__restart_data(io, &d->r_max, sizeof d->r_max);
+    fsdem__restart_data(io, &d->max_disp2, sizeof d->max_disp2);
+    fsdem__restart_int_in(io, &stale, 0, 1, "need_rebuild");
+    fsdem__restart_data(io, &d->forces_valid, sizeof d->forces_valid);
+    fsdem__restart_data(io, &d->rolling, sizeof d->rolling);
+    fsdem__restart_data(io, &d->external, sizeof d->external);
+    fsdem__restart_data(io, &d->forces_cleared, sizeof d->forces_cleared);
+    fsdem__restart_data(io, &d->contacts, sizeof d->contacts);
+    fsdem__restart_data(io, &d->wall_contacts, sizeof d->wall_contacts);
+    fsdem__restart_data(io, &d->max_overlap, sizeof d->max_overlap);
+    if (commit) d->need_rebuild = stale;
+
+    /* materials and their pair table */
+    fsdem__restart_count(io, &nm, 46340, sizeof(fsdem_dem_material), "material count");
+    if (reserve && nm > 0) {
+        fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&d->materials, &d->material_capacity, d->material_count,
+                                            nm, sizeof(fsdem_dem_material)), "the materials");
+        fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&d->pairs, &d->pair_capacity,
+                                            d->material_count * d->material_count, nm * nm, sizeof(fsdem__dem_pair)),
+                            "the materials");
+    }
+    fsdem__restart_data(io, d->materials, sizeof(fsdem_dem_material) * (size_t)nm);
+    fsdem__restart_data(io, d->pairs, sizeof(fsdem__dem_pair) * (size_t)nm * (size_t)nm);
+    if (commit) d->material_count = nm;
+
+    /* walls: geometry where it has moved to, velocity, forces and impulses */
+    fsdem__restart_count(io, &nw, FSDEM__DEM_HELD / 8, 4 * sizeof(int) + 6 * sizeof(fsdem_vec3), "wall count");
+    if (reserve && nw > 0)
+        fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&d->walls, &d->wall_capacity, d->wall_count, nw,
+                                            sizeof(fsdem__dem_wall)), "the walls");
+    for (k = 0; k < nw && io->res == FSDEM_OK; ++k) {
+        fsdem__dem_wall w;
+        int type, material;
+        if (io->mode == FSDEM__RESTART_WRITE) w = d->walls[k];
+        else memset(&w, 0, sizeof w);
+        type = (int)w.d.type;
+        material = w.d.material;
+        fsdem__restart_int_in(io, &type, 0, FSDEM_DEM_WALL_SDF, "wall type");
+        fsdem__restart_value(io, &w.d.a, sizeof w.d.a);
+        fsdem__restart_value(io, &w.d.b, sizeof w.d.b);
+        fsdem__restart_value(io, &w.d.c, sizeof w.d.c);
+        fsdem__restart_value(io, &w.d.velocity, sizeof w.d.velocity);
+        fsdem__restart_int_in(io, &material, 0, nm - 1, "wall material");
+        fsdem__restart_int_in(io, &w.active, 0, 1, "wall active flag");
+        fsdem__restart_value(io, &w.force, sizeof w.force);
+        fsdem__restart_value(io, &w.impulse, sizeof w.impulse);
+        fsdem__restart_value(io, &w.moved, sizeof w.moved);
+        if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_DEM_WALL_SDF) {
+            if (k >= d->wall_count || d->walls[k].d.type != FSDEM_DEM_WALL_SDF)
+                fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                                    "wall %d is an SDF wall in the save: add the same SDF walls (fsdem_dem_wall_sdf), in the "
+                                    "same order, to the object before restoring",
+                                    k);
+            else {
+                w.d.sdf = d->walls[k].d.sdf; /* wall k of the object is overwritten only below */
+                w.d.sdf_user = d->walls[k].d.sdf_user;
+            }
+        }
+        if (commit) {
+            w.d.type = (fsdem_dem_wall_type)type;
+            w.d.material = material;
+            d->walls[k] = w;
+        }
+    }
+    if (commit) d->wall_count = nw;
+
+    /* particles */
+    fsdem__restart_count(io, &n, FSDEM__DEM_MAX_PARTICLES, 8 * sizeof(fsdem_vec3) + 4 * sizeof(fsdem_real),
+                          "particle count");
+    if (reserve) fsdem__restart_need(io, fsdem__dem_reserve_particles(d, n > 0 ? n : 1), "the particles");
+    fsdem__restart_data(io, d->id, sizeof(int) * (size_t)n);
+    fsdem__restart_ints(io, d->material, n, 0, nm - 1, "material of particle");
+    fsdem__restart_ints(io, d->old_of, n, -1, FSDEM__RESTART_INT_MAX, "previous row of particle");
+    fsdem__restart_flags(io, d->fixed, n, 1, "fixed flag of particle");
+    fsdem__restart_data(io, d->x, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->v, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->w, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->f, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->t, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->fext, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->text, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->x_ref, sizeof(fsdem_vec3) * (size_t)n);
+    fsdem__restart_data(io, d->r, sizeof(fsdem_real) * (size_t)n);
+    fsdem__restart_data(io, d->m, sizeof(fsdem_real) * (size_t)n);
+    fsdem__restart_data(io, d->inv_m, sizeof(fsdem_real) * (size_t)n);
+    fsdem__restart_data(io, d->inv_i, sizeof(fsdem_real) * (size_t)n);
+    if (commit) d->n = n;
+
+    /* neighbour lists with contact history, and the pairs of fixed particles listed aside */
+    fsdem__restart_dem_list(io, d, &d->pp, 1, n, stale, nw, &pairs);
+    longest = fsdem__restart_dem_list(io, d, &d->pw, 0, n, stale, nw, &wall_entries);
+    fsdem__restart_count(io, &inert, 1 << 29, 2 * sizeof(int), "inert pair count");
+    if (reserve && inert > 0)
+        fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&d->inert, &d->inert_capacity, 2 * d->inert_count,
+                                            2 * inert, sizeof(int)), "the inert pairs");
+    fsdem__restart_ints(io, d->inert, 2 * inert, 0, stale ? FSDEM__RESTART_INT_MAX : n - 1, "inert pair entry");
+    if (commit) d->inert_count = inert;
+    /* scratch of a force evaluation before the next rebuild, as fsdem__dem_rebuild reserves it */
+    if (reserve && io->res == FSDEM_OK) {
+        if (longest > 0)
+            fsdem__restart_need(io, fsdem__grow(&d->allocator, (void **)&d->hits, &d->hit_capacity, 0, longest,
+                                                sizeof(fsdem__dem_wall_hit)), "the wall contacts");
+        fsdem__restart_need(io, fsdem__arena_reserve(&d->allocator, &d->arena,
+                                                     fsdem__arena_bytes(sizeof(int) * (size_t)pairs) +
+                                                         fsdem__arena_bytes(sizeof(fsdem__dem_batch))),
+                            "the force evaluation");
+    }
+    fsdem__restart_tag(io, "DEM.");
+}
+
+/* ---- >>restart_pic : PIC/FLIP ---- */
+
+/* Everything of a PIC solver, in order. State: time, last dt, steps (they pick the sorting steps),
+   the random-number state, particles with their capacity (a full capacity refuses inflow seeds) and
+   APIC matrices, obstacles (polygons with their vertices) with the static face fractions, solid
+   velocities and cell flags derived from them (recomputing them samples SDF callbacks), the
+   coupler's arrays, cells_fresh with the fractions and level set it vouches for, the pressure (the
+   initial guess of the next solve), the face velocities, effective faces and cell types (views,
+   sampling and fsdem_pic_add_force read them between steps), counters and the last step's figures.
+   Configuration: the grid and the desc fields that steps read, compared. Not saved, rewritten
+   before use: uold, wsum, ftmp, the valid-face marks, the extrapolation queue, rhs, diag, ctmp,
+   cstart and the particle scratch (ptmp, pcell, pidx; pflag is zeroed), the viscous face grids, the
+   linear solvers (set up at every use), CPU times, the allocator, log and message. SDF obstacles
+   keep the object's callbacks; a pressure-extra operator stays as set. */
+/* The gauges of a PIC solver (positions, kinds, radii); their file is not part of the state. */
+static void fsdem__restart_pic_gauges(fsdem__restart *io, fsdem_pic *s) {
+    const fsdem_allocator *al = &s->allocator;
+    int ng = s->gauge_count;
+    fsdem_vec3 *at;
+    int *kind;
+    fsdem_real *radius;
+    if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the object has a gauge file open: close it (fsdem_pic_gauges_close) before restoring and "
+                            "open it again afterwards");
+    fsdem__restart_count(io, &ng, 1 << 24, sizeof(fsdem_vec3) + sizeof(int) + sizeof(fsdem_real), "gauge count");
+    at = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)ng);
+    kind = (int *)fsdem__restart_block(io, al, sizeof(int) * (size_t)ng);
+    radius = (fsdem_real *)fsdem__restart_block(io, al, sizeof(fsdem_real) * (size_t)ng);
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        fsdem__free(al, s->gauge_at, sizeof(fsdem_vec3) * (size_t)s->gauge_capacity);
+        fsdem__free(al, s->gauge_kind, sizeof(int) * (size_t)s->gauge_capacity);
+        fsdem__free(al, s->gauge_radius, sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+        s->gauge_at = at;
+        s->gauge_kind = kind;
+        s->gauge_radius = radius;
+        s->gauge_count = s->gauge_capacity = ng;
+    }
+    fsdem__restart_data(io, s->gauge_at, sizeof(fsdem_vec3) * (size_t)ng);
+    fsdem__restart_ints(io, s->gauge_kind, ng, FSDEM_PIC_GAUGE_LEVEL, FSDEM_PIC_GAUGE_PRESSURE, "gauge kind");
+    fsdem__restart_data(io, s->gauge_radius, sizeof(fsdem_real) * (size_t)ng);
+}
+
+static void fsdem__restart_pic(fsdem__restart *io, void *object) {
+    fsdem_pic *s = (fsdem_pic *)object;
+    const fsdem_pic_desc *pd = &s->desc;
+    const fsdem_allocator *al = &s->allocator;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT, apic = pd->transfer == FSDEM_PIC_TRANSFER_APIC;
+    static const char *bc_names[6] = {"boundary[0]", "boundary[1]", "boundary[2]",
+                                      "boundary[3]", "boundary[4]", "boundary[5]"};
+    static const char *bv_names[6] = {"boundary_velocity[0]", "boundary_velocity[1]", "boundary_velocity[2]",
+                                      "boundary_velocity[3]", "boundary_velocity[4]", "boundary_velocity[5]"};
+    int grid[3], no = s->obst_count, np = s->np, pcap = s->pcap, a, k;
+    fsdem__pic_obst *obst;
+    size_t cells = sizeof(fsdem_real) * (size_t)s->ncell;
+    fsdem__restart_tag(io, "PIC1");
+    for (a = 0; a < 3; ++a) grid[a] = s->n[a];
+    fsdem__restart_value(io, grid, sizeof grid);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK &&
+        (grid[0] != s->n[0] || grid[1] != s->n[1] || grid[2] != s->n[2]))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the grid has %d x %d x %d cells in the save and %d x %d x %d in the object (create the "
+                            "object from the desc it was saved with)",
+                            grid[0], grid[1], grid[2], s->n[0], s->n[1], s->n[2]);
+    fsdem__restart_same_int(io, pd->dim, "dim");
+    fsdem__restart_same_vec3(io, pd->domain_min, "domain_min");
+    fsdem__restart_same_real(io, pd->cell_size, "cell_size");
+    fsdem__restart_same_real(io, pd->density, "density");
+    fsdem__restart_same_real(io, pd->viscosity, "viscosity");
+    fsdem__restart_same_vec3(io, pd->gravity, "gravity");
+    for (k = 0; k < 6; ++k) {
+        fsdem__restart_same_int(io, (int)pd->boundary[k], bc_names[k]);
+        fsdem__restart_same_vec3(io, pd->boundary_velocity[k], bv_names[k]);
+    }
+    fsdem__restart_same_int(io, pd->free_surface, "free_surface");
+    fsdem__restart_same_int(io, (int)pd->transfer, "transfer");
+    fsdem__restart_same_real(io, pd->flip_ratio, "flip_ratio");
+    fsdem__restart_same_int(io, (int)pd->kernel, "kernel");
+    fsdem__restart_same_int(io, pd->particles_per_cell, "particles_per_cell");
+    fsdem__restart_same_real(io, pd->jitter, "jitter");
+    fsdem__restart_same_int(io, pd->min_particles_per_cell, "min_particles_per_cell");
+    fsdem__restart_same_int(io, pd->max_particles_per_cell, "max_particles_per_cell");
+    fsdem__restart_same_int(io, pd->advection_order, "advection_order");
+    fsdem__restart_same_real(io, pd->cfl, "cfl");
+    fsdem__restart_same_real(io, pd->cfl_max, "cfl_max");
+    fsdem__restart_same_real(io, pd->dt_max, "dt_max");
+    fsdem__restart_same_int(io, pd->density_projection, "density_projection");
+    fsdem__restart_same_real(io, pd->ghost_theta_min, "ghost_theta_min");
+    fsdem__restart_same_int(io, pd->extrapolation_layers, "extrapolation_layers");
+    fsdem__restart_same_int(io, (int)pd->pressure_precond, "pressure_precond");
+    fsdem__restart_same_real(io, pd->pressure_tolerance, "pressure_tolerance");
+    fsdem__restart_same_int(io, pd->pressure_max_iterations, "pressure_max_iterations");
+    fsdem__restart_same_int(io, (int)pd->viscosity_precond, "viscosity_precond");
+    fsdem__restart_same_real(io, pd->viscosity_tolerance, "viscosity_tolerance");
+
+    fsdem__restart_data(io, &s->time, sizeof s->time);
+    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
+    fsdem__restart_data(io, &s->steps, sizeof s->steps);
+    fsdem__restart_data(io, &s->rng, sizeof s->rng);
+    fsdem__restart_data(io, &s->cells_fresh, sizeof s->cells_fresh);
+    fsdem__restart_data(io, &s->fluid_cells, sizeof s->fluid_cells);
+    fsdem__restart_data(io, &s->p_iters, sizeof s->p_iters);
+    fsdem__restart_data(io, &s->v_iters, sizeof s->v_iters);
+    fsdem__restart_data(io, &s->d_iters, sizeof s->d_iters);
+    fsdem__restart_data(io, &s->p_res, sizeof s->p_res);
+    fsdem__restart_data(io, &s->max_div, sizeof s->max_div);
+    fsdem__restart_data(io, &s->div_before, sizeof s->div_before);
+    fsdem__restart_data(io, &s->reseeded, sizeof s->reseeded);
+    fsdem__restart_data(io, &s->removed, sizeof s->removed);
+    fsdem__restart_data(io, &s->refused, sizeof s->refused);
+    fsdem__restart_data(io, &s->moved, sizeof s->moved);
+
+    /* obstacles, into a fresh array (polygons own their vertices) */
+    fsdem__restart_count(io, &no, 1 << 20, 2 * sizeof(int) + 5 * sizeof(fsdem_vec3) + sizeof(fsdem_real), "obstacle count");
+    obst = (fsdem__pic_obst *)fsdem__restart_block(io, al, sizeof(fsdem__pic_obst) * (size_t)no);
+    for (k = 0; k < no && io->res == FSDEM_OK; ++k) {
+        fsdem__pic_obst o;
+        fsdem_vec3 *verts;
+        int type, nv;
+        if (io->mode == FSDEM__RESTART_WRITE) o = s->obst[k];
+        else memset(&o, 0, sizeof o);
+        type = (int)o.d.type;
+        nv = o.d.type == FSDEM_PIC_OBSTACLE_POLYGON ? o.d.vertex_count : 0;
+        fsdem__restart_int_in(io, &type, 0, FSDEM_PIC_OBSTACLE_SDF, "obstacle type");
+        fsdem__restart_value(io, &o.d.a, sizeof o.d.a);
+        fsdem__restart_value(io, &o.d.b, sizeof o.d.b);
+        fsdem__restart_value(io, &o.d.radius, sizeof o.d.radius);
+        fsdem__restart_value(io, &o.d.velocity, sizeof o.d.velocity);
+        fsdem__restart_value(io, &o.box_lo, sizeof o.box_lo);
+        fsdem__restart_value(io, &o.box_hi, sizeof o.box_hi);
+        fsdem__restart_count(io, &nv, 1 << 24, sizeof(fsdem_vec3), "polygon vertex count");
+        if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && (type == FSDEM_PIC_OBSTACLE_POLYGON) != (nv >= 3))
+            fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "obstacle %d has %d vertices (corrupted data)", k, nv);
+        verts = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)nv);
+        fsdem__restart_data(io, io->mode == FSDEM__RESTART_WRITE ? o.verts : verts, sizeof(fsdem_vec3) * (size_t)nv);
+        if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_PIC_OBSTACLE_SDF) {
+            if (k >= s->obst_count || s->obst[k].d.type != FSDEM_PIC_OBSTACLE_SDF)
+                fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                                    "obstacle %d is an SDF obstacle in the save: add the same SDF obstacles "
+                                    "(fsdem_pic_obstacle_sdf), in the same order, to the object before restoring",
+                                    k);
+            else {
+                o.d.sdf = s->obst[k].d.sdf;
+                o.d.sdf_user = s->obst[k].d.sdf_user;
+            }
+        }
+        if (commit) {
+            o.d.type = (fsdem_pic_obstacle_type)type;
+            o.d.vertex_count = nv;
+            o.d.vertices = o.verts = verts;
+            obst[k] = o;
+        }
+    }
+    if (commit) {
+        for (k = 0; k < s->obst_count; ++k)
+            if (s->obst[k].verts) fsdem__pic_release(s, s->obst[k].verts, sizeof(fsdem_vec3) * (size_t)s->obst[k].d.vertex_count);
+        fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
+        s->obst = obst;
+        s->obst_count = s->obst_capacity = no;
+        s->bytes += sizeof(fsdem__pic_obst) * (size_t)no;
+        for (k = 0; k < no; ++k) s->bytes += sizeof(fsdem_vec3) * (size_t)obst[k].d.vertex_count;
+    }
+
+    /* particles, into fresh arrays of the saved capacity */
+    fsdem__restart_count(io, &pcap, 1 << 29, 0, "particle capacity");
+    fsdem__restart_count(io, &np, pcap, 2 * sizeof(fsdem_vec3), "particle count");
+    if (io->res == FSDEM_OK) {
+        const size_t vb = sizeof(fsdem_vec3) * (size_t)pcap, ib = sizeof(int) * (size_t)pcap;
+        fsdem_vec3 *px = (fsdem_vec3 *)fsdem__restart_block(io, al, vb), *pv = (fsdem_vec3 *)fsdem__restart_block(io, al, vb);
+        fsdem_vec3 *pt = (fsdem_vec3 *)fsdem__restart_block(io, al, vb), *pc[3] = {NULL, NULL, NULL};
+        int *pcell, *pidx;
+        unsigned char *pflag;
+        for (a = 0; a < 3 && apic; ++a) pc[a] = (fsdem_vec3 *)fsdem__restart_block(io, al, vb);
+        pcell = (int *)fsdem__restart_block(io, al, ib);
+        pidx = (int *)fsdem__restart_block(io, al, ib);
+        pflag = (unsigned char *)fsdem__restart_block(io, al, (size_t)pcap);
+        if (commit) {
+            fsdem__pic_free_particles(s);
+            s->px = px;
+            s->pv = pv;
+            s->ptmp = pt;
+            for (a = 0; a < 3; ++a) s->pc[a] = pc[a];
+            s->pcell = pcell;
+            s->pidx = pidx;
+            s->pflag = pflag;
+            if (pflag) memset(pflag, 0, (size_t)pcap);
+            s->pcap = pcap;
+            s->np = np;
+            s->bytes += (apic ? 6 : 3) * vb + 2 * ib + (size_t)pcap;
+        }
+    }
+    fsdem__restart_data(io, s->px, sizeof(fsdem_vec3) * (size_t)np);
+    fsdem__restart_data(io, s->pv, sizeof(fsdem_vec3) * (size_t)np);
+    for (a = 0; a < 3 && apic; ++a) fsdem__restart_data(io, s->pc[a], sizeof(fsdem_vec3) * (size_t)np);
+
+    /* grid fields, in place (the grid matches) */
+    for (a = 0; a < s->dim; ++a) {
+        const size_t fb = sizeof(fsdem_real) * (size_t)s->nface[a];
+        fsdem__restart_data(io, s->u[a], fb);
+        fsdem__restart_data(io, s->sopen[a], fb);
+        fsdem__restart_data(io, s->svel[a], fb);
+        fsdem__restart_data(io, s->copen[a], fb);
+        fsdem__restart_data(io, s->cvel[a], fb);
+        fsdem__restart_data(io, s->cacc[a], fb);
+        fsdem__restart_data(io, s->E[a], fb);
+        fsdem__restart_data(io, s->us[a], fb);
+    }
+    fsdem__restart_data(io, s->frac, cells);
+    fsdem__restart_data(io, s->phi, cells);
+    fsdem__restart_data(io, s->pres, cells);
+    fsdem__restart_data(io, s->crhs, cells);
+    fsdem__restart_data(io, s->fref, cells);
+    fsdem__restart_flags(io, s->ctype, s->ncell, FSDEM_STENCIL_CELL_SOLID, "type of cell");
+    fsdem__restart_flags(io, s->cnear, s->ncell, 1, "near-solid flag of cell");
+    fsdem__restart_flags(io, s->csolid, s->ncell, 1, "solid flag of cell");
+    fsdem__restart_pic_gauges(io, s);
+    fsdem__restart_tag(io, "PIC.");
+}
+
+/* ---- >>restart_swe : shallow water ---- */
+
+/* The per-cell masks of the SWE: the blocked cells, when there are any (nx*ny flags); `masks`
+   counts them, so data with a mask this build does not know are refused. */
+static void fsdem__restart_swe_masks(fsdem__restart *io, fsdem_swe *s) {
+    int masks = s->blocked ? 1 : 0, k, count = 0;
+    unsigned char *blocked;
+    fsdem__restart_int_in(io, &masks, 0, 1, "the number of per-cell masks (data of a newer build)");
+    blocked = masks ? (unsigned char *)fsdem__restart_block(io, &s->allocator, (size_t)s->n) : NULL;
+    if (masks) fsdem__restart_flags(io, io->mode == FSDEM__RESTART_WRITE ? s->blocked : blocked, s->n, 1, "blocked flag of cell");
+    if (io->mode != FSDEM__RESTART_COMMIT) return;
+    fsdem__free(&s->allocator, s->blocked, (size_t)s->n);
+    s->blocked = blocked;
+    for (k = 0; blocked && k < s->n; ++k) count += blocked[k];
+    s->blocked_count = count;
+}
+
+/* A series of n points (times and values): written, or read into fresh arrays that COMMIT hands to
+   *t and *v after freeing the old ones. */
+static void fsdem__restart_swe_series(fsdem__restart *io, fsdem_swe *s, fsdem_real **t, fsdem_real **v, int *n,
+                                      const char *what) {
+    int count = *n;
+    fsdem_real *ft, *fv;
+    fsdem__restart_count(io, &count, 1 << 28, 2 * sizeof(fsdem_real), what);
+    ft = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
+    fv = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        fsdem__swe_free_series(s, t, v, n);
+        *t = ft;
+        *v = fv;
+        *n = count;
+    }
+    fsdem__restart_data(io, *t, sizeof(fsdem_real) * (size_t)count);
+    fsdem__restart_data(io, *v, sizeof(fsdem_real) * (size_t)count);
+}
+
+/* Everything of a shallow-water solver, in order. State: time, last dt, counters, the bound of the
+   wave speed and of the acceleration (the next adaptive dt reads them) and the other figures of the
+   last step, the volume budget, rain, the surface, discharges and bed exactly, the momentum sources
+   and whether they are in use, the per-cell masks (merge point above), per-cell Manning, the four
+   boundaries with their series, point sources with their series, ids and states, gauge positions.
+   Configuration: the grid and the desc fields that steps read, compared. Not saved: the work rows
+   (prim, rows, south) and the boundary values of the step in flight (bvalue), rewritten by every
+   step; the gauge file, its interval and next output time (restore refuses while a file is open);
+   capacities, the allocator, log and message. */
+static void fsdem__restart_swe(fsdem__restart *io, void *object) {
+    fsdem_swe *s = (fsdem_swe *)object;
+    const fsdem_swe_desc *sd = &s->desc;
+    const fsdem_allocator *al = &s->allocator;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    const size_t cells = sizeof(fsdem_real) * (size_t)s->n;
+    int grid[2], has_manning = s->manning != NULL, ns = s->src_count, next_id = s->src_next_id, ng = s->gauge_count;
+    int side, k;
+    fsdem__swe_src *src;
+    fsdem_real *manning, *xy;
+    fsdem__restart_tag(io, "SWE1");
+    grid[0] = s->nx;
+    grid[1] = s->ny;
+    fsdem__restart_value(io, grid, sizeof grid);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && (grid[0] != s->nx || grid[1] != s->ny))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the grid has %d x %d cells in the save and %d x %d in the object (create the object from "
+                            "the desc it was saved with)",
+                            grid[0], grid[1], s->nx, s->ny);
+    fsdem__restart_same_int(io, sd->dim, "dim");
+    fsdem__restart_same_real(io, sd->x_min, "x_min");
+    fsdem__restart_same_real(io, sd->x_max, "x_max");
+    fsdem__restart_same_real(io, sd->y_min, "y_min");
+    fsdem__restart_same_real(io, sd->y_max, "y_max");
+    fsdem__restart_same_real(io, sd->width, "width");
+    fsdem__restart_same_vec3(io, sd->gravity, "gravity");
+    fsdem__restart_same_real(io, sd->density, "density");
+    fsdem__restart_same_real(io, sd->cfl, "cfl");
+    fsdem__restart_same_real(io, sd->dt_max, "dt_max");
+    fsdem__restart_same_int(io, sd->order, "order");
+    fsdem__restart_same_int(io, (int)sd->limiter, "limiter");
+    fsdem__restart_same_real(io, sd->dry_depth, "dry_depth");
+    fsdem__restart_same_real(io, sd->manning, "manning");
+    fsdem__restart_same_real(io, sd->eddy_viscosity, "eddy_viscosity");
+    if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the object has a gauge file open: close it (fsdem_swe_gauges_close) before restoring and "
+                            "open it again afterwards");
+
+    fsdem__restart_data(io, &s->time, sizeof s->time);
+    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
+    fsdem__restart_data(io, &s->steps, sizeof s->steps);
+    fsdem__restart_data(io, &s->fallbacks, sizeof s->fallbacks);
+    fsdem__restart_data(io, &s->max_wave, sizeof s->max_wave);
+    fsdem__restart_data(io, &s->max_accel, sizeof s->max_accel);
+    fsdem__restart_data(io, &s->max_speed, sizeof s->max_speed);
+    fsdem__restart_data(io, &s->max_depth, sizeof s->max_depth);
+    fsdem__restart_data(io, &s->wet_cells, sizeof s->wet_cells);
+    fsdem__restart_data(io, &s->vol_boundary, sizeof s->vol_boundary);
+    fsdem__restart_data(io, &s->vol_source, sizeof s->vol_source);
+    fsdem__restart_data(io, &s->vol_clipped, sizeof s->vol_clipped);
+    fsdem__restart_data(io, &s->rain, sizeof s->rain);
+    fsdem__restart_data(io, &s->sources_used, sizeof s->sources_used);
+
+    /* the state, exactly, in place */
+    fsdem__restart_data(io, s->eta, cells);
+    fsdem__restart_data(io, s->qx, cells);
+    fsdem__restart_data(io, s->qy, cells);
+    fsdem__restart_data(io, s->bed, cells);
+    fsdem__restart_data(io, s->sx, cells);
+    fsdem__restart_data(io, s->sy, cells);
+    fsdem__restart_swe_masks(io, s);
+
+    /* per-cell Manning: kept in place when the object has the array, else a fresh one */
+    fsdem__restart_int_in(io, &has_manning, 0, 1, "per-cell Manning flag");
+    manning = has_manning && !s->manning ? (fsdem_real *)fsdem__restart_block(io, al, cells) : NULL;
+    if (commit && !has_manning) {
+        fsdem__free(al, s->manning, cells);
+        s->manning = NULL;
+    } else if (commit && manning)
+        s->manning = manning;
+    if (has_manning) fsdem__restart_data(io, s->manning, cells);
+
+    for (side = 0; side < 4 && io->res == FSDEM_OK; ++side) {
+        fsdem__swe_bnd *b = &s->bnd[side];
+        int type = (int)b->type;
+        fsdem_real value = b->value;
+        fsdem__restart_int_in(io, &type, 0, FSDEM_SWE_BC_STAGE, "boundary type");
+        fsdem__restart_value(io, &value, sizeof value);
+        fsdem__restart_swe_series(io, s, &b->t, &b->v, &b->n, "boundary series length");
+        if (commit) {
+            b->type = (fsdem_swe_bc)type;
+            b->value = value;
+        }
+    }
+
+    /* point sources, into a fresh array */
+    fsdem__restart_count(io, &ns, 1 << 24, sizeof(fsdem_real) + 4 * sizeof(int), "point source count");
+    fsdem__restart_value(io, &next_id, sizeof next_id);
+    src = (fsdem__swe_src *)fsdem__restart_block(io, al, sizeof(fsdem__swe_src) * (size_t)ns);
+    for (k = 0; k < ns && io->res == FSDEM_OK; ++k) {
+        fsdem__swe_src q;
+        if (io->mode == FSDEM__RESTART_WRITE) q = s->src[k];
+        else memset(&q, 0, sizeof q);
+        fsdem__restart_value(io, &q.discharge, sizeof q.discharge);
+        fsdem__restart_int_in(io, &q.cell, 0, s->n - 1, "point source cell");
+        fsdem__restart_value(io, &q.id, sizeof q.id);
+        fsdem__restart_int_in(io, &q.active, 0, 1, "point source active flag");
+        fsdem__restart_swe_series(io, s, &q.t, &q.v, &q.n, "point source series length");
+        if (commit) src[k] = q;
+    }
+    if (commit) {
+        for (k = 0; k < s->src_count; ++k) fsdem__swe_free_series(s, &s->src[k].t, &s->src[k].v, &s->src[k].n);
+        fsdem__free(al, s->src, sizeof(fsdem__swe_src) * (size_t)s->src_capacity);
+        s->src = src;
+        s->src_count = s->src_capacity = ns;
+        s->src_next_id = next_id;
+    }
+
+    /* gauge positions (the file is not part of the state) */
+    fsdem__restart_count(io, &ng, 1 << 24, 2 * sizeof(fsdem_real), "gauge count");
+    xy = (fsdem_real *)fsdem__restart_block(io, al, 2 * sizeof(fsdem_real) * (size_t)ng);
+    if (commit) {
+        fsdem__free(al, s->gauge, 2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+        s->gauge = xy;
+        s->gauge_count = s->gauge_capacity = ng;
+    }
+    fsdem__restart_data(io, s->gauge, 2 * sizeof(fsdem_real) * (size_t)ng);
+    fsdem__restart_tag(io, "SWE.");
+}
+
+/* ---- >>restart_swe_dem : SWE-DEM coupler ---- */
+
+/* A coupler's file holds the coupled run: the SWE, then the DEM (restored into the solvers the
+   coupler was created with), then the coupler's own state: counters, the last step, the impulse
+   given to the water and the per-particle force records and reactions (fsdem_swe_dem_get_force and
+   the next step's impulse read them). Configuration: beta, two_way, heave_damping, max_substeps and
+   the water's density, gravity and dry depth taken at creation, compared. Not saved: the solver
+   pointers, the allocator, log and message. */
+static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
+    fsdem_swe_dem *c = (fsdem_swe_dem *)object;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    int count = c->force_capacity, k;
+    fsdem_swe_dem_force *force;
+    fsdem_vec3 *reaction;
+    fsdem__restart_tag(io, "SWD1");
+    io->section = "shallow water";
+    fsdem__restart_swe(io, c->desc.swe);
+    io->section = "debris (DEM)";
+    fsdem__restart_dem(io, c->desc.dem);
+    io->section = NULL;
+    fsdem__restart_same_real(io, c->desc.beta, "beta");
+    fsdem__restart_same_int(io, c->desc.two_way, "two_way");
+    fsdem__restart_same_real(io, c->desc.heave_damping, "heave_damping");
+    fsdem__restart_same_ll(io, c->desc.max_substeps, "max_substeps");
+    fsdem__restart_same_real(io, c->rho, "swe.density");
+    fsdem__restart_same_real(io, c->g, "swe.gravity");
+    fsdem__restart_same_real(io, c->dry, "swe.dry_depth");
+    fsdem__restart_data(io, &c->steps, sizeof c->steps);
+    fsdem__restart_data(io, &c->substeps, sizeof c->substeps);
+    fsdem__restart_data(io, &c->substeps_total, sizeof c->substeps_total);
+    fsdem__restart_data(io, &c->dt_last, sizeof c->dt_last);
+    fsdem__restart_data(io, &c->in_water, sizeof c->in_water);
+    fsdem__restart_data(io, &c->impulse, sizeof c->impulse);
+    fsdem__restart_count(io, &count, 1 << 29, 5 * sizeof(fsdem_vec3) + 3 * sizeof(fsdem_real), "force record count");
+    force = (fsdem_swe_dem_force *)fsdem__restart_block(io, &c->allocator, sizeof *force * (size_t)count);
+    reaction = (fsdem_vec3 *)fsdem__restart_block(io, &c->allocator, sizeof *reaction * (size_t)count);
+    if (commit) {
+        fsdem__free(&c->allocator, c->force, sizeof *force * (size_t)c->force_capacity);
+        fsdem__free(&c->allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
+        c->force = force;
+        c->reaction = reaction;
+        c->force_capacity = count;
+        if (force) memset(force, 0, sizeof *force * (size_t)count);
+    }
+    for (k = 0; k < count && io->res == FSDEM_OK; ++k) {
+        fsdem_swe_dem_force scratch, *f = io->mode == FSDEM__RESTART_WRITE || commit ? &c->force[k] : &scratch;
+        fsdem__restart_data(io, &f->buoyancy, sizeof f->buoyancy);
+        fsdem__restart_data(io, &f->hydrostatic, sizeof f->hydrostatic);
+        fsdem__restart_data(io, &f->dynamic, sizeof f->dynamic);
+        fsdem__restart_data(io, &f->heave, sizeof f->heave);
+        fsdem__restart_data(io, &f->submerged_volume, sizeof f->submerged_volume);
+        fsdem__restart_data(io, &f->frontal_area, sizeof f->frontal_area);
+        fsdem__restart_data(io, &f->surface, sizeof f->surface);
+        fsdem__restart_data(io, &f->in_water, sizeof f->in_water);
+    }
+    fsdem__restart_data(io, c->reaction, sizeof(fsdem_vec3) * (size_t)count);
+    fsdem__restart_tag(io, "SWD.");
+}
+
+/* ---- >>restart_api : memory and files ---- */
+
+/* What the API needs to know of one object. */
+typedef struct fsdem__restart_object {
+    unsigned int kind;
+    int dim, sizes[4];
+    void *object;
+    fsdem__restart_visit_fn visit;
+    const fsdem_allocator *allocator;
+    fsdem__status *status; /* the message is the only part of a saved (const) object that changes */
+    const char *name;
+} fsdem__restart_object;
+
+static const char *fsdem__restart_kind_name(unsigned int kind) {
+    switch (kind) {
+    case FSDEM__RESTART_DEM: return "fsdem_dem";
+    case FSDEM__RESTART_PIC: return "fsdem_pic";
+    case FSDEM__RESTART_SWE: return "fsdem_swe";
+    case FSDEM__RESTART_SWE_DEM: return "fsdem_swe_dem";
+    }
+    return "unknown object";
+}
+
+static fsdem__restart_object fsdem__restart_of_dem(const fsdem_dem *d) {
+    fsdem__restart_object o;
+    o.kind = FSDEM__RESTART_DEM;
+    o.dim = d->desc.dim;
+    o.sizes[0] = d->n;
+    o.sizes[1] = d->material_count;
+    o.sizes[2] = d->wall_count;
+    o.sizes[3] = d->pp.count;
+    o.object = (void *)d;
+    o.visit = fsdem__restart_dem;
+    o.allocator = &d->allocator;
+    o.status = (fsdem__status *)&d->status;
+    o.name = "fsdem_dem";
+    return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_pic(const fsdem_pic *s) {
+    fsdem__restart_object o;
+    o.kind = FSDEM__RESTART_PIC;
+    o.dim = s->dim;
+    o.sizes[0] = s->n[0];
+    o.sizes[1] = s->n[1];
+    o.sizes[2] = s->n[2];
+    o.sizes[3] = s->np;
+    o.object = (void *)s;
+    o.visit = fsdem__restart_pic;
+    o.allocator = &s->allocator;
+    o.status = (fsdem__status *)&s->status;
+    o.name = "fsdem_pic";
+    return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_swe(const fsdem_swe *s) {
+    fsdem__restart_object o;
+    o.kind = FSDEM__RESTART_SWE;
+    o.dim = s->dim;
+    o.sizes[0] = s->nx;
+    o.sizes[1] = s->ny;
+    o.sizes[2] = s->src_count;
+    o.sizes[3] = s->gauge_count;
+    o.object = (void *)s;
+    o.visit = fsdem__restart_swe;
+    o.allocator = &s->allocator;
+    o.status = (fsdem__status *)&s->status;
+    o.name = "fsdem_swe";
+    return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_swe_dem(const fsdem_swe_dem *c) {
+    fsdem__restart_object o;
+    o.kind = FSDEM__RESTART_SWE_DEM;
+    o.dim = c->desc.swe->dim;
+    o.sizes[0] = c->desc.swe->nx;
+    o.sizes[1] = c->desc.swe->ny;
+    o.sizes[2] = c->desc.dem->n;
+    o.sizes[3] = c->force_capacity;
+    o.object = (void *)c;
+    o.visit = fsdem__restart_swe_dem;
+    o.allocator = &c->allocator;
+    o.status = (fsdem__status *)&c->status;
+    o.name = "fsdem_swe_dem";
+    return o;
+}
+
+/* A cursor for `verb` of object o ("save", "restore_memory", ...). */
+static void fsdem__restart_begin(fsdem__restart *io, const fsdem__restart_object *o, const char *verb,
+                                 fsdem__restart_mode mode) {
+    memset(io, 0, sizeof *io);
+    io->mode = mode;
+    io->res = FSDEM_OK;
+    io->allocator = o->allocator;
+    snprintf(io->fn, sizeof io->fn, "%s_%s", o->name, verb);
+}
+
+/* Hands the cursor's result to the object: its message on failure, an empty one on success. */
+static fsdem_result fsdem__restart_end(fsdem__restart *io, const fsdem__restart_object *o) {
+    int k;
+    for (k = io->block_next; k < io->block_count; ++k)
+        fsdem__free(io->blocks[k].allocator, io->blocks[k].ptr, io->blocks[k].bytes);
+    fsdem__free(io->allocator, io->blocks, sizeof *io->blocks * (size_t)io->block_capacity);
+    io->blocks = NULL;
+    io->block_count = io->block_capacity = io->block_next = 0;
+    return io->res == FSDEM_OK ? fsdem__ok(o->status) : fsdem__fail(o->status, io->res, "%s", io->message);
+}
+
+/* The header of o with a payload of `payload` bytes, and the checksum of its first 56 bytes. */
+static unsigned long long fsdem__restart_header(unsigned char h[FSDEM__RESTART_HEADER], const fsdem__restart_object *o,
+                                                unsigned long long payload) {
+    const unsigned int u[6] = {FSDEM__RESTART_VERSION, FSDEM__RESTART_BOM, (unsigned int)sizeof(fsdem_real), o->kind,
+                               (unsigned int)o->dim, 0u};
+    memset(h, 0, FSDEM__RESTART_HEADER);
+    memcpy(h, "FSDEMRST", 8);
+    memcpy(h + 8, u, sizeof u);
+    memcpy(h + 32, o->sizes, sizeof o->sizes);
+    memcpy(h + 48, &payload, 8);
+    return fsdem__restart_fnv(FSDEM__RESTART_FNV_BASIS, h, 56);
+}
+
+static unsigned int fsdem__restart_u32(const unsigned char *p) {
+    unsigned int v;
+    memcpy(&v, p, sizeof v);
+    return v;
+}
+
+/* Measures the payload of o and fills the header; the cursor is then ready to write the payload. */
+static void fsdem__restart_prepare(fsdem__restart *io, const fsdem__restart_object *o,
+                                   unsigned char header[FSDEM__RESTART_HEADER]) {
+    o->visit(io, o->object);
+    io->hash = fsdem__restart_header(header, o, (unsigned long long)io->pos);
+    io->size = io->pos;
+    io->pos = 0;
+}
+
+/* Saves o to `buffer` (`capacity` bytes; NULL: only the size). The payload is measured first, so a
+   buffer too small is refused before anything is written. */
+static fsdem_result fsdem__restart_save_memory(const fsdem__restart_object *o, void *buffer, size_t capacity,
+                                               size_t *size) {
+    fsdem__restart io;
+    unsigned char header[FSDEM__RESTART_HEADER];
+    fsdem__restart_begin(&io, o, "save_memory", FSDEM__RESTART_WRITE);
+    if (!size) {
+        fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "size is NULL");
+        return fsdem__restart_end(&io, o);
+    }
+    fsdem__restart_prepare(&io, o, header);
+    *size = FSDEM__RESTART_HEADER + io.size;
+    if (buffer && capacity < *size)
+        fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "the buffer of %llu bytes is too small: %llu are needed",
+                            (unsigned long long)capacity, (unsigned long long)*size);
+    if (buffer && io.res == FSDEM_OK) {
+        io.out = (unsigned char *)buffer + FSDEM__RESTART_HEADER;
+        o->visit(&io, o->object);
+        FSDEM_ASSERT(io.pos == io.size);
+        memcpy(header + 56, &io.hash, 8);
+        memcpy(buffer, header, FSDEM__RESTART_HEADER);
+    }
+    return fsdem__restart_end(&io, o);
+}
+
+/* Saves o to the file `path` in one pass: header, payload, then the checksum into the header. */
+static fsdem_result fsdem__restart_save_file(const fsdem__restart_object *o, const char *path) {
+    fsdem__restart io;
+    unsigned char header[FSDEM__RESTART_HEADER];
+    FILE *fp;
+    int bad;
+    fsdem__restart_begin(&io, o, "save", FSDEM__RESTART_WRITE);
+    if (!path) {
+        fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "path is NULL");
+        return fsdem__restart_end(&io, o);
+    }
+    fp = fopen(path, "wb");
+    if (!fp) {
+        fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot open '%s' for writing", path);
+        return fsdem__restart_end(&io, o);
+    }
+    fsdem__restart_prepare(&io, o, header);
+    bad = fwrite(header, 1, FSDEM__RESTART_HEADER, fp) != FSDEM__RESTART_HEADER;
+    io.file = fp;
+    o->visit(&io, o->object);
+    memcpy(header + 56, &io.hash, 8);
+    bad |= ferror(fp) || fseek(fp, 56, SEEK_SET) != 0 || fwrite(header + 56, 1, 8, fp) != 8;
+    bad |= fclose(fp) != 0;
+    if (bad) fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot write '%s'", path);
+    return fsdem__restart_end(&io, o);
+}
+
+/* Checks the header of `size` bytes at `data` against o: magic, version, byte order, precision,
+   kind, dimension, the announced size, then the checksum. */
+static void fsdem__restart_check_header(fsdem__restart *io, const fsdem__restart_object *o, const unsigned char *data,
+                                        size_t size) {
+    unsigned long long payload, sum;
+    unsigned int precision, kind, dim;
+    if (!data) {
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "buffer is NULL");
+        return;
+    }
+    if (size < FSDEM__RESTART_HEADER || memcmp(data, "FSDEMRST", 8) != 0) {
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "not a fsdem restart file (%s)",
+                            size < FSDEM__RESTART_HEADER ? "shorter than the 64-byte header" : "no FSDEMRST magic");
+        return;
+    }
+    precision = fsdem__restart_u32(data + 16);
+    kind = fsdem__restart_u32(data + 20);
+    dim = fsdem__restart_u32(data + 24);
+    memcpy(&payload, data + 48, 8);
+    memcpy(&sum, data + 56, 8);
+    if (fsdem__restart_u32(data + 8) != FSDEM__RESTART_VERSION)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "format version %u; this build reads version %u",
+                            fsdem__restart_u32(data + 8), FSDEM__RESTART_VERSION);
+    else if (fsdem__restart_u32(data + 12) != FSDEM__RESTART_BOM)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "written on a machine of another byte order");
+    else if (precision != sizeof(fsdem_real))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "precision: written with %u-byte reals, this build's fsdem_real has %u (%s)",
+                            precision, (unsigned int)sizeof(fsdem_real), sizeof(fsdem_real) == 4 ? "FSDEM_USE_FLOAT" : "double");
+    else if (kind != o->kind)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the data hold the state of a %s, not of a %s",
+                            fsdem__restart_kind_name(kind), fsdem__restart_kind_name(o->kind));
+    else if (dim != (unsigned int)o->dim)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "dimension: the data hold a %uD state, the object is %dD", dim, o->dim);
+    else if (payload != (unsigned long long)(size - FSDEM__RESTART_HEADER))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s: %llu bytes after the header, %llu announced",
+                            payload > (unsigned long long)(size - FSDEM__RESTART_HEADER) ? "truncated" : "trailing bytes",
+                            (unsigned long long)(size - FSDEM__RESTART_HEADER), payload);
+    else if (fsdem__restart_fnv(fsdem__restart_fnv(FSDEM__RESTART_FNV_BASIS, data, 56), data + FSDEM__RESTART_HEADER,
+                                (size_t)payload) != sum)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "checksum mismatch: the data are corrupted");
+}
+
+/* Restores o from `size` bytes at `data`: the header, then the visitor's CHECK, RESERVE and COMMIT
+   passes over the payload. */
+static fsdem_result fsdem__restart_load(const fsdem__restart_object *o, const char *verb, const unsigned char *data,
+                                        size_t size) {
+    fsdem__restart io;
+    static const fsdem__restart_mode passes[3] = {FSDEM__RESTART_CHECK, FSDEM__RESTART_RESERVE, FSDEM__RESTART_COMMIT};
+    int pass;
+    fsdem__restart_begin(&io, o, verb, FSDEM__RESTART_CHECK);
+    fsdem__restart_check_header(&io, o, data, size);
+    for (pass = 0; pass < 3 && io.res == FSDEM_OK; ++pass) {
+        io.mode = passes[pass];
+        io.in = data + FSDEM__RESTART_HEADER;
+        io.size = size - FSDEM__RESTART_HEADER;
+        io.pos = 0;
+        o->visit(&io, o->object);
+        if (io.res == FSDEM_OK && io.pos != io.size)
+            fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "%llu bytes left unread (corrupted data)",
+                                (unsigned long long)(io.size - io.pos));
+    }
+    FSDEM_ASSERT(io.res != FSDEM_OK || io.block_next == io.block_count);
+    return fsdem__restart_end(&io, o);
+}
+
+/* Restores o from the file `path`, read whole into memory (FSDEM_ERR_IO when it cannot be). */
+static fsdem_result fsdem__restart_load_file(const fsdem__restart_object *o, const char *path) {
+    fsdem__restart io;
+    FILE *fp = path ? fopen(path, "rb") : NULL;
+    unsigned char *data = NULL;
+    long length = -1;
+    fsdem_result res;
+    fsdem__restart_begin(&io, o, "restore", FSDEM__RESTART_CHECK);
+    if (!path) fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "path is NULL");
+    else if (!fp) fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot open '%s'", path);
+    else if (fseek(fp, 0, SEEK_END) != 0 || (length = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET) != 0)
+        fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot read '%s'", path);
+    else if (!(data = (unsigned char *)fsdem__alloc(o->allocator, (size_t)length)))
+        fsdem__restart_fail(&io, FSDEM_ERR_OUT_OF_MEMORY, "out of memory for the %ld bytes of '%s'", length, path);
+    else if (fread(data, 1, (size_t)length, fp) != (size_t)length)
+        fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot read '%s'", path);
+    if (fp) fclose(fp);
+    res = io.res == FSDEM_OK ? fsdem__restart_load(o, "restore", data, (size_t)length) : fsdem__restart_end(&io, o);
+    fsdem__free(o->allocator, data, length > 0 ? (size_t)length : 1);
+    return res;
+}
+
+/* The public functions: save and restore, to files and to memory, for each of the four objects (a
+   few lines each around the helpers above). A NULL object is refused with FSDEM_ERR_INVALID_ARG
+   without a message (there is no object to hold it). */
+
+/* fsdem_dem (>>restart): the discrete elements. */
+fsdem_result fsdem_dem_save(const fsdem_dem *dem, const char *path) {
+    fsdem__restart_object o;
+    if (!dem) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_dem(dem);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_dem_restore(fsdem_dem *dem, const char *path) {
+    fsdem__restart_object o;
+    if (!dem) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_dem(dem);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_dem_save_memory(const fsdem_dem *dem, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o;
+    if (!dem) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_dem(dem);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_dem_restore_memory(fsdem_dem *dem, const void *buffer, size_t size) {
+    fsdem__restart_object o;
+    if (!dem) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_dem(dem);
+    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+}
+
+/* fsdem_pic (>>restart): the PIC/FLIP solver. */
+fsdem_result fsdem_pic_save(const fsdem_pic *pic, const char *path) {
+    fsdem__restart_object o;
+    if (!pic) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_pic(pic);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_pic_restore(fsdem_pic *pic, const char *path) {
+    fsdem__restart_object o;
+    if (!pic) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_pic(pic);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_pic_save_memory(const fsdem_pic *pic, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o;
+    if (!pic) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_pic(pic);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_pic_restore_memory(fsdem_pic *pic, const void *buffer, size_t size) {
+    fsdem__restart_object o;
+    if (!pic) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_pic(pic);
+    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+}
+
+/* fsdem_swe (>>restart): the shallow-water solver. */
+fsdem_result fsdem_swe_save(const fsdem_swe *swe, const char *path) {
+    fsdem__restart_object o;
+    if (!swe) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe(swe);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_swe_restore(fsdem_swe *swe, const char *path) {
+    fsdem__restart_object o;
+    if (!swe) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe(swe);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_swe_save_memory(const fsdem_swe *swe, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o;
+    if (!swe) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe(swe);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_swe_restore_memory(fsdem_swe *swe, const void *buffer, size_t size) {
+    fsdem__restart_object o;
+    if (!swe) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe(swe);
+    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+}
+
+/* fsdem_swe_dem (>>restart): the SWE-DEM coupler with its two solvers. */
+fsdem_result fsdem_swe_dem_save(const fsdem_swe_dem *coupler, const char *path) {
+    fsdem__restart_object o;
+    if (!coupler) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe_dem(coupler);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_swe_dem_restore(fsdem_swe_dem *coupler, const char *path) {
+    fsdem__restart_object o;
+    if (!coupler) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe_dem(coupler);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_swe_dem_save_memory(const fsdem_swe_dem *coupler, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o;
+    if (!coupler) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe_dem(coupler);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *buffer, size_t size) {
+    fsdem__restart_object o;
+    if (!coupler) return FSDEM_ERR_INVALID_ARG;
+    o = fsdem__restart_of_swe_dem(coupler);
+    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+}
+
+/* ===== >>impl_io : CSV, ParaView series, VTK XML ====================================================
+
+   Contents: >>io_csv (CSV time series), >>io_vtk (the VTK XML writer core, through which every VTK
+   file of the library is written), >>io_pvd (ParaView series), >>io_dem (particles, walls,
+   contacts), >>io_pic (particles, grid), >>io_swe (fields). */
+
+/* ---- >>io_csv : CSV time series ---- */
+
 
 fsdem_result fsdem_csv_open(fsdem_csv *csv, const char *path, const char *header) {
     FILE *fp;
@@ -11409,42 +12893,469 @@ fsdem_result fsdem_csv_close(fsdem_csv *csv) {
     return bad ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
+/* ---- >>io_vtk : the VTK XML writer core ----
+
+   A writer opens the file (fsdem__vtk_open), starts the dataset (fsdem__vtk_polydata or
+   fsdem__vtk_imagedata: the dataset element, FieldData TimeValue, <Piece>), writes sections of
+   arrays in VTK's order (fsdem__vtk_section, fsdem__vtk_write, fsdem__vtk_section_end; PolyData:
+   PointData, CellData, Points, Verts, Lines, Polys) and closes (fsdem__vtk_close: </Piece>, the
+   appended data, </VTKFile>). An array is a description (fsdem__vtk_array), not a copy: its values
+   are read through it when they are written, which for FSDEM_VTK_APPENDED is at the close, so the
+   data it points to must live until then (the description itself is copied). Each value goes
+   through a double, which holds every Float32, Float64, Int32 and UInt8 value exactly. Binary
+   numbers are written in the machine's byte order, which the root element names. The rules of the
+   three formats are those of fsdem_vtk_format (>>io). */
+
+typedef enum fsdem__vtk_type {
+    FSDEM__VTK_FLOAT32 = 0,
+    FSDEM__VTK_FLOAT64 = 1,
+    FSDEM__VTK_INT32 = 2,
+    FSDEM__VTK_UINT8 = 3
+} fsdem__vtk_type;
+
+#ifdef FSDEM_USE_FLOAT
+#define FSDEM__VTK_REAL FSDEM__VTK_FLOAT32
+#else
+#define FSDEM__VTK_REAL FSDEM__VTK_FLOAT64
+#endif
+
+/* Int32 values are written from an int and byte counts from an unsigned long long. */
+typedef char fsdem__vtk_int_is_32_bits[sizeof(int) == 4 ? 1 : -1];
+typedef char fsdem__vtk_ull_is_64_bits[sizeof(unsigned long long) == 8 ? 1 : -1];
+
+/* Where an array's values come from. */
+typedef enum fsdem__vtk_source {
+    FSDEM__VTK_FROM_REALS = 0,  /* const fsdem_real[count] */
+    FSDEM__VTK_FROM_VEC3S = 1,  /* const fsdem_vec3[count] (3 components) */
+    FSDEM__VTK_FROM_INTS = 2,   /* const int[count] */
+    FSDEM__VTK_FROM_BYTES = 3,  /* const unsigned char[count] */
+    FSDEM__VTK_FROM_RAMP = 4,   /* first + step * index (Int32) */
+    FSDEM__VTK_FROM_DOUBLE = 5, /* one const double, repeated */
+    FSDEM__VTK_FROM_FN = 6      /* a callback per tuple */
+} fsdem__vtk_source;
+
+/* Tuple `index` of a computed array into out[0 .. components - 1]. */
+typedef void (*fsdem__vtk_tuple_fn)(const void *user, long long index, double out[3]);
+
+typedef struct fsdem__vtk_array {
+    const char *name;
+    fsdem__vtk_type type;
+    int components; /* 1 or 3 */
+    long long count; /* tuples */
+    fsdem__vtk_source source;
+    const void *data; /* the values, or the callback's user */
+    fsdem__vtk_tuple_fn fn;
+    long long first, step; /* FSDEM__VTK_FROM_RAMP */
+} fsdem__vtk_array;
+
+#define FSDEM__VTK_MAX_ARRAYS 24 /* arrays of one file (the most any writer has is 14) */
+
+typedef struct fsdem__vtk_writer {
+    FILE *fp;
+    fsdem_vtk_format format;
+    const char *type;      /* "PolyData" or "ImageData" */
+    fsdem__status *status; /* the object's, for the message (may be NULL) */
+    const char *who, *path;
+    double time;           /* s, the TimeValue field */
+    unsigned long long appended; /* FSDEM_VTK_APPENDED: bytes of the blocks announced so far */
+    fsdem__vtk_array queue[FSDEM__VTK_MAX_ARRAYS]; /* FSDEM_VTK_APPENDED: the blocks to write */
+    int queued;
+} fsdem__vtk_writer;
+
+static fsdem__vtk_array fsdem__vtk_from(const char *name, fsdem__vtk_type type, int components, long long count,
+                                       fsdem__vtk_source source, const void *data) {
+    fsdem__vtk_array a;
+    memset(&a, 0, sizeof a);
+    a.name = name;
+    a.type = type;
+    a.components = components;
+    a.count = count;
+    a.source = source;
+    a.data = data;
+    return a;
+}
+static fsdem__vtk_array fsdem__vtk_reals(const char *name, const fsdem_real *p, long long n) {
+    return fsdem__vtk_from(name, FSDEM__VTK_REAL, 1, n, FSDEM__VTK_FROM_REALS, p);
+}
+static fsdem__vtk_array fsdem__vtk_vec3s(const char *name, const fsdem_vec3 *p, long long n) {
+    return fsdem__vtk_from(name, FSDEM__VTK_REAL, 3, n, FSDEM__VTK_FROM_VEC3S, p);
+}
+static fsdem__vtk_array fsdem__vtk_ints(const char *name, const int *p, long long n) {
+    return fsdem__vtk_from(name, FSDEM__VTK_INT32, 1, n, FSDEM__VTK_FROM_INTS, p);
+}
+static fsdem__vtk_array fsdem__vtk_bytes(const char *name, const unsigned char *p, long long n) {
+    return fsdem__vtk_from(name, FSDEM__VTK_UINT8, 1, n, FSDEM__VTK_FROM_BYTES, p);
+}
+/* Int32 values first, first + step, ... (connectivity and offsets of regular cells). */
+static fsdem__vtk_array fsdem__vtk_ramp(const char *name, long long n, long long first, long long step) {
+    fsdem__vtk_array a = fsdem__vtk_from(name, FSDEM__VTK_INT32, 1, n, FSDEM__VTK_FROM_RAMP, NULL);
+    a.first = first;
+    a.step = step;
+    return a;
+}
+static fsdem__vtk_array fsdem__vtk_computed(const char *name, fsdem__vtk_type type, int components, long long n,
+                                           fsdem__vtk_tuple_fn fn, const void *user) {
+    fsdem__vtk_array a = fsdem__vtk_from(name, type, components, n, FSDEM__VTK_FROM_FN, user);
+    a.fn = fn;
+    return a;
+}
+
+static const char *fsdem__vtk_type_name(fsdem__vtk_type t) {
+    switch (t) {
+    case FSDEM__VTK_FLOAT32: return "Float32";
+    case FSDEM__VTK_FLOAT64: return "Float64";
+    case FSDEM__VTK_INT32: return "Int32";
+    default: return "UInt8";
+    }
+}
+
+static size_t fsdem__vtk_type_size(fsdem__vtk_type t) {
+    return t == FSDEM__VTK_FLOAT64 ? 8 : t == FSDEM__VTK_UINT8 ? 1 : 4;
+}
+
+static int fsdem__vtk_little_endian(void) {
+    const unsigned int one = 1;
+    unsigned char first;
+    memcpy(&first, &one, 1);
+    return first == 1;
+}
+
+static void fsdem__vtk_tuple(const fsdem__vtk_array *a, long long i, double v[3]) {
+    switch (a->source) {
+    case FSDEM__VTK_FROM_REALS: v[0] = (double)((const fsdem_real *)a->data)[i]; break;
+    case FSDEM__VTK_FROM_VEC3S: {
+        const fsdem_vec3 p = ((const fsdem_vec3 *)a->data)[i];
+        v[0] = (double)p.x;
+        v[1] = (double)p.y;
+        v[2] = (double)p.z;
+        break;
+    }
+    case FSDEM__VTK_FROM_INTS: v[0] = (double)((const int *)a->data)[i]; break;
+    case FSDEM__VTK_FROM_BYTES: v[0] = (double)((const unsigned char *)a->data)[i]; break;
+    case FSDEM__VTK_FROM_RAMP: v[0] = (double)(a->first + a->step * i); break;
+    case FSDEM__VTK_FROM_DOUBLE: v[0] = *(const double *)a->data; break;
+    default: a->fn(a->data, i, v); break;
+    }
+}
+
+/* One value in the array's type, in the machine's byte order, into out; returns its size. */
+static size_t fsdem__vtk_pack(fsdem__vtk_type t, double v, unsigned char *out) {
+    switch (t) {
+    case FSDEM__VTK_FLOAT32: {
+        const float f = (float)v;
+        memcpy(out, &f, 4);
+        return 4;
+    }
+    case FSDEM__VTK_FLOAT64: memcpy(out, &v, 8); return 8;
+    case FSDEM__VTK_INT32: {
+        const int k = (int)v;
+        memcpy(out, &k, 4);
+        return 4;
+    }
+    default: out[0] = (unsigned char)v; return 1;
+    }
+}
+
+/* Binary output: raw bytes (appended), or base64 (inline) kept as one stream across calls. */
+typedef struct fsdem__vtk_sink {
+    fsdem__vtk_writer *w;
+    unsigned char pending[3];
+    int npending;
+    char text[4096];
+    int ntext;
+} fsdem__vtk_sink;
+
+static void fsdem__vtk_sink_put(fsdem__vtk_sink *s, const unsigned char *p, size_t n) {
+    static const char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    if (s->w->format == FSDEM_VTK_APPENDED) {
+        fwrite(p, 1, n, s->w->fp);
+        return;
+    }
+    while (n--) {
+        s->pending[s->npending++] = *p++;
+        if (s->npending < 3) continue;
+        if (s->ntext + 4 > (int)sizeof s->text) {
+            fwrite(s->text, 1, (size_t)s->ntext, s->w->fp);
+            s->ntext = 0;
+        }
+        s->text[s->ntext++] = digits[s->pending[0] >> 2];
+        s->text[s->ntext++] = digits[((s->pending[0] & 3) << 4) | (s->pending[1] >> 4)];
+        s->text[s->ntext++] = digits[((s->pending[1] & 15) << 2) | (s->pending[2] >> 6)];
+        s->text[s->ntext++] = digits[s->pending[2] & 63];
+        s->npending = 0;
+    }
+}
+
+/* Ends a base64 stream: the last one or two bytes with '=' padding. */
+static void fsdem__vtk_sink_end(fsdem__vtk_sink *s) {
+    static const char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    if (s->w->format == FSDEM_VTK_APPENDED) return;
+    if (s->npending) {
+        const unsigned char b0 = s->pending[0], b1 = s->npending > 1 ? s->pending[1] : 0;
+        char quad[4];
+        quad[0] = digits[b0 >> 2];
+        quad[1] = digits[((b0 & 3) << 4) | (b1 >> 4)];
+        quad[2] = s->npending > 1 ? digits[(b1 & 15) << 2] : '=';
+        quad[3] = '=';
+        fwrite(s->text, 1, (size_t)s->ntext, s->w->fp);
+        s->ntext = 0;
+        fwrite(quad, 1, 4, s->w->fp);
+        s->npending = 0;
+    }
+    fwrite(s->text, 1, (size_t)s->ntext, s->w->fp);
+    s->ntext = 0;
+}
+
+static unsigned long long fsdem__vtk_bytes_of(const fsdem__vtk_array *a) {
+    return (unsigned long long)a->count * (unsigned long long)a->components * fsdem__vtk_type_size(a->type);
+}
+
+/* The values of an array in the writer's format: text, or the byte count and the data in binary. */
+static void fsdem__vtk_values(fsdem__vtk_writer *w, const fsdem__vtk_array *a) {
+    long long i;
+    int c;
+    double v[3];
+    if (w->format == FSDEM_VTK_ASCII) {
+        for (i = 0; i < a->count; ++i) {
+            fsdem__vtk_tuple(a, i, v);
+            for (c = 0; c < a->components; ++c) {
+                const char sep = c + 1 < a->components ? ' ' : '\n';
+                switch (a->type) {
+                case FSDEM__VTK_FLOAT32: fprintf(w->fp, "%.9g%c", (double)(float)v[c], sep); break;
+                case FSDEM__VTK_FLOAT64: fprintf(w->fp, "%.17g%c", v[c], sep); break;
+                case FSDEM__VTK_INT32: fprintf(w->fp, "%d%c", (int)v[c], sep); break;
+                default: fprintf(w->fp, "%u%c", (unsigned)(unsigned char)v[c], sep); break;
+                }
+            }
+        }
+    } else {
+        /* whole tuples of up to 3 x 8 bytes fill the buffer; flushed at 3072 - 24 */
+        unsigned char buf[3072];
+        const unsigned long long bytes = fsdem__vtk_bytes_of(a);
+        fsdem__vtk_sink sink;
+        size_t used;
+        sink.w = w;
+        sink.npending = sink.ntext = 0;
+        memcpy(buf, &bytes, 8);
+        used = 8;
+        for (i = 0; i < a->count; ++i) {
+            if (used + 24 > sizeof buf) {
+                fsdem__vtk_sink_put(&sink, buf, used);
+                used = 0;
+            }
+            fsdem__vtk_tuple(a, i, v);
+            for (c = 0; c < a->components; ++c) used += fsdem__vtk_pack(a->type, v[c], buf + used);
+        }
+        fsdem__vtk_sink_put(&sink, buf, used);
+        fsdem__vtk_sink_end(&sink);
+    }
+}
+
+/* A <DataArray>: inline with its values (ascii, base64), or announced with its offset and queued for
+   the appended data. `field`: a FieldData array, which also names its number of tuples. */
+static void fsdem__vtk_write_array(fsdem__vtk_writer *w, fsdem__vtk_array a, int field) {
+    static const char *const formats[3] = {"ascii", "binary", "appended"};
+    fprintf(w->fp, "<DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" format=\"%s\"", fsdem__vtk_type_name(a.type),
+            a.name, a.components, formats[w->format]);
+    if (field) fprintf(w->fp, " NumberOfTuples=\"%lld\"", a.count);
+    if (w->format == FSDEM_VTK_APPENDED) {
+        FSDEM_ASSERT(w->queued < FSDEM__VTK_MAX_ARRAYS);
+        fprintf(w->fp, " offset=\"%llu\"/>\n", w->appended);
+        w->queue[w->queued++] = a;
+        w->appended += 8 + fsdem__vtk_bytes_of(&a);
+        return;
+    }
+    fputs(">\n", w->fp);
+    fsdem__vtk_values(w, &a);
+    fputs(w->format == FSDEM_VTK_BASE64 ? "\n</DataArray>\n" : "</DataArray>\n", w->fp);
+}
+
+static void fsdem__vtk_write(fsdem__vtk_writer *w, fsdem__vtk_array a) { fsdem__vtk_write_array(w, a, 0); }
+
+/* Checks the arguments every writer shares; the message goes to `status` (may be NULL). */
+static fsdem_result fsdem__vtk_check(fsdem__status *status, const char *who, const char *path, fsdem_vtk_format format) {
+    fsdem__status scratch;
+    fsdem__status *st = status ? status : &scratch;
+    if (!status) scratch.log = NULL;
+    if (!path) return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: path is NULL", who);
+    if ((int)format < (int)FSDEM_VTK_ASCII || (int)format > (int)FSDEM_VTK_APPENDED)
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: format %d is not a fsdem_vtk_format", who, (int)format);
+    return FSDEM_OK;
+}
+
+/* Checks the arguments, creates the file and writes the root element of a dataset `type`. */
+static fsdem_result fsdem__vtk_open(fsdem__vtk_writer *w, fsdem__status *status, const char *who, const char *path,
+                                    fsdem_vtk_format format, const char *type) {
+    fsdem_result res = fsdem__vtk_check(status, who, path, format);
+    memset(w, 0, sizeof *w);
+    if (res != FSDEM_OK) return res;
+    w->format = format;
+    w->type = type;
+    w->status = status;
+    w->who = who;
+    w->path = path;
+    w->fp = fopen(path, "wb");
+    if (!w->fp) {
+        if (status) fsdem__fail(status, FSDEM_ERR_IO, "%s: cannot open '%s' for writing", who, path);
+        return FSDEM_ERR_IO;
+    }
+    fprintf(w->fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"%s\" version=\"1.0\" byte_order=\"%s\" header_type=\"UInt64\">\n",
+            type, fsdem__vtk_little_endian() ? "LittleEndian" : "BigEndian");
+    return FSDEM_OK;
+}
+
+/* The FieldData of the dataset: TimeValue (s). */
+static void fsdem__vtk_time(fsdem__vtk_writer *w, double time) {
+    w->time = time;
+    fputs("<FieldData>\n", w->fp);
+    fsdem__vtk_write_array(w, fsdem__vtk_from("TimeValue", FSDEM__VTK_FLOAT64, 1, 1, FSDEM__VTK_FROM_DOUBLE, &w->time), 1);
+    fputs("</FieldData>\n", w->fp);
+}
+
+/* <PolyData>, the time, and the piece's counts (strips are never written). */
+static void fsdem__vtk_polydata(fsdem__vtk_writer *w, double time, long long points, long long verts, long long lines,
+                                long long polys) {
+    fputs("<PolyData>\n", w->fp);
+    fsdem__vtk_time(w, time);
+    fprintf(w->fp,
+            "<Piece NumberOfPoints=\"%lld\" NumberOfVerts=\"%lld\" NumberOfLines=\"%lld\" NumberOfStrips=\"0\" "
+            "NumberOfPolys=\"%lld\">\n",
+            points, verts, lines, polys);
+}
+
+/* <ImageData> of cells[0] x cells[1] x cells[2] cells (0 for a flat axis: one layer of points), the
+   time, and the piece, which is the whole extent. */
+static void fsdem__vtk_imagedata(fsdem__vtk_writer *w, double time, const int cells[3], const double origin[3],
+                                 const double spacing[3]) {
+    fprintf(w->fp, "<ImageData WholeExtent=\"0 %d 0 %d 0 %d\" Origin=\"%.17g %.17g %.17g\" Spacing=\"%.17g %.17g %.17g\">\n",
+            cells[0], cells[1], cells[2], origin[0], origin[1], origin[2], spacing[0], spacing[1], spacing[2]);
+    fsdem__vtk_time(w, time);
+    fprintf(w->fp, "<Piece Extent=\"0 %d 0 %d 0 %d\">\n", cells[0], cells[1], cells[2]);
+}
+
+/* Opens a section (PointData, CellData, Points, Verts, Lines, Polys) with its active scalars and
+   vectors (may be NULL). */
+static void fsdem__vtk_section(fsdem__vtk_writer *w, const char *tag, const char *scalars, const char *vectors) {
+    fprintf(w->fp, "<%s", tag);
+    if (scalars) fprintf(w->fp, " Scalars=\"%s\"", scalars);
+    if (vectors) fprintf(w->fp, " Vectors=\"%s\"", vectors);
+    fputs(">\n", w->fp);
+}
+
+static void fsdem__vtk_section_end(fsdem__vtk_writer *w, const char *tag) { fprintf(w->fp, "</%s>\n", tag); }
+
+/* A cell section (Verts, Lines, Polys) from its connectivity and offsets (Int32). */
+static void fsdem__vtk_cells(fsdem__vtk_writer *w, const char *tag, fsdem__vtk_array connectivity, fsdem__vtk_array offsets) {
+    fsdem__vtk_section(w, tag, NULL, NULL);
+    fsdem__vtk_write(w, connectivity);
+    fsdem__vtk_write(w, offsets);
+    fsdem__vtk_section_end(w, tag);
+}
+
+/* Closes the piece and the dataset, writes the appended data and closes the file. The object's
+   message names the path on failure, and is cleared on success. */
+static fsdem_result fsdem__vtk_close(fsdem__vtk_writer *w) {
+    int k, bad;
+    fprintf(w->fp, "</Piece>\n</%s>\n", w->type);
+    if (w->format == FSDEM_VTK_APPENDED) {
+        fputs("<AppendedData encoding=\"raw\">\n_", w->fp);
+        for (k = 0; k < w->queued; ++k) fsdem__vtk_values(w, &w->queue[k]);
+        fputs("\n</AppendedData>\n", w->fp);
+    }
+    fputs("</VTKFile>\n", w->fp);
+    bad = ferror(w->fp) != 0;
+    bad |= fclose(w->fp) != 0;
+    w->fp = NULL;
+    if (bad) return w->status ? fsdem__fail(w->status, FSDEM_ERR_IO, "%s: write error on '%s'", w->who, w->path) : FSDEM_ERR_IO;
+    return w->status ? fsdem__ok(w->status) : FSDEM_OK;
+}
+
+/* ---- >>io_pvd : ParaView series ---- */
+
+/* The closing tags, at the current position. */
+static fsdem_result fsdem__io_pvd_finish(FILE *fp) {
+    fputs("</Collection>\n</VTKFile>\n", fp);
+    fflush(fp);
+    return ferror(fp) ? FSDEM_ERR_IO : FSDEM_OK;
+}
+
 fsdem_result fsdem_pvd_open(fsdem_pvd *pvd, const char *path) {
     FILE *fp;
+    long tail;
     if (!pvd || !path) return FSDEM_ERR_INVALID_ARG;
     pvd->file = NULL;
+    pvd->tail = 0;
+    pvd->count = 0;
     fp = fopen(path, "w");
     if (!fp) return FSDEM_ERR_IO;
-    if (fprintf(fp, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n") < 0) {
+    fputs("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n", fp);
+    tail = ftell(fp);
+    if (tail < 0 || fsdem__io_pvd_finish(fp) != FSDEM_OK) {
         fclose(fp);
         return FSDEM_ERR_IO;
     }
     pvd->file = fp;
-    fflush(fp);
+    pvd->tail = tail;
     return FSDEM_OK;
 }
 
-fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, fsdem_real time, const char *file) {
-    if (!pvd || !pvd->file || !file) return FSDEM_ERR_INVALID_ARG;
-    if (fprintf((FILE *)pvd->file, "<DataSet timestep=\"%.9g\" part=\"0\" file=\"%s\"/>\n", (double)time, file) < 0)
-        return FSDEM_ERR_IO;
-    fflush((FILE *)pvd->file);
+/* A piece the series reader can take: a serial VTK XML file by its extension, no control character. */
+static int fsdem__io_pvd_piece_ok(const char *file) {
+    static const char *const ext[5] = {".vtp", ".vtu", ".vti", ".vts", ".vtr"};
+    const char *c;
+    size_t n = strlen(file);
+    int k;
+    for (c = file; *c; ++c)
+        if ((unsigned char)*c < 0x20 || *c == 0x7f) return 0;
+    for (k = 0; k < 5; ++k)
+        if (n > 4 && strcmp(file + n - 4, ext[k]) == 0) return 1;
+    return 0;
+}
+
+fsdem_result fsdem_pvd_add(fsdem_pvd *pvd, double time, const char *file) {
+    FILE *fp;
+    const char *c;
+    long tail;
+    if (!pvd || !pvd->file || !file || !(time == time && time - time == 0) || !fsdem__io_pvd_piece_ok(file))
+        return FSDEM_ERR_INVALID_ARG;
+    fp = (FILE *)pvd->file;
+    if (fseek(fp, pvd->tail, SEEK_SET) != 0) return FSDEM_ERR_IO;
+    fprintf(fp, "<DataSet timestep=\"%.17g\" part=\"0\" file=\"", time);
+    for (c = file; *c; ++c) switch (*c) {
+        case '&': fputs("&amp;", fp); break;
+        case '<': fputs("&lt;", fp); break;
+        case '>': fputs("&gt;", fp); break;
+        case '"': fputs("&quot;", fp); break;
+        case '\'': fputs("&apos;", fp); break;
+        default: fputc(*c, fp); break;
+        }
+    fputs("\"/>\n", fp);
+    tail = ftell(fp);
+    if (tail < 0 || fsdem__io_pvd_finish(fp) != FSDEM_OK) return FSDEM_ERR_IO;
+    pvd->tail = tail;
+    pvd->count++;
     return FSDEM_OK;
 }
 
 fsdem_result fsdem_pvd_close(fsdem_pvd *pvd) {
+    FILE *fp;
     int bad;
     if (!pvd || !pvd->file) return FSDEM_ERR_INVALID_ARG;
-    bad = fprintf((FILE *)pvd->file, "</Collection>\n</VTKFile>\n") < 0;
-    bad |= fclose((FILE *)pvd->file) != 0;
+    fp = (FILE *)pvd->file;
+    /* the tags are there already; written again in case an add failed part way */
+    bad = fseek(fp, pvd->tail, SEEK_SET) != 0 || fsdem__io_pvd_finish(fp) != FSDEM_OK;
+    bad |= fclose(fp) != 0;
     pvd->file = NULL;
     return bad ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
+/* ---- >>io_dem : particles, walls, contacts ---- */
+
 fsdem_result fsdem_dem_write_csv(const fsdem_dem *d, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
+    FILE *fp;
     int i, bad;
-    if (!fp) return FSDEM_ERR_IO;
+    if (!d || !path) return FSDEM_ERR_INVALID_ARG;
+    if (!(fp = fopen(path, "w"))) return FSDEM_ERR_IO;
     fprintf(fp, "id,x,y,z,vx,vy,vz,wx,wy,wz,radius,material\n");
     for (i = 0; i < d->n; ++i)
         fprintf(fp, "%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d\n", d->id[i], (double)d->x[i].x,
@@ -11454,29 +13365,500 @@ fsdem_result fsdem_dem_write_csv(const fsdem_dem *d, const char *path) {
     return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
-static void fsdem__io_vtk_vectors(FILE *fp, const char *name, const fsdem_vec3 *v, int n) {
-    int i;
-    fprintf(fp, "VECTORS %s double\n", name);
-    for (i = 0; i < n; ++i) fprintf(fp, "%.10g %.10g %.10g\n", (double)v[i].x, (double)v[i].y, (double)v[i].z);
+fsdem_result fsdem_dem_write_vtp(const fsdem_dem *d, const char *path, fsdem_vtk_format format) {
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem__vtk_open(&w, (fsdem__status *)&d->status, "fsdem_dem_write_vtp", path, format, "PolyData");
+    if (res != FSDEM_OK) return res;
+    fsdem__vtk_polydata(&w, d->time, d->n, d->n, 0, 0);
+    fsdem__vtk_section(&w, "PointData", "radius", "velocity");
+    fsdem__vtk_write(&w, fsdem__vtk_ints("id", d->id, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("radius", d->r, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("mass", d->m, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_ints("material", d->material, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_bytes("fixed", d->fixed, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("velocity", d->v, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("angular_velocity", d->w, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("force", d->f, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("torque", d->t, d->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("external_force", d->fext, d->n));
+    fsdem__vtk_section_end(&w, "PointData");
+    fsdem__vtk_section(&w, "Points", NULL, NULL);
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", d->x, d->n));
+    fsdem__vtk_section_end(&w, "Points");
+    fsdem__vtk_cells(&w, "Verts", fsdem__vtk_ramp("connectivity", d->n, 0, 1), fsdem__vtk_ramp("offsets", d->n, 1, 1));
+    return fsdem__vtk_close(&w);
 }
 
-fsdem_result fsdem_dem_write_vtk(const fsdem_dem *d, const char *path) {
-    FILE *fp = path ? fopen(path, "w") : NULL;
-    int i, bad;
-    if (!fp) return FSDEM_ERR_IO;
-    fprintf(fp, "# vtk DataFile Version 3.0\nfsdem particles t=%.10g s\nASCII\nDATASET POLYDATA\n", (double)d->time);
-    fprintf(fp, "POINTS %d double\n", d->n);
-    for (i = 0; i < d->n; ++i) fprintf(fp, "%.10g %.10g %.10g\n", (double)d->x[i].x, (double)d->x[i].y, (double)d->x[i].z);
-    fprintf(fp, "VERTICES %d %d\n", d->n, 2 * d->n);
-    for (i = 0; i < d->n; ++i) fprintf(fp, "1 %d\n", i);
-    fprintf(fp, "POINT_DATA %d\nSCALARS radius double 1\nLOOKUP_TABLE default\n", d->n);
-    for (i = 0; i < d->n; ++i) fprintf(fp, "%.10g\n", (double)d->r[i]);
-    fprintf(fp, "SCALARS id int 1\nLOOKUP_TABLE default\n");
-    for (i = 0; i < d->n; ++i) fprintf(fp, "%d\n", d->id[i]);
-    fsdem__io_vtk_vectors(fp, "velocity", d->v, d->n);
-    fsdem__io_vtk_vectors(fp, "angular_velocity", d->w, d->n);
-    bad = ferror(fp);
-    return (fclose(fp) != 0 || bad) ? FSDEM_ERR_IO : FSDEM_OK;
+/* Wall geometry for the writer: points, cells (connectivity, offsets) and per-cell wall data, the
+   line cells (two points) first and then the polygons, as VTK orders PolyData cells. Points are not
+   shared, so the connectivity of point k is k; offsets count from the start of their section. */
+typedef struct fsdem__io_walls {
+    fsdem_vec3 *points;
+    int *connectivity, *offsets, *wall_id;
+    unsigned char *type;
+    fsdem_vec3 *force;
+    int points_count, cells_count;
+    int lines;                     /* the pass: 1 takes line cells, 0 polygons */
+    int section_start;             /* points before the current section */
+    int line_cells, line_points;   /* the line section, after the build */
+} fsdem__io_walls;
+
+#define FSDEM__IO_WALL_POINTS 24 /* the most points of one wall: a 3D box's six faces of four */
+#define FSDEM__IO_WALL_CELLS 6
+
+static void fsdem__io_walls_cell(fsdem__io_walls *g, const fsdem_vec3 *v, int n, int id, const fsdem__dem_wall *w) {
+    int k;
+    if ((n == 2) != g->lines) return; /* the other pass's */
+    for (k = 0; k < n; ++k) {
+        g->connectivity[g->points_count] = g->points_count;
+        g->points[g->points_count++] = v[k];
+    }
+    g->offsets[g->cells_count] = g->points_count - g->section_start;
+    g->wall_id[g->cells_count] = id;
+    g->type[g->cells_count] = (unsigned char)w->d.type;
+    g->force[g->cells_count++] = w->force;
+}
+
+/* Keeps the part of a convex polygon where sign (x_axis - bound) >= 0 (Sutherland-Hodgman). */
+static int fsdem__io_clip(const fsdem_vec3 *in, int n, fsdem_vec3 *out, int axis, fsdem_real bound, fsdem_real sign) {
+    int k, m = 0;
+    for (k = 0; k < n; ++k) {
+        const fsdem_vec3 cur = in[k], prev = in[(k + n - 1) % n];
+        const fsdem_real dc = sign * (fsdem__comp(cur, axis) - bound), dp = sign * (fsdem__comp(prev, axis) - bound);
+        if ((dc >= 0) != (dp >= 0)) {
+            fsdem_vec3 q = fsdem__madd(prev, fsdem__sub(cur, prev), dp / (dp - dc));
+            if (axis == 0) q.x = bound;
+            else if (axis == 1) q.y = bound;
+            else q.z = bound;
+            out[m++] = q;
+        }
+        if (dc >= 0) out[m++] = cur;
+    }
+    return m;
+}
+
+/* A plane (through p, unit normal n) drawn inside the box [lo, hi]: in 3D the convex polygon where
+   they meet, ordered counter-clockwise about n (up to 10 vertices), in 2D the chord of the line
+   through the rectangle (2 vertices, z = 0). Returns the number of vertices; fewer than 3 in 3D or
+   2 in 2D: the plane misses the box. */
+static int fsdem__io_plane_patch(fsdem_vec3 p, fsdem_vec3 n, fsdem_vec3 lo, fsdem_vec3 hi, int dim, fsdem_vec3 *out) {
+    const fsdem_vec3 mid = fsdem__scale(fsdem__add(lo, hi), (fsdem_real)0.5);
+    const fsdem_vec3 c = fsdem__madd(mid, n, -fsdem__dot(fsdem__sub(mid, p), n)); /* mid projected on the plane */
+    fsdem_vec3 diag = fsdem__sub(hi, lo);
+    fsdem_real half;
+    int axis, count;
+    if (dim == 2) diag.z = 0;
+    half = fsdem__norm(diag); /* every point of the box projects within half of c */
+    if (dim == 2) {
+        const fsdem_vec3 t = fsdem_v3(-n.y, n.x, 0);
+        fsdem_real t0 = -half, t1 = half;
+        for (axis = 0; axis < 2; ++axis) {
+            const fsdem_real ta = fsdem__comp(t, axis), ca = fsdem__comp(c, axis);
+            const fsdem_real la = fsdem__comp(lo, axis), ha = fsdem__comp(hi, axis);
+            if (ta == 0) {
+                if (ca < la || ca > ha) return 0;
+            } else {
+                fsdem_real a = (la - ca) / ta, b = (ha - ca) / ta;
+                if (a > b) {
+                    const fsdem_real s = a;
+                    a = b;
+                    b = s;
+                }
+                if (a > t0) t0 = a;
+                if (b < t1) t1 = b;
+            }
+        }
+        if (!(t0 < t1)) return 0;
+        out[0] = fsdem__madd(c, t, t0);
+        out[1] = fsdem__madd(c, t, t1);
+        out[0].z = out[1].z = 0;
+        return 2;
+    } else {
+        /* u, v = n x u: an orthonormal basis of the plane with u x v = n */
+        const fsdem_real ax = n.x < 0 ? -n.x : n.x, ay = n.y < 0 ? -n.y : n.y, az = n.z < 0 ? -n.z : n.z;
+        const fsdem_vec3 e = ax <= ay && ax <= az ? fsdem_v3(1, 0, 0) : ay <= az ? fsdem_v3(0, 1, 0) : fsdem_v3(0, 0, 1);
+        fsdem_vec3 u = fsdem__cross(e, n), v, a[12], b[12];
+        u = fsdem__scale(u, half / fsdem__norm(u));
+        v = fsdem__cross(n, u);
+        a[0] = fsdem__sub(fsdem__sub(c, u), v);
+        a[1] = fsdem__sub(fsdem__add(c, u), v);
+        a[2] = fsdem__add(fsdem__add(c, u), v);
+        a[3] = fsdem__add(fsdem__sub(c, u), v);
+        count = 4;
+        for (axis = 0; axis < 3 && count >= 3; ++axis) {
+            count = fsdem__io_clip(a, count, b, axis, fsdem__comp(lo, axis), 1);
+            count = fsdem__io_clip(b, count, a, axis, fsdem__comp(hi, axis), -1);
+        }
+        if (count < 3) return 0;
+        memcpy(out, a, sizeof *a * (size_t)count);
+        return count;
+    }
+}
+
+/* The cells of the drawable walls of the pass g->lines into g (room for FSDEM__IO_WALL_POINTS points
+   and FSDEM__IO_WALL_CELLS cells per wall). */
+static void fsdem__io_walls_pass(const fsdem_dem *d, fsdem__io_walls *g) {
+    /* a 3D box's faces as corners (bit 0: x at hi, bit 1: y, bit 2: z), counter-clockwise seen from outside */
+    static const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    const int dim = d->desc.dim;
+    int id, f, k;
+    for (id = 0; id < d->wall_count; ++id) {
+        const fsdem__dem_wall *w = &d->walls[id];
+        const fsdem_dem_wall_desc *gd = &w->d;
+        fsdem_vec3 v[12];
+        if (!w->active) continue;
+        switch (gd->type) {
+        case FSDEM_DEM_WALL_PLANE:
+            k = fsdem__io_plane_patch(gd->a, gd->b, d->desc.domain_min, d->desc.domain_max, dim, v);
+            if (k >= (dim == 2 ? 2 : 3)) fsdem__io_walls_cell(g, v, k, id, w);
+            break;
+        case FSDEM_DEM_WALL_BOX_INSIDE:
+        case FSDEM_DEM_WALL_BOX_OUTSIDE:
+            if (dim == 2) {
+                const fsdem_vec3 r[4] = {fsdem_v3(gd->a.x, gd->a.y, 0), fsdem_v3(gd->b.x, gd->a.y, 0), fsdem_v3(gd->b.x, gd->b.y, 0),
+                                         fsdem_v3(gd->a.x, gd->b.y, 0)};
+                for (f = 0; f < 4; ++f) {
+                    v[0] = r[f];
+                    v[1] = r[(f + 1) % 4];
+                    fsdem__io_walls_cell(g, v, 2, id, w);
+                }
+            } else
+                for (f = 0; f < 6; ++f) {
+                    for (k = 0; k < 4; ++k) {
+                        /* an inside box holds the particles: its faces face inwards */
+                        const int corner = faces[f][gd->type == FSDEM_DEM_WALL_BOX_INSIDE ? 3 - k : k];
+                        v[k] = fsdem_v3(corner & 1 ? gd->b.x : gd->a.x, corner & 2 ? gd->b.y : gd->a.y, corner & 4 ? gd->b.z : gd->a.z);
+                    }
+                    fsdem__io_walls_cell(g, v, 4, id, w);
+                }
+            break;
+        case FSDEM_DEM_WALL_SEGMENT:
+            v[0] = gd->a;
+            v[1] = gd->b;
+            fsdem__io_walls_cell(g, v, 2, id, w);
+            break;
+        case FSDEM_DEM_WALL_TRIANGLE:
+            v[0] = gd->a;
+            v[1] = gd->b;
+            v[2] = gd->c;
+            fsdem__io_walls_cell(g, v, 3, id, w);
+            break;
+        default: break; /* SDF: known only through its callback */
+        }
+    }
+}
+
+/* Every drawable wall: the line cells (2D walls, segments), then the polygons (3D walls). */
+static void fsdem__io_walls_build(const fsdem_dem *d, fsdem__io_walls *g) {
+    g->points_count = g->cells_count = g->section_start = 0;
+    g->lines = 1;
+    fsdem__io_walls_pass(d, g);
+    g->line_cells = g->cells_count;
+    g->line_points = g->section_start = g->points_count;
+    g->lines = 0;
+    fsdem__io_walls_pass(d, g);
+}
+
+fsdem_result fsdem_dem_write_walls_vtp(const fsdem_dem *d, const char *path, fsdem_vtk_format format) {
+    static const char *const who = "fsdem_dem_write_walls_vtp";
+    const size_t walls = d && d->wall_count > 0 ? (size_t)d->wall_count : 1; /* no allocation of 0 bytes */
+    const size_t np = FSDEM__IO_WALL_POINTS * walls, nc = FSDEM__IO_WALL_CELLS * walls;
+    fsdem__status *st;
+    fsdem__io_walls g;
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&d->status; /* the message is the object's only mutable part here */
+    res = fsdem__vtk_check(st, who, path, format);
+    if (res != FSDEM_OK) return res;
+    g.points = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * np);
+    g.connectivity = (int *)fsdem__alloc(&d->allocator, sizeof(int) * np);
+    g.offsets = (int *)fsdem__alloc(&d->allocator, sizeof(int) * nc);
+    g.wall_id = (int *)fsdem__alloc(&d->allocator, sizeof(int) * nc);
+    g.type = (unsigned char *)fsdem__alloc(&d->allocator, nc);
+    g.force = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * nc);
+    if (!g.points || !g.connectivity || !g.offsets || !g.wall_id || !g.type || !g.force)
+        res = fsdem__fail(st, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory (%d walls)", who, d->wall_count);
+    else {
+        fsdem__io_walls_build(d, &g);
+        res = fsdem__vtk_open(&w, st, who, path, format, "PolyData");
+        if (res == FSDEM_OK) {
+            const int polys = g.cells_count - g.line_cells;
+            fsdem__vtk_polydata(&w, d->time, g.points_count, 0, g.line_cells, polys);
+            fsdem__vtk_section(&w, "CellData", "wall_id", "force");
+            fsdem__vtk_write(&w, fsdem__vtk_ints("wall_id", g.wall_id, g.cells_count));
+            fsdem__vtk_write(&w, fsdem__vtk_bytes("type", g.type, g.cells_count));
+            fsdem__vtk_write(&w, fsdem__vtk_vec3s("force", g.force, g.cells_count));
+            fsdem__vtk_section_end(&w, "CellData");
+            fsdem__vtk_section(&w, "Points", NULL, NULL);
+            fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", g.points, g.points_count));
+            fsdem__vtk_section_end(&w, "Points");
+            if (g.line_cells)
+                fsdem__vtk_cells(&w, "Lines", fsdem__vtk_ints("connectivity", g.connectivity, g.line_points),
+                                 fsdem__vtk_ints("offsets", g.offsets, g.line_cells));
+            if (polys)
+                fsdem__vtk_cells(&w, "Polys", fsdem__vtk_ints("connectivity", g.connectivity + g.line_points, g.points_count - g.line_points),
+                                 fsdem__vtk_ints("offsets", g.offsets + g.line_cells, polys));
+            res = fsdem__vtk_close(&w);
+        }
+    }
+    fsdem__free(&d->allocator, g.points, sizeof(fsdem_vec3) * np);
+    fsdem__free(&d->allocator, g.connectivity, sizeof(int) * np);
+    fsdem__free(&d->allocator, g.offsets, sizeof(int) * nc);
+    fsdem__free(&d->allocator, g.wall_id, sizeof(int) * nc);
+    fsdem__free(&d->allocator, g.type, nc);
+    fsdem__free(&d->allocator, g.force, sizeof(fsdem_vec3) * nc);
+    return res;
+}
+
+/* Contacts for the writer: two points and the cell data of each. */
+typedef struct fsdem__io_contacts {
+    fsdem_vec3 *points; /* 2 per contact */
+    fsdem_vec3 *force;
+    fsdem_real *normal_force, *overlap;
+    int *particle, *partner;
+    int count;
+} fsdem__io_contacts;
+
+/* The contact law on a filled batch, as fsdem__dem_drain runs it, with the law chosen at run time
+   (one more instantiation of the kernel; the step's are per law). */
+static void fsdem__io_dem_batch_law(fsdem__dem_batch *b, fsdem_dem_law law, fsdem_real h, int pairs, fsdem_real off,
+                                    const fsdem__dem_pair *uniform) {
+    fsdem__dem_batch_law(b, law, h, pairs, off, uniform);
+}
+
+/* Runs the law on a batch of particle pairs or (`walls`) wall contacts and appends its contacts to
+   c, leaving the object as it is (nothing is scattered, no spring is committed); empties the batch. */
+static void fsdem__io_dem_drain(const fsdem_dem *d, fsdem__dem_batch *batch, int walls, fsdem_real h, fsdem__io_contacts *c) {
+    const fsdem__dem_pair *uniform = d->material_count == 1 ? d->pairs : NULL;
+    const fsdem__dem_batch *b = batch; /* read only after the law */
+    const fsdem_real off = d->desc.contact_offset;
+    int k;
+    fsdem__dem_batch_pad(batch, !walls, uniform != NULL);
+    fsdem__io_dem_batch_law(batch, d->desc.law, h, !walls, walls ? 0 : off, uniform);
+    for (k = 0; k < b->count; ++k) {
+        const int i = b->i[k], e = c->count++;
+        c->points[2 * e] = d->x[i];
+        if (walls) {
+            /* the wall's closest point: r_i + offset - overlap from the centre, along -n */
+            const fsdem_vec3 n = fsdem__dem_batch_vec(b->n, k);
+            c->points[2 * e + 1] = fsdem__madd(d->x[i], n, -(d->r[i] + off - b->delta[k]));
+            c->partner[e] = -1 - b->other[k];
+        } else {
+            c->points[2 * e + 1] = d->x[b->other[k]];
+            c->partner[e] = d->id[b->other[k]];
+        }
+        c->force[e] = fsdem__dem_batch_vec(b->force, k);
+        c->normal_force[e] = b->fn[k];
+        c->overlap[e] = b->delta[k];
+        c->particle[e] = d->id[i];
+    }
+    batch->count = 0;
+}
+
+/* The contacts of the last force evaluation with their forces (fsdem_dem_write_contacts_vtp), into c
+   (NULL: only counted); `hits` has room for the longest row of the particle-wall list. Returns
+   their number. */
+static int fsdem__io_dem_contacts(const fsdem_dem *d, fsdem__dem_batch *b, fsdem__dem_wall_hit *hits, fsdem__io_contacts *c) {
+    const fsdem_real off = d->desc.contact_offset;
+    /* Hertz-Mindlin: the held springs as committed, not advanced again; linear: its one-step spring */
+    const fsdem_real h = d->desc.law == FSDEM_DEM_LAW_LINEAR ? d->dt : 0;
+    const int uniform = d->material_count == 1;
+    int i, k, nh, count = 0;
+    if (c) {
+        c->count = 0;
+        b->count = 0;
+    }
+    /* touching pairs, as fsdem__dem_touching finds them */
+    for (k = 0; k < d->pp.count; ++k) {
+        const int key = d->pp.key[k];
+        const int p = d->pp.first[k], q = FSDEM__DEM_PARTNER(key);
+        const fsdem_real ex = d->x[p].x - d->x[q].x, ey = d->x[p].y - d->x[q].y, ez = d->x[p].z - d->x[q].z;
+        const fsdem_real reach = d->r[p] + d->r[q] + off;
+        if (!(ex * ex + ey * ey + ez * ez < reach * reach)) continue;
+        count++;
+        if (!c) continue;
+        fsdem__dem_gather_pair(d, b, b->count++, k, d->desc.law, uniform);
+        if (b->count == FSDEM__DEM_BATCH) fsdem__io_dem_drain(d, b, 0, h, c);
+    }
+    if (c && b->count) fsdem__io_dem_drain(d, b, 0, h, c);
+    /* wall contacts of the free particles, as fsdem__dem_compute_forces_law finds them */
+    for (i = 0; i < d->n; ++i) {
+        if (d->inv_m[i] == 0 || d->pw.start[i] == d->pw.start[i + 1]) continue;
+        nh = fsdem__dem_wall_hits_into(d, i, hits, NULL);
+        count += nh;
+        if (!c) continue;
+        for (k = 0; k < nh; ++k) {
+            fsdem__dem_gather_wall(d, b, b->count++, i, &hits[k], uniform);
+            if (b->count == FSDEM__DEM_BATCH) fsdem__io_dem_drain(d, b, 1, h, c);
+        }
+    }
+    if (c && b->count) fsdem__io_dem_drain(d, b, 1, h, c);
+    return count;
+}
+
+fsdem_result fsdem_dem_write_contacts_vtp(const fsdem_dem *d, const char *path, fsdem_vtk_format format) {
+    static const char *const who = "fsdem_dem_write_contacts_vtp";
+    fsdem__status *st;
+    fsdem__vtk_writer w;
+    fsdem__io_contacts c;
+    fsdem__dem_batch *b = NULL;
+    fsdem__dem_wall_hit *hits = NULL;
+    size_t row_max = 1, n = 1; /* room for the longest wall row and the contacts (no allocation of 0 bytes) */
+    fsdem_result res;
+    int i;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&d->status; /* the message is the object's only mutable part here */
+    res = fsdem__vtk_check(st, who, path, format);
+    if (res != FSDEM_OK) return res;
+    memset(&c, 0, sizeof c);
+    /* the lists describe the particles of the last step unless they were edited since */
+    if (!d->need_rebuild && d->pp.rows == d->n && d->pw.rows == d->n && d->n > 0) {
+        for (i = 0; i < d->n; ++i)
+            if ((size_t)(d->pw.start[i + 1] - d->pw.start[i]) > row_max) row_max = (size_t)(d->pw.start[i + 1] - d->pw.start[i]);
+        b = (fsdem__dem_batch *)fsdem__alloc(&d->allocator, sizeof *b);
+        hits = (fsdem__dem_wall_hit *)fsdem__alloc(&d->allocator, sizeof *hits * row_max);
+        if (b && hits) {
+            n = (size_t)fsdem__io_dem_contacts(d, b, hits, NULL);
+            if (n == 0) n = 1;
+            c.points = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * 2 * n);
+            c.force = (fsdem_vec3 *)fsdem__alloc(&d->allocator, sizeof(fsdem_vec3) * n);
+            c.normal_force = (fsdem_real *)fsdem__alloc(&d->allocator, sizeof(fsdem_real) * n);
+            c.overlap = (fsdem_real *)fsdem__alloc(&d->allocator, sizeof(fsdem_real) * n);
+            c.particle = (int *)fsdem__alloc(&d->allocator, sizeof(int) * n);
+            c.partner = (int *)fsdem__alloc(&d->allocator, sizeof(int) * n);
+        }
+        if (!b || !hits || !c.points || !c.force || !c.normal_force || !c.overlap || !c.particle || !c.partner)
+            res = fsdem__fail(st, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory (%lu contacts)", who, (unsigned long)n);
+        else
+            fsdem__io_dem_contacts(d, b, hits, &c);
+    }
+    if (res == FSDEM_OK) res = fsdem__vtk_open(&w, st, who, path, format, "PolyData");
+    if (res == FSDEM_OK) {
+        fsdem__vtk_polydata(&w, d->time, 2 * (long long)c.count, 0, c.count, 0);
+        fsdem__vtk_section(&w, "CellData", "normal_force", "force");
+        fsdem__vtk_write(&w, fsdem__vtk_vec3s("force", c.force, c.count));
+        fsdem__vtk_write(&w, fsdem__vtk_reals("normal_force", c.normal_force, c.count));
+        fsdem__vtk_write(&w, fsdem__vtk_reals("overlap", c.overlap, c.count));
+        fsdem__vtk_write(&w, fsdem__vtk_ints("particle", c.particle, c.count));
+        fsdem__vtk_write(&w, fsdem__vtk_ints("partner", c.partner, c.count));
+        fsdem__vtk_section_end(&w, "CellData");
+        fsdem__vtk_section(&w, "Points", NULL, NULL);
+        fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", c.points, 2 * (long long)c.count));
+        fsdem__vtk_section_end(&w, "Points");
+        fsdem__vtk_cells(&w, "Lines", fsdem__vtk_ramp("connectivity", 2 * (long long)c.count, 0, 1),
+                         fsdem__vtk_ramp("offsets", c.count, 2, 2));
+        res = fsdem__vtk_close(&w);
+    }
+    fsdem__free(&d->allocator, b, sizeof *b);
+    fsdem__free(&d->allocator, hits, sizeof *hits * row_max);
+    fsdem__free(&d->allocator, c.points, sizeof(fsdem_vec3) * 2 * n);
+    fsdem__free(&d->allocator, c.force, sizeof(fsdem_vec3) * n);
+    fsdem__free(&d->allocator, c.normal_force, sizeof(fsdem_real) * n);
+    fsdem__free(&d->allocator, c.overlap, sizeof(fsdem_real) * n);
+    fsdem__free(&d->allocator, c.particle, sizeof(int) * n);
+    fsdem__free(&d->allocator, c.partner, sizeof(int) * n);
+    return res;
+}
+
+/* ---- >>io_pic : particles, grid ---- */
+
+fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *s, const char *path, fsdem_vtk_format format) {
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem__vtk_open(&w, (fsdem__status *)&s->status, "fsdem_pic_write_particles_vtp", path, format, "PolyData");
+    if (res != FSDEM_OK) return res;
+    fsdem__vtk_polydata(&w, s->time, s->np, s->np, 0, 0);
+    fsdem__vtk_section(&w, "PointData", NULL, "velocity");
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("velocity", s->pv, s->np));
+    fsdem__vtk_section_end(&w, "PointData");
+    fsdem__vtk_section(&w, "Points", NULL, NULL);
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", s->px, s->np));
+    fsdem__vtk_section_end(&w, "Points");
+    fsdem__vtk_cells(&w, "Verts", fsdem__vtk_ramp("connectivity", s->np, 0, 1), fsdem__vtk_ramp("offsets", s->np, 1, 1));
+    return fsdem__vtk_close(&w);
+}
+
+static void fsdem__io_pic_velocity(const void *user, long long c, double out[3]) {
+    const fsdem_pic *s = (const fsdem_pic *)user;
+    const int i = (int)(c % s->n[0]), j = (int)(c / s->n[0] % s->n[1]), k = (int)(c / ((long long)s->n[0] * s->n[1]));
+    const fsdem_vec3 v = fsdem__pic_cell_velocity(s, i, j, k);
+    out[0] = (double)v.x;
+    out[1] = (double)v.y;
+    out[2] = (double)v.z;
+}
+
+fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *s, const char *path, fsdem_vtk_format format) {
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    int cells[3];
+    double origin[3], spacing[3];
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem__vtk_open(&w, (fsdem__status *)&s->status, "fsdem_pic_write_grid_vti", path, format, "ImageData");
+    if (res != FSDEM_OK) return res;
+    cells[0] = s->n[0];
+    cells[1] = s->n[1];
+    cells[2] = s->dim == 3 ? s->n[2] : 0;
+    origin[0] = (double)s->lo.x;
+    origin[1] = (double)s->lo.y;
+    origin[2] = s->dim == 3 ? (double)s->lo.z : 0;
+    spacing[0] = spacing[1] = spacing[2] = (double)s->dx;
+    fsdem__vtk_imagedata(&w, s->time, cells, origin, spacing);
+    fsdem__vtk_section(&w, "CellData", "pressure", "velocity");
+    fsdem__vtk_write(&w, fsdem__vtk_reals("pressure", s->pres, s->ncell));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("phi", s->phi, s->ncell));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("fraction", s->frac, s->ncell));
+    fsdem__vtk_write(&w, fsdem__vtk_bytes("type", s->ctype, s->ncell));
+    fsdem__vtk_write(&w, fsdem__vtk_computed("velocity", FSDEM__VTK_REAL, 3, s->ncell, fsdem__io_pic_velocity, s));
+    fsdem__vtk_section_end(&w, "CellData");
+    return fsdem__vtk_close(&w);
+}
+
+/* ---- >>io_swe : fields ---- */
+
+static void fsdem__io_swe_depth(const void *user, long long k, double out[3]) {
+    const fsdem_swe *s = (const fsdem_swe *)user;
+    const fsdem_real h = s->eta[k] - s->bed[k];
+    out[0] = (double)h;
+}
+
+static void fsdem__io_swe_velocity(const void *user, long long k, double out[3]) {
+    fsdem_real u, v;
+    fsdem__swe_velocity((const fsdem_swe *)user, (int)k, &u, &v);
+    out[0] = (double)u;
+    out[1] = (double)v;
+    out[2] = 0;
+}
+
+fsdem_result fsdem_swe_write_vti(const fsdem_swe *s, const char *path, fsdem_vtk_format format) {
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    int cells[3];
+    double origin[3], spacing[3];
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem__vtk_open(&w, (fsdem__status *)&s->status, "fsdem_swe_write_vti", path, format, "ImageData");
+    if (res != FSDEM_OK) return res;
+    cells[0] = s->nx;
+    cells[1] = s->ny; /* 1 in 1D: one cell of the channel's width */
+    cells[2] = 0;
+    origin[0] = (double)s->desc.x_min;
+    origin[1] = s->dim == 2 ? (double)s->desc.y_min : 0;
+    origin[2] = 0;
+    spacing[0] = (double)s->dx;
+    spacing[1] = (double)s->dy;
+    spacing[2] = 1;
+    fsdem__vtk_imagedata(&w, s->time, cells, origin, spacing);
+    fsdem__vtk_section(&w, "CellData", "h", "velocity");
+    fsdem__vtk_write(&w, fsdem__vtk_computed("h", FSDEM__VTK_REAL, 1, s->n, fsdem__io_swe_depth, s));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("eta", s->eta, s->n));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("bed", s->bed, s->n));
+    fsdem__vtk_write(&w, fsdem__vtk_computed("velocity", FSDEM__VTK_REAL, 3, s->n, fsdem__io_swe_velocity, s));
+    if (s->manning) fsdem__vtk_write(&w, fsdem__vtk_reals("manning", s->manning, s->n));
+    fsdem__vtk_section_end(&w, "CellData");
+    return fsdem__vtk_close(&w);
 }
 
 #endif /* FSDEM_IMPLEMENTATION_DONE */

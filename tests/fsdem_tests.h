@@ -15,6 +15,9 @@ Suite *pic_suite(void);
 Suite *swe_suite(void);
 Suite *couple_swe_suite(void);
 Suite *interface_suite(void);
+Suite *restart_suite(void);
+Suite *robustness_suite(void);
+Suite *io_suite(void);
 
 /* ---- tolerances that follow the precision of fsdem_real ----
 

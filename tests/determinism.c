@@ -1,0 +1,113 @@
+/* Cross-compiler determinism: each solver runs a small scene and prints a hash of its complete saved
+   state (fsdem_X_save_memory). `make determinism` builds this program with gcc and clang at -O0,
+   -O2, -O2 -march=native and -O2 -DFSDEM_NO_SIMD and checks every build prints the pinned hashes of
+   tests/determinism.expected: the results do not depend on the compiler, the optimisation level or
+   the SIMD lane width (the DEM contact kernel runs 1, 2, 4 or 8 contacts per instruction).
+   Usage: determinism            print "<solver> <hash>" lines */
+#define FSDEM_IMPLEMENTATION
+#include "fsdem.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+/* 64-bit FNV-1a of a buffer. */
+static unsigned long long hash_bytes(const unsigned char *p, size_t n) {
+    unsigned long long h = 1469598103934665603ULL;
+    size_t k;
+    for (k = 0; k < n; ++k) h = (h ^ p[k]) * 1099511628211ULL;
+    return h;
+}
+
+typedef fsdem_result (*save_fn)(const void *object, void *buffer, size_t capacity, size_t *size);
+
+static fsdem_result save_dem(const void *o, void *b, size_t c, size_t *s) { return fsdem_dem_save_memory((const fsdem_dem *)o, b, c, s); }
+static fsdem_result save_pic(const void *o, void *b, size_t c, size_t *s) { return fsdem_pic_save_memory((const fsdem_pic *)o, b, c, s); }
+static fsdem_result save_swe(const void *o, void *b, size_t c, size_t *s) { return fsdem_swe_save_memory((const fsdem_swe *)o, b, c, s); }
+
+static int print_hash(const char *name, const void *object, save_fn save) {
+    size_t size = 0;
+    unsigned char *buf;
+    if (save(object, NULL, 0, &size) != FSDEM_OK) return 1;
+    buf = (unsigned char *)malloc(size);
+    if (!buf || save(object, buf, size, &size) != FSDEM_OK) return 1;
+    printf("%s %016llx\n", name, hash_bytes(buf, size));
+    free(buf);
+    return 0;
+}
+
+/* 150 Hertz-Mindlin spheres of two sizes poured into a box: contacts with history, walls, rebuilds. */
+static int dem_scene(void) {
+    fsdem_dem_desc d = fsdem_dem_desc_default(3);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_dem_wall_desc w;
+    fsdem_dem *dem;
+    int mat, i, bad;
+    d.domain_min = fsdem_v3(-0.06, -0.06, -0.01);
+    d.domain_max = fsdem_v3(0.06, 0.06, 0.3);
+    d.dt = 2e-5;
+    if (fsdem_dem_create(&d, &dem) != FSDEM_OK) return 1;
+    m.friction = (fsdem_real)0.4;
+    m.rolling_friction = (fsdem_real)0.02;
+    fsdem_dem_add_material(dem, &m, &mat);
+    w = fsdem_dem_wall_box(fsdem_v3(-0.05, -0.05, 0), fsdem_v3(0.05, 0.05, 0.25), 1, mat);
+    fsdem_dem_add_wall(dem, &w, NULL);
+    for (i = 0; i < 150; ++i) {
+        fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+        p.radius = (fsdem_real)(i % 2 ? 0.006 : 0.0045);
+        p.position = fsdem_v3((fsdem_real)(-0.035 + 0.014 * (i % 6)), (fsdem_real)(-0.035 + 0.014 * (i / 6 % 6)),
+                              (fsdem_real)(0.01 + 0.014 * (i / 36)));
+        p.velocity = fsdem_v3((fsdem_real)(0.1 * ((i * 37) % 11 - 5)), (fsdem_real)(0.1 * ((i * 53) % 7 - 3)), 0);
+        p.material = mat;
+        fsdem_dem_add_particle(dem, &p, NULL);
+    }
+    bad = fsdem_dem_advance(dem, 0.05, NULL) != FSDEM_OK || print_hash("dem", dem, save_dem);
+    fsdem_dem_destroy(dem);
+    return bad;
+}
+
+/* A 2D FLIP dam break with an obstacle: transfers, reseeding (random draws), projections. */
+static int pic_scene(void) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(2);
+    fsdem_pic_obstacle ob = fsdem_pic_obstacle_box(fsdem_v3(0.6, 0, 0), fsdem_v3(0.7, 0.15, 0));
+    fsdem_pic *pic;
+    int k, bad = 0;
+    d.cell_size = (fsdem_real)(1.0 / 48);
+    if (fsdem_pic_create(&d, &pic) != FSDEM_OK) return 1;
+    fsdem_pic_add_obstacle(pic, &ob, NULL);
+    fsdem_pic_fill_box(pic, fsdem_v3(0, 0, 0), fsdem_v3(0.3, 0.6, 0), fsdem_v3(0, 0, 0), NULL);
+    for (k = 0; k < 40 && !bad; ++k) bad = fsdem_pic_step(pic) != FSDEM_OK;
+    bad = bad || print_hash("pic", pic, save_pic);
+    fsdem_pic_destroy(pic);
+    return bad;
+}
+
+static void swe_initial(void *user, fsdem_real x, fsdem_real y, fsdem_swe_cell *c) {
+    (void)user;
+    c->bed = (fsdem_real)(0.05 * y * y);
+    c->depth = x < 0.4 ? 1 : (fsdem_real)0.1;
+    c->u = c->v = 0;
+}
+
+/* A 2D shallow-water dam break over an uneven bed with friction and a building. */
+static int swe_scene(void) {
+    fsdem_swe_desc d = fsdem_swe_desc_default(2);
+    fsdem_swe *swe;
+    int bad;
+    d.nx = 64;
+    d.ny = 32;
+    d.y_max = (fsdem_real)0.5;
+    d.manning = (fsdem_real)0.02;
+    d.limiter = FSDEM_SWE_LIMITER_MC;
+    if (fsdem_swe_create(&d, &swe) != FSDEM_OK) return 1;
+    fsdem_swe_set_cells(swe, swe_initial, NULL);
+    fsdem_swe_block_box(swe, (fsdem_real)0.6, (fsdem_real)0.2, (fsdem_real)0.7, (fsdem_real)0.3);
+    bad = fsdem_swe_advance(swe, 0.5, NULL) != FSDEM_OK || print_hash("swe", swe, save_swe);
+    fsdem_swe_destroy(swe);
+    return bad;
+}
+
+int main(void) {
+    const int bad = dem_scene() | pic_scene() | swe_scene();
+    if (bad) printf("determinism: a scene failed\n");
+    return bad;
+}
