@@ -1137,7 +1137,10 @@ FSDEM_API fsdem_pic_desc fsdem_pic_get_desc(const fsdem_pic *pic);
 
 /* ---- grid and coupling ---- */
 
-/* Read-only view of the grid after the last step (valid while the solver lives). */
+/* Read-only view of the grid after the last step (valid while the solver lives). `cell`, `phi` and
+   `fraction` describe the particles at the end of the step (after advection and reseeding); the
+   face velocities and the pressure are those of the step's projection, made with the cells of its
+   start, so a cell the front entered during the step can show a nonzero divergence. */
 typedef struct fsdem_pic_fields {
     int dim;
     int n[3];                      /* cells per axis (n[2] = 1 in 2D) */
@@ -2908,8 +2911,8 @@ static fsdem_real fsdem__dem_rule_dt(const fsdem_dem *d) {
    exceeds it, as LIGGGHTS' fix check/timestep/gran does: such a run loses energy conservation
    long before a particle leaves the domain. */
 static void fsdem__dem_dt_check(fsdem_dem *d) {
-    const fsdem_real limit = fsdem__dem_rule_dt(d);
-    const fsdem_real stable = fsdem__finite(limit) ? limit : 0;
+    /* no particles: no estimate (and no arithmetic on its infinity, which raises FE_INVALID) */
+    const fsdem_real stable = d->n > 0 ? fsdem__dem_rule_dt(d) : 0;
     if (stable != d->stable_dt) d->dt_warned = 0;
     d->stable_dt = stable;
     if (stable > 0 && d->dt > stable && !d->dt_warned && d->status.log) {
@@ -6769,7 +6772,7 @@ void fsdem_pic_destroy(fsdem_pic *s) {
     fsdem__free(&al, s, sizeof *s);
 }
 
-const char *fsdem_pic_last_error(const fsdem_pic *s) { return s ? s->status.message : "NULL solver"; }
+const char *fsdem_pic_last_error(const fsdem_pic *s) { return s ? s->status.message : "fsdem_pic is NULL"; }
 
 static int fsdem__pic_cell(const fsdem_pic *s, int i, int j, int k) { return (k * s->n[1] + j) * s->n[0] + i; }
 static int fsdem__pic_face(const fsdem_pic *s, int a, int i, int j, int k) {
@@ -8939,11 +8942,11 @@ static fsdem_real fsdem__pic_spread(fsdem_pic *s, int a, fsdem_vec3 point, fsdem
 }
 
 fsdem_result fsdem_pic_add_force(fsdem_pic *s, fsdem_vec3 point, fsdem_real radius, fsdem_vec3 force, int *taken) {
-    const fsdem_real hw = radius > s->dx ? radius : s->dx;
-    fsdem_real wsum[3] = {0, 0, 0};
+    fsdem_real hw, wsum[3] = {0, 0, 0};
     int a;
     if (taken) *taken = 0;
     if (!s) return FSDEM_ERR_INVALID_ARG;
+    hw = radius > s->dx ? radius : s->dx;
     if (!fsdem__finite3(point) || !fsdem__finite3(force) || !(radius >= 0) || !fsdem__finite(radius))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_force: point, force and radius >= 0 must be finite");
     if (s->dim == 2) point.z = 0;
@@ -11170,6 +11173,10 @@ fsdem_result fsdem_swe_gauges_close(fsdem_swe *s) {
 
 fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
     const fsdem_swe *swe = (const fsdem_swe *)user;
+    if (!swe) { /* no bed: far away, so a wall made with a NULL user never touches */
+        if (normal) *normal = fsdem_v3(0, 0, 1);
+        return (fsdem_real)FLT_MAX;
+    }
     const fsdem_real x0 = swe->desc.x_min + swe->dx / 2, x1 = swe->desc.x_min + (swe->nx - (fsdem_real)0.5) * swe->dx;
     const fsdem_real y0 = swe->desc.y_min + swe->dy / 2, y1 = swe->desc.y_min + (swe->ny - (fsdem_real)0.5) * swe->dy;
     fsdem_real x = p.x < x0 ? x0 : p.x > x1 ? x1 : p.x, y = p.y < y0 ? y0 : p.y > y1 ? y1 : p.y, gx, gy, len;
