@@ -2856,7 +2856,7 @@ static fsdem_result fsdem__dem_material_check(const fsdem_dem_material *m, char 
     if (!(m->poisson_ratio > -1 && m->poisson_ratio <= (fsdem_real)0.5))
         return fsdem__reject(msg, size, "fsdem_dem_material.poisson_ratio must be in (-1, 0.5] (got %g)",
                              (double)m->poisson_ratio);
-    if (!(m->restitution >= 1e-6 && m->restitution <= 1))
+    if (!(m->restitution >= (fsdem_real)1e-6 && m->restitution <= 1))
         return fsdem__reject(msg, size, "fsdem_dem_material.restitution must be in [1e-6, 1] (got %g)", (double)m->restitution);
     if (!(m->friction >= 0) || !fsdem__finite(m->friction))
         return fsdem__reject(msg, size, "fsdem_dem_material.friction must be >= 0 (got %g)", (double)m->friction);
