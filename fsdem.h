@@ -7019,33 +7019,24 @@ static fsdem_vec3 fsdem__pic_axis_shift(fsdem_vec3 p, int b, fsdem_real h) {
     return p;
 }
 
-/* Unit gradient of the obstacle distance at p by central differences (obstacles only). */
-static fsdem_vec3 fsdem__pic_obst_normal(const fsdem_pic *s, fsdem_vec3 p) {
+static fsdem_real fsdem__pic_obst_dist(const fsdem_pic *s, fsdem_vec3 p) { return fsdem__pic_obst_min(s, p, NULL); }
+
+/* Unit gradient at p of a distance `dist` by central differences over 1e-3 of a cell (0 where it is
+   flat). */
+static fsdem_vec3 fsdem__pic_gradient(const fsdem_pic *s, fsdem_real (*dist)(const fsdem_pic *, fsdem_vec3), fsdem_vec3 p) {
     fsdem_real h = s->dx * (fsdem_real)1e-3, g[3] = {0, 0, 0}, len;
     int b;
     for (b = 0; b < s->dim; ++b)
-        g[b] = fsdem__pic_obst_min(s, fsdem__pic_axis_shift(p, b, h), NULL) -
-               fsdem__pic_obst_min(s, fsdem__pic_axis_shift(p, b, -h), NULL);
+        g[b] = dist(s, fsdem__pic_axis_shift(p, b, h)) - dist(s, fsdem__pic_axis_shift(p, b, -h));
     len = (fsdem_real)sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-    if (!(len > 0)) return fsdem_v3(0, 0, 0);
-    return fsdem_v3(g[0] / len, g[1] / len, g[2] / len);
+    return len > 0 ? fsdem_v3(g[0] / len, g[1] / len, g[2] / len) : fsdem_v3(0, 0, 0);
 }
 
 fsdem_real fsdem_pic_solid_distance(const fsdem_pic *s, fsdem_vec3 p, fsdem_vec3 *normal) {
-    fsdem_real d;
     if (normal) *normal = fsdem__zero3();
     if (!s) return 0;
-    d = fsdem__pic_solid_sdf(s, p);
-    if (normal) {
-        fsdem_real h = s->dx * (fsdem_real)1e-3, g[3] = {0, 0, 0}, len;
-        int b;
-        for (b = 0; b < s->dim; ++b)
-            g[b] = fsdem__pic_solid_sdf(s, fsdem__pic_axis_shift(p, b, h)) -
-                   fsdem__pic_solid_sdf(s, fsdem__pic_axis_shift(p, b, -h));
-        len = (fsdem_real)sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
-        *normal = len > 0 ? fsdem_v3(g[0] / len, g[1] / len, g[2] / len) : fsdem_v3(0, 0, 0);
-    }
-    return d;
+    if (normal) *normal = fsdem__pic_gradient(s, fsdem__pic_solid_sdf, p);
+    return fsdem__pic_solid_sdf(s, p);
 }
 
 /* Fraction of a segment with end values a, b that lies where the distance is > 0 (linear). */
@@ -8354,7 +8345,7 @@ static int fsdem__pic_constrain(fsdem_pic *s) {
                 fsdem_real d = fsdem__pic_obst_min(s, s->px[p], NULL);
                 fsdem_vec3 nrm;
                 if (d > eps) break;
-                nrm = fsdem__pic_obst_normal(s, s->px[p]);
+                nrm = fsdem__pic_gradient(s, fsdem__pic_obst_dist, s->px[p]);
                 s->px[p] = fsdem__madd(s->px[p], nrm, eps - d);
             }
             if (fsdem__pic_obst_min(s, s->px[p], NULL) <= 0 || !fsdem__pic_open_at(s, s->px[p])) {
