@@ -2432,7 +2432,7 @@ static fsdem_real fsdem__geom_polygon(fsdem_vec3 p, const fsdem_vec3 *v, int cou
 
    Contents: fsdem__kernel (per-axis node range, weights, derivatives and clamped node indices) and
    fsdem__kernel_weights, the tent (linear, 2 nodes) and quadratic B-spline (3 nodes) kernels at a
-   position given in grid units. */
+   position given in grid units; fsdem__kernel_mps, the particle-interaction weight of MPS. */
 
 /* Kernel weights of one point along each axis: nodes lo[b] .. lo[b] + count[b] - 1, weights w and
    their derivatives dw (per grid unit), and the node indices clamped into the grid (idx). */
@@ -2489,6 +2489,14 @@ static void fsdem__kernel_weights(fsdem__kernel *k, int dim, const fsdem_real s[
             k->idx[b][q] = i < 0 ? 0 : i > n[b] - 1 ? n[b] - 1 : i;
         }
     }
+}
+
+/* Weight of the MPS particle interaction at distance r (m) for the radius re (m): the kernel of
+   Zhang et al. (2014), re/(0.85 r + 0.15 re) - 1 for r < re, 0 beyond (seed 002 Eq. 6). It is finite
+   at r = 0 (re/(0.15 re) - 1 = 17/3), unlike the original MPS kernel re/r - 1, which keeps
+   coincident particles from producing infinite number densities and pressure spikes. */
+static inline fsdem_real fsdem__kernel_mps(fsdem_real r, fsdem_real re) {
+    return r < re ? re / ((fsdem_real)0.85 * r + (fsdem_real)0.15 * re) - 1 : 0;
 }
 
 /* ===== >>impl_grid : cell grid ===================================================================== */
