@@ -14,7 +14,6 @@ VALIDATION_DATA ?= validation/data
 CHECK_CFLAGS = $(shell pkg-config --cflags check 2>/dev/null)
 CHECK_LIBS   = $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -lsubunit -lrt -lpthread -lm)
 
-# one file per suite registered in tests/check_main.c
 # every tests/test_<module>.c is a suite registered in tests/check_main.c
 # suites of work in progress (wip/), built against the merged header by their own scripts
 WIP_TEST_SRC := tests/test_mps.c
