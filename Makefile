@@ -22,13 +22,14 @@ EXAMPLES   := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.
 VALIDATION := $(patsubst validation/%/main.c,%,$(wildcard validation/*/main.c))
 BENCHES    := $(patsubst bench/%/main.c,%,$(wildcard bench/*/main.c))
 
-.PHONY: all help test check-deps gnuplot-deps compile-checks valgrind sanitize examples demo validate bench install clean
+.PHONY: all help test check-deps gnuplot-deps compile-checks map-check determinism valgrind sanitize examples demo validate bench install clean
 
 all: $(BUILD)/check_fsdem examples
 
 help:
 	@echo "make test       Check suite (installs Check with apt-get when missing and run as root)"
 	@echo "make test-float the Check suite with fsdem_real = float (-DFSDEM_USE_FLOAT)"
+	@echo "make determinism  the same results from gcc and clang at -O0/-O2/-march=native/no SIMD"
 	@echo "make valgrind   the suite under Valgrind (no errors, no leaks)"
 	@echo "make sanitize   the suite with AddressSanitizer and UndefinedBehaviorSanitizer"
 	@echo "make demo       the headline example (cylinder-layer collapse) in under a minute"
@@ -64,10 +65,32 @@ compile-checks: | $(BUILD)
 	@for c in $(CXX) clang++; do if command -v $$c >/dev/null; then \
 	  $$c $(WARN) -O2 -Werror -c tests/compile_cpp.cpp -I. -o $(BUILD)/compile_cpp.o || exit 1; \
 	  $$c $(WARN) -O2 -Werror -mavx512f -c tests/compile_cpp.cpp -I. -o $(BUILD)/compile_cpp.o || exit 1; fi; done
-	@echo "compile checks: gcc and clang (C99: double, float, AVX-512 lanes, no SIMD), $(CXX) and clang++: warning-free"
+	@$(CC) $(STD) -O0 -c tests/fsdem_impl.c -I. -o $(BUILD)/impl_double.o && $(CC) $(STD) -O0 -c tests/link_float_user.c -I. \
+	  -o $(BUILD)/link_float_user.o
+	@if $(CC) $(BUILD)/link_float_user.o $(BUILD)/impl_double.o -o $(BUILD)/link_mixed $(LDLIBS) 2>/dev/null; then \
+	  echo "compile checks: a float translation unit linked against a double implementation"; exit 1; fi
+	@echo "compile checks: gcc and clang (C99: double, float, AVX-512 lanes, no SIMD), $(CXX) and clang++: warning-free;" \
+	  "float and double objects refuse to link together"
 
-test: compile-checks $(BUILD)/check_fsdem
+# The map of fsdem.h (its >>tag banners) is exact, and the float build's symbol list complete.
+map-check:
+	@sh tests/map_check.sh fsdem.h
+
+test: map-check compile-checks $(BUILD)/check_fsdem
 	$(BUILD)/check_fsdem
+
+# The same results bit for bit from gcc and clang at -O0, -O2, -O2 -march=native and without SIMD:
+# tests/determinism.c prints a hash of each solver's saved state, pinned in tests/determinism.expected
+# (regenerate it, with the reason in the commit, when a change of the numerics is intended).
+DETERMINISM_FLAGS := "-O0" "-O2" "-O2 -march=native" "-O2 -DFSDEM_NO_SIMD"
+determinism: | $(BUILD)
+	@for c in gcc clang; do if command -v $$c >/dev/null; then for f in $(DETERMINISM_FLAGS); do \
+	  $$c $(STD) $(WARN) $$f -I. tests/determinism.c -o $(BUILD)/determinism $(LDLIBS) || exit 1; \
+	  $(BUILD)/determinism > $(BUILD)/determinism.out || exit 1; \
+	  if ! diff -q tests/determinism.expected $(BUILD)/determinism.out >/dev/null; then \
+	    echo "determinism: $$c $$f gives other results:"; diff tests/determinism.expected $(BUILD)/determinism.out; exit 1; fi; \
+	done; fi; done
+	@echo "determinism: gcc and clang at $(DETERMINISM_FLAGS): every solver's state hash as pinned"
 
 # The same suite with fsdem_real = float; its tolerances follow the precision (tests/fsdem_tests.h).
 .PHONY: test-float
