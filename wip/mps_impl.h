@@ -679,6 +679,10 @@ static int fsdem__mps_density(fsdem_mps *s) {
 static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, int i, fsdem_vec3 ghost) {
     fsdem_vec3 g = fsdem__zero3();
     fsdem_real base = phi[i];
+    /* a DUMMY particle higher than the hydrostatic extrapolation reaches is in the air beside the
+       free surface: its ghost pressure is not below 0, as the liquid's (desc.clamp_negative_pressure);
+       a negative ghost pulled the particles at the top of the walls into them */
+    const int clamp = s->desc.clamp_negative_pressure && (ghost.x != 0 || ghost.y != 0 || ghost.z != 0);
     int e;
     if (s->desc.gradient == FSDEM_MPS_GRADIENT_MIN)
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e)
@@ -688,7 +692,11 @@ static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, 
         const int j = s->nb[e];
         const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
         const fsdem_real r2 = fsdem__dot(r, r);
-        const fsdem_real pj = s->kind[j] == FSDEM_MPS_DUMMY ? phi[i] + fsdem__dot(ghost, r) : phi[j];
+        fsdem_real pj = phi[j];
+        if (s->kind[j] == FSDEM_MPS_DUMMY) {
+            pj = phi[i] + fsdem__dot(ghost, r);
+            if (pj < 0 && clamp) pj = 0;
+        }
         if (!(r2 > 0)) continue;
         g = fsdem__madd(g, r, (pj + base) * s->nbw[e] / (r2 * s->eps[j]));
     }
@@ -819,7 +827,8 @@ static fsdem_result fsdem__mps_matrix_room(fsdem_mps *s, long long nnz) {
 /* Assembles the pressure equation (section >>mps, step 4): unknowns are the FLUID and WALL
    particles off the surface with a non-DUMMY neighbour, numbered in particle order, so each row's
    columns ascend with the neighbour rows; row i is seed 002 Eq. 10 = Eq. 12 times
-   -n0 lambda/(2d)/eps_i, which makes it symmetric. The right-hand side goes to s->b. */
+   -n0 lambda/(2d)/eps_i, which makes it symmetric, its DUMMY neighbours at the hydrostatic ghost
+   pressure (their known terms on the right). The right-hand side goes to s->b. */
 static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
     const fsdem_real rho = s->desc.density, gamma = s->desc.gamma;
     const fsdem_real scale = -s->n0 * s->lambda / (2 * (fsdem_real)s->dim);
@@ -864,6 +873,15 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
         /* seed 002 Eq. 12: (1 - gamma) rho/dt div u* - gamma rho/dt^2 (n_i - n0)/n0 */
         source = (1 - gamma) * rho / dt * s->div[i] - gamma * rho / (dt * dt) * (s->nd[i] - s->n0) / s->n0;
         s->b[row] = scale * source / s->eps[i];
+        /* DUMMY neighbours in Eq. 10 at the ghost pressure p_i + rho g.(r_j - r_i), the hydrostatic
+           extrapolation from i that the corrector's gradient uses too (fsdem__mps_grad_at): their
+           (p_j - p_i) w_ij terms are known and move to the right-hand side (the matrix is unchanged,
+           still symmetric) */
+        for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+            const int j = s->nb[e];
+            if (s->kind[j] != FSDEM_MPS_DUMMY) continue;
+            s->b[row] += rho * fsdem__dot(s->desc.gravity, fsdem__sub(s->x[j], s->x[i])) * s->nbw[e] / (s->eps[i] * s->eps[j]);
+        }
         s->sol[row] = s->p[i];
     }
     s->rows = rows;
@@ -889,10 +907,18 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     if (fsdem__mps_neighbours(s) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory building the neighbour list");
     s->surface_count = fsdem__mps_density(s);
-    /* 2. predictor: u* = u + dt (nu lap u + g) (seed 002 Eq. A.6 with eps = 1) */
+    /* 2. predictor: u* = u + dt (nu lap u + g) (seed 002 Eq. A.6 with eps = 1). WALL and DUMMY
+       particles take u* = dt g, their velocity (0) plus the same body force: a uniform field has no
+       divergence (Eq. 9), so gravity alone leaves no source at the walls in Eq. 12, and the walls
+       carry its weight through the hydrostatic ghost pressure of the DUMMY particles in the
+       pressure equation (fsdem__mps_assemble), the discrete Neumann condition dp/dn = rho g.n.
+       With u* = 0 at the solids instead, the source of the rows near a wall held only part of the
+       weight (one-sided Eq. 9 against the one-sided Eq. 10): still water started with 0.7 rho g h
+       at the bottom and fell at 0.25-0.35 g in its first step. */
     for (i = 0; i < s->n; ++i) {
         if (s->kind[i] != FSDEM_MPS_FLUID) {
-            s->us[i] = fsdem__zero3();
+            s->us[i] = fsdem__scale(s->desc.gravity, dt);
+            if (s->dim == 2) s->us[i].z = 0;
             continue;
         }
         s->us[i] = fsdem__add(s->v[i], fsdem__scale(fsdem__add(fsdem__scale(fsdem__mps_lap_at(s, NULL, s->v, i), nu),
