@@ -227,8 +227,8 @@ END_TEST
 /* Still water in the small 2D tank (20 x 20 fluid particles at r0 = 1 cm) for 0.5 s: the
    kernel-averaged pressure at mid-depth is within 5% of rho g (h - y), the water stays in the tank
    and keeps its level, and no particle drifts far. The issue's bound of 0.1 r0 on the drift is NOT
-   reached by this solver yet (about 1.5 r0 is measured: particle jitter of a few cm/s after the
-   start-up transient); the test holds it to 2 r0. */
+   reached by this solver yet (1.10 r0 double, 1.38 r0 float are measured, with particle shifting
+   off, the default; shifting did not lower it, see the >>mps notes); the test holds it to 1.5 r0. */
 START_TEST(test_mps_still_water) {
     const double r0 = 0.01, h = 0.2, rho = 1000, g = 9.81;
     fsdem_mps *m = test_tank(r0, 1000);
@@ -276,6 +276,86 @@ START_TEST(test_mps_still_water) {
     ck_assert(iters > 1 && iters < 100);
     free(x0);
     fsdem_mps_destroy(m);
+}
+END_TEST
+
+/* Particle shifting (desc.shifting, Lind et al. 2012): a block of fluid without gravity whose
+   lattice is disordered by up to 0.15 r0 per axis relaxes toward the uniform number density n0 in
+   its interior with the shift on, and stays as it is with the shift off (the pressure moves
+   nothing here: measured, the interior's n/n0 is unchanged after 20 steps without the shift).
+   Measured in 20 steps of 1 ms with shifting = 0.3 (double and float alike): rms of n/n0 - 1 over
+   the interior 0.0146 -> 0.0076, largest 0.0373 -> 0.0133. The WALL row below the block never
+   moves. */
+START_TEST(test_mps_shifting_relaxes) {
+    const double r0 = 0.01;
+    const int cells = 24;
+    int pass;
+    double rms_end[2], max_end[2], rms0 = 0, max0 = 0;
+    for (pass = 0; pass < 2; ++pass) {
+        fsdem_mps_desc d = fsdem_mps_desc_default(2);
+        fsdem_mps *m = NULL;
+        fsdem_mps_particles p;
+        fsdem_vec3 *x = (fsdem_vec3 *)malloc(sizeof(fsdem_vec3) * (size_t)(cells * cells + cells));
+        fsdem_real *out = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)(cells * cells + cells));
+        fsdem_vec3 wall[24];
+        unsigned long long seed = 12345;
+        int i, k;
+        d.r0 = (fsdem_real)r0;
+        d.gravity = fsdem_v3(0, 0, 0);
+        d.domain_min = fsdem_v3(-1, -1, -1);
+        d.domain_max = fsdem_v3(2, 2, 2);
+        d.shifting = pass == 0 ? 0 : (fsdem_real)0.3;
+        ck_assert_int_eq(fsdem_mps_create(&d, &m), FSDEM_OK);
+        for (i = 0; i < cells * cells; ++i) {
+            double a, b;
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            a = (double)(seed >> 11) / 9007199254740992.0;
+            seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+            b = (double)(seed >> 11) / 9007199254740992.0;
+            x[i] = fsdem_v3((fsdem_real)((i % cells + 0.5 + 0.3 * (a - 0.5)) * r0),
+                            (fsdem_real)((i / cells + 0.5 + 0.3 * (b - 0.5)) * r0), 0);
+        }
+        for (i = 0; i < cells; ++i) wall[i] = fsdem_v3((fsdem_real)((i + 0.5) * r0), (fsdem_real)(-0.5 * r0), 0);
+        ck_assert_int_eq(fsdem_mps_add_particles(m, FSDEM_MPS_FLUID, cells * cells, x, NULL), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_add_particles(m, FSDEM_MPS_WALL, cells, wall, NULL), FSDEM_OK);
+        for (k = 0; k <= 20; ++k) {
+            fsdem_mps_stats st;
+            double s2 = 0, mx = 0;
+            int n = 0;
+            if (k > 0) ck_assert_int_eq(fsdem_mps_step_dt(m, 1e-3f), FSDEM_OK);
+            else ck_assert_int_eq(fsdem_mps_divergence(m, x, out), FSDEM_OK); /* n of the start */
+            p = fsdem_mps_get_particles(m);
+            st = fsdem_mps_get_stats(m);
+            for (i = 0; i < p.count; ++i) {
+                const double cx = p.position[i].x - cells * r0 / 2, cy = p.position[i].y - cells * r0 / 2;
+                if (p.kind[i] == FSDEM_MPS_FLUID && fabs(cx) < 6 * r0 && fabs(cy) < 6 * r0) {
+                    const double e = p.number_density[i] / st.n0 - 1;
+                    s2 += e * e;
+                    if (fabs(e) > mx) mx = fabs(e);
+                    ++n;
+                }
+            }
+            ck_assert_int_gt(n, 100);
+            if (k == 0) {
+                rms0 = sqrt(s2 / n);
+                max0 = mx;
+            }
+            rms_end[pass] = sqrt(s2 / n);
+            max_end[pass] = mx;
+        }
+        for (i = 0; i < cells; ++i)
+            ck_assert(p.position[cells * cells + i].x == (fsdem_real)((i + 0.5) * r0) &&
+                      p.position[cells * cells + i].y == (fsdem_real)(-0.5 * r0));
+        free(x);
+        free(out);
+        fsdem_mps_destroy(m);
+    }
+    TEST_REPORT("interior n/n0 - 1: start rms %.4f max %.4f; after 20 steps shifting off rms %.4f max %.4f, on (0.3) rms %.4f max %.4f",
+                rms0, max0, rms_end[0], max_end[0], rms_end[1], max_end[1]);
+    ck_assert_msg(rms0 > 0.01, "start rms %g", rms0);
+    ck_assert_msg(fabs(rms_end[0] - rms0) < 0.1 * rms0, "shifting off: rms %g -> %g", rms0, rms_end[0]);
+    ck_assert_msg(rms_end[1] < 0.65 * rms0 && max_end[1] < 0.5 * max0, "shifting on: rms %g -> %g, max %g -> %g", rms0,
+                  rms_end[1], max0, max_end[1]);
 }
 END_TEST
 
@@ -419,6 +499,7 @@ Suite *mps_suite(void) {
     tcase_add_test(tc, test_mps_bad_input);
     tcase_add_test(tc, test_mps_null_policy);
     tcase_add_test(tc, test_mps_obstacle);
+    tcase_add_test(tc, test_mps_shifting_relaxes);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -29,7 +29,12 @@
         non-DUMMY j) is symmetric and positive definite (a fsdem_csr, solved by fsdem_pcg);
      5. negative pressures set to 0 when desc.clamp_negative_pressure (the seed says nothing; the
         original MPS clamps, so the default does);
-     6. corrector u = u* - dt/rho grad p (Eq. 8 or the stabilised form, desc.gradient), r += dt u.
+     6. corrector u = u* - dt/rho grad p (Eq. 8 or the stabilised form, desc.gradient), r += dt u;
+     7. when desc.shifting > 0, r += dr, the Fickian particle shift of Lind, Xu, Stansby and Rogers
+        (2012, J. Comput. Phys. 231:1499), dr = -D grad C with D = desc.shifting r0^2 and grad C the
+        kernel sum of Eq. 8 with C = 1, computed at the positions of step 1: FLUID particles only,
+        none on the surface, only tangentially (normal: F of Eq. 15) with a surface neighbour,
+        at most cfl r0 (details at fsdem__mps_shift in the implementation).
    Operators: Eq. 8-10 are exact for linear fields (gradient, divergence) and quadratic fields
    (Laplacian) at particles whose neighbourhood is a full regular lattice; they are first and
    second order only in that sense (consistency is lost near the surface and in disordered regions).
@@ -40,6 +45,15 @@
    down (clamped negative pressure) and they sink about 0.7 r0 in the first 0.15 s, and (b) a
    disturbance that grows along the walls (kinetic energy e-folding in about 20 steps from 0.1 s on,
    faster per second at smaller dt) with the sum form of Eq. 8, not with FSDEM_MPS_GRADIENT_MIN.
+   Particle shifting (step 7) does not cure either: at 0.5 s the drift is 0.97 / 1.35 r0 (double /
+   float) with shifting = 0.02, 1.30 / 1.18 r0 with 0.05, and with 0.1 or more the tank blows up
+   between 0.35 and 0.5 s (mid-depth pressure within 2% whenever it survives); (a) is untouched by
+   a shift that is tangential under the surface and (b) is a shear of whole columns along the
+   wall, which leaves the number density almost uniform. So shifting is off by default; it does
+   relax a disordered lattice (test_mps_shifting_relaxes). Applying the n term of Eq. 12 only to
+   particles without a surface neighbour halved the early sinking of (a) (0.25 r0 at 0.1 s
+   instead of 0.5) but not the drift at 0.5 s (1.00 / 1.21 r0), and no published source for it
+   was at hand, so it is not in the solver.
    Units: m, s, kg/m^3, m^2/s (kinematic viscosity), Pa. In 2D the problem lies in the x-y plane.
    One step allocates nothing once its lists have reached their size (the neighbour list and the
    matrix grow by doubling when the particle arrangement needs more room than ever before). */
@@ -82,6 +96,8 @@ typedef struct fsdem_mps_desc {
     fsdem_vec3 domain_max;          /* m; default (1,1,1) (z unused in 2D) */
     fsdem_mps_gradient_model gradient; /* default FSDEM_MPS_GRADIENT_SUM */
     int clamp_negative_pressure;    /* 1: p < 0 is set to 0 after the solve; default 1 */
+    fsdem_real shifting;            /* -; particle shifting D / r0^2 (Lind et al. 2012, step 7), */
+                                    /*    in [0, 1]; 0 = off; default 0 (see the notes above) */
     fsdem_precond pressure_precond; /* default FSDEM_PRECOND_AUTO (MIC(0) on the CSR matrix) */
     fsdem_real pressure_tolerance;  /* -; relative residual of the pressure solve; default 1e-8 */
                                     /*    (1e-5 in float) */

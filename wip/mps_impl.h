@@ -18,6 +18,7 @@ struct fsdem_mps {
     /* particles, structure of arrays, `cap` allocated */
     int n, cap;
     fsdem_vec3 *x, *v, *us;       /* position, velocity, predicted velocity u* */
+    fsdem_vec3 *shift;            /* particle shift of the step (desc.shifting) */
     fsdem_real *p, *eps, *nd;     /* pressure, porosity, number density */
     fsdem_real *div, *b, *sol;    /* divergence of u*, right-hand side and solution (by unknown) */
     unsigned char *kind, *surf;
@@ -68,6 +69,7 @@ fsdem_mps_desc fsdem_mps_desc_default(int dim) {
     d.domain_max = fsdem_v3(1, 1, 1);
     d.gradient = FSDEM_MPS_GRADIENT_SUM;
     d.clamp_negative_pressure = 1;
+    d.shifting = 0;
     d.pressure_precond = FSDEM_PRECOND_AUTO;
 #ifdef FSDEM_USE_FLOAT
     d.pressure_tolerance = (fsdem_real)1e-5;
@@ -114,6 +116,8 @@ static fsdem_result fsdem__mps_check(const fsdem_mps_desc *d, char *msg, size_t 
                                  (double)fsdem__comp(d->domain_max, a), "xyz"[a], (double)fsdem__comp(d->domain_min, a));
     if ((int)d->gradient < 0 || (int)d->gradient > 1)
         return fsdem__reject(msg, size, "fsdem_mps_desc.gradient = %d is not a fsdem_mps_gradient_model", (int)d->gradient);
+    if (!(d->shifting >= 0 && d->shifting <= 1))
+        return fsdem__reject(msg, size, "fsdem_mps_desc.shifting = %g must be in [0, 1]", (double)d->shifting);
     if ((int)d->pressure_precond < 0 || (int)d->pressure_precond > 4)
         return fsdem__reject(msg, size, "fsdem_mps_desc.pressure_precond = %d must be a fsdem_precond for a CSR matrix "
                              "(AUTO, NONE, JACOBI, IC0, MIC0)", (int)d->pressure_precond);
@@ -196,7 +200,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
 
 /* The particle arrays of a capacity `cap`, with their element sizes (one list for allocation,
    copying and release). */
-#define FSDEM__MPS_ARRAYS 13
+#define FSDEM__MPS_ARRAYS 14
 static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     void **p[FSDEM__MPS_ARRAYS];
     size_t e[FSDEM__MPS_ARRAYS];
@@ -209,6 +213,7 @@ static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     FSDEM__MPS_ARRAY(x);
     FSDEM__MPS_ARRAY(v);
     FSDEM__MPS_ARRAY(us);
+    FSDEM__MPS_ARRAY(shift);
     FSDEM__MPS_ARRAY(p);
     FSDEM__MPS_ARRAY(eps);
     FSDEM__MPS_ARRAY(nd);
@@ -325,6 +330,7 @@ static void fsdem__mps_push(fsdem_mps *s, fsdem_mps_kind kind, fsdem_vec3 x, fsd
     s->x[i] = x;
     s->v[i] = kind == FSDEM_MPS_FLUID ? v : fsdem__zero3();
     s->us[i] = s->v[i];
+    s->shift[i] = fsdem__zero3();
     s->p[i] = 0;
     s->eps[i] = 1;
     s->nd[i] = 0;
@@ -824,6 +830,52 @@ static fsdem_result fsdem__mps_matrix_room(fsdem_mps *s, long long nnz) {
     return FSDEM_OK;
 }
 
+/* Particle shifting (desc.shifting > 0): the Fickian shift of Lind, Xu, Stansby and Rogers (2012),
+   J. Comput. Phys. 231:1499, dr_i = -D grad C_i, with a constant coefficient of order h^2 per
+   step as in that paper (here D = desc.shifting r0^2), adapted to MPS: the concentration
+   gradient is the kernel sum of Eq. 8 with C = 1 at every neighbour, FLUID, WALL and DUMMY alike,
+       grad C_i = d/n0 sum_j 2 (r_j - r_i) w_ij / (|r_j - r_i|^2 eps_j),
+   zero inside a full lattice and pointing to where neighbours crowd (a particle displaced by s
+   from its lattice site has grad C = 1.19 s / r0^2 for re = 4.1 r0 in 2D, so desc.shifting = c
+   moves it back by 1.19 c s in one step). Free surface (after Lind et al. 2012): a surface
+   particle is not shifted; a particle with a surface neighbour (its neighbourhood is cut by the
+   surface) is shifted only tangentially, its normal the asymmetry vector F_i of seed 002 Eq. 15
+   (the shift's component along F_i removed), as the number-density deficiency below the surface is
+   geometry, not clustering. WALL and DUMMY particles never move. The shift is computed at the
+   positions of the start of the step (its neighbour rows) and added after the corrector's move;
+   it is limited to desc.cfl r0 (a choice of this library, not of the paper: a shift is not longer
+   than the motion a step allows). The velocity is not corrected (the paper's Taylor correction of
+   the velocity to the shifted position is left out). Allocates nothing. */
+static void fsdem__mps_shift(fsdem_mps *s) {
+    const fsdem_real D = s->desc.shifting * s->r0 * s->r0, cap = s->desc.cfl * s->r0;
+    int i, e;
+    for (i = 0; i < s->n; ++i) {
+        fsdem_vec3 gc = fsdem__zero3(), F = fsdem__zero3(), d;
+        fsdem_real len;
+        int band = 0;
+        s->shift[i] = fsdem__zero3();
+        if (s->kind[i] != FSDEM_MPS_FLUID || s->surf[i] || D == 0) continue;
+        for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+            const int j = s->nb[e];
+            const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
+            const fsdem_real r2 = fsdem__dot(r, r);
+            if (!(r2 > 0)) continue;
+            band |= s->surf[j];
+            gc = fsdem__madd(gc, r, 2 * s->nbw[e] / (r2 * s->eps[j]));
+            F = fsdem__madd(F, r, s->nbw[e] / ((fsdem_real)sqrt(r2) * s->eps[j]));
+        }
+        d = fsdem__scale(gc, -D * (fsdem_real)s->dim / s->n0);
+        if (band) {
+            const fsdem_real f2 = fsdem__dot(F, F);
+            if (f2 > 0) d = fsdem__madd(d, F, -fsdem__dot(d, F) / f2);
+        }
+        if (s->dim == 2) d.z = 0;
+        len = fsdem__norm(d);
+        if (len > cap) d = fsdem__scale(d, cap / len);
+        s->shift[i] = d;
+    }
+}
+
 /* Assembles the pressure equation (section >>mps, step 4): unknowns are the FLUID and WALL
    particles off the surface with a non-DUMMY neighbour, numbered in particle order, so each row's
    columns ascend with the neighbour rows; row i is seed 002 Eq. 10 = Eq. 12 times
@@ -907,6 +959,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     if (fsdem__mps_neighbours(s) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory building the neighbour list");
     s->surface_count = fsdem__mps_density(s);
+    fsdem__mps_shift(s);
     /* 2. predictor: u* = u + dt (nu lap u + g) (seed 002 Eq. A.6 with eps = 1). WALL and DUMMY
        particles take u* = dt g, their velocity (0) plus the same body force: a uniform field has no
        divergence (Eq. 9), so gravity alone leaves no source at the walls in Eq. 12, and the walls
@@ -965,7 +1018,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         if (s->dim == 2) s->v[i].z = 0;
     }
     for (i = 0; i < s->n; ++i)
-        if (s->kind[i] == FSDEM_MPS_FLUID) s->x[i] = fsdem__madd(s->x[i], s->v[i], dt);
+        if (s->kind[i] == FSDEM_MPS_FLUID) s->x[i] = fsdem__add(fsdem__madd(s->x[i], s->v[i], dt), s->shift[i]);
     s->time += (double)dt;
     s->dt_last = dt;
     s->steps++;
