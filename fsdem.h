@@ -12484,6 +12484,8 @@ static const char *fsdem__restart_kind_name(unsigned int kind) {
 
 static fsdem__restart_object fsdem__restart_of_dem(const fsdem_dem *d) {
     fsdem__restart_object o;
+    memset(&o, 0, sizeof o);
+    if (!d) return o;
     o.kind = FSDEM__RESTART_DEM;
     o.dim = d->desc.dim;
     o.sizes[0] = d->n;
@@ -12500,6 +12502,8 @@ static fsdem__restart_object fsdem__restart_of_dem(const fsdem_dem *d) {
 
 static fsdem__restart_object fsdem__restart_of_pic(const fsdem_pic *s) {
     fsdem__restart_object o;
+    memset(&o, 0, sizeof o);
+    if (!s) return o;
     o.kind = FSDEM__RESTART_PIC;
     o.dim = s->dim;
     o.sizes[0] = s->n[0];
@@ -12516,6 +12520,8 @@ static fsdem__restart_object fsdem__restart_of_pic(const fsdem_pic *s) {
 
 static fsdem__restart_object fsdem__restart_of_swe(const fsdem_swe *s) {
     fsdem__restart_object o;
+    memset(&o, 0, sizeof o);
+    if (!s) return o;
     o.kind = FSDEM__RESTART_SWE;
     o.dim = s->dim;
     o.sizes[0] = s->nx;
@@ -12532,6 +12538,8 @@ static fsdem__restart_object fsdem__restart_of_swe(const fsdem_swe *s) {
 
 static fsdem__restart_object fsdem__restart_of_swe_dem(const fsdem_swe_dem *c) {
     fsdem__restart_object o;
+    memset(&o, 0, sizeof o);
+    if (!c) return o;
     o.kind = FSDEM__RESTART_SWE_DEM;
     o.dim = c->desc.swe->dim;
     o.sizes[0] = c->desc.swe->nx;
@@ -12601,6 +12609,7 @@ static fsdem_result fsdem__restart_save_memory(const fsdem__restart_object *o, v
                                                size_t *size) {
     fsdem__restart io;
     unsigned char header[FSDEM__RESTART_HEADER];
+    if (!o->object) return FSDEM_ERR_INVALID_ARG; /* a NULL handle: no object to hold a message */
     fsdem__restart_begin(&io, o, "save_memory", FSDEM__RESTART_WRITE);
     if (!size) {
         fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "size is NULL");
@@ -12627,6 +12636,7 @@ static fsdem_result fsdem__restart_save_file(const fsdem__restart_object *o, con
     unsigned char header[FSDEM__RESTART_HEADER];
     FILE *fp;
     int bad;
+    if (!o->object) return FSDEM_ERR_INVALID_ARG; /* a NULL handle: no object to hold a message */
     fsdem__restart_begin(&io, o, "save", FSDEM__RESTART_WRITE);
     if (!path) {
         fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "path is NULL");
@@ -12716,10 +12726,12 @@ static fsdem_result fsdem__restart_load(const fsdem__restart_object *o, const ch
 /* Restores o from the file `path`, read whole into memory (FSDEM_ERR_IO when it cannot be). */
 static fsdem_result fsdem__restart_load_file(const fsdem__restart_object *o, const char *path) {
     fsdem__restart io;
-    FILE *fp = path ? fopen(path, "rb") : NULL;
+    FILE *fp;
     unsigned char *data = NULL;
     long length = -1;
     fsdem_result res;
+    if (!o->object) return FSDEM_ERR_INVALID_ARG; /* a NULL handle: no object to hold a message */
+    fp = path ? fopen(path, "rb") : NULL;
     fsdem__restart_begin(&io, o, "restore", FSDEM__RESTART_CHECK);
     if (!path) fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "path is NULL");
     else if (!fp) fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot open '%s'", path);
@@ -12735,124 +12747,98 @@ static fsdem_result fsdem__restart_load_file(const fsdem__restart_object *o, con
     return res;
 }
 
-/* The public functions: save and restore, to files and to memory, for each of the four objects (a
-   few lines each around the helpers above). A NULL object is refused with FSDEM_ERR_INVALID_ARG
-   without a message (there is no object to hold it). */
+/* Restores o from the `size` bytes at `buffer` (a save_memory image). */
+static fsdem_result fsdem__restart_load_memory(const fsdem__restart_object *o, const void *buffer, size_t size) {
+    if (!o->object) return FSDEM_ERR_INVALID_ARG; /* a NULL handle: no object to hold a message */
+    return fsdem__restart_load(o, "restore_memory", (const unsigned char *)buffer, size);
+}
+
+/* The public functions: save and restore, to files and to memory, for each of the four objects:
+   two lines each around the helpers above, which refuse a NULL object with FSDEM_ERR_INVALID_ARG
+   without a message: there is no object to hold it. */
 
 /* fsdem_dem (>>restart): the discrete elements. */
 fsdem_result fsdem_dem_save(const fsdem_dem *dem, const char *path) {
-    fsdem__restart_object o;
-    if (!dem) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_dem(dem);
+    fsdem__restart_object o = fsdem__restart_of_dem(dem);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_dem_restore(fsdem_dem *dem, const char *path) {
-    fsdem__restart_object o;
-    if (!dem) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_dem(dem);
+    fsdem__restart_object o = fsdem__restart_of_dem(dem);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_dem_save_memory(const fsdem_dem *dem, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o;
-    if (!dem) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_dem(dem);
+    fsdem__restart_object o = fsdem__restart_of_dem(dem);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_dem_restore_memory(fsdem_dem *dem, const void *buffer, size_t size) {
-    fsdem__restart_object o;
-    if (!dem) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_dem(dem);
-    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+    fsdem__restart_object o = fsdem__restart_of_dem(dem);
+    return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* fsdem_pic (>>restart): the PIC/FLIP solver. */
 fsdem_result fsdem_pic_save(const fsdem_pic *pic, const char *path) {
-    fsdem__restart_object o;
-    if (!pic) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_pic(pic);
+    fsdem__restart_object o = fsdem__restart_of_pic(pic);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_pic_restore(fsdem_pic *pic, const char *path) {
-    fsdem__restart_object o;
-    if (!pic) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_pic(pic);
+    fsdem__restart_object o = fsdem__restart_of_pic(pic);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_pic_save_memory(const fsdem_pic *pic, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o;
-    if (!pic) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_pic(pic);
+    fsdem__restart_object o = fsdem__restart_of_pic(pic);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_pic_restore_memory(fsdem_pic *pic, const void *buffer, size_t size) {
-    fsdem__restart_object o;
-    if (!pic) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_pic(pic);
-    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+    fsdem__restart_object o = fsdem__restart_of_pic(pic);
+    return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* fsdem_swe (>>restart): the shallow-water solver. */
 fsdem_result fsdem_swe_save(const fsdem_swe *swe, const char *path) {
-    fsdem__restart_object o;
-    if (!swe) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_swe(swe);
+    fsdem__restart_object o = fsdem__restart_of_swe(swe);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_swe_restore(fsdem_swe *swe, const char *path) {
-    fsdem__restart_object o;
-    if (!swe) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_swe(swe);
+    fsdem__restart_object o = fsdem__restart_of_swe(swe);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_swe_save_memory(const fsdem_swe *swe, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o;
-    if (!swe) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_swe(swe);
+    fsdem__restart_object o = fsdem__restart_of_swe(swe);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_swe_restore_memory(fsdem_swe *swe, const void *buffer, size_t size) {
-    fsdem__restart_object o;
-    if (!swe) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_swe(swe);
-    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+    fsdem__restart_object o = fsdem__restart_of_swe(swe);
+    return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* fsdem_swe_dem (>>restart): the SWE-DEM coupler with its two solvers. */
 fsdem_result fsdem_swe_dem_save(const fsdem_swe_dem *coupler, const char *path) {
-    fsdem__restart_object o;
-    if (!coupler) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_swe_dem(coupler);
+    fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_swe_dem_restore(fsdem_swe_dem *coupler, const char *path) {
-    fsdem__restart_object o;
-    if (!coupler) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_swe_dem(coupler);
+    fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_swe_dem_save_memory(const fsdem_swe_dem *coupler, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o;
-    if (!coupler) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_swe_dem(coupler);
+    fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *buffer, size_t size) {
-    fsdem__restart_object o;
-    if (!coupler) return FSDEM_ERR_INVALID_ARG;
-    o = fsdem__restart_of_swe_dem(coupler);
-    return fsdem__restart_load(&o, "restore_memory", (const unsigned char *)buffer, size);
+    fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
+    return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* ===== >>impl_io : CSV, ParaView series, VTK XML ====================================================
