@@ -2136,20 +2136,32 @@ static int fsdem__finite(fsdem_real x) { return x == x && x - x == 0; }
 
 /* A CSV time series of probe values written by a solver as it steps (SWE and PIC gauges): a header,
    then rows at the exact multiples of `interval`, the values interpolated linearly between the
-   start and the end of the step that passed each one (interval 0: one row per step). `before` holds
-   the values at the start of the step in flight, `now` is scratch for those at its end. */
+   start and the end of the step that passed each one (interval 0: one row per step). The series
+   samples its solver itself: a solver's step calls fsdem__series_begin first and fsdem__series_step
+   last, and nothing else. `before` holds the values at the start of the step in flight, `now` those
+   at its end. */
+typedef void (*fsdem__series_sample_fn)(const void *solver, fsdem_real *out);
 typedef struct fsdem__series {
     void *file;            /* FILE*, NULL when closed */
     double interval, next; /* s */
     int columns;           /* values per row after t */
     fsdem_real *before, *now;
+    fsdem__series_sample_fn sample;
+    const void *solver;
 } fsdem__series;
 
-/* Opens `path`, writes `header`, and allocates the rows with `al`; the caller then samples its
-   values into ser->now and writes the first row with fsdem__series_row. FSDEM_ERR_IO,
-   FSDEM_ERR_OUT_OF_MEMORY. */
+/* Writes the row of time t with the values in ser->now. */
+static void fsdem__series_row(fsdem__series *ser, double t) {
+    int k;
+    fprintf((FILE *)ser->file, "\n%.10g", t);
+    for (k = 0; k < ser->columns; ++k) fprintf((FILE *)ser->file, ",%.10g", (double)ser->now[k]);
+}
+
+/* Opens `path`, writes `header` and the row of time t sampled from `solver` by `sample`, and
+   allocates the rows with `al`. FSDEM_ERR_IO, FSDEM_ERR_OUT_OF_MEMORY. */
 static fsdem_result fsdem__series_open(fsdem__series *ser, const fsdem_allocator *al, const char *path, const char *header,
-                                       int columns, double t, double interval) {
+                                       int columns, double t, double interval, fsdem__series_sample_fn sample,
+                                       const void *solver) {
     FILE *fp;
     fsdem_real *rows = (fsdem_real *)fsdem__alloc(al, sizeof(fsdem_real) * 2 * (size_t)columns);
     if (!rows) return FSDEM_ERR_OUT_OF_MEMORY;
@@ -2164,22 +2176,25 @@ static fsdem_result fsdem__series_open(fsdem__series *ser, const fsdem_allocator
     ser->columns = columns;
     ser->before = rows;
     ser->now = rows + columns;
+    ser->sample = sample;
+    ser->solver = solver;
     fputs(header, fp);
+    sample(solver, ser->now);
+    fsdem__series_row(ser, t);
     return FSDEM_OK;
 }
 
-/* Writes the row of time t with the values in ser->now. */
-static void fsdem__series_row(fsdem__series *ser, double t) {
-    int k;
-    fprintf((FILE *)ser->file, "\n%.10g", t);
-    for (k = 0; k < ser->columns; ++k) fprintf((FILE *)ser->file, ",%.10g", (double)ser->now[k]);
+/* Before a step: the values at its start, from which the rows inside it are interpolated. */
+static void fsdem__series_begin(fsdem__series *ser) {
+    if (ser->file && ser->interval > 0) ser->sample(ser->solver, ser->before);
 }
 
-/* After a step from t0 to t1 whose end values are in ser->now: the rows it passed. */
+/* After a step from t0 to t1: samples its end and writes the rows it passed. */
 static fsdem_result fsdem__series_step(fsdem__series *ser, double t0, double t1) {
     FILE *fp = (FILE *)ser->file;
     int k;
     if (!fp) return FSDEM_OK;
+    ser->sample(ser->solver, ser->now);
     if (ser->interval <= 0) fsdem__series_row(ser, t1);
     for (; ser->interval > 0 && ser->next <= t1 * (1 + 1e-12); ser->next += ser->interval) {
         const double w = t1 > t0 ? (ser->next - t0) / (t1 - t0) : 1;
@@ -8671,7 +8686,9 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
     int a, f, bad, layers = fsdem__pic_layers(s);
     fsdem_real umax = 0;
     clock_t t0 = clock();
+    const double time0 = s->time;
     fsdem__ok(&s->status);
+    fsdem__series_begin(&s->gauges);
 
     /* 1. particles to grid, cells, extrapolation, FLIP reference */
     fsdem__pic_effective_faces(s);
@@ -8746,6 +8763,8 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
         worst = fsdem__fail(&s->status, FSDEM_ERR_CFL,
                             "fsdem_pic: step %lld: the projected grid velocity %g m/s moves %g cells in dt = %g s (cfl_max %g)",
                             s->steps, (double)umax, (double)(umax * dt * s->inv_dx), (double)dt, (double)s->desc.cfl_max);
+    if (worst == FSDEM_OK && fsdem__series_step(&s->gauges, time0, s->time) != FSDEM_OK)
+        worst = fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_pic: could not write the gauge file");
     return worst;
 }
 
@@ -9047,7 +9066,8 @@ static fsdem_real fsdem__pic_gauge_value(const fsdem_pic *s, int k) {
                                                      : fsdem__pic_pressure_at(s, s->gauge_at[k], s->gauge_radius[k]);
 }
 
-static void fsdem__pic_gauge_values(const fsdem_pic *s, fsdem_real *out) {
+static void fsdem__pic_gauge_values(const void *solver, fsdem_real *out) {
+    const fsdem_pic *s = (const fsdem_pic *)solver;
     int k;
     for (k = 0; k < s->gauge_count; ++k) out[k] = fsdem__pic_gauge_value(s, k);
 }
@@ -9110,11 +9130,10 @@ fsdem_result fsdem_pic_gauges_open(fsdem_pic *s, const char *path, fsdem_real in
     header[1] = '\0';
     for (k = 0; k < s->gauge_count; ++k)
         n += snprintf(header + n, size - (size_t)n, s->gauge_kind[k] == FSDEM_PIC_GAUGE_LEVEL ? ",level_%d" : ",p_%d", k);
-    res = fsdem__series_open(&s->gauges, &s->allocator, path, header, s->gauge_count, s->time, interval);
+    res = fsdem__series_open(&s->gauges, &s->allocator, path, header, s->gauge_count, s->time, interval,
+                             fsdem__pic_gauge_values, s);
     fsdem__free(&s->allocator, header, size);
     if (res != FSDEM_OK) return fsdem__fail(&s->status, res, "fsdem_pic_gauges_open: cannot open '%s'", path ? path : "(null)");
-    fsdem__pic_gauge_values(s, s->gauges.now);
-    fsdem__series_row(&s->gauges, s->time);
     return fsdem__ok(&s->status);
 }
 
@@ -10890,7 +10909,8 @@ fsdem_result fsdem_swe_stable_dt(const fsdem_swe *s, fsdem_real *dt) {
 }
 
 /* The gauge values h, eta, u, v of every gauge now (as fsdem_swe_sample_state; 0 where it fails). */
-static void fsdem__swe_gauge_values(const fsdem_swe *s, fsdem_real *out) {
+static void fsdem__swe_gauge_values(const void *solver, fsdem_real *out) {
+    const fsdem_swe *s = (const fsdem_swe *)solver;
     int k;
     for (k = 0; k < s->gauge_count; ++k) {
         fsdem_swe_cell c;
@@ -10909,7 +10929,7 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
     int j, k, side;
     fsdem_real tm = s->time + (fsdem_real)0.5 * dt;
     const double t0 = s->time;
-    if (s->gauges.file && s->gauges.interval > 0) fsdem__swe_gauge_values(s, s->gauges.before); /* rows between steps */
+    fsdem__series_begin(&s->gauges);
     memset(&c, 0, sizeof c);
     c.dt = dt;
     c.lx = dt / s->dx;
@@ -10978,7 +10998,6 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
     if (c.bad >= 0)
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_swe_step: non-finite state in cell %d (i=%d, j=%d) at t=%g s",
                            c.bad, c.bad % s->nx, c.bad / s->nx, (double)s->time);
-    if (s->gauges.file) fsdem__swe_gauge_values(s, s->gauges.now);
     if (fsdem__series_step(&s->gauges, t0, s->time) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe: could not write the gauge file");
     return fsdem__ok(&s->status);
@@ -11154,12 +11173,11 @@ fsdem_result fsdem_swe_gauges_open(fsdem_swe *s, const char *path, fsdem_real in
     header[1] = '\0';
     for (k = 0; k < s->gauge_count; ++k)
         n += snprintf(header + n, size - (size_t)n, ",h_%d,eta_%d,u_%d,v_%d", k, k, k, k);
-    res = fsdem__series_open(&s->gauges, &s->allocator, path, header, 4 * s->gauge_count, s->time, interval);
+    res = fsdem__series_open(&s->gauges, &s->allocator, path, header, 4 * s->gauge_count, s->time, interval,
+                             fsdem__swe_gauge_values, s);
     fsdem__free(&s->allocator, header, size);
     if (res != FSDEM_OK)
         return fsdem__fail(&s->status, res, "fsdem_swe_gauges_open: cannot open '%s'", path ? path : "(null)");
-    fsdem__swe_gauge_values(s, s->gauges.now);
-    fsdem__series_row(&s->gauges, s->time);
     return fsdem__ok(&s->status);
 }
 

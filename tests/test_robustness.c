@@ -538,7 +538,10 @@ START_TEST(pic_gauges_in_still_water) {
     fsdem_pic_desc d = fsdem_pic_desc_default(2);
     fsdem_pic *s;
     fsdem_real level, p, patch;
-    int lv, pp, pa;
+    int lv, pp, pa, rows = 0;
+    FILE *fp;
+    char line[512];
+    double t, row[3] = {0, 0, 0};
     d.cell_size = (fsdem_real)(1.0 / 32);
     ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(1, 0.5, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
@@ -561,6 +564,25 @@ START_TEST(pic_gauges_in_still_water) {
     ck_assert_msg(fabs(p / (1000 * 9.81 * 0.25) - 1) < 1e-3, "p %g Pa", (double)p);
     ck_assert_msg(fabs(patch / p - 1) < 1e-3, "patch %g Pa, point %g Pa", (double)patch, (double)p);
     ck_assert_int_eq(fsdem_pic_gauge(s, 3, &p), FSDEM_ERR_NOT_FOUND);
+    /* the file: a row at every multiple of the stored interval up to the end (t = 0 ... 0.5 in double;
+       in float 5 x 0.1f is past 0.5 s), the last one the state the gauges read now (the step ends at
+       0.5 s, so its row is the end values, printed with 10 digits) */
+    fp = fopen("build/test_pic_gauges.csv", "r");
+    ck_assert_ptr_nonnull(fp);
+    ck_assert_ptr_nonnull(fgets(line, sizeof line, fp));
+    ck_assert_str_eq(line, "t,level_0,p_1,p_2\n");
+    while (fgets(line, sizeof line, fp)) {
+        ck_assert_int_eq(sscanf(line, "%lf,%lf,%lf,%lf", &t, &row[0], &row[1], &row[2]), 4);
+        ck_assert_msg(fabs(t - (double)(fsdem_real)0.1 * rows) < 1e-9, "row %d at t = %.12g", rows, t);
+        rows++;
+    }
+    fclose(fp);
+    ck_assert_int_eq(rows, 1 + (int)floor(0.5 * (1 + 1e-12) / (double)(fsdem_real)0.1));
+    if (sizeof(fsdem_real) == 8) {
+        ck_assert_msg(fabs(row[0] - level) < 1e-9 * level && fabs(row[1] - p) < 1e-9 * p && fabs(row[2] - patch) < 1e-9 * patch,
+                      "last row %.10g %.10g %.10g, gauges %.10g %.10g %.10g", row[0], row[1], row[2], (double)level,
+                      (double)p, (double)patch);
+    }
     fsdem_pic_destroy(s);
 }
 END_TEST
