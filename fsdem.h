@@ -9924,6 +9924,25 @@ fsdem_result fsdem_swe_sample_state(const fsdem_swe *s, fsdem_real x, fsdem_real
     return FSDEM_OK;
 }
 
+/* The surface slope d eta / d(axis) at (x, y) with c the water there: a central difference over one
+   cell, its pair moved inside the outermost cell centres near the edge of the grid (beyond them
+   the samples are clamped, flat), one-sided against c when a side lies in a blocked cell. */
+static fsdem_real fsdem__swe_surface_slope(const fsdem_swe *s, fsdem_real x, fsdem_real y, int axis, const fsdem_swe_cell *c) {
+    const int cells = axis == 0 ? s->nx : s->ny;
+    const fsdem_real d = axis == 0 ? s->dx : s->dy, lo_edge = (axis == 0 ? s->desc.x_min : s->desc.y_min) + d,
+                     hi_edge = lo_edge + (fsdem_real)(cells - 2) * d;
+    fsdem_real at = axis == 0 ? x : y, span = 0;
+    fsdem_swe_cell lo, hi;
+    if (cells < 2) return 0;
+    if (at < lo_edge) at = lo_edge;
+    if (at > hi_edge) at = hi_edge;
+    if (fsdem_swe_sample_state(s, axis == 0 ? at - d / 2 : x, axis == 0 ? y : at - d / 2, &lo) == FSDEM_OK) span += d / 2;
+    else lo = *c;
+    if (fsdem_swe_sample_state(s, axis == 0 ? at + d / 2 : x, axis == 0 ? y : at + d / 2, &hi) == FSDEM_OK) span += d / 2;
+    else hi = *c;
+    return span > 0 ? (hi.eta - lo.eta) / span : 0;
+}
+
 fsdem_result fsdem_swe_sample(const fsdem_swe *s, int count, const fsdem_vec3 *points, fsdem_fluid_sample *out) {
     int n;
     if (!s) return FSDEM_ERR_INVALID_ARG;
@@ -9932,23 +9951,17 @@ fsdem_result fsdem_swe_sample(const fsdem_swe *s, int count, const fsdem_vec3 *p
                            count);
     for (n = 0; n < count; ++n) {
         const fsdem_vec3 p = points[n];
-        const fsdem_real rg = s->desc.density * s->g, hx = s->dx / 2, hy = s->dim == 2 ? s->dy / 2 : 0;
-        fsdem_swe_cell c, e0, e1;
+        const fsdem_real rg = s->desc.density * s->g;
+        fsdem_swe_cell c;
         memset(&out[n], 0, sizeof out[n]);
         if (fsdem_swe_sample_state(s, p.x, p.y, &c) != FSDEM_OK || c.depth < s->desc.dry_depth || p.z < c.bed ||
             p.z > c.eta)
             continue;
         out[n].velocity = fsdem_v3(c.u, c.v, 0);
         out[n].volume_fraction = 1;
-        /* hydrostatic p = rho g (eta - z): the surface slope over one cell around the point */
-        fsdem_swe_sample_state(s, p.x - hx, p.y, &e0);
-        fsdem_swe_sample_state(s, p.x + hx, p.y, &e1);
-        out[n].pressure_gradient.x = rg * (e1.eta - e0.eta) / s->dx;
-        if (s->dim == 2) {
-            fsdem_swe_sample_state(s, p.x, p.y - hy, &e0);
-            fsdem_swe_sample_state(s, p.x, p.y + hy, &e1);
-            out[n].pressure_gradient.y = rg * (e1.eta - e0.eta) / s->dy;
-        }
+        /* hydrostatic p = rho g (eta - z) */
+        out[n].pressure_gradient.x = rg * fsdem__swe_surface_slope(s, p.x, p.y, 0, &c);
+        if (s->dim == 2) out[n].pressure_gradient.y = rg * fsdem__swe_surface_slope(s, p.x, p.y, 1, &c);
         out[n].pressure_gradient.z = -rg;
     }
     return fsdem__ok((fsdem__status *)&s->status);

@@ -330,6 +330,13 @@ START_TEST(swe_sample_sloping_lake) {
                           "%dD point %d: fraction %g, velocity %g, gradient %g", dim, q, (double)out[q].volume_fraction,
                           (double)out[q].velocity.x, (double)out[q].pressure_gradient.z);
         }
+        /* inside the outermost half-cells (corner (0.02, 0.02), and (1.98, ...) in 1D), where the samples
+           are clamped to the last centres: the slope of the nearest pair of centres, exact for this plane */
+        pts[0] = fsdem_v3(dim == 2 ? 0.02 : 1.98, dim == 2 ? 0.02 : 0, 0.3);
+        ck_assert_int_eq(fsdem_swe_sample(s, 1, pts, out), FSDEM_OK);
+        ck_assert(out[0].volume_fraction == 1);
+        ck_assert_double_eq_tol(out[0].pressure_gradient.x, rg * 0.02, gtol);
+        ck_assert_double_eq_tol(out[0].pressure_gradient.y, dim == 2 ? rg * -0.03 : 0, gtol);
         ck_assert_int_eq(fsdem_swe_sample(s, 1, pts, NULL), FSDEM_ERR_INVALID_ARG);
         fsdem_swe_destroy(s);
     }
