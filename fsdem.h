@@ -9673,9 +9673,6 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
         s->bed[k] = desc->bed ? desc->bed[k] : 0;
         s->eta[k] = s->bed[k] + (desc->depth ? desc->depth[k] : 0);
     }
-    fsdem__swe_dry_blocked(s);
-    fsdem__swe_dry_blocked(s);
-    fsdem__swe_dry_blocked(s);
     fsdem__swe_scan(s);
     *out = s;
     return FSDEM_OK;
@@ -11495,6 +11492,7 @@ static fsdem_result fsdem__swe_dem_refresh(void *user, fsdem_dem *dem, double ti
 static fsdem_result fsdem__swe_dem_step(fsdem_swe_dem *c, fsdem_real dt, int adaptive) {
     fsdem_result res;
     long long k, substeps = 0;
+    int count;
     res = fsdem_dem_substep_count(c->desc.dem, dt, &substeps);
     if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: %s", fsdem_dem_last_error(c->desc.dem));
     if (substeps > c->desc.max_substeps)
@@ -11505,7 +11503,8 @@ static fsdem_result fsdem__swe_dem_step(fsdem_swe_dem *c, fsdem_real dt, int ada
     if (res != FSDEM_OK) return res;
     res = adaptive ? fsdem_swe_step(c->desc.swe) : fsdem_swe_step_dt(c->desc.swe, dt);
     if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: shallow-water step: %s", fsdem_swe_last_error(c->desc.swe));
-    for (k = 0; k < c->force_capacity && k < fsdem_dem_get_particles(c->desc.dem).count; ++k)
+    count = fsdem_dem_get_particles(c->desc.dem).count;
+    for (k = 0; k < c->force_capacity && k < count; ++k)
         c->impulse = fsdem__madd(c->impulse, c->reaction[k], -dt);
     res = fsdem_dem_advance_with(c->desc.dem, dt, fsdem__swe_dem_refresh, c, &substeps);
     c->steps++;

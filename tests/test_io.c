@@ -1162,7 +1162,6 @@ static void check_swe(int dim) {
         }
         EXPECT(&d, "CellData", "velocity", REAL_TYPE, 3, e, n);
         if (dim == 2) EXPECT(&d, "CellData", "manning", REAL_TYPE, 1, from_reals(manning, n), n);
-        for (i = 0; i < n; ++i) ck_assert(h[i] == fl.eta[i] - fl.bed[i]);
         free(u);
         free(v);
         free(h);
