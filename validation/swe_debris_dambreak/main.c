@@ -55,7 +55,7 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
     fsdem_dem *dem;
     fsdem_swe_dem *cpl;
     fsdem_csv gauges, track;
-    fsdem_real depth[710], dt_dem;
+    fsdem_real depth[710], dt_dem = 0;
     char path[128];
     const double x_debris = x_gate + debris_offset, dx = length / nx;
     double h_gate_exact, speed, t = 0, t_front = -1, t_move = -1, t_visible = -1, gate_err_sum = 0, draft_z;
@@ -95,9 +95,11 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
     debris.position = fsdem_v3(x_debris, 0, draft_z);
     debris.radius = r;
     debris.material = mat;
-    fsdem_dem_add_particle(dem, &debris, NULL);
-    fsdem_dem_stable_dt(dem, &dt_dem); /* Hertz: 0.2 x the Rayleigh time */
-    fsdem_dem_set_dt(dem, dt_dem);
+    if (fsdem_dem_add_particle(dem, &debris, NULL) != FSDEM_OK || fsdem_dem_stable_dt(dem, &dt_dem) != FSDEM_OK ||
+        fsdem_dem_set_dt(dem, dt_dem) != FSDEM_OK) { /* Hertz: 0.2 x the Rayleigh time */
+        fprintf(stderr, "%s: %s\n", name, fsdem_dem_last_error(dem));
+        return 2;
+    }
 
     cd.swe = swe;
     cd.dem = dem;
