@@ -15,9 +15,7 @@ CHECK_CFLAGS = $(shell pkg-config --cflags check 2>/dev/null)
 CHECK_LIBS   = $(shell pkg-config --libs check 2>/dev/null || echo -lcheck -lsubunit -lrt -lpthread -lm)
 
 # every tests/test_<module>.c is a suite registered in tests/check_main.c
-# suites of work in progress (wip/), built against the merged header by their own scripts
-WIP_TEST_SRC := tests/test_mps.c
-TEST_SRC   := $(sort $(filter-out $(WIP_TEST_SRC),$(wildcard tests/test_*.c))) tests/check_main.c tests/fsdem_impl.c
+TEST_SRC   := $(sort $(wildcard tests/test_*.c)) tests/check_main.c tests/fsdem_impl.c
 EXAMPLES   := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.c))
 VALIDATION := $(patsubst validation/%/main.c,%,$(wildcard validation/*/main.c))
 BENCHES    := $(patsubst bench/%/main.c,%,$(wildcard bench/*/main.c))

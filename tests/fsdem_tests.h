@@ -18,6 +18,7 @@ Suite *interface_suite(void);
 Suite *restart_suite(void);
 Suite *robustness_suite(void);
 Suite *io_suite(void);
+Suite *mps_suite(void);
 
 /* ---- tolerances that follow the precision of fsdem_real ----
 
