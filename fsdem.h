@@ -224,11 +224,19 @@
 #define fsdem_mps_gradient fsdem_mps_gradient_f
 #define fsdem_mps_laplacian fsdem_mps_laplacian_f
 #define fsdem_mps_last_error fsdem_mps_last_error_f
+#define fsdem_mps_obstacle_force fsdem_mps_obstacle_force_f
 #define fsdem_mps_pressure_matrix fsdem_mps_pressure_matrix_f
+#define fsdem_mps_probe_height fsdem_mps_probe_height_f
+#define fsdem_mps_probe_pressure fsdem_mps_probe_pressure_f
+#define fsdem_mps_restore fsdem_mps_restore_f
+#define fsdem_mps_restore_memory fsdem_mps_restore_memory_f
+#define fsdem_mps_save fsdem_mps_save_f
+#define fsdem_mps_save_memory fsdem_mps_save_memory_f
 #define fsdem_mps_stable_dt fsdem_mps_stable_dt_f
 #define fsdem_mps_step fsdem_mps_step_f
 #define fsdem_mps_step_dt fsdem_mps_step_dt_f
 #define fsdem_mps_time fsdem_mps_time_f
+#define fsdem_mps_write_vtp fsdem_mps_write_vtp_f
 #define fsdem_pcg_create fsdem_pcg_create_f
 #define fsdem_pcg_desc_check fsdem_pcg_desc_check_f
 #define fsdem_pcg_desc_default fsdem_pcg_desc_default_f
@@ -1929,6 +1937,38 @@ typedef struct fsdem_mps_stats {
 
 FSDEM_API fsdem_mps_stats fsdem_mps_get_stats(const fsdem_mps *mps);
 
+/* ---- probes (the sensors of experiments) ----
+
+   Point probes average over the particles near a point with the smooth weight
+       W(r) = (1 - r^2/R^2)^3 for r < R, 0 beyond,
+   normalised as a kernel (integral 1: C = 4/(pi R^2) in 2D, 315/(64 pi R^3) in 3D) where a
+   volume is measured. They read the state after the last step (positions of its end, pressures of
+   its solve) and scan all particles: O(particles) per call, meant for output times, not for
+   every particle. "Up" is the last axis (y in 2D, z in 3D), as the lattice's free surface. */
+
+/* Pressure (Pa) at `point`: the W-weighted mean (Shepard) of the FLUID and WALL particles within
+   `radius` (m; 0 means re) of it, surface particles (p = 0) included; 0 when none is there (a
+   sensor in the air). A sensor on a wall reads its WALL particles and the liquid beside them.
+   FSDEM_ERR_INVALID_ARG for NULL arguments, a non-finite point or a negative radius. */
+FSDEM_API fsdem_result fsdem_mps_probe_pressure(const fsdem_mps *mps, fsdem_vec3 point, fsdem_real radius,
+                                                fsdem_real *pressure);
+/* Water level (m, a coordinate along the last axis) at the gauge through `gauge` (its x in 2D, x
+   and y in 3D; the last coordinate is ignored): the highest point of that vertical line where the
+   liquid fraction sum_j r0^d W(|r_j - point|) over FLUID particles (R = 2 r0) reaches 1/2, which
+   on a flat surface is the surface of the volume the particles stand for (half a spacing above
+   the top row), interpolated between samples r0/4 apart; domain_min's last coordinate when no
+   liquid is within R of the line. The first liquid from above counts, a jet over the gauge
+   included, as a gauge sees it. FSDEM_ERR_INVALID_ARG for NULL arguments or a non-finite gauge. */
+FSDEM_API fsdem_result fsdem_mps_probe_height(const fsdem_mps *mps, fsdem_vec3 gauge, fsdem_real *height);
+/* Force (N; N per metre of depth in 2D) of the liquid on the box obstacle `id`
+   (fsdem_mps_add_box_obstacle) in the last step: the reaction to the pressure force that its
+   WALL and DUMMY particles exerted on the FLUID particles in the corrector (sum over the pairs of
+   -(mass_i/rho) times their terms of Eq. 8, mass_i = rho r0^d), so that the liquid's momentum
+   change and the obstacle's force balance exactly. Viscous stress is not included (it is of order
+   nu / (u r0) of the pressure force). 0 before the first step. FSDEM_ERR_INVALID_ARG for NULL
+   arguments or an unknown id. */
+FSDEM_API fsdem_result fsdem_mps_obstacle_force(const fsdem_mps *mps, int id, fsdem_vec3 *force);
+
 /* ===== >>restart : checkpoint and restart ========================================================= */
 
 /* Saves the complete state of a solver or coupler to a file or to memory, and restores it, so that
@@ -1953,14 +1993,20 @@ FSDEM_API fsdem_mps_stats fsdem_mps_get_stats(const fsdem_mps *mps);
                     series, point sources, gauge positions, momentum sources, time, counters;
      fsdem_swe_dem  the states of its fsdem_swe and fsdem_dem, restored into the solvers it was
                     created with, and its own counters and per-particle force records (one file
-                    holds the coupled run).
+                    holds the coupled run);
+     fsdem_mps      particles of every kind (positions, velocities, pressures, porosities, kinds,
+                    obstacle membership, and the number density and surface flags of the last
+                    step) and their capacity, obstacles with their last forces, time, counters
+                    (the pressure matrix of the last step is not kept: fsdem_mps_pressure_matrix
+                    is empty until the next step).
    What must match (else FSDEM_ERR_INVALID_ARG naming the field): the desc fields that steps read.
    DEM: dim, domain, gravity, law, integrator, dt_rule, dt_param, skin, contact_offset, linear_*,
    disc_length, rotation. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,
    viscosity, gravity, boundaries, transfer, kernel, seeding and reseeding, advection, cfl,
    dt_max, ghost-fluid, extrapolation and solver settings. SWE: dim, nx, ny, extent, width,
    gravity, density, cfl, dt_max, order, limiter, dry_depth, manning, eddy_viscosity. Coupler:
-   beta, two_way, heave_damping, max_substeps (and its solvers' fields above). Not compared:
+   beta, two_way, heave_damping, max_substeps (and its solvers' fields above). MPS: every field of
+   fsdem_mps_desc but the allocator and log (re as resolved). Not compared:
    allocator, log, DEM dt and capacity, PIC seed and max_memory, SWE rain_rate, boundary, bed and
    depth (all restored or irrelevant once the state is restored).
    Callbacks cannot be saved. An SDF wall (DEM) or SDF obstacle (PIC) of the save takes the
@@ -1989,12 +2035,13 @@ FSDEM_API fsdem_mps_stats fsdem_mps_get_stats(const fsdem_mps *mps);
           8      4  format version (unsigned)
          12      4  byte-order mark 0x01020304 as the saving machine stores it
          16      4  precision: sizeof(fsdem_real), 4 (FSDEM_USE_FLOAT) or 8
-         20      4  object kind: 1 fsdem_dem, 2 fsdem_pic, 3 fsdem_swe, 4 fsdem_swe_dem
+         20      4  object kind: 1 fsdem_dem, 2 fsdem_pic, 3 fsdem_swe, 4 fsdem_swe_dem, 5 fsdem_mps
          24      4  dimension of the object (the SWE's for fsdem_swe_dem)
          28      4  reserved (0)
          32     16  four sizes (int) for tools: DEM particles, materials, walls, pair-list entries;
                     PIC cells along x, y, z and particles; SWE nx, ny, point sources, gauges;
-                    SWE-DEM nx, ny, DEM particles, force records
+                    SWE-DEM nx, ny, DEM particles, force records; MPS particles, FLUID
+                    particles, obstacles, 0
          48      8  payload bytes (unsigned)
          56      8  checksum: 64-bit FNV-1a over bytes 0 to 55 and the payload
    The payload holds tagged sections of integers and reals as the saving machine stores them. */
@@ -2027,6 +2074,12 @@ FSDEM_API fsdem_result fsdem_swe_dem_restore(fsdem_swe_dem *coupler, const char 
 FSDEM_API fsdem_result fsdem_swe_dem_save_memory(const fsdem_swe_dem *coupler, void *buffer, size_t capacity,
                                                  size_t *size);
 FSDEM_API fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *buffer, size_t size);
+
+/* The same four for the MPS solver. */
+FSDEM_API fsdem_result fsdem_mps_save(const fsdem_mps *mps, const char *path);
+FSDEM_API fsdem_result fsdem_mps_restore(fsdem_mps *mps, const char *path);
+FSDEM_API fsdem_result fsdem_mps_save_memory(const fsdem_mps *mps, void *buffer, size_t capacity, size_t *size);
+FSDEM_API fsdem_result fsdem_mps_restore_memory(fsdem_mps *mps, const void *buffer, size_t size);
 
 /* ===== >>io : CSV time series, ParaView series, VTK XML snapshots ================================== */
 
@@ -2153,6 +2206,12 @@ FSDEM_API fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *pic, const
    type (UInt8, fsdem_stencil_cell) and velocity (m/s, cell-centred: the mean of the two faces along
    each axis; z = 0 in 2D), as fsdem_pic_get_fields. */
 FSDEM_API fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *pic, const char *path, fsdem_vtk_format format);
+
+/* MPS particles as PolyData (.vtp): one point and vertex per particle of every kind (z = 0 in 2D),
+   in index order, with point data kind (UInt8, fsdem_mps_kind: show the liquid with a Threshold on
+   kind = 0), surface (UInt8), pressure (Pa), velocity (m/s), number_density and porosity, as
+   fsdem_mps_get_particles. Active scalars pressure, active vectors velocity. */
+FSDEM_API fsdem_result fsdem_mps_write_vtp(const fsdem_mps *mps, const char *path, fsdem_vtk_format format);
 
 /* Shallow-water fields as ImageData (.vti): extent 0..nx x 0..ny x 0..0 points, origin (x_min,
    y_min, 0), spacing (dx, dy, 1); a 1D channel is one cell high, 0..nx x 0..1, origin (x_min, 0, 0),
@@ -2498,6 +2557,11 @@ static fsdem_vec3 fsdem__cross(fsdem_vec3 a, fsdem_vec3 b) {
 static fsdem_real fsdem__norm(fsdem_vec3 a) { return (fsdem_real)sqrt(fsdem__dot(a, a)); }
 static fsdem_vec3 fsdem__zero3(void) { return fsdem_v3(0, 0, 0); }
 static fsdem_real fsdem__comp(fsdem_vec3 v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+static void fsdem__set_comp(fsdem_vec3 *v, int axis, fsdem_real value) {
+    if (axis == 0) v->x = value;
+    else if (axis == 1) v->y = value;
+    else v->z = value;
+}
 
 /* ---- >>core_lane : short vectors for batched kernels ---- */
 
@@ -11831,6 +11895,12 @@ fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
    surface), >>mps_step (predictor, pressure equation, corrector, time stepping), >>mps_views
    (views, statistics). */
 
+/* A box obstacle (fsdem_mps_add_box_obstacle) and the force of the fluid on it in the last step. */
+typedef struct fsdem__mps_obst {
+    fsdem_vec3 lo, hi;
+    fsdem_vec3 force; /* N (N/m in 2D) */
+} fsdem__mps_obst;
+
 struct fsdem_mps {
     fsdem_mps_desc desc;
     fsdem__status status;
@@ -11847,6 +11917,7 @@ struct fsdem_mps {
     fsdem_real *p, *eps, *nd;     /* pressure, porosity, number density */
     fsdem_real *div, *b, *sol;    /* divergence of u*, right-hand side and solution (by unknown) */
     unsigned char *kind, *surf;
+    int *body;                    /* the obstacle a WALL or DUMMY particle belongs to, or -1 */
     int *unknown;                 /* row of each particle in the pressure equation, or -1 */
     int *row_particle;            /* particle of each row */
     int counts[3];                /* particles per kind */
@@ -11864,7 +11935,7 @@ struct fsdem_mps {
     int rows;
     fsdem_pcg *pcg;
     /* obstacles */
-    fsdem_vec3 *obst, *obst_hi;
+    fsdem__mps_obst *obst;
     int obst_n, obst_cap;
     /* time and statistics */
     double time;
@@ -12025,7 +12096,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
 
 /* The particle arrays of a capacity `cap`, with their element sizes (one list for allocation,
    copying and release). */
-#define FSDEM__MPS_ARRAYS 14
+#define FSDEM__MPS_ARRAYS 15
 static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     void **p[FSDEM__MPS_ARRAYS];
     size_t e[FSDEM__MPS_ARRAYS];
@@ -12047,6 +12118,7 @@ static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     FSDEM__MPS_ARRAY(sol);
     FSDEM__MPS_ARRAY(kind);
     FSDEM__MPS_ARRAY(surf);
+    FSDEM__MPS_ARRAY(body);
     FSDEM__MPS_ARRAY(unknown);
     FSDEM__MPS_ARRAY(row_particle);
 #undef FSDEM__MPS_ARRAY
@@ -12077,7 +12149,7 @@ void fsdem_mps_destroy(fsdem_mps *s) {
     fsdem__free(&s->allocator, s->tmp_w, sizeof(fsdem_real) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->a_col, sizeof(int) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->a_val, sizeof(fsdem_real) * (size_t)s->a_cap);
-    fsdem__free(&s->allocator, s->obst, sizeof(fsdem_vec3) * 2 * (size_t)s->obst_cap);
+    fsdem__free(&s->allocator, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
     fsdem_cellgrid_free(&s->grid);
     if (s->pcg) fsdem_pcg_destroy(s->pcg);
     al = s->allocator;
@@ -12161,6 +12233,7 @@ static void fsdem__mps_push(fsdem_mps *s, fsdem_mps_kind kind, fsdem_vec3 x, fsd
     s->nd[i] = 0;
     s->kind[i] = (unsigned char)kind;
     s->surf[i] = 0;
+    s->body[i] = -1;
     s->unknown[i] = -1;
     s->counts[kind]++;
 }
@@ -12234,11 +12307,11 @@ static fsdem_result fsdem__mps_lattice_fill(fsdem_mps *s, const char *fn, fsdem_
 /* Depth of p outside the box [lo, hi] in lattice layers: 0 inside, k when the largest excursion
    along an axis is within (k - 1, k] spacings. `open` (bits of fsdem_side) marks sides beyond which
    a point is rejected (-1). */
-static int fsdem__mps_layer_outside(const fsdem_mps *s, const fsdem_vec3 *box, unsigned open, fsdem_vec3 p) {
+static int fsdem__mps_layer_outside(const fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3 hi, unsigned open, fsdem_vec3 p) {
     fsdem_real worst = 0;
     int a;
     for (a = 0; a < s->dim; ++a) {
-        const fsdem_real x = fsdem__comp(p, a), l = fsdem__comp(box[0], a), h = fsdem__comp(box[1], a);
+        const fsdem_real x = fsdem__comp(p, a), l = fsdem__comp(lo, a), h = fsdem__comp(hi, a);
         const fsdem_real out = x < l ? l - x : x > h ? x - h : 0;
         if (out > 0 && (open & (1u << (2 * a + (x > h))))) return -1;
         if (out > worst) worst = out;
@@ -12247,11 +12320,11 @@ static int fsdem__mps_layer_outside(const fsdem_mps *s, const fsdem_vec3 *box, u
 }
 
 /* Depth of p inside the box in layers: 1 for the outer layer, 0 outside. */
-static int fsdem__mps_layer_inside(const fsdem_mps *s, const fsdem_vec3 *box, fsdem_vec3 p) {
+static int fsdem__mps_layer_inside(const fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3 hi, fsdem_vec3 p) {
     fsdem_real depth = -1;
     int a;
     for (a = 0; a < s->dim; ++a) {
-        const fsdem_real x = fsdem__comp(p, a), l = fsdem__comp(box[0], a), h = fsdem__comp(box[1], a);
+        const fsdem_real x = fsdem__comp(p, a), l = fsdem__comp(lo, a), h = fsdem__comp(hi, a);
         const fsdem_real in = x - l < h - x ? x - l : h - x;
         if (!(in > 0)) return 0;
         if (depth < 0 || in < depth) depth = in;
@@ -12264,7 +12337,7 @@ static int fsdem__mps_classify_fluid(const fsdem_mps *s, const void *user, fsdem
     int o;
     (void)user;
     for (o = 0; o < s->obst_n; ++o)
-        if (fsdem__mps_layer_inside(s, s->obst + 2 * o, p) > 0) return -1;
+        if (fsdem__mps_layer_inside(s, s->obst[o].lo, s->obst[o].hi, p) > 0) return -1;
     return FSDEM_MPS_FLUID;
 }
 
@@ -12276,13 +12349,14 @@ typedef struct fsdem__mps_walls {
 
 static int fsdem__mps_classify_walls(const fsdem_mps *s, const void *user, fsdem_vec3 p) {
     const fsdem__mps_walls *w = (const fsdem__mps_walls *)user;
-    const int layer = fsdem__mps_layer_outside(s, w->box, w->open, p);
+    const int layer = fsdem__mps_layer_outside(s, w->box[0], w->box[1], w->open, p);
     return layer <= 0 || layer > s->layers ? -1 : layer == 1 ? FSDEM_MPS_WALL : FSDEM_MPS_DUMMY;
 }
 
 /* Obstacle: the outer layer inside the box WALL, the next ones DUMMY. */
 static int fsdem__mps_classify_obstacle(const fsdem_mps *s, const void *user, fsdem_vec3 p) {
-    const int layer = fsdem__mps_layer_inside(s, (const fsdem_vec3 *)user, p);
+    const fsdem__mps_obst *o = (const fsdem__mps_obst *)user;
+    const int layer = fsdem__mps_layer_inside(s, o->lo, o->hi, p);
     return layer <= 0 || layer > s->layers ? -1 : layer == 1 ? FSDEM_MPS_WALL : FSDEM_MPS_DUMMY;
 }
 
@@ -12323,27 +12397,31 @@ fsdem_result fsdem_mps_add_box_walls(fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3 hi,
 }
 
 fsdem_result fsdem_mps_add_box_obstacle(fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3 hi, int *id) {
-    fsdem_vec3 box[2];
+    fsdem__mps_obst box;
     fsdem_result r;
+    int first, i;
     if (id) *id = -1;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((r = fsdem__mps_check_box(s, "fsdem_mps_add_box_obstacle", lo, hi)) != FSDEM_OK) return r;
     if (s->obst_n == s->obst_cap) {
         const int cap = s->obst_cap ? 2 * s->obst_cap : 4;
-        fsdem_vec3 *o = (fsdem_vec3 *)fsdem__alloc(&s->allocator, sizeof(fsdem_vec3) * 2 * (size_t)cap);
+        fsdem__mps_obst *o = (fsdem__mps_obst *)fsdem__alloc(&s->allocator, sizeof *o * (size_t)cap);
         if (!o) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_box_obstacle: out of memory");
-        if (s->obst_n) memcpy(o, s->obst, sizeof(fsdem_vec3) * 2 * (size_t)s->obst_n);
-        fsdem__free(&s->allocator, s->obst, sizeof(fsdem_vec3) * 2 * (size_t)s->obst_cap);
+        if (s->obst_n) memcpy(o, s->obst, sizeof *o * (size_t)s->obst_n);
+        fsdem__free(&s->allocator, s->obst, sizeof *o * (size_t)s->obst_cap);
+        s->bytes += sizeof *o * (size_t)(cap - s->obst_cap);
         s->obst = o;
         s->obst_cap = cap;
     }
-    box[0] = lo;
-    box[1] = hi;
-    r = fsdem__mps_lattice_fill(s, "fsdem_mps_add_box_obstacle", lo, lo, hi, fsdem__mps_classify_obstacle, box,
+    box.lo = lo;
+    box.hi = hi;
+    box.force = fsdem__zero3();
+    first = s->n;
+    r = fsdem__mps_lattice_fill(s, "fsdem_mps_add_box_obstacle", lo, lo, hi, fsdem__mps_classify_obstacle, &box,
                                 fsdem__zero3(), NULL);
     if (r != FSDEM_OK) return r;
-    s->obst[2 * s->obst_n] = lo;
-    s->obst[2 * s->obst_n + 1] = hi;
+    for (i = first; i < s->n; ++i) s->body[i] = s->obst_n;
+    s->obst[s->obst_n] = box;
     if (id) *id = s->obst_n;
     s->obst_n++;
     return fsdem__ok(&s->status);
@@ -12506,14 +12584,18 @@ static int fsdem__mps_density(fsdem_mps *s) {
    the pressure step passes ghost = rho g, the hydrostatic extrapolation from i, so the solid
    behind the wall layer pushes as a full neighbourhood of liquid would (skipping the DUMMY
    particles instead leaves the sum form one-sided and pulls particles into walls); the public
-   operator passes 0 (a mirror value, zero normal derivative). */
-static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, int i, fsdem_vec3 ghost) {
+   operator passes 0 (a mirror value, zero normal derivative). When `reaction` is not NULL, the
+   terms of the neighbours that belong to obstacle b are added to reaction[b] as they are, before
+   the factor d/n0 (fsdem__mps_do_step turns them into the obstacles' forces). */
+static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, int i, fsdem_vec3 ghost,
+                                     fsdem__mps_obst *reaction) {
     fsdem_vec3 g = fsdem__zero3();
     fsdem_real base = phi[i];
     /* a DUMMY particle higher than the hydrostatic extrapolation reaches is in the air beside the
        free surface: its ghost pressure is not below 0, as the liquid's (desc.clamp_negative_pressure);
        a negative ghost pulled the particles at the top of the walls into them */
     const int clamp = s->desc.clamp_negative_pressure && (ghost.x != 0 || ghost.y != 0 || ghost.z != 0);
+    fsdem_vec3 term;
     int e;
     if (s->desc.gradient == FSDEM_MPS_GRADIENT_MIN)
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e)
@@ -12529,7 +12611,9 @@ static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, 
             if (pj < 0 && clamp) pj = 0;
         }
         if (!(r2 > 0)) continue;
-        g = fsdem__madd(g, r, (pj + base) * s->nbw[e] / (r2 * s->eps[j]));
+        term = fsdem__scale(r, (pj + base) * s->nbw[e] / (r2 * s->eps[j]));
+        g = fsdem__add(g, term);
+        if (reaction && s->body[j] >= 0) reaction[s->body[j]].force = fsdem__add(reaction[s->body[j]].force, term);
     }
     return fsdem__scale(g, (fsdem_real)s->dim / s->n0);
 }
@@ -12578,7 +12662,7 @@ fsdem_result fsdem_mps_gradient(fsdem_mps *s, const fsdem_real *phi, fsdem_vec3 
     int i;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((r = fsdem__mps_operator_setup(s, "fsdem_mps_gradient", phi, out)) != FSDEM_OK) return r;
-    for (i = 0; i < s->n; ++i) out[i] = s->kind[i] == FSDEM_MPS_DUMMY ? fsdem__zero3() : fsdem__mps_grad_at(s, phi, i, fsdem__zero3());
+    for (i = 0; i < s->n; ++i) out[i] = s->kind[i] == FSDEM_MPS_DUMMY ? fsdem__zero3() : fsdem__mps_grad_at(s, phi, i, fsdem__zero3(), NULL);
     return fsdem__ok(&s->status);
 }
 
@@ -12837,11 +12921,17 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         if (p < 0 && s->desc.clamp_negative_pressure) p = 0;
         s->p[i] = p;
     }
+    for (a = 0; a < s->obst_n; ++a) s->obst[a].force = fsdem__zero3();
     for (i = 0; i < s->n; ++i) {
         if (s->kind[i] != FSDEM_MPS_FLUID) continue;
-        s->v[i] = fsdem__madd(s->us[i], fsdem__mps_grad_at(s, s->p, i, fsdem__scale(s->desc.gravity, rho)), -dt / rho); /* seed 002 Eq. A.5 */
+        s->v[i] = fsdem__madd(s->us[i], fsdem__mps_grad_at(s, s->p, i, fsdem__scale(s->desc.gravity, rho), s->obst),
+                              -dt / rho); /* seed 002 Eq. A.5 */
         if (s->dim == 2) s->v[i].z = 0;
     }
+    /* the obstacles' forces: the reaction to the pressure force their particles exert on the
+       FLUID particles, -(mass_i / rho) (grad p)_i per pair, mass_i = rho r0^d */
+    for (a = 0; a < s->obst_n; ++a)
+        s->obst[a].force = fsdem__scale(s->obst[a].force, (fsdem_real)s->dim / s->n0 * (fsdem_real)pow((double)s->r0, s->dim));
     for (i = 0; i < s->n; ++i)
         if (s->kind[i] == FSDEM_MPS_FLUID) s->x[i] = fsdem__add(fsdem__madd(s->x[i], s->v[i], dt), s->shift[i]);
     s->time += (double)dt;
@@ -12986,11 +13076,109 @@ fsdem_mps_stats fsdem_mps_get_stats(const fsdem_mps *s) {
     return st;
 }
 
+/* ---- >>mps_probes : pressure, water level, obstacle force ---- */
+
+/* W(r) of the probes (section >>mps): (1 - r^2/R^2)^3 inside R, times the normalisation of a kernel
+   when `normalised`. */
+static fsdem_real fsdem__mps_probe_weight(const fsdem_mps *s, fsdem_real r2, fsdem_real R, int normalised) {
+    const fsdem_real q = 1 - r2 / (R * R);
+    const double c = !normalised ? 1 : s->dim == 2 ? 4 / (FSDEM__PI * (double)(R * R)) : 315 / (64 * FSDEM__PI * (double)(R * R * R));
+    return q > 0 ? (fsdem_real)(c * (double)(q * q * q)) : 0;
+}
+
+fsdem_result fsdem_mps_probe_pressure(const fsdem_mps *s, fsdem_vec3 point, fsdem_real radius, fsdem_real *pressure) {
+    double sum = 0, weights = 0;
+    int i;
+    if (pressure) *pressure = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!pressure || !fsdem__finite3(point) || !(radius >= 0) || !fsdem__finite(radius))
+        return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_mps_probe_pressure: %s", !pressure ? "pressure is NULL" : "the point and radius must be finite, radius >= 0");
+    if (radius == 0) radius = s->re;
+    if (s->dim == 2) point.z = 0;
+    for (i = 0; i < s->n; ++i) {
+        fsdem_vec3 d;
+        fsdem_real w;
+        if (s->kind[i] == FSDEM_MPS_DUMMY) continue;
+        d = fsdem__sub(s->x[i], point);
+        w = fsdem__mps_probe_weight(s, fsdem__dot(d, d), radius, 0);
+        sum += (double)(w * s->p[i]);
+        weights += (double)w;
+    }
+    if (weights > 0) *pressure = (fsdem_real)(sum / weights);
+    return fsdem__ok((fsdem__status *)&s->status);
+}
+
+/* Liquid fraction at the point of the gauge line at height z (fsdem_mps_probe_height). */
+static fsdem_real fsdem__mps_liquid_fraction(const fsdem_mps *s, fsdem_vec3 gauge, fsdem_real z, fsdem_real R) {
+    const int up = s->dim - 1;
+    const fsdem_real volume = (fsdem_real)pow((double)s->r0, s->dim);
+    double f = 0;
+    int i;
+    fsdem__set_comp(&gauge, up, z);
+    for (i = 0; i < s->n; ++i) {
+        fsdem_vec3 d;
+        if (s->kind[i] != FSDEM_MPS_FLUID) continue;
+        d = fsdem__sub(s->x[i], gauge);
+        f += (double)fsdem__mps_probe_weight(s, fsdem__dot(d, d), R, 1);
+    }
+    return (fsdem_real)(f * (double)volume);
+}
+
+fsdem_result fsdem_mps_probe_height(const fsdem_mps *s, fsdem_vec3 gauge, fsdem_real *height) {
+    fsdem_real R, step, top = 0, bottom = 0, z, f_above = 0;
+    int i, up, found = 0;
+    if (height) *height = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    R = 2 * s->r0;
+    step = s->r0 / 4;
+    if (!height || !fsdem__finite3(gauge))
+        return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_mps_probe_height: %s", !height ? "height is NULL" : "the gauge position must be finite");
+    up = s->dim - 1;
+    if (s->dim == 2) gauge.z = 0;
+    *height = fsdem__comp(s->desc.domain_min, up);
+    /* the span of the liquid within R of the line */
+    for (i = 0; i < s->n; ++i) {
+        fsdem_vec3 d;
+        fsdem_real zi;
+        if (s->kind[i] != FSDEM_MPS_FLUID) continue;
+        d = fsdem__sub(s->x[i], gauge);
+        fsdem__set_comp(&d, up, 0);
+        if (!(fsdem__dot(d, d) < R * R)) continue;
+        zi = fsdem__comp(s->x[i], up);
+        if (!found || zi > top) top = zi;
+        if (!found || zi < bottom) bottom = zi;
+        found = 1;
+    }
+    if (!found) return fsdem__ok((fsdem__status *)&s->status);
+    /* from above the highest particle down, the first sample whose fraction reaches 1/2 */
+    for (z = top + R; z >= bottom - R; z -= step) {
+        const fsdem_real f = fsdem__mps_liquid_fraction(s, gauge, z, R);
+        if (f >= (fsdem_real)0.5) {
+            *height = z + step * (f - (fsdem_real)0.5) / (f - f_above);
+            break;
+        }
+        f_above = f;
+    }
+    return fsdem__ok((fsdem__status *)&s->status);
+}
+
+fsdem_result fsdem_mps_obstacle_force(const fsdem_mps *s, int id, fsdem_vec3 *force) {
+    if (force) *force = fsdem__zero3();
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!force || id < 0 || id >= s->obst_n)
+        return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_obstacle_force: %s",
+                           !force ? "force is NULL" : "no obstacle has this id");
+    *force = s->obst[id].force;
+    return fsdem__ok((fsdem__status *)&s->status);
+}
+
 /* ===== >>impl_restart : checkpoint and restart =======================================================
 
    Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
-   every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_swe_dem (one visitor per
-   object lists what it saves, in order, and serves saving and restoring alike), >>restart_api
+   every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_swe_dem, >>restart_mps (one
+   visitor per object lists what it saves, in order, and serves saving and restoring alike), >>restart_api
    (memory and files). A restore runs the visitor three times over the payload: CHECK validates
    everything and compares the desc, RESERVE allocates, COMMIT writes into the object. Only COMMIT
    changes the object, and it cannot fail. */
@@ -13007,7 +13195,7 @@ fsdem_mps_stats fsdem_mps_get_stats(const fsdem_mps *s) {
 /* The header stores its fields as unsigned int (4 bytes) and unsigned long long (8 bytes). */
 typedef char fsdem__restart_int_sizes[sizeof(unsigned int) == 4 && sizeof(unsigned long long) == 8 ? 1 : -1];
 
-enum { FSDEM__RESTART_DEM = 1, FSDEM__RESTART_PIC = 2, FSDEM__RESTART_SWE = 3, FSDEM__RESTART_SWE_DEM = 4 };
+enum { FSDEM__RESTART_DEM = 1, FSDEM__RESTART_PIC = 2, FSDEM__RESTART_SWE = 3, FSDEM__RESTART_SWE_DEM = 4, FSDEM__RESTART_MPS = 5 };
 
 typedef enum fsdem__restart_mode {
     FSDEM__RESTART_WRITE = 0,   /* object to payload (to memory, to a file, or only measured) */
@@ -13904,6 +14092,108 @@ static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
     fsdem__restart_tag(io, "SWD.");
 }
 
+/* ---- >>restart_mps : MPS ---- */
+
+/* The particles go into fresh arrays of the saved capacity (all FSDEM__MPS_ARRAYS of them and the
+   four row-offset arrays, as fsdem__mps_reserve makes them); of their contents the state that the
+   next step reads (positions, velocities, pressures: the pressure solve starts from them, kinds,
+   porosities, obstacle membership) and the views of the last step (number density, surface flags)
+   are saved. The neighbour rows and the matrix are rebuilt by every step; their memory stays. */
+static void fsdem__restart_mps(fsdem__restart *io, void *object) {
+    fsdem_mps *s = (fsdem_mps *)object;
+    const fsdem_mps_desc *d = &s->desc;
+    const fsdem_allocator *al = &s->allocator;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    int no = s->obst_n, n = s->n, cap = s->cap, i, a;
+    fsdem__mps_obst *obst;
+    fsdem__restart_tag(io, "MPS1");
+    fsdem__restart_same_int(io, d->dim, "dim");
+    fsdem__restart_same_real(io, d->r0, "r0");
+    fsdem__restart_same_real(io, d->re, "re");
+    fsdem__restart_same_real(io, d->density, "density");
+    fsdem__restart_same_real(io, d->viscosity, "viscosity");
+    fsdem__restart_same_vec3(io, d->gravity, "gravity");
+    fsdem__restart_same_real(io, d->gamma, "gamma");
+    fsdem__restart_same_real(io, d->beta, "beta");
+    fsdem__restart_same_real(io, d->alpha, "alpha");
+    fsdem__restart_same_real(io, d->cfl, "cfl");
+    fsdem__restart_same_real(io, d->dt_max, "dt_max");
+    fsdem__restart_same_vec3(io, d->domain_min, "domain_min");
+    fsdem__restart_same_vec3(io, d->domain_max, "domain_max");
+    fsdem__restart_same_int(io, (int)d->gradient, "gradient");
+    fsdem__restart_same_int(io, d->clamp_negative_pressure, "clamp_negative_pressure");
+    fsdem__restart_same_real(io, d->shifting, "shifting");
+    fsdem__restart_same_int(io, (int)d->pressure_precond, "pressure_precond");
+    fsdem__restart_same_real(io, d->pressure_tolerance, "pressure_tolerance");
+    fsdem__restart_same_int(io, d->pressure_max_iterations, "pressure_max_iterations");
+
+    fsdem__restart_data(io, &s->time, sizeof s->time);
+    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
+    fsdem__restart_data(io, &s->steps, sizeof s->steps);
+    fsdem__restart_data(io, &s->iters_total, sizeof s->iters_total);
+    fsdem__restart_data(io, &s->iters, sizeof s->iters);
+    fsdem__restart_data(io, &s->residual, sizeof s->residual);
+    fsdem__restart_data(io, &s->surface_count, sizeof s->surface_count);
+    fsdem__restart_data(io, &s->pair_count, sizeof s->pair_count);
+
+    /* obstacles, into a fresh array */
+    fsdem__restart_count(io, &no, 1 << 24, sizeof(fsdem__mps_obst), "obstacle count");
+    obst = (fsdem__mps_obst *)fsdem__restart_block(io, al, sizeof *obst * (size_t)no);
+    if (commit) {
+        fsdem__free(al, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
+        s->bytes += sizeof *obst * (size_t)no - sizeof *s->obst * (size_t)s->obst_cap;
+        s->obst = obst;
+        s->obst_n = s->obst_cap = no;
+    }
+    fsdem__restart_data(io, s->obst, sizeof *s->obst * (size_t)no);
+
+    /* particles, into fresh arrays of the saved capacity */
+    fsdem__restart_count(io, &cap, 1 << 29, 0, "particle capacity");
+    fsdem__restart_count(io, &n, cap, 2 * sizeof(fsdem_vec3), "particle count");
+    if (io->res == FSDEM_OK && (io->mode == FSDEM__RESTART_RESERVE || commit)) {
+        void **ptr[FSDEM__MPS_ARRAYS];
+        size_t elem[FSDEM__MPS_ARRAYS];
+        void *fresh[FSDEM__MPS_ARRAYS + 4];
+        const int k = fsdem__mps_arrays(s, ptr, elem);
+        for (a = 0; a < k; ++a) fresh[a] = fsdem__restart_block(io, al, elem[a] * (size_t)cap);
+        for (a = 0; a < 4; ++a) fresh[k + a] = fsdem__restart_block(io, al, sizeof(int) * (size_t)(cap + 1));
+        if (commit) {
+            for (a = 0; a < k; ++a) {
+                fsdem__free(al, *ptr[a], elem[a] * (size_t)s->cap);
+                *ptr[a] = fresh[a];
+                s->bytes += elem[a] * (size_t)cap - elem[a] * (size_t)s->cap;
+            }
+            for (a = 0; a < 4; ++a) {
+                int **rows = fsdem__mps_rows(s, a);
+                fsdem__free(al, *rows, sizeof(int) * (size_t)(s->cap + 1));
+                *rows = (int *)fresh[k + a];
+                memset(*rows, 0, sizeof(int) * (size_t)(cap + 1));
+            }
+            s->bytes += 4 * sizeof(int) * (size_t)cap - 4 * sizeof(int) * (size_t)s->cap;
+            s->cap = cap;
+            s->n = n;
+            s->rows = 0; /* the pressure matrix of the last step is not kept */
+        }
+    }
+    fsdem__restart_data(io, s->x, sizeof *s->x * (size_t)n);
+    fsdem__restart_data(io, s->v, sizeof *s->v * (size_t)n);
+    fsdem__restart_data(io, s->p, sizeof *s->p * (size_t)n);
+    fsdem__restart_data(io, s->eps, sizeof *s->eps * (size_t)n);
+    fsdem__restart_data(io, s->nd, sizeof *s->nd * (size_t)n);
+    fsdem__restart_flags(io, s->kind, n, FSDEM_MPS_DUMMY, "kind of particle");
+    fsdem__restart_flags(io, s->surf, n, 1, "surface flag of particle");
+    fsdem__restart_ints(io, s->body, n, -1, no - 1, "obstacle of particle");
+    if (commit) {
+        s->counts[0] = s->counts[1] = s->counts[2] = 0;
+        for (i = 0; i < n; ++i) {
+            s->counts[s->kind[i]]++;
+            s->us[i] = s->shift[i] = fsdem__zero3();
+            s->unknown[i] = -1;
+        }
+    }
+    fsdem__restart_tag(io, "MPS.");
+}
+
 /* ---- >>restart_api : memory and files ---- */
 
 /* What the API needs to know of one object. */
@@ -13923,6 +14213,7 @@ static const char *fsdem__restart_kind_name(unsigned int kind) {
     case FSDEM__RESTART_PIC: return "fsdem_pic";
     case FSDEM__RESTART_SWE: return "fsdem_swe";
     case FSDEM__RESTART_SWE_DEM: return "fsdem_swe_dem";
+    case FSDEM__RESTART_MPS: return "fsdem_mps";
     }
     return "unknown object";
 }
@@ -13996,6 +14287,24 @@ static fsdem__restart_object fsdem__restart_of_swe_dem(const fsdem_swe_dem *c) {
     o.allocator = &c->allocator;
     o.status = (fsdem__status *)&c->status;
     o.name = "fsdem_swe_dem";
+    return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_mps(const fsdem_mps *s) {
+    fsdem__restart_object o;
+    memset(&o, 0, sizeof o);
+    if (!s) return o;
+    o.kind = FSDEM__RESTART_MPS;
+    o.dim = s->dim;
+    o.sizes[0] = s->n;
+    o.sizes[1] = s->counts[FSDEM_MPS_FLUID];
+    o.sizes[2] = s->obst_n;
+    o.sizes[3] = 0;
+    o.object = (void *)s;
+    o.visit = fsdem__restart_mps;
+    o.allocator = &s->allocator;
+    o.status = (fsdem__status *)&s->status;
+    o.name = "fsdem_mps";
     return o;
 }
 
@@ -14283,6 +14592,26 @@ fsdem_result fsdem_swe_dem_save_memory(const fsdem_swe_dem *coupler, void *buffe
 
 fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *buffer, size_t size) {
     fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
+    return fsdem__restart_load_memory(&o, buffer, size);
+}
+
+fsdem_result fsdem_mps_save(const fsdem_mps *mps, const char *path) {
+    fsdem__restart_object o = fsdem__restart_of_mps(mps);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_mps_restore(fsdem_mps *mps, const char *path) {
+    fsdem__restart_object o = fsdem__restart_of_mps(mps);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_mps_save_memory(const fsdem_mps *mps, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o = fsdem__restart_of_mps(mps);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_mps_restore_memory(fsdem_mps *mps, const void *buffer, size_t size) {
+    fsdem__restart_object o = fsdem__restart_of_mps(mps);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 
@@ -15216,6 +15545,28 @@ fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *s, const char *path,
     fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", s->px, s->np));
     fsdem__vtk_section_end(&w, "Points");
     fsdem__vtk_cells(&w, "Verts", fsdem__vtk_ramp("connectivity", s->np, 0, 1), fsdem__vtk_ramp("offsets", s->np, 1, 1));
+    return fsdem__vtk_close(&w);
+}
+
+fsdem_result fsdem_mps_write_vtp(const fsdem_mps *s, const char *path, fsdem_vtk_format format) {
+    fsdem__vtk_writer w;
+    fsdem_result res;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem__vtk_open(&w, (fsdem__status *)&s->status, "fsdem_mps_write_vtp", path, format, "PolyData");
+    if (res != FSDEM_OK) return res;
+    fsdem__vtk_polydata(&w, s->time, s->n, s->n, 0, 0);
+    fsdem__vtk_section(&w, "PointData", "pressure", "velocity");
+    fsdem__vtk_write(&w, fsdem__vtk_bytes("kind", s->kind, s->n));
+    fsdem__vtk_write(&w, fsdem__vtk_bytes("surface", s->surf, s->n));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("pressure", s->p, s->n));
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("velocity", s->v, s->n));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("number_density", s->nd, s->n));
+    fsdem__vtk_write(&w, fsdem__vtk_reals("porosity", s->eps, s->n));
+    fsdem__vtk_section_end(&w, "PointData");
+    fsdem__vtk_section(&w, "Points", NULL, NULL);
+    fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", s->x, s->n));
+    fsdem__vtk_section_end(&w, "Points");
+    fsdem__vtk_cells(&w, "Verts", fsdem__vtk_ramp("connectivity", s->n, 0, 1), fsdem__vtk_ramp("offsets", s->n, 1, 1));
     return fsdem__vtk_close(&w);
 }
 

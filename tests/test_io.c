@@ -1089,6 +1089,58 @@ static void check_pic(int dim) {
     fsdem_pic_destroy(pic);
 }
 
+/* ---- MPS ---------------------------------------------------------------------------------------- */
+
+static double *from_bytes(const unsigned char *p, long n) {
+    double *e = (double *)malloc(sizeof(double) * (size_t)(n + 1));
+    long i;
+    for (i = 0; i < n; ++i) e[i] = p[i];
+    return e;
+}
+
+static void check_mps(int dim) {
+    fsdem_mps_desc desc = fsdem_mps_desc_default(dim);
+    fsdem_mps *mps = NULL;
+    const fsdem_vec3 hi = dim == 2 ? fsdem_v3(0.2, 0.2, 0) : fsdem_v3(0.1, 0.1, 0.1);
+    int f;
+    desc.r0 = dim == 2 ? 0.02 : 0.025;
+    desc.domain_min = fsdem_v3(-0.2, -0.2, -0.2);
+    ck_assert_int_eq(fsdem_mps_create(&desc, &mps), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_box_walls(mps, fsdem_v3(0, 0, 0), hi, 1u << (dim == 2 ? FSDEM_SIDE_YMAX : FSDEM_SIDE_ZMAX), NULL),
+                     FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(mps, fsdem_v3(0, 0, 0), hi, fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_step(mps), FSDEM_OK);
+    for (f = 0; f < 3; ++f) {
+        fsdem_mps_particles p = fsdem_mps_get_particles(mps);
+        char path[64];
+        xdoc d;
+        snprintf(path, sizeof path, "build/test_io_mps%dd_%s.vtp", dim, FORMAT_NAME[f]);
+        ck_assert_int_eq(fsdem_mps_write_vtp(mps, path, (fsdem_vtk_format)f), FSDEM_OK);
+        vtk_open(&d, path, "PolyData", f, fsdem_mps_time(mps));
+        vtk_piece_counts(&d, p.count, p.count, 0, 0);
+        ck_assert_int_eq(x_arrays_in(&d, "PointData"), 6);
+        EXPECT(&d, "Points", "Points", REAL_TYPE, 3, from_vec3s(p.position, p.count), p.count);
+        EXPECT(&d, "PointData", "kind", "UInt8", 1, from_bytes(p.kind, p.count), p.count);
+        EXPECT(&d, "PointData", "surface", "UInt8", 1, from_bytes(p.surface, p.count), p.count);
+        EXPECT(&d, "PointData", "pressure", REAL_TYPE, 1, from_reals(p.pressure, p.count), p.count);
+        EXPECT(&d, "PointData", "velocity", REAL_TYPE, 3, from_vec3s(p.velocity, p.count), p.count);
+        EXPECT(&d, "PointData", "number_density", REAL_TYPE, 1, from_reals(p.number_density, p.count), p.count);
+        EXPECT(&d, "PointData", "porosity", REAL_TYPE, 1, from_reals(p.porosity, p.count), p.count);
+        EXPECT(&d, "Verts", "offsets", "Int32", 1, from_ramp(p.count, 1, 1), p.count);
+        xdoc_free(&d);
+    }
+    ck_assert_int_eq(fsdem_mps_write_vtp(NULL, "build/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_mps_write_vtp(mps, "build/no/such/dir/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_IO);
+    ck_assert_ptr_nonnull(strstr(fsdem_mps_last_error(mps), "build/no/such/dir/x.vtp"));
+    fsdem_mps_destroy(mps);
+}
+
+START_TEST(io_mps_read_back_2d) { check_mps(2); }
+END_TEST
+
+START_TEST(io_mps_read_back_3d) { check_mps(3); }
+END_TEST
+
 START_TEST(io_pic_read_back_2d) { check_pic(2); }
 END_TEST
 
@@ -1328,6 +1380,8 @@ Suite *io_suite(void) {
     tcase_add_test(tc, io_dem_contacts_empty_before_a_step);
     tcase_add_test(tc, io_pic_read_back_2d);
     tcase_add_test(tc, io_pic_read_back_3d);
+    tcase_add_test(tc, io_mps_read_back_2d);
+    tcase_add_test(tc, io_mps_read_back_3d);
     tcase_add_test(tc, io_swe_read_back_1d);
     tcase_add_test(tc, io_swe_read_back_2d);
     tcase_add_test(tc, io_pvd_valid_after_every_add);

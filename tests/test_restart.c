@@ -1,4 +1,4 @@
-/* Checkpoint and restart: for every solver and the coupler, a run continued from a restored state is
+/* Checkpoint and restart: for every solver (DEM, PIC, SWE, MPS) and the coupler, a run continued from a restored state is
    the uninterrupted run to the last byte of the state (fixed and adaptive dt); bad data (truncated,
    corrupted, other version, precision, dimension, kind, grid or desc) are refused with a message and
    leave the object exactly as it was, as does running out of memory. */
@@ -24,6 +24,7 @@ DEFINE_SAVE(dem)
 DEFINE_SAVE(pic)
 DEFINE_SAVE(swe)
 DEFINE_SAVE(swe_dem)
+DEFINE_SAVE(mps)
 
 /* Two saves are the same bytes; on failure the first differing byte is named. */
 static void same_bytes(const unsigned char *a, size_t na, const unsigned char *b, size_t nb, const char *what) {
@@ -768,6 +769,74 @@ START_TEST(swe_gauge_file_blocks_restore) {
 }
 END_TEST
 
+/* ---- MPS ---------------------------------------------------------------------------------------- */
+
+/* 2D dam break in a tank with a box obstacle on its floor (r0 = 1 cm, 300 fluid particles): the
+   column collapses, the surface and the neighbourhoods change every step. */
+static fsdem_mps_desc mps_desc(void) {
+    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    d.r0 = 0.01;
+    d.domain_min = fsdem_v3(-0.1, -0.1, 0);
+    d.domain_max = fsdem_v3(0.5, 0.4, 0);
+    return d;
+}
+
+static void mps_setup(fsdem_mps *m) {
+    ck_assert_int_eq(fsdem_mps_add_box_walls(m, fsdem_v3(0, 0, 0), fsdem_v3(0.4, 0.3, 0), 1u << FSDEM_SIDE_YMAX, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_box_obstacle(m, fsdem_v3(0.25, 0, 0), fsdem_v3(0.3, 0.05, 0), NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(m, fsdem_v3(0, 0, 0), fsdem_v3(0.1, 0.3, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+}
+
+START_TEST(mps_continues_bit_exact) {
+    const fsdem_mps_desc desc = mps_desc();
+    const char *path = "build/test_restart_mps.bin";
+    fsdem_mps *a = NULL, *c = NULL, *f = NULL, *other = NULL;
+    fsdem_mps_desc od = desc;
+    unsigned char *A, *B, *C, *F, *R;
+    size_t na, nb, nc, nf, nr;
+    ck_assert_int_eq(fsdem_mps_create(&desc, &a), FSDEM_OK);
+    mps_setup(a);
+    ck_assert_int_eq(fsdem_mps_advance(a, 0.03, NULL), FSDEM_OK);
+    A = save_mps(a, &na);
+    ck_assert_int_eq(fsdem_mps_save(a, path), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_advance(a, 0.03, NULL), FSDEM_OK);
+    B = save_mps(a, &nb);
+
+    /* into an empty object of the same desc: nothing to add again */
+    ck_assert_int_eq(fsdem_mps_create(&desc, &c), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_restore_memory(c, A, na), FSDEM_OK);
+    R = save_mps(c, &nr);
+    same_bytes(A, na, R, nr, "MPS save of the restored state");
+    ck_assert_int_eq(fsdem_mps_advance(c, 0.03, NULL), FSDEM_OK);
+    C = save_mps(c, &nc);
+    same_bytes(B, nb, C, nc, "MPS continued from memory");
+
+    /* into an object that already holds particles (others are replaced) */
+    ck_assert_int_eq(fsdem_mps_create(&desc, &f), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(f, fsdem_v3(0, 0, 0), fsdem_v3(0.3, 0.3, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_restore(f, path), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_advance(f, 0.03, NULL), FSDEM_OK);
+    F = save_mps(f, &nf);
+    same_bytes(B, nb, F, nf, "MPS continued from a file");
+
+    /* another desc is refused by name, and the object is unchanged */
+    od.gamma = 0.02;
+    ck_assert_int_eq(fsdem_mps_create(&od, &other), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_restore_memory(other, A, na), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_nonnull(strstr(fsdem_mps_last_error(other), "desc.gamma"));
+    ck_assert_int_eq(fsdem_mps_get_particles(other).count, 0);
+    free(A);
+    free(B);
+    free(C);
+    free(F);
+    free(R);
+    fsdem_mps_destroy(a);
+    fsdem_mps_destroy(c);
+    fsdem_mps_destroy(f);
+    fsdem_mps_destroy(other);
+}
+END_TEST
+
 Suite *restart_suite(void) {
     Suite *s = suite_create("restart");
     TCase *tc = tcase_create("restart");
@@ -779,6 +848,7 @@ Suite *restart_suite(void) {
     tcase_add_test(tc, swe_continues_bit_exact);
     tcase_add_test(tc, swe_dem_continues_bit_exact);
     tcase_add_test(tc, swe_dem_refusal_names_the_solver);
+    tcase_add_test(tc, mps_continues_bit_exact);
     tcase_add_test(tc, bad_data_is_refused_and_changes_nothing);
     tcase_add_test(tc, out_of_memory_changes_nothing);
     tcase_add_test(tc, swe_gauge_file_blocks_restore);
