@@ -1711,7 +1711,8 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
 /* Incompressible free-surface flow by the Moving Particle Semi-implicit method (Koshizuka and Oka
    1996) in the form of seed 002 §2.1: the Zhang kernel (Eq. 6), number density, gradient,
    divergence and Laplacian with the 1/eps_j factor of a per-particle porosity (Eq. 7-11), the
-   mixed source term of the pressure Poisson equation (Eq. 12, gamma = 0.01), free-surface detection
+   mixed source term of the pressure Poisson equation (Eq. 12, gamma = 0.01; Eq. 13, the source
+   times the porosity eps_i, with desc.model = FSDEM_MPS_MODEL_B), free-surface detection
    by number density and neighbour asymmetry (Eq. 14-16), and the CFL rule of Eq. 37 (§2.4).
 
    Particles are of three kinds. FLUID particles move. WALL particles are the layer of a solid next
@@ -1734,7 +1735,8 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
         rho g.(r_j - r_i), as in the corrector's gradient, a known term, which is the Neumann condition
         dp/dn = rho g.n of a wall): Eq. 10 = Eq. 12, its row i multiplied by -n0 lambda/(2d) / eps_i
         so the matrix  A_ii = sum_j w_ij/(eps_i eps_j),  A_ij = -w_ij/(eps_i eps_j)  (sums over the
-        non-DUMMY j) is symmetric and positive definite (a fsdem_csr, solved by fsdem_pcg);
+        non-DUMMY j) is symmetric and positive definite (a fsdem_csr, solved by fsdem_pcg; Eq. 13
+        instead of Eq. 12 with desc.model = FSDEM_MPS_MODEL_B);
      5. negative pressures set to 0 when desc.clamp_negative_pressure (the seed says nothing; the
         original MPS clamps, so the default does);
      6. corrector u = u* - dt/rho grad p (Eq. 8 or the stabilised form, desc.gradient), r += dt u;
@@ -1785,6 +1787,12 @@ typedef enum fsdem_mps_gradient_model {
     FSDEM_MPS_GRADIENT_MIN = 1
 } fsdem_mps_gradient_model;
 
+/* Form of the pressure equation's source with a porosity field (seed 002 §2.1). */
+typedef enum fsdem_mps_model {
+    FSDEM_MPS_MODEL_A = 0, /* Eq. 12: rho_f in both terms of the mixed source */
+    FSDEM_MPS_MODEL_B = 1  /* Eq. 13: eps_f rho_f, eps_f the porosity of the particle (identical at eps = 1) */
+} fsdem_mps_model;
+
 typedef struct fsdem_mps_desc {
     int dim;                        /* 2 or 3 */
     fsdem_real r0;                  /* m; initial particle spacing, > 0; default 0.01 */
@@ -1795,6 +1803,7 @@ typedef struct fsdem_mps_desc {
     fsdem_vec3 gravity;             /* m/s^2; default (0,-9.81,0) in 2D, (0,0,-9.81) in 3D */
     fsdem_real gamma;               /* -; weight of the number-density term of Eq. 12, in [0, 1]; */
                                     /*    default 0.01 */
+    fsdem_mps_model model;          /* source of the pressure equation: Eq. 12 or 13; default A */
     fsdem_real beta;                /* -; surface when n < beta n0 (Eq. 14), in (0, 1); default 0.8 */
     fsdem_real alpha;               /* -; surface when |F| > alpha |F0| (Eq. 16), > 0; default 0.9 */
     fsdem_real cfl;                 /* -; Courant number C of Eq. 37, u_max dt / r0 <= C, in (0, 1]; */
@@ -12012,6 +12021,8 @@ static fsdem_result fsdem__mps_check(const fsdem_mps_desc *d, char *msg, size_t 
                                  (double)fsdem__comp(d->domain_max, a), "xyz"[a], (double)fsdem__comp(d->domain_min, a));
     if ((int)d->gradient < 0 || (int)d->gradient > 1)
         return fsdem__reject(msg, size, "fsdem_mps_desc.gradient = %d is not a fsdem_mps_gradient_model", (int)d->gradient);
+    if ((int)d->model < 0 || (int)d->model > 1)
+        return fsdem__reject(msg, size, "fsdem_mps_desc.model = %d is not a fsdem_mps_model", (int)d->model);
     if (!(d->shifting >= 0 && d->shifting <= 1))
         return fsdem__reject(msg, size, "fsdem_mps_desc.shifting = %g must be in [0, 1]", (double)d->shifting);
     if ((int)d->pressure_precond < 0 || (int)d->pressure_precond > 4)
@@ -12831,8 +12842,10 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
         s->a_col[at] = row;
         s->a_val[at] = diag;
         s->a_start[row + 1] = (int)nnz;
-        /* seed 002 Eq. 12: (1 - gamma) rho/dt div u* - gamma rho/dt^2 (n_i - n0)/n0 */
+        /* seed 002 Eq. 12: (1 - gamma) rho/dt div u* - gamma rho/dt^2 (n_i - n0)/n0; Eq. 13 (model B)
+           the same with eps_i rho */
         source = (1 - gamma) * rho / dt * s->div[i] - gamma * rho / (dt * dt) * (s->nd[i] - s->n0) / s->n0;
+        if (s->desc.model == FSDEM_MPS_MODEL_B) source *= s->eps[i];
         s->b[row] = scale * source / s->eps[i];
         /* DUMMY neighbours in Eq. 10 at the ghost pressure p_i + rho g.(r_j - r_i), the hydrostatic
            extrapolation from i that the corrector's gradient uses too (fsdem__mps_grad_at): their
@@ -14114,6 +14127,7 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_same_real(io, d->viscosity, "viscosity");
     fsdem__restart_same_vec3(io, d->gravity, "gravity");
     fsdem__restart_same_real(io, d->gamma, "gamma");
+    fsdem__restart_same_int(io, (int)d->model, "model");
     fsdem__restart_same_real(io, d->beta, "beta");
     fsdem__restart_same_real(io, d->alpha, "alpha");
     fsdem__restart_same_real(io, d->cfl, "cfl");

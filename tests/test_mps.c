@@ -376,6 +376,10 @@ START_TEST(test_mps_bad_input) {
     d.re = (fsdem_real)(1.5 * d.r0);
     ck_assert_int_eq(fsdem_mps_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert(strstr(msg, "fsdem_mps_desc.re") == msg);
+    d = fsdem_mps_desc_default(2);
+    d.model = (fsdem_mps_model)2;
+    ck_assert_int_eq(fsdem_mps_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert(strstr(msg, "fsdem_mps_desc.model") == msg);
     d = fsdem_mps_desc_default(4);
     ck_assert_int_eq(fsdem_mps_desc_check(&d, NULL, 0), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_mps_desc_check(NULL, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
@@ -548,6 +552,35 @@ START_TEST(test_mps_probes) {
 }
 END_TEST
 
+/* Model B (seed 002 Eq. 13) differs from A (Eq. 12) only by the porosity eps_i on the source: with
+   eps = 1 everywhere the two runs are the same to the last bit; with a porosity field they are not. */
+START_TEST(test_mps_model_b_at_unit_porosity) {
+    fsdem_mps *m[2];
+    fsdem_mps_particles p[2];
+    int k, i;
+    for (k = 0; k < 2; ++k) {
+        fsdem_mps_desc d = fsdem_mps_desc_default(2);
+        d.r0 = 0.02f;
+        d.model = k == 0 ? FSDEM_MPS_MODEL_A : FSDEM_MPS_MODEL_B;
+        d.domain_min = fsdem_v3(-0.2f, -0.2f, 0);
+        ck_assert_int_eq(fsdem_mps_create(&d, &m[k]), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_add_box_walls(m[k], fsdem_v3(0, 0, 0), fsdem_v3(0.4f, 0.3f, 0), 1u << FSDEM_SIDE_YMAX, NULL),
+                         FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_fill_box(m[k], fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.2f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_advance(m[k], 0.05f, NULL), FSDEM_OK);
+        p[k] = fsdem_mps_get_particles(m[k]);
+    }
+    ck_assert_int_eq(p[0].count, p[1].count);
+    ck_assert(memcmp(p[0].position, p[1].position, sizeof(fsdem_vec3) * (size_t)p[0].count) == 0);
+    ck_assert(memcmp(p[0].pressure, p[1].pressure, sizeof(fsdem_real) * (size_t)p[0].count) == 0);
+    for (k = 0; k < 2; ++k)
+        for (i = 0; i < p[k].count; ++i) p[k].porosity[i] = 0.9f;
+    for (k = 0; k < 2; ++k) ck_assert_int_eq(fsdem_mps_step(m[k]), FSDEM_OK);
+    ck_assert(memcmp(p[0].pressure, p[1].pressure, sizeof(fsdem_real) * (size_t)p[0].count) != 0);
+    for (k = 0; k < 2; ++k) fsdem_mps_destroy(m[k]);
+}
+END_TEST
+
 Suite *mps_suite(void) {
     Suite *s = suite_create("mps");
     TCase *tc = tcase_create("mps");
@@ -561,6 +594,7 @@ Suite *mps_suite(void) {
     tcase_add_test(tc, test_mps_obstacle);
     tcase_add_test(tc, test_mps_shifting_relaxes);
     tcase_add_test(tc, test_mps_probes);
+    tcase_add_test(tc, test_mps_model_b_at_unit_porosity);
     suite_add_tcase(s, tc);
     return s;
 }
