@@ -1749,21 +1749,25 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
    (Laplacian) at particles whose neighbourhood is a full regular lattice; they are first and
    second order only in that sense (consistency is lost near the surface and in disordered regions).
    Still water (issue 11 asks a drift below 0.1 r0 in 0.5 s; test_mps_still_water measures 1.1 r0 in
-   double, 1.4 r0 in float, at r0 = 0.01 m, 0.2 m deep): with the wall ghost of step 4 the rows near
-   the walls start in balance; the drift left comes from (a) the top rows, whose number density is
-   short of n0 by geometry (0.85 n0 one row below the surface), so the n term of Eq. 12 pulls them
-   down (clamped negative pressure) and they sink about 0.7 r0 in the first 0.15 s, and (b) a
-   disturbance that grows along the walls (kinetic energy e-folding in about 20 steps from 0.1 s on,
-   faster per second at smaller dt) with the sum form of Eq. 8, not with FSDEM_MPS_GRADIENT_MIN.
-   Particle shifting (step 7) does not cure either: at 0.5 s the drift is 0.97 / 1.35 r0 (double /
-   float) with shifting = 0.02, 1.30 / 1.18 r0 with 0.05, and with 0.1 or more the tank blows up
-   between 0.35 and 0.5 s (mid-depth pressure within 2% whenever it survives); (a) is untouched by
-   a shift that is tangential under the surface and (b) is a shear of whole columns along the
-   wall, which leaves the number density almost uniform. So shifting is off by default; it does
-   relax a disordered lattice (test_mps_shifting_relaxes). Applying the n term of Eq. 12 only to
-   particles without a surface neighbour halved the early sinking of (a) (0.25 r0 at 0.1 s
-   instead of 0.5) but not the drift at 0.5 s (1.00 / 1.21 r0), and no published source for it
-   was at hand, so it is not in the solver.
+   double, 1.4 r0 in float, at r0 = 0.01 m, 0.2 m deep, with the defaults). Two causes, measured:
+   (a) the free-surface band. The lattice at rest is not a discrete equilibrium: the rows below the
+   surface row have number densities short of n0 by geometry (0.85 n0 one row down, re = 4.1 r0),
+   which Eq. 12 reads as expansion. In the first step from rest the density term alone lowers the
+   pressure at mid-depth to 522 Pa against 883 hydrostatic (its weight gamma rho/dt^2 grows as dt
+   shrinks), and the top rows fall (0.7 r0 in 0.15 s). Without it (gamma = 0) Eq. 10 is still one-
+   sided there: the pressure one row down is 2.3 times hydrostatic, and the sum form of Eq. 8
+   pushes that row up at 0.54 g (0.29 g with the min form; the corrected form, exact for linear
+   fields, shows the pressure error itself: rows 1-5 fall at 0.4-1 g with gamma = 0.01). (b) A
+   shear instability along the walls: after a settling phase (1 s with the velocities zeroed after
+   each step) the columns next to each wall slide against each other, alternately up and down,
+   their speed doubling every 0.02 s (about 35/s, the same at dt = 1e-3 and 5e-4 s, with gamma =
+   0.01, 0.001 and 0): a mechanical instability of the pairwise-repulsive sum form against the fixed
+   wall layer, not of the time stepping. Neither particle shifting nor the corrected gradient cures
+   them (drift at 0.5 s: shifting 0.02 / 0.05 with the sum form 0.97 / 1.30 r0, 0.1 or more blows up
+   between 0.35 and 0.5 s; corrected gradient without shifting or with 0.05 blows up by 0.32 s, with
+   0.2 drifts 6.8 r0); both stay behind desc switches, off by default. Mid-depth pressure is within
+   2% whenever the tank survives. A cure needs consistent operators at the free surface (e.g. ghost
+   values above it) and a wall condition that resists shear; not done.
    Units: m, s, kg/m^3, m^2/s (kinematic viscosity), Pa. In 2D the problem lies in the x-y plane.
    One step allocates nothing once its lists have reached their size (the neighbour list and the
    matrix grow by doubling when the particle arrangement needs more room than ever before). */
@@ -1784,7 +1788,13 @@ typedef enum fsdem_mps_gradient_model {
     FSDEM_MPS_GRADIENT_SUM = 0,
     /* Koshizuka, Nobe and Oka (1998): (p_j - min p) with the smallest pressure of i and its
        neighbours; also repulsive, exact for linear fields in the interior of a lattice */
-    FSDEM_MPS_GRADIENT_MIN = 1
+    FSDEM_MPS_GRADIENT_MIN = 1,
+    /* the difference form (p_j - p_i) times the inverse of the moment matrix
+       sum_j w_ij (r_j - r_i)(r_j - r_i)^T / |r_j - r_i|^2, the corrected gradient of Khayyer and
+       Gotoh (2011, Appl. Ocean Res. 33:235; after Randles and Libersky 1996): exact for linear
+       fields in any neighbourhood that spans the space; not repulsive (no pressure force in a
+       uniform pressure), so clustering is left to particle shifting (desc.shifting) */
+    FSDEM_MPS_GRADIENT_CORRECTED = 2
 } fsdem_mps_gradient_model;
 
 /* Form of the pressure equation's source with a porosity field (seed 002 §2.1). */
@@ -12019,7 +12029,7 @@ static fsdem_result fsdem__mps_check(const fsdem_mps_desc *d, char *msg, size_t 
         if (!(fsdem__comp(d->domain_max, a) > fsdem__comp(d->domain_min, a)))
             return fsdem__reject(msg, size, "fsdem_mps_desc.domain_max.%c = %g must exceed domain_min.%c = %g", "xyz"[a],
                                  (double)fsdem__comp(d->domain_max, a), "xyz"[a], (double)fsdem__comp(d->domain_min, a));
-    if ((int)d->gradient < 0 || (int)d->gradient > 1)
+    if ((int)d->gradient < 0 || (int)d->gradient > 2)
         return fsdem__reject(msg, size, "fsdem_mps_desc.gradient = %d is not a fsdem_mps_gradient_model", (int)d->gradient);
     if ((int)d->model < 0 || (int)d->model > 1)
         return fsdem__reject(msg, size, "fsdem_mps_desc.model = %d is not a fsdem_mps_model", (int)d->model);
@@ -12589,19 +12599,64 @@ static int fsdem__mps_density(fsdem_mps *s) {
     return surface;
 }
 
+/* The 3 x 3 matrix (rows) that turns the kernel sum of the gradient at particle i into the
+   gradient: d/n0 times the identity for the forms of Eq. 8, the inverse of the moment matrix
+   M = sum_j w_ij (r_j - r_i)(r_j - r_i)^T / (|r_j - r_i|^2 eps_j) (DUMMY neighbours included) for
+   FSDEM_MPS_GRADIENT_CORRECTED, or d/n0 again where M is singular to rounding (a neighbourhood
+   that does not span the plane or space, e.g. a lone particle or a line of them). */
+static void fsdem__mps_gradient_transform(const fsdem_mps *s, int i, fsdem_vec3 T[3]) {
+    const fsdem_real plain = (fsdem_real)s->dim / s->n0;
+    double m[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, det, c[3][3];
+    int e, a, b;
+    T[0] = fsdem_v3(plain, 0, 0);
+    T[1] = fsdem_v3(0, plain, 0);
+    T[2] = fsdem_v3(0, 0, plain);
+    if (s->desc.gradient != FSDEM_MPS_GRADIENT_CORRECTED) return;
+    for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+        const int j = s->nb[e];
+        const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
+        const double r2 = (double)fsdem__dot(r, r), rv[3] = {(double)r.x, (double)r.y, (double)r.z};
+        if (!(r2 > 0)) continue;
+        for (a = 0; a < 3; ++a)
+            for (b = 0; b < 3; ++b) m[a][b] += rv[a] * rv[b] * (double)(s->nbw[e] / s->eps[j]) / r2;
+    }
+    if (s->dim == 2) m[2][2] = 1, m[0][2] = m[2][0] = m[1][2] = m[2][1] = 0;
+    /* cofactors and determinant; singular when det is tiny against the product of the diagonal */
+    c[0][0] = m[1][1] * m[2][2] - m[1][2] * m[2][1];
+    c[0][1] = m[0][2] * m[2][1] - m[0][1] * m[2][2];
+    c[0][2] = m[0][1] * m[1][2] - m[0][2] * m[1][1];
+    c[1][0] = m[1][2] * m[2][0] - m[1][0] * m[2][2];
+    c[1][1] = m[0][0] * m[2][2] - m[0][2] * m[2][0];
+    c[1][2] = m[0][2] * m[1][0] - m[0][0] * m[1][2];
+    c[2][0] = m[1][0] * m[2][1] - m[1][1] * m[2][0];
+    c[2][1] = m[0][1] * m[2][0] - m[0][0] * m[2][1];
+    c[2][2] = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+    det = m[0][0] * c[0][0] + m[0][1] * c[1][0] + m[0][2] * c[2][0];
+    if (!(det > 1e-6 * m[0][0] * m[1][1] * m[2][2])) return;
+    for (a = 0; a < 3; ++a) T[a] = fsdem_v3((fsdem_real)(c[a][0] / det), (fsdem_real)(c[a][1] / det), (fsdem_real)(c[a][2] / det));
+    if (s->dim == 2) T[2] = fsdem__zero3();
+}
+
+/* T v for the rows T of fsdem__mps_gradient_transform. */
+static fsdem_vec3 fsdem__mps_apply(const fsdem_vec3 T[3], fsdem_vec3 v) {
+    return fsdem_v3(fsdem__dot(T[0], v), fsdem__dot(T[1], v), fsdem__dot(T[2], v));
+}
+
 /* Gradient of phi at particle i (seed 002 Eq. 8): the sum form (phi_j + phi_i) of the seed, or
    Koshizuka et al. (1998) (phi_j - min phi) with the smallest value of i and its non-DUMMY
    neighbours (desc.gradient). A DUMMY neighbour j takes the ghost value phi_i + ghost.(r_j - r_i):
    the pressure step passes ghost = rho g, the hydrostatic extrapolation from i, so the solid
    behind the wall layer pushes as a full neighbourhood of liquid would (skipping the DUMMY
    particles instead leaves the sum form one-sided and pulls particles into walls); the public
-   operator passes 0 (a mirror value, zero normal derivative). When `reaction` is not NULL, the
-   terms of the neighbours that belong to obstacle b are added to reaction[b] as they are, before
-   the factor d/n0 (fsdem__mps_do_step turns them into the obstacles' forces). */
+   operator passes 0 (a mirror value, zero normal derivative). With FSDEM_MPS_GRADIENT_CORRECTED the
+   form is (phi_j - phi_i) and the sum is multiplied by the inverse moment matrix of i (the factor
+   d/n0 of Eq. 8 cancels in it). When `reaction` is not NULL, the terms of the neighbours that
+   belong to obstacle b are added to reaction[b] (fsdem__mps_do_step turns them into the obstacles'
+   forces). */
 static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, int i, fsdem_vec3 ghost,
                                      fsdem__mps_obst *reaction) {
-    fsdem_vec3 g = fsdem__zero3();
-    fsdem_real base = phi[i];
+    fsdem_vec3 g = fsdem__zero3(), T[3];
+    fsdem_real base = s->desc.gradient == FSDEM_MPS_GRADIENT_CORRECTED ? -phi[i] : phi[i];
     /* a DUMMY particle higher than the hydrostatic extrapolation reaches is in the air beside the
        free surface: its ghost pressure is not below 0, as the liquid's (desc.clamp_negative_pressure);
        a negative ghost pulled the particles at the top of the walls into them */
@@ -12612,6 +12667,7 @@ static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, 
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e)
             if (s->kind[s->nb[e]] != FSDEM_MPS_DUMMY && phi[s->nb[e]] < base) base = phi[s->nb[e]];
     if (s->desc.gradient == FSDEM_MPS_GRADIENT_MIN) base = -base;
+    fsdem__mps_gradient_transform(s, i, T);
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
         const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
@@ -12624,9 +12680,10 @@ static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, 
         if (!(r2 > 0)) continue;
         term = fsdem__scale(r, (pj + base) * s->nbw[e] / (r2 * s->eps[j]));
         g = fsdem__add(g, term);
-        if (reaction && s->body[j] >= 0) reaction[s->body[j]].force = fsdem__add(reaction[s->body[j]].force, term);
+        if (reaction && s->body[j] >= 0)
+            reaction[s->body[j]].force = fsdem__add(reaction[s->body[j]].force, fsdem__mps_apply(T, term));
     }
-    return fsdem__scale(g, (fsdem_real)s->dim / s->n0);
+    return fsdem__mps_apply(T, g);
 }
 
 /* Divergence of u at particle i (seed 002 Eq. 9) over its non-DUMMY neighbours. */
@@ -12943,8 +13000,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     }
     /* the obstacles' forces: the reaction to the pressure force their particles exert on the
        FLUID particles, -(mass_i / rho) (grad p)_i per pair, mass_i = rho r0^d */
-    for (a = 0; a < s->obst_n; ++a)
-        s->obst[a].force = fsdem__scale(s->obst[a].force, (fsdem_real)s->dim / s->n0 * (fsdem_real)pow((double)s->r0, s->dim));
+    for (a = 0; a < s->obst_n; ++a) s->obst[a].force = fsdem__scale(s->obst[a].force, (fsdem_real)pow((double)s->r0, s->dim));
     for (i = 0; i < s->n; ++i)
         if (s->kind[i] == FSDEM_MPS_FLUID) s->x[i] = fsdem__add(fsdem__madd(s->x[i], s->v[i], dt), s->shift[i]);
     s->time += (double)dt;
