@@ -2582,6 +2582,84 @@ static void fsdem__set_comp(fsdem_vec3 *v, int axis, fsdem_real value) {
     else v->z = value;
 }
 
+/* ---- >>core_gauges : the point gauges of the particle solvers ---- */
+
+/* Level and pressure gauges of the PIC and MPS solvers: a kind (the value of FSDEM_PIC_GAUGE_LEVEL
+   and FSDEM_MPS_GAUGE_LEVEL, or of the _PRESSURE kinds), a position and a sensor radius per gauge,
+   and the CSV series they write (fsdem__series; columns level_<id> or p_<id>). The solver samples
+   them (its own level and pressure functions) and checks what is its own (the domain, gravity);
+   `fn` names its public function in the messages. */
+enum { FSDEM__GAUGE_LEVEL = 0, FSDEM__GAUGE_PRESSURE = 1 };
+
+typedef struct fsdem__gauges {
+    fsdem_vec3 *at;
+    int *kind;
+    fsdem_real *radius; /* m; 0 for a point */
+    int count, capacity;
+    fsdem__series series;
+} fsdem__gauges;
+
+static fsdem_result fsdem__gauges_add(fsdem__gauges *g, fsdem__status *st, const fsdem_allocator *al, const char *fn, int kind,
+                                      fsdem_vec3 at, fsdem_real radius, int *id) {
+    const int n = g->count;
+    int cap;
+    if (g->series.file) return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: close the gauge file first", fn);
+    if (kind < FSDEM__GAUGE_LEVEL || kind > FSDEM__GAUGE_PRESSURE || !fsdem__finite3(at) || !(radius >= 0) || !fsdem__finite(radius))
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: the kind must be a gauge kind, the position finite, the radius >= 0", fn);
+    if (n == g->capacity) {
+        cap = g->capacity;
+        if (fsdem__grow(al, (void **)&g->at, &cap, n, n + 1, sizeof(fsdem_vec3)) != FSDEM_OK ||
+            (cap = g->capacity, fsdem__grow(al, (void **)&g->kind, &cap, n, n + 1, sizeof(int))) != FSDEM_OK ||
+            (cap = g->capacity, fsdem__grow(al, (void **)&g->radius, &cap, n, n + 1, sizeof(fsdem_real))) != FSDEM_OK)
+            return fsdem__fail(st, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
+        g->capacity = cap;
+    }
+    g->at[n] = at;
+    g->kind[n] = kind;
+    g->radius[n] = radius;
+    g->count++;
+    if (id) *id = n;
+    return fsdem__ok(st);
+}
+
+/* Opens the series at time t (a file already open is closed first). */
+static fsdem_result fsdem__gauges_open(fsdem__gauges *g, fsdem__status *st, const fsdem_allocator *al, const char *fn,
+                                       const char *path, double t, fsdem_real interval, fsdem__series_sample_fn sample,
+                                       const void *solver) {
+    char *header;
+    size_t size;
+    int k, n = 1;
+    fsdem_result res;
+    if (g->count == 0) return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: add gauges first", fn);
+    if (!(interval >= 0) || !fsdem__finite(interval))
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: interval must be >= 0 (got %g s)", fn, (double)interval);
+    fsdem__series_close(&g->series, al);
+    size = 2 + 24 * (size_t)g->count;
+    header = (char *)fsdem__alloc(al, size);
+    if (!header) return fsdem__fail(st, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
+    header[0] = 't';
+    header[1] = '\0';
+    for (k = 0; k < g->count; ++k)
+        n += snprintf(header + n, size - (size_t)n, g->kind[k] == FSDEM__GAUGE_LEVEL ? ",level_%d" : ",p_%d", k);
+    res = fsdem__series_open(&g->series, al, path, header, g->count, t, (double)interval, sample, solver);
+    fsdem__free(al, header, size);
+    if (res != FSDEM_OK) return fsdem__fail(st, res, "%s: cannot open '%s'", fn, path ? path : "(null)");
+    return fsdem__ok(st);
+}
+
+static fsdem_result fsdem__gauges_close(fsdem__gauges *g, fsdem__status *st, const fsdem_allocator *al, const char *fn) {
+    return fsdem__series_close(&g->series, al) == FSDEM_OK ? fsdem__ok(st) : fsdem__fail(st, FSDEM_ERR_IO, "%s: write error", fn);
+}
+
+/* Closes the series and frees the gauges. */
+static void fsdem__gauges_free(fsdem__gauges *g, const fsdem_allocator *al) {
+    fsdem__series_close(&g->series, al);
+    fsdem__free(al, g->at, sizeof(fsdem_vec3) * (size_t)g->capacity);
+    fsdem__free(al, g->kind, sizeof(int) * (size_t)g->capacity);
+    fsdem__free(al, g->radius, sizeof(fsdem_real) * (size_t)g->capacity);
+    memset(g, 0, sizeof *g);
+}
+
 /* ---- >>core_lane : short vectors for batched kernels ---- */
 
 /* An fsdem__lane holds FSDEM__LANES reals that one instruction processes, where the compiler has GNU
@@ -6814,11 +6892,7 @@ struct fsdem_pic {
     fsdem_pic_coupling coupling;     /* the coupler's arrays (fsdem_pic_get_coupling) */
     fsdem_operator_fn pressure_extra; /* fsdem_pic_set_pressure_extra */
     void *pressure_extra_user;
-    fsdem_vec3 *gauge_at;             /* gauges: position, with kind and radius */
-    int *gauge_kind;
-    fsdem_real *gauge_radius;
-    int gauge_count, gauge_capacity;
-    fsdem__series gauges;
+    fsdem__gauges gauges;
 
     /* diagnostics */
     int cells_fresh; /* frac/phi hold the current particle positions (set at the end of a step) */
@@ -7122,10 +7196,7 @@ void fsdem_pic_destroy(fsdem_pic *s) {
             fsdem__pic_release(s, s->obst[a].verts, sizeof(fsdem_vec3) * (size_t)s->obst[a].d.vertex_count);
     fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
     if (s->pcg_p) fsdem_pcg_destroy(s->pcg_p);
-    fsdem__series_close(&s->gauges, &s->allocator);
-    fsdem__free(&s->allocator, s->gauge_at, sizeof(fsdem_vec3) * (size_t)s->gauge_capacity);
-    fsdem__free(&s->allocator, s->gauge_kind, sizeof(int) * (size_t)s->gauge_capacity);
-    fsdem__free(&s->allocator, s->gauge_radius, sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+    fsdem__gauges_free(&s->gauges, &s->allocator);
     al = s->allocator;
     fsdem__free(&al, s, sizeof *s);
 }
@@ -9023,7 +9094,7 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
     clock_t t0 = clock();
     const double time0 = s->time;
     fsdem__ok(&s->status);
-    fsdem__series_begin(&s->gauges);
+    fsdem__series_begin(&s->gauges.series);
 
     /* 1. particles to grid, cells, extrapolation, FLIP reference */
     fsdem__pic_effective_faces(s);
@@ -9098,7 +9169,7 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
         worst = fsdem__fail(&s->status, FSDEM_ERR_CFL,
                             "fsdem_pic: step %lld: the projected grid velocity %g m/s moves %g cells in dt = %g s (cfl_max %g)",
                             s->steps, (double)umax, (double)(umax * dt * s->inv_dx), (double)dt, (double)s->desc.cfl_max);
-    if (worst == FSDEM_OK && fsdem__series_step(&s->gauges, time0, s->time) != FSDEM_OK)
+    if (worst == FSDEM_OK && fsdem__series_step(&s->gauges.series, time0, s->time) != FSDEM_OK)
         worst = fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_pic: could not write the gauge file");
     return worst;
 }
@@ -9397,86 +9468,46 @@ static fsdem_real fsdem__pic_pressure_at(const fsdem_pic *s, fsdem_vec3 p, fsdem
 }
 
 static fsdem_real fsdem__pic_gauge_value(const fsdem_pic *s, int k) {
-    return s->gauge_kind[k] == FSDEM_PIC_GAUGE_LEVEL ? fsdem__pic_level(s, s->gauge_at[k])
-                                                     : fsdem__pic_pressure_at(s, s->gauge_at[k], s->gauge_radius[k]);
+    return s->gauges.kind[k] == FSDEM_PIC_GAUGE_LEVEL ? fsdem__pic_level(s, s->gauges.at[k])
+                                                      : fsdem__pic_pressure_at(s, s->gauges.at[k], s->gauges.radius[k]);
 }
 
 static void fsdem__pic_gauge_values(const void *solver, fsdem_real *out) {
     const fsdem_pic *s = (const fsdem_pic *)solver;
     int k;
-    for (k = 0; k < s->gauge_count; ++k) out[k] = fsdem__pic_gauge_value(s, k);
+    for (k = 0; k < s->gauges.count; ++k) out[k] = fsdem__pic_gauge_value(s, k);
 }
 
 fsdem_result fsdem_pic_add_gauge(fsdem_pic *s, fsdem_pic_gauge_kind kind, fsdem_vec3 position, fsdem_real radius, int *id) {
     fsdem_real up;
-    int b, n, cap;
+    int b;
     if (id) *id = -1;
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    if (s->gauges.file) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_gauge: close the gauge file first");
-    if ((int)kind < 0 || (int)kind > 1 || !fsdem__finite3(position) || !(radius >= 0) || !fsdem__finite(radius))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
-                           "fsdem_pic_add_gauge: the kind must be a fsdem_pic_gauge_kind, the position finite, the radius >= 0");
     if (kind == FSDEM_PIC_GAUGE_LEVEL && fsdem__pic_up_axis(s, &up) < 0)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_gauge: a level gauge needs gravity along one axis");
     for (b = 0; b < s->dim; ++b)
         if (!(fsdem__comp(position, b) >= fsdem__comp(s->lo, b) && fsdem__comp(position, b) <= fsdem__comp(s->hi, b)))
             return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_pic_add_gauge: (%g, %g, %g) is outside the domain",
                                (double)position.x, (double)position.y, (double)position.z);
-    n = s->gauge_count;
-    if (n == s->gauge_capacity) {
-        cap = s->gauge_capacity;
-        if (fsdem__grow(&s->allocator, (void **)&s->gauge_at, &cap, n, n + 1, sizeof(fsdem_vec3)) != FSDEM_OK ||
-            (cap = s->gauge_capacity, fsdem__grow(&s->allocator, (void **)&s->gauge_kind, &cap, n, n + 1, sizeof(int))) != FSDEM_OK ||
-            (cap = s->gauge_capacity, fsdem__grow(&s->allocator, (void **)&s->gauge_radius, &cap, n, n + 1, sizeof(fsdem_real))) !=
-                FSDEM_OK)
-            return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_add_gauge: out of memory");
-        s->gauge_capacity = cap;
-    }
-    s->gauge_at[n] = position;
-    s->gauge_kind[n] = (int)kind;
-    s->gauge_radius[n] = radius;
-    s->gauge_count++;
-    if (id) *id = n;
-    return fsdem__ok(&s->status);
+    return fsdem__gauges_add(&s->gauges, &s->status, &s->allocator, "fsdem_pic_add_gauge", (int)kind, position, radius, id);
 }
 
 fsdem_result fsdem_pic_gauge(const fsdem_pic *s, int id, fsdem_real *value) {
     if (!s || !value) return FSDEM_ERR_INVALID_ARG;
-    if (id < 0 || id >= s->gauge_count) return FSDEM_ERR_NOT_FOUND;
+    if (id < 0 || id >= s->gauges.count) return FSDEM_ERR_NOT_FOUND;
     *value = fsdem__pic_gauge_value(s, id);
     return FSDEM_OK;
 }
 
 fsdem_result fsdem_pic_gauges_open(fsdem_pic *s, const char *path, fsdem_real interval) {
-    char *header;
-    size_t size;
-    int k, n = 1;
-    fsdem_result res;
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    if (s->gauge_count == 0) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_gauges_open: add gauges first");
-    if (!(interval >= 0) || !fsdem__finite(interval))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_gauges_open: interval must be >= 0 (got %g s)",
-                           (double)interval);
-    if (s->gauges.file) fsdem_pic_gauges_close(s);
-    size = 2 + 24 * (size_t)s->gauge_count;
-    header = (char *)fsdem__alloc(&s->allocator, size);
-    if (!header) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_gauges_open: out of memory");
-    header[0] = 't';
-    header[1] = '\0';
-    for (k = 0; k < s->gauge_count; ++k)
-        n += snprintf(header + n, size - (size_t)n, s->gauge_kind[k] == FSDEM_PIC_GAUGE_LEVEL ? ",level_%d" : ",p_%d", k);
-    res = fsdem__series_open(&s->gauges, &s->allocator, path, header, s->gauge_count, s->time, interval,
-                             fsdem__pic_gauge_values, s);
-    fsdem__free(&s->allocator, header, size);
-    if (res != FSDEM_OK) return fsdem__fail(&s->status, res, "fsdem_pic_gauges_open: cannot open '%s'", path ? path : "(null)");
-    return fsdem__ok(&s->status);
+    return fsdem__gauges_open(&s->gauges, &s->status, &s->allocator, "fsdem_pic_gauges_open", path, s->time, interval,
+                              fsdem__pic_gauge_values, s);
 }
 
 fsdem_result fsdem_pic_gauges_close(fsdem_pic *s) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__series_close(&s->gauges, &s->allocator) == FSDEM_OK
-               ? fsdem__ok(&s->status)
-               : fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_pic_gauges_close: write error");
+    return fsdem__gauges_close(&s->gauges, &s->status, &s->allocator, "fsdem_pic_gauges_close");
 }
 
 fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *s) {
@@ -13732,32 +13763,30 @@ static void fsdem__restart_dem(fsdem__restart *io, void *object) {
    linear solvers (set up at every use), CPU times, the allocator, log and message. SDF obstacles
    keep the object's callbacks; a pressure-extra operator stays as set. */
 /* The gauges of a PIC solver (positions, kinds, radii); their file is not part of the state. */
-static void fsdem__restart_pic_gauges(fsdem__restart *io, fsdem_pic *s) {
-    const fsdem_allocator *al = &s->allocator;
-    int ng = s->gauge_count;
+/* Point gauges (fsdem__gauges) into fresh arrays; refused while their file is open (`close` names
+   the function that closes it). */
+static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fsdem_allocator *al, const char *close) {
+    int ng = g->count;
     fsdem_vec3 *at;
     int *kind;
     fsdem_real *radius;
-    if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file)
+    if (io->mode == FSDEM__RESTART_CHECK && g->series.file)
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
-                            "the object has a gauge file open: close it (fsdem_pic_gauges_close) before restoring and "
-                            "open it again afterwards");
+                            "the object has a gauge file open: close it (%s) before restoring and open it again afterwards", close);
     fsdem__restart_count(io, &ng, 1 << 24, sizeof(fsdem_vec3) + sizeof(int) + sizeof(fsdem_real), "gauge count");
     at = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)ng);
     kind = (int *)fsdem__restart_block(io, al, sizeof(int) * (size_t)ng);
     radius = (fsdem_real *)fsdem__restart_block(io, al, sizeof(fsdem_real) * (size_t)ng);
     if (io->mode == FSDEM__RESTART_COMMIT) {
-        fsdem__free(al, s->gauge_at, sizeof(fsdem_vec3) * (size_t)s->gauge_capacity);
-        fsdem__free(al, s->gauge_kind, sizeof(int) * (size_t)s->gauge_capacity);
-        fsdem__free(al, s->gauge_radius, sizeof(fsdem_real) * (size_t)s->gauge_capacity);
-        s->gauge_at = at;
-        s->gauge_kind = kind;
-        s->gauge_radius = radius;
-        s->gauge_count = s->gauge_capacity = ng;
+        fsdem__gauges_free(g, al);
+        g->at = at;
+        g->kind = kind;
+        g->radius = radius;
+        g->count = g->capacity = ng;
     }
-    fsdem__restart_data(io, s->gauge_at, sizeof(fsdem_vec3) * (size_t)ng);
-    fsdem__restart_ints(io, s->gauge_kind, ng, FSDEM_PIC_GAUGE_LEVEL, FSDEM_PIC_GAUGE_PRESSURE, "gauge kind");
-    fsdem__restart_data(io, s->gauge_radius, sizeof(fsdem_real) * (size_t)ng);
+    fsdem__restart_data(io, g->at, sizeof(fsdem_vec3) * (size_t)ng);
+    fsdem__restart_ints(io, g->kind, ng, FSDEM__GAUGE_LEVEL, FSDEM__GAUGE_PRESSURE, "gauge kind");
+    fsdem__restart_data(io, g->radius, sizeof(fsdem_real) * (size_t)ng);
 }
 
 static void fsdem__restart_pic(fsdem__restart *io, void *object) {
@@ -13932,7 +13961,7 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
     fsdem__restart_flags(io, s->ctype, s->ncell, FSDEM_STENCIL_CELL_SOLID, "type of cell");
     fsdem__restart_flags(io, s->cnear, s->ncell, 1, "near-solid flag of cell");
     fsdem__restart_flags(io, s->csolid, s->ncell, 1, "solid flag of cell");
-    fsdem__restart_pic_gauges(io, s);
+    fsdem__restart_gauges(io, &s->gauges, &s->allocator, "fsdem_pic_gauges_close");
     fsdem__restart_tag(io, "PIC.");
 }
 
