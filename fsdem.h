@@ -210,6 +210,7 @@
 #define fsdem_dem_write_walls_vtp fsdem_dem_write_walls_vtp_f
 #define fsdem_mps_add_box_obstacle fsdem_mps_add_box_obstacle_f
 #define fsdem_mps_add_box_walls fsdem_mps_add_box_walls_f
+#define fsdem_mps_add_gauge fsdem_mps_add_gauge_f
 #define fsdem_mps_add_particles fsdem_mps_add_particles_f
 #define fsdem_mps_advance fsdem_mps_advance_f
 #define fsdem_mps_create fsdem_mps_create_f
@@ -218,6 +219,9 @@
 #define fsdem_mps_destroy fsdem_mps_destroy_f
 #define fsdem_mps_divergence fsdem_mps_divergence_f
 #define fsdem_mps_fill_box fsdem_mps_fill_box_f
+#define fsdem_mps_gauge fsdem_mps_gauge_f
+#define fsdem_mps_gauges_close fsdem_mps_gauges_close_f
+#define fsdem_mps_gauges_open fsdem_mps_gauges_open_f
 #define fsdem_mps_get_desc fsdem_mps_get_desc_f
 #define fsdem_mps_get_particles fsdem_mps_get_particles_f
 #define fsdem_mps_get_stats fsdem_mps_get_stats_f
@@ -1995,6 +1999,28 @@ FSDEM_API fsdem_result fsdem_mps_probe_pressure(const fsdem_mps *mps, fsdem_vec3
    liquid is within R of the line. The first liquid from above counts, a jet over the gauge
    included, as a gauge sees it. FSDEM_ERR_INVALID_ARG for NULL arguments or a non-finite gauge. */
 FSDEM_API fsdem_result fsdem_mps_probe_height(const fsdem_mps *mps, fsdem_vec3 gauge, fsdem_real *height);
+/* Gauges: probes at fixed places sampled at exact output times into a CSV series, as the PIC
+   solver's (fsdem_pic_add_gauge). */
+typedef enum fsdem_mps_gauge_kind {
+    FSDEM_MPS_GAUGE_LEVEL = 0,   /* water level at the gauge line through the position (fsdem_mps_probe_height) */
+    FSDEM_MPS_GAUGE_PRESSURE = 1 /* pressure at the position (fsdem_mps_probe_pressure with the radius) */
+} fsdem_mps_gauge_kind;
+
+/* Adds a gauge (before fsdem_mps_gauges_open); its id goes to *id (may be NULL). Radius (m) of a
+   pressure sensor, 0 for re. FSDEM_ERR_OUT_OF_DOMAIN, FSDEM_ERR_INVALID_ARG (bad kind, radius < 0,
+   non-finite input, a file is open), FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_mps_add_gauge(fsdem_mps *mps, fsdem_mps_gauge_kind kind, fsdem_vec3 position, fsdem_real radius,
+                                           int *id);
+/* Gauge `id` now (m or Pa). FSDEM_ERR_NOT_FOUND. */
+FSDEM_API fsdem_result fsdem_mps_gauge(const fsdem_mps *mps, int id, fsdem_real *value);
+/* Opens a gauge time series: a CSV with columns t, then level_<id> or p_<id> per gauge, rows at the
+   multiples of `interval` (s) interpolated linearly within the step that passes each, or one per
+   step for interval 0. FSDEM_ERR_IO, FSDEM_ERR_INVALID_ARG (no gauges, interval < 0). A restore is
+   refused while it is open. */
+FSDEM_API fsdem_result fsdem_mps_gauges_open(fsdem_mps *mps, const char *path, fsdem_real interval);
+/* Closes the gauge file (also done by fsdem_mps_destroy). FSDEM_ERR_IO. */
+FSDEM_API fsdem_result fsdem_mps_gauges_close(fsdem_mps *mps);
+
 /* Force (N; N per metre of depth in 2D) of the liquid on the box obstacle `id`
    (fsdem_mps_add_box_obstacle) in the last step: the pressure of the step on its faces, each WALL
    particle of its skin standing for r0^(d-1) of every face within a spacing of it, its pressure
@@ -12003,6 +12029,7 @@ struct fsdem_mps {
     /* obstacles */
     fsdem__mps_obst *obst;
     int obst_n, obst_cap;
+    fsdem__gauges gauges;
     /* time and statistics */
     double time;
     long long steps, iters_total;
@@ -12225,6 +12252,7 @@ void fsdem_mps_destroy(fsdem_mps *s) {
     fsdem__free(&s->allocator, s->a_col, sizeof(int) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->a_val, sizeof(fsdem_real) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
+    fsdem__gauges_free(&s->gauges, &s->allocator);
     fsdem_cellgrid_free(&s->grid);
     if (s->pcg) fsdem_pcg_destroy(s->pcg);
     al = s->allocator;
@@ -13033,6 +13061,7 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
    a completed step reports a non-finite or escaped particle. */
 static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     const fsdem_real rho = s->desc.density, nu = s->desc.viscosity;
+    const double time0 = s->time;
     fsdem_pcg_info info;
     fsdem_csr A;
     fsdem_result r;
@@ -13044,6 +13073,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         if (!(s->eps[i] > 0 && s->eps[i] <= 1))
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: particle %d has porosity %g outside (0, 1]", i,
                                (double)s->eps[i]);
+    fsdem__series_begin(&s->gauges.series);
     /* 1. neighbours, number density, free surface */
     if (fsdem__mps_neighbours(s) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory building the neighbour list");
@@ -13128,6 +13158,8 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
                 return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_mps: step %lld: particle %d left the domain at (%g, %g, %g) m",
                                    s->steps, i, (double)s->x[i].x, (double)s->x[i].y, (double)s->x[i].z);
     }
+    if (fsdem__series_step(&s->gauges.series, time0, s->time) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_mps: step %lld: writing the gauge file failed", s->steps);
     return fsdem__ok(&s->status);
 }
 
@@ -13143,7 +13175,7 @@ fsdem_result fsdem_mps_stable_dt(const fsdem_mps *s, fsdem_real *dt) {
 }
 
 fsdem_result fsdem_mps_step(fsdem_mps *s) {
-    fsdem_real dt;
+    fsdem_real dt = 0;
     fsdem_result r;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((r = fsdem_mps_stable_dt(s, &dt)) != FSDEM_OK) return r;
@@ -13178,7 +13210,7 @@ fsdem_result fsdem_mps_advance(fsdem_mps *s, fsdem_real duration, long long *ste
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_advance: duration = %g s must be >= 0", (double)duration);
     end = s->time + (double)duration;
     while (s->time < end - 1e-12 * (end > 1 ? end : 1)) {
-        fsdem_real dt;
+        fsdem_real dt = 0;
         if ((r = fsdem_mps_stable_dt(s, &dt)) != FSDEM_OK) break;
         if (s->time + dt > end) dt = (fsdem_real)(end - s->time);
         else if (s->time + 1.5 * dt > end) dt = (fsdem_real)((end - s->time) / 2);
@@ -13262,15 +13294,10 @@ static fsdem_real fsdem__mps_probe_weight(const fsdem_mps *s, fsdem_real r2, fsd
     return q > 0 ? (fsdem_real)(c * (double)(q * q * q)) : 0;
 }
 
-fsdem_result fsdem_mps_probe_pressure(const fsdem_mps *s, fsdem_vec3 point, fsdem_real radius, fsdem_real *pressure) {
+/* Pressure at a point (fsdem_mps_probe_pressure; radius > 0). */
+static fsdem_real fsdem__mps_pressure_at(const fsdem_mps *s, fsdem_vec3 point, fsdem_real radius) {
     double sum = 0, weights = 0;
     int i;
-    if (pressure) *pressure = 0;
-    if (!s) return FSDEM_ERR_INVALID_ARG;
-    if (!pressure || !fsdem__finite3(point) || !(radius >= 0) || !fsdem__finite(radius))
-        return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_INVALID_ARG,
-                           "fsdem_mps_probe_pressure: %s", !pressure ? "pressure is NULL" : "the point and radius must be finite, radius >= 0");
-    if (radius == 0) radius = s->re;
     if (s->dim == 2) point.z = 0;
     for (i = 0; i < s->n; ++i) {
         fsdem_vec3 d;
@@ -13281,7 +13308,16 @@ fsdem_result fsdem_mps_probe_pressure(const fsdem_mps *s, fsdem_vec3 point, fsde
         sum += (double)(w * s->p[i]);
         weights += (double)w;
     }
-    if (weights > 0) *pressure = (fsdem_real)(sum / weights);
+    return weights > 0 ? (fsdem_real)(sum / weights) : 0;
+}
+
+fsdem_result fsdem_mps_probe_pressure(const fsdem_mps *s, fsdem_vec3 point, fsdem_real radius, fsdem_real *pressure) {
+    if (pressure) *pressure = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!pressure || !fsdem__finite3(point) || !(radius >= 0) || !fsdem__finite(radius))
+        return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_mps_probe_pressure: %s", !pressure ? "pressure is NULL" : "the point and radius must be finite, radius >= 0");
+    *pressure = fsdem__mps_pressure_at(s, point, radius > 0 ? radius : s->re);
     return fsdem__ok((fsdem__status *)&s->status);
 }
 
@@ -13301,19 +13337,13 @@ static fsdem_real fsdem__mps_liquid_fraction(const fsdem_mps *s, fsdem_vec3 gaug
     return (fsdem_real)(f * (double)volume);
 }
 
-fsdem_result fsdem_mps_probe_height(const fsdem_mps *s, fsdem_vec3 gauge, fsdem_real *height) {
-    fsdem_real R, step, top = 0, bottom = 0, z, f_above = 0;
-    int i, up, found = 0;
-    if (height) *height = 0;
-    if (!s) return FSDEM_ERR_INVALID_ARG;
-    R = 2 * s->r0;
-    step = s->r0 / 4;
-    if (!height || !fsdem__finite3(gauge))
-        return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_INVALID_ARG,
-                           "fsdem_mps_probe_height: %s", !height ? "height is NULL" : "the gauge position must be finite");
-    up = s->dim - 1;
+/* Water level at a gauge line (fsdem_mps_probe_height). */
+static fsdem_real fsdem__mps_level(const fsdem_mps *s, fsdem_vec3 gauge) {
+    const int up = s->dim - 1;
+    const fsdem_real R = 2 * s->r0, step = s->r0 / 4;
+    fsdem_real top = 0, bottom = 0, z, f_above = 0;
+    int i, found = 0;
     if (s->dim == 2) gauge.z = 0;
-    *height = fsdem__comp(s->desc.domain_min, up);
     /* the span of the liquid within R of the line */
     for (i = 0; i < s->n; ++i) {
         fsdem_vec3 d;
@@ -13327,17 +13357,65 @@ fsdem_result fsdem_mps_probe_height(const fsdem_mps *s, fsdem_vec3 gauge, fsdem_
         if (!found || zi < bottom) bottom = zi;
         found = 1;
     }
-    if (!found) return fsdem__ok((fsdem__status *)&s->status);
     /* from above the highest particle down, the first sample whose fraction reaches 1/2 */
-    for (z = top + R; z >= bottom - R; z -= step) {
+    for (z = top + R; found && z >= bottom - R; z -= step) {
         const fsdem_real f = fsdem__mps_liquid_fraction(s, gauge, z, R);
-        if (f >= (fsdem_real)0.5) {
-            *height = z + step * (f - (fsdem_real)0.5) / (f - f_above);
-            break;
-        }
+        if (f >= (fsdem_real)0.5) return z + step * (f - (fsdem_real)0.5) / (f - f_above);
         f_above = f;
     }
+    return fsdem__comp(s->desc.domain_min, up);
+}
+
+fsdem_result fsdem_mps_probe_height(const fsdem_mps *s, fsdem_vec3 gauge, fsdem_real *height) {
+    if (height) *height = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!height || !fsdem__finite3(gauge))
+        return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_mps_probe_height: %s", !height ? "height is NULL" : "the gauge position must be finite");
+    *height = fsdem__mps_level(s, gauge);
     return fsdem__ok((fsdem__status *)&s->status);
+}
+
+/* The value of gauge k (section >>mps, gauges). */
+static fsdem_real fsdem__mps_gauge_value(const fsdem_mps *s, int k) {
+    return s->gauges.kind[k] == FSDEM_MPS_GAUGE_LEVEL
+               ? fsdem__mps_level(s, s->gauges.at[k])
+               : fsdem__mps_pressure_at(s, s->gauges.at[k], s->gauges.radius[k] > 0 ? s->gauges.radius[k] : s->re);
+}
+
+static void fsdem__mps_gauge_values(const void *solver, fsdem_real *out) {
+    const fsdem_mps *s = (const fsdem_mps *)solver;
+    int k;
+    for (k = 0; k < s->gauges.count; ++k) out[k] = fsdem__mps_gauge_value(s, k);
+}
+
+fsdem_result fsdem_mps_add_gauge(fsdem_mps *s, fsdem_mps_gauge_kind kind, fsdem_vec3 position, fsdem_real radius, int *id) {
+    int a;
+    if (id) *id = -1;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    for (a = 0; a < s->dim && fsdem__finite3(position); ++a)
+        if (!(fsdem__comp(position, a) >= fsdem__comp(s->desc.domain_min, a) && fsdem__comp(position, a) <= fsdem__comp(s->desc.domain_max, a)))
+            return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_mps_add_gauge: (%g, %g, %g) is outside the domain",
+                               (double)position.x, (double)position.y, (double)position.z);
+    return fsdem__gauges_add(&s->gauges, &s->status, &s->allocator, "fsdem_mps_add_gauge", (int)kind, position, radius, id);
+}
+
+fsdem_result fsdem_mps_gauge(const fsdem_mps *s, int id, fsdem_real *value) {
+    if (!s || !value) return FSDEM_ERR_INVALID_ARG;
+    if (id < 0 || id >= s->gauges.count) return FSDEM_ERR_NOT_FOUND;
+    *value = fsdem__mps_gauge_value(s, id);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_mps_gauges_open(fsdem_mps *s, const char *path, fsdem_real interval) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__gauges_open(&s->gauges, &s->status, &s->allocator, "fsdem_mps_gauges_open", path, s->time, interval,
+                              fsdem__mps_gauge_values, s);
+}
+
+fsdem_result fsdem_mps_gauges_close(fsdem_mps *s) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__gauges_close(&s->gauges, &s->status, &s->allocator, "fsdem_mps_gauges_close");
 }
 
 fsdem_result fsdem_mps_obstacle_force(const fsdem_mps *s, int id, fsdem_vec3 *force) {
@@ -14360,6 +14438,7 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_flags(io, s->kind, n, FSDEM_MPS_DUMMY, "kind of particle");
     fsdem__restart_flags(io, s->surf, n, 1, "surface flag of particle");
     fsdem__restart_ints(io, s->body, n, -1, no - 1, "obstacle of particle");
+    fsdem__restart_gauges(io, &s->gauges, al, "fsdem_mps_gauges_close");
     if (commit) {
         s->counts[0] = s->counts[1] = s->counts[2] = 0;
         for (i = 0; i < n; ++i) {

@@ -518,7 +518,7 @@ START_TEST(test_mps_probes) {
     fsdem_mps *m = NULL;
     fsdem_real level, p_liquid, p_wall;
     fsdem_vec3 F;
-    int id;
+    int id, gauge[2];
     d.r0 = (fsdem_real)r0;
     d.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
     d.domain_max = fsdem_v3(0.3f, 0.5f, 0);
@@ -534,7 +534,36 @@ START_TEST(test_mps_probes) {
     ck_assert_int_eq(fsdem_mps_probe_height(m, fsdem_v3(-0.05f, 0, 0), &level), FSDEM_OK);
     ck_assert(level == d.domain_min.y);
 
+    /* the same probes as gauges writing a series at every 25 ms */
+    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_LEVEL, fsdem_v3(0.03f, 0, 0), 0, &gauge[0]), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_PRESSURE, fsdem_v3(0.03f, 0.1f, 0), 0, &gauge[1]), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_PRESSURE, fsdem_v3(5, 0, 0), 0, NULL), FSDEM_ERR_OUT_OF_DOMAIN);
+    ck_assert_int_eq(fsdem_mps_gauges_open(m, "build/test_mps_gauges.csv", (fsdem_real)0.025), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_LEVEL, fsdem_v3(0.1f, 0, 0), 0, NULL), FSDEM_ERR_INVALID_ARG);
+
     ck_assert_int_eq(fsdem_mps_advance(m, 0.1f, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_gauges_close(m), FSDEM_OK);
+    {
+        FILE *f = fopen("build/test_mps_gauges.csv", "r");
+        char line[256];
+        double t = -1, lv = 0, pv = 0;
+        fsdem_real g0, g1;
+        int rows = 0;
+        ck_assert_ptr_nonnull(f);
+        ck_assert_ptr_nonnull(fgets(line, sizeof line, f));
+        ck_assert_str_eq(line, "t,level_0,p_1\n");
+        while (fgets(line, sizeof line, f) && sscanf(line, "%lf,%lf,%lf", &t, &lv, &pv) == 3) ++rows;
+        fclose(f);
+        ck_assert_int_eq(rows, 5); /* t = 0, 0.025, 0.05, 0.075, 0.1 */
+        ck_assert(fabs(t - 0.1) < 1e-6);
+        /* the row at 0.1 s is interpolated within the last step, which ends at most 1e-6 s later
+           (the duration 0.1f is 0.1 + 1.5e-9 s in double): within 1e-3 of a step's change */
+        ck_assert_int_eq(fsdem_mps_gauge(m, gauge[0], &g0), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_gauge(m, gauge[1], &g1), FSDEM_OK);
+        ck_assert_msg(fabs(lv - g0) <= 1e-3 * r0 && fabs(pv - g1) <= 1e-3 * g1, "last row %g %g, gauges %g %g", lv, pv, (double)g0,
+                      (double)g1);
+        ck_assert_int_eq(fsdem_mps_gauge(m, 7, &g0), FSDEM_ERR_NOT_FOUND);
+    }
     ck_assert_int_eq(fsdem_mps_obstacle_force(m, id, &F), FSDEM_OK);
     ck_assert_int_eq(fsdem_mps_probe_pressure(m, fsdem_v3(0.03f, 0.1f, 0), 0, &p_liquid), FSDEM_OK);
     ck_assert_int_eq(fsdem_mps_probe_pressure(m, fsdem_v3(0, 0.05f, 0), (fsdem_real)(2 * r0), &p_wall), FSDEM_OK);
