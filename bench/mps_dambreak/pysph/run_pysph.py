@@ -31,8 +31,6 @@ import re
 import sys
 import time
 
-import numpy as np
-
 from pysph.examples import dam_break_2d as db
 from pysph.solver.utils import load
 
