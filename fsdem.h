@@ -2327,7 +2327,8 @@ FSDEM_API fsdem_result fsdem_swe_write_vti(const fsdem_swe *swe, const char *pat
 /* ===== >>impl_core : results, allocator, messages, vector algebra ================================== */
 
 /* Contents: results and messages, the allocator and growth, the per-step scratch arena, the status
-   every object keeps, finite-value checks, 3-vector algebra, and >>core_lane (short vectors for the
+   every object keeps, finite-value checks, the CSV series of probes, 3-vector algebra,
+   >>core_gauges (the point gauges of the particle solvers) and >>core_lane (short vectors for the
    batched kernels). */
 
 #define FSDEM__PI 3.14159265358979323846
@@ -11987,8 +11988,8 @@ fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
 /* Contents: the object below; >>mps_desc (defaults, validation, lattice constants, creation),
    >>mps_particles (storage, lattice fills, walls, obstacles), >>mps_neighbours (cell-list search
    into sorted neighbour rows), >>mps_operators (number density, gradient, divergence, Laplacian,
-   surface), >>mps_step (predictor, pressure equation, corrector, time stepping), >>mps_views
-   (views, statistics). */
+   surface), >>mps_step (predictor, pressure equation, corrector, collisions, time stepping),
+   >>mps_views (views, statistics), >>mps_probes (pressure, water level, obstacle force, gauges). */
 
 /* A box obstacle (fsdem_mps_add_box_obstacle) and the force of the fluid on it in the last step. */
 typedef struct fsdem__mps_obst {
