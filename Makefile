@@ -128,7 +128,7 @@ gnuplot-deps:
 
 # The cases read their reference data from VALIDATION_DATA (passed as the first argument; compiled in
 # as the default, so build/validation/<case>/run works on its own).
-$(BUILD)/validation/%/run: validation/%/main.c validation/common.h validation/pic_dambreak.h fsdem.h | $(BUILD)
+$(BUILD)/validation/%/run: validation/%/main.c validation/common.h validation/pic_dambreak.h validation/dambreak_protocol.h fsdem.h | $(BUILD)
 	@mkdir -p $(dir $@)
 	$(CC) $(STD) $(WARN) -O2 -I. -Ivalidation -DVC_DATA_DIR='"$(abspath $(VALIDATION_DATA))"' $< -o $@ $(LDLIBS)
 
