@@ -1,7 +1,7 @@
 /* Still water in an open tank, MPS, 2D and 3D: the time history of the pressure at the bottom centre.
    Usage: run [DATA_DIR]   (the reference is analytic, p = rho g (depth); no file is read)
-   Writes pressure.csv (2D, gamma = 0.01, checked), pressure_3d.csv (3D, checked), pressure_gamma0.csv,
-   pressure_3d_gamma0.csv (gamma = 0, reported), pressure_r0_half.csv (2D at r0/2, reported) and
+   Writes pressure.csv (2D, gamma = 0.01, checked), pressure_3d.csv (3D, checked), pressure_gamma0.csv
+   (2D, gamma = 0, checked), pressure_3d_gamma0.csv (3D, gamma = 0, reported), pressure_r0_half.csv (2D at r0/2, reported) and
    profile*.csv (the centre line at 0.25 s: y, p, rho g (h - y)) of each run. Pressure columns:
    t, p_bottom (point sensor, radius r0), p_bottom_re (radius re),
    level (fsdem_mps_probe_height at the centre), max_speed, surface, iterations. */
@@ -237,6 +237,11 @@ int main(int argc, char **argv) {
         /* gamma = 0: the source term of Eq. 12 without the number-density part, reported */
         o0 = run(dim, r0, width, depth, 0.0, dim == 2 ? "_gamma0" : "_3d_gamma0");
         report(dim == 2 ? "2d_gamma0" : "3d_gamma0", &o0, 0.0);
+        if (dim == 2) { /* it holds in 2D, so it is checked with the same bounds (3D: reported) */
+            vc_check(CASE, "2d_gamma0_run_completed_2s", o0.failed ? 0 : 1, 1, 0);
+            vc_check_rel(CASE, "2d_gamma0_bottom_pressure_mean_Pa", o0.mean, rho * g * depth, 0.02);
+            vc_check(CASE, "2d_gamma0_bottom_pressure_rms_over_rho_g_h", o0.rms / (rho * g * depth), 0, 0.05);
+        }
         if (dim == 2) { /* the same at half the spacing: the offset of the surface scales with r0 */
             outcome oh = run(dim, r0 / 2, width, depth, 0.01, "_r0_half");
             report("2d_r0_half", &oh, 0.01);
