@@ -1,8 +1,8 @@
 /* Still water in an open tank, MPS, 2D and 3D: the time history of the pressure at the bottom centre.
    Usage: run [DATA_DIR]   (the reference is analytic, p = rho g (depth); no file is read)
    Writes pressure.csv (2D, gamma = 0.01, checked), pressure_3d.csv (3D, checked), pressure_gamma0.csv
-   (2D, gamma = 0, checked), pressure_3d_gamma0.csv (3D, gamma = 0, reported), pressure_r0_half.csv (2D at r0/2, reported) and
-   profile*.csv (the centre line at 0.25 s: y, p, rho g (h - y)) of each run. Pressure columns:
+   (2D, gamma = 0, checked), pressure_3d_gamma0.csv (3D, gamma = 0, reported), pressure_r0_half.csv
+   (2D at r0/2, reported) and profile*.csv (the centre line at 0.25 s: y, p, rho g (h - y)) of each run. Pressure columns:
    t, p_bottom (point sensor, radius r0), p_bottom_re (radius re),
    level (fsdem_mps_probe_height at the centre), max_speed, surface, iterations. */
 #define FSDEM_IMPLEMENTATION
