@@ -2645,13 +2645,19 @@ typedef struct fsdem__gauges {
     fsdem__series series;
 } fsdem__gauges;
 
+/* Appends a gauge at `at`, which must lie in the box [lo, hi] along the first `dim` axes. */
 static fsdem_result fsdem__gauges_add(fsdem__gauges *g, fsdem__status *st, const fsdem_allocator *al, const char *fn, int kind,
-                                      fsdem_vec3 at, fsdem_real radius, int *id) {
+                                      fsdem_vec3 at, fsdem_real radius, int dim, fsdem_vec3 lo, fsdem_vec3 hi, int *id) {
     const int n = g->count;
-    int cap;
+    int cap, a;
+    if (id) *id = -1;
     if (g->series.file) return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: close the gauge file first", fn);
     if (kind < FSDEM__GAUGE_LEVEL || kind > FSDEM__GAUGE_PRESSURE || !fsdem__finite3(at) || !(radius >= 0) || !fsdem__finite(radius))
         return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: the kind must be a gauge kind, the position finite, the radius >= 0", fn);
+    for (a = 0; a < dim; ++a)
+        if (!(fsdem__comp(at, a) >= fsdem__comp(lo, a) && fsdem__comp(at, a) <= fsdem__comp(hi, a)))
+            return fsdem__fail(st, FSDEM_ERR_OUT_OF_DOMAIN, "%s: (%g, %g, %g) is outside the domain", fn, (double)at.x, (double)at.y,
+                               (double)at.z);
     if (n == g->capacity) {
         cap = g->capacity;
         if (fsdem__grow(al, (void **)&g->at, &cap, n, n + 1, sizeof(fsdem_vec3)) != FSDEM_OK ||
@@ -9526,16 +9532,12 @@ static void fsdem__pic_gauge_values(const void *solver, fsdem_real *out) {
 
 fsdem_result fsdem_pic_add_gauge(fsdem_pic *s, fsdem_pic_gauge_kind kind, fsdem_vec3 position, fsdem_real radius, int *id) {
     fsdem_real up;
-    int b;
     if (id) *id = -1;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (kind == FSDEM_PIC_GAUGE_LEVEL && fsdem__pic_up_axis(s, &up) < 0)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_gauge: a level gauge needs gravity along one axis");
-    for (b = 0; b < s->dim; ++b)
-        if (!(fsdem__comp(position, b) >= fsdem__comp(s->lo, b) && fsdem__comp(position, b) <= fsdem__comp(s->hi, b)))
-            return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_pic_add_gauge: (%g, %g, %g) is outside the domain",
-                               (double)position.x, (double)position.y, (double)position.z);
-    return fsdem__gauges_add(&s->gauges, &s->status, &s->allocator, "fsdem_pic_add_gauge", (int)kind, position, radius, id);
+    return fsdem__gauges_add(&s->gauges, &s->status, &s->allocator, "fsdem_pic_add_gauge", (int)kind, position, radius, s->dim, s->lo,
+                             s->hi, id);
 }
 
 fsdem_result fsdem_pic_gauge(const fsdem_pic *s, int id, fsdem_real *value) {
@@ -13404,14 +13406,10 @@ static void fsdem__mps_gauge_values(const void *solver, fsdem_real *out) {
 }
 
 fsdem_result fsdem_mps_add_gauge(fsdem_mps *s, fsdem_mps_gauge_kind kind, fsdem_vec3 position, fsdem_real radius, int *id) {
-    int a;
     if (id) *id = -1;
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    for (a = 0; a < s->dim && fsdem__finite3(position); ++a)
-        if (!(fsdem__comp(position, a) >= fsdem__comp(s->desc.domain_min, a) && fsdem__comp(position, a) <= fsdem__comp(s->desc.domain_max, a)))
-            return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_mps_add_gauge: (%g, %g, %g) is outside the domain",
-                               (double)position.x, (double)position.y, (double)position.z);
-    return fsdem__gauges_add(&s->gauges, &s->status, &s->allocator, "fsdem_mps_add_gauge", (int)kind, position, radius, id);
+    return fsdem__gauges_add(&s->gauges, &s->status, &s->allocator, "fsdem_mps_add_gauge", (int)kind, position, radius, s->dim,
+                             s->desc.domain_min, s->desc.domain_max, id);
 }
 
 fsdem_result fsdem_mps_gauge(const fsdem_mps *s, int id, fsdem_real *value) {

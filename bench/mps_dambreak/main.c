@@ -6,7 +6,7 @@
    [0, 1] x [0, 2] m at the left wall (fsdem_mps_fill_box: 67 x 133 = 8,911 FLUID particles at
    r0 = 0.015 m). Everything else is fsdem_mps_desc_default(2): re = 4.1 r0, gamma = 0.01,
    beta = 0.8, alpha = 0.9, CFL 0.2 with adaptive dt (dt_max 1e-3 s), min-form gradient,
-   collisions at 0.5 r0, negative pressures clamped, no shifting, MIC(0)-PCG to 1e-8. The domain is [-0.1, 4.1] x
+   collisions at 0.8 r0, negative pressures clamped, no shifting, MIC(0)-PCG to 1e-8. The domain is [-0.1, 4.1] x
    [-0.1, 6] m. Simulated to t = 0.6 s in 0.1 s chunks by fsdem_mps_advance (each chunk ends exactly
    on its time, so the fronts at 0.4 and 0.6 s are at those times), single thread.
    Figures: wall_s = wall-clock seconds of the stepping (creation and filling excluded, as PySPH's
