@@ -115,8 +115,26 @@ static void db_write_front_table(const db_front_table *f, double a, const char *
 
 /* ref_front.csv (Martin & Moyce) and ref_front_ko.csv (Koshizuka & Oka). */
 static void db_write_ref_front(const db_ref *r) {
+    fsdem_csv c;
+    int i;
     db_write_front_table(&r->mm, DB_A, "ref_front.csv");
     db_write_front_table(&r->ko, DB_A, "ref_front_ko.csv");
+    if (fsdem_csv_open(&c, "ref_height.csv", "t,h_column") != FSDEM_OK) return;
+    for (i = 0; i < r->ne; ++i) {
+        fsdem_real row[2];
+        row[0] = (fsdem_real)(r->tau[i] * sqrt(DB_A / DB_G));
+        row[1] = (fsdem_real)(r->eta[i] * 2 * DB_A);
+        fsdem_csv_row(&c, row, 2);
+    }
+    fsdem_csv_close(&c);
+}
+
+/* Simulated time (s) long enough for both Martin & Moyce tables (the residual height runs to
+   tau = 7.4). */
+static double db_end_time(const db_ref *r) {
+    double t = r->tau[r->ne - 1] * sqrt(DB_A / DB_G) + 0.01;
+    if (r->mm.T[r->mm.n - 1] * sqrt(DB_A / (2 * DB_G)) > t) t = r->mm.T[r->mm.n - 1] * sqrt(DB_A / (2 * DB_G)) + 0.01;
+    return t;
 }
 
 /* Writes run `s` delayed by dT (in T) as `csv_name` (t,x_front in s, m), for the plots. */

@@ -186,7 +186,6 @@ static db_series mm, mm_coarse, ko;
 
 int main(int argc, char **argv) {
     db_ref ref;
-    fsdem_csv rf;
     mb_extra ex, ex_coarse, ex_ko;
     const char *dir = vc_data_dir(argc, argv);
     int n = argc > 2 ? atoi(argv[2]) : 40, i;
@@ -196,20 +195,9 @@ int main(int argc, char **argv) {
         vc_check(CASE, "reference_loaded", 0, 1, 0);
         return vc_exit_code();
     }
-    /* long enough for both Martin & Moyce tables (the residual height runs to tau = 7.4) */
-    t_end = ref.tau[ref.ne - 1] * sqrt(DB_A / DB_G) + 0.01;
-    if (ref.mm.T[ref.mm.n - 1] * sqrt(DB_A / (2 * DB_G)) > t_end)
-        t_end = ref.mm.T[ref.mm.n - 1] * sqrt(DB_A / (2 * DB_G)) + 0.01;
+    t_end = db_end_time(&ref);
     db_write_ref_front(&ref);
     db_write_front_table(&ref.ko, KO_L, "ref_front_ko_L.csv");
-    fsdem_csv_open(&rf, "ref_height.csv", "t,h_column");
-    for (i = 0; i < ref.ne; ++i) {
-        fsdem_real row[2];
-        row[0] = (fsdem_real)(ref.tau[i] * sqrt(DB_A / DB_G));
-        row[1] = (fsdem_real)(ref.eta[i] * 2 * DB_A);
-        fsdem_csv_row(&rf, row, 2);
-    }
-    fsdem_csv_close(&rf);
 
     /* ---- Martin & Moyce, a/n: the checks ---- */
     mb_run(DB_A, DB_LENGTH, n, t_end, 1e30, "front.csv", "density.csv", &mm, &ex);

@@ -20,7 +20,6 @@ static db_series runs[3], plain;
 
 int main(int argc, char **argv) {
     db_ref ref;
-    fsdem_csv rf;
     const char *dir = vc_data_dir(argc, argv);
     int n0 = argc > 2 ? atoi(argv[2]) : 40, level, i;
     double t_end;
@@ -28,19 +27,8 @@ int main(int argc, char **argv) {
         vc_check(CASE, "reference_loaded", 0, 1, 0);
         return vc_exit_code();
     }
-    /* long enough for both tables (the residual height runs to tau = 7.4) */
-    t_end = ref.tau[ref.ne - 1] * sqrt(DB_A / DB_G) + 0.01;
-    if (ref.mm.T[ref.mm.n - 1] * sqrt(DB_A / (2 * DB_G)) > t_end)
-        t_end = ref.mm.T[ref.mm.n - 1] * sqrt(DB_A / (2 * DB_G)) + 0.01;
+    t_end = db_end_time(&ref);
     db_write_ref_front(&ref);
-    fsdem_csv_open(&rf, "ref_height.csv", "t,h_column");
-    for (i = 0; i < ref.ne; ++i) {
-        fsdem_real row[2];
-        row[0] = (fsdem_real)(ref.tau[i] * sqrt(DB_A / DB_G));
-        row[1] = (fsdem_real)(ref.eta[i] * 2 * DB_A);
-        fsdem_csv_row(&rf, row, 2);
-    }
-    fsdem_csv_close(&rf);
 
     for (level = 2; level >= 0; --level) { /* coarse first: quick feedback */
         int n = n0 >> level;
