@@ -15304,6 +15304,28 @@ static fsdem_result fsdem__vtk_close(fsdem__vtk_writer *w) {
     return w->status ? fsdem__ok(w->status) : FSDEM_OK;
 }
 
+/* A particle snapshot (PolyData, one point and one vertex per particle), in two halves around its
+   point data: the file, its header and the opening of <PointData> with the active arrays; then
+   the closing of <PointData>, the points and the vertices, and the file closed. */
+static fsdem_result fsdem__vtk_particles_begin(fsdem__vtk_writer *w, const fsdem__status *status, const char *who, const char *path,
+                                               fsdem_vtk_format format, double time, long long n, const char *scalars,
+                                               const char *vectors) {
+    const fsdem_result res = fsdem__vtk_open(w, (fsdem__status *)status, who, path, format, "PolyData");
+    if (res != FSDEM_OK) return res;
+    fsdem__vtk_polydata(w, time, n, n, 0, 0);
+    fsdem__vtk_section(w, "PointData", scalars, vectors);
+    return FSDEM_OK;
+}
+
+static fsdem_result fsdem__vtk_particles_end(fsdem__vtk_writer *w, const fsdem_vec3 *points, long long n) {
+    fsdem__vtk_section_end(w, "PointData");
+    fsdem__vtk_section(w, "Points", NULL, NULL);
+    fsdem__vtk_write(w, fsdem__vtk_vec3s("Points", points, n));
+    fsdem__vtk_section_end(w, "Points");
+    fsdem__vtk_cells(w, "Verts", fsdem__vtk_ramp("connectivity", n, 0, 1), fsdem__vtk_ramp("offsets", n, 1, 1));
+    return fsdem__vtk_close(w);
+}
+
 /* ---- >>io_pvd : ParaView series ---- */
 
 /* The closing tags, at the current position. */
@@ -15403,10 +15425,8 @@ fsdem_result fsdem_dem_write_vtp(const fsdem_dem *d, const char *path, fsdem_vtk
     fsdem__vtk_writer w;
     fsdem_result res;
     if (!d) return FSDEM_ERR_INVALID_ARG;
-    res = fsdem__vtk_open(&w, (fsdem__status *)&d->status, "fsdem_dem_write_vtp", path, format, "PolyData");
+    res = fsdem__vtk_particles_begin(&w, &d->status, "fsdem_dem_write_vtp", path, format, d->time, d->n, "radius", "velocity");
     if (res != FSDEM_OK) return res;
-    fsdem__vtk_polydata(&w, d->time, d->n, d->n, 0, 0);
-    fsdem__vtk_section(&w, "PointData", "radius", "velocity");
     fsdem__vtk_write(&w, fsdem__vtk_ints("id", d->id, d->n));
     fsdem__vtk_write(&w, fsdem__vtk_reals("radius", d->r, d->n));
     fsdem__vtk_write(&w, fsdem__vtk_reals("mass", d->m, d->n));
@@ -15417,12 +15437,7 @@ fsdem_result fsdem_dem_write_vtp(const fsdem_dem *d, const char *path, fsdem_vtk
     fsdem__vtk_write(&w, fsdem__vtk_vec3s("force", d->f, d->n));
     fsdem__vtk_write(&w, fsdem__vtk_vec3s("torque", d->t, d->n));
     fsdem__vtk_write(&w, fsdem__vtk_vec3s("external_force", d->fext, d->n));
-    fsdem__vtk_section_end(&w, "PointData");
-    fsdem__vtk_section(&w, "Points", NULL, NULL);
-    fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", d->x, d->n));
-    fsdem__vtk_section_end(&w, "Points");
-    fsdem__vtk_cells(&w, "Verts", fsdem__vtk_ramp("connectivity", d->n, 0, 1), fsdem__vtk_ramp("offsets", d->n, 1, 1));
-    return fsdem__vtk_close(&w);
+    return fsdem__vtk_particles_end(&w, d->x, d->n);
 }
 
 /* Wall geometry for the writer: points, cells (connectivity, offsets) and per-cell wall data, the
@@ -15803,39 +15818,25 @@ fsdem_result fsdem_pic_write_particles_vtp(const fsdem_pic *s, const char *path,
     fsdem__vtk_writer w;
     fsdem_result res;
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    res = fsdem__vtk_open(&w, (fsdem__status *)&s->status, "fsdem_pic_write_particles_vtp", path, format, "PolyData");
+    res = fsdem__vtk_particles_begin(&w, &s->status, "fsdem_pic_write_particles_vtp", path, format, s->time, s->np, NULL, "velocity");
     if (res != FSDEM_OK) return res;
-    fsdem__vtk_polydata(&w, s->time, s->np, s->np, 0, 0);
-    fsdem__vtk_section(&w, "PointData", NULL, "velocity");
     fsdem__vtk_write(&w, fsdem__vtk_vec3s("velocity", s->pv, s->np));
-    fsdem__vtk_section_end(&w, "PointData");
-    fsdem__vtk_section(&w, "Points", NULL, NULL);
-    fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", s->px, s->np));
-    fsdem__vtk_section_end(&w, "Points");
-    fsdem__vtk_cells(&w, "Verts", fsdem__vtk_ramp("connectivity", s->np, 0, 1), fsdem__vtk_ramp("offsets", s->np, 1, 1));
-    return fsdem__vtk_close(&w);
+    return fsdem__vtk_particles_end(&w, s->px, s->np);
 }
 
 fsdem_result fsdem_mps_write_vtp(const fsdem_mps *s, const char *path, fsdem_vtk_format format) {
     fsdem__vtk_writer w;
     fsdem_result res;
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    res = fsdem__vtk_open(&w, (fsdem__status *)&s->status, "fsdem_mps_write_vtp", path, format, "PolyData");
+    res = fsdem__vtk_particles_begin(&w, &s->status, "fsdem_mps_write_vtp", path, format, s->time, s->n, "pressure", "velocity");
     if (res != FSDEM_OK) return res;
-    fsdem__vtk_polydata(&w, s->time, s->n, s->n, 0, 0);
-    fsdem__vtk_section(&w, "PointData", "pressure", "velocity");
     fsdem__vtk_write(&w, fsdem__vtk_bytes("kind", s->kind, s->n));
     fsdem__vtk_write(&w, fsdem__vtk_bytes("surface", s->surf, s->n));
     fsdem__vtk_write(&w, fsdem__vtk_reals("pressure", s->p, s->n));
     fsdem__vtk_write(&w, fsdem__vtk_vec3s("velocity", s->v, s->n));
     fsdem__vtk_write(&w, fsdem__vtk_reals("number_density", s->nd, s->n));
     fsdem__vtk_write(&w, fsdem__vtk_reals("porosity", s->eps, s->n));
-    fsdem__vtk_section_end(&w, "PointData");
-    fsdem__vtk_section(&w, "Points", NULL, NULL);
-    fsdem__vtk_write(&w, fsdem__vtk_vec3s("Points", s->x, s->n));
-    fsdem__vtk_section_end(&w, "Points");
-    fsdem__vtk_cells(&w, "Verts", fsdem__vtk_ramp("connectivity", s->n, 0, 1), fsdem__vtk_ramp("offsets", s->n, 1, 1));
-    return fsdem__vtk_close(&w);
+    return fsdem__vtk_particles_end(&w, s->x, s->n);
 }
 
 static void fsdem__io_pic_velocity(const void *user, long long c, double out[3]) {
