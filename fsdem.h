@@ -12995,6 +12995,7 @@ static void fsdem__mps_collide(fsdem_mps *s, fsdem_real dt) {
 static void fsdem__mps_obstacle_forces(fsdem_mps *s) {
     const fsdem_real area = (fsdem_real)pow((double)s->r0, s->dim - 1), rho = s->desc.density;
     int i, a, side;
+    if (s->obst_n == 0) return; /* no obstacle: no pass over the particles */
     for (a = 0; a < s->obst_n; ++a) s->obst[a].force = fsdem__zero3();
     for (i = 0; i < s->n; ++i) {
         fsdem__mps_obst *o;
@@ -14869,6 +14870,7 @@ fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *bu
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 
+/* fsdem_mps (>>restart): the MPS solver. */
 fsdem_result fsdem_mps_save(const fsdem_mps *mps, const char *path) {
     fsdem__restart_object o = fsdem__restart_of_mps(mps);
     return fsdem__restart_save_file(&o, path);
