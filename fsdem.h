@@ -23,11 +23,14 @@
      >>swe      shallow-water equations in 1D and 2D: HLL, MUSCL-Hancock, wet/dry, well-balanced
                 (seed 003)
      >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
+     >>mps      MPS free-surface particle solver: fluid, wall and dummy particles, mixed-source
+                pressure equation on the shared PCG, probes and gauges (seed 002)
      >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
                 to memory, bit-exact continuation (versioned binary format with a checksum)
      >>io       CSV time series; ParaView .pvd series, valid after every entry; VTK XML snapshots
                 of every solver (ascii, inline base64 or appended raw): DEM particles, walls and
-                contacts (.vtp), PIC particles (.vtp) and grid (.vti), shallow-water fields (.vti)
+                contacts (.vtp), PIC particles (.vtp) and grid (.vti), shallow-water fields (.vti),
+                MPS particles (.vtp)
      >>impl     implementation, in the same order (each chapter opens with its contents)
      >>licence  MIT
 
@@ -78,7 +81,7 @@
      fsdem_dem_destroy(dem);
 
    ONE DIALECT FOR EVERY SOLVER
-     Each solver (fsdem_dem, fsdem_pic, fsdem_swe) and each coupler (fsdem_swe_dem) speaks these
+     Each solver (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_mps) and each coupler (fsdem_swe_dem) speaks these
      verbs; X is the object's name. A solver adds verbs of its own (add_particle, set_bed, ...).
        fsdem_X_desc fsdem_X_desc_default(dim)      defaults (couplers and fsdem_pcg: no argument)
        fsdem_result fsdem_X_desc_check(desc, message, size)  validation without creating anything
