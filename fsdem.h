@@ -81,8 +81,8 @@
      fsdem_dem_destroy(dem);
 
    ONE DIALECT FOR EVERY SOLVER
-     Each solver (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_mps) and each coupler (fsdem_swe_dem) speaks these
-     verbs; X is the object's name. A solver adds verbs of its own (add_particle, set_bed, ...).
+     Each solver (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_mps) and each coupler (fsdem_swe_dem)
+     speaks these verbs; X is the object's name. A solver adds verbs of its own (add_particle, set_bed, ...).
        fsdem_X_desc fsdem_X_desc_default(dim)      defaults (couplers and fsdem_pcg: no argument)
        fsdem_result fsdem_X_desc_check(desc, message, size)  validation without creating anything
        fsdem_result fsdem_X_create(desc, &x)        *x is NULL on failure; destroy with _destroy
