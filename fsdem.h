@@ -124,8 +124,11 @@
              callback at every force evaluation, Verlet substeps fused)
        fluid fsdem_<fluid>_sample (velocity, pressure gradient, volume fraction at points),
              fsdem_<fluid>_add_force / _clear_forces (momentum sources), fsdem_<fluid>_get_coupling
-             (writable per-cell or per-face arrays), fsdem_<fluid>_get_desc, stable_dt, step_dt,
-             and for the shallow water fsdem_swe_sample_state (depth-averaged state at (x, y)).
+             (writable per-cell, per-face or per-particle arrays), fsdem_<fluid>_get_desc, stable_dt,
+             step_dt, and for the shallow water fsdem_swe_sample_state (depth-averaged state at
+             (x, y)). The MPS solver, whose fluid is particles, is sampled through its particle view
+             (fsdem_mps_get_particles: positions, velocities, pressure gradients) and takes forces
+             and porosities through fsdem_mps_get_coupling.
 
    THREAD SAFETY
      No global mutable state. Distinct objects may be used from distinct threads at once; one
@@ -225,6 +228,7 @@
 #define fsdem_mps_gauge fsdem_mps_gauge_f
 #define fsdem_mps_gauges_close fsdem_mps_gauges_close_f
 #define fsdem_mps_gauges_open fsdem_mps_gauges_open_f
+#define fsdem_mps_get_coupling fsdem_mps_get_coupling_f
 #define fsdem_mps_get_desc fsdem_mps_get_desc_f
 #define fsdem_mps_get_particles fsdem_mps_get_particles_f
 #define fsdem_mps_get_stats fsdem_mps_get_stats_f
@@ -1918,9 +1922,28 @@ typedef struct fsdem_mps_particles {
     const unsigned char *surface;     /* 1: free-surface particle (p = 0) at the last step */
     const fsdem_real *number_density; /* -; n_i of Eq. 7 at the last step (0 for DUMMY) */
     fsdem_real *porosity;             /* -; eps_f per particle */
+    const fsdem_vec3 *pressure_gradient; /* Pa/m; grad p of the last corrector at FLUID particles */
+                                      /*    (desc.gradient form; 0 elsewhere and before a step) */
+    fsdem_real mass;                  /* kg (kg/m in 2D); the fluid of one particle, rho r0^d */
 } fsdem_mps_particles;
 
 FSDEM_API fsdem_mps_particles fsdem_mps_get_particles(fsdem_mps *mps);
+
+/* What a coupler writes (>>doc, COUPLING INTERFACE): a force on every particle (N; N per metre of
+   depth in 2D), held over later steps and applied to FLUID particles in the predictor (step 2:
+   u* += dt force / mass), and the porosity eps of Eq. 7-16 (the same array as the view's). The
+   forces start at zero; steps read them only once this function has handed them out. Valid until
+   particles are added. With desc.model = FSDEM_MPS_MODEL_B the corrector divides the pressure
+   acceleration by eps_i (seed 002 Eq. 5: the fluid takes the whole pressure gradient of the
+   mixture), with Model A it does not (Eq. 2: -eps grad P on a volume of mixture, i.e. -grad P on
+   the fluid's own volume). */
+typedef struct fsdem_mps_coupling {
+    int count;
+    fsdem_vec3 *force;                /* N (N/m in 2D) */
+    fsdem_real *porosity;             /* -; in (0, 1] */
+} fsdem_mps_coupling;
+
+FSDEM_API fsdem_mps_coupling fsdem_mps_get_coupling(fsdem_mps *mps);
 
 /* ---- particle-interaction operators (seed 002 Eq. 7-10) ---- */
 
@@ -12022,6 +12045,9 @@ struct fsdem_mps {
     fsdem_vec3 *x, *v, *us;       /* position, velocity, predicted velocity u* */
     fsdem_vec3 *shift;            /* particle shift of the step (desc.shifting) */
     fsdem_real *p, *eps, *nd;     /* pressure, porosity, number density */
+    fsdem_vec3 *fext;             /* external force of a coupler (N; N/m in 2D), FLUID particles */
+    fsdem_vec3 *gradp;            /* pressure gradient of the last corrector (Pa/m), FLUID particles */
+    int external;                 /* fext may be nonzero (fsdem_mps_get_coupling handed it out) */
     fsdem_real *div, *b, *sol;    /* divergence of u*, right-hand side and solution (by unknown) */
     unsigned char *kind, *surf;
     int *body;                    /* the obstacle a WALL or DUMMY particle belongs to, or -1 */
@@ -12219,7 +12245,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
 
 /* The particle arrays of a capacity `cap`, with their element sizes (one list for allocation,
    copying and release). */
-#define FSDEM__MPS_ARRAYS 15
+#define FSDEM__MPS_ARRAYS 17
 static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     void **p[FSDEM__MPS_ARRAYS];
     size_t e[FSDEM__MPS_ARRAYS];
@@ -12236,6 +12262,8 @@ static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     FSDEM__MPS_ARRAY(p);
     FSDEM__MPS_ARRAY(eps);
     FSDEM__MPS_ARRAY(nd);
+    FSDEM__MPS_ARRAY(fext);
+    FSDEM__MPS_ARRAY(gradp);
     FSDEM__MPS_ARRAY(div);
     FSDEM__MPS_ARRAY(b);
     FSDEM__MPS_ARRAY(sol);
@@ -12355,6 +12383,7 @@ static void fsdem__mps_push(fsdem_mps *s, fsdem_mps_kind kind, fsdem_vec3 x, fsd
     s->p[i] = 0;
     s->eps[i] = 1;
     s->nd[i] = 0;
+    s->fext[i] = s->gradp[i] = fsdem__zero3();
     s->kind[i] = (unsigned char)kind;
     s->surf[i] = 0;
     s->body[i] = -1;
@@ -12872,6 +12901,11 @@ static fsdem_real fsdem__mps_umax(const fsdem_mps *s, int *who) {
     return (fsdem_real)sqrt(m2);
 }
 
+/* Mass of the fluid a particle stands for: rho r0^d (kg; kg per metre of depth in 2D). */
+static fsdem_real fsdem__mps_mass(const fsdem_mps *s) {
+    return s->desc.density * s->r0 * s->r0 * (s->dim == 3 ? s->r0 : 1);
+}
+
 /* The stable step of the CFL rule of seed 002 Eq. 37, u_max dt / r0 <= C, at most dt_max. */
 static fsdem_real fsdem__mps_dt_from(const fsdem_mps *s, fsdem_real umax) {
     fsdem_real dt = s->desc.dt_max;
@@ -13085,7 +13119,7 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
 /* One step of dt (the section's steps 1-6). Failures before the pressure is known change nothing;
    a completed step reports a non-finite or escaped particle. */
 static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
-    const fsdem_real rho = s->desc.density, nu = s->desc.viscosity;
+    const fsdem_real rho = s->desc.density, nu = s->desc.viscosity, mass = fsdem__mps_mass(s);
     const double time0 = s->time;
     fsdem_pcg_info info;
     fsdem_csr A;
@@ -13120,6 +13154,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         }
         s->us[i] = fsdem__add(s->v[i], fsdem__scale(fsdem__add(fsdem__scale(fsdem__mps_lap_at(s, NULL, s->v, i), nu),
                                                                 s->desc.gravity), dt));
+        if (s->external) s->us[i] = fsdem__madd(s->us[i], s->fext[i], dt / mass); /* a coupler's force (Eq. 2, 4) */
         if (s->dim == 2) s->us[i].z = 0;
     }
     for (i = 0; i < s->n; ++i) s->div[i] = s->kind[i] == FSDEM_MPS_DUMMY ? 0 : fsdem__mps_div_at(s, s->us, i);
@@ -13158,8 +13193,13 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         s->p[i] = p;
     }
     for (i = 0; i < s->n; ++i) {
+        fsdem_real per_mass = -dt / rho;
         if (s->kind[i] != FSDEM_MPS_FLUID) continue;
-        s->v[i] = fsdem__madd(s->us[i], fsdem__mps_grad_at(s, s->p, i, fsdem__scale(s->desc.gravity, rho)), -dt / rho); /* seed 002 Eq. A.5 */
+        /* seed 002 Eq. A.5; with Model B the whole pressure gradient acts on the fluid (Eq. 4-5:
+           -grad P per volume of mixture, which is 1/eps_i times the particle's volume of fluid) */
+        if (s->desc.model == FSDEM_MPS_MODEL_B) per_mass /= s->eps[i];
+        s->gradp[i] = fsdem__mps_grad_at(s, s->p, i, fsdem__scale(s->desc.gravity, rho));
+        s->v[i] = fsdem__madd(s->us[i], s->gradp[i], per_mass);
         if (s->dim == 2) s->v[i].z = 0;
     }
     fsdem__mps_obstacle_forces(s);
@@ -13265,7 +13305,20 @@ fsdem_mps_particles fsdem_mps_get_particles(fsdem_mps *s) {
     v.surface = s->surf;
     v.number_density = s->nd;
     v.porosity = s->eps;
+    v.pressure_gradient = s->gradp;
+    v.mass = fsdem__mps_mass(s);
     return v;
+}
+
+fsdem_mps_coupling fsdem_mps_get_coupling(fsdem_mps *s) {
+    fsdem_mps_coupling c;
+    memset(&c, 0, sizeof c);
+    if (!s) return c;
+    s->external = 1;
+    c.count = s->n;
+    c.force = s->fext;
+    c.porosity = s->eps;
+    return c;
 }
 
 fsdem_csr fsdem_mps_pressure_matrix(const fsdem_mps *s, const int **rows_particle) {
@@ -14371,8 +14424,9 @@ static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
 /* The particles go into fresh arrays of the saved capacity (all FSDEM__MPS_ARRAYS of them and the
    four row-offset arrays, as fsdem__mps_reserve makes them); of their contents the state that the
    next step reads (positions, velocities, pressures: the pressure solve starts from them, kinds,
-   porosities, obstacle membership) and the views of the last step (number density, surface flags)
-   are saved. The neighbour rows and the matrix are rebuilt by every step; their memory stays. */
+   porosities, a coupler's forces, obstacle membership) and the views of the last step (number
+   density, surface flags, pressure gradients) are saved. The neighbour rows and the matrix are
+   rebuilt by every step; their memory stays. */
 static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem_mps *s = (fsdem_mps *)object;
     const fsdem_mps_desc *d = &s->desc;
@@ -14380,7 +14434,7 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
     int no = s->obst_n, n = s->n, cap = s->cap, i, a;
     fsdem__mps_obst *obst;
-    fsdem__restart_tag(io, "MPS1");
+    fsdem__restart_tag(io, "MPS2");
     fsdem__restart_same_int(io, d->dim, "dim");
     fsdem__restart_same_real(io, d->r0, "r0");
     fsdem__restart_same_real(io, d->re, "re");
@@ -14457,6 +14511,9 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_data(io, s->p, sizeof *s->p * (size_t)n);
     fsdem__restart_data(io, s->eps, sizeof *s->eps * (size_t)n);
     fsdem__restart_data(io, s->nd, sizeof *s->nd * (size_t)n);
+    fsdem__restart_data(io, &s->external, sizeof s->external);
+    fsdem__restart_data(io, s->fext, sizeof *s->fext * (size_t)n);
+    fsdem__restart_data(io, s->gradp, sizeof *s->gradp * (size_t)n);
     fsdem__restart_flags(io, s->kind, n, FSDEM_MPS_DUMMY, "kind of particle");
     fsdem__restart_flags(io, s->surf, n, 1, "surface flag of particle");
     fsdem__restart_ints(io, s->body, n, -1, no - 1, "obstacle of particle");
