@@ -25,6 +25,8 @@
      >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
      >>mps      MPS free-surface particle solver: fluid, wall and dummy particles, mixed-source
                 pressure equation on the shared PCG, probes and gauges (seed 002)
+     >>drag     drag laws of unresolved couplings: Stokes, Schiller-Naumann, Ergun/Wen-Yu (seed 002
+                Eq. 26), Gidaspow blend, Di Felice, Beetstra-van der Hoef-Kuipers
      >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
                 to memory, bit-exact continuation (versioned binary format with a checksum)
      >>io       CSV time series; ParaView .pvd series, valid after every entry; VTK XML snapshots
@@ -214,6 +216,8 @@
 #define fsdem_dem_write_csv fsdem_dem_write_csv_f
 #define fsdem_dem_write_vtp fsdem_dem_write_vtp_f
 #define fsdem_dem_write_walls_vtp fsdem_dem_write_walls_vtp_f
+#define fsdem_drag_coefficient fsdem_drag_coefficient_f
+#define fsdem_drag_law_name fsdem_drag_law_name_f
 #define fsdem_mps_add_box_obstacle fsdem_mps_add_box_obstacle_f
 #define fsdem_mps_add_box_walls fsdem_mps_add_box_walls_f
 #define fsdem_mps_add_gauge fsdem_mps_add_gauge_f
@@ -2058,6 +2062,66 @@ FSDEM_API fsdem_result fsdem_mps_gauges_close(fsdem_mps *mps);
    (of order nu / (u r0) of the pressure force). 0 before the first step. FSDEM_ERR_INVALID_ARG for
    NULL arguments or an unknown id. */
 FSDEM_API fsdem_result fsdem_mps_obstacle_force(const fsdem_mps *mps, int id, fsdem_vec3 *force);
+
+/* ===== >>drag : drag laws of unresolved couplings (seed 002 Eq. 25-28 and the literature) ===== */
+
+/* The drag of the fluid on one sphere of diameter d and volume V = pi d^3 / 6 at porosity eps (fluid
+   volume fraction around it), for the couplers whose grid or particles are coarser than the sphere:
+       F = c V (u - v),   c = beta / (1 - eps)   (kg m^-3 s^-1)
+   with u the intrinsic fluid velocity at the sphere, v the sphere's, beta the interphase momentum
+   exchange coefficient of seed 002 Eq. 25-26. F is the drag WITHOUT the pressure-gradient part: a
+   coupler adds -V grad P itself (seed 002 Eq. 34, Model A), or uses F / eps - V rho_f g where only the
+   dynamic pressure comes from the drag (Eq. 35, Model B). c is returned rather than beta because it
+   stays finite at eps = 1 (a lone sphere), where beta = 0.
+
+   Reynolds numbers: Re = eps rho_f d |u - v| / mu_f (Eq. 28, the superficial slip) for the laws of a
+   suspension; Re = rho_f d |u - v| / mu_f for the isolated-sphere laws. mu_f is the DYNAMIC viscosity.
+   Every law is written so that |u - v| = 0 (Re = 0) gives its creeping-flow limit, no 0/0.
+
+   Each published form converted to c (each sense checked against Eq. 26, see >>impl_drag):
+     STOKES            c = 18 mu / d^2: c V = 3 pi mu d.
+     SCHILLER_NAUMANN  the isolated sphere's F = Cd (pi d^2 / 8) rho |u - v|^2 with Cd of Eq. 27
+                       (Schiller and Naumann 1933; 0.44 above Re = 1000): c = 0.75 Cd rho |u - v| / d.
+     ERGUN_WEN_YU      Eq. 26 as printed, divided by (1 - eps): Ergun (1952) for eps <= 0.8,
+                       c = 150 (1 - eps) mu / (eps d^2) + 1.75 rho |u - v| / d; Wen and Yu (1966) above,
+                       c = 0.75 Cd rho |u - v| eps^-1.65 / d (Cd of Eq. 27 at the Re of Eq. 28). c jumps
+                       at eps = 0.8: d = 1 mm in water (1000 kg/m^3, 1e-3 Pa s) at 0.01 m/s (Re = 8)
+                       has c = 55000 on the Ergun side and 52866.60 on the Wen-Yu side (-3.9 %).
+     GIDASPOW          the two terms of Eq. 26 blended as Huilin and Gidaspow (2003),
+                       beta = (1 - phi) beta_WenYu + phi beta_Ergun, phi = 1/2 + atan(262.5 (eps_s - 0.2)) / pi,
+                       eps_s = 1 - eps (262.5 = 150 * 1.75): smooth, half and half at eps = 0.8. The
+                       Ergun share never vanishes: 0.606 % at eps = 1, where c is 0.99394 of Stokes.
+     DI_FELICE         Di Felice (1994): F = F0 eps^-chi, F0 the single-sphere drag at the superficial
+                       slip U = eps |u - v| (Cd0 = (0.63 + 4.8 / sqrt(Re))^2, Re of Eq. 28),
+                       chi = 3.7 - 0.65 exp(-(1.5 - log10 Re)^2 / 2): c = 0.75 Cd0 rho |u - v| eps^(2 - chi) / d.
+                       F is already the drag of Eq. 25 (see >>impl_drag). Its creeping limit is 0.96 of
+                       Stokes (Cd0 -> 23.04 / Re). Below eps = 0.435 c falls as the slip grows over a
+                       band of Re (0.29 to 1.7 at eps = 0.4, 0.024 to 5 at eps = 0.05) where chi falls
+                       faster than Cd0 |u - v| grows; the force c V |u - v| still grows.
+     BEETSTRA          Beetstra, van der Hoef and Kuipers (2007): F(phi, Re) = F_d / (3 pi mu d eps |u - v|),
+                       phi = 1 - eps, F_d the drag of Eq. 25 (the total force is F_d / eps):
+                       c = 18 mu eps F / d^2, exactly Stokes at eps = 1, Re = 0. */
+typedef enum fsdem_drag_law {
+    FSDEM_DRAG_STOKES = 0,           /* isolated sphere, creeping flow: 3 pi mu d, porosity ignored */
+    FSDEM_DRAG_SCHILLER_NAUMANN = 1, /* isolated sphere, Cd of Eq. 27, Re = rho d |u - v| / mu, porosity ignored */
+    FSDEM_DRAG_ERGUN_WEN_YU = 2,     /* seed 002 Eq. 26 exactly: Ergun for eps <= 0.8, Wen-Yu above */
+    FSDEM_DRAG_GIDASPOW = 3,         /* Ergun and Wen-Yu joined by the smooth blend of Huilin and Gidaspow (2003) */
+    FSDEM_DRAG_DI_FELICE = 4,        /* Di Felice (1994) */
+    FSDEM_DRAG_BEETSTRA = 5          /* Beetstra, van der Hoef and Kuipers (2007) */
+} fsdem_drag_law;
+
+/* Coefficient of the drag on one particle: F = c V (u - v) as above. Writes c (kg m^-3 s^-1) to
+   *per_volume and beta = c (1 - eps) to *beta; either pointer may be NULL. porosity in (0, 1],
+   diameter > 0 (m), slip_speed = |u - v| >= 0 (m/s), density rho_f > 0 (kg/m^3), viscosity mu_f > 0
+   (dynamic, Pa s), all finite, and a known law; otherwise FSDEM_ERR_INVALID_ARG, nothing written, and
+   `message` (may be NULL) names the argument. FSDEM_ERR_NAN (nothing written) where c overflows. */
+FSDEM_API fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsdem_real diameter,
+                                              fsdem_real slip_speed, fsdem_real density, fsdem_real viscosity,
+                                              fsdem_real *per_volume, fsdem_real *beta, char *message,
+                                              size_t message_size);
+
+/* Name of a law ("ergun_wen_yu", ...), "unknown" for other values. Never NULL. */
+FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
 
 /* ===== >>restart : checkpoint and restart ========================================================= */
 
@@ -13501,6 +13565,121 @@ fsdem_result fsdem_mps_obstacle_force(const fsdem_mps *s, int id, fsdem_vec3 *fo
                            !force ? "force is NULL" : "no obstacle has this id");
     *force = s->obst[id].force;
     return fsdem__ok((fsdem__status *)&s->status);
+}
+
+/* ===== >>impl_drag : drag laws ===== */
+
+/* Contents: the Wen-Yu term (also the Schiller-Naumann law, at eps = 1), the per-law coefficient
+   c = beta / (1 - eps) without checks for the couplers' per-particle loops, the checked public function
+   and the names.
+
+   Why each published form is read as the drag of seed 002 Eq. 25 (the -V grad P part excluded):
+   - Ergun: the beta of Eq. 26 with -eps grad P in the fluid's momentum balance gives Ergun's pressure
+     drop, 150 phi^2 mu U / (eps^3 d^2) at the superficial U.
+   - Di Felice: in a settling suspension the drag in this sense balances the weight less the buoyancy
+     of the suspension's density, eps (rho_p - rho_f) g V; with Richardson-Zaki's n = 4.65 that makes
+     chi = n - 1 = 3.65, Di Felice's 3.7, and his form with chi = 3.65 and Cd of Eq. 27 is exactly the
+     Wen-Yu branch of Eq. 26 (eps^(2 - 3.65) = eps^-1.65). (Read as the total force, F / eps, chi would
+     have to be n = 4.65.)
+   - Beetstra: F(phi, 0) = 10 phi / eps^2 + ... gives c = 180 phi mu / (eps d^2), the Carman-Kozeny
+     twin of Ergun's 150 phi mu / (eps d^2) in Eq. 26; read as the total force it would be eps times
+     that, off from Ergun by a factor eps. */
+
+/* Wen and Yu (1966) as in seed 002 Eq. 26: c = 0.75 Cd rho slip eps^-1.65 / d with Cd of Eq. 27 at
+   Re = eps rho d slip / mu (Eq. 28). Written with Cd Re = 24 (1 + 0.15 Re^0.687) and rho slip / d =
+   Re mu / (eps d^2), so Re = 0 gives 18 mu eps^-2.65 / d^2 with no 0/0. At eps = 1 this is the
+   Schiller-Naumann law of an isolated sphere. */
+static fsdem_real fsdem__drag_wen_yu(fsdem_real eps, fsdem_real d, fsdem_real slip, fsdem_real rho, fsdem_real mu) {
+    const fsdem_real re = eps * rho * d * slip / mu;
+    const fsdem_real cd_re = re <= 1000 ? 24 * (1 + (fsdem_real)0.15 * (fsdem_real)pow(re, 0.687)) : (fsdem_real)0.44 * re;
+    return (fsdem_real)0.75 * cd_re * mu / (d * d) * (fsdem_real)pow(eps, -2.65);
+}
+
+/* Ergun (1952) as in seed 002 Eq. 26, divided by (1 - eps). */
+static fsdem_real fsdem__drag_ergun(fsdem_real eps, fsdem_real d, fsdem_real slip, fsdem_real rho, fsdem_real mu) {
+    return 150 * (1 - eps) * mu / (eps * d * d) + (fsdem_real)1.75 * rho * slip / d;
+}
+
+/* c of `law` (kg m^-3 s^-1) for valid arguments (fsdem_drag_coefficient checks them). */
+static fsdem_real fsdem__drag_per_volume(fsdem_drag_law law, fsdem_real eps, fsdem_real d, fsdem_real slip,
+                                         fsdem_real rho, fsdem_real mu) {
+    switch (law) {
+    case FSDEM_DRAG_STOKES: return 18 * mu / (d * d);
+    case FSDEM_DRAG_SCHILLER_NAUMANN: return fsdem__drag_wen_yu(1, d, slip, rho, mu);
+    case FSDEM_DRAG_ERGUN_WEN_YU:
+        /* the switch in fsdem_real, so a float build puts eps = 0.8f on the Ergun side too */
+        return eps <= (fsdem_real)0.8 ? fsdem__drag_ergun(eps, d, slip, rho, mu) : fsdem__drag_wen_yu(eps, d, slip, rho, mu);
+    case FSDEM_DRAG_GIDASPOW: {
+        /* the blend of beta is the same blend of c: both terms carry the one factor (1 - eps) */
+        const fsdem_real phi = (fsdem_real)(0.5 + atan(262.5 * ((1 - eps) - 0.2)) / FSDEM__PI);
+        return (1 - phi) * fsdem__drag_wen_yu(eps, d, slip, rho, mu) + phi * fsdem__drag_ergun(eps, d, slip, rho, mu);
+    }
+    case FSDEM_DRAG_DI_FELICE: {
+        /* Cd0 slip = (0.63 sqrt(slip) + 4.8 sqrt(slip / Re))^2 with slip / Re = mu / (eps rho d): finite at
+           Re = 0, where chi -> 3.7 (the Gaussian in log10 Re vanishes) and c -> 17.28 mu eps^-2.7 / d^2 */
+        const fsdem_real re = eps * rho * d * slip / mu;
+        const fsdem_real lg = re > 0 ? (fsdem_real)1.5 - (fsdem_real)log10(re) : 0;
+        const fsdem_real chi = re > 0 ? (fsdem_real)(3.7 - 0.65 * exp(-0.5 * lg * lg)) : (fsdem_real)3.7;
+        const fsdem_real root = (fsdem_real)(0.63 * sqrt(slip) + 4.8 * sqrt(mu / (eps * rho * d)));
+        return (fsdem_real)0.75 * rho * root * root * (fsdem_real)pow(eps, 2 - chi) / d;
+    }
+    case FSDEM_DRAG_BEETSTRA: {
+        /* the Re term Re / (24 eps^2) (A + 8.4 Re^-0.343) / (1 + 10^(3 phi) Re^-a), a = (1 + 4 phi) / 2,
+           multiplied through by Re^a: (Re A + 8.4 Re^0.657) Re^a / (24 eps^2 (Re^a + 10^(3 phi))), which
+           is 0 at Re = 0 (like Re^(1.157 + 2 phi)) instead of 0 * inf / inf */
+        const fsdem_real phi = 1 - eps, re = eps * rho * d * slip / mu;
+        const fsdem_real ra = (fsdem_real)pow(re, 0.5 + 2 * phi);
+        const fsdem_real inertial = (re * (1 / eps + 3 * phi * eps) + (fsdem_real)8.4 * (fsdem_real)pow(re, 0.657)) * ra /
+                                    (24 * eps * eps * (ra + (fsdem_real)pow(10.0, 3 * phi)));
+        const fsdem_real f = 10 * phi / (eps * eps) + eps * eps * (1 + (fsdem_real)1.5 * (fsdem_real)sqrt(phi)) +
+                             (fsdem_real)0.413 * inertial;
+        return 18 * mu * eps * f / (d * d);
+    }
+    }
+    return 0;
+}
+
+const char *fsdem_drag_law_name(fsdem_drag_law law) {
+    switch (law) {
+    case FSDEM_DRAG_STOKES: return "stokes";
+    case FSDEM_DRAG_SCHILLER_NAUMANN: return "schiller_naumann";
+    case FSDEM_DRAG_ERGUN_WEN_YU: return "ergun_wen_yu";
+    case FSDEM_DRAG_GIDASPOW: return "gidaspow";
+    case FSDEM_DRAG_DI_FELICE: return "di_felice";
+    case FSDEM_DRAG_BEETSTRA: return "beetstra";
+    }
+    return "unknown";
+}
+
+fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsdem_real diameter, fsdem_real slip_speed,
+                                    fsdem_real density, fsdem_real viscosity, fsdem_real *per_volume, fsdem_real *beta,
+                                    char *message, size_t message_size) {
+    static const char fn[] = "fsdem_drag_coefficient";
+    fsdem_real c;
+    if ((int)law < (int)FSDEM_DRAG_STOKES || (int)law > (int)FSDEM_DRAG_BEETSTRA)
+        return fsdem__reject(message, message_size, "%s: law must be a fsdem_drag_law, got %d", fn, (int)law);
+    if (!(porosity > 0 && porosity <= 1))
+        return fsdem__reject(message, message_size, "%s: porosity must be in (0, 1], got %g", fn, (double)porosity);
+    if (!(diameter > 0) || !fsdem__finite(diameter))
+        return fsdem__reject(message, message_size, "%s: diameter must be > 0 and finite, got %g m", fn, (double)diameter);
+    if (!(slip_speed >= 0) || !fsdem__finite(slip_speed))
+        return fsdem__reject(message, message_size, "%s: slip_speed must be >= 0 and finite, got %g m/s", fn,
+                             (double)slip_speed);
+    if (!(density > 0) || !fsdem__finite(density))
+        return fsdem__reject(message, message_size, "%s: density must be > 0 and finite, got %g kg/m^3", fn, (double)density);
+    if (!(viscosity > 0) || !fsdem__finite(viscosity))
+        return fsdem__reject(message, message_size, "%s: viscosity must be > 0 and finite, got %g Pa s", fn,
+                             (double)viscosity);
+    c = fsdem__drag_per_volume(law, porosity, diameter, slip_speed, density, viscosity);
+    if (!fsdem__finite(c)) {
+        if (message && message_size)
+            snprintf(message, message_size, "%s: c = %g kg m^-3 s^-1 is not finite (d = %g m too small?)", fn, (double)c,
+                     (double)diameter);
+        return FSDEM_ERR_NAN;
+    }
+    if (per_volume) *per_volume = c;
+    if (beta) *beta = c * (1 - porosity);
+    return FSDEM_OK;
 }
 
 /* ===== >>impl_restart : checkpoint and restart =======================================================

@@ -19,6 +19,7 @@ Suite *restart_suite(void);
 Suite *robustness_suite(void);
 Suite *io_suite(void);
 Suite *mps_suite(void);
+Suite *drag_suite(void);
 
 /* ---- tolerances that follow the precision of fsdem_real ----
 
