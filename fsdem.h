@@ -27,6 +27,8 @@
                 pressure equation on the shared PCG, probes and gauges (seed 002)
      >>drag     drag laws of unresolved couplings: Stokes, Schiller-Naumann, Ergun/Wen-Yu (seed 002
                 Eq. 26), Gidaspow blend, Di Felice, Beetstra-van der Hoef-Kuipers
+     >>couple_mps  unresolved MPS-DEM, Models A and B: porosity and momentum exchange by local
+                averaging, sequential staggered substepping (seed 002)
      >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
                 to memory, bit-exact continuation (versioned binary format with a checksum)
      >>io       CSV time series; ParaView .pvd series, valid after every entry; VTK XML snapshots
@@ -83,8 +85,9 @@
      fsdem_dem_destroy(dem);
 
    ONE DIALECT FOR EVERY SOLVER
-     Each solver (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_mps) and each coupler (fsdem_swe_dem)
-     speaks these verbs; X is the object's name. A solver adds verbs of its own (add_particle, set_bed, ...).
+     Each solver (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_mps) and each coupler (fsdem_swe_dem,
+     fsdem_mps_dem) speaks these verbs; X is the object's name. A solver adds verbs of its own
+     (add_particle, set_bed, ...).
        fsdem_X_desc fsdem_X_desc_default(dim)      defaults (couplers and fsdem_pcg: no argument)
        fsdem_result fsdem_X_desc_check(desc, message, size)  validation without creating anything
        fsdem_result fsdem_X_create(desc, &x)        *x is NULL on failure; destroy with _destroy
@@ -119,7 +122,7 @@
      interpolation weights are "kernels" (>>kernel).
 
    COUPLING INTERFACE
-     A coupler is named fsdem_<fluid>_dem (fsdem_swe_dem; next fsdem_mps_dem, fsdem_pic_dem) and
+     A coupler is named fsdem_<fluid>_dem (fsdem_swe_dem, fsdem_mps_dem; next fsdem_pic_dem) and
      holds non-owning pointers to a fluid and a DEM. It reaches them only through these functions:
        DEM   fsdem_dem_get_particles (read), fsdem_dem_get_desc, fsdem_dem_get_coupling (writable
              external loads), fsdem_dem_substep_count, fsdem_dem_advance_with (substeps with a
@@ -224,6 +227,20 @@
 #define fsdem_mps_add_particles fsdem_mps_add_particles_f
 #define fsdem_mps_advance fsdem_mps_advance_f
 #define fsdem_mps_create fsdem_mps_create_f
+#define fsdem_mps_dem_advance fsdem_mps_dem_advance_f
+#define fsdem_mps_dem_create fsdem_mps_dem_create_f
+#define fsdem_mps_dem_desc_check fsdem_mps_dem_desc_check_f
+#define fsdem_mps_dem_desc_default fsdem_mps_dem_desc_default_f
+#define fsdem_mps_dem_destroy fsdem_mps_dem_destroy_f
+#define fsdem_mps_dem_get_desc fsdem_mps_dem_get_desc_f
+#define fsdem_mps_dem_get_force fsdem_mps_dem_get_force_f
+#define fsdem_mps_dem_get_stats fsdem_mps_dem_get_stats_f
+#define fsdem_mps_dem_last_error fsdem_mps_dem_last_error_f
+#define fsdem_mps_dem_stable_dt fsdem_mps_dem_stable_dt_f
+#define fsdem_mps_dem_step fsdem_mps_dem_step_f
+#define fsdem_mps_dem_step_dt fsdem_mps_dem_step_dt_f
+#define fsdem_mps_dem_time fsdem_mps_dem_time_f
+#define fsdem_mps_dem_update fsdem_mps_dem_update_f
 #define fsdem_mps_desc_check fsdem_mps_desc_check_f
 #define fsdem_mps_desc_default fsdem_mps_desc_default_f
 #define fsdem_mps_destroy fsdem_mps_destroy_f
@@ -2122,6 +2139,127 @@ FSDEM_API fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real por
 
 /* Name of a law ("ergun_wen_yu", ...), "unknown" for other values. Never NULL. */
 FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
+
+/* ===== >>couple_mps : unresolved MPS-DEM, Models A and B (seed 002) ================================ */
+
+/* Two-way coupling of MPS water (fsdem_mps) with DEM sediment (fsdem_dem) by local averaging, after
+   seed 002 §2.1-2.4. The DEM particles are smaller than the MPS spacing (unresolved): the water sees
+   them through a porosity field and a momentum exchange, computed with the weight
+       w_s(r) = 4 (r/r_e)^5 - 5 (r/r_e)^4 + 1 for r < r_e, 0 beyond               (Eq. 29)
+   whose integral over space is n_s = (10 pi / 21) r_e^3 in 3D (Eq. 30) and, by the same integral
+   over the plane (int_0^1 (4x^5 - 5x^4 + 1) 2 pi x dx = 2 pi (4/7 - 5/6 + 1/2)), n_s = (10 pi / 21)
+   r_e^2 in 2D, where volumes are areas per unit depth (a disc of radius R stands for pi R^2).
+   Every coupled step:
+     1. porosity of the MPS particles (FLUID and WALL), eps_i = 1 - sum_k w_s(r_ik) V_k / n_s
+        (Eq. 31), not let below desc.min_porosity; written to the MPS (its Eq. 7-16 use 1/eps_j);
+     2. at each DEM particle k, over the FLUID particles i within r_e: porosity eps_k (Eq. 32), fluid
+        velocity u_k (Eq. 33), and for Model A the pressure gradient grad P_k, the same w_s average
+        of the gradients the MPS corrector applied to those particles;
+     3. drag F^d = c V_k (u_k - v_k) with c = beta/(1 - eps) of the chosen law (>>drag; Eq. 25-28
+        with FSDEM_DRAG_ERGUN_WEN_YU) and the force on the particle (held over the DEM substeps):
+          Model A (the MPS desc.model):  F^int = F^d - V_k grad P_k            (Eq. 34)
+          Model B:                       F^int = F^d / eps_k - V_k rho_f g     (Eq. 35);
+     4. the reaction on the fluid (Eq. 36): FLUID particle i gets -sum_k X_k w_s(r_ki) / W_k with
+        W_k = sum_j w_s(r_kj) over the FLUID particles j, where X_k is the force that the fluid and
+        the solid exchange: F^d (Model A, Eq. 2: the solid's -V grad P is the mixture pressure acting
+        on the solid's volume, as -grad P on its own volume acts on each fluid particle) or F^int
+        (Model B, Eq. 4: f_B). Each X_k is split into weights that sum to one, so the fluid gets
+        exactly -sum_k X_k: the exchange conserves momentum to rounding;
+     5. one MPS step of dt, then the DEM over the same dt in K = fsdem_dem_substep_count substeps
+        (fsdem_dem_advance) with the forces of 3 held: the sequential staggered scheme with the
+        MPS step of Eq. 37 and DEM steps of Eq. 38 (Sun et al. 2021's MSS as the seed uses it; here
+        the forces are held, not interpolated, over the substeps).
+   The MPS particle velocity is the intrinsic fluid velocity u_f and each MPS particle carries the
+   fluid mass rho_f r0^d: in a porous region it stands for a volume of mixture r0^d / eps, which is
+   what the 1/eps_j of Eq. 7 counts (so the particles spread where solids are). Eq. 2 and 4 are the
+   momentum of that volume; their D eps / Dt terms (u_d = eps u_f, eps changing along the path) are
+   not included.
+   Held forces are explicit: a step longer than the drag relaxation time of a particle, m_k /
+   (c V_k) (with Model B's 1/eps_k), would overshoot, so the coupled stable step is also at most
+   desc.drag_dt_fraction of the shortest one. Virtual mass, lift and lubrication forces are not
+   included (the seed leaves them out, §2.3). */
+
+typedef struct fsdem_mps_dem fsdem_mps_dem;
+
+typedef struct fsdem_mps_dem_desc {
+    fsdem_mps *mps;               /* water; not owned; must outlive the coupler */
+    fsdem_dem *dem;               /* sediment; same dim and gravity as the MPS; not owned */
+    fsdem_drag_law drag;          /* default FSDEM_DRAG_ERGUN_WEN_YU (seed 002 Eq. 26) */
+    fsdem_real radius;            /* m; r_e of w_s (Eq. 29); 0: the MPS re (4.1 r0 by default), */
+                                  /*    which the seed's text implies; default 0 */
+    fsdem_real min_porosity;      /* -; floor of eps_i (Eq. 31 can go below 0 where DEM particles */
+                                  /*    overlap in a kernel), in (0, 1); default 0.2 */
+    fsdem_real drag_dt_fraction;  /* -; coupled step <= this fraction of the shortest drag */
+                                  /*    relaxation time, in (0, 1]; default 0.5 */
+    long long max_substeps;       /* DEM substeps one coupled step may take; a longer step is */
+                                  /*    refused before anything moves; default 100000 */
+    fsdem_log_fn log;             /* optional; default NULL */
+    void *log_user;
+} fsdem_mps_dem_desc;
+
+FSDEM_API fsdem_mps_dem_desc fsdem_mps_dem_desc_default(void);
+/* Checks a desc: both solvers set, the same dim and gravity, the ranges above. FSDEM_OK or
+   FSDEM_ERR_INVALID_ARG with the reason, naming the field, in `message` (may be NULL). */
+FSDEM_API fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *desc, char *message, size_t message_size);
+/* Creates a coupler (its memory from the DEM's allocator). FSDEM_ERR_INVALID_ARG as the check
+   (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_mps_dem_destroy leaves the
+   solvers alive. */
+FSDEM_API fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem **out);
+FSDEM_API void fsdem_mps_dem_destroy(fsdem_mps_dem *coupler);
+FSDEM_API const char *fsdem_mps_dem_last_error(const fsdem_mps_dem *coupler);
+/* The desc in force (radius resolved). */
+FSDEM_API fsdem_mps_dem_desc fsdem_mps_dem_get_desc(const fsdem_mps_dem *coupler);
+
+/* Fluid state and forces at one DEM particle, from the last update. */
+typedef struct fsdem_mps_dem_force {
+    fsdem_vec3 drag;              /* N; F^d of Eq. 25 */
+    fsdem_vec3 pressure;          /* N; -V grad P (Model A, Eq. 34) or -V rho_f g (Model B, Eq. 35) */
+    fsdem_vec3 total;             /* N; F^int, the external force the DEM particle is given */
+    fsdem_vec3 fluid_velocity;    /* m/s; u_k of Eq. 33 */
+    fsdem_real porosity;          /* -; eps_k of Eq. 32 (1 when dry) */
+    fsdem_real reynolds;          /* -; Eq. 28 */
+    int wet;                      /* 1 when FLUID particles are within the radius (else no force) */
+} fsdem_mps_dem_force;
+
+/* Steps 1-4 of the section at the current state: porosities into the MPS, forces into the DEM's
+   external loads and the reactions into the MPS's coupling forces. A step does it first; call it to
+   see the fields without stepping. FSDEM_ERR_OUT_OF_MEMORY (nothing changed), FSDEM_ERR_NAN (a
+   force is not finite; the particle is named). */
+FSDEM_API fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *coupler);
+/* Forces on DEM particle `index` from the last update. FSDEM_ERR_NOT_FOUND for a bad index or
+   before the first update. */
+FSDEM_API fsdem_result fsdem_mps_dem_get_force(const fsdem_mps_dem *coupler, int index, fsdem_mps_dem_force *out);
+/* One coupled step of the stable dt (fsdem_mps_dem_stable_dt after the update). The DEM substep
+   count is checked before anything moves (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of
+   either solver are passed on with their message. */
+FSDEM_API fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *coupler);
+/* One coupled step of exactly dt (s): FSDEM_ERR_CFL, nothing moved, when dt exceeds the MPS CFL
+   step (Eq. 37) or the drag limit of the section. */
+FSDEM_API fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *coupler, fsdem_real dt);
+/* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
+FSDEM_API fsdem_result fsdem_mps_dem_advance(fsdem_mps_dem *coupler, fsdem_real duration, long long *steps);
+/* Stable coupled step (s): the MPS's (Eq. 37) and the drag limit of the last update. */
+FSDEM_API fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *coupler, fsdem_real *dt);
+/* The MPS time (s). */
+FSDEM_API double fsdem_mps_dem_time(const fsdem_mps_dem *coupler);
+
+typedef struct fsdem_mps_dem_stats {
+    long long steps;              /* coupled steps */
+    double time;                  /* s */
+    fsdem_real dt;                /* s, the last coupled step */
+    long long substeps;           /* DEM substeps of the last coupled step */
+    long long substeps_total;
+    int wet;                      /* DEM particles in water at the last update */
+    fsdem_vec3 drag;              /* N; sum of F^d, last update */
+    fsdem_vec3 pressure;          /* N; sum of the pressure parts (-V grad P or -V rho g) */
+    fsdem_vec3 to_fluid;          /* N; sum of the reactions given to the fluid (= -sum X_k) */
+    fsdem_real drag_dt;           /* s; the drag limit of the last update (0: none) */
+    long long pairs;              /* DEM-MPS pairs within the radius, last update */
+    double seconds_mps;           /* CPU seconds in MPS steps */
+    double seconds_dem;           /* CPU seconds in DEM substeps and the coupling (updates) */
+} fsdem_mps_dem_stats;
+
+FSDEM_API fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *coupler);
 
 /* ===== >>restart : checkpoint and restart ========================================================= */
 
@@ -13680,6 +13818,419 @@ fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsd
     if (per_volume) *per_volume = c;
     if (beta) *beta = c * (1 - porosity);
     return FSDEM_OK;
+}
+
+/* ===== >>impl_couple_mps : unresolved MPS-DEM ========================================================
+
+   Contents: >>couple_mps_object (desc, creation), >>couple_mps_exchange (seed 002 Eq. 25-36: pairs,
+   porosity, averages, forces, reactions), >>couple_mps_step (coupled time stepping). The coupler
+   reaches the solvers through their coupling functions only (>>doc). */
+
+/* ---- >>couple_mps_object : desc, creation ---- */
+
+/* An MPS particle within the radius of a DEM particle, and its w_s (Eq. 29). */
+typedef struct fsdem__mps_dem_pair {
+    int particle;
+    fsdem_real weight;
+} fsdem__mps_dem_pair;
+
+struct fsdem_mps_dem {
+    fsdem_mps_dem_desc desc;
+    fsdem__status status;
+    fsdem_allocator allocator;
+    int dim;
+    fsdem_mps_model model;         /* the MPS desc's */
+    fsdem_real rho, mu;            /* fluid density, dynamic viscosity */
+    fsdem_real ns;                 /* n_s of Eq. 30 (m^3; m^2 in 2D) */
+    fsdem_real depth;              /* m; the DEM's disc_length in 2D (forces per metre on the MPS), 1 in 3D */
+    fsdem_vec3 gravity;            /* m/s^2 */
+    fsdem_cellgrid grid;           /* MPS particles, cells of edge `radius` */
+    /* DEM-MPS pairs within the radius, by DEM particle: start[k] .. start[k+1] */
+    int *start, start_cap;
+    fsdem__mps_dem_pair *pair;
+    int pair_cap;
+    fsdem_real *solid;             /* per MPS particle: sum_k w_s V_k (Eq. 31) */
+    int solid_cap;
+    fsdem_mps_dem_force *force;    /* per DEM particle */
+    int force_cap, forces;         /* forces: DEM particles of the last update (0: none yet) */
+    /* statistics */
+    long long steps, substeps, substeps_total, pairs;
+    fsdem_real dt_last, drag_dt;
+    int wet;
+    fsdem_vec3 drag_sum, pressure_sum, fluid_sum;
+    double sec_mps, sec_dem;
+};
+
+fsdem_mps_dem_desc fsdem_mps_dem_desc_default(void) {
+    fsdem_mps_dem_desc d;
+    memset(&d, 0, sizeof d);
+    d.drag = FSDEM_DRAG_ERGUN_WEN_YU;
+    d.radius = 0;
+    d.min_porosity = (fsdem_real)0.2;
+    d.drag_dt_fraction = (fsdem_real)0.5;
+    d.max_substeps = 100000;
+    return d;
+}
+
+fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, size_t size) {
+    fsdem_dem_desc dd;
+    fsdem_mps_desc md;
+    if (!d) return fsdem__reject(msg, size, "fsdem_mps_dem_desc is NULL");
+    if (!d->mps || !d->dem) return fsdem__reject(msg, size, "fsdem_mps_dem_desc.mps and .dem must both be set");
+    dd = fsdem_dem_get_desc(d->dem);
+    md = fsdem_mps_get_desc(d->mps);
+    if (dd.dim != md.dim)
+        return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the DEM is %dD and the MPS %dD", dd.dim, md.dim);
+    if (fsdem__norm(fsdem__sub(dd.gravity, md.gravity)) > 1e-12 * fsdem__norm(md.gravity))
+        return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the DEM gravity (%g, %g, %g) differs from the MPS's (%g, %g, %g) m/s^2",
+                             (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)md.gravity.x,
+                             (double)md.gravity.y, (double)md.gravity.z);
+    if (strcmp(fsdem_drag_law_name(d->drag), "unknown") == 0)
+        return fsdem__reject(msg, size, "fsdem_mps_dem_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
+    if (!(d->radius == 0 || (d->radius > 0 && fsdem__finite(d->radius))))
+        return fsdem__reject(msg, size, "fsdem_mps_dem_desc.radius must be 0 (the MPS re) or > 0 (got %g m)", (double)d->radius);
+    if (!(d->min_porosity > 0 && d->min_porosity < 1))
+        return fsdem__reject(msg, size, "fsdem_mps_dem_desc.min_porosity must be in (0, 1) (got %g)", (double)d->min_porosity);
+    if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
+        return fsdem__reject(msg, size, "fsdem_mps_dem_desc.drag_dt_fraction must be in (0, 1] (got %g)",
+                             (double)d->drag_dt_fraction);
+    if (d->max_substeps < 1)
+        return fsdem__reject(msg, size, "fsdem_mps_dem_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem **out) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_allocator al;
+    fsdem_mps_dem *c;
+    fsdem_mps_desc md;
+    fsdem_result res;
+    fsdem_real re;
+    if (out) *out = NULL;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem_mps_dem_desc_check(desc, msg, sizeof msg);
+    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
+    c = (fsdem_mps_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
+                                           res == FSDEM_OK ? &al : NULL, sizeof *c, "fsdem_mps_dem_create", &res);
+    if (!c) return res;
+    md = fsdem_mps_get_desc(desc->mps);
+    c->desc = *desc;
+    c->allocator = al;
+    c->status.log = desc->log;
+    c->status.log_user = desc->log_user;
+    c->dim = md.dim;
+    c->model = md.model;
+    c->rho = md.density;
+    c->mu = md.density * md.viscosity;
+    c->gravity = md.gravity;
+    c->depth = md.dim == 2 ? fsdem_dem_get_desc(desc->dem).disc_length : 1;
+    re = c->desc.radius = desc->radius > 0 ? desc->radius : md.re;
+    /* Eq. 30: n_s = int w_s dV = (10 pi / 21) r_e^3; in the plane the same integral is (10 pi / 21) r_e^2 */
+    c->ns = (fsdem_real)(10 * FSDEM__PI / 21) * re * re * (c->dim == 3 ? re : 1);
+    if (fsdem_cellgrid_setup(&c->grid, &c->allocator, c->dim, md.domain_min, md.domain_max, re, 0) != FSDEM_OK) {
+        fsdem__log_oom(desc->log, desc->log_user, "fsdem_mps_dem_create", sizeof c->grid);
+        fsdem_mps_dem_destroy(c);
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    }
+    *out = c;
+    return FSDEM_OK;
+}
+
+void fsdem_mps_dem_destroy(fsdem_mps_dem *c) {
+    fsdem_allocator al;
+    if (!c) return;
+    al = c->allocator;
+    fsdem_cellgrid_free(&c->grid);
+    fsdem__free(&al, c->start, sizeof(int) * (size_t)c->start_cap);
+    fsdem__free(&al, c->pair, sizeof *c->pair * (size_t)c->pair_cap);
+    fsdem__free(&al, c->solid, sizeof(fsdem_real) * (size_t)c->solid_cap);
+    fsdem__free(&al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
+    fsdem__free(&al, c, sizeof *c);
+}
+
+const char *fsdem_mps_dem_last_error(const fsdem_mps_dem *c) { return c ? c->status.message : "fsdem_mps_dem is NULL"; }
+
+fsdem_mps_dem_desc fsdem_mps_dem_get_desc(const fsdem_mps_dem *c) {
+    fsdem_mps_dem_desc d;
+    if (c) return c->desc;
+    memset(&d, 0, sizeof d);
+    return d;
+}
+
+/* ---- >>couple_mps_exchange : pairs, porosity, averages, forces, reactions ---- */
+
+/* Eq. 29 at distance r (0 beyond re). */
+static fsdem_real fsdem__mps_dem_weight(fsdem_real r, fsdem_real re) {
+    const fsdem_real x = r / re, x4 = x * x * x * x;
+    return x < 1 ? 4 * x4 * x - 5 * x4 + 1 : 0;
+}
+
+/* Volume of DEM particle k that the porosity counts: the sphere, or in 2D the disc's area (volume
+   per metre of depth, as the MPS's). */
+static fsdem_real fsdem__mps_dem_volume(const fsdem_mps_dem *c, fsdem_real r) {
+    return c->dim == 3 ? (fsdem_real)(4 * FSDEM__PI / 3) * r * r * r : (fsdem_real)FSDEM__PI * r * r;
+}
+
+/* Makes room for the per-particle arrays (nd DEM, nm MPS particles). */
+static fsdem_result fsdem__mps_dem_room(fsdem_mps_dem *c, int nd, int nm) {
+    const fsdem_allocator *al = &c->allocator;
+    int cap = c->force_cap;
+    if (fsdem__grow(al, (void **)&c->start, &c->start_cap, 0, nd + 1, sizeof(int)) != FSDEM_OK ||
+        fsdem__grow(al, (void **)&c->force, &cap, 0, nd, sizeof(fsdem_mps_dem_force)) != FSDEM_OK)
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    c->force_cap = cap;
+    return fsdem__grow(al, (void **)&c->solid, &c->solid_cap, 0, nm, sizeof(fsdem_real));
+}
+
+/* The non-DUMMY MPS particles within the radius of every DEM particle, with their w_s. */
+static fsdem_result fsdem__mps_dem_pairs(fsdem_mps_dem *c, const fsdem_dem_particles *dv, const fsdem_mps_particles *mv) {
+    const fsdem_real re = c->desc.radius, re2 = re * re;
+    int k, m, e, n = 0;
+    if (fsdem_cellgrid_build(&c->grid, mv->position, mv->count) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    for (k = 0; k < dv->count; ++k) {
+        int coord[3], cells[27];
+        const int nc = (fsdem_cellgrid_cell(&c->grid, dv->position[k], coord), fsdem_cellgrid_neighbourhood(&c->grid, coord, cells));
+        c->start[k] = n;
+        for (m = 0; m < nc; ++m)
+            for (e = c->grid.cell_start[cells[m]]; e < c->grid.cell_start[cells[m] + 1]; ++e) {
+                const int i = c->grid.items[e];
+                const fsdem_vec3 d = fsdem__sub(mv->position[i], dv->position[k]);
+                const fsdem_real r2 = fsdem__dot(d, d);
+                if (mv->kind[i] == FSDEM_MPS_DUMMY || !(r2 < re2)) continue;
+                if (n == c->pair_cap &&
+                    fsdem__grow(&c->allocator, (void **)&c->pair, &c->pair_cap, n, n + 1, sizeof *c->pair) != FSDEM_OK)
+                    return FSDEM_ERR_OUT_OF_MEMORY;
+                c->pair[n].particle = i;
+                c->pair[n++].weight = fsdem__mps_dem_weight((fsdem_real)sqrt(r2), re);
+            }
+    }
+    c->start[dv->count] = n;
+    c->pairs = n;
+    return FSDEM_OK;
+}
+
+/* Steps 3-4 of >>couple_mps for DEM particle k, whose FLUID neighbours' weights sum to W > 0 with
+   porosity eps, velocity u and pressure gradient gp (w_s averages): its force, and the reactions. */
+static void fsdem__mps_dem_exchange(fsdem_mps_dem *c, const fsdem_dem_particles *dv, const fsdem_mps_particles *mv,
+                                    const fsdem_mps_coupling *mc, int k, fsdem_real W, fsdem_real eps, fsdem_vec3 u,
+                                    fsdem_vec3 gp) {
+    fsdem_mps_dem_force *f = &c->force[k];
+    const fsdem_real r = dv->radius[k], V = fsdem__mps_dem_volume(c, r) * (c->dim == 2 ? c->depth : 1);
+    const fsdem_vec3 slip = fsdem__sub(u, dv->velocity[k]);
+    const fsdem_real speed = fsdem__norm(slip);
+    const fsdem_real per_volume = fsdem__drag_per_volume(c->desc.drag, eps, 2 * r, speed, c->rho, c->mu);
+    fsdem_real coefficient = per_volume * V; /* kg/s: the force per unit slip on the particle */
+    fsdem_vec3 exchanged;
+    int e;
+    f->wet = 1;
+    f->porosity = eps;
+    f->fluid_velocity = u;
+    f->reynolds = eps * c->rho * 2 * r * speed / c->mu; /* Eq. 28 */
+    f->drag = fsdem__scale(slip, coefficient);          /* Eq. 25 */
+    if (c->model == FSDEM_MPS_MODEL_A) {
+        f->pressure = fsdem__scale(gp, -V); /* Eq. 34 */
+        f->total = fsdem__add(f->drag, f->pressure);
+        exchanged = f->drag;
+    } else {
+        f->pressure = fsdem__scale(c->gravity, -V * c->rho); /* Eq. 35 */
+        f->total = fsdem__madd(f->pressure, f->drag, 1 / eps);
+        coefficient /= eps;
+        exchanged = f->total;
+    }
+    if (!dv->fixed[k] && coefficient > 0) {
+        const fsdem_real tau = dv->mass[k] / coefficient; /* drag relaxation time */
+        if (c->drag_dt == 0 || tau < c->drag_dt) c->drag_dt = tau;
+    }
+    /* Eq. 36: the reaction shared in proportion to w_s / W, whose shares sum to one */
+    exchanged = fsdem__scale(exchanged, -1 / (W * c->depth));
+    for (e = c->start[k]; e < c->start[k + 1]; ++e) {
+        const int i = c->pair[e].particle;
+        if (mv->kind[i] == FSDEM_MPS_FLUID) mc->force[i] = fsdem__madd(mc->force[i], exchanged, c->pair[e].weight);
+    }
+}
+
+fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
+    fsdem_dem_particles dv;
+    fsdem_mps_particles mv;
+    fsdem_mps_coupling mc;
+    fsdem_dem_coupling dc;
+    clock_t t0 = clock();
+    int i, k, e;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    dv = fsdem_dem_get_particles(c->desc.dem);
+    mv = fsdem_mps_get_particles(c->desc.mps);
+    if (fsdem__mps_dem_room(c, dv.count, mv.count) != FSDEM_OK || fsdem__mps_dem_pairs(c, &dv, &mv) != FSDEM_OK)
+        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem_update: out of memory (%d DEM and %d MPS particles)",
+                           dv.count, mv.count);
+    mc = fsdem_mps_get_coupling(c->desc.mps);
+    dc = fsdem_dem_get_coupling(c->desc.dem);
+    /* 1. porosity of the MPS particles, Eq. 31 */
+    for (i = 0; i < mv.count; ++i) c->solid[i] = 0;
+    for (k = 0; k < dv.count; ++k) {
+        const fsdem_real V = fsdem__mps_dem_volume(c, dv.radius[k]);
+        for (e = c->start[k]; e < c->start[k + 1]; ++e) c->solid[c->pair[e].particle] += c->pair[e].weight * V;
+    }
+    for (i = 0; i < mv.count; ++i) {
+        fsdem_real eps = 1 - c->solid[i] / c->ns;
+        if (mv.kind[i] == FSDEM_MPS_DUMMY) eps = 1;
+        mc.porosity[i] = eps > c->desc.min_porosity ? eps : c->desc.min_porosity;
+        mc.force[i] = fsdem__zero3();
+    }
+    /* 2-4. averages at the DEM particles (Eq. 32-33), forces (Eq. 25-28, 34-35), reactions (Eq. 36) */
+    c->wet = 0;
+    c->drag_dt = 0;
+    c->drag_sum = c->pressure_sum = fsdem__zero3();
+    for (k = 0; k < dv.count; ++k) {
+        fsdem_real W = 0, E = 0;
+        fsdem_vec3 U = fsdem__zero3(), G = fsdem__zero3();
+        for (e = c->start[k]; e < c->start[k + 1]; ++e) {
+            const int i = c->pair[e].particle;
+            const fsdem_real w = c->pair[e].weight;
+            if (mv.kind[i] != FSDEM_MPS_FLUID) continue;
+            W += w;
+            E += w * mc.porosity[i];
+            U = fsdem__madd(U, mv.velocity[i], w);
+            G = fsdem__madd(G, mv.pressure_gradient[i], w);
+        }
+        memset(&c->force[k], 0, sizeof c->force[k]);
+        c->force[k].porosity = 1;
+        if (W > 0) {
+            fsdem__mps_dem_exchange(c, &dv, &mv, &mc, k, W, E / W, fsdem__scale(U, 1 / W), fsdem__scale(G, 1 / W));
+            c->wet++;
+        }
+        if (!fsdem__finite3(c->force[k].total))
+            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_mps_dem_update: the fluid force on DEM particle %d is not finite", k);
+        dc.force[k] = c->force[k].total;
+        c->drag_sum = fsdem__add(c->drag_sum, c->force[k].drag);
+        c->pressure_sum = fsdem__add(c->pressure_sum, c->force[k].pressure);
+    }
+    c->fluid_sum = fsdem__zero3();
+    for (i = 0; i < mv.count; ++i) c->fluid_sum = fsdem__add(c->fluid_sum, mc.force[i]);
+    c->fluid_sum = fsdem__scale(c->fluid_sum, c->depth);
+    c->forces = dv.count;
+    c->sec_dem += (double)(clock() - t0) / CLOCKS_PER_SEC;
+    return fsdem__ok(&c->status);
+}
+
+fsdem_result fsdem_mps_dem_get_force(const fsdem_mps_dem *c, int index, fsdem_mps_dem_force *out) {
+    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
+    if (index < 0 || index >= c->forces)
+        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_mps_dem_get_force: no particle %d in the last update",
+                           index);
+    *out = c->force[index];
+    return FSDEM_OK;
+}
+
+/* ---- >>couple_mps_step : coupled time stepping ---- */
+
+/* The stable coupled step of the last update: the MPS's (Eq. 37) and the drag limit. */
+static fsdem_result fsdem__mps_dem_stable(const fsdem_mps_dem *c, fsdem_real *dt) {
+    const fsdem_result res = fsdem_mps_stable_dt(c->desc.mps, dt);
+    if (res != FSDEM_OK) return res;
+    if (c->drag_dt > 0 && c->desc.drag_dt_fraction * c->drag_dt < *dt) *dt = c->desc.drag_dt_fraction * c->drag_dt;
+    return FSDEM_OK;
+}
+
+/* Step 5 of >>couple_mps after an update: the MPS step of dt, then the DEM substeps. */
+static fsdem_result fsdem__mps_dem_run(fsdem_mps_dem *c, fsdem_real dt) {
+    long long substeps = 0;
+    fsdem_result res = fsdem_dem_substep_count(c->desc.dem, dt, &substeps);
+    clock_t t0, t1;
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_mps_dem: %s", fsdem_dem_last_error(c->desc.dem));
+    if (substeps > c->desc.max_substeps)
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_mps_dem: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)",
+                           (double)dt, substeps, c->desc.max_substeps, (double)fsdem_dem_get_desc(c->desc.dem).dt);
+    if (c->drag_dt > 0 && dt > c->desc.drag_dt_fraction * c->drag_dt * (1 + (fsdem_real)1e-6))
+        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
+                           "fsdem_mps_dem: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s", (double)dt,
+                           (double)c->desc.drag_dt_fraction, (double)c->drag_dt);
+    t0 = clock();
+    res = fsdem_mps_step_dt(c->desc.mps, dt);
+    t1 = clock();
+    c->sec_mps += (double)(t1 - t0) / CLOCKS_PER_SEC;
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_mps_dem: MPS step: %s", fsdem_mps_last_error(c->desc.mps));
+    res = fsdem_dem_advance(c->desc.dem, dt, &substeps);
+    c->sec_dem += (double)(clock() - t1) / CLOCKS_PER_SEC;
+    c->steps++;
+    c->dt_last = dt;
+    c->substeps = substeps;
+    c->substeps_total += substeps;
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_mps_dem: DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
+    return fsdem__ok(&c->status);
+}
+
+fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *c) {
+    fsdem_real dt = 0;
+    fsdem_result res;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if ((res = fsdem_mps_dem_update(c)) != FSDEM_OK) return res;
+    if ((res = fsdem__mps_dem_stable(c, &dt)) != FSDEM_OK)
+        return fsdem__fail(&c->status, res, "fsdem_mps_dem_step: %s", fsdem_mps_last_error(c->desc.mps));
+    return fsdem__mps_dem_run(c, dt);
+}
+
+fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *c, fsdem_real dt) {
+    fsdem_result res;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_dem_step_dt: dt = %g s must be > 0 and finite", (double)dt);
+    if ((res = fsdem_mps_dem_update(c)) != FSDEM_OK) return res;
+    return fsdem__mps_dem_run(c, dt);
+}
+
+fsdem_result fsdem_mps_dem_advance(fsdem_mps_dem *c, fsdem_real duration, long long *steps) {
+    double end;
+    long long n = 0;
+    fsdem_result res = FSDEM_OK;
+    if (steps) *steps = 0;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_dem_advance: duration = %g s must be >= 0", (double)duration);
+    end = fsdem_mps_time(c->desc.mps) + (double)duration;
+    while (res == FSDEM_OK && fsdem_mps_time(c->desc.mps) < end - 1e-12 * (end > 1 ? end : 1)) {
+        const double left = end - fsdem_mps_time(c->desc.mps);
+        fsdem_real dt = 0;
+        if ((res = fsdem_mps_dem_update(c)) != FSDEM_OK) break;
+        if ((res = fsdem__mps_dem_stable(c, &dt)) != FSDEM_OK) {
+            fsdem__fail(&c->status, res, "fsdem_mps_dem_advance: %s", fsdem_mps_last_error(c->desc.mps));
+            break;
+        }
+        /* the last steps shortened to end exactly, as fsdem_mps_advance does */
+        if ((double)dt >= left) dt = (fsdem_real)left;
+        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
+        res = fsdem__mps_dem_run(c, dt);
+        ++n;
+    }
+    if (steps) *steps = n;
+    return res;
+}
+
+fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) {
+    if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__mps_dem_stable(c, dt);
+}
+
+double fsdem_mps_dem_time(const fsdem_mps_dem *c) { return c ? fsdem_mps_time(c->desc.mps) : 0; }
+
+fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *c) {
+    fsdem_mps_dem_stats st;
+    memset(&st, 0, sizeof st);
+    if (!c) return st;
+    st.steps = c->steps;
+    st.time = fsdem_mps_time(c->desc.mps);
+    st.dt = c->dt_last;
+    st.substeps = c->substeps;
+    st.substeps_total = c->substeps_total;
+    st.wet = c->wet;
+    st.drag = c->drag_sum;
+    st.pressure = c->pressure_sum;
+    st.to_fluid = c->fluid_sum;
+    st.drag_dt = c->drag_dt;
+    st.pairs = c->pairs;
+    st.seconds_mps = c->sec_mps;
+    st.seconds_dem = c->sec_dem;
+    return st;
 }
 
 /* ===== >>impl_restart : checkpoint and restart =======================================================

@@ -20,6 +20,7 @@ Suite *robustness_suite(void);
 Suite *io_suite(void);
 Suite *mps_suite(void);
 Suite *drag_suite(void);
+Suite *couple_mps_suite(void);
 
 /* ---- tolerances that follow the precision of fsdem_real ----
 
