@@ -2180,7 +2180,10 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
    Held forces are explicit: a step longer than the drag relaxation time of a particle, m_k /
    (c V_k) (with Model B's 1/eps_k), would overshoot, so the coupled stable step is also at most
    desc.drag_dt_fraction of the shortest one. Virtual mass, lift and lubrication forces are not
-   included (the seed leaves them out, §2.3). */
+   included (the seed leaves them out, §2.3).
+   Loads on a structure come in the seed's two parts (Fig. 18-19): the fluid's, the pressure on a
+   box obstacle of the MPS (fsdem_mps_obstacle_force), and the sediment's, the contact force on a
+   DEM wall at the same place (fsdem_dem_wall_force); validation/mpsdem_obstacle records both. */
 
 typedef struct fsdem_mps_dem fsdem_mps_dem;
 
