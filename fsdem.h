@@ -13851,7 +13851,7 @@ struct fsdem_mps_dem {
     fsdem_real cell_volume;        /* r0^d of the MPS lattice (m^3; m^2 in 2D) */
     fsdem_real depth;              /* m; the DEM's disc_length in 2D (forces per metre on the MPS), 1 in 3D */
     fsdem_vec3 gravity;            /* m/s^2 */
-    fsdem_cellgrid grid;           /* MPS particles, cells of edge `radius` */
+    fsdem_cellgrid grid;           /* MPS particles, cells of edge radius / 2 (fsdem__mps_dem_ranges) */
     /* DEM-MPS pairs within the radius, by DEM particle: start[k] .. start[k+1] */
     int *start, start_cap;
     fsdem__mps_dem_pair *pair;
@@ -13935,7 +13935,7 @@ fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem 
     /* Eq. 30: n_s = int w_s dV = (10 pi / 21) r_e^3; in the plane the same integral is (10 pi / 21) r_e^2 */
     c->ns = (fsdem_real)(10 * FSDEM__PI / 21) * re * re * (c->dim == 3 ? re : 1);
     c->cell_volume = md.r0 * md.r0 * (c->dim == 3 ? md.r0 : 1);
-    if (fsdem_cellgrid_setup(&c->grid, &c->allocator, c->dim, md.domain_min, md.domain_max, re, 0) != FSDEM_OK) {
+    if (fsdem_cellgrid_setup(&c->grid, &c->allocator, c->dim, md.domain_min, md.domain_max, re / 2, 0) != FSDEM_OK) {
         fsdem__log_oom(desc->log, desc->log_user, "fsdem_mps_dem_create", sizeof c->grid);
         fsdem_mps_dem_destroy(c);
         return FSDEM_ERR_OUT_OF_MEMORY;
@@ -13979,6 +13979,35 @@ static fsdem_real fsdem__mps_dem_volume(const fsdem_mps_dem *c, fsdem_real r) {
     return c->dim == 3 ? (fsdem_real)(4 * FSDEM__PI / 3) * r * r * r : (fsdem_real)FSDEM__PI * r * r;
 }
 
+/* The grid's items within distance r of p, as ranges of `items`: the cells are r/2 wide and a row
+   of cells along x is contiguous in the grid's order, so the block of 5 cells per axis around p is
+   at most 25 ranges in 3D (5 in 2D); rows whose nearest point is farther than r are left out. This
+   scans about 60% of the candidates of the 3^d block of cells r wide. Returns the number of ranges. */
+static int fsdem__mps_dem_ranges(const fsdem_cellgrid *g, fsdem_vec3 p, fsdem_real r, int range[25][2]) {
+    int lo[3], hi[3], a, y, z, count = 0;
+    for (a = 0; a < 3; ++a) {
+        const fsdem_real x = fsdem__comp(p, a) - fsdem__comp(g->origin, a);
+        lo[a] = (int)floor((x - r) * g->inv_cell_size);
+        hi[a] = (int)floor((x + r) * g->inv_cell_size);
+        if (a == 2 && g->dim == 2) lo[a] = hi[a] = 0;
+        if (lo[a] < 0) lo[a] = 0;
+        if (hi[a] > g->n[a] - 1) hi[a] = g->n[a] - 1;
+        if (lo[a] > hi[a]) return 0;
+    }
+    for (z = lo[2]; z <= hi[2]; ++z)
+        for (y = lo[1]; y <= hi[1]; ++y) {
+            /* distance from p to the row's slab in y and z (0 inside it) */
+            const fsdem_real cy = fsdem__comp(g->origin, 1) + (fsdem_real)y * g->cell_size, cz = fsdem__comp(g->origin, 2) + (fsdem_real)z * g->cell_size;
+            const fsdem_real dy = p.y < cy ? cy - p.y : p.y > cy + g->cell_size ? p.y - cy - g->cell_size : 0;
+            const fsdem_real dz = g->dim == 2 ? 0 : p.z < cz ? cz - p.z : p.z > cz + g->cell_size ? p.z - cz - g->cell_size : 0;
+            const int row = (z * g->n[1] + y) * g->n[0];
+            if (dy * dy + dz * dz >= r * r) continue;
+            range[count][0] = g->cell_start[row + lo[0]];
+            range[count++][1] = g->cell_start[row + hi[0] + 1];
+        }
+    return count;
+}
+
 /* The normaliser of Eq. 31 at MPS particle i: n_s (Eq. 30) less the part of the weight's integral
    that lies inside the tank's walls and obstacles, the sum of w_s r0^d over their WALL and DUMMY
    particles (a lattice of cells of volume r0^d, which covers the walls to re = 4.1 r0 deep). Next
@@ -13988,10 +14017,10 @@ static fsdem_real fsdem__mps_dem_volume(const fsdem_mps_dem *c, fsdem_real r) {
 static fsdem_real fsdem__mps_dem_open_weight(const fsdem_mps_dem *c, const fsdem_mps_particles *mv, int i) {
     const fsdem_real re = c->desc.radius, re2 = re * re;
     fsdem_real walls = 0;
-    int coord[3], cells[27], m, e;
-    const int nc = (fsdem_cellgrid_cell(&c->grid, mv->position[i], coord), fsdem_cellgrid_neighbourhood(&c->grid, coord, cells));
-    for (m = 0; m < nc; ++m)
-        for (e = c->grid.cell_start[cells[m]]; e < c->grid.cell_start[cells[m] + 1]; ++e) {
+    int range[25][2], m, e;
+    const int nr = fsdem__mps_dem_ranges(&c->grid, mv->position[i], re, range);
+    for (m = 0; m < nr; ++m)
+        for (e = range[m][0]; e < range[m][1]; ++e) {
             const int j = c->grid.items[e];
             const fsdem_vec3 d = fsdem__sub(mv->position[j], mv->position[i]);
             const fsdem_real r2 = fsdem__dot(d, d);
@@ -14019,11 +14048,11 @@ static fsdem_result fsdem__mps_dem_pairs(fsdem_mps_dem *c, const fsdem_dem_parti
     int k, m, e, n = 0;
     if (fsdem_cellgrid_build(&c->grid, mv->position, mv->count) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     for (k = 0; k < dv->count; ++k) {
-        int coord[3], cells[27];
-        const int nc = (fsdem_cellgrid_cell(&c->grid, dv->position[k], coord), fsdem_cellgrid_neighbourhood(&c->grid, coord, cells));
+        int range[25][2];
+        const int nr = fsdem__mps_dem_ranges(&c->grid, dv->position[k], re, range);
         c->start[k] = n;
-        for (m = 0; m < nc; ++m)
-            for (e = c->grid.cell_start[cells[m]]; e < c->grid.cell_start[cells[m] + 1]; ++e) {
+        for (m = 0; m < nr; ++m)
+            for (e = range[m][0]; e < range[m][1]; ++e) {
                 const int i = c->grid.items[e];
                 const fsdem_vec3 d = fsdem__sub(mv->position[i], dv->position[k]);
                 const fsdem_real r2 = fsdem__dot(d, d);
