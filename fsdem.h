@@ -236,6 +236,10 @@
 #define fsdem_mps_dem_get_force fsdem_mps_dem_get_force_f
 #define fsdem_mps_dem_get_stats fsdem_mps_dem_get_stats_f
 #define fsdem_mps_dem_last_error fsdem_mps_dem_last_error_f
+#define fsdem_mps_dem_restore fsdem_mps_dem_restore_f
+#define fsdem_mps_dem_restore_memory fsdem_mps_dem_restore_memory_f
+#define fsdem_mps_dem_save fsdem_mps_dem_save_f
+#define fsdem_mps_dem_save_memory fsdem_mps_dem_save_memory_f
 #define fsdem_mps_dem_stable_dt fsdem_mps_dem_stable_dt_f
 #define fsdem_mps_dem_step fsdem_mps_dem_step_f
 #define fsdem_mps_dem_step_dt fsdem_mps_dem_step_dt_f
@@ -2333,13 +2337,14 @@ FSDEM_API fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *coupl
           8      4  format version (unsigned)
          12      4  byte-order mark 0x01020304 as the saving machine stores it
          16      4  precision: sizeof(fsdem_real), 4 (FSDEM_USE_FLOAT) or 8
-         20      4  object kind: 1 fsdem_dem, 2 fsdem_pic, 3 fsdem_swe, 4 fsdem_swe_dem, 5 fsdem_mps
+         20      4  object kind: 1 fsdem_dem, 2 fsdem_pic, 3 fsdem_swe, 4 fsdem_swe_dem, 5 fsdem_mps,
+                    6 fsdem_mps_dem
          24      4  dimension of the object (the SWE's for fsdem_swe_dem)
          28      4  reserved (0)
          32     16  four sizes (int) for tools: DEM particles, materials, walls, pair-list entries;
                     PIC cells along x, y, z and particles; SWE nx, ny, point sources, gauges;
                     SWE-DEM nx, ny, DEM particles, force records; MPS particles, FLUID
-                    particles, obstacles, 0
+                    particles, obstacles, 0; MPS-DEM MPS particles, DEM particles, force records, 0
          48      8  payload bytes (unsigned)
          56      8  checksum: 64-bit FNV-1a over bytes 0 to 55 and the payload
    The payload holds tagged sections of integers and reals as the saving machine stores them. */
@@ -2378,6 +2383,13 @@ FSDEM_API fsdem_result fsdem_mps_save(const fsdem_mps *mps, const char *path);
 FSDEM_API fsdem_result fsdem_mps_restore(fsdem_mps *mps, const char *path);
 FSDEM_API fsdem_result fsdem_mps_save_memory(const fsdem_mps *mps, void *buffer, size_t capacity, size_t *size);
 FSDEM_API fsdem_result fsdem_mps_restore_memory(fsdem_mps *mps, const void *buffer, size_t size);
+
+/* The same four for the MPS-DEM coupler: its solvers' states are saved and restored with it. */
+FSDEM_API fsdem_result fsdem_mps_dem_save(const fsdem_mps_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_mps_dem_restore(fsdem_mps_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_mps_dem_save_memory(const fsdem_mps_dem *coupler, void *buffer, size_t capacity,
+                                                 size_t *size);
+FSDEM_API fsdem_result fsdem_mps_dem_restore_memory(fsdem_mps_dem *coupler, const void *buffer, size_t size);
 
 /* ===== >>io : CSV time series, ParaView series, VTK XML snapshots ================================== */
 
@@ -14296,8 +14308,9 @@ fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *c) {
 /* ===== >>impl_restart : checkpoint and restart =======================================================
 
    Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
-   every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_swe_dem, >>restart_mps (one
-   visitor per object lists what it saves, in order, and serves saving and restoring alike), >>restart_api
+   every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_swe_dem, >>restart_mps,
+   >>restart_mps_dem (one visitor per object lists what it saves, in order, and serves saving and
+   restoring alike), >>restart_api
    (memory and files). A restore runs the visitor three times over the payload: CHECK validates
    everything and compares the desc, RESERVE allocates, COMMIT writes into the object. Only COMMIT
    changes the object, and it cannot fail. */
@@ -14314,7 +14327,8 @@ fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *c) {
 /* The header stores its fields as unsigned int (4 bytes) and unsigned long long (8 bytes). */
 typedef char fsdem__restart_int_sizes[sizeof(unsigned int) == 4 && sizeof(unsigned long long) == 8 ? 1 : -1];
 
-enum { FSDEM__RESTART_DEM = 1, FSDEM__RESTART_PIC = 2, FSDEM__RESTART_SWE = 3, FSDEM__RESTART_SWE_DEM = 4, FSDEM__RESTART_MPS = 5 };
+enum { FSDEM__RESTART_DEM = 1, FSDEM__RESTART_PIC = 2, FSDEM__RESTART_SWE = 3, FSDEM__RESTART_SWE_DEM = 4, FSDEM__RESTART_MPS = 5,
+       FSDEM__RESTART_MPS_DEM = 6 };
 
 typedef enum fsdem__restart_mode {
     FSDEM__RESTART_WRITE = 0,   /* object to payload (to memory, to a file, or only measured) */
@@ -15319,6 +15333,58 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_tag(io, "MPS.");
 }
 
+/* ---- >>restart_mps_dem : MPS-DEM coupler ---- */
+
+/* The two solvers, then the coupler's counters and the force records of its last update (a step
+   recomputes them first, so they only serve fsdem_mps_dem_get_force until then). The pair lists
+   and the grid are rebuilt by every update. */
+static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
+    fsdem_mps_dem *c = (fsdem_mps_dem *)object;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    int count = c->forces, k;
+    fsdem_mps_dem_force *force;
+    fsdem__restart_tag(io, "MPD1");
+    io->section = "water (MPS)";
+    fsdem__restart_mps(io, c->desc.mps);
+    io->section = "sediment (DEM)";
+    fsdem__restart_dem(io, c->desc.dem);
+    io->section = NULL;
+    fsdem__restart_same_int(io, (int)c->desc.drag, "drag");
+    fsdem__restart_same_real(io, c->desc.radius, "radius");
+    fsdem__restart_same_real(io, c->desc.min_porosity, "min_porosity");
+    fsdem__restart_same_real(io, c->desc.drag_dt_fraction, "drag_dt_fraction");
+    fsdem__restart_same_ll(io, c->desc.max_substeps, "max_substeps");
+    fsdem__restart_data(io, &c->steps, sizeof c->steps);
+    fsdem__restart_data(io, &c->substeps, sizeof c->substeps);
+    fsdem__restart_data(io, &c->substeps_total, sizeof c->substeps_total);
+    fsdem__restart_data(io, &c->pairs, sizeof c->pairs);
+    fsdem__restart_data(io, &c->dt_last, sizeof c->dt_last);
+    fsdem__restart_data(io, &c->drag_dt, sizeof c->drag_dt);
+    fsdem__restart_data(io, &c->wet, sizeof c->wet);
+    fsdem__restart_data(io, &c->drag_sum, sizeof c->drag_sum);
+    fsdem__restart_data(io, &c->pressure_sum, sizeof c->pressure_sum);
+    fsdem__restart_data(io, &c->fluid_sum, sizeof c->fluid_sum);
+    fsdem__restart_count(io, &count, 1 << 29, 4 * sizeof(fsdem_vec3) + 2 * sizeof(fsdem_real), "force record count");
+    force = (fsdem_mps_dem_force *)fsdem__restart_block(io, &c->allocator, sizeof *force * (size_t)count);
+    if (commit) {
+        fsdem__free(&c->allocator, c->force, sizeof *force * (size_t)c->force_cap);
+        c->force = force;
+        c->forces = c->force_cap = count;
+        if (force) memset(force, 0, sizeof *force * (size_t)count);
+    }
+    for (k = 0; k < count && io->res == FSDEM_OK; ++k) {
+        fsdem_mps_dem_force scratch, *f = io->mode == FSDEM__RESTART_WRITE || commit ? &c->force[k] : &scratch;
+        fsdem__restart_data(io, &f->drag, sizeof f->drag);
+        fsdem__restart_data(io, &f->pressure, sizeof f->pressure);
+        fsdem__restart_data(io, &f->total, sizeof f->total);
+        fsdem__restart_data(io, &f->fluid_velocity, sizeof f->fluid_velocity);
+        fsdem__restart_data(io, &f->porosity, sizeof f->porosity);
+        fsdem__restart_data(io, &f->reynolds, sizeof f->reynolds);
+        fsdem__restart_data(io, &f->wet, sizeof f->wet);
+    }
+    fsdem__restart_tag(io, "MPD.");
+}
+
 /* ---- >>restart_api : memory and files ---- */
 
 /* What the API needs to know of one object. */
@@ -15339,6 +15405,7 @@ static const char *fsdem__restart_kind_name(unsigned int kind) {
     case FSDEM__RESTART_SWE: return "fsdem_swe";
     case FSDEM__RESTART_SWE_DEM: return "fsdem_swe_dem";
     case FSDEM__RESTART_MPS: return "fsdem_mps";
+    case FSDEM__RESTART_MPS_DEM: return "fsdem_mps_dem";
     }
     return "unknown object";
 }
@@ -15430,6 +15497,24 @@ static fsdem__restart_object fsdem__restart_of_mps(const fsdem_mps *s) {
     o.allocator = &s->allocator;
     o.status = (fsdem__status *)&s->status;
     o.name = "fsdem_mps";
+    return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_mps_dem(const fsdem_mps_dem *c) {
+    fsdem__restart_object o;
+    memset(&o, 0, sizeof o);
+    if (!c) return o;
+    o.kind = FSDEM__RESTART_MPS_DEM;
+    o.dim = c->dim;
+    o.sizes[0] = c->desc.mps->n;
+    o.sizes[1] = c->desc.dem->n;
+    o.sizes[2] = c->forces;
+    o.sizes[3] = 0;
+    o.object = (void *)c;
+    o.visit = fsdem__restart_mps_dem;
+    o.allocator = &c->allocator;
+    o.status = (fsdem__status *)&c->status;
+    o.name = "fsdem_mps_dem";
     return o;
 }
 
@@ -15738,6 +15823,27 @@ fsdem_result fsdem_mps_save_memory(const fsdem_mps *mps, void *buffer, size_t ca
 
 fsdem_result fsdem_mps_restore_memory(fsdem_mps *mps, const void *buffer, size_t size) {
     fsdem__restart_object o = fsdem__restart_of_mps(mps);
+    return fsdem__restart_load_memory(&o, buffer, size);
+}
+
+/* fsdem_mps_dem (>>restart): the MPS-DEM coupler with its two solvers. */
+fsdem_result fsdem_mps_dem_save(const fsdem_mps_dem *coupler, const char *path) {
+    fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_mps_dem_restore(fsdem_mps_dem *coupler, const char *path) {
+    fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_mps_dem_save_memory(const fsdem_mps_dem *coupler, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_mps_dem_restore_memory(fsdem_mps_dem *coupler, const void *buffer, size_t size) {
+    fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 

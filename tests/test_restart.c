@@ -1,4 +1,4 @@
-/* Checkpoint and restart: for every solver (DEM, PIC, SWE, MPS) and the coupler, a run continued from a restored state is
+/* Checkpoint and restart: for every solver (DEM, PIC, SWE, MPS) and the couplers, a run continued from a restored state is
    the uninterrupted run to the last byte of the state (fixed and adaptive dt); bad data (truncated,
    corrupted, other version, precision, dimension, kind, grid or desc) are refused with a message and
    leave the object exactly as it was, as does running out of memory. */
@@ -25,6 +25,7 @@ DEFINE_SAVE(pic)
 DEFINE_SAVE(swe)
 DEFINE_SAVE(swe_dem)
 DEFINE_SAVE(mps)
+DEFINE_SAVE(mps_dem)
 
 /* Two saves are the same bytes; on failure the first differing byte is named. */
 static void same_bytes(const unsigned char *a, size_t na, const unsigned char *b, size_t nb, const char *what) {
@@ -837,6 +838,91 @@ START_TEST(mps_continues_bit_exact) {
 }
 END_TEST
 
+/* ---- MPS-DEM ---- */
+
+typedef struct mps_world {
+    fsdem_mps *mps;
+    fsdem_dem *dem;
+    fsdem_mps_dem *cpl;
+} mps_world;
+
+/* The MPS tank of mps_continues_bit_exact (Model B) with a few sinking grains in its column;
+   `bare`: the solvers are only created (the restore brings their state). */
+static mps_world mps_world_new(int bare) {
+    mps_world w;
+    fsdem_mps_desc md = mps_desc();
+    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+    fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
+    md.model = FSDEM_MPS_MODEL_B;
+    ck_assert_int_eq(fsdem_mps_create(&md, &w.mps), FSDEM_OK);
+    dd.domain_min = fsdem_v3(md.domain_min.x, md.domain_min.y, -1);
+    dd.domain_max = fsdem_v3(md.domain_max.x, md.domain_max.y, 1);
+    dd.gravity = md.gravity;
+    dd.dt = 2e-5;
+    ck_assert_int_eq(fsdem_dem_create(&dd, &w.dem), FSDEM_OK);
+    if (!bare) {
+        fsdem_dem_material m = fsdem_dem_material_default();
+        int mat, k;
+        mps_setup(w.mps);
+        ck_assert_int_eq(fsdem_dem_add_material(w.dem, &m, &mat), FSDEM_OK);
+        for (k = 0; k < 6; ++k) {
+            fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+            p.position = fsdem_v3((fsdem_real)(0.02 + 0.012 * k), (fsdem_real)(0.2 - 0.01 * (k % 2)), 0);
+            p.radius = 0.003f;
+            p.material = mat;
+            ck_assert_int_eq(fsdem_dem_add_particle(w.dem, &p, NULL), FSDEM_OK);
+        }
+    }
+    cd.mps = w.mps;
+    cd.dem = w.dem;
+    ck_assert_int_eq(fsdem_mps_dem_create(&cd, &w.cpl), FSDEM_OK);
+    return w;
+}
+
+static void mps_world_free(mps_world *w) {
+    fsdem_mps_dem_destroy(w->cpl);
+    fsdem_dem_destroy(w->dem);
+    fsdem_mps_destroy(w->mps);
+}
+
+START_TEST(mps_dem_continues_bit_exact) {
+    const char *path = "build/test_restart_mps_dem.bin";
+    mps_world a = mps_world_new(0), c = mps_world_new(1), f = mps_world_new(1);
+    unsigned char *A, *B, *C, *F, *R;
+    size_t na, nb, nc, nf, nr;
+    fsdem_mps_dem_force fa, fc;
+    ck_assert_int_eq(fsdem_mps_dem_advance(a.cpl, 0.02f, NULL), FSDEM_OK);
+    A = save_mps_dem(a.cpl, &na);
+    ck_assert_int_eq(fsdem_mps_dem_save(a.cpl, path), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_dem_get_force(a.cpl, 3, &fa), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_dem_advance(a.cpl, 0.02f, NULL), FSDEM_OK);
+    B = save_mps_dem(a.cpl, &nb);
+
+    ck_assert_int_eq(fsdem_mps_dem_restore_memory(c.cpl, A, na), FSDEM_OK);
+    R = save_mps_dem(c.cpl, &nr);
+    same_bytes(A, na, R, nr, "MPS-DEM save of the restored state");
+    ck_assert_int_eq(fsdem_mps_dem_get_force(c.cpl, 3, &fc), FSDEM_OK);
+    ck_assert(fc.drag.y == fa.drag.y && fc.porosity == fa.porosity && fc.wet == fa.wet);
+    ck_assert_int_eq(fsdem_mps_dem_advance(c.cpl, 0.02f, NULL), FSDEM_OK);
+    C = save_mps_dem(c.cpl, &nc);
+    same_bytes(B, nb, C, nc, "MPS-DEM continued from memory");
+    ck_assert(fsdem_dem_get_particles(c.dem).position[2].y == fsdem_dem_get_particles(a.dem).position[2].y);
+
+    ck_assert_int_eq(fsdem_mps_dem_restore(f.cpl, path), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_dem_advance(f.cpl, 0.02f, NULL), FSDEM_OK);
+    F = save_mps_dem(f.cpl, &nf);
+    same_bytes(B, nb, F, nf, "MPS-DEM continued from a file");
+    free(A);
+    free(B);
+    free(C);
+    free(F);
+    free(R);
+    mps_world_free(&a);
+    mps_world_free(&c);
+    mps_world_free(&f);
+}
+END_TEST
+
 Suite *restart_suite(void) {
     Suite *s = suite_create("restart");
     TCase *tc = tcase_create("restart");
@@ -849,6 +935,7 @@ Suite *restart_suite(void) {
     tcase_add_test(tc, swe_dem_continues_bit_exact);
     tcase_add_test(tc, swe_dem_refusal_names_the_solver);
     tcase_add_test(tc, mps_continues_bit_exact);
+    tcase_add_test(tc, mps_dem_continues_bit_exact);
     tcase_add_test(tc, bad_data_is_refused_and_changes_nothing);
     tcase_add_test(tc, out_of_memory_changes_nothing);
     tcase_add_test(tc, swe_gauge_file_blocks_restore);
