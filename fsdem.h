@@ -5344,6 +5344,20 @@ static fsdem_result fsdem__dem_advance_verlet(fsdem_dem *d, fsdem_real h, long l
     return FSDEM_OK;
 }
 
+/* A coupler's check before a fluid step of dt moves anything: the DEM can follow it in at most
+   `max` substeps; the failure goes to the coupler's `status` under its name `who`. */
+static fsdem_result fsdem__dem_substeps_within(const fsdem_dem *d, fsdem_real dt, long long max, fsdem__status *status,
+                                               const char *who) {
+    long long substeps = 0;
+    const fsdem_result res = fsdem_dem_substep_count(d, dt, &substeps);
+    if (res != FSDEM_OK) return fsdem__fail(status, res, "%s: %s", who, fsdem_dem_last_error(d));
+    if (substeps > max)
+        return fsdem__fail(status, FSDEM_ERR_INVALID_ARG,
+                           "%s: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)", who,
+                           (double)dt, substeps, max, (double)d->dt);
+    return FSDEM_OK;
+}
+
 fsdem_result fsdem_dem_advance_with(fsdem_dem *d, fsdem_real duration, fsdem_dem_substep_fn fn, void *user,
                                     long long *steps) {
     long long k, count = 0;
@@ -12159,12 +12173,8 @@ static fsdem_result fsdem__swe_dem_step(fsdem_swe_dem *c, fsdem_real dt, int ada
     fsdem_result res;
     long long k, substeps = 0;
     int count;
-    res = fsdem_dem_substep_count(c->desc.dem, dt, &substeps);
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: %s", fsdem_dem_last_error(c->desc.dem));
-    if (substeps > c->desc.max_substeps)
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG,
-                           "fsdem_swe_dem: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)",
-                           (double)dt, substeps, c->desc.max_substeps, (double)fsdem_dem_get_desc(c->desc.dem).dt);
+    res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_swe_dem");
+    if (res != FSDEM_OK) return res;
     res = fsdem_swe_dem_update_forces(c);
     if (res != FSDEM_OK) return res;
     res = adaptive ? fsdem_swe_step(c->desc.swe) : fsdem_swe_step_dt(c->desc.swe, dt);
@@ -14206,13 +14216,9 @@ static fsdem_result fsdem__mps_dem_stable(const fsdem_mps_dem *c, fsdem_real *dt
 /* Step 5 of >>couple_mps after an update: the MPS step of dt, then the DEM substeps. */
 static fsdem_result fsdem__mps_dem_run(fsdem_mps_dem *c, fsdem_real dt) {
     long long substeps = 0;
-    fsdem_result res = fsdem_dem_substep_count(c->desc.dem, dt, &substeps);
+    fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_mps_dem");
     clock_t t0, t1;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_mps_dem: %s", fsdem_dem_last_error(c->desc.dem));
-    if (substeps > c->desc.max_substeps)
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG,
-                           "fsdem_mps_dem: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)",
-                           (double)dt, substeps, c->desc.max_substeps, (double)fsdem_dem_get_desc(c->desc.dem).dt);
+    if (res != FSDEM_OK) return res;
     if (c->drag_dt > 0 && dt > c->desc.drag_dt_fraction * c->drag_dt * (1 + (fsdem_real)1e-6))
         return fsdem__fail(&c->status, FSDEM_ERR_CFL,
                            "fsdem_mps_dem: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s", (double)dt,
