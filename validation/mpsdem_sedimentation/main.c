@@ -45,6 +45,7 @@ typedef struct outcome {
     double ek_max_rise;         /* J: the largest such rise */
     double drag_end, drag_mean_end, pres_z_end, pres_mag_end, pres_z_mean_end, pres_z_min_end, pres_z_max_end;
     double p_mean_end, p_rms_end, level_end, bed_top_end;
+    double vmix_start, vmix_end;  /* m^3: sum over FLUID particles of r0^3 / eps_i, first and last sample */
     long long steps, substeps;
     double dem_dt, cpu_mps, cpu_dem, wall_seconds;
 } outcome;
@@ -232,6 +233,14 @@ static outcome run(const setup *S, fsdem_mps_model model) {
         row[13] = (fsdem_real)cs.substeps;
         fsdem_csv_row(&csv, row, 14);
         o.t_reached = t;
+        {
+            const fsdem_mps_particles mv = fsdem_mps_get_particles(mps);
+            double vmix = 0;
+            for (i = 0; i < mv.count; ++i)
+                if (mv.kind[i] == FSDEM_MPS_FLUID) vmix += r0 * r0 * r0 / mv.porosity[i];
+            if (k == 0) o.vmix_start = vmix;
+            o.vmix_end = vmix;
+        }
         if (ek > o.ek_peak) o.ek_peak = ek, o.t_peak = t;
         if (fabs(t - 0.45) < 0.5 * T_OUT) o.ek_045 = ek;
         if (fabs(t - 0.3) < 0.5 * T_OUT) o.ek_03 = ek;
@@ -295,8 +304,11 @@ static void report(char tag, const outcome *o) {
     vc_info(CASE, "model %c: %s (t reached %.4f s)%s%s", tag, o->failed ? "FAILED" : "completed", o->t_reached,
             o->failed ? ": " : "", o->failed ? o->error : "");
     vc_info(CASE, "model %c: analytic: V_f = %.4e m^3 (%d x r0^3), V_s = %.4e m^3, H = (V_f + V_s)/A = %.5f m, "
-                  "rho g H = %.2f Pa; sum V rho_f g = %.5f N; submerged weight %.5f N",
+                  "rho g H = %.2f Pa; sum V rho_f g = %.5f N; submerged weight = %.5f N",
             tag, o->Vf, o->fluid, o->Vs, o->H, rho_f * g * o->H, o->B, o->W_sub);
+    vc_info(CASE, "model %c: mixture volume of the FLUID particles, sum r0^3/eps_i: %.4e m^3 at the start, %.4e m^3 at "
+                  "the end, against V_f + V_s = %.4e m^3 (the solid volume they see: %.4f V_s at the end; its level %.5f m)",
+            tag, o->vmix_start, o->vmix_end, o->Vf + o->Vs, (o->vmix_end - o->Vf) / o->Vs, o->vmix_end / (o->Lx * o->Ly));
     vc_info(CASE, "model %c: Ek peak %.4e J at %.3f s; Ek(0.30) %.4e, Ek(0.45) %.4e (%.3g%% of peak), Ek(end) %.4e "
                   "(%.3g%%); 0.01-s samples after 0.3 s that rose above the one before (above 1e-4 of the peak): %d, "
                   "largest rise %.3e J",

@@ -5,10 +5,10 @@ set terminal pngcairo size 1000,600 font ",11"
 set grid
 set key top right
 set xlabel 't [s]'
-num(pat) = real(system("sed -n 's/.*model B: analytic.*" . pat . " = \\([0-9.eE+-]*\\) .*/\\1/p' checks.txt | head -1"))
+num(pat) = real(system("sed -n 's|.*model B: analytic.*" . pat . " = \\([0-9.eE+-]*\\) .*|\\1|p' checks.txt | head -1"))
 pref = num('rho g H')
 buoy = num('sum V rho_f g')
-wsub = num('submerged weight')
+wsub = 1.5 * buoy  # (rho_s - rho_f) / rho_f = 1.5
 hlev = num('H = (V_f + V_s)/A')
 
 set output 'kinetic_energy.png'
