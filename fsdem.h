@@ -2154,8 +2154,11 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
    over the plane (int_0^1 (4x^5 - 5x^4 + 1) 2 pi x dx = 2 pi (4/7 - 5/6 + 1/2)), n_s = (10 pi / 21)
    r_e^2 in 2D, where volumes are areas per unit depth (a disc of radius R stands for pi R^2).
    Every coupled step:
-     1. porosity of the MPS particles (FLUID and WALL), eps_i = 1 - sum_k w_s(r_ik) V_k / n_s
-        (Eq. 31), not let below desc.min_porosity; written to the MPS (its Eq. 7-16 use 1/eps_j).
+     1. porosity of the FLUID particles, eps_i = 1 - sum_k w_s(r_ik) V_k / n_s (Eq. 31), not let
+        below desc.min_porosity; written to the MPS (its Eq. 7-16 use 1/eps_j). WALL and DUMMY
+        particles keep eps = 1: they sit on the fixed r0 lattice, so a 1/eps on them would count
+        them more than once in the number density of their neighbours and read a bed on the floor
+        as compressed (the bottom pressure of a settled bed came out twice hydrostatic).
         Within r_e of a wall or obstacle n_s is reduced by the part of the weight's integral that
         lies inside the solid (the sum of w_s r0^d over its WALL and DUMMY particles): Eq. 31 as
         printed reads a bed packed against a wall as looser there (not done at the free surface);
@@ -14154,7 +14157,7 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
     }
     for (i = 0; i < mv.count; ++i) {
         fsdem_real eps = 1;
-        if (mv.kind[i] != FSDEM_MPS_DUMMY && c->solid[i] > 0) eps = 1 - c->solid[i] / fsdem__mps_dem_open_weight(c, &mv, i);
+        if (mv.kind[i] == FSDEM_MPS_FLUID && c->solid[i] > 0) eps = 1 - c->solid[i] / fsdem__mps_dem_open_weight(c, &mv, i);
         mc.porosity[i] = eps > c->desc.min_porosity ? eps : c->desc.min_porosity;
         mc.force[i] = fsdem__zero3();
     }
