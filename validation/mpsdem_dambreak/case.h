@@ -184,7 +184,7 @@ static inline fsdem_result sd_advance(sd_case *c, double duration, long long *st
     return c->cpl ? fsdem_mps_dem_advance(c->cpl, (fsdem_real)duration, steps) : fsdem_mps_advance(c->mps, (fsdem_real)duration, steps);
 }
 
-static const char *sd_last_error(const sd_case *c) {
+static inline const char *sd_last_error(const sd_case *c) {
     if (c->cpl && fsdem_mps_dem_last_error(c->cpl)[0]) return fsdem_mps_dem_last_error(c->cpl);
     return fsdem_mps_last_error(c->mps);
 }
