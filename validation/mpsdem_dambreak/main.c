@@ -212,7 +212,8 @@ int main(int argc, char **argv) {
             runs[n].model = 'A', runs[n++].r0 = 0.002;
         }
     }
-    vc_info(CASE, "%s: %d runs to t = %.2f s (Model A, B; W = clear water)", all ? "--all" : "default set", n, T_END);
+    vc_info(CASE, "%s: %d runs to t = %.2f s (Model A, B; W = clear water)",
+            all ? "--all" : argc > 2 && strcmp(argv[2], "--only") == 0 ? "--only" : "default set", n, T_END);
     for (i = 0; i < n; ++i) {
         char name[64];
         run_name(&runs[i], name, sizeof name);
