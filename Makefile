@@ -132,6 +132,9 @@ $(BUILD)/validation/%/run: validation/%/main.c validation/common.h validation/pi
 	@mkdir -p $(dir $@)
 	$(CC) $(STD) $(WARN) -O2 -I. -Ivalidation -DVC_DATA_DIR='"$(abspath $(VALIDATION_DATA))"' $< -o $@ $(LDLIBS)
 
+# the MPS-DEM dam break's case is shared by its validation case and its bench
+$(BUILD)/validation/mpsdem_dambreak/run $(BUILD)/bench/mpsdem_dambreak: validation/mpsdem_dambreak/case.h
+
 validate: SHELL := /bin/bash
 validate: $(foreach v,$(VALIDATION),$(BUILD)/validation/$(v)/run) | gnuplot-deps
 	@status=0; for v in $(VALIDATION); do \
