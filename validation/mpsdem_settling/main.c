@@ -1,11 +1,18 @@
 /* Hindered settling of a uniform suspension of DEM spheres in MPS water (unresolved MPS-DEM coupling,
    seed 002 §2.3, Model B, drag law of Eq. 26) against Richardson-Zaki: U = u_t eps^n.
-   Usage: run [DATA_DIR]   (the reference is analytic; no file is read)
+   Usage: run [DATA_DIR] [--phi=F] [--t-end=S] [--t-start=S]   (the reference is analytic; no file
+   is read). Default: the three fractions 0.1, 0.2, 0.3 to T_END; --phi runs one of them.
    Writes settling_<law>_phi<phi>.csv per run: t, v_band (mean vertical velocity of the particles in
    the measuring box, m/s), u_band (mean vertical velocity of the FLUID particles there), eps_band
    (mean porosity eps_k of the particles there), n_band, z_top (99th percentile of the particles'
    heights), z_bed (top of the bed: the highest height below which the particles' mean speed is
-   under 10% of u_t, see bed_top), and summary.csv (one row per run). */
+   under 10% of u_t, see bed_top), u_wall (the fluid within r_e of the side walls at the box's
+   heights), q_total (the volume flux of fluid and solid through the whole cross-section at the
+   box's heights: zero in an incompressible mixture in a closed tank), and profile_phi<phi>.csv
+   (averages over the window in r0 slabs: fluid velocity, porosity of the FLUID particles and
+   particle velocity in the core and within r_e of the side walls, FLUID particles per slab and the
+   whole cross-section's volume flux), lateral_phi<phi>.csv (the same at the box's heights against
+   the distance to the nearest side wall, r0/2 bins). */
 #define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
@@ -23,10 +30,10 @@ static const double r0 = 0.004, d = 0.002;
 /* measuring box: r_e (4.1 r0) from the side walls, heights [Z_LO, Z_HI] r0 */
 #define Z_LO 10.0
 #define Z_HI 18.0
-#define T_START 0.2 /* s: the window starts after the transient (see README) */
-#ifndef T_END
-#define T_END 0.4 /* s: the cost bound (10 min for the three runs) */
-#endif
+static double T_START = 0.2; /* s: the window starts after the transient (see README); --t-start */
+static double T_END = 0.4;   /* s: the cost bound (10 min for the three runs); --t-end */
+#define NZ 40                /* profile slabs, r0 thick, from the floor */
+#define NL 16                /* lateral bins, r0/2 wide, by the distance to the nearest side wall */
 #define SAMPLE 0.01 /* s */
 
 static double mu(void) { return rho * nu; }
@@ -106,8 +113,18 @@ static int cmp_double(const void *a, const void *b) {
     return x < y ? -1 : x > y;
 }
 
-static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_name) {
-    const double W = WIDTH * r0, eps0 = 1 - phi, pad = 6 * r0;
+/* window averages of the profiles: [0] fluid velocity, [1] FLUID porosity, [2] their count (core),
+   [3]-[5] the same within r_e of the side walls, [6] particle velocity core, [7] count, [8] particle
+   velocity wall, [9] count, [10] the whole cross-section's volume flux (fluid + solid), [11] free-
+   surface FLUID particles, [12], [13] number density n_i of Eq. 7 core, wall, [14] pressure core */
+enum { PF_U, PF_E, PF_N, PF_UW, PF_EW, PF_NW, PF_V, PF_NV, PF_VW, PF_NVW, PF_Q, PF_S, PF_ND, PF_NDW, PF_P, PF_COUNT };
+/* lateral: [0] fluid velocity, [1] FLUID porosity, [2] count, [3] particle velocity, [4] count */
+enum { PL_U, PL_E, PL_N, PL_V, PL_NV, PL_COUNT };
+
+static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_name, const char *profile_name, const char *lateral_name) {
+    double prof[NZ][PF_COUNT], lat[NL][PL_COUNT];
+    const double W = WIDTH * r0, pad = 6 * r0, V = PI / 6 * d * d * d;
+    double eps0 = 1 - phi;
     const double re = 4.1 * r0, x_lo = re, x_hi = W - re;
     fsdem_mps_desc md = fsdem_mps_desc_default(3);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
@@ -123,6 +140,8 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
     int i, j, k, nf = 0, layers, nx, nz, material;
     double z_susp, a, ax, az, next = 0, sv = 0, sv2 = 0, su = 0, se = 0, sn = 0;
     memset(&o, 0, sizeof o);
+    memset(prof, 0, sizeof prof);
+    memset(lat, 0, sizeof lat);
     o.phi = phi;
     md.r0 = (fsdem_real)r0;
     md.model = FSDEM_MPS_MODEL_B;
@@ -138,8 +157,19 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
     fsdem_mps_add_box_walls(mps, fsdem_v3(0, 0, 0), fsdem_v3((fsdem_real)W, (fsdem_real)W, (fsdem_real)((SUSP + CLEAR + 4) * r0)),
                             1u << FSDEM_SIDE_ZMAX, NULL);
     /* water: in the suspension the layers are r0 / eps0 apart (each MPS particle stands for a volume
-       of mixture r0^3 / eps, Eq. 7 with 1/eps_j), r0 above it */
+       of mixture r0^3 / eps, Eq. 7 with 1/eps_j), r0 above it, with eps0 the porosity of the
+       particle lattice itself, not the nominal 1 - phi: a lattice of nx^2 nz cells of the
+       suspension's height z_susp = layers r0 / eps0 has phi = nx^2 nz V / (W^2 z_susp), so
+       phi = c (1 - phi) with c = nx^2 nz V / (W^2 layers r0). (The nominal eps0 left the water
+       0.8% short of n0 at phi 0.1, 0.9 against the lattice's 0.908, and the column sank.) */
     layers = (int)floor(SUSP * eps0 + 1e-9);
+    a = d * cbrt(PI / (6 * phi));
+    nx = (int)floor(W / a);
+    nz = (int)floor(layers * r0 / eps0 / a);
+    {
+        const double c = nx * nx * nz * V / (W * W * layers * r0);
+        eps0 = 1 - c / (1 + c);
+    }
     z_susp = layers * r0 / eps0;
     pos = (fsdem_vec3 *)malloc(sizeof *pos * (size_t)(WIDTH * WIDTH * (layers + CLEAR)));
     for (k = 0; k < layers + CLEAR; ++k)
@@ -172,9 +202,6 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
         fsdem_dem_wall_desc box = fsdem_dem_wall_box(fsdem_v3(0, 0, 0), fsdem_v3((fsdem_real)W, (fsdem_real)W, (fsdem_real)((SUSP + CLEAR + 4) * r0)), 1, material);
         fsdem_dem_add_wall(dem, &box, NULL);
     }
-    a = d * cbrt(PI / (6 * phi));
-    nx = (int)floor(W / a);
-    nz = (int)floor(z_susp / a);
     ax = W / nx;
     az = z_susp / nz;
     for (k = 0; k < nz; ++k)
@@ -205,7 +232,7 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
         goto done;
     }
     heights = (double *)malloc(sizeof *heights * (size_t)o.particles);
-    fsdem_csv_open(&csv, csv_name, "t,v_band,u_band,eps_band,n_band,z_top,z_bed,u_wall");
+    fsdem_csv_open(&csv, csv_name, "t,v_band,u_band,eps_band,n_band,z_top,z_bed,u_wall,q_total");
     while (fsdem_mps_dem_time(cpl) < T_END - 1e-9) {
         fsdem_result r = fsdem_mps_dem_step(cpl);
         double t = fsdem_mps_dem_time(cpl);
@@ -217,9 +244,44 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
         if (t >= next - 1e-9) {
             const fsdem_dem_particles dv = fsdem_dem_get_particles(dem);
             const fsdem_mps_particles mv = fsdem_mps_get_particles(mps);
-            double v = 0, u = 0, e = 0, uw = 0, row[8];
+            const double vol = W * W * r0;
+            const int win = t >= T_START - 1e-9;
+            double v = 0, u = 0, e = 0, uw = 0, q = 0, row[9];
             int n = 0, m = 0, mw = 0;
             next += SAMPLE;
+            for (k = 0; k < dv.count; ++k) {
+                const fsdem_vec3 x = dv.position[k];
+                const int s = (int)floor(x.z / r0), wall = x.x < x_lo || x.x > x_hi || x.y < x_lo || x.y > x_hi;
+                const double dw = fmin(fmin(x.x, W - x.x), fmin(x.y, W - x.y));
+                const int b = (int)floor(dw / (0.5 * r0));
+                if (x.z > Z_LO * r0 && x.z < Z_HI * r0) q += V * dv.velocity[k].z;
+                if (!win) continue;
+                if (s >= 0 && s < NZ) {
+                    prof[s][wall ? PF_VW : PF_V] += dv.velocity[k].z, prof[s][wall ? PF_NVW : PF_NV] += 1;
+                    prof[s][PF_Q] += V * dv.velocity[k].z / vol;
+                }
+                if (x.z > Z_LO * r0 && x.z < Z_HI * r0 && b >= 0 && b < NL) lat[b][PL_V] += dv.velocity[k].z, lat[b][PL_NV] += 1;
+            }
+            for (i = 0; i < mv.count; ++i) {
+                const fsdem_vec3 x = mv.position[i];
+                const int s = (int)floor(x.z / r0), wall = x.x < x_lo || x.x > x_hi || x.y < x_lo || x.y > x_hi;
+                const double dw = fmin(fmin(x.x, W - x.x), fmin(x.y, W - x.y));
+                const int b = (int)floor(dw / (0.5 * r0));
+                if (mv.kind[i] != FSDEM_MPS_FLUID) continue;
+                if (x.z > Z_LO * r0 && x.z < Z_HI * r0) q += r0 * r0 * r0 * mv.velocity[i].z;
+                if (!win) continue;
+                if (s >= 0 && s < NZ) {
+                    prof[s][wall ? PF_UW : PF_U] += mv.velocity[i].z, prof[s][wall ? PF_EW : PF_E] += mv.porosity[i];
+                    prof[s][wall ? PF_NW : PF_N] += 1;
+                    prof[s][PF_S] += mv.surface[i];
+                    prof[s][wall ? PF_NDW : PF_ND] += mv.number_density[i];
+                    if (!wall) prof[s][PF_P] += mv.pressure[i];
+                    prof[s][PF_Q] += r0 * r0 * r0 * mv.velocity[i].z / vol;
+                }
+                if (x.z > Z_LO * r0 && x.z < Z_HI * r0 && b >= 0 && b < NL)
+                    lat[b][PL_U] += mv.velocity[i].z, lat[b][PL_E] += mv.porosity[i], lat[b][PL_N] += 1;
+            }
+            q /= W * W * (Z_HI - Z_LO) * r0;
             for (k = 0; k < dv.count; ++k) {
                 const fsdem_vec3 x = dv.position[k];
                 fsdem_mps_dem_force f;
@@ -253,7 +315,8 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
             row[5] = (fsdem_real)heights[(int)(0.99 * (dv.count - 1))];
             row[6] = (fsdem_real)bed_top(&dv, ut);
             row[7] = (fsdem_real)(mw ? uw / mw : NAN);
-            fsdem_csv_row(&csv, row, 8);
+            row[8] = (fsdem_real)q;
+            fsdem_csv_row(&csv, row, 9);
             o.u_wall = row[7];
             o.top_end = row[5];
             o.bed_end = row[6];
@@ -265,6 +328,29 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
                 sn += 1;
             }
         }
+    }
+    fsdem_csv_close(&csv);
+    fsdem_csv_open(&csv, profile_name, "z,u_core,eps_core,n_fluid_core,u_wall,eps_wall,n_fluid_wall,v_core,v_wall,q_total,surface,nd_core,nd_wall,p_core");
+    for (k = 0; k < NZ && sn > 0; ++k) {
+        const double *P = prof[k];
+        fsdem_real row[14];
+        row[0] = (k + 0.5) * r0;
+        row[1] = P[PF_N] ? P[PF_U] / P[PF_N] : NAN, row[2] = P[PF_N] ? P[PF_E] / P[PF_N] : NAN, row[3] = P[PF_N] / sn;
+        row[4] = P[PF_NW] ? P[PF_UW] / P[PF_NW] : NAN, row[5] = P[PF_NW] ? P[PF_EW] / P[PF_NW] : NAN, row[6] = P[PF_NW] / sn;
+        row[7] = P[PF_NV] ? P[PF_V] / P[PF_NV] : NAN, row[8] = P[PF_NVW] ? P[PF_VW] / P[PF_NVW] : NAN, row[9] = P[PF_Q] / sn;
+        row[10] = P[PF_S] / sn, row[11] = P[PF_N] ? P[PF_ND] / P[PF_N] : NAN, row[12] = P[PF_NW] ? P[PF_NDW] / P[PF_NW] : NAN;
+        row[13] = P[PF_N] ? P[PF_P] / P[PF_N] : NAN;
+        fsdem_csv_row(&csv, row, 14);
+    }
+    fsdem_csv_close(&csv);
+    fsdem_csv_open(&csv, lateral_name, "dist_wall,u,eps,n_fluid,v,n_particles");
+    for (k = 0; k < NL && sn > 0; ++k) {
+        const double *P = lat[k];
+        fsdem_real row[6];
+        row[0] = (k + 0.5) * 0.5 * r0;
+        row[1] = P[PL_N] ? P[PL_U] / P[PL_N] : NAN, row[2] = P[PL_N] ? P[PL_E] / P[PL_N] : NAN, row[3] = P[PL_N] / sn;
+        row[4] = P[PL_NV] ? P[PL_V] / P[PL_NV] : NAN, row[5] = P[PL_NV] / sn;
+        fsdem_csv_row(&csv, row, 6);
     }
     fsdem_csv_close(&csv);
     if (sn > 0) {
@@ -296,21 +382,35 @@ int main(int argc, char **argv) {
     static const double fractions[] = {0.1, 0.2, 0.3};
     const fsdem_drag_law law = FSDEM_DRAG_ERGUN_WEN_YU;
     const double ut = terminal(law), Re_t = rho * d * ut / mu(), n = rz_exponent(Re_t);
-    int f;
-    (void)argc;
-    (void)argv;
+    int f, only = -1;
+    for (f = 1; f < argc; ++f) {
+        if (!strncmp(argv[f], "--t-end=", 8)) T_END = atof(argv[f] + 8);
+        else if (!strncmp(argv[f], "--t-start=", 10)) T_START = atof(argv[f] + 10);
+        else if (!strncmp(argv[f], "--phi=", 6)) {
+            const double p = atof(argv[f] + 6);
+            for (only = 0; only < 3 && fabs(fractions[only] - p) > 1e-6; ++only) continue;
+            if (only == 3) {
+                printf("--phi: 0.1, 0.2 or 0.3\n");
+                return 2;
+            }
+        }
+    }
+    if (!(T_END > 0 && T_START >= 0 && T_START < T_END)) {
+        printf("usage: run [DATA_DIR] [--phi=F] [--t-end=S] [--t-start=S] (0 <= t_start < t_end)\n");
+        return 2;
+    }
     vc_info(CASE, "d %g m, r0 %g m (d = r0/%g), rho_s %g, rho %g kg/m^3, nu %g m^2/s; %s: u_t %.5f m/s (Stokes %.5f), Re_t %.3f, "
                   "Rowe's n %.4f",
             d, r0, r0 / d, rho_s, rho, nu, fsdem_drag_law_name(law), ut, (rho_s - rho) * g * d * d / (18 * mu()), Re_t, n);
     for (f = 0; f < 3; ++f) {
-        char name[80], metric[80];
-#ifdef ONLY
-        if (f != ONLY) continue;
-#endif
+        char name[80], pname[80], lname[80], metric[80];
         outcome o;
         double U_rz, U_law;
+        if (only >= 0 && f != only) continue;
         snprintf(name, sizeof name, "settling_%s_phi%.1f.csv", fsdem_drag_law_name(law), fractions[f]);
-        o = run(fractions[f], law, ut, name);
+        snprintf(pname, sizeof pname, "profile_phi%.1f.csv", fractions[f]);
+        snprintf(lname, sizeof lname, "lateral_phi%.1f.csv", fractions[f]);
+        o = run(fractions[f], law, ut, name, pname, lname);
         U_rz = ut * pow(o.eps_nominal, n);
         U_law = law_prediction(law, o.eps_nominal);
         vc_info(CASE, "phi %.3f: %d particles, %d FLUID (%d MPS in all), %d coupled steps (mean dt %.2e s, %.1f DEM substeps each), %.1f s CPU (MPS %.1f s)%s%s", o.phi,
