@@ -7,15 +7,10 @@ set multiplot layout 1,2
 set title 'mean settling speed of the particles in the measuring box (down positive)'
 set xlabel 't [s]'
 set ylabel 'v [m/s]'
-plot 'settling_ergun_wen_yu_phi0.1.csv' using 1:2 with lines title 'phi 0.1', \
-     'settling_ergun_wen_yu_phi0.2.csv' using 1:2 with lines title 'phi 0.2', \
-     'settling_ergun_wen_yu_phi0.3.csv' using 1:2 with lines title 'phi 0.3'
+# the default run writes phi 0.1 only (--phi=all for the others)
+plot 'settling_ergun_wen_yu_phi0.1.csv' using 1:2 with lines title 'phi 0.1'
 set title 'mean vertical fluid velocity: box (solid) and within r_e of the walls (dashed)'
 set ylabel 'u [m/s]'
 plot 'settling_ergun_wen_yu_phi0.1.csv' using 1:3 with lines lc 1 title 'phi 0.1', \
-     'settling_ergun_wen_yu_phi0.1.csv' using 1:8 with lines lc 1 dt 2 notitle, \
-     'settling_ergun_wen_yu_phi0.2.csv' using 1:3 with lines lc 2 title 'phi 0.2', \
-     'settling_ergun_wen_yu_phi0.2.csv' using 1:8 with lines lc 2 dt 2 notitle, \
-     'settling_ergun_wen_yu_phi0.3.csv' using 1:3 with lines lc 3 title 'phi 0.3', \
-     'settling_ergun_wen_yu_phi0.3.csv' using 1:8 with lines lc 3 dt 2 notitle
+     'settling_ergun_wen_yu_phi0.1.csv' using 1:8 with lines lc 1 dt 2 notitle
 unset multiplot
