@@ -2169,14 +2169,9 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
         with FSDEM_DRAG_ERGUN_WEN_YU) and the force on the particle (held over the DEM substeps):
           Model A (the MPS desc.model):  F^int = F^d - V_k grad P_k            (Eq. 34)
           Model B:                       F^int = F^d / eps_k - V_k rho_f g     (Eq. 35);
-     4. the reaction on the fluid (Eq. 36): FLUID particle i gets -sum_k X_k s_ki / sum_j s_kj (sum
-        over the FLUID particles j) with s_ki = w_s(r_ki) (r0^d / eps_i) / open_i: the seed's
-        w_s(r_ki) weighted by the volume of mixture the particle stands for over the open part of
-        its kernel (open_i = n_s less the walls' part, step 1), a Shepard correction. With w_s alone
-        the water within r0 of a wall took 0.72 of the bulk's reaction per volume in a uniform
-        suspension (its kernel is cut by the wall) and a circulation cell rose along the walls; in
-        the interior of a uniform packing s_ki is w_s times a constant. X_k is the force that the
-        fluid and the solid exchange: F^d (Model A, Eq. 2: the solid's -V grad P is the mixture pressure acting
+     4. the reaction on the fluid (Eq. 36): FLUID particle i gets -sum_k X_k w_s(r_ki) / W_k with
+        W_k = sum_j w_s(r_kj) over the FLUID particles j, where X_k is the force that the fluid and
+        the solid exchange: F^d (Model A, Eq. 2: the solid's -V grad P is the mixture pressure acting
         on the solid's volume, as -grad P on its own volume acts on each fluid particle) or F^int
         (Model B, Eq. 4: f_B). Each X_k is split into weights that sum to one, so the fluid gets
         exactly -sum_k X_k: the exchange conserves momentum to rounding;
@@ -13887,8 +13882,7 @@ struct fsdem_mps_dem {
     fsdem__mps_dem_pair *pair;
     int pair_cap;
     fsdem_real *solid;             /* per MPS particle: sum_k w_s V_k (Eq. 31) */
-    fsdem_real *share;             /* per MPS particle: its weight in Eq. 36 besides w_s, 1 / (eps_i open_i) */
-    int solid_cap, share_cap;
+    int solid_cap;
     fsdem_mps_dem_force *force;    /* per DEM particle */
     int force_cap, forces;         /* forces: DEM particles of the last update (0: none yet) */
     /* statistics */
@@ -13983,7 +13977,6 @@ void fsdem_mps_dem_destroy(fsdem_mps_dem *c) {
     fsdem__free(&al, c->start, sizeof(int) * (size_t)c->start_cap);
     fsdem__free(&al, c->pair, sizeof *c->pair * (size_t)c->pair_cap);
     fsdem__free(&al, c->solid, sizeof(fsdem_real) * (size_t)c->solid_cap);
-    fsdem__free(&al, c->share, sizeof(fsdem_real) * (size_t)c->share_cap);
     fsdem__free(&al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
     fsdem__free(&al, c, sizeof *c);
 }
@@ -14071,7 +14064,6 @@ static fsdem_result fsdem__mps_dem_room(fsdem_mps_dem *c, int nd, int nm) {
         fsdem__grow(al, (void **)&c->force, &cap, 0, nd, sizeof(fsdem_mps_dem_force)) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
     c->force_cap = cap;
-    if (fsdem__grow(al, (void **)&c->share, &c->share_cap, 0, nm, sizeof(fsdem_real)) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     return fsdem__grow(al, (void **)&c->solid, &c->solid_cap, 0, nm, sizeof(fsdem_real));
 }
 
@@ -14102,11 +14094,10 @@ static fsdem_result fsdem__mps_dem_pairs(fsdem_mps_dem *c, const fsdem_dem_parti
     return FSDEM_OK;
 }
 
-/* Steps 3-4 of >>couple_mps for DEM particle k, whose FLUID neighbours have porosity eps, velocity
-   u and pressure gradient gp (w_s averages) and shares w_s(r_ki) share_i summing to S > 0: its
-   force, and the reactions. */
+/* Steps 3-4 of >>couple_mps for DEM particle k, whose FLUID neighbours' weights sum to W > 0 with
+   porosity eps, velocity u and pressure gradient gp (w_s averages): its force, and the reactions. */
 static void fsdem__mps_dem_exchange(fsdem_mps_dem *c, const fsdem_dem_particles *dv, const fsdem_mps_particles *mv,
-                                    const fsdem_mps_coupling *mc, int k, fsdem_real S, fsdem_real eps, fsdem_vec3 u,
+                                    const fsdem_mps_coupling *mc, int k, fsdem_real W, fsdem_real eps, fsdem_vec3 u,
                                     fsdem_vec3 gp) {
     fsdem_mps_dem_force *f = &c->force[k];
     const fsdem_real r = dv->radius[k], V = fsdem__mps_dem_volume(c, r) * (c->dim == 2 ? c->depth : 1);
@@ -14135,11 +14126,11 @@ static void fsdem__mps_dem_exchange(fsdem_mps_dem *c, const fsdem_dem_particles 
         const fsdem_real tau = dv->mass[k] / coefficient; /* drag relaxation time */
         if (c->drag_dt == 0 || tau < c->drag_dt) c->drag_dt = tau;
     }
-    /* Eq. 36: the reaction shared in proportion to w_s share_i / S, whose shares sum to one */
-    exchanged = fsdem__scale(exchanged, -1 / (S * c->depth));
+    /* Eq. 36: the reaction shared in proportion to w_s / W, whose shares sum to one */
+    exchanged = fsdem__scale(exchanged, -1 / (W * c->depth));
     for (e = c->start[k]; e < c->start[k + 1]; ++e) {
         const int i = c->pair[e].particle;
-        if (mv->kind[i] == FSDEM_MPS_FLUID) mc->force[i] = fsdem__madd(mc->force[i], exchanged, c->pair[e].weight * c->share[i]);
+        if (mv->kind[i] == FSDEM_MPS_FLUID) mc->force[i] = fsdem__madd(mc->force[i], exchanged, c->pair[e].weight);
     }
 }
 
@@ -14165,13 +14156,9 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
         for (e = c->start[k]; e < c->start[k + 1]; ++e) c->solid[c->pair[e].particle] += c->pair[e].weight * V;
     }
     for (i = 0; i < mv.count; ++i) {
-        fsdem_real eps = 1, open = c->ns;
-        if (mv.kind[i] == FSDEM_MPS_FLUID && c->solid[i] > 0) {
-            open = fsdem__mps_dem_open_weight(c, &mv, i);
-            eps = 1 - c->solid[i] / open;
-        }
+        fsdem_real eps = 1;
+        if (mv.kind[i] == FSDEM_MPS_FLUID && c->solid[i] > 0) eps = 1 - c->solid[i] / fsdem__mps_dem_open_weight(c, &mv, i);
         mc.porosity[i] = eps > c->desc.min_porosity ? eps : c->desc.min_porosity;
-        c->share[i] = 1 / (mc.porosity[i] * open);
         mc.force[i] = fsdem__zero3();
     }
     /* 2-4. averages at the DEM particles (Eq. 32-33), forces (Eq. 25-28, 34-35), reactions (Eq. 36) */
@@ -14179,14 +14166,13 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
     c->drag_dt = 0;
     c->drag_sum = c->pressure_sum = fsdem__zero3();
     for (k = 0; k < dv.count; ++k) {
-        fsdem_real W = 0, E = 0, S = 0;
+        fsdem_real W = 0, E = 0;
         fsdem_vec3 U = fsdem__zero3(), G = fsdem__zero3();
         for (e = c->start[k]; e < c->start[k + 1]; ++e) {
             const int i = c->pair[e].particle;
             const fsdem_real w = c->pair[e].weight;
             if (mv.kind[i] != FSDEM_MPS_FLUID) continue;
             W += w;
-            S += w * c->share[i];
             E += w * mc.porosity[i];
             U = fsdem__madd(U, mv.velocity[i], w);
             G = fsdem__madd(G, mv.pressure_gradient[i], w);
@@ -14194,7 +14180,7 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
         memset(&c->force[k], 0, sizeof c->force[k]);
         c->force[k].porosity = 1;
         if (W > 0) {
-            fsdem__mps_dem_exchange(c, &dv, &mv, &mc, k, S, E / W, fsdem__scale(U, 1 / W), fsdem__scale(G, 1 / W));
+            fsdem__mps_dem_exchange(c, &dv, &mv, &mc, k, W, E / W, fsdem__scale(U, 1 / W), fsdem__scale(G, 1 / W));
             c->wet++;
         }
         if (!fsdem__finite3(c->force[k].total))
