@@ -2174,7 +2174,12 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
         the solid exchange: F^d (Model A, Eq. 2: the solid's -V grad P is the mixture pressure acting
         on the solid's volume, as -grad P on its own volume acts on each fluid particle) or F^int
         (Model B, Eq. 4: f_B). Each X_k is split into weights that sum to one, so the fluid gets
-        exactly -sum_k X_k: the exchange conserves momentum to rounding;
+        exactly -sum_k X_k: the exchange conserves momentum to rounding. Limitation: next to a wall
+        the kernel is cut, and in a uniform suspension the water within r0 of a wall gets 0.5-0.7
+        of the bulk's reaction per volume (0.9-1.1 at 2-4 r0), which drives a circulation along the
+        walls (validation/mpsdem_settling); weighting the shares by the open part of each
+        particle's kernel evened it to 0.9-1.2 but over-pushed edges and corners and reversed the
+        cell, so Eq. 36 is kept as printed;
      5. one MPS step of dt, then the DEM over the same dt in K = fsdem_dem_substep_count substeps
         (fsdem_dem_advance) with the forces of 3 held: the sequential staggered scheme with the
         MPS step of Eq. 37 and DEM steps of Eq. 38 (Sun et al. 2021's MSS as the seed uses it; here
