@@ -7177,6 +7177,7 @@ struct fsdem_pic {
     int fstep[3][3];   /* face index stride of axis-a faces along b */
     fsdem_real dx, inv_dx;
     fsdem_vec3 lo, hi; /* grid box */
+    fsdem_real surface_tol; /* m; solid distances within this count as on the surface (>>pic_geometry) */
     double time;
     fsdem_real dt_last;
     long long steps;
@@ -7568,6 +7569,17 @@ static void fsdem__pic_layout(fsdem_pic *s, const fsdem_pic_desc *desc) {
     s->hi.x = s->lo.x + s->dx * (fsdem_real)s->n[0];
     s->hi.y = s->lo.y + s->dx * (fsdem_real)s->n[1];
     if (s->dim == 3) s->hi.z = s->lo.z + s->dx * (fsdem_real)s->n[2];
+    {
+        /* a millionth of the cell or of the largest coordinate, whichever is larger: above the
+           rounding of face positions (float included), far below any geometric detail */
+        fsdem_real extent = s->dx;
+        for (a = 0; a < 3; ++a) {
+            fsdem_real m = (fsdem_real)fabs(fsdem__comp(s->lo, a)), M = (fsdem_real)fabs(fsdem__comp(s->hi, a));
+            if (m > extent) extent = m;
+            if (M > extent) extent = M;
+        }
+        s->surface_tol = (fsdem_real)fsdem__tolerance(1e-6) * extent;
+    }
     s->cstep[0] = 1;
     s->cstep[1] = s->n[0];
     s->cstep[2] = s->n[0] * s->n[1];
@@ -7819,6 +7831,17 @@ static fsdem_real fsdem__pic_frac3(fsdem_real a, fsdem_real b, fsdem_real c) {
 
 #define FSDEM__PIC_SUB 4 /* sub-segments (sub-squares per side) of a face for its open fraction */
 
+/* Distance to the obstacle union for the face fractions, 0 within surface_tol of the surface. A
+   face lying on a solid's side (a box edge on a grid line) must not depend on the rounding of the
+   two coordinates: left to it, the face could come out open by 1e-15 of its area and leave a
+   chain of cells joined only by such faces, a near-singular pressure operator. Counted as on the
+   surface, a sample point there is solid (fsdem__pic_frac2 opens only d > 0), so a side on a face
+   and a side a hair off it give the same fractions. */
+static fsdem_real fsdem__pic_face_sample(const fsdem_pic *s, fsdem_vec3 p) {
+    fsdem_real d = fsdem__pic_obst_min(s, p, NULL);
+    return (fsdem_real)fabs(d) <= s->surface_tol ? 0 : d;
+}
+
 /* Open fraction of the face of axis a with lower corner `c0` (m), spanning one cell along the
    other axes, for the obstacle union. */
 static fsdem_real fsdem__pic_face_fraction(const fsdem_pic *s, int a, fsdem_vec3 c0) {
@@ -7827,19 +7850,19 @@ static fsdem_real fsdem__pic_face_fraction(const fsdem_pic *s, int a, fsdem_vec3
     int b1 = (a + 1) % 3, b2 = (a + 2) % 3, i, j;
     if (s->dim == 2) {
         int b = a == 0 ? 1 : 0;
-        for (i = 0; i <= S; ++i) v[0][i] = fsdem__pic_obst_min(s, fsdem__pic_axis_shift(c0, b, h * (fsdem_real)i), NULL);
+        for (i = 0; i <= S; ++i) v[0][i] = fsdem__pic_face_sample(s, fsdem__pic_axis_shift(c0, b, h * (fsdem_real)i));
         for (i = 0; i < S; ++i) sum += fsdem__pic_frac2(v[0][i], v[0][i + 1]);
         return sum / S;
     }
     for (j = 0; j <= S; ++j)
         for (i = 0; i <= S; ++i)
-            v[j][i] = fsdem__pic_obst_min(
-                s, fsdem__pic_axis_shift(fsdem__pic_axis_shift(c0, b1, h * (fsdem_real)i), b2, h * (fsdem_real)j), NULL);
+            v[j][i] = fsdem__pic_face_sample(
+                s, fsdem__pic_axis_shift(fsdem__pic_axis_shift(c0, b1, h * (fsdem_real)i), b2, h * (fsdem_real)j));
     for (j = 0; j < S; ++j)
         for (i = 0; i < S; ++i) {
             fsdem_vec3 m = fsdem__pic_axis_shift(fsdem__pic_axis_shift(c0, b1, h * ((fsdem_real)i + (fsdem_real)0.5)), b2,
                                                  h * ((fsdem_real)j + (fsdem_real)0.5));
-            fsdem_real vc = fsdem__pic_obst_min(s, m, NULL);
+            fsdem_real vc = fsdem__pic_face_sample(s, m);
             sum += fsdem__pic_frac3(vc, v[j][i], v[j][i + 1]) + fsdem__pic_frac3(vc, v[j][i + 1], v[j + 1][i + 1]) +
                    fsdem__pic_frac3(vc, v[j + 1][i + 1], v[j + 1][i]) + fsdem__pic_frac3(vc, v[j + 1][i], v[j][i]);
         }
