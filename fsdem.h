@@ -29,6 +29,8 @@
                 Eq. 26), Gidaspow blend, Di Felice, Beetstra-van der Hoef-Kuipers
      >>couple_mps  unresolved MPS-DEM, Models A and B: porosity and momentum exchange by local
                 averaging, sequential staggered substepping (seed 002)
+     >>couple_pic  resolved cut-cell PIC-DEM: moving discs and spheres in the pressure equation
+                (implicit solid velocity), the gap and contact dissipation, subcycling (seed 000)
      >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
                 to memory, bit-exact continuation (versioned binary format with a checksum)
      >>io       CSV time series; ParaView .pvd series, valid after every entry; VTK XML snapshots
@@ -122,7 +124,7 @@
      interpolation weights are "kernels" (>>kernel).
 
    COUPLING INTERFACE
-     A coupler is named fsdem_<fluid>_dem (fsdem_swe_dem, fsdem_mps_dem; next fsdem_pic_dem) and
+     A coupler is named fsdem_<fluid>_dem (fsdem_swe_dem, fsdem_mps_dem, fsdem_pic_dem) and
      holds non-owning pointers to a fluid and a DEM. It reaches them only through these functions:
        DEM   fsdem_dem_get_particles (read), fsdem_dem_get_desc, fsdem_dem_get_coupling (writable
              external loads), fsdem_dem_substep_count, fsdem_dem_advance_with (substeps with a
@@ -133,7 +135,11 @@
              step_dt, and for the shallow water fsdem_swe_sample_state (depth-averaged state at
              (x, y)). The MPS solver, whose fluid is particles, is sampled through its particle view
              (fsdem_mps_get_particles: positions, velocities, pressure gradients) and takes forces
-             and porosities through fsdem_mps_get_coupling.
+             and porosities through fsdem_mps_get_coupling. The PIC, whose solids are cut faces,
+             takes moving solids through fsdem_pic_get_coupling (open fractions, solid velocities,
+             references; shear read back), fsdem_pic_set_pressure_extra (an implicit term of the
+             pressure operator) and fsdem_pic_exclude_particles, and is read through
+             fsdem_pic_get_fields (pressure, open fractions) and fsdem_pic_get_particles.
 
    THREAD SAFETY
      No global mutable state. Distinct objects may be used from distinct threads at once; one
@@ -289,9 +295,23 @@
 #define fsdem_pic_advance fsdem_pic_advance_f
 #define fsdem_pic_clear_forces fsdem_pic_clear_forces_f
 #define fsdem_pic_create fsdem_pic_create_f
+#define fsdem_pic_dem_advance fsdem_pic_dem_advance_f
+#define fsdem_pic_dem_create fsdem_pic_dem_create_f
+#define fsdem_pic_dem_desc_check fsdem_pic_dem_desc_check_f
+#define fsdem_pic_dem_desc_default fsdem_pic_dem_desc_default_f
+#define fsdem_pic_dem_destroy fsdem_pic_dem_destroy_f
+#define fsdem_pic_dem_get_body fsdem_pic_dem_get_body_f
+#define fsdem_pic_dem_get_desc fsdem_pic_dem_get_desc_f
+#define fsdem_pic_dem_get_stats fsdem_pic_dem_get_stats_f
+#define fsdem_pic_dem_last_error fsdem_pic_dem_last_error_f
+#define fsdem_pic_dem_stable_dt fsdem_pic_dem_stable_dt_f
+#define fsdem_pic_dem_step fsdem_pic_dem_step_f
+#define fsdem_pic_dem_step_dt fsdem_pic_dem_step_dt_f
+#define fsdem_pic_dem_time fsdem_pic_dem_time_f
 #define fsdem_pic_desc_check fsdem_pic_desc_check_f
 #define fsdem_pic_desc_default fsdem_pic_desc_default_f
 #define fsdem_pic_destroy fsdem_pic_destroy_f
+#define fsdem_pic_exclude_particles fsdem_pic_exclude_particles_f
 #define fsdem_pic_fill_box fsdem_pic_fill_box_f
 #define fsdem_pic_fill_sdf fsdem_pic_fill_sdf_f
 #define fsdem_pic_gauge fsdem_pic_gauge_f
@@ -1233,9 +1253,17 @@ FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
    - acceleration[a][f]: extra acceleration (m/s^2) added with gravity (default 0; kept until
      changed; fsdem_pic_add_force adds to it, fsdem_pic_clear_forces zeroes it);
    - pressure_rhs[c]: added to the right-hand side of the pressure equation
-     sum_f E_f (p_c - p_nb) = -(rho dx^2/dt) div (Pa; default 0, kept until changed).
+     sum_f E_f (p_c - p_nb) = -(rho dx^2/dt) div (Pa; default 0, kept until changed);
+   - reference[c]: the part of cell c's fluid-fraction kernel that moving solids leave open (default
+     1): the particle count of a full cell is divided by it, as by the static obstacles' own part, so
+     that water around a moving body reads full and keeps its pressure;
+   - shear[a][f] (read only; NULL without viscosity): the viscous force component a (N; N/m in 2D)
+     that the liquid exerted on the closed face f (E = 0) during the last step's implicit viscous
+     solve, rho nu dx^(dim-2) sum (u_nb - us_f) over the liquid faces next to it; the liquid got
+     exactly the opposite, so a coupler that hands it to the solid conserves momentum.
    A cell whose faces are all closed becomes SOLID. Particles are pushed out of static obstacles
-   only; keeping them out of moving solids is the coupler's part. */
+   in every step; moving solids are the coupler's (fsdem_pic_exclude_particles). The arrays are read
+   by the next step, which recounts the fluid fractions after this call. */
 typedef struct fsdem_pic_coupling {
     int dim;
     int n[3];
@@ -1244,6 +1272,8 @@ typedef struct fsdem_pic_coupling {
     fsdem_real *solid_velocity[3];
     fsdem_real *acceleration[3];
     fsdem_real *pressure_rhs;
+    fsdem_real *reference;
+    const fsdem_real *shear[3];
 } fsdem_pic_coupling;
 
 FSDEM_API fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *pic);
@@ -1267,6 +1297,15 @@ FSDEM_API fsdem_result fsdem_pic_add_force(fsdem_pic *pic, fsdem_vec3 point, fsd
                                           int *taken);
 /* Zeroes the coupling accelerations. */
 FSDEM_API fsdem_result fsdem_pic_clear_forces(fsdem_pic *pic);
+/* Keeps particles out of a solid region given by `solid` (distance in m, positive in the liquid,
+   with the unit normal towards the liquid; `user` is passed on), such as moving bodies after they
+   moved. Particles at a distance below 1e-3 dx are moved along the normal to 1e-3 dx (`remove` = 0:
+   the liquid the region swept is kept and the density projection of later steps spreads it) or
+   removed (`remove` = 1: the liquid the region now holds, e.g. where a body is first placed). The
+   number moved or removed goes to *count (may be NULL). FSDEM_ERR_INVALID_ARG for NULL pic or
+   solid, FSDEM_ERR_NAN (the particle is named; nothing moved) when the distance is not finite. */
+FSDEM_API fsdem_result fsdem_pic_exclude_particles(fsdem_pic *pic, fsdem_sdf_fn solid, void *user, int remove,
+                                                   int *count);
 
 /* ---- gauges ---- */
 
@@ -2278,6 +2317,130 @@ typedef struct fsdem_mps_dem_stats {
 } fsdem_mps_dem_stats;
 
 FSDEM_API fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *coupler);
+
+/* ===== >>couple_pic : resolved cut-cell PIC-DEM (seed 000) ========================================= */
+
+/* Two-way coupling of PIC/FLIP water (fsdem_pic) with DEM discs (2D) or spheres (3D) (fsdem_dem)
+   that the water sees at their true shape, after seed 000 §2. Every coupled step of dt:
+     1. predicted body velocities Q* = (V*, w*) = Q^n + dt M^-1 (F_g + F_collision^n): gravity and
+        the contact forces of the DEM's last step (Eq. 6, with the collisions at time n as the seed's
+        prediction; fixed DEM particles keep their velocity);
+     2. each body becomes a moving cut-cell solid of the PIC (fsdem_pic_get_coupling): for every
+        face near it the closed fraction 1 - E_b from its exact signed distance (sampled as the
+        static obstacles are), and on the face the solid velocity V* + w* x (x_f - X_b). Bodies do
+        not overlap (the gap below), so on a face shared by two the closed parts add and the solid
+        velocity is their closed-fraction-weighted mean: the solid flux is exact. The cells whose
+        fluid-fraction kernel a body covers get the reference that keeps them full;
+     3. the implicit solid velocity of Eq. 5-6: the solid flux of cell c, J_c . Q / dx with
+        J_c = sum over c's faces of s (1 - E_b) [e_a, (x_f - X_b) x e_a] (s = +1 on the upper face,
+        -1 on the lower), enters the pressure equation with Q^{n+1} = Q* + dt M^-1 G, where
+        G = dx^(dim-1) sum_c p_c J_c is the pressure force and torque. This adds the symmetric
+        positive semi-definite term rho dx^dim J M^-1 J^T p to the operator (fsdem_pic_set_pressure
+        _extra), so the pressure and the body velocities are solved together: no added-mass
+        instability however light the body. G is the discrete adjoint of the solid flux: the
+        pressure's power on the bodies equals minus the power it spends on the water they
+        displace, and in hydrostatic water G = rho g dx^dim sum (1 - E) over the faces normal to
+        gravity, the body volume as the faces see it;
+     4. one PIC step; then the fluid force on each body is G from the step's pressure plus the
+        viscous force, the momentum the implicit viscous solve gave the closed faces of the body
+        (fsdem_pic_coupling.shear), with their moments about the centre. The water loses exactly
+        what the bodies gain (both are the same face sums), so momentum is conserved to the solver
+        tolerance. The viscous force is explicit in the body velocity: the step is limited to
+        desc.viscous_dt_fraction of a body's viscous relaxation time;
+     5. the DEM over dt in K = INT(dt/dt_DEM) substeps (Eq. 25, fsdem_dem_advance) with the fluid
+        force and torque held: with the DEM's predictor-corrector integrator these are Eq. 21-24,
+        except that the fluid impulse is spread evenly over the substeps instead of given at the
+        start (the same end velocity; positions differ by O(dt^2 F/m));
+     6. the gap (§2.2.2): the DEM's contact_offset is the imaginary boundary of Eq. 19 (the seed
+        uses 2 dx), so contacts start before the real surfaces meet and a gap of open cells stays
+        between them. In the contact area of every contact (a square of side desc.contact_length,
+        4 dx in the seed, centred on the middle of the gap) the water particles' velocities are
+        multiplied by C (Eq. 20), linear in the distance from the contact point along the tangent:
+        desc.dissipation (beta) at the point, 1 at the area's edge; beta = 1 switches it off;
+     7. the water particles inside a body at its new position are moved to its surface
+        (fsdem_pic_exclude_particles); the density projection of later steps spreads them. On
+        creation, and when bodies are added, the particles inside the new bodies are removed.
+   Forces are per unit depth in the 2D PIC; the DEM's discs of length disc_length receive them
+   times that length. Contacts with domain walls are the DEM's walls (add them to the DEM). */
+
+typedef struct fsdem_pic_dem fsdem_pic_dem;
+
+typedef struct fsdem_pic_dem_desc {
+    fsdem_pic *pic;                /* water; not owned; must outlive the coupler */
+    fsdem_dem *dem;                /* bodies; same dim and gravity as the PIC; not owned; its */
+                                   /*    contact_offset is the imaginary boundary (Eq. 19) */
+    fsdem_real dissipation;        /* -; beta of Eq. 20 in [0, 1]; 1 switches it off; default 0.5 */
+    fsdem_real contact_length;     /* m; side of the contact area of Eq. 20; 0: 4 dx; default 0 */
+    fsdem_real viscous_dt_fraction; /* -; coupled step <= this fraction of the shortest viscous */
+                                   /*    relaxation time of a body, in (0, 1]; default 0.5 */
+    long long max_substeps;        /* DEM substeps one coupled step may take; a longer step is */
+                                   /*    refused before anything moves; default 100000 */
+    fsdem_log_fn log;              /* optional; default NULL */
+    void *log_user;
+} fsdem_pic_dem_desc;
+
+FSDEM_API fsdem_pic_dem_desc fsdem_pic_dem_desc_default(void);
+/* Checks a desc: both solvers set, the same dim and gravity, the ranges above. FSDEM_OK or
+   FSDEM_ERR_INVALID_ARG with the reason, naming the field, in `message` (may be NULL). */
+FSDEM_API fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *desc, char *message, size_t message_size);
+/* Creates a coupler (its memory from the DEM's allocator), removes the water particles inside the
+   bodies and installs the implicit term in the PIC's pressure operator. FSDEM_ERR_INVALID_ARG as
+   the check (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_pic_dem_destroy
+   removes the term and the moving solids from the PIC and leaves both solvers alive. */
+FSDEM_API fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem **out);
+FSDEM_API void fsdem_pic_dem_destroy(fsdem_pic_dem *coupler);
+FSDEM_API const char *fsdem_pic_dem_last_error(const fsdem_pic_dem *coupler);
+/* The desc in force (contact_length resolved). */
+FSDEM_API fsdem_pic_dem_desc fsdem_pic_dem_get_desc(const fsdem_pic_dem *coupler);
+
+/* The fluid's load on one body in the last coupled step (whole body: N and N m, the 2D PIC's per
+   metre values times disc_length). */
+typedef struct fsdem_pic_dem_body {
+    fsdem_vec3 pressure_force;   /* N; G of step 3 */
+    fsdem_vec3 viscous_force;    /* N; step 4 */
+    fsdem_vec3 torque;           /* N m; pressure and viscous, about the centre */
+    fsdem_real volume;           /* m^3; the body volume the faces see: dx^dim sum (1 - E) over */
+                                 /*    the faces of every axis, divided by dim (per metre in 2D) */
+    int faces;                   /* faces the body covers or cuts */
+} fsdem_pic_dem_body;
+
+/* Load on DEM particle `index` from the last step. FSDEM_ERR_NOT_FOUND for a bad index or before the
+   first step. */
+FSDEM_API fsdem_result fsdem_pic_dem_get_body(const fsdem_pic_dem *coupler, int index, fsdem_pic_dem_body *out);
+/* One coupled step of the stable dt. The DEM substep count is checked before anything moves
+   (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of either solver are passed on with their
+   message. */
+FSDEM_API fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *coupler);
+/* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite, FSDEM_ERR_CFL
+   when dt exceeds the PIC's cfl_max, a body would move more than cfl_max cells or dt exceeds the
+   viscous limit; nothing moved then. */
+FSDEM_API fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *coupler, fsdem_real dt);
+/* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
+FSDEM_API fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *coupler, fsdem_real duration, long long *steps);
+/* Stable coupled step (s): the PIC's, the bodies' speed over the PIC's cfl (cfl dx / (|V| + |w| r +
+   sqrt(|g| dx))) and the viscous limit. FSDEM_ERR_NAN when a velocity is not finite. */
+FSDEM_API fsdem_result fsdem_pic_dem_stable_dt(fsdem_pic_dem *coupler, fsdem_real *dt);
+/* The PIC time (s). */
+FSDEM_API double fsdem_pic_dem_time(const fsdem_pic_dem *coupler);
+
+typedef struct fsdem_pic_dem_stats {
+    long long steps;             /* coupled steps */
+    double time;                 /* s */
+    fsdem_real dt;               /* s, the last coupled step */
+    long long substeps;          /* DEM substeps of the last step */
+    long long substeps_total;
+    fsdem_vec3 fluid_force;      /* N; sum of the fluid forces on the bodies, last step */
+    fsdem_real viscous_dt;       /* s; the viscous limit of the last step (0: none) */
+    int contacts;                /* contacts (gap areas) after the last step */
+    long long dissipated;        /* particle velocities scaled by Eq. 20, total */
+    long long pushed;            /* particles moved out of bodies, total */
+    long long removed;           /* particles removed inside new bodies, total */
+    double seconds_pic;          /* CPU seconds in PIC steps */
+    double seconds_dem;          /* CPU seconds in DEM substeps */
+    double seconds_coupling;     /* CPU seconds in the coupling (faces, forces, gap, exclusion) */
+} fsdem_pic_dem_stats;
+
+FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupler);
 
 /* ===== >>restart : checkpoint and restart ========================================================= */
 
@@ -7197,6 +7360,7 @@ struct fsdem_pic {
     fsdem_real *u[3], *uold[3], *wsum[3], *ftmp[3];
     fsdem_real *sopen[3], *svel[3];           /* static obstacles: open fraction, solid velocity */
     fsdem_real *copen[3], *cvel[3], *cacc[3]; /* coupler arrays */
+    fsdem_real *shear[3];                     /* viscous force on closed faces (viscosity > 0) */
     fsdem_real *E[3], *us[3];                 /* effective open fraction and solid velocity */
     unsigned char *fvalid[3], *fvalid2[3];
     int *fqueue; /* breadth-first front of the extrapolation, max(nface) entries */
@@ -7204,6 +7368,7 @@ struct fsdem_pic {
 
     /* cells */
     fsdem_real *frac, *fref, *phi, *pres, *rhs, *diag, *ctmp, *crhs;
+    fsdem_real *cref; /* coupler's factor on fref (moving solids) */
     unsigned char *ctype, *cnear, *csolid;
     int *cstart; /* ncell + 1 */
 
@@ -7466,6 +7631,7 @@ static int fsdem__pic_arrays(fsdem_pic *s, fsdem__pic_array t[FSDEM__PIC_MAX_ARR
         FSDEM__PIC_BYTES(fvalid[a], nf);
         FSDEM__PIC_BYTES(fvalid2[a], nf);
         if (s->desc.viscosity > 0) {
+            FSDEM__PIC_REALS(shear[a], nf, 0);
             FSDEM__PIC_BYTES(vcell[a], nf);
             for (b = 0; b < s->dim; ++b) {
                 size_t m = 1;
@@ -7482,6 +7648,7 @@ static int fsdem__pic_arrays(fsdem_pic *s, fsdem__pic_array t[FSDEM__PIC_MAX_ARR
     FSDEM__PIC_REALS(diag, nc, 0);
     FSDEM__PIC_REALS(ctmp, nc, 0);
     FSDEM__PIC_REALS(crhs, nc, 0);
+    FSDEM__PIC_REALS(cref, nc, 1);
     FSDEM__PIC_BYTES(ctype, nc);
     FSDEM__PIC_BYTES(cnear, nc);
     FSDEM__PIC_BYTES(csolid, nc);
@@ -7697,8 +7864,10 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
         s->coupling.open[a] = s->copen[a];
         s->coupling.solid_velocity[a] = s->cvel[a];
         s->coupling.acceleration[a] = s->cacc[a];
+        s->coupling.shear[a] = s->shear[a];
     }
     s->coupling.pressure_rhs = s->crhs;
+    s->coupling.reference = s->cref;
     fsdem__pic_static_flags(s);
     fsdem__pic_compute_fref(s);
     *out = s;
@@ -7837,32 +8006,40 @@ static fsdem_real fsdem__pic_frac3(fsdem_real a, fsdem_real b, fsdem_real c) {
    chain of cells joined only by such faces, a near-singular pressure operator. Counted as on the
    surface, a sample point there is solid (fsdem__pic_frac2 opens only d > 0), so a side on a face
    and a side a hair off it give the same fractions. */
-static fsdem_real fsdem__pic_face_sample(const fsdem_pic *s, fsdem_vec3 p) {
-    fsdem_real d = fsdem__pic_obst_min(s, p, NULL);
+typedef fsdem_real (*fsdem__pic_dist_fn)(const void *solid, fsdem_vec3 p);
+
+static fsdem_real fsdem__pic_face_sample(const fsdem_pic *s, fsdem__pic_dist_fn dist, const void *solid, fsdem_vec3 p) {
+    fsdem_real d = dist(solid, p);
     return (fsdem_real)fabs(d) <= s->surface_tol ? 0 : d;
 }
 
+/* The obstacle union as a fsdem__pic_dist_fn (`solid` is the solver). */
+static fsdem_real fsdem__pic_obstacles_dist(const void *solid, fsdem_vec3 p) {
+    return fsdem__pic_obst_min((const fsdem_pic *)solid, p, NULL);
+}
+
 /* Open fraction of the face of axis a with lower corner `c0` (m), spanning one cell along the
-   other axes, for the obstacle union. */
-static fsdem_real fsdem__pic_face_fraction(const fsdem_pic *s, int a, fsdem_vec3 c0) {
+   other axes, outside the solid whose signed distance is dist(solid, p) (the obstacle union, or a
+   coupler's moving body). */
+static fsdem_real fsdem__pic_face_fraction(const fsdem_pic *s, int a, fsdem_vec3 c0, fsdem__pic_dist_fn dist, const void *solid) {
     const int S = FSDEM__PIC_SUB;
     fsdem_real h = s->dx / S, v[FSDEM__PIC_SUB + 1][FSDEM__PIC_SUB + 1], sum = 0;
     int b1 = (a + 1) % 3, b2 = (a + 2) % 3, i, j;
     if (s->dim == 2) {
         int b = a == 0 ? 1 : 0;
-        for (i = 0; i <= S; ++i) v[0][i] = fsdem__pic_face_sample(s, fsdem__pic_axis_shift(c0, b, h * (fsdem_real)i));
+        for (i = 0; i <= S; ++i) v[0][i] = fsdem__pic_face_sample(s, dist, solid, fsdem__pic_axis_shift(c0, b, h * (fsdem_real)i));
         for (i = 0; i < S; ++i) sum += fsdem__pic_frac2(v[0][i], v[0][i + 1]);
         return sum / S;
     }
     for (j = 0; j <= S; ++j)
         for (i = 0; i <= S; ++i)
             v[j][i] = fsdem__pic_face_sample(
-                s, fsdem__pic_axis_shift(fsdem__pic_axis_shift(c0, b1, h * (fsdem_real)i), b2, h * (fsdem_real)j));
+                s, dist, solid, fsdem__pic_axis_shift(fsdem__pic_axis_shift(c0, b1, h * (fsdem_real)i), b2, h * (fsdem_real)j));
     for (j = 0; j < S; ++j)
         for (i = 0; i < S; ++i) {
             fsdem_vec3 m = fsdem__pic_axis_shift(fsdem__pic_axis_shift(c0, b1, h * ((fsdem_real)i + (fsdem_real)0.5)), b2,
                                                  h * ((fsdem_real)j + (fsdem_real)0.5));
-            fsdem_real vc = fsdem__pic_face_sample(s, m);
+            fsdem_real vc = fsdem__pic_face_sample(s, dist, solid, m);
             sum += fsdem__pic_frac3(vc, v[j][i], v[j][i + 1]) + fsdem__pic_frac3(vc, v[j][i + 1], v[j + 1][i + 1]) +
                    fsdem__pic_frac3(vc, v[j + 1][i + 1], v[j + 1][i]) + fsdem__pic_frac3(vc, v[j + 1][i], v[j][i]);
         }
@@ -7902,7 +8079,7 @@ static int fsdem__pic_static_faces(const fsdem_pic *s, fsdem_real *open[3], fsde
                     if (d > reach) continue;
                     p = fsdem__pic_axis_shift(p, (a + 1) % s->dim, -s->dx / 2);
                     if (s->dim == 3) p = fsdem__pic_axis_shift(p, (a + 2) % 3, -s->dx / 2);
-                    open[a][f] = fsdem__pic_face_fraction(s, a, p);
+                    open[a][f] = fsdem__pic_face_fraction(s, a, p, fsdem__pic_obstacles_dist, s);
                 }
     for (k = 0; k < s->n[2]; ++k)
         for (j = 0; j < s->n[1]; ++j)
@@ -8591,6 +8768,11 @@ static int fsdem__pic_g2p(fsdem_pic *s) {
 /* Reference fractions below this mark cells mostly inside obstacles (see fsdem__pic_fraction). */
 #define FSDEM__PIC_FREF_RELIABLE ((fsdem_real)0.5)
 
+/* Cell c is mostly inside static obstacles or moving solids (its particle count is unreliable). */
+static int fsdem__pic_mostly_solid(const fsdem_pic *s, int c) {
+    return (s->cnear[c] || s->cref[c] < 1) && s->fref[c] * s->cref[c] < FSDEM__PIC_FREF_RELIABLE;
+}
+
 /* E and us of every face from the static obstacles, the coupler arrays and the domain sides. */
 static void fsdem__pic_effective_faces(fsdem_pic *s) {
     int a, i, j, k;
@@ -8649,7 +8831,8 @@ static void fsdem__pic_fraction(fsdem_pic *s) {
         }
     }
     for (c = 0; c < s->ncell; ++c) {
-        fsdem_real f = s->fref[c] > (fsdem_real)1e-3 ? s->frac[c] * inv_ppc / s->fref[c] : 0;
+        const fsdem_real ref = s->fref[c] * s->cref[c];
+        fsdem_real f = ref > (fsdem_real)1e-3 ? s->frac[c] * inv_ppc / ref : 0;
         s->frac[c] = f;
         if (f >= 1) s->phi[c] = -s->dx;
         else if (f >= (fsdem_real)0.5) s->phi[c] = -s->dx * (1 - (fsdem_real)sqrt(2 * (1 - f)));
@@ -8658,8 +8841,8 @@ static void fsdem__pic_fraction(fsdem_pic *s) {
     /* In cells mostly inside obstacles the count of a few particles over a small reference is
        unreliable (an isolated "air" cell under water would put p = 0 deep in the liquid); their
        phi is extended from the neighbours that are mostly open, as level sets are extended into
-       solids. */
-    if (s->obst_count) {
+       solids (static obstacles and the coupler's moving ones alike). */
+    {
         int i, j, k, a, sg, coord[3];
         for (k = 0; k < s->n[2]; ++k)
             for (j = 0; j < s->n[1]; ++j)
@@ -8667,7 +8850,7 @@ static void fsdem__pic_fraction(fsdem_pic *s) {
                     fsdem_real sum = 0;
                     int cnt = 0;
                     c = fsdem__pic_cell(s, i, j, k);
-                    if (!s->cnear[c] || s->fref[c] >= FSDEM__PIC_FREF_RELIABLE) continue;
+                    if (!fsdem__pic_mostly_solid(s, c)) continue;
                     coord[0] = i;
                     coord[1] = j;
                     coord[2] = k;
@@ -8676,7 +8859,7 @@ static void fsdem__pic_fraction(fsdem_pic *s) {
                             int nc = coord[a] + sg, nb;
                             if (nc < 0 || nc >= s->n[a]) continue;
                             nb = c + sg * s->cstep[a];
-                            if (s->fref[nb] < FSDEM__PIC_FREF_RELIABLE) continue;
+                            if (s->fref[nb] * s->cref[nb] < FSDEM__PIC_FREF_RELIABLE) continue;
                             sum += s->phi[nb];
                             cnt++;
                         }
@@ -8684,7 +8867,7 @@ static void fsdem__pic_fraction(fsdem_pic *s) {
                     else s->ctmp[c] = s->phi[c];
                 }
         for (c = 0; c < s->ncell; ++c)
-            if (s->cnear[c] && s->fref[c] < FSDEM__PIC_FREF_RELIABLE) s->phi[c] = s->ctmp[c];
+            if (fsdem__pic_mostly_solid(s, c)) s->phi[c] = s->ctmp[c];
     }
 }
 
@@ -8819,6 +9002,34 @@ static int fsdem__pic_layers(const fsdem_pic *s) {
 
 /* ---- >>pic_viscosity : implicit nu lap(u), one stencil solve per component ---- */
 
+/* The viscous force on the closed faces of component a after its solve (fsdem_pic_coupling.shear):
+   each unknown face f next to a closed face g lost rho dx^dim (dt nu / dx^2)(u_f - us_g) of
+   momentum to it over dt, the Dirichlet term of the solve, so the forces sum to the momentum the
+   liquid lost to solids. */
+static void fsdem__pic_shear(fsdem_pic *s, int a) {
+    const int *fn = s->fn[a];
+    const unsigned char *cell = s->vcell[a];
+    fsdem_real c = s->desc.density * s->desc.viscosity * (s->dim == 3 ? s->dx : 1);
+    int b, i, j, k, sg, coord[3];
+    memset(s->shear[a], 0, sizeof(fsdem_real) * (size_t)s->nface[a]);
+    for (k = 0; k < fn[2]; ++k)
+        for (j = 0; j < fn[1]; ++j)
+            for (i = 0; i < fn[0]; ++i) {
+                int f = (k * fn[1] + j) * fn[0] + i;
+                if (cell[f] != FSDEM_STENCIL_CELL_FLUID) continue;
+                coord[0] = i;
+                coord[1] = j;
+                coord[2] = k;
+                for (b = 0; b < s->dim; ++b)
+                    for (sg = -1; sg <= 1; sg += 2) {
+                        int nc = coord[b] + sg, g;
+                        if (nc < 0 || nc >= fn[b]) continue;
+                        g = f + sg * s->fstep[a][b];
+                        if (cell[g] != FSDEM_STENCIL_CELL_FLUID && s->E[a][g] <= 0) s->shear[a][g] += c * (s->u[a][f] - s->us[a][g]);
+                    }
+            }
+}
+
 /* Solves (I - dt nu L) u = u* on every face with E > 0 next to a fluid cell. The face grid of each
    component is a stencil grid of its own; the equation is divided by k = dt nu / dx^2:
        u/k + sum_nb (u - u_nb) + sum_dirichlet c (u - U) = u_star/k,
@@ -8899,6 +9110,7 @@ static fsdem_result fsdem__pic_viscosity(fsdem_pic *s, fsdem_real dt) {
         if (r == FSDEM_OK) r = fsdem_pcg_solve(s->pcg_v[a], rhs, s->u[a], &info);
         else info.iterations = 0;
         s->v_iters += info.iterations;
+        fsdem__pic_shear(s, a);
         if (r != FSDEM_OK && worst == FSDEM_OK) {
             worst = r;
             fsdem__fail(&s->status, r, "fsdem_pic: viscous solve of component %c failed: %s", "xyz"[a],
@@ -9151,7 +9363,7 @@ static fsdem_result fsdem__pic_density_projection(fsdem_pic *s) {
     for (k = 0; k < s->n[2]; ++k)
         for (j = 0; j < s->n[1]; ++j)
             for (i = 0; i < s->n[0]; ++i) {
-                fsdem_real f, rr;
+                fsdem_real f, rr, ref;
                 int surface = 0, coord[3];
                 c = fsdem__pic_cell(s, i, j, k);
                 s->ctmp[c] = 0;
@@ -9174,11 +9386,12 @@ static fsdem_result fsdem__pic_density_projection(fsdem_pic *s) {
                 if (f > (fsdem_real)1.5) f = (fsdem_real)1.5;
                 rr = 1 - f;
                 if (surface && rr > 0) rr = 0;
-                if (s->fref[c] < FSDEM__PIC_FREF_RELIABLE) rr = 0; /* count unreliable (mostly solid) */
+                ref = s->fref[c] * s->cref[c];
+                if (ref < FSDEM__PIC_FREF_RELIABLE) rr = 0; /* count unreliable (mostly solid) */
                 if (rr != 0) any = 1;
                 /* the volume to move is the deficit of the open part of the cell; the fluxes
                    through the faces are weighted by their open fractions E like the pressure's */
-                s->rhs[c] = -dx2 * rr * (s->fref[c] < 1 ? s->fref[c] : 1);
+                s->rhs[c] = -dx2 * rr * (ref < 1 ? ref : 1);
             }
     s->d_iters = 0;
     if (!any) return FSDEM_OK;
@@ -9309,7 +9522,8 @@ static int fsdem__pic_donor(fsdem_pic *s, int i, int j, int k, int *taken) {
 /* Keeps the particle counts of the cells in range without changing the water volume (the particle
    count is the volume once the density projection has evened the particles out):
    - cells with more than max_particles_per_cell lose the excess;
-   - interior fluid cells (no air neighbour) with fewer than min_particles_per_cell and a fluid
+   - interior fluid cells (no air neighbour) with fewer than min_particles_per_cell (times the part
+     of the cell's kernel that solids leave open) and a fluid
      fraction below 1 get particles up to that minimum (with the grid velocity), each one taken
      from a crowded neighbour (more than particles_per_cell); without such a neighbour nothing is
      added (the density projection evens out the rest);
@@ -9355,7 +9569,9 @@ static int fsdem__pic_reseed(fsdem_pic *s) {
                         if (fsdem__pic_random_in_cell(s, i, j, k, &x)) fsdem__pic_append(s, x, s->desc.boundary_velocity[inflow]);
                     continue;
                 }
-                if (minp > 0 && count < minp && interior && s->ctype[c] == FSDEM_STENCIL_CELL_FLUID && s->frac[c] < 1) {
+                /* the minimum is that of the cell's open part (the solids' share of the kernel aside) */
+                if (minp > 0 && count < minp * s->fref[c] * s->cref[c] && interior && s->ctype[c] == FSDEM_STENCIL_CELL_FLUID &&
+                    s->frac[c] < 1) {
                     fsdem_vec3 x;
                     for (q = count; q < minp; ++q) {
                         int donor;
@@ -9608,7 +9824,10 @@ fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *s) {
 
 fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *s) {
     fsdem_pic_coupling c;
-    if (s) return s->coupling;
+    if (s) {
+        s->cells_fresh = 0; /* the caller may change the references: the next step recounts the cells */
+        return s->coupling;
+    }
     memset(&c, 0, sizeof c);
     return c;
 }
@@ -9738,6 +9957,45 @@ fsdem_result fsdem_pic_clear_forces(fsdem_pic *s) {
     int a;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     for (a = 0; a < s->dim; ++a) memset(s->cacc[a], 0, sizeof(fsdem_real) * (size_t)s->nface[a]);
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_pic_exclude_particles(fsdem_pic *s, fsdem_sdf_fn solid, void *user, int remove, int *count) {
+    const fsdem_real eps = s ? s->dx * (fsdem_real)1e-3 : 0;
+    int p, it, n = 0;
+    if (count) *count = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!solid) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_exclude_particles: NULL solid callback");
+    /* the new positions go to ptmp first, so a distance that is not a number leaves every particle */
+    for (p = 0; p < s->np; ++p) {
+        fsdem_vec3 x = s->px[p], nrm;
+        fsdem_real d = solid(user, x, &nrm);
+        s->pflag[p] = 0;
+        for (it = 0; it < 3 && d < eps; ++it) {
+            if (!fsdem__finite(d) || !fsdem__finite3(nrm)) break;
+            s->pflag[p] = 1;
+            if (remove) break;
+            x = fsdem__madd(x, nrm, eps - d);
+            d = solid(user, x, &nrm);
+        }
+        if (!fsdem__finite(d) || !fsdem__finite3(nrm))
+            return fsdem__fail(&s->status, FSDEM_ERR_NAN,
+                               "fsdem_pic_exclude_particles: the solid's distance at particle %d (%g, %g, %g) is not finite", p,
+                               (double)s->px[p].x, (double)s->px[p].y, (double)s->px[p].z);
+        s->ptmp[p] = x;
+        n += s->pflag[p];
+    }
+    if (n) {
+        if (remove) {
+            fsdem__pic_remove_marked(s);
+            s->removed += n;
+        } else {
+            memcpy(s->px, s->ptmp, sizeof(fsdem_vec3) * (size_t)s->np);
+            memset(s->pflag, 0, (size_t)s->np); /* the steps mark particles to remove in it */
+        }
+        fsdem__pic_refresh(s);
+    }
+    if (count) *count = n;
     return fsdem__ok(&s->status);
 }
 
@@ -14342,6 +14600,850 @@ fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *c) {
     return st;
 }
 
+/* ===== >>impl_couple_pic : resolved PIC-DEM ==========================================================
+
+   Contents: >>couple_pic_object (desc, creation, per-body storage), >>couple_pic_faces (bodies as
+   moving cut-cell solids: face fractions, solid velocities, J, references), >>couple_pic_exchange
+   (the implicit pressure term, fluid forces), >>couple_pic_gap (Eq. 20, particles out of bodies),
+   >>couple_pic_step (coupled time stepping). The coupler writes the PIC through its coupling
+   functions and cuts the faces with the PIC's own face-fraction routine (fsdem__pic_face_fraction),
+   so static obstacles and moving bodies are cut alike. */
+
+/* ---- >>couple_pic_object : desc, creation, per-body storage ---- */
+
+/* For every PIC cell, the items (bodies or contacts) whose box covers it: item[start[c] ..
+   start[c + 1]). */
+typedef struct fsdem__pic_dem_map {
+    int *start; /* ncell + 1 */
+    int *item;
+    int item_cap;
+} fsdem__pic_dem_map;
+
+struct fsdem_pic_dem {
+    fsdem_pic_dem_desc desc;
+    fsdem__status status;
+    fsdem_allocator allocator;
+    int dim;
+    fsdem_real rho, nu;            /* liquid density, kinematic viscosity */
+    fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC works per metre), 1 in 3D */
+    fsdem_vec3 gravity;            /* m/s^2 */
+    /* per body (DEM particle), `bodies` of them */
+    int bodies, body_cap;
+    fsdem_vec3 *vstar, *wstar;     /* predicted velocities Q* (step 1) */
+    fsdem_real *inv_m, *inv_i;     /* 1/kg and 1/(kg m^2) per metre of depth (0: fixed) */
+    fsdem_vec3 *fp, *fv, *tq;      /* last step's loads on the whole body (N, N m) */
+    fsdem_real *volume;            /* m^3 (m^2 in 2D) as the faces see it */
+    fsdem_real *relax;             /* s; viscous relaxation time (0: none) */
+    /* faces each body covers or cuts: entries face_start[b] .. face_start[b + 1] */
+    int *face_start;
+    int *face;                     /* face index in its axis */
+    unsigned char *face_axis;
+    fsdem_real *face_closed;       /* 1 - E_b */
+    int face_count, face_cap;
+    /* J of each body: cells jac_start[b] .. jac_start[b + 1], linear and angular parts */
+    int *jac_start, *jac_cell;
+    fsdem_vec3 *jac_v, *jac_w;
+    int jac_count, jac_cap;
+    int *ref_cell;                 /* cells whose reference the coupler lowered */
+    int ref_count, ref_cap;
+    int *slot;                     /* per cell: entry of the current body's J, -1 */
+    fsdem__pic_dem_map body_map, contact_map;
+    fsdem_dem_contact *contact;    /* contacts after the last step, and their points (step 6) */
+    fsdem_vec3 *contact_point;
+    int contact_count, contact_cap;
+    int operator_set;              /* the pressure term is installed */
+    /* statistics */
+    long long steps, substeps, substeps_total, dissipated, pushed, removed;
+    fsdem_real dt_last, viscous_dt;
+    fsdem_vec3 force_sum;
+    double sec_pic, sec_dem, sec_coupling;
+    int loaded;                    /* the loads of a step are in fp, fv, tq */
+};
+
+fsdem_pic_dem_desc fsdem_pic_dem_desc_default(void) {
+    fsdem_pic_dem_desc d;
+    memset(&d, 0, sizeof d);
+    d.dissipation = (fsdem_real)0.5;
+    d.contact_length = 0;
+    d.viscous_dt_fraction = (fsdem_real)0.5;
+    d.max_substeps = 100000;
+    return d;
+}
+
+fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *d, char *msg, size_t size) {
+    fsdem_dem_desc dd;
+    fsdem_pic_desc pd;
+    if (!d) return fsdem__reject(msg, size, "fsdem_pic_dem_desc is NULL");
+    if (!d->pic || !d->dem) return fsdem__reject(msg, size, "fsdem_pic_dem_desc.pic and .dem must both be set");
+    dd = fsdem_dem_get_desc(d->dem);
+    pd = fsdem_pic_get_desc(d->pic);
+    if (dd.dim != pd.dim) return fsdem__reject(msg, size, "fsdem_pic_dem_desc: the DEM is %dD and the PIC %dD", dd.dim, pd.dim);
+    if (fsdem__norm(fsdem__sub(dd.gravity, pd.gravity)) > 1e-12 * fsdem__norm(pd.gravity))
+        return fsdem__reject(msg, size, "fsdem_pic_dem_desc: the DEM gravity (%g, %g, %g) differs from the PIC's (%g, %g, %g) m/s^2",
+                             (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)pd.gravity.x,
+                             (double)pd.gravity.y, (double)pd.gravity.z);
+    if (!(d->dissipation >= 0 && d->dissipation <= 1))
+        return fsdem__reject(msg, size, "fsdem_pic_dem_desc.dissipation must be in [0, 1] (got %g)", (double)d->dissipation);
+    if (!(d->contact_length >= 0) || !fsdem__finite(d->contact_length))
+        return fsdem__reject(msg, size, "fsdem_pic_dem_desc.contact_length must be 0 (4 dx) or > 0 (got %g m)",
+                             (double)d->contact_length);
+    if (!(d->viscous_dt_fraction > 0 && d->viscous_dt_fraction <= 1))
+        return fsdem__reject(msg, size, "fsdem_pic_dem_desc.viscous_dt_fraction must be in (0, 1] (got %g)",
+                             (double)d->viscous_dt_fraction);
+    if (d->max_substeps < 1)
+        return fsdem__reject(msg, size, "fsdem_pic_dem_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
+    return FSDEM_OK;
+}
+
+static void fsdem__pic_dem_free_bodies(fsdem_pic_dem *c) {
+    const size_t n = (size_t)c->body_cap, V = sizeof(fsdem_vec3) * n, R = sizeof(fsdem_real) * n;
+    fsdem__free(&c->allocator, c->vstar, V);
+    fsdem__free(&c->allocator, c->wstar, V);
+    fsdem__free(&c->allocator, c->fp, V);
+    fsdem__free(&c->allocator, c->fv, V);
+    fsdem__free(&c->allocator, c->tq, V);
+    fsdem__free(&c->allocator, c->inv_m, R);
+    fsdem__free(&c->allocator, c->inv_i, R);
+    fsdem__free(&c->allocator, c->volume, R);
+    fsdem__free(&c->allocator, c->relax, R);
+    fsdem__free(&c->allocator, c->face_start, sizeof(int) * (n + 1));
+    fsdem__free(&c->allocator, c->jac_start, sizeof(int) * (n + 1));
+    c->vstar = c->wstar = c->fp = c->fv = c->tq = NULL;
+    c->inv_m = c->inv_i = c->volume = c->relax = NULL;
+    c->face_start = c->jac_start = NULL;
+    c->body_cap = 0;
+}
+
+/* Per-body arrays for `n` bodies (zeroed). Allocates only when the DEM has more particles than any
+   step before. */
+static fsdem_result fsdem__pic_dem_reserve_bodies(fsdem_pic_dem *c, int n) {
+    const size_t m = (size_t)(n > 0 ? n : 1), V = sizeof(fsdem_vec3) * m, R = sizeof(fsdem_real) * m;
+    if (n <= c->body_cap && c->vstar) return FSDEM_OK;
+    fsdem__pic_dem_free_bodies(c);
+    c->vstar = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
+    c->wstar = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
+    c->fp = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
+    c->fv = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
+    c->tq = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
+    c->inv_m = (fsdem_real *)fsdem__alloc(&c->allocator, R);
+    c->inv_i = (fsdem_real *)fsdem__alloc(&c->allocator, R);
+    c->volume = (fsdem_real *)fsdem__alloc(&c->allocator, R);
+    c->relax = (fsdem_real *)fsdem__alloc(&c->allocator, R);
+    c->face_start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (m + 1));
+    c->jac_start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (m + 1));
+    c->body_cap = (int)m;
+    if (!c->vstar || !c->wstar || !c->fp || !c->fv || !c->tq || !c->inv_m || !c->inv_i || !c->volume || !c->relax ||
+        !c->face_start || !c->jac_start) {
+        fsdem__pic_dem_free_bodies(c);
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    }
+    memset(c->vstar, 0, V);
+    memset(c->wstar, 0, V);
+    memset(c->fp, 0, V);
+    memset(c->fv, 0, V);
+    memset(c->tq, 0, V);
+    memset(c->volume, 0, R);
+    memset(c->relax, 0, R);
+    memset(c->face_start, 0, sizeof(int) * (m + 1));
+    memset(c->jac_start, 0, sizeof(int) * (m + 1));
+    c->loaded = 0;
+    return FSDEM_OK;
+}
+
+static void fsdem__pic_dem_release(fsdem_pic_dem *c) {
+    const int ncell = c->desc.pic->ncell;
+    fsdem__pic_dem_free_bodies(c);
+    fsdem__free(&c->allocator, c->face, sizeof(int) * (size_t)c->face_cap);
+    fsdem__free(&c->allocator, c->face_axis, (size_t)c->face_cap);
+    fsdem__free(&c->allocator, c->face_closed, sizeof(fsdem_real) * (size_t)c->face_cap);
+    fsdem__free(&c->allocator, c->jac_cell, sizeof(int) * (size_t)c->jac_cap);
+    fsdem__free(&c->allocator, c->jac_v, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
+    fsdem__free(&c->allocator, c->jac_w, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
+    fsdem__free(&c->allocator, c->ref_cell, sizeof(int) * (size_t)c->ref_cap);
+    fsdem__free(&c->allocator, c->slot, sizeof(int) * (size_t)ncell);
+    fsdem__free(&c->allocator, c->body_map.start, sizeof(int) * (size_t)(ncell + 1));
+    fsdem__free(&c->allocator, c->body_map.item, sizeof(int) * (size_t)c->body_map.item_cap);
+    fsdem__free(&c->allocator, c->contact_map.start, sizeof(int) * (size_t)(ncell + 1));
+    fsdem__free(&c->allocator, c->contact_map.item, sizeof(int) * (size_t)c->contact_map.item_cap);
+    fsdem__free(&c->allocator, c->contact, sizeof(fsdem_dem_contact) * (size_t)c->contact_cap);
+    fsdem__free(&c->allocator, c->contact_point, sizeof(fsdem_vec3) * (size_t)c->contact_cap);
+}
+
+static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt);
+static fsdem_result fsdem__pic_dem_exclude(fsdem_pic_dem *c, int from, int remove);
+static void fsdem__pic_dem_clear_faces(fsdem_pic_dem *c);
+static void fsdem__pic_dem_operator(void *user, const fsdem_real *p, fsdem_real *y);
+
+fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem **out) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_allocator al;
+    fsdem_pic_dem *c;
+    fsdem_pic_desc pd;
+    fsdem_result res;
+    int ncell, i;
+    if (out) *out = NULL;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem_pic_dem_desc_check(desc, msg, sizeof msg);
+    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
+    c = (fsdem_pic_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
+                                           res == FSDEM_OK ? &al : NULL, sizeof *c, "fsdem_pic_dem_create", &res);
+    if (!c) return res;
+    pd = fsdem_pic_get_desc(desc->pic);
+    c->desc = *desc;
+    c->allocator = al;
+    c->status.log = desc->log;
+    c->status.log_user = desc->log_user;
+    c->dim = pd.dim;
+    c->rho = pd.density;
+    c->nu = pd.viscosity;
+    c->gravity = pd.gravity;
+    c->depth = pd.dim == 2 ? fsdem_dem_get_desc(desc->dem).disc_length : 1;
+    if (!(desc->contact_length > 0)) c->desc.contact_length = 4 * pd.cell_size; /* seed 000 §2.2.2 */
+    ncell = desc->pic->ncell;
+    c->slot = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)ncell);
+    c->body_map.start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)(ncell + 1));
+    c->contact_map.start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)(ncell + 1));
+    res = c->slot && c->body_map.start && c->contact_map.start ? FSDEM_OK : FSDEM_ERR_OUT_OF_MEMORY;
+    if (res == FSDEM_OK) {
+        for (i = 0; i < ncell; ++i) c->slot[i] = -1;
+        res = fsdem__pic_dem_reserve_bodies(c, fsdem_dem_get_particles(desc->dem).count);
+    }
+    if (res == FSDEM_OK) res = fsdem__pic_dem_exclude(c, 0, 1);
+    if (res == FSDEM_OK) res = fsdem__pic_dem_faces(c, 0);
+    if (res == FSDEM_OK) res = fsdem_pic_set_pressure_extra(desc->pic, fsdem__pic_dem_operator, c);
+    if (res != FSDEM_OK) {
+        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, c->status.message[0] ? c->status.message : "fsdem_pic_dem_create: out of memory");
+        fsdem_pic_dem_destroy(c);
+        return res;
+    }
+    c->operator_set = 1;
+    *out = c;
+    return FSDEM_OK;
+}
+
+void fsdem_pic_dem_destroy(fsdem_pic_dem *c) {
+    fsdem_allocator al;
+    if (!c) return;
+    al = c->allocator;
+    if (c->operator_set) fsdem_pic_set_pressure_extra(c->desc.pic, NULL, NULL);
+    if (c->face) fsdem__pic_dem_clear_faces(c);
+    fsdem__pic_dem_release(c);
+    fsdem__free(&al, c, sizeof *c);
+}
+
+const char *fsdem_pic_dem_last_error(const fsdem_pic_dem *c) { return c ? c->status.message : "fsdem_pic_dem is NULL"; }
+
+fsdem_pic_dem_desc fsdem_pic_dem_get_desc(const fsdem_pic_dem *c) {
+    fsdem_pic_dem_desc d;
+    if (c) return c->desc;
+    memset(&d, 0, sizeof d);
+    return d;
+}
+
+/* ---- >>couple_pic_faces : bodies as moving cut-cell solids ---- */
+
+/* A disc or sphere as a fsdem__pic_dist_fn. */
+typedef struct fsdem__pic_dem_ball {
+    fsdem_vec3 centre;
+    fsdem_real radius;
+} fsdem__pic_dem_ball;
+
+static fsdem_real fsdem__pic_dem_ball_dist(const void *solid, fsdem_vec3 p) {
+    const fsdem__pic_dem_ball *b = (const fsdem__pic_dem_ball *)solid;
+    return fsdem__norm(fsdem__sub(p, b->centre)) - b->radius;
+}
+
+/* Index range [*lo, *hi] along axis q of the grid points at lo_q + (i + off) dx that lie within
+   [x0, x1], clamped to 0 .. count - 1 (empty when *lo > *hi). */
+static void fsdem__pic_dem_range(const fsdem_pic *s, int q, fsdem_real off, fsdem_real x0, fsdem_real x1, int count, int *lo, int *hi) {
+    const fsdem_real o = fsdem__comp(s->lo, q);
+    double a = ceil((double)((x0 - o) * s->inv_dx - off)), b = floor((double)((x1 - o) * s->inv_dx - off));
+    *lo = a < 0 ? 0 : a > count ? count : (int)a;
+    *hi = b >= count ? count - 1 : b < -1 ? -1 : (int)b;
+}
+
+/* Adds `v`, `w` to cell `cell`'s entry of the J of the body being cut (entries from `first`). */
+static fsdem_result fsdem__pic_dem_jac_add(fsdem_pic_dem *c, int cell, fsdem_vec3 v, fsdem_vec3 w) {
+    int e = c->slot[cell];
+    if (e < 0) {
+        int cap = c->jac_cap;
+        if (c->jac_count == c->jac_cap) {
+            if (fsdem__grow(&c->allocator, (void **)&c->jac_cell, &cap, c->jac_count, c->jac_count + 1, sizeof(int)) != FSDEM_OK)
+                return FSDEM_ERR_OUT_OF_MEMORY;
+            cap = c->jac_cap;
+            if (fsdem__grow(&c->allocator, (void **)&c->jac_v, &cap, c->jac_count, c->jac_count + 1, sizeof(fsdem_vec3)) != FSDEM_OK)
+                return FSDEM_ERR_OUT_OF_MEMORY;
+            cap = c->jac_cap;
+            if (fsdem__grow(&c->allocator, (void **)&c->jac_w, &cap, c->jac_count, c->jac_count + 1, sizeof(fsdem_vec3)) != FSDEM_OK)
+                return FSDEM_ERR_OUT_OF_MEMORY;
+            c->jac_cap = cap;
+        }
+        e = c->slot[cell] = c->jac_count++;
+        c->jac_cell[e] = cell;
+        c->jac_v[e] = c->jac_w[e] = fsdem__zero3();
+    }
+    c->jac_v[e] = fsdem__add(c->jac_v[e], v);
+    c->jac_w[e] = fsdem__add(c->jac_w[e], w);
+    return FSDEM_OK;
+}
+
+static fsdem_result fsdem__pic_dem_face_add(fsdem_pic_dem *c, int a, int f, fsdem_real closed) {
+    if (c->face_count == c->face_cap) {
+        int cap = c->face_cap;
+        if (fsdem__grow(&c->allocator, (void **)&c->face, &cap, c->face_count, c->face_count + 1, sizeof(int)) != FSDEM_OK)
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        cap = c->face_cap;
+        if (fsdem__grow(&c->allocator, (void **)&c->face_axis, &cap, c->face_count, c->face_count + 1, 1) != FSDEM_OK)
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        cap = c->face_cap;
+        if (fsdem__grow(&c->allocator, (void **)&c->face_closed, &cap, c->face_count, c->face_count + 1, sizeof(fsdem_real)) !=
+            FSDEM_OK)
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        c->face_cap = cap;
+    }
+    c->face[c->face_count] = f;
+    c->face_axis[c->face_count] = (unsigned char)a;
+    c->face_closed[c->face_count] = closed;
+    c->face_count++;
+    return FSDEM_OK;
+}
+
+/* Gives the faces and references of the last cut back to the PIC (open, at rest, full). */
+static void fsdem__pic_dem_clear_faces(fsdem_pic_dem *c) {
+    fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
+    int e;
+    for (e = 0; e < c->face_count; ++e) {
+        cp.open[c->face_axis[e]][c->face[e]] = 1;
+        cp.solid_velocity[c->face_axis[e]][c->face[e]] = 0;
+    }
+    for (e = 0; e < c->ref_count; ++e) cp.reference[c->ref_cell[e]] = 1;
+    c->face_count = c->ref_count = 0;
+}
+
+/* Part of the fluid-fraction kernel of cell (i, j, k) (the tent over the 2^dim cells around its
+   centre) outside the ball, sampled on 4 points per axis (fsdem__pic_compute_fref samples the
+   static obstacles alike). */
+static fsdem_real fsdem__pic_dem_kernel_open(const fsdem_pic *s, const fsdem__pic_dem_ball *ball, int i, int j, int k) {
+    const int S = 4;
+    const fsdem_vec3 cc = fsdem__pic_cell_pos(s, i, j, k);
+    const fsdem_real h = 2 * s->dx / (fsdem_real)S;
+    fsdem_real open = 0, all = 0;
+    int q[3], m;
+    for (q[2] = 0; q[2] < (s->dim == 3 ? S : 1); ++q[2])
+        for (q[1] = 0; q[1] < S; ++q[1])
+            for (q[0] = 0; q[0] < S; ++q[0]) {
+                fsdem_vec3 p = cc;
+                fsdem_real w = 1;
+                for (m = 0; m < s->dim; ++m) {
+                    const fsdem_real off = -s->dx + h * ((fsdem_real)q[m] + (fsdem_real)0.5);
+                    w *= 1 - (fsdem_real)fabs(off) * s->inv_dx;
+                    p = fsdem__pic_axis_shift(p, m, off);
+                }
+                all += w;
+                if (fsdem__pic_dem_ball_dist(ball, p) > 0) open += w;
+            }
+    return open / all;
+}
+
+/* Cuts body b (steps 2-3 of >>couple_pic): its faces (the closed parts and solid fluxes added to
+   the PIC's coupling arrays, marked pending by a negative open value), its J and its references. */
+static fsdem_result fsdem__pic_dem_cut(fsdem_pic_dem *c, int b, fsdem_vec3 centre, fsdem_real radius) {
+    fsdem_pic *s = c->desc.pic;
+    fsdem_pic_coupling cp = fsdem_pic_get_coupling(s);
+    const fsdem__pic_dem_ball ball = {centre, radius};
+    const fsdem_real reach = s->dx * (s->dim == 3 ? (fsdem_real)0.7072 : (fsdem_real)0.5001), margin = radius + s->dx;
+    int a, q, lo[3], hi[3], idx[3], e;
+    c->face_start[b] = c->face_count;
+    c->jac_start[b] = c->jac_count;
+    for (a = 0; a < s->dim; ++a) {
+        for (q = 0; q < 3; ++q) {
+            if (q < s->dim)
+                fsdem__pic_dem_range(s, q, q == a ? 0 : (fsdem_real)0.5, fsdem__comp(centre, q) - margin, fsdem__comp(centre, q) + margin,
+                                     s->fn[a][q], &lo[q], &hi[q]);
+            else lo[q] = hi[q] = 0;
+        }
+        for (idx[2] = lo[2]; idx[2] <= hi[2]; ++idx[2])
+            for (idx[1] = lo[1]; idx[1] <= hi[1]; ++idx[1])
+                for (idx[0] = lo[0]; idx[0] <= hi[0]; ++idx[0]) {
+                    const int f = fsdem__pic_face(s, a, idx[0], idx[1], idx[2]), coord = idx[a];
+                    const fsdem_vec3 pf = fsdem__pic_face_pos(s, a, idx[0], idx[1], idx[2]), arm = fsdem__sub(pf, centre);
+                    const fsdem_real d = fsdem__norm(arm) - radius;
+                    fsdem_real closed, *open = &cp.open[a][f];
+                    fsdem_vec3 ea = fsdem__zero3(), us;
+                    if (d > reach) continue;
+                    /* the domain's closed sides keep E = 0 and their own velocity (>>pic_cells) */
+                    if ((coord == 0 || coord == s->n[a]) && fsdem__pic_side_closed(s, 2 * a + (coord != 0))) continue;
+                    if (d < -reach) closed = 1;
+                    else {
+                        fsdem_vec3 corner = fsdem__pic_axis_shift(pf, (a + 1) % s->dim, -s->dx / 2);
+                        if (s->dim == 3) corner = fsdem__pic_axis_shift(corner, (a + 2) % 3, -s->dx / 2);
+                        closed = 1 - fsdem__pic_face_fraction(s, a, corner, fsdem__pic_dem_ball_dist, &ball);
+                    }
+                    if (!(closed > 0)) continue;
+                    if (fsdem__pic_dem_face_add(c, a, f, closed) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+                    us = fsdem__add(c->vstar[b], fsdem__cross(c->wstar[b], arm));
+                    if (*open >= 0) { /* first body on this face */
+                        *open = -closed;
+                        cp.solid_velocity[a][f] = closed * fsdem__comp(us, a);
+                    } else {
+                        *open -= closed;
+                        cp.solid_velocity[a][f] += closed * fsdem__comp(us, a);
+                    }
+                    /* J: the face is the upper face of the cell below it (s = +1) and the lower face
+                       of the cell above it (s = -1) */
+                    ea = fsdem__pic_axis_shift(ea, a, closed);
+                    if (coord > 0 && fsdem__pic_dem_jac_add(c, fsdem__pic_cell(s, idx[0] - (a == 0), idx[1] - (a == 1), idx[2] - (a == 2)),
+                                                            ea, fsdem__cross(arm, ea)) != FSDEM_OK)
+                        return FSDEM_ERR_OUT_OF_MEMORY;
+                    if (coord < s->n[a] && fsdem__pic_dem_jac_add(c, fsdem__pic_cell(s, idx[0], idx[1], idx[2]), fsdem__scale(ea, -1),
+                                                                 fsdem__scale(fsdem__cross(arm, ea), -1)) != FSDEM_OK)
+                        return FSDEM_ERR_OUT_OF_MEMORY;
+                }
+    }
+    for (e = c->jac_start[b]; e < c->jac_count; ++e) c->slot[c->jac_cell[e]] = -1;
+    /* references of the cells whose kernel the body reaches */
+    for (q = 0; q < 3; ++q) {
+        if (q < s->dim) fsdem__pic_dem_range(s, q, (fsdem_real)0.5, fsdem__comp(centre, q) - margin, fsdem__comp(centre, q) + margin, s->n[q], &lo[q], &hi[q]);
+        else lo[q] = hi[q] = 0;
+    }
+    for (idx[2] = lo[2]; idx[2] <= hi[2]; ++idx[2])
+        for (idx[1] = lo[1]; idx[1] <= hi[1]; ++idx[1])
+            for (idx[0] = lo[0]; idx[0] <= hi[0]; ++idx[0]) {
+                const int cell = fsdem__pic_cell(s, idx[0], idx[1], idx[2]);
+                const fsdem_real open = fsdem__pic_dem_kernel_open(s, &ball, idx[0], idx[1], idx[2]);
+                if (open >= 1) continue;
+                if (c->ref_count == c->ref_cap &&
+                    fsdem__grow(&c->allocator, (void **)&c->ref_cell, &c->ref_cap, c->ref_count, c->ref_count + 1, sizeof(int)) != FSDEM_OK)
+                    return FSDEM_ERR_OUT_OF_MEMORY;
+                c->ref_cell[c->ref_count++] = cell;
+                cp.reference[cell] *= open; /* bodies do not overlap: their parts multiply */
+            }
+    return FSDEM_OK;
+}
+
+/* Steps 1-3 of >>couple_pic for a coming step of dt (0: the state only, at creation): Q*, then every
+   body cut into the PIC's coupling arrays, then the viscous relaxation times. */
+static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
+    fsdem_pic *s = c->desc.pic;
+    fsdem_pic_coupling cp = fsdem_pic_get_coupling(s);
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    const fsdem_real inertia = c->dim == 3 ? (fsdem_real)0.4 : (fsdem_real)0.5; /* the DEM's spheres and discs */
+    const fsdem_real visc = c->rho * c->nu * (c->dim == 3 ? s->dx : 1);    /* >>pic_viscosity, per pair */
+    int b, e, q;
+    fsdem_result res;
+    if ((res = fsdem__pic_dem_reserve_bodies(c, P.count)) != FSDEM_OK) return res;
+    fsdem__pic_dem_clear_faces(c);
+    c->jac_count = 0;
+    c->bodies = P.count;
+    for (b = 0; b < P.count; ++b) {
+        const fsdem_real m = P.mass[b], I = inertia * m * P.radius[b] * P.radius[b];
+        if (P.fixed[b]) {
+            c->inv_m[b] = c->inv_i[b] = 0;
+            c->vstar[b] = P.velocity[b];
+            c->wstar[b] = P.angular_velocity[b];
+        } else {
+            c->inv_m[b] = c->depth / m;
+            c->inv_i[b] = c->depth / I;
+            c->vstar[b] = fsdem__add(P.velocity[b], fsdem__scale(fsdem__add(c->gravity, fsdem__scale(P.force[b], 1 / m)), dt));
+            c->wstar[b] = fsdem__add(P.angular_velocity[b], fsdem__scale(P.torque[b], dt / I));
+        }
+        if (c->dim == 2) {
+            c->vstar[b].z = 0;
+            c->wstar[b].x = c->wstar[b].y = 0;
+        }
+        if ((res = fsdem__pic_dem_cut(c, b, P.position[b], P.radius[b])) != FSDEM_OK) {
+            c->face_start[b + 1] = c->face_count;
+            c->jac_start[b + 1] = c->jac_count;
+            c->bodies = b + 1;
+            return fsdem__fail(&c->status, res, "fsdem_pic_dem: out of memory cutting body %d", b);
+        }
+    }
+    c->face_start[P.count] = c->face_count;
+    c->jac_start[P.count] = c->jac_count;
+    /* pending faces: open fraction and the closed-fraction-weighted solid velocity */
+    for (e = 0; e < c->face_count; ++e) {
+        fsdem_real *open = &cp.open[c->face_axis[e]][c->face[e]];
+        if (*open < 0) {
+            const fsdem_real closed = -*open;
+            cp.solid_velocity[c->face_axis[e]][c->face[e]] /= closed;
+            *open = closed < 1 ? 1 - closed : 0;
+        }
+    }
+    /* volume as the faces see it, and the viscous relaxation time: the fastest component of the
+       viscous solve's pull, visc per (closed face, open neighbour) pair (>>pic_viscosity) */
+    c->viscous_dt = 0;
+    for (b = 0; b < c->bodies; ++b) {
+        int pairs[3] = {0, 0, 0}, most = 0;
+        fsdem_real vol = 0;
+        for (e = c->face_start[b]; e < c->face_start[b + 1]; ++e) {
+            const int a = c->face_axis[e], f = c->face[e];
+            vol += c->face_closed[e];
+            if (cp.open[a][f] > 0) continue;
+            for (q = 0; q < s->dim; ++q) {
+                int coord = q == 0 ? f % s->fn[a][0] : q == 1 ? f / s->fn[a][0] % s->fn[a][1] : f / (s->fn[a][0] * s->fn[a][1]);
+                if (coord > 0 && cp.open[a][f - s->fstep[a][q]] > 0) pairs[a]++;
+                if (coord + 1 < s->fn[a][q] && cp.open[a][f + s->fstep[a][q]] > 0) pairs[a]++;
+            }
+        }
+        c->volume[b] = vol * s->dx * s->dx * (s->dim == 3 ? s->dx : 1) / (fsdem_real)s->dim;
+        for (q = 0; q < s->dim; ++q)
+            if (pairs[q] > most) most = pairs[q];
+        c->relax[b] = 0;
+        if (visc > 0 && most > 0 && c->inv_m[b] > 0) {
+            /* translation m / (visc pairs); rotation I / (visc pairs r^2) is shorter (I < m r^2) */
+            const fsdem_real mr = c->depth / c->inv_m[b] < c->depth / (c->inv_i[b] * P.radius[b] * P.radius[b])
+                                      ? c->depth / c->inv_m[b]
+                                      : c->depth / (c->inv_i[b] * P.radius[b] * P.radius[b]);
+            c->relax[b] = mr / (c->depth * visc * (fsdem_real)most);
+            if (c->viscous_dt == 0 || c->relax[b] < c->viscous_dt) c->viscous_dt = c->relax[b];
+        }
+    }
+    return FSDEM_OK;
+}
+
+/* ---- >>couple_pic_exchange : the implicit pressure term, fluid forces ---- */
+
+/* y += rho dx^dim J M^-1 J^T p over the FLUID cells (step 3 of >>couple_pic), per metre in 2D. */
+static void fsdem__pic_dem_operator(void *user, const fsdem_real *p, fsdem_real *y) {
+    const fsdem_pic_dem *c = (const fsdem_pic_dem *)user;
+    const fsdem_pic *s = c->desc.pic;
+    const unsigned char *type = s->ctype;
+    const fsdem_real area = s->dim == 3 ? s->dx * s->dx : s->dx, k = c->rho * area * s->dx;
+    int b, e;
+    for (b = 0; b < c->bodies; ++b) {
+        fsdem_vec3 G = fsdem__zero3(), T = fsdem__zero3(), acc, alpha;
+        if (c->inv_m[b] == 0) continue;
+        for (e = c->jac_start[b]; e < c->jac_start[b + 1]; ++e) {
+            const int cell = c->jac_cell[e];
+            if (type[cell] != FSDEM_STENCIL_CELL_FLUID) continue;
+            G = fsdem__madd(G, c->jac_v[e], p[cell]);
+            T = fsdem__madd(T, c->jac_w[e], p[cell]);
+        }
+        acc = fsdem__scale(G, area * c->inv_m[b]);
+        alpha = fsdem__scale(T, area * c->inv_i[b]);
+        for (e = c->jac_start[b]; e < c->jac_start[b + 1]; ++e) {
+            const int cell = c->jac_cell[e];
+            if (type[cell] != FSDEM_STENCIL_CELL_FLUID) continue;
+            y[cell] += k * (fsdem__dot(c->jac_v[e], acc) + fsdem__dot(c->jac_w[e], alpha));
+        }
+    }
+}
+
+/* Step 4 of >>couple_pic after the PIC step: the pressure force G and the viscous force of every
+   body from the step's pressure and shear, given to the DEM as held external loads. */
+static fsdem_result fsdem__pic_dem_loads(fsdem_pic_dem *c) {
+    const fsdem_pic *s = c->desc.pic;
+    fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
+    const fsdem_pic_fields g = fsdem_pic_get_fields(s);
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
+    const fsdem_real area = s->dim == 3 ? s->dx * s->dx : s->dx;
+    int b, e;
+    c->force_sum = fsdem__zero3();
+    for (b = 0; b < c->bodies; ++b) {
+        fsdem_vec3 G = fsdem__zero3(), T = fsdem__zero3(), F = fsdem__zero3(), Tv = fsdem__zero3();
+        for (e = c->jac_start[b]; e < c->jac_start[b + 1]; ++e) {
+            G = fsdem__madd(G, c->jac_v[e], g.pressure[c->jac_cell[e]]);
+            T = fsdem__madd(T, c->jac_w[e], g.pressure[c->jac_cell[e]]);
+        }
+        for (e = c->face_start[b]; e < c->face_start[b + 1] && cp.shear[0]; ++e) {
+            const int a = c->face_axis[e], f = c->face[e];
+            const fsdem_real closed = 1 - cp.open[a][f], share = closed > c->face_closed[e] ? c->face_closed[e] / closed : 1;
+            const fsdem_real v = cp.shear[a][f] * share;
+            fsdem_vec3 force = fsdem__pic_axis_shift(fsdem__zero3(), a, v), arm;
+            int idx[3];
+            if (v == 0) continue;
+            idx[0] = f % s->fn[a][0];
+            idx[1] = f / s->fn[a][0] % s->fn[a][1];
+            idx[2] = f / (s->fn[a][0] * s->fn[a][1]);
+            arm = fsdem__sub(fsdem__pic_face_pos(s, a, idx[0], idx[1], idx[2]), P.position[b]);
+            F = fsdem__add(F, force);
+            Tv = fsdem__add(Tv, fsdem__cross(arm, force));
+        }
+        c->fp[b] = fsdem__scale(G, area * c->depth);
+        c->fv[b] = fsdem__scale(F, c->depth);
+        c->tq[b] = fsdem__scale(fsdem__add(fsdem__scale(T, area), Tv), c->depth);
+        if (!fsdem__finite3(c->fp[b]) || !fsdem__finite3(c->fv[b]) || !fsdem__finite3(c->tq[b]))
+            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_pic_dem: the fluid force on body %d is not finite", b);
+        c->force_sum = fsdem__add(c->force_sum, fsdem__add(c->fp[b], c->fv[b]));
+        if (dc.count > b) {
+            dc.force[b] = fsdem__add(c->fp[b], c->fv[b]);
+            dc.torque[b] = c->tq[b];
+        }
+    }
+    c->loaded = 1;
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_pic_dem_get_body(const fsdem_pic_dem *c, int index, fsdem_pic_dem_body *out) {
+    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
+    if (!c->loaded || index < 0 || index >= c->bodies)
+        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_pic_dem_get_body: no body %d in the last step (%d)",
+                           index, c->loaded ? c->bodies : 0);
+    out->pressure_force = c->fp[index];
+    out->viscous_force = c->fv[index];
+    out->torque = c->tq[index];
+    out->volume = c->volume[index];
+    out->faces = c->face_start[index + 1] - c->face_start[index];
+    return fsdem__ok((fsdem__status *)&c->status);
+}
+
+/* ---- >>couple_pic_gap : Eq. 20, particles out of bodies ---- */
+
+/* Builds the cell map of `count` boxes [centre_i - half_i, centre_i + half_i]. */
+static fsdem_result fsdem__pic_dem_map_build(fsdem_pic_dem *c, fsdem__pic_dem_map *map, int count, const fsdem_vec3 *centre,
+                                             const fsdem_real *half, fsdem_real half_all) {
+    const fsdem_pic *s = c->desc.pic;
+    int pass, i, q, lo[3], hi[3], idx[3], total = 0;
+    memset(map->start, 0, sizeof(int) * (size_t)(s->ncell + 1));
+    for (pass = 0; pass < 2; ++pass) {
+        for (i = 0; i < count; ++i) {
+            const fsdem_real h = half ? half[i] : half_all;
+            for (q = 0; q < 3; ++q) {
+                if (q < s->dim) fsdem__pic_dem_range(s, q, (fsdem_real)0.5, fsdem__comp(centre[i], q) - h - s->dx / 2,
+                                                     fsdem__comp(centre[i], q) + h + s->dx / 2, s->n[q], &lo[q], &hi[q]);
+                else lo[q] = hi[q] = 0;
+            }
+            for (idx[2] = lo[2]; idx[2] <= hi[2]; ++idx[2])
+                for (idx[1] = lo[1]; idx[1] <= hi[1]; ++idx[1])
+                    for (idx[0] = lo[0]; idx[0] <= hi[0]; ++idx[0]) {
+                        const int cell = fsdem__pic_cell(s, idx[0], idx[1], idx[2]);
+                        if (pass == 0) map->start[cell + 1]++;
+                        else map->item[map->start[cell]++] = i;
+                    }
+        }
+        if (pass == 0) {
+            for (i = 0; i < s->ncell; ++i) map->start[i + 1] += map->start[i];
+            total = map->start[s->ncell];
+            if (fsdem__grow(&c->allocator, (void **)&map->item, &map->item_cap, 0, total > 0 ? total : 1, sizeof(int)) != FSDEM_OK)
+                return FSDEM_ERR_OUT_OF_MEMORY;
+        }
+    }
+    /* the second pass advanced every start to the next cell's: shift back */
+    for (i = s->ncell; i > 0; --i) map->start[i] = map->start[i - 1];
+    map->start[0] = 0;
+    return FSDEM_OK;
+}
+
+/* The bodies as one solid for fsdem_pic_exclude_particles (`user` is the coupler). */
+static fsdem_real fsdem__pic_dem_solid(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
+    const fsdem_pic_dem *c = (const fsdem_pic_dem *)user;
+    const fsdem_pic *s = c->desc.pic;
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    const int cell = fsdem__pic_cell_of(s, p);
+    fsdem_real best = (fsdem_real)1e30;
+    int e;
+    *normal = fsdem_v3(1, 0, 0);
+    for (e = c->body_map.start[cell]; e < c->body_map.start[cell + 1]; ++e) {
+        const int b = c->body_map.item[e];
+        const fsdem_vec3 r = fsdem__sub(p, P.position[b]);
+        const fsdem_real len = fsdem__norm(r), d = len - P.radius[b];
+        if (d < best) {
+            best = d;
+            *normal = len > 0 ? fsdem__scale(r, 1 / len) : fsdem_v3(0, 1, 0);
+        }
+    }
+    return best;
+}
+
+/* Step 7 of >>couple_pic: particles inside bodies `from` .. are moved out (remove = 0) or removed. */
+static fsdem_result fsdem__pic_dem_exclude(fsdem_pic_dem *c, int from, int remove) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    int moved = 0, e;
+    fsdem_result res;
+    if (from >= P.count) return FSDEM_OK;
+    if (fsdem__pic_dem_map_build(c, &c->body_map, P.count - from, P.position + from, P.radius + from, 0) != FSDEM_OK)
+        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the bodies");
+    for (e = 0; e < c->body_map.start[c->desc.pic->ncell] && from > 0; ++e) c->body_map.item[e] += from;
+    res = fsdem_pic_exclude_particles(c->desc.pic, fsdem__pic_dem_solid, c, remove, &moved);
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
+    if (remove) c->removed += moved;
+    else c->pushed += moved;
+    return FSDEM_OK;
+}
+
+/* Step 6 of >>couple_pic: Eq. 20 in the contact area of every contact of the DEM's positions. */
+static fsdem_result fsdem__pic_dem_gap(fsdem_pic_dem *c) {
+    const fsdem_real beta = c->desc.dissipation, half = c->desc.contact_length / 2;
+    const fsdem_real offset = fsdem_dem_get_desc(c->desc.dem).contact_offset;
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    const fsdem_pic_particles W = fsdem_pic_get_particles(c->desc.pic);
+    const fsdem_pic *s = c->desc.pic;
+    int n = fsdem_dem_contacts(c->desc.dem, NULL, 0), k, p, e;
+    if (n < 0) return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
+    if (n > c->contact_cap) {
+        const size_t old = (size_t)c->contact_cap;
+        fsdem__free(&c->allocator, c->contact, sizeof(fsdem_dem_contact) * old);
+        fsdem__free(&c->allocator, c->contact_point, sizeof(fsdem_vec3) * old);
+        c->contact_cap = 0;
+        c->contact = (fsdem_dem_contact *)fsdem__alloc(&c->allocator, sizeof(fsdem_dem_contact) * (size_t)n);
+        c->contact_point = (fsdem_vec3 *)fsdem__alloc(&c->allocator, sizeof(fsdem_vec3) * (size_t)n);
+        if (!c->contact || !c->contact_point) {
+            fsdem__free(&c->allocator, c->contact, sizeof(fsdem_dem_contact) * (size_t)n);
+            fsdem__free(&c->allocator, c->contact_point, sizeof(fsdem_vec3) * (size_t)n);
+            c->contact = NULL;
+            c->contact_point = NULL;
+            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
+        }
+        c->contact_cap = n;
+    }
+    c->contact_count = n = n > 0 ? fsdem_dem_contacts(c->desc.dem, c->contact, c->contact_cap) : 0;
+    if (beta >= 1 || n == 0) return FSDEM_OK;
+    /* the contact point: the middle of the gap between the real surfaces, offset - overlap wide */
+    for (k = 0; k < n; ++k) {
+        const fsdem_dem_contact *ct = &c->contact[k];
+        c->contact_point[k] = fsdem__madd(P.position[ct->i], ct->normal, -(P.radius[ct->i] + (offset - ct->overlap) / 2));
+    }
+    if (fsdem__pic_dem_map_build(c, &c->contact_map, n, c->contact_point, NULL, half) != FSDEM_OK)
+        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the contacts");
+    for (p = 0; p < W.count; ++p) {
+        const int cell = fsdem__pic_cell_of(s, W.position[p]);
+        for (e = c->contact_map.start[cell]; e < c->contact_map.start[cell + 1]; ++e) {
+            const int q = c->contact_map.item[e];
+            const fsdem_vec3 rel = fsdem__sub(W.position[p], c->contact_point[q]), nrm = c->contact[q].normal;
+            const fsdem_real sn = fsdem__dot(rel, nrm), t = fsdem__norm(fsdem__madd(rel, nrm, -sn));
+            if ((fsdem_real)fabs(sn) > half || t > half) continue;
+            W.velocity[p] = fsdem__scale(W.velocity[p], beta + (1 - beta) * t / half); /* Eq. 20, C of Fig. 3 */
+            c->dissipated++;
+        }
+    }
+    return FSDEM_OK;
+}
+
+/* ---- >>couple_pic_step : coupled time stepping ---- */
+
+/* The stable coupled step (>>couple_pic, fsdem_pic_dem_stable_dt). */
+static fsdem_result fsdem__pic_dem_stable(fsdem_pic_dem *c, fsdem_real *dt) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    const fsdem_pic_desc pd = fsdem_pic_get_desc(c->desc.pic);
+    const fsdem_real dx = pd.cell_size;
+    fsdem_real vmax = 0;
+    int b;
+    fsdem_result res = fsdem_pic_stable_dt(c->desc.pic, dt);
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
+    for (b = 0; b < P.count; ++b) {
+        const fsdem_real v = fsdem__norm(P.velocity[b]) + fsdem__norm(P.angular_velocity[b]) * P.radius[b];
+        if (!fsdem__finite(v)) return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_pic_dem: body %d has a non-finite velocity", b);
+        if (v > vmax) vmax = v;
+    }
+    {
+        const fsdem_real body = pd.cfl * dx / (vmax + (fsdem_real)sqrt(fsdem__norm(pd.gravity) * dx));
+        if (body < *dt) *dt = body;
+    }
+    if (c->viscous_dt > 0 && c->desc.viscous_dt_fraction * c->viscous_dt < *dt) *dt = c->desc.viscous_dt_fraction * c->viscous_dt;
+    return FSDEM_OK;
+}
+
+/* One coupled step of dt (steps 1-7 of >>couple_pic). */
+static fsdem_result fsdem__pic_dem_run(fsdem_pic_dem *c, fsdem_real dt) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    const fsdem_pic_desc pd = fsdem_pic_get_desc(c->desc.pic);
+    long long substeps = 0;
+    int b, before = c->bodies;
+    clock_t t0 = clock(), t1, t2;
+    fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_pic_dem");
+    if (res != FSDEM_OK) return res;
+    for (b = 0; b < P.count; ++b) {
+        const fsdem_real v = fsdem__norm(P.velocity[b]) + fsdem__norm(P.angular_velocity[b]) * P.radius[b];
+        if (v * dt > pd.cfl_max * pd.cell_size)
+            return fsdem__fail(&c->status, FSDEM_ERR_CFL, "fsdem_pic_dem: body %d at %g m/s moves %g cells in dt = %g s (cfl_max %g)", b,
+                               (double)v, (double)(v * dt / pd.cell_size), (double)dt, (double)pd.cfl_max);
+    }
+    if (P.count > before && (res = fsdem__pic_dem_exclude(c, before, 1)) != FSDEM_OK) return res;
+    if ((res = fsdem__pic_dem_faces(c, dt)) != FSDEM_OK) return res;
+    if (c->viscous_dt > 0 && dt > c->desc.viscous_dt_fraction * c->viscous_dt * (1 + (fsdem_real)1e-6))
+        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
+                           "fsdem_pic_dem: dt = %g s exceeds viscous_dt_fraction %g of the shortest viscous relaxation time %g s",
+                           (double)dt, (double)c->desc.viscous_dt_fraction, (double)c->viscous_dt);
+    t1 = clock();
+    c->sec_coupling += (double)(t1 - t0) / CLOCKS_PER_SEC;
+    res = fsdem_pic_step_dt(c->desc.pic, dt);
+    t2 = clock();
+    c->sec_pic += (double)(t2 - t1) / CLOCKS_PER_SEC;
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
+    if ((res = fsdem__pic_dem_loads(c)) != FSDEM_OK) return res;
+    t1 = clock();
+    c->sec_coupling += (double)(t1 - t2) / CLOCKS_PER_SEC;
+    res = fsdem_dem_advance(c->desc.dem, dt, &substeps);
+    t2 = clock();
+    c->sec_dem += (double)(t2 - t1) / CLOCKS_PER_SEC;
+    c->steps++;
+    c->dt_last = dt;
+    c->substeps = substeps;
+    c->substeps_total += substeps;
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
+    if ((res = fsdem__pic_dem_gap(c)) == FSDEM_OK) res = fsdem__pic_dem_exclude(c, 0, 0);
+    c->sec_coupling += (double)(clock() - t2) / CLOCKS_PER_SEC;
+    if (res != FSDEM_OK) return res;
+    return fsdem__ok(&c->status);
+}
+
+fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *c) {
+    fsdem_real dt = 0;
+    fsdem_result res;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if ((res = fsdem__pic_dem_stable(c, &dt)) != FSDEM_OK) return res;
+    return fsdem__pic_dem_run(c, dt);
+}
+
+fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *c, fsdem_real dt) {
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_dem_step_dt: dt = %g s must be > 0 and finite", (double)dt);
+    return fsdem__pic_dem_run(c, dt);
+}
+
+fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *c, fsdem_real duration, long long *steps) {
+    double end;
+    long long n = 0;
+    fsdem_result res = FSDEM_OK;
+    if (steps) *steps = 0;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_dem_advance: duration = %g s must be >= 0", (double)duration);
+    end = fsdem_pic_time(c->desc.pic) + (double)duration;
+    while (res == FSDEM_OK && fsdem_pic_time(c->desc.pic) < end - 1e-12 * (end > 1 ? end : 1)) {
+        const double left = end - fsdem_pic_time(c->desc.pic);
+        fsdem_real dt = 0;
+        if ((res = fsdem__pic_dem_stable(c, &dt)) != FSDEM_OK) break;
+        /* the last steps shortened to end exactly, as fsdem_pic_advance does */
+        if ((double)dt >= left) dt = (fsdem_real)left;
+        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
+        res = fsdem__pic_dem_run(c, dt);
+        ++n;
+    }
+    if (steps) *steps = n;
+    return res;
+}
+
+fsdem_result fsdem_pic_dem_stable_dt(fsdem_pic_dem *c, fsdem_real *dt) {
+    if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__pic_dem_stable(c, dt);
+}
+
+double fsdem_pic_dem_time(const fsdem_pic_dem *c) { return c ? fsdem_pic_time(c->desc.pic) : 0; }
+
+fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
+    fsdem_pic_dem_stats st;
+    memset(&st, 0, sizeof st);
+    if (!c) return st;
+    st.steps = c->steps;
+    st.time = fsdem_pic_time(c->desc.pic);
+    st.dt = c->dt_last;
+    st.substeps = c->substeps;
+    st.substeps_total = c->substeps_total;
+    st.fluid_force = c->force_sum;
+    st.viscous_dt = c->viscous_dt;
+    st.contacts = c->contact_count;
+    st.dissipated = c->dissipated;
+    st.pushed = c->pushed;
+    st.removed = c->removed;
+    st.seconds_pic = c->sec_pic;
+    st.seconds_dem = c->sec_dem;
+    st.seconds_coupling = c->sec_coupling;
+    return st;
+}
+
 /* ===== >>impl_restart : checkpoint and restart =======================================================
 
    Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
@@ -14871,7 +15973,7 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
     int grid[3], no = s->obst_count, np = s->np, pcap = s->pcap, a, k;
     fsdem__pic_obst *obst;
     size_t cells = sizeof(fsdem_real) * (size_t)s->ncell;
-    fsdem__restart_tag(io, "PIC1");
+    fsdem__restart_tag(io, "PIC2");
     for (a = 0; a < 3; ++a) grid[a] = s->n[a];
     fsdem__restart_value(io, grid, sizeof grid);
     if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK &&
@@ -15027,6 +16129,7 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
     fsdem__restart_data(io, s->phi, cells);
     fsdem__restart_data(io, s->pres, cells);
     fsdem__restart_data(io, s->crhs, cells);
+    fsdem__restart_data(io, s->cref, cells);
     fsdem__restart_data(io, s->fref, cells);
     fsdem__restart_flags(io, s->ctype, s->ncell, FSDEM_STENCIL_CELL_SOLID, "type of cell");
     fsdem__restart_flags(io, s->cnear, s->ncell, 1, "near-solid flag of cell");
