@@ -134,6 +134,8 @@ $(BUILD)/validation/%/run: validation/%/main.c validation/common.h validation/pi
 
 # the MPS-DEM dam break's case is shared by its validation case and its bench
 $(BUILD)/validation/mpsdem_dambreak/run $(BUILD)/bench/mpsdem_dambreak: validation/mpsdem_dambreak/case.h
+# the PIC-DEM cylinder dam break's case is shared by its validation case and its bench
+$(BUILD)/validation/picdem_cylinder_dambreak/run $(BUILD)/bench/picdem_dambreak: validation/picdem_cylinder_dambreak/case.h
 
 validate: SHELL := /bin/bash
 validate: $(foreach v,$(VALIDATION),$(BUILD)/validation/$(v)/run) | gnuplot-deps
