@@ -15108,7 +15108,8 @@ static void fsdem__pic_dem_operator(void *user, const fsdem_real *p, fsdem_real 
     const fsdem_pic_dem *c = (const fsdem_pic_dem *)user;
     const fsdem_pic *s = c->desc.pic;
     const unsigned char *type = s->ctype;
-    const fsdem_real area = s->dim == 3 ? s->dx * s->dx : s->dx, k = c->rho * area * s->dx;
+    /* with acc = M^-1 G (G = dx^(dim-1) J^T p) the term is rho dx J . acc */
+    const fsdem_real area = s->dim == 3 ? s->dx * s->dx : s->dx, k = c->rho * s->dx;
     int b, e;
     for (b = 0; b < c->bodies; ++b) {
         fsdem_vec3 G = fsdem__zero3(), T = fsdem__zero3(), acc, alpha;

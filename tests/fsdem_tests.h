@@ -21,6 +21,7 @@ Suite *io_suite(void);
 Suite *mps_suite(void);
 Suite *drag_suite(void);
 Suite *couple_mps_suite(void);
+Suite *couple_pic_suite(void);
 
 /* ---- tolerances that follow the precision of fsdem_real ----
 
