@@ -304,6 +304,10 @@
 #define fsdem_pic_dem_get_desc fsdem_pic_dem_get_desc_f
 #define fsdem_pic_dem_get_stats fsdem_pic_dem_get_stats_f
 #define fsdem_pic_dem_last_error fsdem_pic_dem_last_error_f
+#define fsdem_pic_dem_restore fsdem_pic_dem_restore_f
+#define fsdem_pic_dem_restore_memory fsdem_pic_dem_restore_memory_f
+#define fsdem_pic_dem_save fsdem_pic_dem_save_f
+#define fsdem_pic_dem_save_memory fsdem_pic_dem_save_memory_f
 #define fsdem_pic_dem_stable_dt fsdem_pic_dem_stable_dt_f
 #define fsdem_pic_dem_step fsdem_pic_dem_step_f
 #define fsdem_pic_dem_step_dt fsdem_pic_dem_step_dt_f
@@ -2386,7 +2390,9 @@ FSDEM_API fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *desc, 
 /* Creates a coupler (its memory from the DEM's allocator), removes the water particles inside the
    bodies and installs the implicit term in the PIC's pressure operator. FSDEM_ERR_INVALID_ARG as
    the check (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_pic_dem_destroy
-   removes the term and the moving solids from the PIC and leaves both solvers alive. */
+   removes the term and the moving solids from the PIC and leaves both solvers alive. The coupler
+   owns the PIC's open, solid_velocity and reference arrays (fsdem_pic_get_coupling): every step
+   resets and rewrites them. */
 FSDEM_API fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem **out);
 FSDEM_API void fsdem_pic_dem_destroy(fsdem_pic_dem *coupler);
 FSDEM_API const char *fsdem_pic_dem_last_error(const fsdem_pic_dem *coupler);
@@ -2561,6 +2567,13 @@ FSDEM_API fsdem_result fsdem_mps_dem_restore(fsdem_mps_dem *coupler, const char 
 FSDEM_API fsdem_result fsdem_mps_dem_save_memory(const fsdem_mps_dem *coupler, void *buffer, size_t capacity,
                                                  size_t *size);
 FSDEM_API fsdem_result fsdem_mps_dem_restore_memory(fsdem_mps_dem *coupler, const void *buffer, size_t size);
+
+/* The same four for the PIC-DEM coupler: its solvers' states are saved and restored with it. */
+FSDEM_API fsdem_result fsdem_pic_dem_save(const fsdem_pic_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_pic_dem_restore(fsdem_pic_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_pic_dem_save_memory(const fsdem_pic_dem *coupler, void *buffer, size_t capacity,
+                                                 size_t *size);
+FSDEM_API fsdem_result fsdem_pic_dem_restore_memory(fsdem_pic_dem *coupler, const void *buffer, size_t size);
 
 /* ===== >>io : CSV time series, ParaView series, VTK XML snapshots ================================== */
 
@@ -14644,8 +14657,7 @@ struct fsdem_pic_dem {
     int *jac_start, *jac_cell;
     fsdem_vec3 *jac_v, *jac_w;
     int jac_count, jac_cap;
-    int *ref_cell;                 /* cells whose reference the coupler lowered */
-    int ref_count, ref_cap;
+
     int *slot;                     /* per cell: entry of the current body's J, -1 */
     fsdem__pic_dem_map body_map, contact_map;
     fsdem_dem_contact *contact;    /* contacts after the last step, and their points (step 6) */
@@ -14759,7 +14771,6 @@ static void fsdem__pic_dem_release(fsdem_pic_dem *c) {
     fsdem__free(&c->allocator, c->jac_cell, sizeof(int) * (size_t)c->jac_cap);
     fsdem__free(&c->allocator, c->jac_v, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
     fsdem__free(&c->allocator, c->jac_w, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
-    fsdem__free(&c->allocator, c->ref_cell, sizeof(int) * (size_t)c->ref_cap);
     fsdem__free(&c->allocator, c->slot, sizeof(int) * (size_t)ncell);
     fsdem__free(&c->allocator, c->body_map.start, sizeof(int) * (size_t)(ncell + 1));
     fsdem__free(&c->allocator, c->body_map.item, sizeof(int) * (size_t)c->body_map.item_cap);
@@ -14826,7 +14837,7 @@ void fsdem_pic_dem_destroy(fsdem_pic_dem *c) {
     if (!c) return;
     al = c->allocator;
     if (c->operator_set) fsdem_pic_set_pressure_extra(c->desc.pic, NULL, NULL);
-    if (c->face) fsdem__pic_dem_clear_faces(c);
+    fsdem__pic_dem_clear_faces(c);
     fsdem__pic_dem_release(c);
     fsdem__free(&al, c, sizeof *c);
 }
@@ -14908,16 +14919,17 @@ static fsdem_result fsdem__pic_dem_face_add(fsdem_pic_dem *c, int a, int f, fsde
     return FSDEM_OK;
 }
 
-/* Gives the faces and references of the last cut back to the PIC (open, at rest, full). */
+/* Resets the PIC's moving-solid arrays (open, at rest, full), all of them: the coupler owns them,
+   and a restored PIC may hold another run's cut. */
 static void fsdem__pic_dem_clear_faces(fsdem_pic_dem *c) {
     fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
-    int e;
-    for (e = 0; e < c->face_count; ++e) {
-        cp.open[c->face_axis[e]][c->face[e]] = 1;
-        cp.solid_velocity[c->face_axis[e]][c->face[e]] = 0;
+    int a, e;
+    for (a = 0; a < cp.dim; ++a) {
+        for (e = 0; e < cp.face_count[a]; ++e) cp.open[a][e] = 1;
+        memset(cp.solid_velocity[a], 0, sizeof(fsdem_real) * (size_t)cp.face_count[a]);
     }
-    for (e = 0; e < c->ref_count; ++e) cp.reference[c->ref_cell[e]] = 1;
-    c->face_count = c->ref_count = 0;
+    for (e = 0; e < c->desc.pic->ncell; ++e) cp.reference[e] = 1;
+    c->face_count = 0;
 }
 
 /* Part of the fluid-fraction kernel of cell (i, j, k) (the tent over the 2^dim cells around its
@@ -15011,12 +15023,7 @@ static fsdem_result fsdem__pic_dem_cut(fsdem_pic_dem *c, int b, fsdem_vec3 centr
             for (idx[0] = lo[0]; idx[0] <= hi[0]; ++idx[0]) {
                 const int cell = fsdem__pic_cell(s, idx[0], idx[1], idx[2]);
                 const fsdem_real open = fsdem__pic_dem_kernel_open(s, &ball, idx[0], idx[1], idx[2]);
-                if (open >= 1) continue;
-                if (c->ref_count == c->ref_cap &&
-                    fsdem__grow(&c->allocator, (void **)&c->ref_cell, &c->ref_cap, c->ref_count, c->ref_count + 1, sizeof(int)) != FSDEM_OK)
-                    return FSDEM_ERR_OUT_OF_MEMORY;
-                c->ref_cell[c->ref_count++] = cell;
-                cp.reference[cell] *= open; /* bodies do not overlap: their parts multiply */
+                if (open < 1) cp.reference[cell] *= open; /* bodies do not overlap: their parts multiply */
             }
     return FSDEM_OK;
 }
@@ -15449,7 +15456,7 @@ fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
 
    Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
    every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_swe_dem, >>restart_mps,
-   >>restart_mps_dem (one visitor per object lists what it saves, in order, and serves saving and
+   >>restart_mps_dem, >>restart_pic_dem (one visitor per object lists what it saves, in order, and serves saving and
    restoring alike), >>restart_api
    (memory and files). A restore runs the visitor three times over the payload: CHECK validates
    everything and compares the desc, RESERVE allocates, COMMIT writes into the object. Only COMMIT
@@ -15468,7 +15475,7 @@ fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
 typedef char fsdem__restart_int_sizes[sizeof(unsigned int) == 4 && sizeof(unsigned long long) == 8 ? 1 : -1];
 
 enum { FSDEM__RESTART_DEM = 1, FSDEM__RESTART_PIC = 2, FSDEM__RESTART_SWE = 3, FSDEM__RESTART_SWE_DEM = 4, FSDEM__RESTART_MPS = 5,
-       FSDEM__RESTART_MPS_DEM = 6 };
+       FSDEM__RESTART_MPS_DEM = 6, FSDEM__RESTART_PIC_DEM = 7 };
 
 typedef enum fsdem__restart_mode {
     FSDEM__RESTART_WRITE = 0,   /* object to payload (to memory, to a file, or only measured) */
@@ -16526,6 +16533,54 @@ static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
     fsdem__restart_tag(io, "MPD.");
 }
 
+/* ---- >>restart_pic_dem : PIC-DEM coupler ---- */
+
+/* The two solvers, then the coupler's counters, its viscous limit and the loads of its last step.
+   Its cut (faces, J, references) is redone at the start of every step over the PIC's reset coupling
+   arrays, so it is not saved; the viscous limit of the saved step is: the run goes on bit for bit. */
+static void fsdem__restart_pic_dem(fsdem__restart *io, void *object) {
+    fsdem_pic_dem *c = (fsdem_pic_dem *)object;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    int count = c->loaded ? c->bodies : 0, b;
+    fsdem__restart_tag(io, "PDM1");
+    io->section = "water (PIC)";
+    fsdem__restart_pic(io, c->desc.pic);
+    io->section = "bodies (DEM)";
+    fsdem__restart_dem(io, c->desc.dem);
+    io->section = NULL;
+    fsdem__restart_same_real(io, c->desc.dissipation, "dissipation");
+    fsdem__restart_same_real(io, c->desc.contact_length, "contact_length");
+    fsdem__restart_same_real(io, c->desc.viscous_dt_fraction, "viscous_dt_fraction");
+    fsdem__restart_same_ll(io, c->desc.max_substeps, "max_substeps");
+    fsdem__restart_data(io, &c->steps, sizeof c->steps);
+    fsdem__restart_data(io, &c->substeps, sizeof c->substeps);
+    fsdem__restart_data(io, &c->substeps_total, sizeof c->substeps_total);
+    fsdem__restart_data(io, &c->dissipated, sizeof c->dissipated);
+    fsdem__restart_data(io, &c->pushed, sizeof c->pushed);
+    fsdem__restart_data(io, &c->removed, sizeof c->removed);
+    fsdem__restart_data(io, &c->dt_last, sizeof c->dt_last);
+    fsdem__restart_data(io, &c->viscous_dt, sizeof c->viscous_dt);
+    fsdem__restart_data(io, &c->force_sum, sizeof c->force_sum);
+    fsdem__restart_count(io, &count, 1 << 29, 3 * sizeof(fsdem_vec3) + sizeof(fsdem_real), "body load count");
+    if (io->mode == FSDEM__RESTART_RESERVE && fsdem__pic_dem_reserve_bodies(c, count) != FSDEM_OK) io->res = FSDEM_ERR_OUT_OF_MEMORY;
+    if (commit) { /* the next step cuts afresh, as every step does */
+        c->face_count = c->jac_count = 0;
+        c->bodies = count;
+        c->loaded = count > 0;
+        for (b = 0; b <= count; ++b) c->face_start[b] = c->jac_start[b] = 0;
+    }
+    for (b = 0; b < count && io->res == FSDEM_OK; ++b) {
+        fsdem_vec3 scratch[3];
+        fsdem_real vol;
+        const int here = io->mode == FSDEM__RESTART_WRITE || commit;
+        fsdem__restart_data(io, here ? &c->fp[b] : &scratch[0], sizeof(fsdem_vec3));
+        fsdem__restart_data(io, here ? &c->fv[b] : &scratch[1], sizeof(fsdem_vec3));
+        fsdem__restart_data(io, here ? &c->tq[b] : &scratch[2], sizeof(fsdem_vec3));
+        fsdem__restart_data(io, here ? &c->volume[b] : &vol, sizeof(fsdem_real));
+    }
+    fsdem__restart_tag(io, "PDM.");
+}
+
 /* ---- >>restart_api : memory and files ---- */
 
 /* What the API needs to know of one object. */
@@ -16547,6 +16602,7 @@ static const char *fsdem__restart_kind_name(unsigned int kind) {
     case FSDEM__RESTART_SWE_DEM: return "fsdem_swe_dem";
     case FSDEM__RESTART_MPS: return "fsdem_mps";
     case FSDEM__RESTART_MPS_DEM: return "fsdem_mps_dem";
+    case FSDEM__RESTART_PIC_DEM: return "fsdem_pic_dem";
     }
     return "unknown object";
 }
@@ -16656,6 +16712,24 @@ static fsdem__restart_object fsdem__restart_of_mps_dem(const fsdem_mps_dem *c) {
     o.allocator = &c->allocator;
     o.status = (fsdem__status *)&c->status;
     o.name = "fsdem_mps_dem";
+    return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_pic_dem(const fsdem_pic_dem *c) {
+    fsdem__restart_object o;
+    memset(&o, 0, sizeof o);
+    if (!c) return o;
+    o.kind = FSDEM__RESTART_PIC_DEM;
+    o.dim = c->dim;
+    o.sizes[0] = c->desc.pic->np;
+    o.sizes[1] = c->desc.dem->n;
+    o.sizes[2] = c->loaded ? c->bodies : 0;
+    o.sizes[3] = 0;
+    o.object = (void *)c;
+    o.visit = fsdem__restart_pic_dem;
+    o.allocator = &c->allocator;
+    o.status = (fsdem__status *)&c->status;
+    o.name = "fsdem_pic_dem";
     return o;
 }
 
@@ -16985,6 +17059,27 @@ fsdem_result fsdem_mps_dem_save_memory(const fsdem_mps_dem *coupler, void *buffe
 
 fsdem_result fsdem_mps_dem_restore_memory(fsdem_mps_dem *coupler, const void *buffer, size_t size) {
     fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
+    return fsdem__restart_load_memory(&o, buffer, size);
+}
+
+/* fsdem_pic_dem (>>restart): the PIC-DEM coupler with its two solvers. */
+fsdem_result fsdem_pic_dem_save(const fsdem_pic_dem *coupler, const char *path) {
+    fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_pic_dem_restore(fsdem_pic_dem *coupler, const char *path) {
+    fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_pic_dem_save_memory(const fsdem_pic_dem *coupler, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_pic_dem_restore_memory(fsdem_pic_dem *coupler, const void *buffer, size_t size) {
+    fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 

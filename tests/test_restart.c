@@ -26,6 +26,7 @@ DEFINE_SAVE(swe)
 DEFINE_SAVE(swe_dem)
 DEFINE_SAVE(mps)
 DEFINE_SAVE(mps_dem)
+DEFINE_SAVE(pic_dem)
 
 /* Two saves are the same bytes; on failure the first differing byte is named. */
 static void same_bytes(const unsigned char *a, size_t na, const unsigned char *b, size_t nb, const char *what) {
@@ -923,6 +924,101 @@ START_TEST(mps_dem_continues_bit_exact) {
 }
 END_TEST
 
+/* ---- PIC-DEM ---- */
+
+typedef struct pic_world {
+    fsdem_pic *pic;
+    fsdem_dem *dem;
+    fsdem_pic_dem *cpl;
+} pic_world;
+
+/* A water tank with two discs, a light one rising and a heavy one sinking onto the floor (contacts,
+   Eq. 20); `bare`: the solvers are only created (the restore brings their state). */
+static pic_world pic_world_new(int bare) {
+    pic_world w;
+    fsdem_pic_desc pd = fsdem_pic_desc_default(2);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+    fsdem_pic_dem_desc cd = fsdem_pic_dem_desc_default();
+    pd.cell_size = 0.01f;
+    pd.domain_max = fsdem_v3(0.3f, 0.3f, 0);
+    pd.viscosity = 1e-4f;
+    pd.dt_max = 2e-3f;
+    ck_assert_int_eq(fsdem_pic_create(&pd, &w.pic), FSDEM_OK);
+    dd.domain_min = fsdem_v3(0, 0, -1);
+    dd.domain_max = fsdem_v3(0.3f, 0.3f, 1);
+    dd.contact_offset = 0.02f;
+    dd.integrator = FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR;
+    dd.dt = 1e-4f;
+    ck_assert_int_eq(fsdem_dem_create(&dd, &w.dem), FSDEM_OK);
+    if (!bare) {
+        fsdem_dem_material light = fsdem_dem_material_default(), heavy = fsdem_dem_material_default();
+        fsdem_dem_wall_desc floor = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 1, 0), 0);
+        fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+        int ml, mh;
+        light.density = 600;
+        heavy.density = 2500;
+        ck_assert_int_eq(fsdem_dem_add_material(w.dem, &light, &ml), FSDEM_OK);
+        ck_assert_int_eq(fsdem_dem_add_material(w.dem, &heavy, &mh), FSDEM_OK);
+        ck_assert_int_eq(fsdem_dem_add_wall(w.dem, &floor, NULL), FSDEM_OK);
+        p.radius = 0.03f;
+        p.material = ml;
+        p.position = fsdem_v3(0.1f, 0.1f, 0);
+        ck_assert_int_eq(fsdem_dem_add_particle(w.dem, &p, NULL), FSDEM_OK);
+        p.material = mh;
+        p.position = fsdem_v3(0.2f, 0.06f, 0);
+        ck_assert_int_eq(fsdem_dem_add_particle(w.dem, &p, NULL), FSDEM_OK);
+        ck_assert_int_eq(fsdem_pic_fill_box(w.pic, fsdem_v3(0, 0, 0), fsdem_v3(0.3f, 0.22f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    }
+    cd.pic = w.pic;
+    cd.dem = w.dem;
+    ck_assert_int_eq(fsdem_pic_dem_create(&cd, &w.cpl), FSDEM_OK);
+    return w;
+}
+
+static void pic_world_free(pic_world *w) {
+    fsdem_pic_dem_destroy(w->cpl);
+    fsdem_dem_destroy(w->dem);
+    fsdem_pic_destroy(w->pic);
+}
+
+START_TEST(pic_dem_continues_bit_exact) {
+    const char *path = "build/test_restart_pic_dem.bin";
+    pic_world a = pic_world_new(0), c = pic_world_new(1), f = pic_world_new(1);
+    unsigned char *A, *B, *C, *F, *R;
+    size_t na, nb, nc, nf, nr;
+    fsdem_pic_dem_body ba, bc;
+    ck_assert_int_eq(fsdem_pic_dem_advance(a.cpl, 0.03f, NULL), FSDEM_OK);
+    A = save_pic_dem(a.cpl, &na);
+    ck_assert_int_eq(fsdem_pic_dem_save(a.cpl, path), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_body(a.cpl, 1, &ba), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_advance(a.cpl, 0.03f, NULL), FSDEM_OK);
+    B = save_pic_dem(a.cpl, &nb);
+
+    ck_assert_int_eq(fsdem_pic_dem_restore_memory(c.cpl, A, na), FSDEM_OK);
+    R = save_pic_dem(c.cpl, &nr);
+    same_bytes(A, na, R, nr, "PIC-DEM save of the restored state");
+    ck_assert_int_eq(fsdem_pic_dem_get_body(c.cpl, 1, &bc), FSDEM_OK);
+    ck_assert(bc.pressure_force.y == ba.pressure_force.y && bc.volume == ba.volume);
+    ck_assert_int_eq(fsdem_pic_dem_advance(c.cpl, 0.03f, NULL), FSDEM_OK);
+    C = save_pic_dem(c.cpl, &nc);
+    same_bytes(B, nb, C, nc, "PIC-DEM continued from memory");
+    ck_assert(fsdem_dem_get_particles(c.dem).position[0].y == fsdem_dem_get_particles(a.dem).position[0].y);
+
+    ck_assert_int_eq(fsdem_pic_dem_restore(f.cpl, path), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_advance(f.cpl, 0.03f, NULL), FSDEM_OK);
+    F = save_pic_dem(f.cpl, &nf);
+    same_bytes(B, nb, F, nf, "PIC-DEM continued from a file");
+    free(A);
+    free(B);
+    free(C);
+    free(F);
+    free(R);
+    pic_world_free(&a);
+    pic_world_free(&c);
+    pic_world_free(&f);
+}
+END_TEST
+
 Suite *restart_suite(void) {
     Suite *s = suite_create("restart");
     TCase *tc = tcase_create("restart");
@@ -936,6 +1032,7 @@ Suite *restart_suite(void) {
     tcase_add_test(tc, swe_dem_refusal_names_the_solver);
     tcase_add_test(tc, mps_continues_bit_exact);
     tcase_add_test(tc, mps_dem_continues_bit_exact);
+    tcase_add_test(tc, pic_dem_continues_bit_exact);
     tcase_add_test(tc, bad_data_is_refused_and_changes_nothing);
     tcase_add_test(tc, out_of_memory_changes_nothing);
     tcase_add_test(tc, swe_gauge_file_blocks_restore);
