@@ -1038,7 +1038,7 @@ FSDEM_API void fsdem_csr_apply(const fsdem_csr *matrix, const fsdem_real *x, fsd
    Eq. 6), all without touching the projection.
 
    Step (fsdem_pic_step): P2G -> classify cells -> extrapolate -> save the grid velocity for FLIP ->
-   gravity and coupler accelerations -> implicit viscosity -> pressure projection -> extrapolate ->
+   implicit viscosity -> gravity and coupler accelerations -> pressure projection -> extrapolate ->
    G2P -> RK2/RK3 advection -> push particles out of solids, drop those leaving through outflows ->
    density projection -> reseeding. No allocation happens inside a step. */
 
@@ -7610,7 +7610,8 @@ typedef struct fsdem__pic_array {
     fsdem_real fill;
 } fsdem__pic_array;
 
-#define FSDEM__PIC_MAX_ARRAYS 64
+/* 18 per axis (13, and 5 for the implicit viscosity) and 14 per cell: 68 in 3D with viscosity */
+#define FSDEM__PIC_MAX_ARRAYS 80
 
 static void fsdem__pic_array_add(fsdem__pic_array *t, int *n, void **ptr, size_t count, size_t elem, fsdem_real fill) {
     FSDEM_ASSERT(*n < FSDEM__PIC_MAX_ARRAYS);
@@ -9683,17 +9684,19 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
     fsdem__pic_solid_faces(s, s->u, 0);
     for (a = 0; a < s->dim; ++a) memcpy(s->uold[a], s->u[a], sizeof(fsdem_real) * (size_t)s->nface[a]);
 
-    /* 2. body forces and coupler accelerations */
+    /* 2. implicit viscosity, then body forces and coupler accelerations: in that order water at
+       rest under gravity is not sheared against solids (the viscous solve would otherwise act on
+       g dt, which the projection removes, and leave a spurious force on every wall and body) */
+    if (s->desc.viscosity > 0) {
+        r = fsdem__pic_viscosity(s, dt);
+        if (r != FSDEM_OK && worst == FSDEM_OK) worst = r;
+    }
     for (a = 0; a < s->dim; ++a) {
         fsdem_real g = fsdem__comp(s->desc.gravity, a) * dt;
         for (f = 0; f < s->nface[a]; ++f) s->u[a][f] += g + dt * s->cacc[a][f];
     }
 
-    /* 3. implicit viscosity, pressure projection */
-    if (s->desc.viscosity > 0) {
-        r = fsdem__pic_viscosity(s, dt);
-        if (r != FSDEM_OK && worst == FSDEM_OK) worst = r;
-    }
+    /* 3. pressure projection */
     r = fsdem__pic_project(s, dt);
     if (r != FSDEM_OK && worst == FSDEM_OK) worst = r;
     for (a = 0; a < s->dim; ++a)
