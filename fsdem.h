@@ -5542,6 +5542,36 @@ static fsdem_result fsdem__dem_substeps_within(const fsdem_dem *d, fsdem_real dt
     return FSDEM_OK;
 }
 
+/* The advance of a coupler whose step is prepared (forces, stable dt) and then run: steps until
+   exactly `duration` later, the last ones shortened to end exactly as the solvers' advances do
+   (fsdem_mps_dem_advance, fsdem_pic_dem_advance). */
+typedef struct fsdem__coupled_verbs {
+    double (*now)(const void *coupler);                        /* the fluid's time (s) */
+    fsdem_result (*prepare)(void *coupler, fsdem_real *dt);    /* the stable dt of the coming step */
+    fsdem_result (*run)(void *coupler, fsdem_real dt);         /* one coupled step of dt */
+} fsdem__coupled_verbs;
+
+static fsdem_result fsdem__coupled_advance(void *c, fsdem__status *status, const char *who, const fsdem__coupled_verbs *v,
+                                           fsdem_real duration, long long *steps) {
+    double end;
+    long long n = 0;
+    fsdem_result res = FSDEM_OK;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__fail(status, FSDEM_ERR_INVALID_ARG, "%s: duration = %g s must be >= 0", who, (double)duration);
+    end = v->now(c) + (double)duration;
+    while (res == FSDEM_OK && v->now(c) < end - 1e-12 * (end > 1 ? end : 1)) {
+        const double left = end - v->now(c);
+        fsdem_real dt = 0;
+        if ((res = v->prepare(c, &dt)) != FSDEM_OK) break;
+        if ((double)dt >= left) dt = (fsdem_real)left;
+        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
+        res = v->run(c, dt);
+        ++n;
+    }
+    if (steps) *steps = n;
+    return res;
+}
+
 fsdem_result fsdem_dem_advance_with(fsdem_dem *d, fsdem_real duration, fsdem_dem_substep_fn fn, void *user,
                                     long long *steps) {
     long long k, count = 0;
@@ -14562,31 +14592,24 @@ fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *c, fsdem_real dt) {
     return fsdem__mps_dem_run(c, dt);
 }
 
+/* fsdem__coupled_advance's verbs for this coupler: the update and its stable step, the step. */
+static double fsdem__mps_dem_now(const void *c) { return fsdem_mps_time(((const fsdem_mps_dem *)c)->desc.mps); }
+
+static fsdem_result fsdem__mps_dem_prepare(void *object, fsdem_real *dt) {
+    fsdem_mps_dem *c = (fsdem_mps_dem *)object;
+    fsdem_result res = fsdem_mps_dem_update(c);
+    if (res == FSDEM_OK && (res = fsdem__mps_dem_stable(c, dt)) != FSDEM_OK)
+        fsdem__fail(&c->status, res, "fsdem_mps_dem_advance: %s", fsdem_mps_last_error(c->desc.mps));
+    return res;
+}
+
+static fsdem_result fsdem__mps_dem_go(void *c, fsdem_real dt) { return fsdem__mps_dem_run((fsdem_mps_dem *)c, dt); }
+
 fsdem_result fsdem_mps_dem_advance(fsdem_mps_dem *c, fsdem_real duration, long long *steps) {
-    double end;
-    long long n = 0;
-    fsdem_result res = FSDEM_OK;
+    static const fsdem__coupled_verbs verbs = {fsdem__mps_dem_now, fsdem__mps_dem_prepare, fsdem__mps_dem_go};
     if (steps) *steps = 0;
     if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(duration >= 0) || !fsdem__finite(duration))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_dem_advance: duration = %g s must be >= 0", (double)duration);
-    end = fsdem_mps_time(c->desc.mps) + (double)duration;
-    while (res == FSDEM_OK && fsdem_mps_time(c->desc.mps) < end - 1e-12 * (end > 1 ? end : 1)) {
-        const double left = end - fsdem_mps_time(c->desc.mps);
-        fsdem_real dt = 0;
-        if ((res = fsdem_mps_dem_update(c)) != FSDEM_OK) break;
-        if ((res = fsdem__mps_dem_stable(c, &dt)) != FSDEM_OK) {
-            fsdem__fail(&c->status, res, "fsdem_mps_dem_advance: %s", fsdem_mps_last_error(c->desc.mps));
-            break;
-        }
-        /* the last steps shortened to end exactly, as fsdem_mps_advance does */
-        if ((double)dt >= left) dt = (fsdem_real)left;
-        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
-        res = fsdem__mps_dem_run(c, dt);
-        ++n;
-    }
-    if (steps) *steps = n;
-    return res;
+    return fsdem__coupled_advance(c, &c->status, "fsdem_mps_dem_advance", &verbs, duration, steps);
 }
 
 fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) {
@@ -15404,27 +15427,16 @@ fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *c, fsdem_real dt) {
     return fsdem__pic_dem_run(c, dt);
 }
 
+/* fsdem__coupled_advance's verbs for this coupler. */
+static double fsdem__pic_dem_now(const void *c) { return fsdem_pic_time(((const fsdem_pic_dem *)c)->desc.pic); }
+static fsdem_result fsdem__pic_dem_prepare(void *c, fsdem_real *dt) { return fsdem__pic_dem_stable((fsdem_pic_dem *)c, dt); }
+static fsdem_result fsdem__pic_dem_go(void *c, fsdem_real dt) { return fsdem__pic_dem_run((fsdem_pic_dem *)c, dt); }
+
 fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *c, fsdem_real duration, long long *steps) {
-    double end;
-    long long n = 0;
-    fsdem_result res = FSDEM_OK;
+    static const fsdem__coupled_verbs verbs = {fsdem__pic_dem_now, fsdem__pic_dem_prepare, fsdem__pic_dem_go};
     if (steps) *steps = 0;
     if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(duration >= 0) || !fsdem__finite(duration))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_dem_advance: duration = %g s must be >= 0", (double)duration);
-    end = fsdem_pic_time(c->desc.pic) + (double)duration;
-    while (res == FSDEM_OK && fsdem_pic_time(c->desc.pic) < end - 1e-12 * (end > 1 ? end : 1)) {
-        const double left = end - fsdem_pic_time(c->desc.pic);
-        fsdem_real dt = 0;
-        if ((res = fsdem__pic_dem_stable(c, &dt)) != FSDEM_OK) break;
-        /* the last steps shortened to end exactly, as fsdem_pic_advance does */
-        if ((double)dt >= left) dt = (fsdem_real)left;
-        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
-        res = fsdem__pic_dem_run(c, dt);
-        ++n;
-    }
-    if (steps) *steps = n;
-    return res;
+    return fsdem__coupled_advance(c, &c->status, "fsdem_pic_dem_advance", &verbs, duration, steps);
 }
 
 fsdem_result fsdem_pic_dem_stable_dt(fsdem_pic_dem *c, fsdem_real *dt) {
