@@ -2357,10 +2357,12 @@ FSDEM_API fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *coupl
         start (the same end velocity; positions differ by O(dt^2 F/m));
      6. the gap (§2.2.2): the DEM's contact_offset is the imaginary boundary of Eq. 19 (the seed
         uses 2 dx), so contacts start before the real surfaces meet and a gap of open cells stays
-        between them. In the contact area of every contact (a square of side desc.contact_length,
-        4 dx in the seed, centred on the middle of the gap) the water particles' velocities are
-        multiplied by C (Eq. 20), linear in the distance from the contact point along the tangent:
-        desc.dissipation (beta) at the point, 1 at the area's edge; beta = 1 switches it off;
+        between them. In the contact area of every contact (centred on the middle of the gap, of
+        length desc.contact_length along the tangent, 4 dx in the seed, and as wide along the normal:
+        a square in 2D, a short cylinder in 3D) the water particles' velocities are multiplied by C
+        (Eq. 20), linear in the distance t from the contact point along the tangent: desc.dissipation
+        (beta) at the point, 1 at the area's edge (C = beta + (1 - beta) 2 t / length); beta = 1
+        switches it off. The seed gives the area's length, not its width; the width is a choice;
      7. the water particles inside a body at its new position are moved to its surface
         (fsdem_pic_exclude_particles); the density projection of later steps spreads them. On
         creation, and when bodies are added, the particles inside the new bodies are removed.
