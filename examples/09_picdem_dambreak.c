@@ -18,7 +18,7 @@
    ParaView: open both .pvd files and walls.vtp; cylinders: Glyph, Sphere, scale by "radius",
    factor 2; water: Points, colour by velocity.
 
-   Run:  make examples && cd build/examples && ./09_picdem_dambreak      (about 15 s of CPU)
+   Run:  make examples && cd build/examples && ./09_picdem_dambreak      (about 10 s of CPU; 18 MB)
    Build by hand: cc -std=c99 -O2 -I. examples/09_picdem_dambreak.c -o picdem_dambreak -lm */
 #define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
