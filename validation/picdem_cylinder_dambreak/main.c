@@ -170,6 +170,8 @@ int main(int argc, char **argv) {
     }
     vc_info(CASE, "dx = %g m (seed: %g m), %.2f s per run", dx, WD_SEED_DX, t_end);
     memset(res, 0, sizeof res);
+    for (i = 0; i < 4; ++i)
+        for (j = 0; j < 2; ++j) res[i][j].arrival = -1; /* runs left out print -1 */
     for (i = 0; i < 4; ++i) {
         if (only && layer_counts[i] != only) continue;
         for (j = 0; j < 2; ++j) {
@@ -192,7 +194,7 @@ int main(int argc, char **argv) {
             snprintf(metric, sizeof metric, "%s_12_layers_arrive_after_6", j ? "b1" : "b05");
             vc_check(CASE, metric, res[0][j].arrival >= 0 && arrival_key(&res[3][j]) > arrival_key(&res[0][j]) ? 1 : 0, 1, 0);
         }
-    vc_info(CASE, "arrival times (s; -1: not within %.2f s): layers beta=0.5 beta=1", t_end);
+    vc_info(CASE, "arrival times (s; -1: not within %.2f s or not run): layers beta=0.5 beta=1", t_end);
     for (i = 0; i < 4; ++i)
         if (!only || layer_counts[i] == only)
             vc_info(CASE, "arrival L%d %.4f %.4f", layer_counts[i], res[i][0].arrival, res[i][1].arrival);
