@@ -232,9 +232,11 @@ static int run(const options *o, int perforated, result *r, FILE *cyl_csv, FILE 
         }
     }
     {
-        fsdem_real st;
-        fsdem_dem_stable_dt(dem, &st);
-        fsdem_dem_set_dt(dem, st);
+        fsdem_real st = 0; /* Eq. 18 with gamma = 150 */
+        if (fsdem_dem_stable_dt(dem, &st) != FSDEM_OK || fsdem_dem_set_dt(dem, st) != FSDEM_OK) {
+            fprintf(stderr, "%s\n", fsdem_dem_last_error(dem));
+            return -1;
+        }
     }
 
     if (!o->dry) {
