@@ -3,13 +3,15 @@
    the bottom of a tank full of water; a continuous and a perforated pipe. Resolved PIC-DEM
    (fsdem_pic_dem), 2D. The geometry of the seed's Fig. 11 is not given in its text: README.md states
    the one chosen here.
-   Usage: run [DATA_DIR] [--seed] [--dx M] [--t-max S] [--pipe continuous|perforated]
+   Usage: run [DATA_DIR] [--seed] [--dx M] [--t-max S] [--pipe continuous|perforated] [--dry]
      DATA_DIR is ignored (no reference data exist for this case);
      --seed   the seed's grid, dx = 0.05 cm, with 0.1 cm holes (default: dx = 0.1 cm, holes of
               2 cells = 0.2 cm, see README.md);
      --dx M   another grid (m; holes of max(0.1 cm, 2 dx));
      --t-max  end of a run when cylinders are still in the pipe (default 4 s);
-     --pipe   run one pipe only (the comparison check is then skipped).
+     --pipe   run one pipe only (the comparison check is then skipped);
+     --dry    the DEM alone with the same walls, no water (dump times for reference; the checks
+              on water and the comparison are skipped).
    Writes cylinders.csv, levels.csv and cylinders_<pipe>_<t>.csv snapshots into the working
    directory. */
 #define FSDEM_IMPLEMENTATION
@@ -394,14 +396,17 @@ static void report(const options *o, const result *r, const char *tag) {
     vc_check(CASE, m, r->outside, 0, 0);
     snprintf(m, sizeof m, "%s_all_cylinders_left_pipe", tag);
     vc_check(CASE, m, r->t_dump >= 0, 1, 0);
-    snprintf(m, sizeof m, "%s_volume_drift", tag);
-    vc_check(CASE, m, r->volume_drift, 0, 0.005);
+    if (!o->dry) {
+        snprintf(m, sizeof m, "%s_volume_drift", tag);
+        vc_check(CASE, m, r->volume_drift, 0, 0.005);
+    }
     if (r->t_dump >= 0)
         vc_info(CASE, "%s: first cylinder below the pipe bottom at t = %.3f s, all at t = %.3f s (dump time)%s", tag,
                 r->t_first_out, r->t_dump, r->reentered ? "; one came back above it later" : "");
     else
         vc_info(CASE, "%s: first cylinder below the pipe bottom at t = %.3f s; not all by t = %.3f s", tag, r->t_first_out,
                 r->t_end);
+    if (o->dry) return;
     vc_info(CASE, "%s: level inside the pipe %.4f m at t = 0, lowest %.4f m at t = %.3f s (drop %.2f mm), then up by %.2f mm (to t = %.3f s); outside %.4f m at t = 0, highest %.4f m (+%.2f mm)",
             tag, r->level0_in, r->level_min_in, r->t_level_min_in, 1e3 * (r->level0_in - r->level_min_in),
             1e3 * r->level_rise_after_min, r->t_level_max_after, r->level0_out, r->level_max_out,
@@ -463,7 +468,7 @@ int main(int argc, char **argv) {
         vc_check(CASE, "continuous_level_drop_beyond_noise", r->level0_in - r->level_min_in > threshold, 1, 0);
         vc_check(CASE, "continuous_level_rise_after_minimum", r->level_rise_after_min > threshold, 1, 0);
     }
-    if (res[0].ran && res[1].ran) {
+    if (res[0].ran && res[1].ran && !o.dry) {
         /* seed 000 section 3.3: the perforated pipe dumps without delay */
         const int both = res[0].t_dump >= 0 && res[1].t_dump >= 0;
         vc_check(CASE, "perforated_dumps_faster", both && res[1].t_dump < res[0].t_dump, 1, 0);
