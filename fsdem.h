@@ -15475,12 +15475,14 @@ static fsdem_result fsdem__pic_dem_run(fsdem_pic_dem *c, fsdem_real dt) {
             return fsdem__fail(&c->status, FSDEM_ERR_CFL, "fsdem_pic_dem: body %d at %g m/s moves %g cells in dt = %g s (cfl_max %g)", b,
                                (double)v, (double)(v * dt / pd.cell_size), (double)dt, (double)pd.cfl_max);
     }
-    if (P.count > before && (res = fsdem__pic_dem_exclude(c, before, 1)) != FSDEM_OK) return res;
-    if ((res = fsdem__pic_dem_faces(c, dt)) != FSDEM_OK) return res;
+    /* the limit of the last cut, the one fsdem_pic_dem_stable_dt gave (the new cut may be a little
+       stricter: the step it limits is the next) */
     if (c->viscous_dt > 0 && dt > c->desc.viscous_dt_fraction * c->viscous_dt * (1 + (fsdem_real)1e-6))
         return fsdem__fail(&c->status, FSDEM_ERR_CFL,
                            "fsdem_pic_dem: dt = %g s exceeds viscous_dt_fraction %g of the shortest viscous relaxation time %g s",
                            (double)dt, (double)c->desc.viscous_dt_fraction, (double)c->viscous_dt);
+    if (P.count > before && (res = fsdem__pic_dem_exclude(c, before, 1)) != FSDEM_OK) return res;
+    if ((res = fsdem__pic_dem_faces(c, dt)) != FSDEM_OK) return res;
     t1 = clock();
     c->sec_coupling += (double)(t1 - t0) / CLOCKS_PER_SEC;
     res = fsdem_pic_step_dt(c->desc.pic, dt);
