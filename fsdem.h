@@ -2357,10 +2357,12 @@ FSDEM_API fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *coupl
         start (the same end velocity; positions differ by O(dt^2 F/m));
      6. the gap (§2.2.2): the DEM's contact_offset is the imaginary boundary of Eq. 19 (the seed
         uses 2 dx), so contacts start before the real surfaces meet and a gap of open cells stays
-        between them. In the contact area of every contact (a square of side desc.contact_length,
-        4 dx in the seed, centred on the middle of the gap) the water particles' velocities are
-        multiplied by C (Eq. 20), linear in the distance from the contact point along the tangent:
-        desc.dissipation (beta) at the point, 1 at the area's edge; beta = 1 switches it off;
+        between them. In the contact area of every contact (centred on the middle of the gap, of
+        length desc.contact_length along the tangent, 4 dx in the seed, and as wide along the normal:
+        a square in 2D, a short cylinder in 3D) the water particles' velocities are multiplied by C
+        (Eq. 20), linear in the distance t from the contact point along the tangent: desc.dissipation
+        (beta) at the point, 1 at the area's edge (C = beta + (1 - beta) 2 t / length); beta = 1
+        switches it off. The seed gives the area's length, not its width; the width is a choice;
      7. the water particles inside a body at its new position are moved to its surface
         (fsdem_pic_exclude_particles); the density projection of later steps spreads them. On
         creation, and when bodies are added, the particles inside the new bodies are removed.
@@ -5540,6 +5542,36 @@ static fsdem_result fsdem__dem_substeps_within(const fsdem_dem *d, fsdem_real dt
                            "%s: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)", who,
                            (double)dt, substeps, max, (double)d->dt);
     return FSDEM_OK;
+}
+
+/* The advance of a coupler whose step is prepared (forces, stable dt) and then run: steps until
+   exactly `duration` later, the last ones shortened to end exactly as the solvers' advances do
+   (fsdem_mps_dem_advance, fsdem_pic_dem_advance). */
+typedef struct fsdem__coupled_verbs {
+    double (*now)(const void *coupler);                        /* the fluid's time (s) */
+    fsdem_result (*prepare)(void *coupler, fsdem_real *dt);    /* the stable dt of the coming step */
+    fsdem_result (*run)(void *coupler, fsdem_real dt);         /* one coupled step of dt */
+} fsdem__coupled_verbs;
+
+static fsdem_result fsdem__coupled_advance(void *c, fsdem__status *status, const char *who, const fsdem__coupled_verbs *v,
+                                           fsdem_real duration, long long *steps) {
+    double end;
+    long long n = 0;
+    fsdem_result res = FSDEM_OK;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__fail(status, FSDEM_ERR_INVALID_ARG, "%s: duration = %g s must be >= 0", who, (double)duration);
+    end = v->now(c) + (double)duration;
+    while (res == FSDEM_OK && v->now(c) < end - 1e-12 * (end > 1 ? end : 1)) {
+        const double left = end - v->now(c);
+        fsdem_real dt = 0;
+        if ((res = v->prepare(c, &dt)) != FSDEM_OK) break;
+        if ((double)dt >= left) dt = (fsdem_real)left;
+        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
+        res = v->run(c, dt);
+        ++n;
+    }
+    if (steps) *steps = n;
+    return res;
 }
 
 fsdem_result fsdem_dem_advance_with(fsdem_dem *d, fsdem_real duration, fsdem_dem_substep_fn fn, void *user,
@@ -14562,31 +14594,24 @@ fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *c, fsdem_real dt) {
     return fsdem__mps_dem_run(c, dt);
 }
 
+/* fsdem__coupled_advance's verbs for this coupler: the update and its stable step, the step. */
+static double fsdem__mps_dem_now(const void *c) { return fsdem_mps_time(((const fsdem_mps_dem *)c)->desc.mps); }
+
+static fsdem_result fsdem__mps_dem_prepare(void *object, fsdem_real *dt) {
+    fsdem_mps_dem *c = (fsdem_mps_dem *)object;
+    fsdem_result res = fsdem_mps_dem_update(c);
+    if (res == FSDEM_OK && (res = fsdem__mps_dem_stable(c, dt)) != FSDEM_OK)
+        fsdem__fail(&c->status, res, "fsdem_mps_dem_advance: %s", fsdem_mps_last_error(c->desc.mps));
+    return res;
+}
+
+static fsdem_result fsdem__mps_dem_go(void *c, fsdem_real dt) { return fsdem__mps_dem_run((fsdem_mps_dem *)c, dt); }
+
 fsdem_result fsdem_mps_dem_advance(fsdem_mps_dem *c, fsdem_real duration, long long *steps) {
-    double end;
-    long long n = 0;
-    fsdem_result res = FSDEM_OK;
+    static const fsdem__coupled_verbs verbs = {fsdem__mps_dem_now, fsdem__mps_dem_prepare, fsdem__mps_dem_go};
     if (steps) *steps = 0;
     if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(duration >= 0) || !fsdem__finite(duration))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_dem_advance: duration = %g s must be >= 0", (double)duration);
-    end = fsdem_mps_time(c->desc.mps) + (double)duration;
-    while (res == FSDEM_OK && fsdem_mps_time(c->desc.mps) < end - 1e-12 * (end > 1 ? end : 1)) {
-        const double left = end - fsdem_mps_time(c->desc.mps);
-        fsdem_real dt = 0;
-        if ((res = fsdem_mps_dem_update(c)) != FSDEM_OK) break;
-        if ((res = fsdem__mps_dem_stable(c, &dt)) != FSDEM_OK) {
-            fsdem__fail(&c->status, res, "fsdem_mps_dem_advance: %s", fsdem_mps_last_error(c->desc.mps));
-            break;
-        }
-        /* the last steps shortened to end exactly, as fsdem_mps_advance does */
-        if ((double)dt >= left) dt = (fsdem_real)left;
-        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
-        res = fsdem__mps_dem_run(c, dt);
-        ++n;
-    }
-    if (steps) *steps = n;
-    return res;
+    return fsdem__coupled_advance(c, &c->status, "fsdem_mps_dem_advance", &verbs, duration, steps);
 }
 
 fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) {
@@ -14960,16 +14985,15 @@ static fsdem_real fsdem__pic_dem_kernel_open(const fsdem_pic *s, const fsdem__pi
     return open / all;
 }
 
-/* Cuts body b (steps 2-3 of >>couple_pic): its faces (the closed parts and solid fluxes added to
-   the PIC's coupling arrays, marked pending by a negative open value), its J and its references. */
+/* Cuts body b (step 2 of >>couple_pic): its faces (the closed parts and solid fluxes added to the
+   PIC's coupling arrays, marked pending by a negative open value) and its references. */
 static fsdem_result fsdem__pic_dem_cut(fsdem_pic_dem *c, int b, fsdem_vec3 centre, fsdem_real radius) {
     fsdem_pic *s = c->desc.pic;
     fsdem_pic_coupling cp = fsdem_pic_get_coupling(s);
     const fsdem__pic_dem_ball ball = {centre, radius};
     const fsdem_real reach = s->dx * (s->dim == 3 ? (fsdem_real)0.7072 : (fsdem_real)0.5001), margin = radius + s->dx;
-    int a, q, lo[3], hi[3], idx[3], e;
+    int a, q, lo[3], hi[3], idx[3];
     c->face_start[b] = c->face_count;
-    c->jac_start[b] = c->jac_count;
     for (a = 0; a < s->dim; ++a) {
         for (q = 0; q < 3; ++q) {
             if (q < s->dim)
@@ -14984,7 +15008,7 @@ static fsdem_result fsdem__pic_dem_cut(fsdem_pic_dem *c, int b, fsdem_vec3 centr
                     const fsdem_vec3 pf = fsdem__pic_face_pos(s, a, idx[0], idx[1], idx[2]), arm = fsdem__sub(pf, centre);
                     const fsdem_real d = fsdem__norm(arm) - radius;
                     fsdem_real closed, *open = &cp.open[a][f];
-                    fsdem_vec3 ea = fsdem__zero3(), us;
+                    fsdem_vec3 us;
                     if (d > reach) continue;
                     /* the domain's closed sides keep E = 0 and their own velocity (>>pic_cells) */
                     if ((coord == 0 || coord == s->n[a]) && fsdem__pic_side_closed(s, 2 * a + (coord != 0))) continue;
@@ -15004,18 +15028,8 @@ static fsdem_result fsdem__pic_dem_cut(fsdem_pic_dem *c, int b, fsdem_vec3 centr
                         *open -= closed;
                         cp.solid_velocity[a][f] += closed * fsdem__comp(us, a);
                     }
-                    /* J: the face is the upper face of the cell below it (s = +1) and the lower face
-                       of the cell above it (s = -1) */
-                    ea = fsdem__pic_axis_shift(ea, a, closed);
-                    if (coord > 0 && fsdem__pic_dem_jac_add(c, fsdem__pic_cell(s, idx[0] - (a == 0), idx[1] - (a == 1), idx[2] - (a == 2)),
-                                                            ea, fsdem__cross(arm, ea)) != FSDEM_OK)
-                        return FSDEM_ERR_OUT_OF_MEMORY;
-                    if (coord < s->n[a] && fsdem__pic_dem_jac_add(c, fsdem__pic_cell(s, idx[0], idx[1], idx[2]), fsdem__scale(ea, -1),
-                                                                 fsdem__scale(fsdem__cross(arm, ea), -1)) != FSDEM_OK)
-                        return FSDEM_ERR_OUT_OF_MEMORY;
                 }
     }
-    for (e = c->jac_start[b]; e < c->jac_count; ++e) c->slot[c->jac_cell[e]] = -1;
     /* references of the cells whose kernel the body reaches */
     for (q = 0; q < 3; ++q) {
         if (q < s->dim) fsdem__pic_dem_range(s, q, (fsdem_real)0.5, fsdem__comp(centre, q) - margin, fsdem__comp(centre, q) + margin, s->n[q], &lo[q], &hi[q]);
@@ -15031,6 +15045,39 @@ static fsdem_result fsdem__pic_dem_cut(fsdem_pic_dem *c, int b, fsdem_vec3 centr
     return FSDEM_OK;
 }
 
+/* J of body b (step 3 of >>couple_pic) from the final closed parts of its faces: each face is the
+   upper face of the cell below it (s = +1) and the lower face of the cell above it (s = -1). */
+static fsdem_result fsdem__pic_dem_jacobian(fsdem_pic_dem *c, int b, fsdem_vec3 centre) {
+    const fsdem_pic *s = c->desc.pic;
+    int e, idx[3];
+    c->jac_start[b] = c->jac_count;
+    for (e = c->face_start[b]; e < c->face_start[b + 1]; ++e) {
+        const int a = c->face_axis[e], f = c->face[e];
+        fsdem_vec3 ea = fsdem__pic_axis_shift(fsdem__zero3(), a, c->face_closed[e]), arm, w;
+        int coord;
+        idx[0] = f % s->fn[a][0];
+        idx[1] = f / s->fn[a][0] % s->fn[a][1];
+        idx[2] = f / (s->fn[a][0] * s->fn[a][1]);
+        coord = idx[a];
+        arm = fsdem__sub(fsdem__pic_face_pos(s, a, idx[0], idx[1], idx[2]), centre);
+        w = fsdem__cross(arm, ea);
+        if (coord > 0 &&
+            fsdem__pic_dem_jac_add(c, fsdem__pic_cell(s, idx[0] - (a == 0), idx[1] - (a == 1), idx[2] - (a == 2)), ea, w) != FSDEM_OK)
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        if (coord < s->n[a] &&
+            fsdem__pic_dem_jac_add(c, fsdem__pic_cell(s, idx[0], idx[1], idx[2]), fsdem__scale(ea, -1), fsdem__scale(w, -1)) != FSDEM_OK)
+            return FSDEM_ERR_OUT_OF_MEMORY;
+    }
+    c->jac_start[b + 1] = c->jac_count;
+    for (e = c->jac_start[b]; e < c->jac_count; ++e) c->slot[c->jac_cell[e]] = -1;
+    return FSDEM_OK;
+}
+
+/* Faces that bodies leave open by less than this are closed: the projection controls only E u on a
+   face, so the velocity of a sliver of a face (a gap between bodies, the edge of a body) would be
+   free to spike. */
+#define FSDEM__PIC_DEM_MIN_OPEN ((fsdem_real)0.02)
+
 /* Steps 1-3 of >>couple_pic for a coming step of dt (0: the state only, at creation): Q*, then every
    body cut into the PIC's coupling arrays, then the viscous relaxation times. */
 static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
@@ -15043,7 +15090,6 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
     fsdem_result res;
     if ((res = fsdem__pic_dem_reserve_bodies(c, P.count)) != FSDEM_OK) return res;
     fsdem__pic_dem_clear_faces(c);
-    c->jac_count = 0;
     c->bodies = P.count;
     for (b = 0; b < P.count; ++b) {
         const fsdem_real m = P.mass[b], I = inertia * m * P.radius[b] * P.radius[b];
@@ -15063,22 +15109,34 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
         }
         if ((res = fsdem__pic_dem_cut(c, b, P.position[b], P.radius[b])) != FSDEM_OK) {
             c->face_start[b + 1] = c->face_count;
-            c->jac_start[b + 1] = c->jac_count;
             c->bodies = b + 1;
+            for (q = 0; q <= c->bodies; ++q) c->jac_start[q] = 0;
             return fsdem__fail(&c->status, res, "fsdem_pic_dem: out of memory cutting body %d", b);
         }
     }
     c->face_start[P.count] = c->face_count;
-    c->jac_start[P.count] = c->jac_count;
-    /* pending faces: open fraction and the closed-fraction-weighted solid velocity */
+    /* pending faces (open = -(sum of the closed parts)): each body's part scaled to the final closed
+       part (slivers closed), then the open fraction and the closed-part-weighted solid velocity */
+    for (e = 0; e < c->face_count; ++e) {
+        const fsdem_real total = -cp.open[c->face_axis[e]][c->face[e]];
+        const fsdem_real final_closed = total > 1 - FSDEM__PIC_DEM_MIN_OPEN ? 1 : total;
+        c->face_closed[e] *= final_closed / total;
+    }
     for (e = 0; e < c->face_count; ++e) {
         fsdem_real *open = &cp.open[c->face_axis[e]][c->face[e]];
         if (*open < 0) {
             const fsdem_real closed = -*open;
             cp.solid_velocity[c->face_axis[e]][c->face[e]] /= closed;
-            *open = closed < 1 ? 1 - closed : 0;
+            *open = closed > 1 - FSDEM__PIC_DEM_MIN_OPEN ? 0 : 1 - closed;
         }
     }
+    c->jac_count = 0;
+    for (b = 0; b < P.count; ++b)
+        if ((res = fsdem__pic_dem_jacobian(c, b, P.position[b])) != FSDEM_OK) {
+            for (q = 0; q <= c->bodies; ++q) c->jac_start[q] = 0;
+            c->jac_count = 0;
+            return fsdem__fail(&c->status, res, "fsdem_pic_dem: out of memory for the J of body %d", b);
+        }
     /* volume as the faces see it, and the viscous relaxation time: the fastest component of the
        viscous solve's pull, visc per (closed face, open neighbour) pair (>>pic_viscosity) */
     c->viscous_dt = 0;
@@ -15404,27 +15462,16 @@ fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *c, fsdem_real dt) {
     return fsdem__pic_dem_run(c, dt);
 }
 
+/* fsdem__coupled_advance's verbs for this coupler. */
+static double fsdem__pic_dem_now(const void *c) { return fsdem_pic_time(((const fsdem_pic_dem *)c)->desc.pic); }
+static fsdem_result fsdem__pic_dem_prepare(void *c, fsdem_real *dt) { return fsdem__pic_dem_stable((fsdem_pic_dem *)c, dt); }
+static fsdem_result fsdem__pic_dem_go(void *c, fsdem_real dt) { return fsdem__pic_dem_run((fsdem_pic_dem *)c, dt); }
+
 fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *c, fsdem_real duration, long long *steps) {
-    double end;
-    long long n = 0;
-    fsdem_result res = FSDEM_OK;
+    static const fsdem__coupled_verbs verbs = {fsdem__pic_dem_now, fsdem__pic_dem_prepare, fsdem__pic_dem_go};
     if (steps) *steps = 0;
     if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(duration >= 0) || !fsdem__finite(duration))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_dem_advance: duration = %g s must be >= 0", (double)duration);
-    end = fsdem_pic_time(c->desc.pic) + (double)duration;
-    while (res == FSDEM_OK && fsdem_pic_time(c->desc.pic) < end - 1e-12 * (end > 1 ? end : 1)) {
-        const double left = end - fsdem_pic_time(c->desc.pic);
-        fsdem_real dt = 0;
-        if ((res = fsdem__pic_dem_stable(c, &dt)) != FSDEM_OK) break;
-        /* the last steps shortened to end exactly, as fsdem_pic_advance does */
-        if ((double)dt >= left) dt = (fsdem_real)left;
-        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
-        res = fsdem__pic_dem_run(c, dt);
-        ++n;
-    }
-    if (steps) *steps = n;
-    return res;
+    return fsdem__coupled_advance(c, &c->status, "fsdem_pic_dem_advance", &verbs, duration, steps);
 }
 
 fsdem_result fsdem_pic_dem_stable_dt(fsdem_pic_dem *c, fsdem_real *dt) {
