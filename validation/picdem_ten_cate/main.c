@@ -8,7 +8,9 @@
    Usage: run [DATA_DIR] [--fine] [--cells=N] [--t-end=S]
      default: dx = 20 mm / 14 (10.5 cells per diameter; the box is 70 x 70 x 112 cells);
      --fine: dx = 20 mm / 18 (13.5 cells per diameter, 90 x 90 x 144 cells);
-     --cells=N: dx = 20 mm / N; --t-end=S: stop at S seconds (default 4 s, or once the sphere rests).
+     --cells=N: dx = 20 mm / N; --t-end=S: stop at S seconds (default 4 s, or once the sphere rests);
+     --ppc=N particles per cell (default 1), --vfrac=F viscous_dt_fraction (default 1),
+     --tol=T pressure and viscous solver tolerance (default 1e-6).
    Writes sphere.csv (t, gap, w) and forces.csv (t, pressure and viscous force, body volume). */
 #define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
@@ -60,8 +62,8 @@ static double gap_at(double t) {
 
 int main(int argc, char **argv) {
     const char *dir = VC_DATA_DIR;
-    int cells = 14, a, ppc = 8;
-    double vfrac = 1.0, tol = 1e-8;
+    int cells = 14, a, ppc = 1;
+    double vfrac = 1.0, tol = 1e-6;
     double t_end = 4.0;
     fsdem_pic_desc pd = fsdem_pic_desc_default(3);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
