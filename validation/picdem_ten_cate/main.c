@@ -263,7 +263,7 @@ int main(int argc, char **argv) {
             rms += e * e;
             n++;
         }
-        rms = sqrt(rms / (n > 0 ? n : 1));
+        rms = n > 0 ? sqrt(rms / n) : NAN; /* no point compared: no pass */
         for (i = 0; i < tg.rows; ++i) {
             const double t = atof(tg.cell[i * tg.cols + ig_t]), gd = atof(tg.cell[i * tg.cols + ig_g]);
             double e;
