@@ -1261,6 +1261,10 @@ FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
    - reference[c]: the part of cell c's fluid-fraction kernel that moving solids leave open (default
      1): the particle count of a full cell is divided by it, as by the static obstacles' own part, so
      that water around a moving body reads full and keeps its pressure;
+   - viscous_velocity[a][f] (NULL without viscosity): the moving solid's velocity on face f at the
+     start of the step, the no-slip value of the implicit viscous solve, which comes before gravity
+     and the accelerations (solid_velocity, the velocity at the end of the step, includes them; a
+     body at rest in water at rest would otherwise be sheared by its own g dt); default 0;
    - shear[a][f] (read only; NULL without viscosity): the viscous force component a (N; N/m in 2D)
      that the liquid exerted on the closed face f (E = 0) during the last step's implicit viscous
      solve, rho nu dx^(dim-2) sum (u_nb - us_f) over the liquid faces next to it; the liquid got
@@ -1278,6 +1282,7 @@ typedef struct fsdem_pic_coupling {
     fsdem_real *pressure_rhs;
     fsdem_real *reference;
     const fsdem_real *shear[3];
+    fsdem_real *viscous_velocity[3];
 } fsdem_pic_coupling;
 
 FSDEM_API fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *pic);
@@ -7417,6 +7422,7 @@ struct fsdem_pic {
     fsdem_real *sopen[3], *svel[3];           /* static obstacles: open fraction, solid velocity */
     fsdem_real *copen[3], *cvel[3], *cacc[3]; /* coupler arrays */
     fsdem_real *shear[3];                     /* viscous force on closed faces (viscosity > 0) */
+    fsdem_real *cvisc[3];                     /* coupler: no-slip velocity of moving solids (viscosity > 0) */
     fsdem_real *E[3], *us[3];                 /* effective open fraction and solid velocity */
     unsigned char *fvalid[3], *fvalid2[3];
     int *fqueue; /* breadth-first front of the extrapolation, max(nface) entries */
@@ -7653,7 +7659,7 @@ typedef struct fsdem__pic_array {
     fsdem_real fill;
 } fsdem__pic_array;
 
-/* 18 per axis (13, and 5 for the implicit viscosity) and 14 per cell: 68 in 3D with viscosity */
+/* 19 per axis (13, and 6 for the implicit viscosity) and 14 per cell: 71 in 3D with viscosity */
 #define FSDEM__PIC_MAX_ARRAYS 80
 
 static void fsdem__pic_array_add(fsdem__pic_array *t, int *n, void **ptr, size_t count, size_t elem, fsdem_real fill) {
@@ -7689,6 +7695,7 @@ static int fsdem__pic_arrays(fsdem_pic *s, fsdem__pic_array t[FSDEM__PIC_MAX_ARR
         FSDEM__PIC_BYTES(fvalid2[a], nf);
         if (s->desc.viscosity > 0) {
             FSDEM__PIC_REALS(shear[a], nf, 0);
+            FSDEM__PIC_REALS(cvisc[a], nf, 0);
             FSDEM__PIC_BYTES(vcell[a], nf);
             for (b = 0; b < s->dim; ++b) {
                 size_t m = 1;
@@ -7922,6 +7929,7 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
         s->coupling.solid_velocity[a] = s->cvel[a];
         s->coupling.acceleration[a] = s->cacc[a];
         s->coupling.shear[a] = s->shear[a];
+        s->coupling.viscous_velocity[a] = s->cvisc[a];
     }
     s->coupling.pressure_rhs = s->crhs;
     s->coupling.reference = s->cref;
@@ -9059,6 +9067,13 @@ static int fsdem__pic_layers(const fsdem_pic *s) {
 
 /* ---- >>pic_viscosity : implicit nu lap(u), one stencil solve per component ---- */
 
+/* No-slip velocity of the closed face g of axis a in the viscous solve: a moving solid's velocity at
+   the start of the step (fsdem_pic_coupling.viscous_velocity; the projection takes its velocity at
+   the end, solid_velocity, which holds the step's gravity too), else the face's solid velocity. */
+static fsdem_real fsdem__pic_noslip(const fsdem_pic *s, int a, int g) {
+    return s->copen[a][g] < s->sopen[a][g] ? s->cvisc[a][g] : s->us[a][g];
+}
+
 /* The viscous force on the closed faces of component a after its solve (fsdem_pic_coupling.shear):
    each unknown face f next to a closed face g lost rho dx^dim (dt nu / dx^2)(u_f - us_g) of
    momentum to it over dt, the Dirichlet term of the solve, so the forces sum to the momentum the
@@ -9082,7 +9097,7 @@ static void fsdem__pic_shear(fsdem_pic *s, int a) {
                         int nc = coord[b] + sg, g;
                         if (nc < 0 || nc >= fn[b]) continue;
                         g = f + sg * s->fstep[a][b];
-                        if (cell[g] != FSDEM_STENCIL_CELL_FLUID && s->E[a][g] <= 0) s->shear[a][g] += c * (s->u[a][f] - s->us[a][g]);
+                        if (cell[g] != FSDEM_STENCIL_CELL_FLUID && s->E[a][g] <= 0) s->shear[a][g] += c * (s->u[a][f] - fsdem__pic_noslip(s, a, g));
                     }
             }
 }
@@ -9151,7 +9166,7 @@ static fsdem_result fsdem__pic_viscosity(fsdem_pic *s, fsdem_real dt) {
                             if (cell[g] == FSDEM_STENCIL_CELL_FLUID) continue;
                             if (s->E[a][g] <= 0) {
                                 d += 1;
-                                r0 += s->us[a][g];
+                                r0 += fsdem__pic_noslip(s, a, g);
                             }
                         }
                     dg[f] = inv_k + d;
@@ -14977,6 +14992,7 @@ static void fsdem__pic_dem_clear_faces(fsdem_pic_dem *c) {
     for (a = 0; a < cp.dim; ++a) {
         for (e = 0; e < cp.face_count[a]; ++e) cp.open[a][e] = 1;
         memset(cp.solid_velocity[a], 0, sizeof(fsdem_real) * (size_t)cp.face_count[a]);
+        if (cp.viscous_velocity[a]) memset(cp.viscous_velocity[a], 0, sizeof(fsdem_real) * (size_t)cp.face_count[a]);
     }
     for (e = 0; e < c->desc.pic->ncell; ++e) cp.reference[e] = 1;
     c->face_count = 0;
@@ -15145,7 +15161,8 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
             c->vstar[b].z = 0;
             c->wstar[b].x = c->wstar[b].y = 0;
         }
-        /* the solid fluxes: closed part times the body's velocity at the face centre */
+        /* the solid fluxes: closed part times the body's velocity at the face centre, Q* for the
+           projection and the start velocity for the viscous solve's no-slip */
         for (e = c->face_start[b]; e < c->face_start[b + 1]; ++e) {
             const int a = c->face_axis[e], f = c->face[e];
             int idx[3];
@@ -15155,6 +15172,9 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
             idx[2] = f / (s->fn[a][0] * s->fn[a][1]);
             arm = fsdem__sub(fsdem__pic_face_pos(s, a, idx[0], idx[1], idx[2]), P.position[b]);
             cp.solid_velocity[a][f] += c->face_closed[e] * fsdem__comp(fsdem__add(c->vstar[b], fsdem__cross(c->wstar[b], arm)), a);
+            if (cp.viscous_velocity[a])
+                cp.viscous_velocity[a][f] +=
+                    c->face_closed[e] * fsdem__comp(fsdem__add(P.velocity[b], fsdem__cross(P.angular_velocity[b], arm)), a);
         }
     }
     /* open fractions, and the solid velocity as the closed-part-weighted mean */
@@ -15163,6 +15183,7 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
         if (*open < 0) {
             const fsdem_real total = -*open, closed = total > 1 - FSDEM__PIC_DEM_MIN_OPEN ? 1 : total;
             cp.solid_velocity[c->face_axis[e]][c->face[e]] /= closed;
+            if (cp.viscous_velocity[c->face_axis[e]]) cp.viscous_velocity[c->face_axis[e]][c->face[e]] /= closed;
             *open = 1 - closed;
         }
     }
@@ -16215,6 +16236,7 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
         fsdem__restart_data(io, s->svel[a], fb);
         fsdem__restart_data(io, s->copen[a], fb);
         fsdem__restart_data(io, s->cvel[a], fb);
+        if (s->cvisc[a]) fsdem__restart_data(io, s->cvisc[a], fb); /* viscosity > 0, as the desc */
         fsdem__restart_data(io, s->cacc[a], fb);
         fsdem__restart_data(io, s->E[a], fb);
         fsdem__restart_data(io, s->us[a], fb);
