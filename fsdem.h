@@ -2380,7 +2380,12 @@ FSDEM_API fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *coupl
         external force (in Q* too). Bodies of the water's density are then in exact balance and
         floating drafts are exact on the grid; the exchange with the water is not touched.
    Forces are per unit depth in the 2D PIC; the DEM's discs of length disc_length receive them
-   times that length. Contacts with domain walls are the DEM's walls (add them to the DEM). */
+   times that length. Contacts with domain walls are the DEM's walls (add them to the DEM).
+   Next to moving bodies two PIC statistics do not mean what they mean elsewhere: max_divergence
+   takes the solid flux of the predicted velocity Q*, not of the end velocity the pressure was solved
+   with, and fluid_volume counts cut cells whole; particle_volume is the water volume. A dam break
+   from rest wants fsdem_pic_desc.dt_max well below sqrt(dx / g): the PIC's step estimate does not
+   foresee the impulsive start, and its CFL check would end the first step. */
 
 typedef struct fsdem_pic_dem fsdem_pic_dem;
 
