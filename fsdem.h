@@ -15359,12 +15359,13 @@ static fsdem_result fsdem__pic_dem_map_build(fsdem_pic_dem *c, fsdem__pic_dem_ma
 /* The bodies as one solid for fsdem_pic_exclude_particles (`user` is the coupler). */
 static fsdem_real fsdem__pic_dem_solid(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
     const fsdem_pic_dem *c = (const fsdem_pic_dem *)user;
-    const fsdem_pic *s = c->desc.pic;
-    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
-    const int cell = fsdem__pic_cell_of(s, p);
+    const int cell = fsdem__pic_cell_of(c->desc.pic, p);
+    fsdem_dem_particles P;
     fsdem_real best = (fsdem_real)1e30;
     int e;
     *normal = fsdem_v3(1, 0, 0);
+    if (c->body_map.start[cell] == c->body_map.start[cell + 1]) return best; /* most particles: no body near */
+    P = fsdem_dem_get_particles(c->desc.dem);
     for (e = c->body_map.start[cell]; e < c->body_map.start[cell + 1]; ++e) {
         const int b = c->body_map.item[e];
         const fsdem_vec3 r = fsdem__sub(p, P.position[b]);
