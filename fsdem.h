@@ -88,8 +88,9 @@
 
    ONE DIALECT FOR EVERY SOLVER
      Each solver (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_mps) and each coupler (fsdem_swe_dem,
-     fsdem_mps_dem) speaks these verbs; X is the object's name. A solver adds verbs of its own
-     (add_particle, set_bed, ...).
+     fsdem_mps_dem, fsdem_pic_dem) speaks these verbs; X is the object's name (tests/map_check.sh
+     holds every one of them to the table). A solver adds verbs of its own (add_particle, set_bed,
+     ...); a coupler's per-particle record is fsdem_X_get_force(x, index, &record).
        fsdem_X_desc fsdem_X_desc_default(dim)      defaults (couplers and fsdem_pcg: no argument)
        fsdem_result fsdem_X_desc_check(desc, message, size)  validation without creating anything
        fsdem_result fsdem_X_create(desc, &x)        *x is NULL on failure; destroy with _destroy
@@ -119,7 +120,8 @@
      (`fsdem_pic_add_obstacle: ...`), the desc field (`fsdem_swe_desc.cfl must ...`), or for failures
      inside time stepping the object (`fsdem_dem: particle 12 (id 40) left the domain ...`).
      Public types of a module carry its name (fsdem_dem_material, fsdem_pic_bc); enum values are
-     FSDEM_<ENUM>_<VALUE>; private names are fsdem__<module>_... (core helpers: fsdem__...).
+     FSDEM_<ENUM>_<VALUE> (fsdem_dem_law: FSDEM_DEM_LAW_LINEAR), result codes alone excepted
+     (FSDEM_OK, FSDEM_ERR_<WHAT>); private names are fsdem__<module>_... (core helpers: fsdem__...).
      "stencil" means one thing: the matrix-free MAC-grid operator fsdem_stencil of >>linalg;
      interpolation weights are "kernels" (>>kernel).
 
@@ -251,6 +253,7 @@
 #define fsdem_mps_dem_step_dt fsdem_mps_dem_step_dt_f
 #define fsdem_mps_dem_time fsdem_mps_dem_time_f
 #define fsdem_mps_dem_update fsdem_mps_dem_update_f
+#define fsdem_mps_dem_write_csv fsdem_mps_dem_write_csv_f
 #define fsdem_mps_desc_check fsdem_mps_desc_check_f
 #define fsdem_mps_desc_default fsdem_mps_desc_default_f
 #define fsdem_mps_destroy fsdem_mps_destroy_f
@@ -278,6 +281,7 @@
 #define fsdem_mps_step fsdem_mps_step_f
 #define fsdem_mps_step_dt fsdem_mps_step_dt_f
 #define fsdem_mps_time fsdem_mps_time_f
+#define fsdem_mps_write_csv fsdem_mps_write_csv_f
 #define fsdem_mps_write_vtp fsdem_mps_write_vtp_f
 #define fsdem_pcg_create fsdem_pcg_create_f
 #define fsdem_pcg_desc_check fsdem_pcg_desc_check_f
@@ -300,8 +304,8 @@
 #define fsdem_pic_dem_desc_check fsdem_pic_dem_desc_check_f
 #define fsdem_pic_dem_desc_default fsdem_pic_dem_desc_default_f
 #define fsdem_pic_dem_destroy fsdem_pic_dem_destroy_f
-#define fsdem_pic_dem_get_body fsdem_pic_dem_get_body_f
 #define fsdem_pic_dem_get_desc fsdem_pic_dem_get_desc_f
+#define fsdem_pic_dem_get_force fsdem_pic_dem_get_force_f
 #define fsdem_pic_dem_get_stats fsdem_pic_dem_get_stats_f
 #define fsdem_pic_dem_last_error fsdem_pic_dem_last_error_f
 #define fsdem_pic_dem_restore fsdem_pic_dem_restore_f
@@ -312,6 +316,7 @@
 #define fsdem_pic_dem_step fsdem_pic_dem_step_f
 #define fsdem_pic_dem_step_dt fsdem_pic_dem_step_dt_f
 #define fsdem_pic_dem_time fsdem_pic_dem_time_f
+#define fsdem_pic_dem_write_csv fsdem_pic_dem_write_csv_f
 #define fsdem_pic_desc_check fsdem_pic_desc_check_f
 #define fsdem_pic_desc_default fsdem_pic_desc_default_f
 #define fsdem_pic_destroy fsdem_pic_destroy_f
@@ -383,6 +388,7 @@
 #define fsdem_swe_dem_step_dt fsdem_swe_dem_step_dt_f
 #define fsdem_swe_dem_time fsdem_swe_dem_time_f
 #define fsdem_swe_dem_update_forces fsdem_swe_dem_update_forces_f
+#define fsdem_swe_dem_write_csv fsdem_swe_dem_write_csv_f
 #define fsdem_swe_desc_check fsdem_swe_desc_check_f
 #define fsdem_swe_desc_default fsdem_swe_desc_default_f
 #define fsdem_swe_destroy fsdem_swe_destroy_f
@@ -469,9 +475,9 @@ typedef enum fsdem_result {
 FSDEM_API const char *fsdem_result_string(fsdem_result result);
 
 typedef enum fsdem_log_level {
-    FSDEM_LOG_ERROR = 0,
-    FSDEM_LOG_WARNING = 1,
-    FSDEM_LOG_INFO = 2
+    FSDEM_LOG_LEVEL_ERROR = 0,
+    FSDEM_LOG_LEVEL_WARNING = 1,
+    FSDEM_LOG_LEVEL_INFO = 2
 } fsdem_log_level;
 
 /* Optional log sink. `message` is valid only during the call. */
@@ -606,14 +612,14 @@ FSDEM_API fsdem_dem_material fsdem_dem_material_default(void);
 typedef enum fsdem_dem_dt_rule {
     /* the rule of the contact law: LINEAR_SEED000 for FSDEM_DEM_LAW_LINEAR, RAYLEIGH for
        FSDEM_DEM_LAW_HERTZ_MINDLIN, GIC for FSDEM_DEM_LAW_GIC */
-    FSDEM_DEM_DT_AUTO = 0,
+    FSDEM_DEM_DT_RULE_AUTO = 0,
     /* seed 000 Eq. 18: (2 pi / gamma) sqrt(m_ij / k), k from Eq. 10; dt_param is gamma (default 150) */
-    FSDEM_DEM_DT_LINEAR_SEED000 = 1,
+    FSDEM_DEM_DT_RULE_LINEAR_SEED000 = 1,
     /* seed 002 Eq. 38, the Rayleigh time pi R sqrt(2 rho (1+nu)/E) / (0.1631 nu + 0.8766) over all
        particles, times dt_param, a safety fraction in (0, 1] (default 0.2, as LIGGGHTS advises) */
-    FSDEM_DEM_DT_RAYLEIGH = 2,
+    FSDEM_DEM_DT_RULE_RAYLEIGH = 2,
     /* seed 004 Eq. 32: (1/2) sqrt(m / k_n), k_n = E r, times dt_param in (0, 1] (default 1) */
-    FSDEM_DEM_DT_GIC = 3
+    FSDEM_DEM_DT_RULE_GIC = 3
 } fsdem_dem_dt_rule;
 
 typedef struct fsdem_dem_desc {
@@ -624,7 +630,7 @@ typedef struct fsdem_dem_desc {
     fsdem_dem_law law;          /* default FSDEM_DEM_LAW_HERTZ_MINDLIN */
     fsdem_dem_integrator integrator;    /* default FSDEM_DEM_INTEGRATOR_VERLET */
     fsdem_real dt;                  /* s; time step; default 1e-5 */
-    fsdem_dem_dt_rule dt_rule;      /* rule of fsdem_dem_stable_dt; default FSDEM_DEM_DT_AUTO */
+    fsdem_dem_dt_rule dt_rule;      /* rule of fsdem_dem_stable_dt; default FSDEM_DEM_DT_RULE_AUTO */
     fsdem_real dt_param;            /* gamma or safety fraction of the rule; 0: its default; default 0 */
     fsdem_real skin;                /* m; neighbour-list margin; < 0: 0.25 x largest radius; default -1 */
     fsdem_real contact_offset;      /* m; imaginary-boundary gap of seed 000 Eq. 19 (2 dx there): */
@@ -718,12 +724,12 @@ FSDEM_API fsdem_dem_coupling fsdem_dem_get_coupling(fsdem_dem *dem);
 /* ---- walls ---- */
 
 typedef enum fsdem_dem_wall_type {
-    FSDEM_DEM_WALL_PLANE = 0,       /* infinite plane through `a` with unit normal `b` (towards particles) */
-    FSDEM_DEM_WALL_BOX_INSIDE = 1,  /* axis-aligned box [a, b] holding the particles inside */
-    FSDEM_DEM_WALL_BOX_OUTSIDE = 2, /* axis-aligned solid box [a, b]; particles stay outside */
-    FSDEM_DEM_WALL_SEGMENT = 3,     /* 2D segment a-b (both sides) */
-    FSDEM_DEM_WALL_TRIANGLE = 4,    /* 3D triangle a-b-c (both sides) */
-    FSDEM_DEM_WALL_SDF = 5          /* signed distance given by a callback (moved by it: fsdem_dem_wall_moved) */
+    FSDEM_DEM_WALL_TYPE_PLANE = 0,       /* infinite plane through `a` with unit normal `b` (towards particles) */
+    FSDEM_DEM_WALL_TYPE_BOX_INSIDE = 1,  /* axis-aligned box [a, b] holding the particles inside */
+    FSDEM_DEM_WALL_TYPE_BOX_OUTSIDE = 2, /* axis-aligned solid box [a, b]; particles stay outside */
+    FSDEM_DEM_WALL_TYPE_SEGMENT = 3,     /* 2D segment a-b (both sides) */
+    FSDEM_DEM_WALL_TYPE_TRIANGLE = 4,    /* 3D triangle a-b-c (both sides) */
+    FSDEM_DEM_WALL_TYPE_SDF = 5          /* signed distance given by a callback (moved by it: fsdem_dem_wall_moved) */
 } fsdem_dem_wall_type;
 
 
@@ -732,7 +738,7 @@ typedef struct fsdem_dem_wall_desc {
     fsdem_vec3 a, b, c;   /* m; geometry, meaning per type above */
     fsdem_vec3 velocity;  /* m/s; the wall translates with it; default 0 */
     int material;         /* index from fsdem_dem_add_material */
-    fsdem_sdf_fn sdf;     /* FSDEM_DEM_WALL_SDF only */
+    fsdem_sdf_fn sdf;     /* FSDEM_DEM_WALL_TYPE_SDF only */
     void *sdf_user;
 } fsdem_dem_wall_desc;
 
@@ -1133,12 +1139,12 @@ FSDEM_API const char *fsdem_pic_last_error(const fsdem_pic *pic);
 /* ---- obstacles ---- */
 
 typedef enum fsdem_pic_obstacle_type {
-    FSDEM_PIC_OBSTACLE_BOX = 0,      /* axis-aligned solid box [a, b] */
-    FSDEM_PIC_OBSTACLE_SPHERE = 1,   /* sphere (3D) or disc (2D), centre a, radius `radius` */
-    FSDEM_PIC_OBSTACLE_CYLINDER = 2, /* 3D: flat-capped cylinder with axis a-b and `radius`; */
+    FSDEM_PIC_OBSTACLE_TYPE_BOX = 0,      /* axis-aligned solid box [a, b] */
+    FSDEM_PIC_OBSTACLE_TYPE_SPHERE = 1,   /* sphere (3D) or disc (2D), centre a, radius `radius` */
+    FSDEM_PIC_OBSTACLE_TYPE_CYLINDER = 2, /* 3D: flat-capped cylinder with axis a-b and `radius`; */
                                      /*    2D: a disc like SPHERE */
-    FSDEM_PIC_OBSTACLE_POLYGON = 3,  /* 2D: closed polygon `vertices` (x, y used), any orientation */
-    FSDEM_PIC_OBSTACLE_SDF = 4       /* callback: signed distance, positive on the liquid side */
+    FSDEM_PIC_OBSTACLE_TYPE_POLYGON = 3,  /* 2D: closed polygon `vertices` (x, y used), any orientation */
+    FSDEM_PIC_OBSTACLE_TYPE_SDF = 4       /* callback: signed distance, positive on the liquid side */
 } fsdem_pic_obstacle_type;
 
 typedef struct fsdem_pic_obstacle {
@@ -1322,10 +1328,10 @@ typedef enum fsdem_pic_gauge_kind {
     /* water level: the elevation (m, the coordinate along -gravity) of the highest free surface
        above the point's column of cells (the cell column holding x in 2D, x-y in 3D), where phi
        crosses 0 between two cell centres; the bottom of the domain when the column is dry */
-    FSDEM_PIC_GAUGE_LEVEL = 0,
+    FSDEM_PIC_GAUGE_KIND_LEVEL = 0,
     /* pressure (Pa): at the point (trilinear between cell centres) for radius 0, else the mean over
        the non-solid cells whose centres lie within `radius` of it (a sensor patch on a wall) */
-    FSDEM_PIC_GAUGE_PRESSURE = 1
+    FSDEM_PIC_GAUGE_KIND_PRESSURE = 1
 } fsdem_pic_gauge_kind;
 
 /* Adds a gauge (before fsdem_pic_gauges_open); its id goes to *id (may be NULL). The level gauge
@@ -1867,9 +1873,9 @@ typedef struct fsdem_mps fsdem_mps;
 
 /* Kind of a particle (fsdem_mps_particles.kind). */
 typedef enum fsdem_mps_kind {
-    FSDEM_MPS_FLUID = 0, /* moves; pressure solved (0 on the free surface) */
-    FSDEM_MPS_WALL = 1,  /* fixed; pressure solved; the solid layer next to the fluid */
-    FSDEM_MPS_DUMMY = 2  /* fixed; no pressure; completes the number density behind a wall layer */
+    FSDEM_MPS_KIND_FLUID = 0, /* moves; pressure solved (0 on the free surface) */
+    FSDEM_MPS_KIND_WALL = 1,  /* fixed; pressure solved; the solid layer next to the fluid */
+    FSDEM_MPS_KIND_DUMMY = 2  /* fixed; no pressure; completes the number density behind a wall layer */
 } fsdem_mps_kind;
 
 /* Pressure gradient of the corrector. */
@@ -1881,18 +1887,18 @@ typedef enum fsdem_mps_gradient_model {
        opposite level: in a 2D dam break (4 m tank, 1 x 2 m column, r0 = 0.015 m) the pressure of
        the lower half of the column swung between +4.1e5 and -3.8e5 Pa from one step to the next
        at t = 0.20 s and the run blew up (0.09 s without collisions, 0.28 s with them) */
-    FSDEM_MPS_GRADIENT_SUM = 0,
+    FSDEM_MPS_GRADIENT_MODEL_SUM = 0,
     /* Koshizuka, Nobe and Oka (1998): (p_j - min p) with the smallest pressure of i and its
        neighbours; also repulsive, exact for linear fields in the interior of a lattice, and blind
        to a uniform pressure level; with the collisions of step 6b the dam break above runs through
        (without them it failed at 0.19 s); the default */
-    FSDEM_MPS_GRADIENT_MIN = 1,
+    FSDEM_MPS_GRADIENT_MODEL_MIN = 1,
     /* the difference form (p_j - p_i) times the inverse of the moment matrix
        sum_j w_ij (r_j - r_i)(r_j - r_i)^T / |r_j - r_i|^2, the corrected gradient of Khayyer and
        Gotoh (2011, Appl. Ocean Res. 33:235; after Randles and Libersky 1996): exact for linear
        fields in any neighbourhood that spans the space; not repulsive (no pressure force in a
        uniform pressure), so clustering is left to particle shifting (desc.shifting) */
-    FSDEM_MPS_GRADIENT_CORRECTED = 2
+    FSDEM_MPS_GRADIENT_MODEL_CORRECTED = 2
 } fsdem_mps_gradient_model;
 
 /* Form of the pressure equation's source with a porosity field (seed 002 §2.1). */
@@ -1919,7 +1925,7 @@ typedef struct fsdem_mps_desc {
     fsdem_real dt_max;              /* s; longest step (taken while nothing moves); default 1e-3 */
     fsdem_vec3 domain_min;          /* m; every particle must stay inside; default (0,0,0) */
     fsdem_vec3 domain_max;          /* m; default (1,1,1) (z unused in 2D) */
-    fsdem_mps_gradient_model gradient; /* default FSDEM_MPS_GRADIENT_MIN (see the enum) */
+    fsdem_mps_gradient_model gradient; /* default FSDEM_MPS_GRADIENT_MODEL_MIN (see the enum) */
     int clamp_negative_pressure;    /* 1: p < 0 is set to 0 after the solve; default 1 */
     fsdem_real collision_distance;  /* -; in units of r0: approaching FLUID particles that would */
                                     /*    come closer collide (step 6b), in [0, 1); 0 = off; */
@@ -2104,8 +2110,8 @@ FSDEM_API fsdem_result fsdem_mps_probe_height(const fsdem_mps *mps, fsdem_vec3 g
 /* Gauges: probes at fixed places sampled at exact output times into a CSV series, as the PIC
    solver's (fsdem_pic_add_gauge). */
 typedef enum fsdem_mps_gauge_kind {
-    FSDEM_MPS_GAUGE_LEVEL = 0,   /* water level at the gauge line through the position (fsdem_mps_probe_height) */
-    FSDEM_MPS_GAUGE_PRESSURE = 1 /* pressure at the position (fsdem_mps_probe_pressure with the radius) */
+    FSDEM_MPS_GAUGE_KIND_LEVEL = 0,   /* water level at the gauge line through the position (fsdem_mps_probe_height) */
+    FSDEM_MPS_GAUGE_KIND_PRESSURE = 1 /* pressure at the position (fsdem_mps_probe_pressure with the radius) */
 } fsdem_mps_gauge_kind;
 
 /* Adds a gauge (before fsdem_mps_gauges_open); its id goes to *id (may be NULL). Radius (m) of a
@@ -2171,12 +2177,12 @@ FSDEM_API fsdem_result fsdem_mps_obstacle_force(const fsdem_mps *mps, int id, fs
                        phi = 1 - eps, F_d the drag of Eq. 25 (the total force is F_d / eps):
                        c = 18 mu eps F / d^2, exactly Stokes at eps = 1, Re = 0. */
 typedef enum fsdem_drag_law {
-    FSDEM_DRAG_STOKES = 0,           /* isolated sphere, creeping flow: 3 pi mu d, porosity ignored */
-    FSDEM_DRAG_SCHILLER_NAUMANN = 1, /* isolated sphere, Cd of Eq. 27, Re = rho d |u - v| / mu, porosity ignored */
-    FSDEM_DRAG_ERGUN_WEN_YU = 2,     /* seed 002 Eq. 26 exactly: Ergun for eps <= 0.8, Wen-Yu above */
-    FSDEM_DRAG_GIDASPOW = 3,         /* Ergun and Wen-Yu joined by the smooth blend of Huilin and Gidaspow (2003) */
-    FSDEM_DRAG_DI_FELICE = 4,        /* Di Felice (1994) */
-    FSDEM_DRAG_BEETSTRA = 5          /* Beetstra, van der Hoef and Kuipers (2007) */
+    FSDEM_DRAG_LAW_STOKES = 0,           /* isolated sphere, creeping flow: 3 pi mu d, porosity ignored */
+    FSDEM_DRAG_LAW_SCHILLER_NAUMANN = 1, /* isolated sphere, Cd of Eq. 27, Re = rho d |u - v| / mu, porosity ignored */
+    FSDEM_DRAG_LAW_ERGUN_WEN_YU = 2,     /* seed 002 Eq. 26 exactly: Ergun for eps <= 0.8, Wen-Yu above */
+    FSDEM_DRAG_LAW_GIDASPOW = 3,         /* Ergun and Wen-Yu joined by the smooth blend of Huilin and Gidaspow (2003) */
+    FSDEM_DRAG_LAW_DI_FELICE = 4,        /* Di Felice (1994) */
+    FSDEM_DRAG_LAW_BEETSTRA = 5          /* Beetstra, van der Hoef and Kuipers (2007) */
 } fsdem_drag_law;
 
 /* Coefficient of the drag on one particle: F = c V (u - v) as above. Writes c (kg m^-3 s^-1) to
@@ -2214,7 +2220,7 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
         velocity u_k (Eq. 33), and for Model A the pressure gradient grad P_k, the same w_s average
         of the gradients the MPS corrector applied to those particles;
      3. drag F^d = c V_k (u_k - v_k) with c = beta/(1 - eps) of the chosen law (>>drag; Eq. 25-28
-        with FSDEM_DRAG_ERGUN_WEN_YU) and the force on the particle (held over the DEM substeps):
+        with FSDEM_DRAG_LAW_ERGUN_WEN_YU) and the force on the particle (held over the DEM substeps):
           Model A (the MPS desc.model):  F^int = F^d - V_k grad P_k            (Eq. 34)
           Model B:                       F^int = F^d / eps_k - V_k rho_f g     (Eq. 35);
      4. the reaction on the fluid (Eq. 36): FLUID particle i gets -sum_k X_k w_s(r_ki) / W_k with
@@ -2250,7 +2256,7 @@ typedef struct fsdem_mps_dem fsdem_mps_dem;
 typedef struct fsdem_mps_dem_desc {
     fsdem_mps *mps;               /* water; not owned; must outlive the coupler */
     fsdem_dem *dem;               /* sediment; same dim and gravity as the MPS; not owned */
-    fsdem_drag_law drag;          /* default FSDEM_DRAG_ERGUN_WEN_YU (seed 002 Eq. 26) */
+    fsdem_drag_law drag;          /* default FSDEM_DRAG_LAW_ERGUN_WEN_YU (seed 002 Eq. 26) */
     fsdem_real radius;            /* m; r_e of w_s (Eq. 29); 0: the MPS re (4.1 r0 by default), */
                                   /*    which the seed's text implies; default 0 */
     fsdem_real min_porosity;      /* -; floor of eps_i (Eq. 31 can go below 0 where DEM particles */
@@ -2423,7 +2429,7 @@ FSDEM_API fsdem_pic_dem_desc fsdem_pic_dem_get_desc(const fsdem_pic_dem *coupler
 
 /* The fluid's load on one body in the last coupled step (whole body: N and N m, the 2D PIC's per
    metre values times disc_length). */
-typedef struct fsdem_pic_dem_body {
+typedef struct fsdem_pic_dem_force {
     fsdem_vec3 pressure_force;   /* N; G of step 3 */
     fsdem_vec3 viscous_force;    /* N; step 4 */
     fsdem_vec3 torque;           /* N m; pressure and viscous, about the centre */
@@ -2431,11 +2437,11 @@ typedef struct fsdem_pic_dem_body {
     fsdem_real volume;           /* m^3; V_g, the body volume the faces normal to gravity see (item */
                                  /*    8; per metre in 2D) */
     int faces;                   /* faces the body covers or cuts */
-} fsdem_pic_dem_body;
+} fsdem_pic_dem_force;
 
 /* Load on DEM particle `index` from the last step. FSDEM_ERR_NOT_FOUND for a bad index or before the
    first step. */
-FSDEM_API fsdem_result fsdem_pic_dem_get_body(const fsdem_pic_dem *coupler, int index, fsdem_pic_dem_body *out);
+FSDEM_API fsdem_result fsdem_pic_dem_get_force(const fsdem_pic_dem *coupler, int index, fsdem_pic_dem_force *out);
 /* One coupled step of the stable dt. The DEM substep count is checked before anything moves
    (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of either solver are passed on with their
    message. */
@@ -2500,7 +2506,11 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
                     obstacle membership, and the number density and surface flags of the last
                     step) and their capacity, obstacles with their last forces, time, counters
                     (the pressure matrix of the last step is not kept: fsdem_mps_pressure_matrix
-                    is empty until the next step).
+                    is empty until the next step);
+     fsdem_mps_dem  the states of its fsdem_mps and fsdem_dem, restored into the solvers it was
+                    created with, and its own counters and per-particle force records;
+     fsdem_pic_dem  the states of its fsdem_pic and fsdem_dem, restored into the solvers it was
+                    created with, and its own counters and per-body load records.
    What must match (else FSDEM_ERR_INVALID_ARG naming the field): the desc fields that steps read.
    DEM: dim, domain, gravity, law, integrator, dt_rule, dt_param, skin, contact_offset, linear_*,
    disc_length, rotation. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,
@@ -2538,13 +2548,14 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
          12      4  byte-order mark 0x01020304 as the saving machine stores it
          16      4  precision: sizeof(fsdem_real), 4 (FSDEM_USE_FLOAT) or 8
          20      4  object kind: 1 fsdem_dem, 2 fsdem_pic, 3 fsdem_swe, 4 fsdem_swe_dem, 5 fsdem_mps,
-                    6 fsdem_mps_dem
+                    6 fsdem_mps_dem, 7 fsdem_pic_dem
          24      4  dimension of the object (the SWE's for fsdem_swe_dem)
          28      4  reserved (0)
          32     16  four sizes (int) for tools: DEM particles, materials, walls, pair-list entries;
                     PIC cells along x, y, z and particles; SWE nx, ny, point sources, gauges;
                     SWE-DEM nx, ny, DEM particles, force records; MPS particles, FLUID
-                    particles, obstacles, 0; MPS-DEM MPS particles, DEM particles, force records, 0
+                    particles, obstacles, 0; MPS-DEM MPS particles, DEM particles, force records, 0;
+                    PIC-DEM PIC particles, DEM particles, body load records, 0
          48      8  payload bytes (unsigned)
          56      8  checksum: 64-bit FNV-1a over bytes 0 to 55 and the payload
    The payload holds tagged sections of integers and reals as the saving machine stores them. */
@@ -2630,19 +2641,19 @@ typedef enum fsdem_vtk_format {
        read back to the same bits; the largest files, readable in an editor. A NaN or infinite
        value is written as nan/inf, which VTK's ascii parser stops at: look at a failed state in a
        binary format. */
-    FSDEM_VTK_ASCII = 0,
+    FSDEM_VTK_FORMAT_ASCII = 0,
     /* format="binary": inline base64 (RFC 4648 alphabet, '=' padding, no line breaks). Each array
        is one base64 stream of a UInt64 byte count (the number of data bytes that follow, not
        counting itself) followed by the data, as VTK's own writer encodes uncompressed data (it
        encodes the header separately only in compressed files; VTK 9.1's reader takes either).
        Exact, 4/3 of the raw size, and the file is well-formed XML. */
-    FSDEM_VTK_BASE64 = 1,
+    FSDEM_VTK_FORMAT_BASE64 = 1,
     /* format="appended": each <DataArray> carries offset="N" and no content; after the dataset,
        <AppendedData encoding="raw"> holds '_' and then, array after array in the order of the
        file, a UInt64 byte count and the raw bytes. N counts bytes from the first byte after the
        '_' to the array's count. Exact, the smallest and fastest to write and read; the raw bytes
        make the file not well-formed XML, as VTK's reader expects of appended raw data. */
-    FSDEM_VTK_APPENDED = 2
+    FSDEM_VTK_FORMAT_APPENDED = 2
 } fsdem_vtk_format;
 
 /* A ParaView time series (.pvd collection): open, add one entry per written file, close. The file
@@ -2729,6 +2740,23 @@ FSDEM_API fsdem_result fsdem_pic_write_grid_vti(const fsdem_pic *pic, const char
    kind = 0), surface (UInt8), pressure (Pa), velocity (m/s), number_density and porosity, as
    fsdem_mps_get_particles. Active scalars pressure, active vectors velocity. */
 FSDEM_API fsdem_result fsdem_mps_write_vtp(const fsdem_mps *mps, const char *path, fsdem_vtk_format format);
+/* MPS particles as CSV, one row per particle of every kind in index order:
+   kind,surface,x,y,z,vx,vy,vz,pressure,number_density,porosity (kind a fsdem_mps_kind). */
+FSDEM_API fsdem_result fsdem_mps_write_csv(const fsdem_mps *mps, const char *path);
+
+/* A coupler's per-particle records (fsdem_X_get_force) as CSV, one row per DEM particle that has
+   one, in index order; the first column is the particle's stable id (fsdem_dem_particles.id).
+   Before the first update or step the file holds the header alone.
+     SWE-DEM  id,buoyancy_z,hydrostatic_x,hydrostatic_y,dynamic_x,dynamic_y,heave_z,submerged_volume,
+              frontal_area,surface,in_water
+     MPS-DEM  id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,
+              fluid_u,fluid_v,fluid_w,porosity,reynolds,wet
+     PIC-DEM  id,pressure_x,pressure_y,pressure_z,viscous_x,viscous_y,viscous_z,torque_x,torque_y,
+              torque_z,weight_correction_x,weight_correction_y,weight_correction_z,volume,faces
+   Units as in the record types (N, N m, m^3, m^2, m, m/s). */
+FSDEM_API fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *coupler, const char *path);
 
 /* Shallow-water fields as ImageData (.vti): extent 0..nx x 0..ny x 0..0 points, origin (x_min,
    y_min, 0), spacing (dx, dy, 1); a 1D channel is one cell high, 0..nx x 0..1, origin (x_min, 0, 0),
@@ -2916,7 +2944,7 @@ typedef struct fsdem__status {
 
 static fsdem_result fsdem__vfail(fsdem__status *s, fsdem_result code, const char *fmt, va_list ap) {
     vsnprintf(s->message, sizeof s->message, fmt, ap);
-    if (s->log) s->log(s->log_user, FSDEM_LOG_ERROR, s->message);
+    if (s->log) s->log(s->log_user, FSDEM_LOG_LEVEL_ERROR, s->message);
     return code;
 }
 
@@ -2934,7 +2962,7 @@ static void fsdem__log_oom(fsdem_log_fn log, void *log_user, const char *what, s
     char msg[128];
     if (!log) return;
     snprintf(msg, sizeof msg, "%s: out of memory (%lu bytes)", what, (unsigned long)bytes);
-    log(log_user, FSDEM_LOG_ERROR, msg);
+    log(log_user, FSDEM_LOG_LEVEL_ERROR, msg);
 }
 
 static fsdem_result fsdem__ok(fsdem__status *s) {
@@ -2950,7 +2978,7 @@ static void *fsdem__object_new(fsdem_result checked, const char *why, fsdem_log_
                                const fsdem_allocator *al, size_t size, const char *name, fsdem_result *res) {
     void *obj;
     if (checked != FSDEM_OK) {
-        if (log) log(log_user, FSDEM_LOG_ERROR, why);
+        if (log) log(log_user, FSDEM_LOG_LEVEL_ERROR, why);
         *res = checked;
         return NULL;
     }
@@ -3083,8 +3111,8 @@ static void fsdem__set_comp(fsdem_vec3 *v, int axis, fsdem_real value) {
 
 /* ---- >>core_gauges : the point gauges of the particle solvers ---- */
 
-/* Level and pressure gauges of the PIC and MPS solvers: a kind (the value of FSDEM_PIC_GAUGE_LEVEL
-   and FSDEM_MPS_GAUGE_LEVEL, or of the _PRESSURE kinds), a position and a sensor radius per gauge,
+/* Level and pressure gauges of the PIC and MPS solvers: a kind (the value of FSDEM_PIC_GAUGE_KIND_LEVEL
+   and FSDEM_MPS_GAUGE_KIND_LEVEL, or of the _PRESSURE kinds), a position and a sensor radius per gauge,
    and the CSV series they write (fsdem__series; columns level_<id> or p_<id>). The solver samples
    them (its own level and pressure functions) and checks what is its own (the domain, gravity);
    `fn` names its public function in the messages. */
@@ -3708,7 +3736,7 @@ fsdem_dem_desc fsdem_dem_desc_default(int dim) {
     d.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
     d.integrator = FSDEM_DEM_INTEGRATOR_VERLET;
     d.dt = (fsdem_real)1e-5;
-    d.dt_rule = FSDEM_DEM_DT_AUTO;
+    d.dt_rule = FSDEM_DEM_DT_RULE_AUTO;
     d.dt_param = 0;
     d.skin = -1;
     d.contact_offset = 0;
@@ -3752,16 +3780,16 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
                              (int)d->integrator);
     if (!(d->dt > 0) || !fsdem__finite(d->dt))
         return fsdem__reject(msg, size, "fsdem_dem_desc.dt must be > 0 and finite (got %g s)", (double)d->dt);
-    if ((int)d->dt_rule < (int)FSDEM_DEM_DT_AUTO || (int)d->dt_rule > (int)FSDEM_DEM_DT_GIC)
+    if ((int)d->dt_rule < (int)FSDEM_DEM_DT_RULE_AUTO || (int)d->dt_rule > (int)FSDEM_DEM_DT_RULE_GIC)
         return fsdem__reject(msg, size, "fsdem_dem_desc.dt_rule is not a fsdem_dem_dt_rule (%d)", (int)d->dt_rule);
     if (!(d->dt_param >= 0) || !fsdem__finite(d->dt_param))
         return fsdem__reject(msg, size, "fsdem_dem_desc.dt_param must be >= 0 (got %g)", (double)d->dt_param);
-    if (d->dt_param > 1 && d->dt_rule != FSDEM_DEM_DT_LINEAR_SEED000 &&
-        !(d->dt_rule == FSDEM_DEM_DT_AUTO && d->law == FSDEM_DEM_LAW_LINEAR))
+    if (d->dt_param > 1 && d->dt_rule != FSDEM_DEM_DT_RULE_LINEAR_SEED000 &&
+        !(d->dt_rule == FSDEM_DEM_DT_RULE_AUTO && d->law == FSDEM_DEM_LAW_LINEAR))
         return fsdem__reject(msg, size, "fsdem_dem_desc.dt_param: a safety fraction must be in (0, 1] (got %g)",
                              (double)d->dt_param);
-    if (d->dt_rule == FSDEM_DEM_DT_LINEAR_SEED000 && d->law != FSDEM_DEM_LAW_LINEAR)
-        return fsdem__reject(msg, size, "fsdem_dem_desc.dt_rule FSDEM_DEM_DT_LINEAR_SEED000 needs the linear law");
+    if (d->dt_rule == FSDEM_DEM_DT_RULE_LINEAR_SEED000 && d->law != FSDEM_DEM_LAW_LINEAR)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.dt_rule FSDEM_DEM_DT_RULE_LINEAR_SEED000 needs the linear law");
     if (!fsdem__finite(d->skin)) return fsdem__reject(msg, size, "fsdem_dem_desc.skin is not finite");
     if (!(d->contact_offset >= 0) || !fsdem__finite(d->contact_offset))
         return fsdem__reject(msg, size, "fsdem_dem_desc.contact_offset must be >= 0 (got %g m)",
@@ -3811,9 +3839,9 @@ static fsdem_result fsdem__dem_material_check(const fsdem_dem_material *m, char 
 
 static const char *fsdem__dem_rule_name(fsdem_dem_dt_rule rule) {
     switch (rule) {
-    case FSDEM_DEM_DT_LINEAR_SEED000: return "seed 000 Eq. 18";
-    case FSDEM_DEM_DT_RAYLEIGH: return "Rayleigh time, seed 002 Eq. 38";
-    case FSDEM_DEM_DT_GIC: return "seed 004 Eq. 32";
+    case FSDEM_DEM_DT_RULE_LINEAR_SEED000: return "seed 000 Eq. 18";
+    case FSDEM_DEM_DT_RULE_RAYLEIGH: return "Rayleigh time, seed 002 Eq. 38";
+    case FSDEM_DEM_DT_RULE_GIC: return "seed 004 Eq. 32";
     default: return "?";
     }
 }
@@ -3824,10 +3852,10 @@ static fsdem_real fsdem__dem_rule_dt(const fsdem_dem *d) {
     const fsdem_real param = d->desc.dt_param;
     int i;
     switch (d->desc.dt_rule) {
-    case FSDEM_DEM_DT_LINEAR_SEED000:
+    case FSDEM_DEM_DT_RULE_LINEAR_SEED000:
         /* Eq. 18 with Eq. 10: m_ij / k = theta dx / ||g|| whatever the masses */
         return d->n ? (fsdem_real)(2 * FSDEM__PI) / param / (fsdem_real)sqrt(d->k0_linear) : best;
-    case FSDEM_DEM_DT_RAYLEIGH:
+    case FSDEM_DEM_DT_RULE_RAYLEIGH:
         /* seed 002 Eq. 38 prints 0.01631; the Rayleigh-wave fit it cites (Thornton & Randall 1988)
            is 0.1631 nu + 0.8766, which we use. */
         for (i = 0; i < d->n; ++i) {
@@ -3860,7 +3888,7 @@ static void fsdem__dem_dt_check(fsdem_dem *d) {
         char msg[FSDEM__MESSAGE_SIZE];
         snprintf(msg, sizeof msg, "fsdem_dem: dt = %g s is %.3g times the stable dt %g s (%s)", (double)d->dt,
                  (double)(d->dt / stable), (double)stable, fsdem__dem_rule_name(d->desc.dt_rule));
-        d->status.log(d->status.log_user, FSDEM_LOG_WARNING, msg);
+        d->status.log(d->status.log_user, FSDEM_LOG_LEVEL_WARNING, msg);
         d->dt_warned = 1;
     }
 }
@@ -4327,13 +4355,13 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
                                        desc ? &desc->allocator : NULL, sizeof *d, "fsdem_dem_create", &res);
     if (!d) return res;
     d->desc = *desc;
-    if (desc->dt_rule == FSDEM_DEM_DT_AUTO)
-        d->desc.dt_rule = desc->law == FSDEM_DEM_LAW_LINEAR  ? FSDEM_DEM_DT_LINEAR_SEED000
-                          : desc->law == FSDEM_DEM_LAW_GIC ? FSDEM_DEM_DT_GIC
-                                                           : FSDEM_DEM_DT_RAYLEIGH;
+    if (desc->dt_rule == FSDEM_DEM_DT_RULE_AUTO)
+        d->desc.dt_rule = desc->law == FSDEM_DEM_LAW_LINEAR  ? FSDEM_DEM_DT_RULE_LINEAR_SEED000
+                          : desc->law == FSDEM_DEM_LAW_GIC ? FSDEM_DEM_DT_RULE_GIC
+                                                           : FSDEM_DEM_DT_RULE_RAYLEIGH;
     if (desc->dt_param == 0)
-        d->desc.dt_param = d->desc.dt_rule == FSDEM_DEM_DT_LINEAR_SEED000 ? 150
-                           : d->desc.dt_rule == FSDEM_DEM_DT_RAYLEIGH   ? (fsdem_real)0.2
+        d->desc.dt_param = d->desc.dt_rule == FSDEM_DEM_DT_RULE_LINEAR_SEED000 ? 150
+                           : d->desc.dt_rule == FSDEM_DEM_DT_RULE_RAYLEIGH   ? (fsdem_real)0.2
                                                                         : 1;
     d->allocator = desc->allocator;
     d->status.log = desc->log;
@@ -4586,26 +4614,26 @@ static fsdem_dem_wall_desc fsdem__dem_wall_desc(fsdem_dem_wall_type type, fsdem_
 }
 
 fsdem_dem_wall_desc fsdem_dem_wall_plane(fsdem_vec3 point, fsdem_vec3 normal, int material) {
-    return fsdem__dem_wall_desc(FSDEM_DEM_WALL_PLANE, point, normal, fsdem__zero3(), material);
+    return fsdem__dem_wall_desc(FSDEM_DEM_WALL_TYPE_PLANE, point, normal, fsdem__zero3(), material);
 }
 fsdem_dem_wall_desc fsdem_dem_wall_box(fsdem_vec3 lo, fsdem_vec3 hi, int inside, int material) {
-    return fsdem__dem_wall_desc(inside ? FSDEM_DEM_WALL_BOX_INSIDE : FSDEM_DEM_WALL_BOX_OUTSIDE, lo, hi, fsdem__zero3(), material);
+    return fsdem__dem_wall_desc(inside ? FSDEM_DEM_WALL_TYPE_BOX_INSIDE : FSDEM_DEM_WALL_TYPE_BOX_OUTSIDE, lo, hi, fsdem__zero3(), material);
 }
 fsdem_dem_wall_desc fsdem_dem_wall_segment(fsdem_vec3 a, fsdem_vec3 b, int material) {
-    return fsdem__dem_wall_desc(FSDEM_DEM_WALL_SEGMENT, a, b, fsdem__zero3(), material);
+    return fsdem__dem_wall_desc(FSDEM_DEM_WALL_TYPE_SEGMENT, a, b, fsdem__zero3(), material);
 }
 fsdem_dem_wall_desc fsdem_dem_wall_triangle(fsdem_vec3 a, fsdem_vec3 b, fsdem_vec3 c, int material) {
-    return fsdem__dem_wall_desc(FSDEM_DEM_WALL_TRIANGLE, a, b, c, material);
+    return fsdem__dem_wall_desc(FSDEM_DEM_WALL_TYPE_TRIANGLE, a, b, c, material);
 }
 fsdem_dem_wall_desc fsdem_dem_wall_sdf(fsdem_sdf_fn sdf, void *user, int material) {
-    fsdem_dem_wall_desc w = fsdem__dem_wall_desc(FSDEM_DEM_WALL_SDF, fsdem__zero3(), fsdem__zero3(), fsdem__zero3(), material);
+    fsdem_dem_wall_desc w = fsdem__dem_wall_desc(FSDEM_DEM_WALL_TYPE_SDF, fsdem__zero3(), fsdem__zero3(), fsdem__zero3(), material);
     w.sdf = sdf;
     w.sdf_user = user;
     return w;
 }
 
 static int fsdem__dem_wall_faces(const fsdem__dem_wall *w, int dim) {
-    return w->d.type == FSDEM_DEM_WALL_BOX_INSIDE ? 2 * dim : 1;
+    return w->d.type == FSDEM_DEM_WALL_TYPE_BOX_INSIDE ? 2 * dim : 1;
 }
 
 /* Signed distance (m) from p to face `face` of a wall, with the unit normal from the wall towards p.
@@ -4617,18 +4645,18 @@ static fsdem_real fsdem__dem_wall_distance(const fsdem__dem_wall *w, int face, f
     fsdem_real dist;
     *on_feature = 0;
     switch (g->type) {
-    case FSDEM_DEM_WALL_PLANE:
+    case FSDEM_DEM_WALL_TYPE_PLANE:
         *n = g->b;
         return fsdem__dot(fsdem__sub(p, g->a), g->b);
-    case FSDEM_DEM_WALL_BOX_INSIDE: {
+    case FSDEM_DEM_WALL_TYPE_BOX_INSIDE: {
         int axis = face / 2;
         fsdem_real e[3] = {0, 0, 0};
         e[axis] = face % 2 == 0 ? 1 : -1;
         *n = fsdem_v3(e[0], e[1], e[2]);
         return face % 2 == 0 ? fsdem__comp(p, axis) - fsdem__comp(g->a, axis) : fsdem__comp(g->b, axis) - fsdem__comp(p, axis);
     }
-    case FSDEM_DEM_WALL_BOX_OUTSIDE: return fsdem__geom_box(p, g->a, g->b, dim, n);
-    case FSDEM_DEM_WALL_SEGMENT: {
+    case FSDEM_DEM_WALL_TYPE_BOX_OUTSIDE: return fsdem__geom_box(p, g->a, g->b, dim, n);
+    case FSDEM_DEM_WALL_TYPE_SEGMENT: {
         fsdem_vec3 ab = fsdem__sub(g->b, g->a), perp = fsdem_v3(-ab.y, ab.x, 0);
         fsdem_real len = fsdem__norm(perp);
         fsdem_vec3 q = fsdem__geom_closest_on_segment(p, g->a, g->b);
@@ -4638,14 +4666,14 @@ static fsdem_real fsdem__dem_wall_distance(const fsdem__dem_wall *w, int face, f
         *n = fsdem__geom_direction(p, q, perp, &dist);
         return dist;
     }
-    case FSDEM_DEM_WALL_TRIANGLE: {
+    case FSDEM_DEM_WALL_TYPE_TRIANGLE: {
         fsdem_vec3 nrm = fsdem__cross(fsdem__sub(g->b, g->a), fsdem__sub(g->c, g->a));
         fsdem_vec3 q = fsdem__geom_closest_on_triangle(p, g->a, g->b, g->c, on_feature);
         nrm = fsdem__scale(nrm, 1 / fsdem__norm(nrm));
         *n = fsdem__geom_direction(p, q, nrm, &dist);
         return dist;
     }
-    case FSDEM_DEM_WALL_SDF:
+    case FSDEM_DEM_WALL_TYPE_SDF:
     default: {
         fsdem_vec3 grad = fsdem_v3(0, 0, 1);
         fsdem_real len;
@@ -4674,7 +4702,7 @@ fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_dem_wall_desc *desc, i
         g.a.z = g.b.z = g.c.z = g.velocity.z = 0;
     }
     switch (g.type) {
-    case FSDEM_DEM_WALL_PLANE: {
+    case FSDEM_DEM_WALL_TYPE_PLANE: {
         fsdem_real len, big;
         if (d->desc.dim == 2) g.b.z = 0;
         /* scaled by its largest component first, so a normal of (1e300, 1e300, 1e300) does not
@@ -4686,21 +4714,21 @@ fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_dem_wall_desc *desc, i
         g.b = fsdem__scale(g.b, 1 / len);
         break;
     }
-    case FSDEM_DEM_WALL_BOX_INSIDE:
-    case FSDEM_DEM_WALL_BOX_OUTSIDE:
+    case FSDEM_DEM_WALL_TYPE_BOX_INSIDE:
+    case FSDEM_DEM_WALL_TYPE_BOX_OUTSIDE:
         for (axis = 0; axis < d->desc.dim; ++axis)
             if (!(fsdem__comp(g.b, axis) > fsdem__comp(g.a, axis)) || !fsdem__finite(fsdem__comp(g.b, axis) - fsdem__comp(g.a, axis)))
                 return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
                                    "fsdem_dem_wall_box: hi must exceed lo by a finite extent on axis %d", axis);
         break;
-    case FSDEM_DEM_WALL_SEGMENT:
+    case FSDEM_DEM_WALL_TYPE_SEGMENT:
         if (d->desc.dim != 2)
             return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_segment: segments need dim = 2 (use triangles in 3D)");
         if (!(fsdem__norm(fsdem__sub(g.b, g.a)) > 0) || !fsdem__finite(fsdem__norm(fsdem__sub(g.b, g.a))))
             return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
                                "fsdem_dem_wall_segment: the end points must be distinct at a finite distance");
         break;
-    case FSDEM_DEM_WALL_TRIANGLE:
+    case FSDEM_DEM_WALL_TYPE_TRIANGLE:
         if (d->desc.dim != 3)
             return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_triangle: triangles need dim = 3 (use segments in 2D)");
         {
@@ -4712,7 +4740,7 @@ fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_dem_wall_desc *desc, i
                                    (double)area2);
         }
         break;
-    case FSDEM_DEM_WALL_SDF:
+    case FSDEM_DEM_WALL_TYPE_SDF:
         if (!g.sdf) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_sdf: the callback is NULL");
         if (fsdem__norm(g.velocity) > 0)
             return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
@@ -4761,7 +4789,7 @@ fsdem_result fsdem_dem_set_wall_velocity(fsdem_dem *d, int id, fsdem_vec3 veloci
     if (!w) return d ? FSDEM_ERR_NOT_FOUND : FSDEM_ERR_INVALID_ARG;
     if (!fsdem__finite3(velocity))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_set_wall_velocity: velocity must be finite");
-    if (w->d.type == FSDEM_DEM_WALL_SDF && fsdem__norm(velocity) > 0)
+    if (w->d.type == FSDEM_DEM_WALL_TYPE_SDF && fsdem__norm(velocity) > 0)
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_set_wall_velocity: an SDF wall moves in its callback");
     if (d->desc.dim == 2) velocity.z = 0;
     w->d.velocity = velocity;
@@ -5378,7 +5406,7 @@ static void fsdem__dem_move_walls(fsdem_dem *d, fsdem_real h) {
     for (k = 0; k < d->wall_count; ++k) {
         fsdem__dem_wall *w = &d->walls[k];
         fsdem_vec3 dv = fsdem__scale(w->d.velocity, h);
-        if (w->d.type == FSDEM_DEM_WALL_PLANE) w->d.a = fsdem__add(w->d.a, dv); /* b is the normal */
+        if (w->d.type == FSDEM_DEM_WALL_TYPE_PLANE) w->d.a = fsdem__add(w->d.a, dv); /* b is the normal */
         else {
             w->d.a = fsdem__add(w->d.a, dv);
             w->d.b = fsdem__add(w->d.b, dv);
@@ -7911,7 +7939,7 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
             snprintf(msg, sizeof msg, "fsdem_pic_create: domain_max.%c rounded from %.9g to %.9g m (%d cells of %g m)",
                      "xyz"[a], (double)fsdem__comp(desc->domain_max, a), (double)fsdem__comp(s->hi, a), s->n[a],
                      (double)s->dx);
-            desc->log(desc->log_user, FSDEM_LOG_INFO, msg);
+            desc->log(desc->log_user, FSDEM_LOG_LEVEL_INFO, msg);
         }
     if (fsdem__pic_allocate(s) != FSDEM_OK) {
         snprintf(msg, sizeof msg, "fsdem_pic_create: out of memory allocating the %d x %d x %d grid", s->n[0], s->n[1],
@@ -7922,7 +7950,7 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
         r = r == FSDEM_ERR_INVALID_ARG ? FSDEM_ERR_INVALID_ARG : FSDEM_ERR_OUT_OF_MEMORY;
     }
     if (r != FSDEM_OK) {
-        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, msg);
+        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, msg);
         fsdem_pic_destroy(s);
         return r;
     }
@@ -7963,13 +7991,13 @@ static fsdem_real fsdem__pic_obst_sdf(const fsdem_pic *s, const fsdem__pic_obst 
     const fsdem_pic_obstacle *d = &o->d;
     fsdem_vec3 normal;
     switch (d->type) {
-    case FSDEM_PIC_OBSTACLE_BOX: return fsdem__geom_box(p, d->a, d->b, s->dim, &normal);
-    case FSDEM_PIC_OBSTACLE_CYLINDER:
+    case FSDEM_PIC_OBSTACLE_TYPE_BOX: return fsdem__geom_box(p, d->a, d->b, s->dim, &normal);
+    case FSDEM_PIC_OBSTACLE_TYPE_CYLINDER:
         if (s->dim == 3) return fsdem__geom_cylinder(p, d->a, d->b, d->radius);
         return fsdem__geom_sphere(p, d->a, d->radius, 2); /* a disc in 2D */
-    case FSDEM_PIC_OBSTACLE_SPHERE: return fsdem__geom_sphere(p, d->a, d->radius, s->dim);
-    case FSDEM_PIC_OBSTACLE_POLYGON: return fsdem__geom_polygon(p, o->verts, d->vertex_count);
-    case FSDEM_PIC_OBSTACLE_SDF: return d->sdf(d->sdf_user, p, &normal);
+    case FSDEM_PIC_OBSTACLE_TYPE_SPHERE: return fsdem__geom_sphere(p, d->a, d->radius, s->dim);
+    case FSDEM_PIC_OBSTACLE_TYPE_POLYGON: return fsdem__geom_polygon(p, o->verts, d->vertex_count);
+    case FSDEM_PIC_OBSTACLE_TYPE_SDF: return d->sdf(d->sdf_user, p, &normal);
     }
     return 1e30f;
 }
@@ -8261,7 +8289,7 @@ static void fsdem__pic_compute_fref(fsdem_pic *s) {
 fsdem_pic_obstacle fsdem_pic_obstacle_box(fsdem_vec3 lo, fsdem_vec3 hi) {
     fsdem_pic_obstacle o;
     memset(&o, 0, sizeof o);
-    o.type = FSDEM_PIC_OBSTACLE_BOX;
+    o.type = FSDEM_PIC_OBSTACLE_TYPE_BOX;
     o.a = lo;
     o.b = hi;
     return o;
@@ -8270,7 +8298,7 @@ fsdem_pic_obstacle fsdem_pic_obstacle_box(fsdem_vec3 lo, fsdem_vec3 hi) {
 fsdem_pic_obstacle fsdem_pic_obstacle_sphere(fsdem_vec3 centre, fsdem_real radius) {
     fsdem_pic_obstacle o;
     memset(&o, 0, sizeof o);
-    o.type = FSDEM_PIC_OBSTACLE_SPHERE;
+    o.type = FSDEM_PIC_OBSTACLE_TYPE_SPHERE;
     o.a = centre;
     o.radius = radius;
     return o;
@@ -8279,7 +8307,7 @@ fsdem_pic_obstacle fsdem_pic_obstacle_sphere(fsdem_vec3 centre, fsdem_real radiu
 fsdem_pic_obstacle fsdem_pic_obstacle_cylinder(fsdem_vec3 a, fsdem_vec3 b, fsdem_real radius) {
     fsdem_pic_obstacle o;
     memset(&o, 0, sizeof o);
-    o.type = FSDEM_PIC_OBSTACLE_CYLINDER;
+    o.type = FSDEM_PIC_OBSTACLE_TYPE_CYLINDER;
     o.a = a;
     o.b = b;
     o.radius = radius;
@@ -8289,7 +8317,7 @@ fsdem_pic_obstacle fsdem_pic_obstacle_cylinder(fsdem_vec3 a, fsdem_vec3 b, fsdem
 fsdem_pic_obstacle fsdem_pic_obstacle_polygon(const fsdem_vec3 *vertices, int count) {
     fsdem_pic_obstacle o;
     memset(&o, 0, sizeof o);
-    o.type = FSDEM_PIC_OBSTACLE_POLYGON;
+    o.type = FSDEM_PIC_OBSTACLE_TYPE_POLYGON;
     o.vertices = vertices;
     o.vertex_count = count;
     return o;
@@ -8298,7 +8326,7 @@ fsdem_pic_obstacle fsdem_pic_obstacle_polygon(const fsdem_vec3 *vertices, int co
 fsdem_pic_obstacle fsdem_pic_obstacle_sdf(fsdem_sdf_fn sdf, void *user) {
     fsdem_pic_obstacle o;
     memset(&o, 0, sizeof o);
-    o.type = FSDEM_PIC_OBSTACLE_SDF;
+    o.type = FSDEM_PIC_OBSTACLE_TYPE_SDF;
     o.sdf = sdf;
     o.sdf_user = user;
     return o;
@@ -8326,7 +8354,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
     memset(&o, 0, sizeof o);
     o.d = *ob;
     switch (ob->type) {
-    case FSDEM_PIC_OBSTACLE_BOX:
+    case FSDEM_PIC_OBSTACLE_TYPE_BOX:
         for (b = 0; b < s->dim; ++b)
             if (!(fsdem__comp(ob->b, b) > fsdem__comp(ob->a, b)))
                 return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (box): b.%c must exceed a.%c",
@@ -8334,17 +8362,17 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
         o.box_lo = ob->a;
         o.box_hi = ob->b;
         break;
-    case FSDEM_PIC_OBSTACLE_SPHERE:
-    case FSDEM_PIC_OBSTACLE_CYLINDER:
+    case FSDEM_PIC_OBSTACLE_TYPE_SPHERE:
+    case FSDEM_PIC_OBSTACLE_TYPE_CYLINDER:
         if (!(ob->radius > 0))
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (%s): radius = %g must be > 0",
                                s->obst_count, name, (double)ob->radius);
-        if (ob->type == FSDEM_PIC_OBSTACLE_CYLINDER && s->dim == 3 && !(fsdem__norm(fsdem__sub(ob->b, ob->a)) > 0))
+        if (ob->type == FSDEM_PIC_OBSTACLE_TYPE_CYLINDER && s->dim == 3 && !(fsdem__norm(fsdem__sub(ob->b, ob->a)) > 0))
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (cylinder): axis a-b has zero length",
                                s->obst_count);
         o.box_lo = fsdem__sub(ob->a, fsdem_v3(ob->radius, ob->radius, ob->radius));
         o.box_hi = fsdem__add(ob->a, fsdem_v3(ob->radius, ob->radius, ob->radius));
-        if (ob->type == FSDEM_PIC_OBSTACLE_CYLINDER && s->dim == 3)
+        if (ob->type == FSDEM_PIC_OBSTACLE_TYPE_CYLINDER && s->dim == 3)
             for (b = 0; b < 3; ++b) {
                 fsdem_real lo = fsdem__comp(ob->b, b) - ob->radius, hi = fsdem__comp(ob->b, b) + ob->radius;
                 if (b == 0) { if (lo < o.box_lo.x) o.box_lo.x = lo; if (hi > o.box_hi.x) o.box_hi.x = hi; }
@@ -8352,7 +8380,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
                 if (b == 2) { if (lo < o.box_lo.z) o.box_lo.z = lo; if (hi > o.box_hi.z) o.box_hi.z = hi; }
             }
         break;
-    case FSDEM_PIC_OBSTACLE_POLYGON:
+    case FSDEM_PIC_OBSTACLE_TYPE_POLYGON:
         if (s->dim != 2)
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (polygon): polygons are 2D only",
                                s->obst_count);
@@ -8381,7 +8409,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
                                    "fsdem_pic_add_obstacle: obstacle %d (polygon): the vertices enclose no area", s->obst_count);
         }
         break;
-    case FSDEM_PIC_OBSTACLE_SDF:
+    case FSDEM_PIC_OBSTACLE_TYPE_SDF:
         if (!ob->sdf)
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (sdf): NULL callback", s->obst_count);
         for (i = 0; i < s->ncell; ++i) {
@@ -8398,7 +8426,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
         o.box_hi = fsdem__add(s->hi, fsdem_v3(1e30f, 1e30f, 1e30f));
         break;
     }
-    if (ob->type != FSDEM_PIC_OBSTACLE_SDF) {
+    if (ob->type != FSDEM_PIC_OBSTACLE_TYPE_SDF) {
         fsdem_real pad = 2 * s->dx;
         o.box_lo = fsdem__sub(o.box_lo, fsdem_v3(pad, pad, pad));
         o.box_hi = fsdem__add(o.box_hi, fsdem_v3(pad, pad, pad));
@@ -8407,7 +8435,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
         o.box_lo.z = -1e30f;
         o.box_hi.z = 1e30f;
     }
-    if (ob->type == FSDEM_PIC_OBSTACLE_POLYGON) {
+    if (ob->type == FSDEM_PIC_OBSTACLE_TYPE_POLYGON) {
         o.verts = (fsdem_vec3 *)fsdem__pic_alloc(s, sizeof(fsdem_vec3) * (size_t)ob->vertex_count);
         if (!o.verts) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_add_obstacle: out of memory");
         memcpy(o.verts, ob->vertices, sizeof(fsdem_vec3) * (size_t)ob->vertex_count);
@@ -10093,7 +10121,7 @@ static int fsdem__pic_up_axis(const fsdem_pic *s, fsdem_real *up) {
     return best;
 }
 
-/* Elevation of the highest free surface above p's column (FSDEM_PIC_GAUGE_LEVEL). */
+/* Elevation of the highest free surface above p's column (FSDEM_PIC_GAUGE_KIND_LEVEL). */
 static fsdem_real fsdem__pic_level(const fsdem_pic *s, fsdem_vec3 p) {
     fsdem_real up = 1, g[3];
     const int u = fsdem__pic_up_axis(s, &up);
@@ -10124,7 +10152,7 @@ static fsdem_real fsdem__pic_level(const fsdem_pic *s, fsdem_vec3 p) {
     return up > 0 ? fsdem__comp(s->lo, u) : fsdem__comp(s->hi, u);
 }
 
-/* Pressure at p (FSDEM_PIC_GAUGE_PRESSURE): trilinear between cell centres, or the mean over the
+/* Pressure at p (FSDEM_PIC_GAUGE_KIND_PRESSURE): trilinear between cell centres, or the mean over the
    non-solid cells within `radius`. */
 static fsdem_real fsdem__pic_pressure_at(const fsdem_pic *s, fsdem_vec3 p, fsdem_real radius) {
     fsdem_real g[3], sum = 0;
@@ -10154,7 +10182,7 @@ static fsdem_real fsdem__pic_pressure_at(const fsdem_pic *s, fsdem_vec3 p, fsdem
 }
 
 static fsdem_real fsdem__pic_gauge_value(const fsdem_pic *s, int k) {
-    return s->gauges.kind[k] == FSDEM_PIC_GAUGE_LEVEL ? fsdem__pic_level(s, s->gauges.at[k])
+    return s->gauges.kind[k] == FSDEM_PIC_GAUGE_KIND_LEVEL ? fsdem__pic_level(s, s->gauges.at[k])
                                                       : fsdem__pic_pressure_at(s, s->gauges.at[k], s->gauges.radius[k]);
 }
 
@@ -10168,7 +10196,7 @@ fsdem_result fsdem_pic_add_gauge(fsdem_pic *s, fsdem_pic_gauge_kind kind, fsdem_
     fsdem_real up;
     if (id) *id = -1;
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    if (kind == FSDEM_PIC_GAUGE_LEVEL && fsdem__pic_up_axis(s, &up) < 0)
+    if (kind == FSDEM_PIC_GAUGE_KIND_LEVEL && fsdem__pic_up_axis(s, &up) < 0)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_gauge: a level gauge needs gravity along one axis");
     return fsdem__gauges_add(&s->gauges, &s->status, &s->allocator, "fsdem_pic_add_gauge", (int)kind, position, radius, s->dim, s->lo,
                              s->hi, id);
@@ -12695,7 +12723,7 @@ fsdem_mps_desc fsdem_mps_desc_default(int dim) {
     d.dt_max = (fsdem_real)1e-3;
     d.domain_min = fsdem_v3(0, 0, 0);
     d.domain_max = fsdem_v3(1, 1, 1);
-    d.gradient = FSDEM_MPS_GRADIENT_MIN;
+    d.gradient = FSDEM_MPS_GRADIENT_MODEL_MIN;
     d.clamp_negative_pressure = 1;
     d.collision_distance = (fsdem_real)0.8;
     d.restitution = (fsdem_real)0.2;
@@ -12975,7 +13003,7 @@ static void fsdem__mps_push(fsdem_mps *s, fsdem_mps_kind kind, fsdem_vec3 x, fsd
     const int i = s->n++;
     if (s->dim == 2) x.z = v.z = 0;
     s->x[i] = x;
-    s->v[i] = kind == FSDEM_MPS_FLUID ? v : fsdem__zero3();
+    s->v[i] = kind == FSDEM_MPS_KIND_FLUID ? v : fsdem__zero3();
     s->us[i] = s->v[i];
     s->shift[i] = fsdem__zero3();
     s->p[i] = 0;
@@ -13089,7 +13117,7 @@ static int fsdem__mps_classify_fluid(const fsdem_mps *s, const void *user, fsdem
     (void)user;
     for (o = 0; o < s->obst_n; ++o)
         if (fsdem__mps_layer_inside(s, s->obst[o].lo, s->obst[o].hi, p) > 0) return -1;
-    return FSDEM_MPS_FLUID;
+    return FSDEM_MPS_KIND_FLUID;
 }
 
 /* Tank walls: the first layer outside the box WALL, the next ones DUMMY. */
@@ -13101,14 +13129,14 @@ typedef struct fsdem__mps_walls {
 static int fsdem__mps_classify_walls(const fsdem_mps *s, const void *user, fsdem_vec3 p) {
     const fsdem__mps_walls *w = (const fsdem__mps_walls *)user;
     const int layer = fsdem__mps_layer_outside(s, w->box[0], w->box[1], w->open, p);
-    return layer <= 0 || layer > s->layers ? -1 : layer == 1 ? FSDEM_MPS_WALL : FSDEM_MPS_DUMMY;
+    return layer <= 0 || layer > s->layers ? -1 : layer == 1 ? FSDEM_MPS_KIND_WALL : FSDEM_MPS_KIND_DUMMY;
 }
 
 /* Obstacle: the outer layer inside the box WALL, the next ones DUMMY. */
 static int fsdem__mps_classify_obstacle(const fsdem_mps *s, const void *user, fsdem_vec3 p) {
     const fsdem__mps_obst *o = (const fsdem__mps_obst *)user;
     const int layer = fsdem__mps_layer_inside(s, o->lo, o->hi, p);
-    return layer <= 0 || layer > s->layers ? -1 : layer == 1 ? FSDEM_MPS_WALL : FSDEM_MPS_DUMMY;
+    return layer <= 0 || layer > s->layers ? -1 : layer == 1 ? FSDEM_MPS_KIND_WALL : FSDEM_MPS_KIND_DUMMY;
 }
 
 /* Checks a box argument of the fills (`fn` names the caller). */
@@ -13224,7 +13252,7 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
                     const fsdem_vec3 d = fsdem__sub(s->x[pa], s->x[pb]);
                     s->pairs[2 * count] = pa;
                     s->pairs[2 * count + 1] = pb;
-                    count += fsdem__dot(d, d) < re2 && (s->kind[pa] != FSDEM_MPS_DUMMY || s->kind[pb] != FSDEM_MPS_DUMMY);
+                    count += fsdem__dot(d, d) < re2 && (s->kind[pa] != FSDEM_MPS_KIND_DUMMY || s->kind[pb] != FSDEM_MPS_KIND_DUMMY);
                 }
             }
         }
@@ -13237,11 +13265,11 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     memset(s->nb_start, 0, sizeof(int) * (size_t)(s->n + 1));
     for (e = 0; e < count; ++e) {
         const int pa = s->pairs[2 * e], pb = s->pairs[2 * e + 1];
-        if (s->kind[pa] != FSDEM_MPS_DUMMY) {
+        if (s->kind[pa] != FSDEM_MPS_KIND_DUMMY) {
             s->nb_start[pa + 1]++;
             s->tmp_start[pb + 1]++;
         }
-        if (s->kind[pb] != FSDEM_MPS_DUMMY) {
+        if (s->kind[pb] != FSDEM_MPS_KIND_DUMMY) {
             s->nb_start[pb + 1]++;
             s->tmp_start[pa + 1]++;
         }
@@ -13279,11 +13307,11 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     for (e = 0; e < count; ++e) {
         const int pa = s->pairs[2 * e], pb = s->pairs[2 * e + 1];
         const fsdem_real w = fsdem__kernel_mps(fsdem__norm(fsdem__sub(s->x[pa], s->x[pb])), s->re);
-        if (s->kind[pa] != FSDEM_MPS_DUMMY) {
+        if (s->kind[pa] != FSDEM_MPS_KIND_DUMMY) {
             s->tmp_nb[s->cursor[pb]] = pa;
             s->tmp_w[s->cursor[pb]++] = w;
         }
-        if (s->kind[pb] != FSDEM_MPS_DUMMY) {
+        if (s->kind[pb] != FSDEM_MPS_KIND_DUMMY) {
             s->tmp_nb[s->cursor[pa]] = pb;
             s->tmp_w[s->cursor[pa]++] = w;
         }
@@ -13312,7 +13340,7 @@ static int fsdem__mps_density(fsdem_mps *s) {
         fsdem_vec3 F = fsdem__zero3();
         s->nd[i] = 0;
         s->surf[i] = 0;
-        if (s->kind[i] == FSDEM_MPS_DUMMY) continue;
+        if (s->kind[i] == FSDEM_MPS_KIND_DUMMY) continue;
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
             const fsdem_real we = s->nbw[e] / s->eps[j];
@@ -13332,7 +13360,7 @@ static int fsdem__mps_density(fsdem_mps *s) {
 /* The 3 x 3 matrix (rows) that turns the kernel sum of the gradient at particle i into the
    gradient: d/n0 times the identity for the forms of Eq. 8, the inverse of the moment matrix
    M = sum_j w_ij (r_j - r_i)(r_j - r_i)^T / (|r_j - r_i|^2 eps_j) (DUMMY neighbours included) for
-   FSDEM_MPS_GRADIENT_CORRECTED, or d/n0 again where M is singular to rounding (a neighbourhood
+   FSDEM_MPS_GRADIENT_MODEL_CORRECTED, or d/n0 again where M is singular to rounding (a neighbourhood
    that does not span the plane or space, e.g. a lone particle or a line of them). */
 static void fsdem__mps_gradient_transform(const fsdem_mps *s, int i, fsdem_vec3 T[3]) {
     const fsdem_real plain = (fsdem_real)s->dim / s->n0;
@@ -13341,7 +13369,7 @@ static void fsdem__mps_gradient_transform(const fsdem_mps *s, int i, fsdem_vec3 
     T[0] = fsdem_v3(plain, 0, 0);
     T[1] = fsdem_v3(0, plain, 0);
     T[2] = fsdem_v3(0, 0, plain);
-    if (s->desc.gradient != FSDEM_MPS_GRADIENT_CORRECTED) return;
+    if (s->desc.gradient != FSDEM_MPS_GRADIENT_MODEL_CORRECTED) return;
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
         const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
@@ -13378,28 +13406,28 @@ static fsdem_vec3 fsdem__mps_apply(const fsdem_vec3 T[3], fsdem_vec3 v) {
    the pressure step passes ghost = rho g, the hydrostatic extrapolation from i, so the solid
    behind the wall layer pushes as a full neighbourhood of liquid would (skipping the DUMMY
    particles instead leaves the sum form one-sided and pulls particles into walls); the public
-   operator passes 0 (a mirror value, zero normal derivative). With FSDEM_MPS_GRADIENT_CORRECTED the
+   operator passes 0 (a mirror value, zero normal derivative). With FSDEM_MPS_GRADIENT_MODEL_CORRECTED the
    form is (phi_j - phi_i) and the sum is multiplied by the inverse moment matrix of i (the factor
    d/n0 of Eq. 8 cancels in it). */
 static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, int i, fsdem_vec3 ghost) {
     fsdem_vec3 g = fsdem__zero3(), T[3];
-    fsdem_real base = s->desc.gradient == FSDEM_MPS_GRADIENT_CORRECTED ? -phi[i] : phi[i];
+    fsdem_real base = s->desc.gradient == FSDEM_MPS_GRADIENT_MODEL_CORRECTED ? -phi[i] : phi[i];
     /* a DUMMY particle higher than the hydrostatic extrapolation reaches is in the air beside the
        free surface: its ghost pressure is not below 0, as the liquid's (desc.clamp_negative_pressure);
        a negative ghost pulled the particles at the top of the walls into them */
     const int clamp = s->desc.clamp_negative_pressure && (ghost.x != 0 || ghost.y != 0 || ghost.z != 0);
     int e;
-    if (s->desc.gradient == FSDEM_MPS_GRADIENT_MIN)
+    if (s->desc.gradient == FSDEM_MPS_GRADIENT_MODEL_MIN)
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e)
-            if (s->kind[s->nb[e]] != FSDEM_MPS_DUMMY && phi[s->nb[e]] < base) base = phi[s->nb[e]];
-    if (s->desc.gradient == FSDEM_MPS_GRADIENT_MIN) base = -base;
+            if (s->kind[s->nb[e]] != FSDEM_MPS_KIND_DUMMY && phi[s->nb[e]] < base) base = phi[s->nb[e]];
+    if (s->desc.gradient == FSDEM_MPS_GRADIENT_MODEL_MIN) base = -base;
     fsdem__mps_gradient_transform(s, i, T);
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
         const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
         const fsdem_real r2 = fsdem__dot(r, r);
         fsdem_real pj = phi[j];
-        if (s->kind[j] == FSDEM_MPS_DUMMY) {
+        if (s->kind[j] == FSDEM_MPS_KIND_DUMMY) {
             pj = phi[i] + fsdem__dot(ghost, r);
             if (pj < 0 && clamp) pj = 0;
         }
@@ -13417,7 +13445,7 @@ static fsdem_real fsdem__mps_div_at(const fsdem_mps *s, const fsdem_vec3 *u, int
         const int j = s->nb[e];
         const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
         const fsdem_real r2 = fsdem__dot(r, r);
-        if (s->kind[j] == FSDEM_MPS_DUMMY || !(r2 > 0)) continue;
+        if (s->kind[j] == FSDEM_MPS_KIND_DUMMY || !(r2 > 0)) continue;
         d += fsdem__dot(fsdem__sub(u[j], u[i]), r) * s->nbw[e] / (r2 * s->eps[j]);
     }
     return d * (fsdem_real)s->dim / s->n0;
@@ -13431,7 +13459,7 @@ static fsdem_vec3 fsdem__mps_lap_at(const fsdem_mps *s, const fsdem_real *phi, c
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
         const fsdem_real we = s->nbw[e] / s->eps[j];
-        if (s->kind[j] == FSDEM_MPS_DUMMY) continue;
+        if (s->kind[j] == FSDEM_MPS_KIND_DUMMY) continue;
         if (phi) l.x += (phi[j] - phi[i]) * we;
         else l = fsdem__madd(l, fsdem__sub(u[j], u[i]), we);
     }
@@ -13453,7 +13481,7 @@ fsdem_result fsdem_mps_gradient(fsdem_mps *s, const fsdem_real *phi, fsdem_vec3 
     int i;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((r = fsdem__mps_operator_setup(s, "fsdem_mps_gradient", phi, out)) != FSDEM_OK) return r;
-    for (i = 0; i < s->n; ++i) out[i] = s->kind[i] == FSDEM_MPS_DUMMY ? fsdem__zero3() : fsdem__mps_grad_at(s, phi, i, fsdem__zero3());
+    for (i = 0; i < s->n; ++i) out[i] = s->kind[i] == FSDEM_MPS_KIND_DUMMY ? fsdem__zero3() : fsdem__mps_grad_at(s, phi, i, fsdem__zero3());
     return fsdem__ok(&s->status);
 }
 
@@ -13462,7 +13490,7 @@ fsdem_result fsdem_mps_divergence(fsdem_mps *s, const fsdem_vec3 *field, fsdem_r
     int i;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((r = fsdem__mps_operator_setup(s, "fsdem_mps_divergence", field, out)) != FSDEM_OK) return r;
-    for (i = 0; i < s->n; ++i) out[i] = s->kind[i] == FSDEM_MPS_DUMMY ? 0 : fsdem__mps_div_at(s, field, i);
+    for (i = 0; i < s->n; ++i) out[i] = s->kind[i] == FSDEM_MPS_KIND_DUMMY ? 0 : fsdem__mps_div_at(s, field, i);
     return fsdem__ok(&s->status);
 }
 
@@ -13471,7 +13499,7 @@ fsdem_result fsdem_mps_laplacian(fsdem_mps *s, const fsdem_real *phi, fsdem_real
     int i;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((r = fsdem__mps_operator_setup(s, "fsdem_mps_laplacian", phi, out)) != FSDEM_OK) return r;
-    for (i = 0; i < s->n; ++i) out[i] = s->kind[i] == FSDEM_MPS_DUMMY ? 0 : fsdem__mps_lap_at(s, phi, NULL, i).x;
+    for (i = 0; i < s->n; ++i) out[i] = s->kind[i] == FSDEM_MPS_KIND_DUMMY ? 0 : fsdem__mps_lap_at(s, phi, NULL, i).x;
     return fsdem__ok(&s->status);
 }
 
@@ -13485,7 +13513,7 @@ static fsdem_real fsdem__mps_umax(const fsdem_mps *s, int *who) {
     *who = -1;
     for (i = 0; i < s->n; ++i) {
         fsdem_real v2;
-        if (s->kind[i] != FSDEM_MPS_FLUID) continue;
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         v2 = fsdem__dot(s->v[i], s->v[i]);
         if (!fsdem__finite(v2)) {
             *who = i;
@@ -13559,7 +13587,7 @@ static void fsdem__mps_shift(fsdem_mps *s) {
         fsdem_real len;
         int band = 0;
         s->shift[i] = fsdem__zero3();
-        if (s->kind[i] != FSDEM_MPS_FLUID || s->surf[i] || D == 0) continue;
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID || s->surf[i] || D == 0) continue;
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
             const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
@@ -13598,9 +13626,9 @@ static void fsdem__mps_collide(fsdem_mps *s, fsdem_real dt) {
     int i, k;
     if (!(dc > 0)) return;
     for (i = 0; i < s->n; ++i) {
-        if (s->kind[i] != FSDEM_MPS_FLUID) continue;
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         for (k = s->nb_start[i]; k < s->nb_start[i + 1]; ++k) {
-            const int j = s->nb[k], fluid = s->kind[j] == FSDEM_MPS_FLUID;
+            const int j = s->nb[k], fluid = s->kind[j] == FSDEM_MPS_KIND_FLUID;
             const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
             const fsdem_vec3 dv = fsdem__sub(s->v[j], s->v[i]);
             const fsdem_vec3 ahead = fsdem__madd(r, dv, dt);
@@ -13634,7 +13662,7 @@ static void fsdem__mps_obstacle_forces(fsdem_mps *s) {
     for (a = 0; a < s->obst_n; ++a) s->obst[a].force = fsdem__zero3();
     for (i = 0; i < s->n; ++i) {
         fsdem__mps_obst *o;
-        if (s->kind[i] != FSDEM_MPS_WALL || s->body[i] < 0) continue;
+        if (s->kind[i] != FSDEM_MPS_KIND_WALL || s->body[i] < 0) continue;
         o = &s->obst[s->body[i]];
         for (a = 0; a < s->dim; ++a)
             for (side = 0; side < 2; ++side) {
@@ -13661,8 +13689,8 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
     for (i = 0; i < s->n; ++i) {
         int solid_only = 1;
         s->unknown[i] = -1;
-        if (s->kind[i] == FSDEM_MPS_DUMMY || s->surf[i]) continue;
-        for (e = s->nb_start[i]; e < s->nb_start[i + 1] && solid_only; ++e) solid_only = s->kind[s->nb[e]] == FSDEM_MPS_DUMMY;
+        if (s->kind[i] == FSDEM_MPS_KIND_DUMMY || s->surf[i]) continue;
+        for (e = s->nb_start[i]; e < s->nb_start[i + 1] && solid_only; ++e) solid_only = s->kind[s->nb[e]] == FSDEM_MPS_KIND_DUMMY;
         if (solid_only) continue;
         s->row_particle[rows] = i;
         s->unknown[i] = rows++;
@@ -13683,7 +13711,7 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
             const fsdem_real a = s->nbw[e] / (s->eps[i] * s->eps[j]);
-            if (s->kind[j] == FSDEM_MPS_DUMMY) continue;
+            if (s->kind[j] == FSDEM_MPS_KIND_DUMMY) continue;
             diag += a;
             if (s->unknown[j] < 0) continue;
             if (at < 0 && j > i) at = nnz++; /* the diagonal's place among ascending columns */
@@ -13705,7 +13733,7 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
            still symmetric) */
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
-            if (s->kind[j] != FSDEM_MPS_DUMMY) continue;
+            if (s->kind[j] != FSDEM_MPS_KIND_DUMMY) continue;
             s->b[row] += rho * fsdem__dot(s->desc.gravity, fsdem__sub(s->x[j], s->x[i])) * s->nbw[e] / (s->eps[i] * s->eps[j]);
         }
         s->sol[row] = s->p[i];
@@ -13724,7 +13752,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     fsdem_result r;
     clock_t t0 = clock(), t1, tp;
     int i, a, bad = -1;
-    if (s->counts[FSDEM_MPS_FLUID] == 0)
+    if (s->counts[FSDEM_MPS_KIND_FLUID] == 0)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: no FLUID particles to step");
     for (i = 0; i < s->n; ++i)
         if (!(s->eps[i] > 0 && s->eps[i] <= 1))
@@ -13745,7 +13773,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
        weight (one-sided Eq. 9 against the one-sided Eq. 10): still water started with 0.7 rho g h
        at the bottom and fell at 0.25-0.35 g in its first step. */
     for (i = 0; i < s->n; ++i) {
-        if (s->kind[i] != FSDEM_MPS_FLUID) {
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID) {
             s->us[i] = fsdem__scale(s->desc.gravity, dt);
             if (s->dim == 2) s->us[i].z = 0;
             continue;
@@ -13755,7 +13783,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         if (s->external) s->us[i] = fsdem__madd(s->us[i], s->fext[i], dt / mass); /* a coupler's force (Eq. 2, 4) */
         if (s->dim == 2) s->us[i].z = 0;
     }
-    for (i = 0; i < s->n; ++i) s->div[i] = s->kind[i] == FSDEM_MPS_DUMMY ? 0 : fsdem__mps_div_at(s, s->us, i);
+    for (i = 0; i < s->n; ++i) s->div[i] = s->kind[i] == FSDEM_MPS_KIND_DUMMY ? 0 : fsdem__mps_div_at(s, s->us, i);
     /* 3. pressure equation */
     tp = clock();
     if (fsdem__mps_assemble(s, dt) != FSDEM_OK)
@@ -13792,7 +13820,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     }
     for (i = 0; i < s->n; ++i) {
         fsdem_real per_mass = -dt / rho;
-        if (s->kind[i] != FSDEM_MPS_FLUID) continue;
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         /* seed 002 Eq. A.5; with Model B the whole pressure gradient acts on the fluid (Eq. 4-5:
            -grad P per volume of mixture, which is 1/eps_i times the particle's volume of fluid) */
         if (s->desc.model == FSDEM_MPS_MODEL_B) per_mass /= s->eps[i];
@@ -13803,20 +13831,20 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     fsdem__mps_obstacle_forces(s);
     fsdem__mps_collide(s, dt);
     for (i = 0; i < s->n; ++i)
-        if (s->kind[i] == FSDEM_MPS_FLUID) s->x[i] = fsdem__add(fsdem__madd(s->x[i], s->v[i], dt), s->shift[i]);
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID) s->x[i] = fsdem__add(fsdem__madd(s->x[i], s->v[i], dt), s->shift[i]);
     s->time += (double)dt;
     s->dt_last = dt;
     s->steps++;
     s->iters_total += s->iters;
     s->sec_total += (double)(clock() - t1) / CLOCKS_PER_SEC + (double)(t1 - t0) / CLOCKS_PER_SEC;
     for (i = 0; i < s->n && bad < 0; ++i)
-        if (s->kind[i] == FSDEM_MPS_FLUID && (!fsdem__finite3(s->v[i]) || !fsdem__finite3(s->x[i]) || !fsdem__finite(s->p[i])))
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID && (!fsdem__finite3(s->v[i]) || !fsdem__finite3(s->x[i]) || !fsdem__finite(s->p[i])))
             bad = i;
     if (bad >= 0)
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_mps: step %lld: particle %d has a non-finite velocity, position or pressure",
                            s->steps, bad);
     for (i = 0; i < s->n; ++i) {
-        if (s->kind[i] != FSDEM_MPS_FLUID) continue;
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         for (a = 0; a < s->dim; ++a)
             if (fsdem__comp(s->x[i], a) < fsdem__comp(s->desc.domain_min, a) || fsdem__comp(s->x[i], a) > fsdem__comp(s->desc.domain_max, a))
                 return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_mps: step %lld: particle %d left the domain at (%g, %g, %g) m",
@@ -13940,9 +13968,9 @@ fsdem_mps_stats fsdem_mps_get_stats(const fsdem_mps *s) {
     st.steps = s->steps;
     st.time = s->time;
     st.dt = s->dt_last;
-    st.fluid = s->counts[FSDEM_MPS_FLUID];
-    st.wall = s->counts[FSDEM_MPS_WALL];
-    st.dummy = s->counts[FSDEM_MPS_DUMMY];
+    st.fluid = s->counts[FSDEM_MPS_KIND_FLUID];
+    st.wall = s->counts[FSDEM_MPS_KIND_WALL];
+    st.dummy = s->counts[FSDEM_MPS_KIND_DUMMY];
     st.surface = s->surface_count;
     st.unknowns = s->rows;
     st.neighbours = s->pair_count;
@@ -13979,7 +14007,7 @@ static fsdem_real fsdem__mps_pressure_at(const fsdem_mps *s, fsdem_vec3 point, f
     for (i = 0; i < s->n; ++i) {
         fsdem_vec3 d;
         fsdem_real w;
-        if (s->kind[i] == FSDEM_MPS_DUMMY) continue;
+        if (s->kind[i] == FSDEM_MPS_KIND_DUMMY) continue;
         d = fsdem__sub(s->x[i], point);
         w = fsdem__mps_probe_weight(s, fsdem__dot(d, d), radius, 0);
         sum += (double)(w * s->p[i]);
@@ -14007,7 +14035,7 @@ static fsdem_real fsdem__mps_liquid_fraction(const fsdem_mps *s, fsdem_vec3 gaug
     fsdem__set_comp(&gauge, up, z);
     for (i = 0; i < s->n; ++i) {
         fsdem_vec3 d;
-        if (s->kind[i] != FSDEM_MPS_FLUID) continue;
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         d = fsdem__sub(s->x[i], gauge);
         f += (double)fsdem__mps_probe_weight(s, fsdem__dot(d, d), R, 1);
     }
@@ -14025,7 +14053,7 @@ static fsdem_real fsdem__mps_level(const fsdem_mps *s, fsdem_vec3 gauge) {
     for (i = 0; i < s->n; ++i) {
         fsdem_vec3 d;
         fsdem_real zi;
-        if (s->kind[i] != FSDEM_MPS_FLUID) continue;
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         d = fsdem__sub(s->x[i], gauge);
         fsdem__set_comp(&d, up, 0);
         if (!(fsdem__dot(d, d) < R * R)) continue;
@@ -14055,7 +14083,7 @@ fsdem_result fsdem_mps_probe_height(const fsdem_mps *s, fsdem_vec3 gauge, fsdem_
 
 /* The value of gauge k (section >>mps, gauges). */
 static fsdem_real fsdem__mps_gauge_value(const fsdem_mps *s, int k) {
-    return s->gauges.kind[k] == FSDEM_MPS_GAUGE_LEVEL
+    return s->gauges.kind[k] == FSDEM_MPS_GAUGE_KIND_LEVEL
                ? fsdem__mps_level(s, s->gauges.at[k])
                : fsdem__mps_pressure_at(s, s->gauges.at[k], s->gauges.radius[k] > 0 ? s->gauges.radius[k] : s->re);
 }
@@ -14138,17 +14166,17 @@ static fsdem_real fsdem__drag_ergun(fsdem_real eps, fsdem_real d, fsdem_real sli
 static fsdem_real fsdem__drag_per_volume(fsdem_drag_law law, fsdem_real eps, fsdem_real d, fsdem_real slip,
                                          fsdem_real rho, fsdem_real mu) {
     switch (law) {
-    case FSDEM_DRAG_STOKES: return 18 * mu / (d * d);
-    case FSDEM_DRAG_SCHILLER_NAUMANN: return fsdem__drag_wen_yu(1, d, slip, rho, mu);
-    case FSDEM_DRAG_ERGUN_WEN_YU:
+    case FSDEM_DRAG_LAW_STOKES: return 18 * mu / (d * d);
+    case FSDEM_DRAG_LAW_SCHILLER_NAUMANN: return fsdem__drag_wen_yu(1, d, slip, rho, mu);
+    case FSDEM_DRAG_LAW_ERGUN_WEN_YU:
         /* the switch in fsdem_real, so a float build puts eps = 0.8f on the Ergun side too */
         return eps <= (fsdem_real)0.8 ? fsdem__drag_ergun(eps, d, slip, rho, mu) : fsdem__drag_wen_yu(eps, d, slip, rho, mu);
-    case FSDEM_DRAG_GIDASPOW: {
+    case FSDEM_DRAG_LAW_GIDASPOW: {
         /* the blend of beta is the same blend of c: both terms carry the one factor (1 - eps) */
         const fsdem_real phi = (fsdem_real)(0.5 + atan(262.5 * ((1 - eps) - 0.2)) / FSDEM__PI);
         return (1 - phi) * fsdem__drag_wen_yu(eps, d, slip, rho, mu) + phi * fsdem__drag_ergun(eps, d, slip, rho, mu);
     }
-    case FSDEM_DRAG_DI_FELICE: {
+    case FSDEM_DRAG_LAW_DI_FELICE: {
         /* Cd0 slip = (0.63 sqrt(slip) + 4.8 sqrt(slip / Re))^2 with slip / Re = mu / (eps rho d): finite at
            Re = 0, where chi -> 3.7 (the Gaussian in log10 Re vanishes) and c -> 17.28 mu eps^-2.7 / d^2 */
         const fsdem_real re = eps * rho * d * slip / mu;
@@ -14157,7 +14185,7 @@ static fsdem_real fsdem__drag_per_volume(fsdem_drag_law law, fsdem_real eps, fsd
         const fsdem_real root = (fsdem_real)(0.63 * sqrt(slip) + 4.8 * sqrt(mu / (eps * rho * d)));
         return (fsdem_real)0.75 * rho * root * root * (fsdem_real)pow(eps, 2 - chi) / d;
     }
-    case FSDEM_DRAG_BEETSTRA: {
+    case FSDEM_DRAG_LAW_BEETSTRA: {
         /* the Re term Re / (24 eps^2) (A + 8.4 Re^-0.343) / (1 + 10^(3 phi) Re^-a), a = (1 + 4 phi) / 2,
            multiplied through by Re^a: (Re A + 8.4 Re^0.657) Re^a / (24 eps^2 (Re^a + 10^(3 phi))), which
            is 0 at Re = 0 (like Re^(1.157 + 2 phi)) instead of 0 * inf / inf */
@@ -14175,12 +14203,12 @@ static fsdem_real fsdem__drag_per_volume(fsdem_drag_law law, fsdem_real eps, fsd
 
 const char *fsdem_drag_law_name(fsdem_drag_law law) {
     switch (law) {
-    case FSDEM_DRAG_STOKES: return "stokes";
-    case FSDEM_DRAG_SCHILLER_NAUMANN: return "schiller_naumann";
-    case FSDEM_DRAG_ERGUN_WEN_YU: return "ergun_wen_yu";
-    case FSDEM_DRAG_GIDASPOW: return "gidaspow";
-    case FSDEM_DRAG_DI_FELICE: return "di_felice";
-    case FSDEM_DRAG_BEETSTRA: return "beetstra";
+    case FSDEM_DRAG_LAW_STOKES: return "stokes";
+    case FSDEM_DRAG_LAW_SCHILLER_NAUMANN: return "schiller_naumann";
+    case FSDEM_DRAG_LAW_ERGUN_WEN_YU: return "ergun_wen_yu";
+    case FSDEM_DRAG_LAW_GIDASPOW: return "gidaspow";
+    case FSDEM_DRAG_LAW_DI_FELICE: return "di_felice";
+    case FSDEM_DRAG_LAW_BEETSTRA: return "beetstra";
     }
     return "unknown";
 }
@@ -14190,7 +14218,7 @@ fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsd
                                     char *message, size_t message_size) {
     static const char fn[] = "fsdem_drag_coefficient";
     fsdem_real c;
-    if ((int)law < (int)FSDEM_DRAG_STOKES || (int)law > (int)FSDEM_DRAG_BEETSTRA)
+    if ((int)law < (int)FSDEM_DRAG_LAW_STOKES || (int)law > (int)FSDEM_DRAG_LAW_BEETSTRA)
         return fsdem__reject(message, message_size, "%s: law must be a fsdem_drag_law, got %d", fn, (int)law);
     if (!(porosity > 0 && porosity <= 1))
         return fsdem__reject(message, message_size, "%s: porosity must be in (0, 1], got %g", fn, (double)porosity);
@@ -14261,7 +14289,7 @@ struct fsdem_mps_dem {
 fsdem_mps_dem_desc fsdem_mps_dem_desc_default(void) {
     fsdem_mps_dem_desc d;
     memset(&d, 0, sizeof d);
-    d.drag = FSDEM_DRAG_ERGUN_WEN_YU;
+    d.drag = FSDEM_DRAG_LAW_ERGUN_WEN_YU;
     d.radius = 0;
     d.min_porosity = (fsdem_real)0.2;
     d.drag_dt_fraction = (fsdem_real)0.5;
@@ -14414,7 +14442,7 @@ static fsdem_real fsdem__mps_dem_open_weight(const fsdem_mps_dem *c, const fsdem
             const int j = c->grid.items[e];
             const fsdem_vec3 d = fsdem__sub(mv->position[j], mv->position[i]);
             const fsdem_real r2 = fsdem__dot(d, d);
-            if (mv->kind[j] != FSDEM_MPS_FLUID && r2 < re2) walls += fsdem__mps_dem_weight((fsdem_real)sqrt(r2), re);
+            if (mv->kind[j] != FSDEM_MPS_KIND_FLUID && r2 < re2) walls += fsdem__mps_dem_weight((fsdem_real)sqrt(r2), re);
         }
     walls *= c->cell_volume;
     /* a corner of three walls leaves an eighth open; the floor only guards a particle pushed into a wall */
@@ -14446,7 +14474,7 @@ static fsdem_result fsdem__mps_dem_pairs(fsdem_mps_dem *c, const fsdem_dem_parti
                 const int i = c->grid.items[e];
                 const fsdem_vec3 d = fsdem__sub(mv->position[i], dv->position[k]);
                 const fsdem_real r2 = fsdem__dot(d, d);
-                if (mv->kind[i] == FSDEM_MPS_DUMMY || !(r2 < re2)) continue;
+                if (mv->kind[i] == FSDEM_MPS_KIND_DUMMY || !(r2 < re2)) continue;
                 if (n == c->pair_cap &&
                     fsdem__grow(&c->allocator, (void **)&c->pair, &c->pair_cap, n, n + 1, sizeof *c->pair) != FSDEM_OK)
                     return FSDEM_ERR_OUT_OF_MEMORY;
@@ -14495,7 +14523,7 @@ static void fsdem__mps_dem_exchange(fsdem_mps_dem *c, const fsdem_dem_particles 
     exchanged = fsdem__scale(exchanged, -1 / (W * c->depth));
     for (e = c->start[k]; e < c->start[k + 1]; ++e) {
         const int i = c->pair[e].particle;
-        if (mv->kind[i] == FSDEM_MPS_FLUID) mc->force[i] = fsdem__madd(mc->force[i], exchanged, c->pair[e].weight);
+        if (mv->kind[i] == FSDEM_MPS_KIND_FLUID) mc->force[i] = fsdem__madd(mc->force[i], exchanged, c->pair[e].weight);
     }
 }
 
@@ -14522,7 +14550,7 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
     }
     for (i = 0; i < mv.count; ++i) {
         fsdem_real eps = 1;
-        if (mv.kind[i] == FSDEM_MPS_FLUID && c->solid[i] > 0) eps = 1 - c->solid[i] / fsdem__mps_dem_open_weight(c, &mv, i);
+        if (mv.kind[i] == FSDEM_MPS_KIND_FLUID && c->solid[i] > 0) eps = 1 - c->solid[i] / fsdem__mps_dem_open_weight(c, &mv, i);
         mc.porosity[i] = eps > c->desc.min_porosity ? eps : c->desc.min_porosity;
         mc.force[i] = fsdem__zero3();
     }
@@ -14536,7 +14564,7 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
         for (e = c->start[k]; e < c->start[k + 1]; ++e) {
             const int i = c->pair[e].particle;
             const fsdem_real w = c->pair[e].weight;
-            if (mv.kind[i] != FSDEM_MPS_FLUID) continue;
+            if (mv.kind[i] != FSDEM_MPS_KIND_FLUID) continue;
             W += w;
             E += w * mc.porosity[i];
             U = fsdem__madd(U, mv.velocity[i], w);
@@ -14893,7 +14921,7 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
     if (res == FSDEM_OK) res = fsdem__pic_dem_faces(c, 0);
     if (res == FSDEM_OK) res = fsdem_pic_set_pressure_extra(desc->pic, fsdem__pic_dem_operator, c);
     if (res != FSDEM_OK) {
-        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_ERROR, c->status.message[0] ? c->status.message : "fsdem_pic_dem_create: out of memory");
+        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, c->status.message[0] ? c->status.message : "fsdem_pic_dem_create: out of memory");
         fsdem_pic_dem_destroy(c);
         return res;
     }
@@ -15305,10 +15333,10 @@ static fsdem_result fsdem__pic_dem_loads(fsdem_pic_dem *c) {
     return FSDEM_OK;
 }
 
-fsdem_result fsdem_pic_dem_get_body(const fsdem_pic_dem *c, int index, fsdem_pic_dem_body *out) {
+fsdem_result fsdem_pic_dem_get_force(const fsdem_pic_dem *c, int index, fsdem_pic_dem_force *out) {
     if (!c || !out) return FSDEM_ERR_INVALID_ARG;
     if (!c->loaded || index < 0 || index >= c->bodies)
-        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_pic_dem_get_body: no body %d in the last step (%d)",
+        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_pic_dem_get_force: no body %d in the last step (%d)",
                            index, c->loaded ? c->bodies : 0);
     out->pressure_force = c->fp[index];
     out->viscous_force = c->fv[index];
@@ -15970,7 +15998,7 @@ static void fsdem__restart_dem(fsdem__restart *io, void *object) {
         else memset(&w, 0, sizeof w);
         type = (int)w.d.type;
         material = w.d.material;
-        fsdem__restart_int_in(io, &type, 0, FSDEM_DEM_WALL_SDF, "wall type");
+        fsdem__restart_int_in(io, &type, 0, FSDEM_DEM_WALL_TYPE_SDF, "wall type");
         fsdem__restart_value(io, &w.d.a, sizeof w.d.a);
         fsdem__restart_value(io, &w.d.b, sizeof w.d.b);
         fsdem__restart_value(io, &w.d.c, sizeof w.d.c);
@@ -15980,8 +16008,8 @@ static void fsdem__restart_dem(fsdem__restart *io, void *object) {
         fsdem__restart_value(io, &w.force, sizeof w.force);
         fsdem__restart_value(io, &w.impulse, sizeof w.impulse);
         fsdem__restart_value(io, &w.moved, sizeof w.moved);
-        if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_DEM_WALL_SDF) {
-            if (k >= d->wall_count || d->walls[k].d.type != FSDEM_DEM_WALL_SDF)
+        if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_DEM_WALL_TYPE_SDF) {
+            if (k >= d->wall_count || d->walls[k].d.type != FSDEM_DEM_WALL_TYPE_SDF)
                 fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                                     "wall %d is an SDF wall in the save: add the same SDF walls (fsdem_dem_wall_sdf), in the "
                                     "same order, to the object before restoring",
@@ -16163,8 +16191,8 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
         if (io->mode == FSDEM__RESTART_WRITE) o = s->obst[k];
         else memset(&o, 0, sizeof o);
         type = (int)o.d.type;
-        nv = o.d.type == FSDEM_PIC_OBSTACLE_POLYGON ? o.d.vertex_count : 0;
-        fsdem__restart_int_in(io, &type, 0, FSDEM_PIC_OBSTACLE_SDF, "obstacle type");
+        nv = o.d.type == FSDEM_PIC_OBSTACLE_TYPE_POLYGON ? o.d.vertex_count : 0;
+        fsdem__restart_int_in(io, &type, 0, FSDEM_PIC_OBSTACLE_TYPE_SDF, "obstacle type");
         fsdem__restart_value(io, &o.d.a, sizeof o.d.a);
         fsdem__restart_value(io, &o.d.b, sizeof o.d.b);
         fsdem__restart_value(io, &o.d.radius, sizeof o.d.radius);
@@ -16172,12 +16200,12 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
         fsdem__restart_value(io, &o.box_lo, sizeof o.box_lo);
         fsdem__restart_value(io, &o.box_hi, sizeof o.box_hi);
         fsdem__restart_count(io, &nv, 1 << 24, sizeof(fsdem_vec3), "polygon vertex count");
-        if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && (type == FSDEM_PIC_OBSTACLE_POLYGON) != (nv >= 3))
+        if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && (type == FSDEM_PIC_OBSTACLE_TYPE_POLYGON) != (nv >= 3))
             fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "obstacle %d has %d vertices (corrupted data)", k, nv);
         verts = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)nv);
         fsdem__restart_data(io, io->mode == FSDEM__RESTART_WRITE ? o.verts : verts, sizeof(fsdem_vec3) * (size_t)nv);
-        if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_PIC_OBSTACLE_SDF) {
-            if (k >= s->obst_count || s->obst[k].d.type != FSDEM_PIC_OBSTACLE_SDF)
+        if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_PIC_OBSTACLE_TYPE_SDF) {
+            if (k >= s->obst_count || s->obst[k].d.type != FSDEM_PIC_OBSTACLE_TYPE_SDF)
                 fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                                     "obstacle %d is an SDF obstacle in the save: add the same SDF obstacles "
                                     "(fsdem_pic_obstacle_sdf), in the same order, to the object before restoring",
@@ -16582,7 +16610,7 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_data(io, &s->external, sizeof s->external);
     fsdem__restart_data(io, s->fext, sizeof *s->fext * (size_t)n);
     fsdem__restart_data(io, s->gradp, sizeof *s->gradp * (size_t)n);
-    fsdem__restart_flags(io, s->kind, n, FSDEM_MPS_DUMMY, "kind of particle");
+    fsdem__restart_flags(io, s->kind, n, FSDEM_MPS_KIND_DUMMY, "kind of particle");
     fsdem__restart_flags(io, s->surf, n, 1, "surface flag of particle");
     fsdem__restart_ints(io, s->body, n, -1, no - 1, "obstacle of particle");
     fsdem__restart_gauges(io, &s->gauges, al, "fsdem_mps_gauges_close");
@@ -16804,7 +16832,7 @@ static fsdem__restart_object fsdem__restart_of_mps(const fsdem_mps *s) {
     o.kind = FSDEM__RESTART_MPS;
     o.dim = s->dim;
     o.sizes[0] = s->n;
-    o.sizes[1] = s->counts[FSDEM_MPS_FLUID];
+    o.sizes[1] = s->counts[FSDEM_MPS_KIND_FLUID];
     o.sizes[2] = s->obst_n;
     o.sizes[3] = 0;
     o.object = (void *)s;
@@ -17252,7 +17280,7 @@ fsdem_result fsdem_csv_close(fsdem_csv *csv) {
    arrays in VTK's order (fsdem__vtk_section, fsdem__vtk_write, fsdem__vtk_section_end; PolyData:
    PointData, CellData, Points, Verts, Lines, Polys) and closes (fsdem__vtk_close: </Piece>, the
    appended data, </VTKFile>). An array is a description (fsdem__vtk_array), not a copy: its values
-   are read through it when they are written, which for FSDEM_VTK_APPENDED is at the close, so the
+   are read through it when they are written, which for FSDEM_VTK_FORMAT_APPENDED is at the close, so the
    data it points to must live until then (the description itself is copied). Each value goes
    through a double, which holds every Float32, Float64, Int32 and UInt8 value exactly. Binary
    numbers are written in the machine's byte order, which the root element names. The rules of the
@@ -17309,8 +17337,8 @@ typedef struct fsdem__vtk_writer {
     fsdem__status *status; /* the object's, for the message (may be NULL) */
     const char *who, *path;
     double time;           /* s, the TimeValue field */
-    unsigned long long appended; /* FSDEM_VTK_APPENDED: bytes of the blocks announced so far */
-    fsdem__vtk_array queue[FSDEM__VTK_MAX_ARRAYS]; /* FSDEM_VTK_APPENDED: the blocks to write */
+    unsigned long long appended; /* FSDEM_VTK_FORMAT_APPENDED: bytes of the blocks announced so far */
+    fsdem__vtk_array queue[FSDEM__VTK_MAX_ARRAYS]; /* FSDEM_VTK_FORMAT_APPENDED: the blocks to write */
     int queued;
 } fsdem__vtk_writer;
 
@@ -17419,7 +17447,7 @@ typedef struct fsdem__vtk_sink {
 
 static void fsdem__vtk_sink_put(fsdem__vtk_sink *s, const unsigned char *p, size_t n) {
     static const char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    if (s->w->format == FSDEM_VTK_APPENDED) {
+    if (s->w->format == FSDEM_VTK_FORMAT_APPENDED) {
         fwrite(p, 1, n, s->w->fp);
         return;
     }
@@ -17441,7 +17469,7 @@ static void fsdem__vtk_sink_put(fsdem__vtk_sink *s, const unsigned char *p, size
 /* Ends a base64 stream: the last one or two bytes with '=' padding. */
 static void fsdem__vtk_sink_end(fsdem__vtk_sink *s) {
     static const char digits[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    if (s->w->format == FSDEM_VTK_APPENDED) return;
+    if (s->w->format == FSDEM_VTK_FORMAT_APPENDED) return;
     if (s->npending) {
         const unsigned char b0 = s->pending[0], b1 = s->npending > 1 ? s->pending[1] : 0;
         char quad[4];
@@ -17467,7 +17495,7 @@ static void fsdem__vtk_values(fsdem__vtk_writer *w, const fsdem__vtk_array *a) {
     long long i;
     int c;
     double v[3];
-    if (w->format == FSDEM_VTK_ASCII) {
+    if (w->format == FSDEM_VTK_FORMAT_ASCII) {
         for (i = 0; i < a->count; ++i) {
             fsdem__vtk_tuple(a, i, v);
             for (c = 0; c < a->components; ++c) {
@@ -17510,7 +17538,7 @@ static void fsdem__vtk_write_array(fsdem__vtk_writer *w, fsdem__vtk_array a, int
     fprintf(w->fp, "<DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" format=\"%s\"", fsdem__vtk_type_name(a.type),
             a.name, a.components, formats[w->format]);
     if (field) fprintf(w->fp, " NumberOfTuples=\"%lld\"", a.count);
-    if (w->format == FSDEM_VTK_APPENDED) {
+    if (w->format == FSDEM_VTK_FORMAT_APPENDED) {
         FSDEM_ASSERT(w->queued < FSDEM__VTK_MAX_ARRAYS);
         fprintf(w->fp, " offset=\"%llu\"/>\n", w->appended);
         w->queue[w->queued++] = a;
@@ -17519,7 +17547,7 @@ static void fsdem__vtk_write_array(fsdem__vtk_writer *w, fsdem__vtk_array a, int
     }
     fputs(">\n", w->fp);
     fsdem__vtk_values(w, &a);
-    fputs(w->format == FSDEM_VTK_BASE64 ? "\n</DataArray>\n" : "</DataArray>\n", w->fp);
+    fputs(w->format == FSDEM_VTK_FORMAT_BASE64 ? "\n</DataArray>\n" : "</DataArray>\n", w->fp);
 }
 
 static void fsdem__vtk_write(fsdem__vtk_writer *w, fsdem__vtk_array a) { fsdem__vtk_write_array(w, a, 0); }
@@ -17530,7 +17558,7 @@ static fsdem_result fsdem__vtk_check(fsdem__status *status, const char *who, con
     fsdem__status *st = status ? status : &scratch;
     if (!status) scratch.log = NULL;
     if (!path) return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: path is NULL", who);
-    if ((int)format < (int)FSDEM_VTK_ASCII || (int)format > (int)FSDEM_VTK_APPENDED)
+    if ((int)format < (int)FSDEM_VTK_FORMAT_ASCII || (int)format > (int)FSDEM_VTK_FORMAT_APPENDED)
         return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: format %d is not a fsdem_vtk_format", who, (int)format);
     return FSDEM_OK;
 }
@@ -17609,7 +17637,7 @@ static void fsdem__vtk_cells(fsdem__vtk_writer *w, const char *tag, fsdem__vtk_a
 static fsdem_result fsdem__vtk_close(fsdem__vtk_writer *w) {
     int k, bad;
     fprintf(w->fp, "</Piece>\n</%s>\n", w->type);
-    if (w->format == FSDEM_VTK_APPENDED) {
+    if (w->format == FSDEM_VTK_FORMAT_APPENDED) {
         fputs("<AppendedData encoding=\"raw\">\n_", w->fp);
         for (k = 0; k < w->queued; ++k) fsdem__vtk_values(w, &w->queue[k]);
         fputs("\n</AppendedData>\n", w->fp);
@@ -17877,12 +17905,12 @@ static void fsdem__io_walls_pass(const fsdem_dem *d, fsdem__io_walls *g) {
         fsdem_vec3 v[12];
         if (!w->active) continue;
         switch (gd->type) {
-        case FSDEM_DEM_WALL_PLANE:
+        case FSDEM_DEM_WALL_TYPE_PLANE:
             k = fsdem__io_plane_patch(gd->a, gd->b, d->desc.domain_min, d->desc.domain_max, dim, v);
             if (k >= (dim == 2 ? 2 : 3)) fsdem__io_walls_cell(g, v, k, id, w);
             break;
-        case FSDEM_DEM_WALL_BOX_INSIDE:
-        case FSDEM_DEM_WALL_BOX_OUTSIDE:
+        case FSDEM_DEM_WALL_TYPE_BOX_INSIDE:
+        case FSDEM_DEM_WALL_TYPE_BOX_OUTSIDE:
             if (dim == 2) {
                 const fsdem_vec3 r[4] = {fsdem_v3(gd->a.x, gd->a.y, 0), fsdem_v3(gd->b.x, gd->a.y, 0), fsdem_v3(gd->b.x, gd->b.y, 0),
                                          fsdem_v3(gd->a.x, gd->b.y, 0)};
@@ -17895,18 +17923,18 @@ static void fsdem__io_walls_pass(const fsdem_dem *d, fsdem__io_walls *g) {
                 for (f = 0; f < 6; ++f) {
                     for (k = 0; k < 4; ++k) {
                         /* an inside box holds the particles: its faces face inwards */
-                        const int corner = faces[f][gd->type == FSDEM_DEM_WALL_BOX_INSIDE ? 3 - k : k];
+                        const int corner = faces[f][gd->type == FSDEM_DEM_WALL_TYPE_BOX_INSIDE ? 3 - k : k];
                         v[k] = fsdem_v3(corner & 1 ? gd->b.x : gd->a.x, corner & 2 ? gd->b.y : gd->a.y, corner & 4 ? gd->b.z : gd->a.z);
                     }
                     fsdem__io_walls_cell(g, v, 4, id, w);
                 }
             break;
-        case FSDEM_DEM_WALL_SEGMENT:
+        case FSDEM_DEM_WALL_TYPE_SEGMENT:
             v[0] = gd->a;
             v[1] = gd->b;
             fsdem__io_walls_cell(g, v, 2, id, w);
             break;
-        case FSDEM_DEM_WALL_TRIANGLE:
+        case FSDEM_DEM_WALL_TYPE_TRIANGLE:
             v[0] = gd->a;
             v[1] = gd->b;
             v[2] = gd->c;
@@ -18155,6 +18183,127 @@ fsdem_result fsdem_mps_write_vtp(const fsdem_mps *s, const char *path, fsdem_vtk
     fsdem__vtk_write(&w, fsdem__vtk_reals("number_density", s->nd, s->n));
     fsdem__vtk_write(&w, fsdem__vtk_reals("porosity", s->eps, s->n));
     return fsdem__vtk_particles_end(&w, s->x, s->n);
+}
+
+/* ---- CSV snapshots of rows of numbers ---- */
+
+/* Fills the values of row `index`; returns 0 when the row is left out. */
+typedef int (*fsdem__io_row_fn)(const void *object, int index, double *values);
+
+/* Writes `header` and the rows 0 .. rows-1 that `row` gives (as many values as the header has
+   names), with 17 significant digits so that they read back exactly. */
+static fsdem_result fsdem__io_write_rows(const fsdem__status *status, const char *who, const char *path, const char *header,
+                                         int rows, fsdem__io_row_fn row, const void *object) {
+    double values[32];
+    int columns = 1, index, k, bad;
+    const char *h;
+    FILE *fp;
+    if (!path) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_INVALID_ARG, "%s: path is NULL", who);
+    for (h = header; *h; ++h) columns += *h == ',';
+    FSDEM_ASSERT(columns <= (int)(sizeof values / sizeof values[0]));
+    if (!(fp = fopen(path, "w"))) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_IO, "%s: cannot open '%s' for writing", who, path);
+    fprintf(fp, "%s\n", header);
+    for (index = 0; index < rows; ++index) {
+        if (!row(object, index, values)) continue;
+        for (k = 0; k < columns; ++k) fprintf(fp, k ? ",%.17g" : "%.17g", values[k]);
+        fputc('\n', fp);
+    }
+    bad = ferror(fp);
+    if (fclose(fp) != 0 || bad) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_IO, "%s: cannot write '%s'", who, path);
+    return fsdem__ok((fsdem__status *)status);
+}
+
+static void fsdem__io_put3(double *v, fsdem_vec3 a) {
+    v[0] = (double)a.x;
+    v[1] = (double)a.y;
+    v[2] = (double)a.z;
+}
+
+static int fsdem__io_mps_row(const void *object, int i, double *v) {
+    const fsdem_mps *s = (const fsdem_mps *)object;
+    v[0] = s->kind[i];
+    v[1] = s->surf[i];
+    fsdem__io_put3(v + 2, s->x[i]);
+    fsdem__io_put3(v + 5, s->v[i]);
+    v[8] = (double)s->p[i];
+    v[9] = (double)s->nd[i];
+    v[10] = (double)s->eps[i];
+    return 1;
+}
+
+fsdem_result fsdem_mps_write_csv(const fsdem_mps *s, const char *path) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__io_write_rows(&s->status, "fsdem_mps_write_csv", path,
+                                "kind,surface,x,y,z,vx,vy,vz,pressure,number_density,porosity", s->n, fsdem__io_mps_row, s);
+}
+
+static int fsdem__io_swe_dem_row(const void *object, int i, double *v) {
+    const fsdem_swe_dem *c = (const fsdem_swe_dem *)object;
+    fsdem_swe_dem_force f;
+    if (i >= c->force_capacity) return 0;
+    f = c->force[i];
+    v[0] = fsdem_dem_get_particles(c->desc.dem).id[i];
+    v[1] = (double)f.buoyancy.z;
+    v[2] = (double)f.hydrostatic.x;
+    v[3] = (double)f.hydrostatic.y;
+    v[4] = (double)f.dynamic.x;
+    v[5] = (double)f.dynamic.y;
+    v[6] = (double)f.heave.z;
+    v[7] = (double)f.submerged_volume;
+    v[8] = (double)f.frontal_area;
+    v[9] = (double)f.surface;
+    v[10] = f.in_water;
+    return 1;
+}
+
+fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *c, const char *path) {
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__io_write_rows(&c->status, "fsdem_swe_dem_write_csv", path,
+                                "id,buoyancy_z,hydrostatic_x,hydrostatic_y,dynamic_x,dynamic_y,heave_z,submerged_volume,"
+                                "frontal_area,surface,in_water",
+                                fsdem_dem_get_particles(c->desc.dem).count, fsdem__io_swe_dem_row, c);
+}
+
+static int fsdem__io_mps_dem_row(const void *object, int i, double *v) {
+    const fsdem_mps_dem *c = (const fsdem_mps_dem *)object;
+    const fsdem_mps_dem_force *f = &c->force[i];
+    v[0] = fsdem_dem_get_particles(c->desc.dem).id[i];
+    fsdem__io_put3(v + 1, f->drag);
+    fsdem__io_put3(v + 4, f->pressure);
+    fsdem__io_put3(v + 7, f->total);
+    fsdem__io_put3(v + 10, f->fluid_velocity);
+    v[13] = (double)f->porosity;
+    v[14] = (double)f->reynolds;
+    v[15] = f->wet;
+    return 1;
+}
+
+fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *c, const char *path) {
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__io_write_rows(&c->status, "fsdem_mps_dem_write_csv", path,
+                                "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,fluid_u,"
+                                "fluid_v,fluid_w,porosity,reynolds,wet",
+                                c->forces, fsdem__io_mps_dem_row, c);
+}
+
+static int fsdem__io_pic_dem_row(const void *object, int i, double *v) {
+    const fsdem_pic_dem *c = (const fsdem_pic_dem *)object;
+    v[0] = fsdem_dem_get_particles(c->desc.dem).id[i];
+    fsdem__io_put3(v + 1, c->fp[i]);
+    fsdem__io_put3(v + 4, c->fv[i]);
+    fsdem__io_put3(v + 7, c->tq[i]);
+    fsdem__io_put3(v + 10, c->wc[i]);
+    v[13] = (double)c->volume[i];
+    v[14] = c->face_start[i + 1] - c->face_start[i];
+    return 1;
+}
+
+fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *c, const char *path) {
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__io_write_rows(&c->status, "fsdem_pic_dem_write_csv", path,
+                                "id,pressure_x,pressure_y,pressure_z,viscous_x,viscous_y,viscous_z,torque_x,torque_y,torque_z,"
+                                "weight_correction_x,weight_correction_y,weight_correction_z,volume,faces",
+                                c->loaded ? c->bodies : 0, fsdem__io_pic_dem_row, c);
 }
 
 static void fsdem__io_pic_velocity(const void *user, long long c, double out[3]) {

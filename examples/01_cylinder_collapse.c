@@ -71,7 +71,7 @@ int main(void) {
            steps);
     printf("%6s %9s %9s %12s %8s\n", "t [s]", "x_ave [m]", "z_ave [m]", "E_kin [J]", "contacts");
     /* binary (appended raw) output: exact and compact; the series stay valid after every entry */
-    if (fsdem_dem_write_walls_vtp(dem, "walls.vtp", FSDEM_VTK_APPENDED) != FSDEM_OK ||
+    if (fsdem_dem_write_walls_vtp(dem, "walls.vtp", FSDEM_VTK_FORMAT_APPENDED) != FSDEM_OK ||
         fsdem_pvd_open(&particles, "collapse.pvd") != FSDEM_OK || fsdem_pvd_open(&contacts, "contacts.pvd") != FSDEM_OK) {
         printf("cannot write the output files here\n");
         fsdem_dem_destroy(dem);
@@ -96,10 +96,10 @@ int main(void) {
             snprintf(path, sizeof path, "collapse_%03d.csv", frame);
             fsdem_dem_write_csv(dem, path);
             snprintf(path, sizeof path, "collapse_%03d.vtp", frame);
-            fsdem_dem_write_vtp(dem, path, FSDEM_VTK_APPENDED);
+            fsdem_dem_write_vtp(dem, path, FSDEM_VTK_FORMAT_APPENDED);
             fsdem_pvd_add(&particles, t, path);
             snprintf(path, sizeof path, "contacts_%03d.vtp", frame);
-            fsdem_dem_write_contacts_vtp(dem, path, FSDEM_VTK_APPENDED);
+            fsdem_dem_write_contacts_vtp(dem, path, FSDEM_VTK_FORMAT_APPENDED);
             fsdem_pvd_add(&contacts, t, path);
             frame++;
         }

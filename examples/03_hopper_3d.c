@@ -4,7 +4,7 @@
    z = 0.3 m, outlet 0.048 m wide at z = 0.2 m, so six particle diameters) is made of four trapezoids,
    two triangles each. About a thousand glass-like spheres (r = 4 mm, Hertz-Mindlin, mu = 0.3) start
    in a loose lattice above the funnel, fall in and drain through the outlet onto the floor of a box
-   (FSDEM_DEM_WALL_BOX_INSIDE). The program prints the number of discharged spheres (centre below the
+   (FSDEM_DEM_WALL_TYPE_BOX_INSIDE). The program prints the number of discharged spheres (centre below the
    outlet) every 0.1 s; the count grows at a nearly steady rate while the funnel drains, as Beverloo's
    law expects for a hopper, and then levels off.
 

@@ -8,7 +8,7 @@
    iterations. Progress (time, steps, front position, kinetic energy, CPU time) is printed every
    0.1 s. The time step is the solver's adaptive one (fsdem_pic_advance: CFL 1 by default).
    The VTK files are binary (appended raw data): exact, smaller and faster to write than ASCII;
-   pass FSDEM_VTK_ASCII to read them in an editor.
+   pass FSDEM_VTK_FORMAT_ASCII to read them in an editor.
 
    Run:  make examples && cd build/examples && ./04_pic_dambreak      (about 15 s; ~70 MB of ASCII files)
    Build by hand: cc -std=c99 -O2 -I. examples/04_pic_dambreak.c -o dambreak -lm */
@@ -22,9 +22,9 @@ static void write_frame(fsdem_pic *pic, fsdem_pvd *particles, fsdem_pvd *grid, i
     char name[64];
     double t = fsdem_pic_time(pic);
     snprintf(name, sizeof name, "particles_%04d.vtp", frame);
-    if (fsdem_pic_write_particles_vtp(pic, name, FSDEM_VTK_APPENDED) == FSDEM_OK) fsdem_pvd_add(particles, t, name);
+    if (fsdem_pic_write_particles_vtp(pic, name, FSDEM_VTK_FORMAT_APPENDED) == FSDEM_OK) fsdem_pvd_add(particles, t, name);
     snprintf(name, sizeof name, "grid_%04d.vti", frame);
-    if (fsdem_pic_write_grid_vti(pic, name, FSDEM_VTK_APPENDED) == FSDEM_OK) fsdem_pvd_add(grid, t, name);
+    if (fsdem_pic_write_grid_vti(pic, name, FSDEM_VTK_FORMAT_APPENDED) == FSDEM_OK) fsdem_pvd_add(grid, t, name);
 }
 
 /* Surge front: the largest x of a particle lying within the lowest 2 cm of the tank. */

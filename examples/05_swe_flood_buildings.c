@@ -11,7 +11,7 @@
 
 static void log_line(void *user, fsdem_log_level level, const char *message) {
     (void)user;
-    fprintf(stderr, "%s: %s\n", level == FSDEM_LOG_ERROR ? "error" : "note", message);
+    fprintf(stderr, "%s: %s\n", level == FSDEM_LOG_LEVEL_ERROR ? "error" : "note", message);
 }
 
 /* Reservoir of 1 m behind x = 4 m, a film of 1 cm downstream (a wet street), flat bed with a slight

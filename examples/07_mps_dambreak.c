@@ -24,7 +24,7 @@
 static void write_frame(fsdem_mps *mps, fsdem_pvd *series, int frame) {
     char name[64];
     snprintf(name, sizeof name, "mps_%04d.vtp", frame);
-    if (fsdem_mps_write_vtp(mps, name, FSDEM_VTK_APPENDED) == FSDEM_OK) fsdem_pvd_add(series, fsdem_mps_time(mps), name);
+    if (fsdem_mps_write_vtp(mps, name, FSDEM_VTK_FORMAT_APPENDED) == FSDEM_OK) fsdem_pvd_add(series, fsdem_mps_time(mps), name);
 }
 
 /* Surge front: the largest x of a water particle. */
@@ -33,7 +33,7 @@ static double front(fsdem_mps *mps) {
     double x = 0;
     int i;
     for (i = 0; i < p.count; ++i)
-        if (p.kind[i] == FSDEM_MPS_FLUID && p.position[i].x > x) x = p.position[i].x;
+        if (p.kind[i] == FSDEM_MPS_KIND_FLUID && p.position[i].x > x) x = p.position[i].x;
     return x;
 }
 

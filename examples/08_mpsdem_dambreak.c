@@ -45,7 +45,7 @@ static double water_front(fsdem_mps *mps) {
     double x = 0;
     int i;
     for (i = 0; i < p.count; ++i)
-        if (p.kind[i] == FSDEM_MPS_FLUID && p.position[i].x > x) x = p.position[i].x;
+        if (p.kind[i] == FSDEM_MPS_KIND_FLUID && p.position[i].x > x) x = p.position[i].x;
     return x;
 }
 
@@ -84,7 +84,7 @@ int main(void) {
     dd.domain_min = md.domain_min;
     dd.domain_max = md.domain_max;
     dd.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
-    dd.dt_rule = FSDEM_DEM_DT_RAYLEIGH;
+    dd.dt_rule = FSDEM_DEM_DT_RULE_RAYLEIGH;
     glass.density = 2500;
     glass.young_modulus = 1e8;
     glass.poisson_ratio = 0.2;
@@ -135,7 +135,7 @@ int main(void) {
             for (j = 0; j < ny; ++j)
                 for (i = 0; i < nx; ++i)
                     x[water++] = fsdem_v3((fsdem_real)((i + 0.5) * sx), (fsdem_real)((j + 0.5) * sy), (fsdem_real)((k + 0.5) * sz));
-        k = fsdem_mps_add_particles(mps, FSDEM_MPS_FLUID, water, x, NULL);
+        k = fsdem_mps_add_particles(mps, FSDEM_MPS_KIND_FLUID, water, x, NULL);
         free(x);
         if (k != FSDEM_OK) goto done;
     }
@@ -177,9 +177,9 @@ int main(void) {
         row[2] = (fsdem_real)sediment_front(dem);
         fsdem_csv_row(&csv, row, 3);
         snprintf(name, sizeof name, "water_%04d.vtp", frame);
-        if (fsdem_mps_write_vtp(mps, name, FSDEM_VTK_APPENDED) == FSDEM_OK) fsdem_pvd_add(&water_series, row[0], name);
+        if (fsdem_mps_write_vtp(mps, name, FSDEM_VTK_FORMAT_APPENDED) == FSDEM_OK) fsdem_pvd_add(&water_series, row[0], name);
         snprintf(name, sizeof name, "sediment_%04d.vtp", frame);
-        if (fsdem_dem_write_vtp(dem, name, FSDEM_VTK_APPENDED) == FSDEM_OK) fsdem_pvd_add(&sediment_series, row[0], name);
+        if (fsdem_dem_write_vtp(dem, name, FSDEM_VTK_FORMAT_APPENDED) == FSDEM_OK) fsdem_pvd_add(&sediment_series, row[0], name);
         if (frame % 5 == 0)
             printf("%6.2f %6lld %10.4f %10.4f %8.3f %8.1f %8.1f\n", (double)row[0], st.steps, (double)row[1], (double)row[2],
                    (double)fsdem_mps_get_stats(mps).max_speed, st.seconds_mps, st.seconds_dem);

@@ -109,7 +109,7 @@ int main(void) {
         fsdem_pvd_close(&water_series);
         goto done;
     }
-    fsdem_dem_write_walls_vtp(dem, "walls.vtp", FSDEM_VTK_APPENDED);
+    fsdem_dem_write_walls_vtp(dem, "walls.vtp", FSDEM_VTK_FORMAT_APPENDED);
     printf("2D PIC-DEM dam break: %d water particles (dx = %g m), %d cylinders (DEM dt %.3g s), beta %.1f, to t = %.1f s\n",
            fsdem_pic_get_stats(pic).particles, DX, fsdem_dem_get_particles(dem).count, (double)dem_dt, (double)cd.dissipation, t_end);
     printf("%6s %6s %9s %9s %9s %8s %8s %8s\n", "t (s)", "steps", "x_ave(m)", "x_max(m)", "contacts", "PIC (s)", "DEM (s)", "cpl (s)");
@@ -126,9 +126,9 @@ int main(void) {
             if (P.position[i].x > x_max) x_max = P.position[i].x;
         }
         snprintf(name, sizeof name, "water_%04d.vtp", frame);
-        if (fsdem_pic_write_particles_vtp(pic, name, FSDEM_VTK_APPENDED) == FSDEM_OK) fsdem_pvd_add(&water_series, t, name);
+        if (fsdem_pic_write_particles_vtp(pic, name, FSDEM_VTK_FORMAT_APPENDED) == FSDEM_OK) fsdem_pvd_add(&water_series, t, name);
         snprintf(name, sizeof name, "cylinders_%04d.vtp", frame);
-        if (fsdem_dem_write_vtp(dem, name, FSDEM_VTK_APPENDED) == FSDEM_OK) fsdem_pvd_add(&cylinder_series, t, name);
+        if (fsdem_dem_write_vtp(dem, name, FSDEM_VTK_FORMAT_APPENDED) == FSDEM_OK) fsdem_pvd_add(&cylinder_series, t, name);
         if (frame % 5 == 0)
             printf("%6.2f %6lld %9.4f %9.4f %9d %8.1f %8.1f %8.1f\n", t, st.steps, x_ave, x_max, st.contacts, st.seconds_pic,
                    st.seconds_dem, st.seconds_coupling);

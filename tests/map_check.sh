@@ -7,7 +7,10 @@
 #   - a >>tag named anywhere (a reference such as "(>>dem_law)") names no banner;
 #   - an implementation chapter does not open with a contents comment naming its subsections;
 #   - a subsection (or a chapter without subsections) runs over MAX_LINES lines;
-#   - the float build's precision-suffixed symbol list (>>config) differs from the FSDEM_API functions.
+#   - the float build's precision-suffixed symbol list (>>config) differs from the FSDEM_API functions;
+#   - a public enum value breaks FSDEM_<ENUM>_<VALUE> (fsdem_result's codes excepted, as >>doc says);
+#   - the objects of the verb table in >>doc ("ONE DIALECT FOR EVERY SOLVER") are not exactly those
+#     with a create and a step, or one of them lacks a verb of the table (couplers: and get_force).
 # Usage: sh tests/map_check.sh [fsdem.h]          check
 #        sh tests/map_check.sh --symbols [fsdem.h] print the symbol block for >>config
 set -u
@@ -90,4 +93,33 @@ if [ "$listed" != "$api" ]; then
     echo "  regenerate it with: sh tests/map_check.sh --symbols"
     exit 1
 fi
-echo "map check: $(grep -c '>>' "$file") map lines, banners unique, order and references resolve, contents listed, symbols complete"
+# enum values: FSDEM_<ENUM>_<VALUE> for every public enum but fsdem_result
+awk '
+function fail(msg) { print "map_check: " msg; bad = 1 }
+/^typedef enum fsdem_[a-z][a-z0-9_]* \{/ { name = $3; inenum = (name != "fsdem_result"); prefix = toupper(name) "_"; next }
+inenum && /^\}/ { inenum = 0; next }
+inenum && /^ *FSDEM_[A-Z0-9_]+ *(= *-?[0-9]+)? *,? *(\/\*.*)?$/ {
+    match($0, /FSDEM_[A-Z0-9_]+/); v = substr($0, RSTART, RLENGTH)
+    if (index(v, prefix) != 1) fail("enum " name ": value " v " is not " prefix "<VALUE>")
+}
+END { if (bad) exit 1 }' "$file" || exit 1
+
+# the verb table: its object list against the objects that have a create and a step, and its verbs
+listed_objects=$(awk '/Each solver \(fsdem_/ { on = 1 } on { text = text " " $0 } on && /speaks these verbs/ { on = 0 }
+                      END { while (match(text, /fsdem_[a-z_]+/)) { print substr(text, RSTART, RLENGTH); text = substr(text, RSTART + RLENGTH) } }' "$file" | sort -u)
+stepping=$(for f in $api; do case $f in *_create) o=${f%_create}; echo "$api" | grep -qx "${o}_step" && echo "$o";; esac; done | sort -u)
+if [ "$listed_objects" != "$stepping" ]; then
+    echo "map_check: the verb table of >>doc lists [$(echo $listed_objects)], the objects with create and step are [$(echo $stepping)]"
+    exit 1
+fi
+verbs="desc_default desc_check create destroy last_error get_desc step step_dt advance stable_dt time get_stats save restore save_memory restore_memory"
+for o in $stepping; do
+    need=$verbs
+    case $o in fsdem_?*_dem) need="$need get_force";; esac
+    for v in $need; do
+        echo "$api" | grep -qx "${o}_$v" || { echo "map_check: ${o}_$v is missing (the verb table of >>doc promises it)"; exit 1; }
+    done
+    echo "$api" | grep -qE "^${o}_write_([a-z]+_)?csv\$" || { echo "map_check: ${o} writes no CSV (${o}_write_csv or _write_<what>_csv)"; exit 1; }
+done
+
+echo "map check: $(grep -c '>>' "$file") map lines, banners unique, order and references resolve, contents listed, symbols complete, enum names and verb table hold"

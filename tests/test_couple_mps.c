@@ -108,7 +108,7 @@ START_TEST(test_mps_dem_porosity_packing) {
             for (i = 0; i < mv.count; ++i) {
                 const fsdem_vec3 x = mv.position[i];
                 const double edge = m * a - re;
-                if (mv.kind[i] != FSDEM_MPS_FLUID) continue;
+                if (mv.kind[i] != FSDEM_MPS_KIND_FLUID) continue;
                 if (!walled && (x.x < re || x.x > edge || x.y < re || x.y > edge || (dim == 3 && (x.z < re || x.z > edge)))) continue;
                 counted++;
                 if (fabs(mv.porosity[i] - (1 - phi)) > worst) worst = fabs(mv.porosity[i] - (1 - phi));
@@ -159,7 +159,7 @@ START_TEST(test_mps_dem_momentum_exchange) {
             fsdem_mps_particles mv = fsdem_mps_get_particles(t.mps);
             int i, step;
             for (i = 0; i < mv.count; ++i)
-                if (mv.kind[i] == FSDEM_MPS_FLUID) mv.velocity[i] = fsdem_v3((fsdem_real)(0.05 * sin(40 * mv.position[i].y)), 0, 0);
+                if (mv.kind[i] == FSDEM_MPS_KIND_FLUID) mv.velocity[i] = fsdem_v3((fsdem_real)(0.05 * sin(40 * mv.position[i].y)), 0, 0);
             for (i = 0; i < 40; ++i) {
                 const double s = i * 0.618034;
                 const fsdem_vec3 x = fsdem_v3((fsdem_real)(0.02 + 0.06 * (s - floor(s))), (fsdem_real)(0.01 + 0.0011 * i),
@@ -225,7 +225,7 @@ END_TEST
 
 static double test_per_volume(double eps, double d, double slip, double rho, double mu) {
     fsdem_real c = 0;
-    ck_assert_int_eq(fsdem_drag_coefficient(FSDEM_DRAG_ERGUN_WEN_YU, (fsdem_real)eps, (fsdem_real)d, (fsdem_real)slip,
+    ck_assert_int_eq(fsdem_drag_coefficient(FSDEM_DRAG_LAW_ERGUN_WEN_YU, (fsdem_real)eps, (fsdem_real)d, (fsdem_real)slip,
                                             (fsdem_real)rho, (fsdem_real)mu, &c, NULL, NULL, 0),
                      FSDEM_OK);
     return c;
@@ -320,7 +320,7 @@ START_TEST(test_mps_dem_bad_input) {
     d.drag = (fsdem_drag_law)99;
     ck_assert_int_eq(fsdem_mps_dem_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_nonnull(strstr(msg, "drag"));
-    d.drag = FSDEM_DRAG_ERGUN_WEN_YU;
+    d.drag = FSDEM_DRAG_LAW_ERGUN_WEN_YU;
     d.radius = -1;
     ck_assert_int_eq(fsdem_mps_dem_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_nonnull(strstr(msg, "radius"));

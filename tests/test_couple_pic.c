@@ -116,7 +116,7 @@ static double fsdem_test_norm(fsdem_vec3 v) { return sqrt((double)v.x * v.x + (d
 
 /* Archimedes (issue 13): a body held fully submerged in still water feels rho g V. The coupler's
    pressure force is J^T p, which in hydrostatic water is exactly rho g dx^dim sum (1 - E) over the
-   faces normal to gravity (the body's volume as the faces see it, fsdem_pic_dem_body.volume from
+   faces normal to gravity (the body's volume as the faces see it, fsdem_pic_dem_force.volume from
    all axes), to the solver tolerance; that volume is a midpoint rule over the cross-sections, whose
    error is largest when the centre lies on a face: -0.58% at 16 cells per radius (2D: the chord has a
    square-root end) and -0.69% at 6 cells per radius (3D), both inside the 1% of the issue. */
@@ -125,11 +125,11 @@ static void check_archimedes(int dim) {
     const fsdem_vec3 centre = dim == 2 ? fsdem_v3(0.15, 0.125, 0) : fsdem_v3(0.125, 0.125, 0.125);
     tank t = make_tank(dim, L, dim == 2 ? 0.25 : 0.22, 0, G, dx, centre, R, 2000, 1, fsdem_v3(0, 0, 0), 1e-3);
     const double V = dim == 2 ? PI * R * R : 4.0 / 3.0 * PI * R * R * R;
-    fsdem_pic_dem_body b;
+    fsdem_pic_dem_force b;
     double up, side, vface;
     int k;
     for (k = 0; k < 3; ++k) ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)1e-3), FSDEM_OK);
-    ck_assert_int_eq(fsdem_pic_dem_get_body(t.cp, 0, &b), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 0, &b), FSDEM_OK);
     up = dim == 2 ? b.pressure_force.y : b.pressure_force.z;
     side = fabs(b.pressure_force.x) + fabs(dim == 2 ? 0 : b.pressure_force.y);
     /* the faces normal to gravity alone: the hydrostatic sum */
@@ -166,11 +166,11 @@ START_TEST(moving_disc_keeps_volume_and_balances_impulses) {
     double worst = 0, inside = 0, drag = 0;
     int k, p;
     for (k = 0; k < 100; ++k) {
-        fsdem_pic_dem_body b;
+        fsdem_pic_dem_force b;
         fsdem_pic_particles w;
         fsdem_dem_particles d;
         ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)2e-3), FSDEM_OK);
-        ck_assert_int_eq(fsdem_pic_dem_get_body(t.cp, 0, &b), FSDEM_OK);
+        ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 0, &b), FSDEM_OK);
         w = fsdem_pic_get_particles(t.pic);
         d = fsdem_dem_get_particles(t.dem);
         ck_assert_int_eq(w.count, count0);
@@ -205,7 +205,7 @@ START_TEST(fixed_disc_in_a_stream_feels_drag_along_it) {
     fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
     fsdem_pic_dem_desc cd = fsdem_pic_dem_desc_default();
     tank t;
-    fsdem_pic_dem_body b;
+    fsdem_pic_dem_force b;
     pd.cell_size = 0.01;
     pd.jitter = 0;
     pd.free_surface = 0;
@@ -230,7 +230,7 @@ START_TEST(fixed_disc_in_a_stream_feels_drag_along_it) {
     cd.dem = t.dem;
     ck_assert_int_eq(fsdem_pic_dem_create(&cd, &t.cp), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_dem_advance(t.cp, 0.4, NULL), FSDEM_OK);
-    ck_assert_int_eq(fsdem_pic_dem_get_body(t.cp, 0, &b), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 0, &b), FSDEM_OK);
     {
         const double fx = b.pressure_force.x + b.viscous_force.x, fy = b.pressure_force.y + b.viscous_force.y;
         TEST_REPORT("stream 0.02 m/s: pressure (%.4g, %.2g) N/m, viscous (%.4g, %.2g) N/m, friction share %.3f", b.pressure_force.x,
@@ -387,7 +387,7 @@ START_TEST(bad_input_is_refused) {
     fsdem_dem *dem3 = NULL;
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     char msg[256];
-    fsdem_pic_dem_body b;
+    fsdem_pic_dem_force b;
     ck_assert_int_eq(fsdem_pic_dem_desc_check(&cd, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_nonnull(strstr(msg, ".pic"));
     cd.pic = t.pic;
@@ -403,7 +403,7 @@ START_TEST(bad_input_is_refused) {
     ck_assert_ptr_nonnull(strstr(msg, "dissipation"));
     ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)NAN), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, -1), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_pic_dem_get_body(t.cp, 0, &b), FSDEM_ERR_NOT_FOUND); /* no step yet */
+    ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 0, &b), FSDEM_ERR_NOT_FOUND); /* no step yet */
     /* a step so long the body would cross many cells: refused, nothing moved */
     {
         fsdem_dem_particles d = fsdem_dem_get_particles(t.dem);
@@ -416,8 +416,8 @@ START_TEST(bad_input_is_refused) {
     }
     /* still usable */
     ck_assert_int_eq(fsdem_pic_dem_step(t.cp), FSDEM_OK);
-    ck_assert_int_eq(fsdem_pic_dem_get_body(t.cp, 0, &b), FSDEM_OK);
-    ck_assert_int_eq(fsdem_pic_dem_get_body(t.cp, 1, &b), FSDEM_ERR_NOT_FOUND);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 0, &b), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 1, &b), FSDEM_ERR_NOT_FOUND);
     fsdem_dem_destroy(dem3);
     free_tank(&t);
 }

@@ -1459,7 +1459,7 @@ START_TEST(dt_estimates_follow_their_formulas) {
     /* closed form: rounding only (float: the library's ~8 roundings of fsdem_real inputs, 16 eps) */
     ck_assert(fabs(dt / expected - 1) < TOL(1e-12, 16));
     d.linear_accel = 4 * G; /* ||g|| of Eq. 10 set explicitly */
-    d.dt_rule = FSDEM_DEM_DT_LINEAR_SEED000;
+    d.dt_rule = FSDEM_DEM_DT_RULE_LINEAR_SEED000;
     d.dt_param = 100;
     ck_assert_int_eq(rule_dt(d, radii, NULL, 1, &dt), FSDEM_OK);
     expected = 2 * PI / 100 * sqrt(0.01 * 0.004 / (4 * G));
@@ -1480,11 +1480,11 @@ START_TEST(dt_estimates_follow_their_formulas) {
     d.dt_param = 1.5;
     ck_assert_int_eq(fsdem_dem_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_nonnull(strstr(msg, "dt_param"));
-    d.dt_rule = FSDEM_DEM_DT_LINEAR_SEED000;
+    d.dt_rule = FSDEM_DEM_DT_RULE_LINEAR_SEED000;
     d.dt_param = 0;
     ck_assert_int_eq(fsdem_dem_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_nonnull(strstr(msg, "linear law"));
-    d.dt_rule = FSDEM_DEM_DT_GIC;
+    d.dt_rule = FSDEM_DEM_DT_RULE_GIC;
     ck_assert_int_eq(rule_dt(d, radii, steel, 4, &dt), FSDEM_OK);
     best = HUGE_VAL;
     for (i = 0; i < 4; ++i) {

@@ -41,32 +41,32 @@ START_TEST(test_drag_by_hand) {
         fsdem_drag_law law;
         double eps, d, slip, rho, mu, c;
     } pt[] = {
-        {FSDEM_DRAG_STOKES, 0.5, 1e-3, 0.01, 1000, 1e-3, 18000.0},                    /* Re 10 */
-        {FSDEM_DRAG_STOKES, 1, 2e-3, 0, 1000, 1e-3, 4500.0},                          /* Re 0 */
-        {FSDEM_DRAG_STOKES, 0.3, 5e-4, 1, 1.2, 1.8e-5, 1296.0},                       /* Re 33, air */
-        {FSDEM_DRAG_SCHILLER_NAUMANN, 0.5, 1e-3, 1e-4, 1000, 1e-3, 18555.09046091572}, /* Re 0.1 */
-        {FSDEM_DRAG_SCHILLER_NAUMANN, 0.7, 1e-3, 0.01, 1000, 1e-3, 31132.99455366946}, /* Re 10 */
-        {FSDEM_DRAG_SCHILLER_NAUMANN, 1, 1e-3, 0.5, 1000, 1e-3, 210999.4881109174},    /* Re 500 */
-        {FSDEM_DRAG_SCHILLER_NAUMANN, 0.9, 1e-3, 2, 1000, 1e-3, 660000.0},             /* Re 2000, Cd 0.44 */
-        {FSDEM_DRAG_ERGUN_WEN_YU, 0.4, 1e-3, 0.01, 1000, 1e-3, 242500.0},              /* Ergun, Re 4 */
-        {FSDEM_DRAG_ERGUN_WEN_YU, 0.6, 1e-3, 0.5, 1000, 1e-3, 975000.0},               /* Ergun, Re 300 */
-        {FSDEM_DRAG_ERGUN_WEN_YU, 0.8, 1e-3, 0.01, 1000, 1e-3, 55000.0},               /* Ergun at the switch, Re 8 */
-        {FSDEM_DRAG_ERGUN_WEN_YU, 0.5, 2e-4, 0.3, 1.2, 1.8e-5, 70650.0},               /* Ergun, Re 2, air */
-        {FSDEM_DRAG_ERGUN_WEN_YU, 0.95, 1e-3, 1e-4, 1000, 1e-3, 21234.66595818474},    /* Wen-Yu, Re 0.095 */
-        {FSDEM_DRAG_ERGUN_WEN_YU, 0.9, 1e-3, 0.5, 1000, 1e-3, 261141.3389686217},      /* Wen-Yu, Re 450 */
-        {FSDEM_DRAG_ERGUN_WEN_YU, 0.99, 1e-3, 1.2, 1000, 1e-3, 402621.6412201916},     /* Wen-Yu, Re 1188, Cd 0.44 */
-        {FSDEM_DRAG_GIDASPOW, 0.4, 1e-3, 0.01, 1000, 1e-3, 242624.0801949256},         /* Re 4 */
-        {FSDEM_DRAG_GIDASPOW, 0.7, 1e-3, 0.1, 1000, 1e-3, 238506.2806930664},          /* Re 70 */
-        {FSDEM_DRAG_GIDASPOW, 0.8, 1e-3, 0.01, 1000, 1e-3, 53933.30025266872},         /* Re 8, phi = 1/2 */
-        {FSDEM_DRAG_GIDASPOW, 0.9, 1e-3, 0.5, 1000, 1e-3, 268783.4509735878},          /* Re 450 */
-        {FSDEM_DRAG_DI_FELICE, 0.4, 1e-3, 1e-4, 1000, 1e-3, 214094.5240637036},        /* Re 0.04 */
-        {FSDEM_DRAG_DI_FELICE, 0.75, 2e-4, 0.3, 1.2, 1.8e-5, 22797.3826430913},        /* Re 3, air */
-        {FSDEM_DRAG_DI_FELICE, 0.6, 1e-3, 0.05, 1000, 1e-3, 145500.835272926},         /* Re 30 */
-        {FSDEM_DRAG_DI_FELICE, 0.9, 1e-3, 0.5, 1000, 1e-3, 317503.2710881037},         /* Re 450 */
-        {FSDEM_DRAG_BEETSTRA, 0.4, 1e-3, 1e-4, 1000, 1e-3, 272490.5619576339},         /* Re 0.04 */
-        {FSDEM_DRAG_BEETSTRA, 0.75, 2e-4, 0.3, 1.2, 1.8e-5, 34465.57587356321},        /* Re 3, air */
-        {FSDEM_DRAG_BEETSTRA, 0.6, 1e-3, 0.05, 1000, 1e-3, 192660.1646375388},         /* Re 30 */
-        {FSDEM_DRAG_BEETSTRA, 0.9, 1e-3, 0.5, 1000, 1e-3, 403193.7123828798},          /* Re 450 */
+        {FSDEM_DRAG_LAW_STOKES, 0.5, 1e-3, 0.01, 1000, 1e-3, 18000.0},                    /* Re 10 */
+        {FSDEM_DRAG_LAW_STOKES, 1, 2e-3, 0, 1000, 1e-3, 4500.0},                          /* Re 0 */
+        {FSDEM_DRAG_LAW_STOKES, 0.3, 5e-4, 1, 1.2, 1.8e-5, 1296.0},                       /* Re 33, air */
+        {FSDEM_DRAG_LAW_SCHILLER_NAUMANN, 0.5, 1e-3, 1e-4, 1000, 1e-3, 18555.09046091572}, /* Re 0.1 */
+        {FSDEM_DRAG_LAW_SCHILLER_NAUMANN, 0.7, 1e-3, 0.01, 1000, 1e-3, 31132.99455366946}, /* Re 10 */
+        {FSDEM_DRAG_LAW_SCHILLER_NAUMANN, 1, 1e-3, 0.5, 1000, 1e-3, 210999.4881109174},    /* Re 500 */
+        {FSDEM_DRAG_LAW_SCHILLER_NAUMANN, 0.9, 1e-3, 2, 1000, 1e-3, 660000.0},             /* Re 2000, Cd 0.44 */
+        {FSDEM_DRAG_LAW_ERGUN_WEN_YU, 0.4, 1e-3, 0.01, 1000, 1e-3, 242500.0},              /* Ergun, Re 4 */
+        {FSDEM_DRAG_LAW_ERGUN_WEN_YU, 0.6, 1e-3, 0.5, 1000, 1e-3, 975000.0},               /* Ergun, Re 300 */
+        {FSDEM_DRAG_LAW_ERGUN_WEN_YU, 0.8, 1e-3, 0.01, 1000, 1e-3, 55000.0},               /* Ergun at the switch, Re 8 */
+        {FSDEM_DRAG_LAW_ERGUN_WEN_YU, 0.5, 2e-4, 0.3, 1.2, 1.8e-5, 70650.0},               /* Ergun, Re 2, air */
+        {FSDEM_DRAG_LAW_ERGUN_WEN_YU, 0.95, 1e-3, 1e-4, 1000, 1e-3, 21234.66595818474},    /* Wen-Yu, Re 0.095 */
+        {FSDEM_DRAG_LAW_ERGUN_WEN_YU, 0.9, 1e-3, 0.5, 1000, 1e-3, 261141.3389686217},      /* Wen-Yu, Re 450 */
+        {FSDEM_DRAG_LAW_ERGUN_WEN_YU, 0.99, 1e-3, 1.2, 1000, 1e-3, 402621.6412201916},     /* Wen-Yu, Re 1188, Cd 0.44 */
+        {FSDEM_DRAG_LAW_GIDASPOW, 0.4, 1e-3, 0.01, 1000, 1e-3, 242624.0801949256},         /* Re 4 */
+        {FSDEM_DRAG_LAW_GIDASPOW, 0.7, 1e-3, 0.1, 1000, 1e-3, 238506.2806930664},          /* Re 70 */
+        {FSDEM_DRAG_LAW_GIDASPOW, 0.8, 1e-3, 0.01, 1000, 1e-3, 53933.30025266872},         /* Re 8, phi = 1/2 */
+        {FSDEM_DRAG_LAW_GIDASPOW, 0.9, 1e-3, 0.5, 1000, 1e-3, 268783.4509735878},          /* Re 450 */
+        {FSDEM_DRAG_LAW_DI_FELICE, 0.4, 1e-3, 1e-4, 1000, 1e-3, 214094.5240637036},        /* Re 0.04 */
+        {FSDEM_DRAG_LAW_DI_FELICE, 0.75, 2e-4, 0.3, 1.2, 1.8e-5, 22797.3826430913},        /* Re 3, air */
+        {FSDEM_DRAG_LAW_DI_FELICE, 0.6, 1e-3, 0.05, 1000, 1e-3, 145500.835272926},         /* Re 30 */
+        {FSDEM_DRAG_LAW_DI_FELICE, 0.9, 1e-3, 0.5, 1000, 1e-3, 317503.2710881037},         /* Re 450 */
+        {FSDEM_DRAG_LAW_BEETSTRA, 0.4, 1e-3, 1e-4, 1000, 1e-3, 272490.5619576339},         /* Re 0.04 */
+        {FSDEM_DRAG_LAW_BEETSTRA, 0.75, 2e-4, 0.3, 1.2, 1.8e-5, 34465.57587356321},        /* Re 3, air */
+        {FSDEM_DRAG_LAW_BEETSTRA, 0.6, 1e-3, 0.05, 1000, 1e-3, 192660.1646375388},         /* Re 30 */
+        {FSDEM_DRAG_LAW_BEETSTRA, 0.9, 1e-3, 0.5, 1000, 1e-3, 403193.7123828798},          /* Re 450 */
     };
     /* rounding of the inputs to fsdem_real and of a few pow/exp calls, relative */
     const double tol = TOL(1e-12, 64);
@@ -88,10 +88,10 @@ START_TEST(test_drag_switch_at_0_8) {
        Just above 0.8: 0.8 + 1e-9 in double, one float step (0.8 + 1e-7) in float, where Wen-Yu changes by
        3e-7 relative, within the float tolerance. */
     const double above = TEST_FLOAT ? 0.8000001 : 0.800000001, below = TEST_FLOAT ? 0.7999999 : 0.799999999;
-    const double ergun = test_c(FSDEM_DRAG_ERGUN_WEN_YU, 0.8, 1e-3, 0.01, 1000, 1e-3);
-    const double wen_yu = test_c(FSDEM_DRAG_ERGUN_WEN_YU, above, 1e-3, 0.01, 1000, 1e-3);
-    const double g_below = test_c(FSDEM_DRAG_GIDASPOW, below, 1e-3, 0.01, 1000, 1e-3);
-    const double g_above = test_c(FSDEM_DRAG_GIDASPOW, above, 1e-3, 0.01, 1000, 1e-3);
+    const double ergun = test_c(FSDEM_DRAG_LAW_ERGUN_WEN_YU, 0.8, 1e-3, 0.01, 1000, 1e-3);
+    const double wen_yu = test_c(FSDEM_DRAG_LAW_ERGUN_WEN_YU, above, 1e-3, 0.01, 1000, 1e-3);
+    const double g_below = test_c(FSDEM_DRAG_LAW_GIDASPOW, below, 1e-3, 0.01, 1000, 1e-3);
+    const double g_above = test_c(FSDEM_DRAG_LAW_GIDASPOW, above, 1e-3, 0.01, 1000, 1e-3);
     const double g_jump = fabs(g_above - g_below) / g_below, step = (double)(fsdem_real)above - (double)(fsdem_real)below;
     ck_assert((fsdem_real)above > (fsdem_real)0.8 && (fsdem_real)below < (fsdem_real)0.8);
     /* by hand: Ergun 150 * 0.2 / 0.8 * 1e-3 / 1e-6 + 1.75 * 1000 * 0.01 / 1e-3 = 37500 + 17500; Wen-Yu at
@@ -108,14 +108,14 @@ END_TEST
 
 START_TEST(test_drag_limits) {
     /* eps = 1 and Re = 0: Stokes' 3 pi mu d for the laws that reduce to it. */
-    static const fsdem_drag_law exact[] = {FSDEM_DRAG_STOKES, FSDEM_DRAG_SCHILLER_NAUMANN, FSDEM_DRAG_ERGUN_WEN_YU,
-                                           FSDEM_DRAG_BEETSTRA};
-    static const fsdem_drag_law all[] = {FSDEM_DRAG_STOKES, FSDEM_DRAG_SCHILLER_NAUMANN, FSDEM_DRAG_ERGUN_WEN_YU,
-                                         FSDEM_DRAG_GIDASPOW, FSDEM_DRAG_DI_FELICE, FSDEM_DRAG_BEETSTRA};
+    static const fsdem_drag_law exact[] = {FSDEM_DRAG_LAW_STOKES, FSDEM_DRAG_LAW_SCHILLER_NAUMANN, FSDEM_DRAG_LAW_ERGUN_WEN_YU,
+                                           FSDEM_DRAG_LAW_BEETSTRA};
+    static const fsdem_drag_law all[] = {FSDEM_DRAG_LAW_STOKES, FSDEM_DRAG_LAW_SCHILLER_NAUMANN, FSDEM_DRAG_LAW_ERGUN_WEN_YU,
+                                         FSDEM_DRAG_LAW_GIDASPOW, FSDEM_DRAG_LAW_DI_FELICE, FSDEM_DRAG_LAW_BEETSTRA};
     /* the Ergun share of the blend at eps = 1 is 1/2 - atan(52.5) / pi = 0.606 %, and Ergun's c vanishes at eps = 1,
        Re = 0; Di Felice: 0.75 * 4.8^2 / 18 = 0.96 */
-    const double gidaspow = test_over_stokes(FSDEM_DRAG_GIDASPOW, 1, 1e-3, 0, 1000, 1e-3);
-    const double di_felice = test_over_stokes(FSDEM_DRAG_DI_FELICE, 1, 1e-3, 0, 1000, 1e-3);
+    const double gidaspow = test_over_stokes(FSDEM_DRAG_LAW_GIDASPOW, 1, 1e-3, 0, 1000, 1e-3);
+    const double di_felice = test_over_stokes(FSDEM_DRAG_LAW_DI_FELICE, 1, 1e-3, 0, 1000, 1e-3);
     size_t i;
     for (i = 0; i < sizeof exact / sizeof exact[0]; ++i) {
         const double r = test_over_stokes(exact[i], 1, 2e-3, 0, 1000, 1e-3);
@@ -140,13 +140,13 @@ END_TEST
 START_TEST(test_drag_monotone_in_slip) {
     static const double eps[] = {0.05, 0.4, 0.6, 0.8, 0.85, 0.95, 1};
     int law, e, k;
-    for (law = FSDEM_DRAG_STOKES; law <= FSDEM_DRAG_BEETSTRA; ++law)
+    for (law = FSDEM_DRAG_LAW_STOKES; law <= FSDEM_DRAG_LAW_BEETSTRA; ++law)
         for (e = 0; e < (int)(sizeof eps / sizeof eps[0]); ++e) {
             double prev = test_c((fsdem_drag_law)law, eps[e], 1e-3, 0, 1000, 1e-3);
             ck_assert_msg(prev > 0 && isfinite(prev), "%s eps %g: c %g at slip 0", fsdem_drag_law_name((fsdem_drag_law)law),
                           eps[e], prev);
             /* Di Felice's c dips below eps ~ 0.435 (checked below) */
-            if (law == FSDEM_DRAG_DI_FELICE && eps[e] < 0.5) continue;
+            if (law == FSDEM_DRAG_LAW_DI_FELICE && eps[e] < 0.5) continue;
             /* slip 1e-7 to 10 m/s, Re up to 1e4, 8 per decade */
             for (k = 0; k <= 64; ++k) {
                 const double slip = 1e-7 * pow(10, k / 8.0), c = test_c((fsdem_drag_law)law, eps[e], 1e-3, slip, 1000, 1e-3);
@@ -159,8 +159,8 @@ START_TEST(test_drag_monotone_in_slip) {
        than Cd0 slip grows: c (by hand) 218007.8985604854 at Re = 0.2, 215680.0852306065 at Re = 2; the force
        c V slip still grows tenfold */
     {
-        const double c1 = test_c(FSDEM_DRAG_DI_FELICE, 0.4, 1e-3, 5e-4, 1000, 1e-3);
-        const double c2 = test_c(FSDEM_DRAG_DI_FELICE, 0.4, 1e-3, 5e-3, 1000, 1e-3);
+        const double c1 = test_c(FSDEM_DRAG_LAW_DI_FELICE, 0.4, 1e-3, 5e-4, 1000, 1e-3);
+        const double c2 = test_c(FSDEM_DRAG_LAW_DI_FELICE, 0.4, 1e-3, 5e-3, 1000, 1e-3);
         ck_assert_msg(fabs(c1 - 218007.8985604854) <= TOL(1e-12, 64) * c1 && fabs(c2 - 215680.0852306065) <= TOL(1e-12, 64) * c2,
                       "Di Felice at eps 0.4: %.16g, %.16g", c1, c2);
         TEST_REPORT("Di Felice, eps 0.4: c %.10g at Re 0.2, %.10g at Re 2", c1, c2);
@@ -176,17 +176,17 @@ START_TEST(test_drag_bad_input) {
     } bad[] = {
         {99, 0.5, 1e-3, 0.01, 1000, 1e-3, "law"},
         {-1, 0.5, 1e-3, 0.01, 1000, 1e-3, "law"},
-        {FSDEM_DRAG_STOKES, 0, 1e-3, 0.01, 1000, 1e-3, "porosity"},
-        {FSDEM_DRAG_GIDASPOW, 1.5, 1e-3, 0.01, 1000, 1e-3, "porosity"},
-        {FSDEM_DRAG_BEETSTRA, NAN, 1e-3, 0.01, 1000, 1e-3, "porosity"},
-        {FSDEM_DRAG_DI_FELICE, 0.5, 0, 0.01, 1000, 1e-3, "diameter"},
-        {FSDEM_DRAG_ERGUN_WEN_YU, 0.5, -1e-3, 0.01, 1000, 1e-3, "diameter"},
-        {FSDEM_DRAG_ERGUN_WEN_YU, 0.5, INFINITY, 0.01, 1000, 1e-3, "diameter"},
-        {FSDEM_DRAG_SCHILLER_NAUMANN, 0.5, 1e-3, -0.01, 1000, 1e-3, "slip_speed"},
-        {FSDEM_DRAG_SCHILLER_NAUMANN, 0.5, 1e-3, NAN, 1000, 1e-3, "slip_speed"},
-        {FSDEM_DRAG_DI_FELICE, 0.5, 1e-3, 0.01, 0, 1e-3, "density"},
-        {FSDEM_DRAG_BEETSTRA, 0.5, 1e-3, 0.01, 1000, 0, "viscosity"},
-        {FSDEM_DRAG_BEETSTRA, 0.5, 1e-3, 0.01, 1000, INFINITY, "viscosity"},
+        {FSDEM_DRAG_LAW_STOKES, 0, 1e-3, 0.01, 1000, 1e-3, "porosity"},
+        {FSDEM_DRAG_LAW_GIDASPOW, 1.5, 1e-3, 0.01, 1000, 1e-3, "porosity"},
+        {FSDEM_DRAG_LAW_BEETSTRA, NAN, 1e-3, 0.01, 1000, 1e-3, "porosity"},
+        {FSDEM_DRAG_LAW_DI_FELICE, 0.5, 0, 0.01, 1000, 1e-3, "diameter"},
+        {FSDEM_DRAG_LAW_ERGUN_WEN_YU, 0.5, -1e-3, 0.01, 1000, 1e-3, "diameter"},
+        {FSDEM_DRAG_LAW_ERGUN_WEN_YU, 0.5, INFINITY, 0.01, 1000, 1e-3, "diameter"},
+        {FSDEM_DRAG_LAW_SCHILLER_NAUMANN, 0.5, 1e-3, -0.01, 1000, 1e-3, "slip_speed"},
+        {FSDEM_DRAG_LAW_SCHILLER_NAUMANN, 0.5, 1e-3, NAN, 1000, 1e-3, "slip_speed"},
+        {FSDEM_DRAG_LAW_DI_FELICE, 0.5, 1e-3, 0.01, 0, 1e-3, "density"},
+        {FSDEM_DRAG_LAW_BEETSTRA, 0.5, 1e-3, 0.01, 1000, 0, "viscosity"},
+        {FSDEM_DRAG_LAW_BEETSTRA, 0.5, 1e-3, 0.01, 1000, INFINITY, "viscosity"},
     };
     size_t i;
     for (i = 0; i < sizeof bad / sizeof bad[0]; ++i) {
@@ -207,7 +207,7 @@ START_TEST(test_drag_bad_input) {
         /* valid but so small a sphere that 18 mu / d^2 overflows */
         fsdem_real c = -7, beta = -7;
         char msg[256] = "";
-        ck_assert_int_eq(fsdem_drag_coefficient(FSDEM_DRAG_STOKES, 0.5, (fsdem_real)(TEST_FLOAT ? 1e-30 : 1e-200), 0, 1000,
+        ck_assert_int_eq(fsdem_drag_coefficient(FSDEM_DRAG_LAW_STOKES, 0.5, (fsdem_real)(TEST_FLOAT ? 1e-30 : 1e-200), 0, 1000,
                                                 (fsdem_real)1e-3, &c, &beta, msg, sizeof msg),
                          FSDEM_ERR_NAN);
         ck_assert(c == -7 && beta == -7 && strstr(msg, "not finite"));
@@ -215,7 +215,7 @@ START_TEST(test_drag_bad_input) {
     /* NULL outputs are allowed; beta is 0 at eps = 1 where c is finite */
     {
         fsdem_real beta = -7;
-        ck_assert_int_eq(fsdem_drag_coefficient(FSDEM_DRAG_GIDASPOW, 1, (fsdem_real)1e-3, 0, 1000, (fsdem_real)1e-3, NULL, &beta,
+        ck_assert_int_eq(fsdem_drag_coefficient(FSDEM_DRAG_LAW_GIDASPOW, 1, (fsdem_real)1e-3, 0, 1000, (fsdem_real)1e-3, NULL, &beta,
                                                 NULL, 0),
                          FSDEM_OK);
         ck_assert(beta == 0);
@@ -226,7 +226,7 @@ END_TEST
 START_TEST(test_drag_names) {
     static const char *const expected[] = {"stokes", "schiller_naumann", "ergun_wen_yu", "gidaspow", "di_felice", "beetstra"};
     int law, other;
-    for (law = FSDEM_DRAG_STOKES; law <= FSDEM_DRAG_BEETSTRA; ++law) {
+    for (law = FSDEM_DRAG_LAW_STOKES; law <= FSDEM_DRAG_LAW_BEETSTRA; ++law) {
         ck_assert_str_eq(fsdem_drag_law_name((fsdem_drag_law)law), expected[law]);
         for (other = 0; other < law; ++other)
             ck_assert_str_ne(fsdem_drag_law_name((fsdem_drag_law)law), fsdem_drag_law_name((fsdem_drag_law)other));

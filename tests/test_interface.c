@@ -777,9 +777,9 @@ START_TEST(null_objects_are_refused) {
         IF_ZERO(&p, "fsdem_dem_get_stats(NULL)", st.steps + st.time + st.dt + st.contacts + (double)st.memory_bytes);
         IF_TRUE(&p, "fsdem_dem_contacts(NULL, NULL, 0)", fsdem_dem_contacts(NULL, NULL, 0) == FSDEM_ERR_INVALID_ARG);
         IF_REFUSED(&p, fsdem_dem_write_csv(NULL, "build/never_null.csv"));
-        IF_REFUSED(&p, fsdem_dem_write_vtp(NULL, "build/never_null.vtp", FSDEM_VTK_ASCII));
-        IF_REFUSED(&p, fsdem_dem_write_walls_vtp(NULL, "build/never_null.vtp", FSDEM_VTK_ASCII));
-        IF_REFUSED(&p, fsdem_dem_write_contacts_vtp(NULL, "build/never_null.vtp", FSDEM_VTK_ASCII));
+        IF_REFUSED(&p, fsdem_dem_write_vtp(NULL, "build/never_null.vtp", FSDEM_VTK_FORMAT_ASCII));
+        IF_REFUSED(&p, fsdem_dem_write_walls_vtp(NULL, "build/never_null.vtp", FSDEM_VTK_FORMAT_ASCII));
+        IF_REFUSED(&p, fsdem_dem_write_contacts_vtp(NULL, "build/never_null.vtp", FSDEM_VTK_FORMAT_ASCII));
         IF_REFUSED(&p, fsdem_dem_save(NULL, "build/never_null.rst"));
         IF_REFUSED(&p, fsdem_dem_restore(NULL, "build/never_null.rst"));
         IF_REFUSED(&p, fsdem_dem_save_memory(NULL, NULL, 0, NULL));
@@ -858,7 +858,7 @@ START_TEST(null_objects_are_refused) {
         IF_REFUSED(&p, fsdem_pic_sample(NULL, 1, &v, &out));
         IF_REFUSED(&p, fsdem_pic_add_force(NULL, v, 0, v, &taken));
         IF_REFUSED(&p, fsdem_pic_clear_forces(NULL));
-        IF_REFUSED(&p, fsdem_pic_add_gauge(NULL, FSDEM_PIC_GAUGE_PRESSURE, v, 0, &idx));
+        IF_REFUSED(&p, fsdem_pic_add_gauge(NULL, FSDEM_PIC_GAUGE_KIND_PRESSURE, v, 0, &idx));
         IF_REFUSED(&p, fsdem_pic_gauge(NULL, 0, &dt));
         IF_REFUSED(&p, fsdem_pic_gauges_open(NULL, "build/never_null.csv", 0));
         IF_REFUSED(&p, fsdem_pic_gauges_close(NULL));
@@ -866,10 +866,10 @@ START_TEST(null_objects_are_refused) {
         st = fsdem_pic_get_stats(NULL);
         IF_ZERO(&p, "fsdem_pic_get_stats(NULL)", st.steps + st.time + st.particles + st.fluid_cells + (double)st.memory_bytes);
         IF_REFUSED(&p, fsdem_pic_write_particles_csv(NULL, "build/never_null.csv"));
-        IF_REFUSED(&p, fsdem_pic_write_particles_vtp(NULL, "build/never_null.vtp", FSDEM_VTK_ASCII));
+        IF_REFUSED(&p, fsdem_pic_write_particles_vtp(NULL, "build/never_null.vtp", FSDEM_VTK_FORMAT_ASCII));
         IF_REFUSED(&p, fsdem_pic_write_grid_csv(NULL, "build/never_null.csv"));
-        IF_REFUSED(&p, fsdem_pic_write_grid_vti(NULL, "build/never_null.vti", FSDEM_VTK_ASCII));
-        IF_REFUSED(&p, fsdem_pic_add_gauge(NULL, FSDEM_PIC_GAUGE_LEVEL, fsdem_v3(0, 0, 0), 0, NULL));
+        IF_REFUSED(&p, fsdem_pic_write_grid_vti(NULL, "build/never_null.vti", FSDEM_VTK_FORMAT_ASCII));
+        IF_REFUSED(&p, fsdem_pic_add_gauge(NULL, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(0, 0, 0), 0, NULL));
         IF_REFUSED(&p, fsdem_pic_gauges_open(NULL, "build/never_null.csv", 0));
         IF_REFUSED(&p, fsdem_pic_gauges_close(NULL));
         IF_REFUSED(&p, fsdem_pic_save(NULL, "build/never_null.rst"));
@@ -945,7 +945,7 @@ START_TEST(null_objects_are_refused) {
         st = fsdem_swe_get_stats(NULL);
         IF_ZERO(&p, "fsdem_swe_get_stats(NULL)", st.steps + st.time + st.wet_cells + (double)st.memory_bytes);
         IF_REFUSED(&p, fsdem_swe_write_csv(NULL, "build/never_null.csv"));
-        IF_REFUSED(&p, fsdem_swe_write_vti(NULL, "build/never_null.vti", FSDEM_VTK_ASCII));
+        IF_REFUSED(&p, fsdem_swe_write_vti(NULL, "build/never_null.vti", FSDEM_VTK_FORMAT_ASCII));
         IF_REFUSED(&p, fsdem_swe_set_blocked(NULL, NULL));
         IF_REFUSED(&p, fsdem_swe_block_box(NULL, 0, 0, 1, 1));
         IF_REFUSED(&p, fsdem_swe_block_polygon(NULL, NULL, 0));

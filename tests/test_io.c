@@ -452,7 +452,7 @@ static void vtk_open(xdoc *d, const char *path, const char *type, int format, do
     ck_assert_int_eq(x_count(d, type), 1);
     ck_assert_int_eq(d->nodes[x_find(d, type, 0)].parent, root);
     ck_assert_int_eq(x_count(d, "Piece"), 1);
-    ck_assert_int_eq(x_count(d, "AppendedData"), format == FSDEM_VTK_APPENDED);
+    ck_assert_int_eq(x_count(d, "AppendedData"), format == FSDEM_VTK_FORMAT_APPENDED);
     for (k = 0; k < d->count; ++k)
         if (strcmp(d->nodes[k].name, "DataArray") == 0) ck_assert_str_eq(x_attr(d, k, "format"), FORMAT_NAME[format]);
     x_check_appended(d);
@@ -978,12 +978,12 @@ START_TEST(io_dem_contacts_other_laws_leave_the_object_unchanged) {
         fsdem_dem *dem = dem_pile(3, laws[l], 0.5, 5, 0.0118), *twin = dem_pile(3, laws[l], 0.5, 5, 0.0118);
         fsdem_dem_particles p, q;
         contacts_file c;
-        ck_assert_int_eq(fsdem_dem_write_contacts_vtp(dem, "build/test_io_contacts_law.vtp", FSDEM_VTK_APPENDED), FSDEM_OK);
-        contacts_read("build/test_io_contacts_law.vtp", FSDEM_VTK_APPENDED, fsdem_dem_time(dem), &c);
+        ck_assert_int_eq(fsdem_dem_write_contacts_vtp(dem, "build/test_io_contacts_law.vtp", FSDEM_VTK_FORMAT_APPENDED), FSDEM_OK);
+        contacts_read("build/test_io_contacts_law.vtp", FSDEM_VTK_FORMAT_APPENDED, fsdem_dem_time(dem), &c);
         check_contacts(dem, &c, 0, 1, 0); /* GIC's stiff walls have thrown the bottom layer off */
         contacts_free(&c);
-        ck_assert_int_eq(fsdem_dem_write_walls_vtp(dem, "build/test_io_walls_law.vtp", FSDEM_VTK_BASE64), FSDEM_OK);
-        ck_assert_int_eq(fsdem_dem_write_vtp(dem, "build/test_io_dem_law.vtp", FSDEM_VTK_ASCII), FSDEM_OK);
+        ck_assert_int_eq(fsdem_dem_write_walls_vtp(dem, "build/test_io_walls_law.vtp", FSDEM_VTK_FORMAT_BASE64), FSDEM_OK);
+        ck_assert_int_eq(fsdem_dem_write_vtp(dem, "build/test_io_dem_law.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_OK);
         for (k = 0; k < 50; ++k) {
             ck_assert_int_eq(fsdem_dem_step(dem), FSDEM_OK);
             ck_assert_int_eq(fsdem_dem_step(twin), FSDEM_OK);
@@ -1129,8 +1129,8 @@ static void check_mps(int dim) {
         EXPECT(&d, "Verts", "offsets", "Int32", 1, from_ramp(p.count, 1, 1), p.count);
         xdoc_free(&d);
     }
-    ck_assert_int_eq(fsdem_mps_write_vtp(NULL, "build/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_mps_write_vtp(mps, "build/no/such/dir/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_IO);
+    ck_assert_int_eq(fsdem_mps_write_vtp(NULL, "build/x.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_mps_write_vtp(mps, "build/no/such/dir/x.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_IO);
     ck_assert_ptr_nonnull(strstr(fsdem_mps_last_error(mps), "build/no/such/dir/x.vtp"));
     fsdem_mps_destroy(mps);
 }
@@ -1332,33 +1332,33 @@ START_TEST(io_writers_refuse_bad_arguments) {
     pd.domain_max = fsdem_v3(0.4, 0.4, 0);
     pd.cell_size = 0.1;
     ck_assert_int_eq(fsdem_pic_create(&pd, &pic), FSDEM_OK);
-    ck_assert_int_eq(fsdem_dem_write_vtp(NULL, "build/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_dem_write_walls_vtp(NULL, "build/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_dem_write_contacts_vtp(NULL, "build/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_pic_write_particles_vtp(NULL, "build/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_pic_write_grid_vti(NULL, "build/x.vti", FSDEM_VTK_ASCII), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_swe_write_vti(NULL, "build/x.vti", FSDEM_VTK_ASCII), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_dem_write_vtp(NULL, "build/x.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_dem_write_walls_vtp(NULL, "build/x.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_dem_write_contacts_vtp(NULL, "build/x.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_pic_write_particles_vtp(NULL, "build/x.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_pic_write_grid_vti(NULL, "build/x.vti", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_swe_write_vti(NULL, "build/x.vti", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_dem_write_csv(NULL, "build/x.csv"), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_dem_write_vtp(dem, NULL, FSDEM_VTK_ASCII), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_dem_write_vtp(dem, NULL, FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_INVALID_ARG);
     ck_assert_str_eq(fsdem_dem_last_error(dem), "fsdem_dem_write_vtp: path is NULL");
     ck_assert_int_eq(fsdem_dem_write_vtp(dem, "build/x.vtp", bad), FSDEM_ERR_INVALID_ARG);
     ck_assert_str_eq(fsdem_dem_last_error(dem), "fsdem_dem_write_vtp: format 3 is not a fsdem_vtk_format");
     ck_assert_int_eq(fsdem_dem_write_walls_vtp(dem, "build/x.vtp", (fsdem_vtk_format)-1), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_dem_write_contacts_vtp(dem, NULL, FSDEM_VTK_BASE64), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_dem_write_contacts_vtp(dem, NULL, FSDEM_VTK_FORMAT_BASE64), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_pic_write_particles_vtp(pic, "build/x.vtp", bad), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_pic_write_grid_vti(pic, NULL, FSDEM_VTK_ASCII), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_pic_write_grid_vti(pic, NULL, FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_swe_write_vti(swe, "build/x.vti", bad), FSDEM_ERR_INVALID_ARG);
     ck_assert_str_eq(fsdem_swe_last_error(swe), "fsdem_swe_write_vti: format 3 is not a fsdem_vtk_format");
-    ck_assert_int_eq(fsdem_dem_write_vtp(dem, "build/no/such/dir/x.vtp", FSDEM_VTK_APPENDED), FSDEM_ERR_IO);
+    ck_assert_int_eq(fsdem_dem_write_vtp(dem, "build/no/such/dir/x.vtp", FSDEM_VTK_FORMAT_APPENDED), FSDEM_ERR_IO);
     ck_assert_str_eq(fsdem_dem_last_error(dem), "fsdem_dem_write_vtp: cannot open 'build/no/such/dir/x.vtp' for writing");
-    ck_assert_int_eq(fsdem_dem_write_walls_vtp(dem, "build/no/such/dir/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_IO);
-    ck_assert_int_eq(fsdem_dem_write_contacts_vtp(dem, "build/no/such/dir/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_IO);
-    ck_assert_int_eq(fsdem_pic_write_particles_vtp(pic, "build/no/such/dir/x.vtp", FSDEM_VTK_ASCII), FSDEM_ERR_IO);
-    ck_assert_int_eq(fsdem_pic_write_grid_vti(pic, "build/no/such/dir/x.vti", FSDEM_VTK_ASCII), FSDEM_ERR_IO);
-    ck_assert_int_eq(fsdem_swe_write_vti(swe, "build/no/such/dir/x.vti", FSDEM_VTK_ASCII), FSDEM_ERR_IO);
+    ck_assert_int_eq(fsdem_dem_write_walls_vtp(dem, "build/no/such/dir/x.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_IO);
+    ck_assert_int_eq(fsdem_dem_write_contacts_vtp(dem, "build/no/such/dir/x.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_IO);
+    ck_assert_int_eq(fsdem_pic_write_particles_vtp(pic, "build/no/such/dir/x.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_IO);
+    ck_assert_int_eq(fsdem_pic_write_grid_vti(pic, "build/no/such/dir/x.vti", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_IO);
+    ck_assert_int_eq(fsdem_swe_write_vti(swe, "build/no/such/dir/x.vti", FSDEM_VTK_FORMAT_ASCII), FSDEM_ERR_IO);
     ck_assert_int_eq(fsdem_dem_write_csv(dem, "build/no/such/dir/x.csv"), FSDEM_ERR_IO);
     /* a success clears the message */
-    ck_assert_int_eq(fsdem_dem_write_vtp(dem, "build/test_io_ok.vtp", FSDEM_VTK_ASCII), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_write_vtp(dem, "build/test_io_ok.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_OK);
     ck_assert_str_eq(fsdem_dem_last_error(dem), "");
     fsdem_dem_destroy(dem);
     fsdem_swe_destroy(swe);

@@ -146,7 +146,7 @@ START_TEST(test_mps_operators_exact) {
             ck_assert_msg(worst_d < TOL(1e-9, 1e5), "dim %d model %d: divergence error %g", dim, model, worst_d);
             ck_assert_msg(worst_n < TOL(1e-10, 1e4) * st.n0, "dim %d: number density off n0 by %g", dim, worst_n);
             /* where the neighbourhood is cut (the block's corner, particle 0) only the corrected form is exact */
-            if (model == FSDEM_MPS_GRADIENT_CORRECTED)
+            if (model == FSDEM_MPS_GRADIENT_MODEL_CORRECTED)
                 ck_assert_msg(fabs(grad[0].x - 3) + fabs(grad[0].y + 2) < TOL(1e-9, 1e5), "dim %d: corner gradient error %g", dim,
                               fabs(grad[0].x - 3) + fabs(grad[0].y + 2));
             else
@@ -251,7 +251,7 @@ START_TEST(test_mps_still_water) {
     st = fsdem_mps_get_stats(m);
     for (i = 0; i < p.count; ++i) {
         double dx, dy, d, rx, ry, r;
-        if (p.kind[i] != FSDEM_MPS_FLUID) continue;
+        if (p.kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         dx = p.position[i].x - x0[i].x;
         dy = p.position[i].y - x0[i].y;
         d = sqrt(dx * dx + dy * dy);
@@ -323,8 +323,8 @@ START_TEST(test_mps_shifting_relaxes) {
                             (fsdem_real)((i / cells + 0.5 + 0.3 * (b - 0.5)) * r0), 0);
         }
         for (i = 0; i < cells; ++i) wall[i] = fsdem_v3((fsdem_real)((i + 0.5) * r0), (fsdem_real)(-0.5 * r0), 0);
-        ck_assert_int_eq(fsdem_mps_add_particles(m, FSDEM_MPS_FLUID, cells * cells, x, NULL), FSDEM_OK);
-        ck_assert_int_eq(fsdem_mps_add_particles(m, FSDEM_MPS_WALL, cells, wall, NULL), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_add_particles(m, FSDEM_MPS_KIND_FLUID, cells * cells, x, NULL), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_add_particles(m, FSDEM_MPS_KIND_WALL, cells, wall, NULL), FSDEM_OK);
         for (k = 0; k <= 20; ++k) {
             fsdem_mps_stats st;
             double s2 = 0, mx = 0;
@@ -335,7 +335,7 @@ START_TEST(test_mps_shifting_relaxes) {
             st = fsdem_mps_get_stats(m);
             for (i = 0; i < p.count; ++i) {
                 const double cx = p.position[i].x - cells * r0 / 2, cy = p.position[i].y - cells * r0 / 2;
-                if (p.kind[i] == FSDEM_MPS_FLUID && fabs(cx) < 6 * r0 && fabs(cy) < 6 * r0) {
+                if (p.kind[i] == FSDEM_MPS_KIND_FLUID && fabs(cx) < 6 * r0 && fabs(cy) < 6 * r0) {
                     const double e = p.number_density[i] / st.n0 - 1;
                     s2 += e * e;
                     if (fabs(e) > mx) mx = fabs(e);
@@ -403,16 +403,16 @@ START_TEST(test_mps_bad_input) {
     }
     p = fsdem_mps_get_particles(m);
     x = fsdem_v3(5, 0.1f, 0);
-    ck_assert_int_eq(fsdem_mps_add_particles(m, FSDEM_MPS_FLUID, 1, &x, NULL), FSDEM_ERR_OUT_OF_DOMAIN);
+    ck_assert_int_eq(fsdem_mps_add_particles(m, FSDEM_MPS_KIND_FLUID, 1, &x, NULL), FSDEM_ERR_OUT_OF_DOMAIN);
     x = fsdem_v3((fsdem_real)NAN, 0.1f, 0);
-    ck_assert_int_eq(fsdem_mps_add_particles(m, FSDEM_MPS_FLUID, 1, &x, NULL), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_mps_add_particles(m, FSDEM_MPS_KIND_FLUID, 1, &x, NULL), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_mps_add_particles(m, (fsdem_mps_kind)7, 1, &x, NULL), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_mps_get_particles(m).count, p.count);
     ck_assert_int_eq(fsdem_mps_fill_box(m, fsdem_v3(0, 0, 0), fsdem_v3(0.001f, 0.1f, 0), fsdem_v3(0, 0, 0), NULL),
                      FSDEM_ERR_INVALID_ARG);
 
     /* CFL (Eq. 37): a fast particle and a long step; nothing changes */
-    for (i = 0; i < p.count && p.kind[i] != FSDEM_MPS_FLUID; ++i) {
+    for (i = 0; i < p.count && p.kind[i] != FSDEM_MPS_KIND_FLUID; ++i) {
     }
     p.velocity[i] = fsdem_v3(1, 0, 0);
     ck_assert_int_eq(fsdem_mps_step_dt(m, 0.01f), FSDEM_ERR_CFL);
@@ -457,7 +457,7 @@ START_TEST(test_mps_null_policy) {
     ck_assert_int_eq(fsdem_mps_step_dt(NULL, 1e-3f), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_mps_advance(NULL, 1, &steps), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_mps_stable_dt(NULL, &dt), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_mps_add_particles(NULL, FSDEM_MPS_FLUID, 1, &v, NULL), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_mps_add_particles(NULL, FSDEM_MPS_KIND_FLUID, 1, &v, NULL), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_mps_fill_box(NULL, v, v, v, NULL), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_mps_add_box_walls(NULL, v, v, 0, NULL), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_mps_add_box_obstacle(NULL, v, v, NULL), FSDEM_ERR_INVALID_ARG);
@@ -487,8 +487,8 @@ START_TEST(test_mps_obstacle) {
     /* 10 x 4 lattice points in the box: the 4 rows are within the 5 layers, the skin is 2 10 + 2 2 */
     p = fsdem_mps_get_particles(o);
     for (i = 0; i < p.count; ++i) {
-        wall += p.kind[i] == FSDEM_MPS_WALL;
-        dummy += p.kind[i] == FSDEM_MPS_DUMMY;
+        wall += p.kind[i] == FSDEM_MPS_KIND_WALL;
+        dummy += p.kind[i] == FSDEM_MPS_KIND_DUMMY;
     }
     ck_assert_int_eq(wall, 24);
     ck_assert_int_eq(dummy, 16);
@@ -535,11 +535,11 @@ START_TEST(test_mps_probes) {
     ck_assert(level == d.domain_min.y);
 
     /* the same probes as gauges writing a series at every 25 ms */
-    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_LEVEL, fsdem_v3(0.03f, 0, 0), 0, &gauge[0]), FSDEM_OK);
-    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_PRESSURE, fsdem_v3(0.03f, 0.1f, 0), 0, &gauge[1]), FSDEM_OK);
-    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_PRESSURE, fsdem_v3(5, 0, 0), 0, NULL), FSDEM_ERR_OUT_OF_DOMAIN);
+    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_KIND_LEVEL, fsdem_v3(0.03f, 0, 0), 0, &gauge[0]), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_KIND_PRESSURE, fsdem_v3(0.03f, 0.1f, 0), 0, &gauge[1]), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_KIND_PRESSURE, fsdem_v3(5, 0, 0), 0, NULL), FSDEM_ERR_OUT_OF_DOMAIN);
     ck_assert_int_eq(fsdem_mps_gauges_open(m, "build/test_mps_gauges.csv", (fsdem_real)0.025), FSDEM_OK);
-    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_LEVEL, fsdem_v3(0.1f, 0, 0), 0, NULL), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_mps_add_gauge(m, FSDEM_MPS_GAUGE_KIND_LEVEL, fsdem_v3(0.1f, 0, 0), 0, NULL), FSDEM_ERR_INVALID_ARG);
 
     ck_assert_int_eq(fsdem_mps_advance(m, 0.1f, NULL), FSDEM_OK);
     ck_assert_int_eq(fsdem_mps_gauges_close(m), FSDEM_OK);

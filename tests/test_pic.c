@@ -535,9 +535,9 @@ START_TEST(output_files_are_written) {
     fsdem_pvd pvd;
     ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_write_particles_csv(s, "build/test_pic_particles.csv"), FSDEM_OK);
-    ck_assert_int_eq(fsdem_pic_write_particles_vtp(s, "build/test_pic_particles.vtp", FSDEM_VTK_ASCII), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_write_particles_vtp(s, "build/test_pic_particles.vtp", FSDEM_VTK_FORMAT_ASCII), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_write_grid_csv(s, "build/test_pic_grid.csv"), FSDEM_OK);
-    ck_assert_int_eq(fsdem_pic_write_grid_vti(s, "build/test_pic_grid.vti", FSDEM_VTK_BASE64), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_write_grid_vti(s, "build/test_pic_grid.vti", FSDEM_VTK_FORMAT_BASE64), FSDEM_OK);
     ck_assert_int_eq(fsdem_pvd_open(&pvd, "build/test_pic.pvd"), FSDEM_OK);
     ck_assert_int_eq(fsdem_pvd_add(&pvd, fsdem_pic_time(s), "test_pic_grid.vti"), FSDEM_OK);
     ck_assert_int_eq(fsdem_pvd_close(&pvd), FSDEM_OK);
@@ -546,7 +546,7 @@ START_TEST(output_files_are_written) {
     ck_assert(file_starts_with("build/test_pic_grid.csv", "i,j,k,x,y,z,type,p,phi,fraction,u,v,w\n"));
     ck_assert(file_starts_with("build/test_pic_grid.vti", "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\""));
     ck_assert(file_starts_with("build/test_pic.pvd", "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\""));
-    ck_assert_int_eq(fsdem_pic_write_grid_vti(s, "/nonexistent-dir/x.vti", FSDEM_VTK_APPENDED), FSDEM_ERR_IO);
+    ck_assert_int_eq(fsdem_pic_write_grid_vti(s, "/nonexistent-dir/x.vti", FSDEM_VTK_FORMAT_APPENDED), FSDEM_ERR_IO);
     fsdem_pic_destroy(s);
 }
 END_TEST

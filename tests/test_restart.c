@@ -986,18 +986,18 @@ START_TEST(pic_dem_continues_bit_exact) {
     pic_world a = pic_world_new(0), c = pic_world_new(1), f = pic_world_new(1);
     unsigned char *A, *B, *C, *F, *R;
     size_t na, nb, nc, nf, nr;
-    fsdem_pic_dem_body ba, bc;
+    fsdem_pic_dem_force ba, bc;
     ck_assert_int_eq(fsdem_pic_dem_advance(a.cpl, 0.03f, NULL), FSDEM_OK);
     A = save_pic_dem(a.cpl, &na);
     ck_assert_int_eq(fsdem_pic_dem_save(a.cpl, path), FSDEM_OK);
-    ck_assert_int_eq(fsdem_pic_dem_get_body(a.cpl, 1, &ba), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(a.cpl, 1, &ba), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_dem_advance(a.cpl, 0.03f, NULL), FSDEM_OK);
     B = save_pic_dem(a.cpl, &nb);
 
     ck_assert_int_eq(fsdem_pic_dem_restore_memory(c.cpl, A, na), FSDEM_OK);
     R = save_pic_dem(c.cpl, &nr);
     same_bytes(A, na, R, nr, "PIC-DEM save of the restored state");
-    ck_assert_int_eq(fsdem_pic_dem_get_body(c.cpl, 1, &bc), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(c.cpl, 1, &bc), FSDEM_OK);
     ck_assert(bc.pressure_force.y == ba.pressure_force.y && bc.volume == ba.volume);
     ck_assert_int_eq(fsdem_pic_dem_advance(c.cpl, 0.03f, NULL), FSDEM_OK);
     C = save_pic_dem(c.cpl, &nc);

@@ -282,8 +282,8 @@ START_TEST(pic_rounding_is_logged) {
     pd.log = capture;
     pd.log_user = &log;
     ck_assert_int_eq(fsdem_pic_create(&pd, &pic), FSDEM_OK);
-    ck_assert_int_eq(log.count[FSDEM_LOG_INFO], 2); /* x and y (1/0.03 = 33.3 cells) */
-    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_INFO], "rounded"));
+    ck_assert_int_eq(log.count[FSDEM_LOG_LEVEL_INFO], 2); /* x and y (1/0.03 = 33.3 cells) */
+    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_LEVEL_INFO], "rounded"));
     ck_assert(fabs(fsdem_pic_get_desc(pic).domain_max.x - 3.21) < 1e-5);
     fsdem_pic_destroy(pic);
 }
@@ -310,14 +310,14 @@ START_TEST(out_of_memory_at_creation_is_logged) {
     dd.log = sd.log = gd.log = pd.log = capture;
     dd.log_user = sd.log_user = gd.log_user = pd.log_user = &log;
     ck_assert_int_eq(fsdem_dem_create(&dd, &dem), FSDEM_ERR_OUT_OF_MEMORY);
-    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_ERROR], "fsdem_dem_create: out of memory"));
+    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_LEVEL_ERROR], "fsdem_dem_create: out of memory"));
     ck_assert_int_eq(fsdem_swe_create(&sd, &swe), FSDEM_ERR_OUT_OF_MEMORY);
-    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_ERROR], "fsdem_swe_create: out of memory"));
+    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_LEVEL_ERROR], "fsdem_swe_create: out of memory"));
     ck_assert_int_eq(fsdem_pcg_create(&gd, &pcg), FSDEM_ERR_OUT_OF_MEMORY);
-    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_ERROR], "fsdem_pcg_create: out of memory"));
+    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_LEVEL_ERROR], "fsdem_pcg_create: out of memory"));
     ck_assert_int_eq(fsdem_pic_create(&pd, &pic), FSDEM_ERR_OUT_OF_MEMORY);
-    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_ERROR], "fsdem_pic_create: out of memory"));
-    ck_assert(!dem && !swe && !pcg && !pic && log.count[FSDEM_LOG_ERROR] == 4);
+    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_LEVEL_ERROR], "fsdem_pic_create: out of memory"));
+    ck_assert(!dem && !swe && !pcg && !pic && log.count[FSDEM_LOG_LEVEL_ERROR] == 4);
 }
 END_TEST
 
@@ -347,11 +347,11 @@ START_TEST(dem_dt_above_the_estimate_is_warned) {
     ck_assert_int_eq(fsdem_dem_stable_dt(dem, &stable), FSDEM_OK);
     ck_assert_int_eq(fsdem_dem_set_dt(dem, 10 * stable), FSDEM_OK);
     ck_assert_int_eq(fsdem_dem_step(dem), FSDEM_OK);
-    ck_assert_int_eq(log.count[FSDEM_LOG_WARNING], 1);
-    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_WARNING], "stable dt"));
+    ck_assert_int_eq(log.count[FSDEM_LOG_LEVEL_WARNING], 1);
+    ck_assert_ptr_nonnull(strstr(log.last[FSDEM_LOG_LEVEL_WARNING], "stable dt"));
     ck_assert(fabs(fsdem_dem_get_stats(dem).dt_ratio - 10) < 1e-4);
     ck_assert_int_eq(fsdem_dem_step(dem), FSDEM_OK);
-    ck_assert_int_eq(log.count[FSDEM_LOG_WARNING], 1); /* once per change */
+    ck_assert_int_eq(log.count[FSDEM_LOG_LEVEL_WARNING], 1); /* once per change */
     /* 1e4 times the estimate: the sphere goes through the floor, and the error says why */
     ck_assert_int_eq(fsdem_dem_set_dt(dem, 1e4 * stable), FSDEM_OK);
     for (k = 0; k < 100 && res == FSDEM_OK; ++k) res = fsdem_dem_step(dem);
@@ -545,12 +545,12 @@ START_TEST(pic_gauges_in_still_water) {
     d.cell_size = (fsdem_real)(1.0 / 32);
     ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), fsdem_v3(1, 0.5, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
-    ck_assert_int_eq(fsdem_pic_add_gauge(s, FSDEM_PIC_GAUGE_LEVEL, fsdem_v3(0.3, 0, 0), 0, &lv), FSDEM_OK);
-    ck_assert_int_eq(fsdem_pic_add_gauge(s, FSDEM_PIC_GAUGE_PRESSURE, fsdem_v3(0.5, 0.25, 0), 0, &pp), FSDEM_OK);
-    ck_assert_int_eq(fsdem_pic_add_gauge(s, FSDEM_PIC_GAUGE_PRESSURE, fsdem_v3(0.5, 0.25, 0), (fsdem_real)0.08, &pa),
+    ck_assert_int_eq(fsdem_pic_add_gauge(s, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(0.3, 0, 0), 0, &lv), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_add_gauge(s, FSDEM_PIC_GAUGE_KIND_PRESSURE, fsdem_v3(0.5, 0.25, 0), 0, &pp), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_add_gauge(s, FSDEM_PIC_GAUGE_KIND_PRESSURE, fsdem_v3(0.5, 0.25, 0), (fsdem_real)0.08, &pa),
                      FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_add_gauge(s, (fsdem_pic_gauge_kind)7, fsdem_v3(0.5, 0.25, 0), 0, NULL), FSDEM_ERR_INVALID_ARG);
-    ck_assert_int_eq(fsdem_pic_add_gauge(s, FSDEM_PIC_GAUGE_LEVEL, fsdem_v3(2, 0.25, 0), 0, NULL), FSDEM_ERR_OUT_OF_DOMAIN);
+    ck_assert_int_eq(fsdem_pic_add_gauge(s, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(2, 0.25, 0), 0, NULL), FSDEM_ERR_OUT_OF_DOMAIN);
     ck_assert_int_eq(fsdem_pic_gauges_open(s, "build/test_pic_gauges.csv", 0.1), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_advance(s, 0.5, NULL), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_gauges_close(s), FSDEM_OK);

@@ -949,7 +949,7 @@ START_TEST(swe_sampling_and_output) {
     fclose(fp);
     ck_assert_int_eq(rows, 50);
     /* the VTK snapshot is read back completely in the io suite (tests/test_io.c) */
-    ck_assert_int_eq(fsdem_swe_write_vti(s, "build/test_swe_field.vti", FSDEM_VTK_ASCII), FSDEM_OK);
+    ck_assert_int_eq(fsdem_swe_write_vti(s, "build/test_swe_field.vti", FSDEM_VTK_FORMAT_ASCII), FSDEM_OK);
     fp = fopen("build/test_swe_field.vti", "r");
     ck_assert_ptr_nonnull(fp);
     rows = 0;

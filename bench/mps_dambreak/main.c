@@ -53,7 +53,7 @@ static double front(fsdem_mps *mps) {
     double x = -1e30;
     int i;
     for (i = 0; i < p.count; ++i)
-        if (p.kind[i] == FSDEM_MPS_FLUID && (double)p.position[i].x > x) x = (double)p.position[i].x;
+        if (p.kind[i] == FSDEM_MPS_KIND_FLUID && (double)p.position[i].x > x) x = (double)p.position[i].x;
     return x;
 }
 
@@ -63,7 +63,7 @@ static int outside_tank(fsdem_mps *mps, fsdem_vec3 lo, fsdem_vec3 hi) {
     int i, n = 0;
     for (i = 0; i < p.count; ++i) {
         fsdem_vec3 r = p.position[i];
-        if (p.kind[i] != FSDEM_MPS_FLUID) continue;
+        if (p.kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         if (r.x < lo.x || r.x > hi.x || r.y < lo.y) ++n;
         else if (p.dim == 2 ? 0 : (r.y > hi.y || r.z < lo.z)) ++n;
     }

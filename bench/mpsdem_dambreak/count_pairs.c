@@ -30,9 +30,9 @@ int main(void) {
                     int pb = g.items[b];
                     fsdem_vec3 x = fsdem_v3(p.position[pa].x - p.position[pb].x, p.position[pa].y - p.position[pb].y, p.position[pa].z - p.position[pb].z);
                     cand++;
-                    dd += p.kind[pa] == FSDEM_MPS_DUMMY && p.kind[pb] == FSDEM_MPS_DUMMY;
-                    fixed += p.kind[pa] != FSDEM_MPS_FLUID && p.kind[pb] != FSDEM_MPS_FLUID;
-                    kept += x.x * x.x + x.y * x.y + x.z * x.z < d.re * d.re && !(p.kind[pa] == FSDEM_MPS_DUMMY && p.kind[pb] == FSDEM_MPS_DUMMY);
+                    dd += p.kind[pa] == FSDEM_MPS_KIND_DUMMY && p.kind[pb] == FSDEM_MPS_KIND_DUMMY;
+                    fixed += p.kind[pa] != FSDEM_MPS_KIND_FLUID && p.kind[pb] != FSDEM_MPS_KIND_FLUID;
+                    kept += x.x * x.x + x.y * x.y + x.z * x.z < d.re * d.re && !(p.kind[pa] == FSDEM_MPS_KIND_DUMMY && p.kind[pb] == FSDEM_MPS_KIND_DUMMY);
                 }
             }
     }

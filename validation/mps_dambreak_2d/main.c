@@ -44,7 +44,7 @@ static void mb_measure(fsdem_mps *s, double r0, double *front, double *hcol) {
     *front = 0;
     *hcol = 0;
     for (i = 0; i < p.count; ++i) {
-        if (p.kind[i] != FSDEM_MPS_FLUID) continue;
+        if (p.kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         if (p.position[i].x + 0.5 * r0 > *front) *front = p.position[i].x + 0.5 * r0;
         if (p.position[i].x < r0 && p.position[i].y + 0.5 * r0 > *hcol) *hcol = p.position[i].y + 0.5 * r0;
     }
@@ -58,7 +58,7 @@ static double mb_inner_density(fsdem_mps *s, int *surface) {
     int i, k = 0;
     *surface = 0;
     for (i = 0; i < p.count; ++i) {
-        if (p.kind[i] != FSDEM_MPS_FLUID) continue;
+        if (p.kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         if (p.surface[i]) {
             (*surface)++;
             continue;

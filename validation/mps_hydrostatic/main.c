@@ -178,7 +178,7 @@ static outcome run(int dim, double r0, double width, double depth, double gamma,
     for (i = 0; i < p.count; ++i) {
         fsdem_vec3 a = p.position[i], b = start[i];
         double dx = a.x - b.x, dy = a.y - b.y, dz = a.z - b.z, dd = sqrt(dx * dx + dy * dy + dz * dz);
-        if (p.kind[i] != FSDEM_MPS_FLUID) continue;
+        if (p.kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         if (dd > o.max_disp) o.max_disp = dd;
         if ((up == 1 ? b.y : b.z) > depth - r0) { /* the top row */
             o.mean_top_sink += (up == 1 ? b.y - a.y : b.z - a.z);

@@ -101,7 +101,7 @@ static inline int sd_create(sd_case *c, double r0, fsdem_mps_model model, int se
         dd.domain_min = md.domain_min;
         dd.domain_max = md.domain_max;
         dd.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
-        dd.dt_rule = FSDEM_DEM_DT_RAYLEIGH;
+        dd.dt_rule = FSDEM_DEM_DT_RULE_RAYLEIGH;
         if ((r = fsdem_dem_create(&dd, &c->dem)) != FSDEM_OK) {
             snprintf(c->error, sizeof c->error, "fsdem_dem_create: %s", fsdem_result_string(r));
             sd_destroy(c);
@@ -149,7 +149,7 @@ static inline int sd_create(sd_case *c, double r0, fsdem_mps_model model, int se
             for (j = 0; j < ny; ++j)
                 for (i = 0; i < nx; ++i)
                     x[m++] = fsdem_v3((fsdem_real)((i + 0.5) * sx), (fsdem_real)((j + 0.5) * sy), (fsdem_real)((k + 0.5) * sz));
-        r = fsdem_mps_add_particles(c->mps, FSDEM_MPS_FLUID, n, x, NULL);
+        r = fsdem_mps_add_particles(c->mps, FSDEM_MPS_KIND_FLUID, n, x, NULL);
         free(x);
         if (r != FSDEM_OK) goto mps_error;
         c->fluid = n;
@@ -217,7 +217,7 @@ static inline sd_fronts sd_measure(const sd_case *c, double fraction) {
     memset(&f, 0, sizeof f);
     if (!v) return f;
     for (i = 0; i < mp.count; ++i)
-        if (mp.kind[i] == FSDEM_MPS_FLUID) v[n++] = (double)mp.position[i].x;
+        if (mp.kind[i] == FSDEM_MPS_KIND_FLUID) v[n++] = (double)mp.position[i].x;
     if (n > 0) {
         f.water_q = sd__kth_largest(v, n, (int)(fraction * n)) + c->r0 / 2;
         f.water_max = v[0] + c->r0 / 2;

@@ -103,7 +103,7 @@ int main(int argc, char **argv) {
     }
     top = z_bed0 + L + ABOVE * r0;
     fsdem_mps_add_box_walls(mps, fsdem_v3(0, 0, 0), fsdem_v3((fsdem_real)W, (fsdem_real)W, (fsdem_real)(top + 6 * r0)), 1u << FSDEM_SIDE_ZMAX, NULL);
-    if (fsdem_mps_add_particles(mps, FSDEM_MPS_FLUID, nf, pos, NULL) != FSDEM_OK) {
+    if (fsdem_mps_add_particles(mps, FSDEM_MPS_KIND_FLUID, nf, pos, NULL) != FSDEM_OK) {
         printf("%s\n", fsdem_mps_last_error(mps));
         return 1;
     }
@@ -127,7 +127,7 @@ int main(int argc, char **argv) {
     fsdem_dem_set_dt(dem, 1e-3f); /* fixed particles only: no contact to resolve */
     cd.mps = mps;
     cd.dem = dem;
-    cd.drag = FSDEM_DRAG_ERGUN_WEN_YU;
+    cd.drag = FSDEM_DRAG_LAW_ERGUN_WEN_YU;
     if (fsdem_mps_dem_create(&cd, &cpl) != FSDEM_OK) return 1;
     {
         const double Re = rho * U * d / mu, visc = 150 * mu * pow(1 - eps_pack, 2) * U / (pow(eps_pack, 3) * d * d),
@@ -179,7 +179,7 @@ int main(int argc, char **argv) {
                 for (i = 0; i < mv.count; ++i) {
                     const fsdem_vec3 x = mv.position[i];
                     const int core = x.x > re && x.x < W - re && x.y > re && x.y < W - re;
-                    if (mv.kind[i] != FSDEM_MPS_FLUID || x.z < zb + re || x.z > zb + L - re) continue;
+                    if (mv.kind[i] != FSDEM_MPS_KIND_FLUID || x.z < zb + re || x.z > zb + L - re) continue;
                     if (core) qc += r0 * r0 * r0 * mv.velocity[i].z;
                     else qw += r0 * r0 * r0 * mv.velocity[i].z;
                 }
@@ -225,7 +225,7 @@ int main(int argc, char **argv) {
             const fsdem_vec3 x = mv.position[i];
             const int s = (int)floor((x.z - zb - z0) / h);
             const int core = x.x > re && x.x < W - re && x.y > re && x.y < W - re;
-            if (mv.kind[i] != FSDEM_MPS_FLUID || s < 0 || s >= NS) continue;
+            if (mv.kind[i] != FSDEM_MPS_KIND_FLUID || s < 0 || s >= NS) continue;
             se[s] += mv.porosity[i], ne[s] += 1;
             if (core) sc[s] += mv.porosity[i], nc[s] += 1;
             if (core && x.z > zb + re && x.z < zb + L - re) ec += mv.porosity[i], n_core++;

@@ -44,7 +44,7 @@ static double water_front(fsdem_mps *s) {
     double m = tank_len;
     int i;
     for (i = 0; i < v.count; ++i)
-        if (v.kind[i] == FSDEM_MPS_FLUID && v.position[i].x < m) m = v.position[i].x;
+        if (v.kind[i] == FSDEM_MPS_KIND_FLUID && v.position[i].x < m) m = v.position[i].x;
     return m;
 }
 
@@ -131,7 +131,7 @@ static void run_case(int k, int cells, double t_end, outcome *o) {
                 for (i = 0; i < bx; ++i)
                     bed[nbed++] = fsdem_v3((fsdem_real)(x0 + (i + 0.5) * Lcol / bx), (fsdem_real)((j + 0.5) * W / by),
                                            (fsdem_real)((l + 0.5) * Hbed / bz));
-        if (nbed && fsdem_mps_add_particles(s, FSDEM_MPS_FLUID, nbed, bed, NULL) != FSDEM_OK) {
+        if (nbed && fsdem_mps_add_particles(s, FSDEM_MPS_KIND_FLUID, nbed, bed, NULL) != FSDEM_OK) {
             snprintf(o->error, sizeof o->error, "bed water: %.540s", fsdem_mps_last_error(s));
             o->failed = 1;
             goto done;

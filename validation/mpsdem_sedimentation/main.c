@@ -154,7 +154,7 @@ static outcome run(const setup *S, fsdem_mps_model model) {
 
     cd.mps = mps;
     cd.dem = dem;
-    cd.drag = FSDEM_DRAG_ERGUN_WEN_YU;
+    cd.drag = FSDEM_DRAG_LAW_ERGUN_WEN_YU;
     if (fsdem_mps_dem_create(&cd, &cpl) != FSDEM_OK) {
         o.failed = 1;
         snprintf(o.error, sizeof o.error, "fsdem_mps_dem_create failed");
@@ -239,7 +239,7 @@ static outcome run(const setup *S, fsdem_mps_model model) {
             const fsdem_mps_particles mv = fsdem_mps_get_particles(mps);
             double vmix = 0;
             for (i = 0; i < mv.count; ++i)
-                if (mv.kind[i] == FSDEM_MPS_FLUID) vmix += r0 * r0 * r0 / mv.porosity[i];
+                if (mv.kind[i] == FSDEM_MPS_KIND_FLUID) vmix += r0 * r0 * r0 / mv.porosity[i];
             if (k == 0) o.vmix_start = vmix;
             o.vmix_end = vmix;
         }

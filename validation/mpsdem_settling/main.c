@@ -179,7 +179,7 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
                 const double z = k < layers ? (k + 0.5) * r0 / eps0 : z_susp + (k - layers + 0.5) * r0;
                 pos[nf++] = fsdem_v3((fsdem_real)((i + 0.5) * r0), (fsdem_real)((j + 0.5) * r0), (fsdem_real)z);
             }
-    if (fsdem_mps_add_particles(mps, FSDEM_MPS_FLUID, nf, pos, NULL) != FSDEM_OK) {
+    if (fsdem_mps_add_particles(mps, FSDEM_MPS_KIND_FLUID, nf, pos, NULL) != FSDEM_OK) {
         snprintf(o.error, sizeof o.error, "%s", fsdem_mps_last_error(mps));
         o.failed = 1;
         goto done;
@@ -268,7 +268,7 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
                 const int s = (int)floor(x.z / r0), wall = x.x < x_lo || x.x > x_hi || x.y < x_lo || x.y > x_hi;
                 const double dw = fmin(fmin(x.x, W - x.x), fmin(x.y, W - x.y));
                 const int b = (int)floor(dw / (0.5 * r0));
-                if (mv.kind[i] != FSDEM_MPS_FLUID) continue;
+                if (mv.kind[i] != FSDEM_MPS_KIND_FLUID) continue;
                 if (x.z > Z_LO * r0 && x.z < Z_HI * r0) q += r0 * r0 * r0 * mv.velocity[i].z;
                 if (!win) continue;
                 if (s >= 0 && s < NZ) {
@@ -295,10 +295,10 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
             }
             for (i = 0; i < mv.count; ++i) {
                 const fsdem_vec3 x = mv.position[i];
-                if (mv.kind[i] == FSDEM_MPS_FLUID && x.z > Z_LO * r0 && x.z < Z_HI * r0 &&
+                if (mv.kind[i] == FSDEM_MPS_KIND_FLUID && x.z > Z_LO * r0 && x.z < Z_HI * r0 &&
                     (x.x < x_lo || x.x > x_hi || x.y < x_lo || x.y > x_hi))
                     uw += mv.velocity[i].z, mw++;
-                if (mv.kind[i] != FSDEM_MPS_FLUID || x.x < x_lo || x.x > x_hi || x.y < x_lo || x.y > x_hi || x.z < Z_LO * r0 ||
+                if (mv.kind[i] != FSDEM_MPS_KIND_FLUID || x.x < x_lo || x.x > x_hi || x.y < x_lo || x.y > x_hi || x.z < Z_LO * r0 ||
                     x.z > Z_HI * r0)
                     continue;
                 u += mv.velocity[i].z;
@@ -381,7 +381,7 @@ done:
 
 int main(int argc, char **argv) {
     static const double fractions[] = {0.1, 0.2, 0.3};
-    const fsdem_drag_law law = FSDEM_DRAG_ERGUN_WEN_YU;
+    const fsdem_drag_law law = FSDEM_DRAG_LAW_ERGUN_WEN_YU;
     const double ut = terminal(law), Re_t = rho * d * ut / mu(), n = rz_exponent(Re_t);
     int f, only = 0; /* default phi 0.1 alone (163 s CPU); --phi=all for the three (not timed) */
     for (f = 1; f < argc; ++f) {

@@ -44,11 +44,11 @@ static void snapshot(const wd_case *c, const char *tag, double t) {
     snprintf(path, sizeof path, "water_%s_%.2f.csv", tag, t);
     fsdem_pic_write_particles_csv(c->pic, path);
     snprintf(path, sizeof path, "water_%s_%.2f.vtp", tag, t);
-    fsdem_pic_write_particles_vtp(c->pic, path, FSDEM_VTK_APPENDED);
+    fsdem_pic_write_particles_vtp(c->pic, path, FSDEM_VTK_FORMAT_APPENDED);
     snprintf(path, sizeof path, "cylinders_%s_%.2f.csv", tag, t);
     fsdem_dem_write_csv(c->dem, path);
     snprintf(path, sizeof path, "cylinders_%s_%.2f.vtp", tag, t);
-    fsdem_dem_write_vtp(c->dem, path, FSDEM_VTK_APPENDED);
+    fsdem_dem_write_vtp(c->dem, path, FSDEM_VTK_FORMAT_APPENDED);
 }
 
 static void run(double dx, int layers, double beta, double t_end, result *res) {

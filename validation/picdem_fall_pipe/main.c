@@ -261,13 +261,13 @@ static int run(const options *o, int perforated, result *r, FILE *cyl_csv, FILE 
         fsdem_pic_fill_box(pic, fsdem_v3(0, 0, 0), fsdem_v3(tank_w, depth, 0), fsdem_v3(0, 0, 0), NULL);
         /* level gauges: the pipe's axis, 10 cm either side (clear of the funnel above), and every
            cell column inside the pipe */
-        fsdem_pic_add_gauge(pic, FSDEM_PIC_GAUGE_LEVEL, fsdem_v3(xc, pipe_bottom + 0.01, 0), 0, &gauge[0]);
-        fsdem_pic_add_gauge(pic, FSDEM_PIC_GAUGE_LEVEL, fsdem_v3(xc - 0.10, 0.01, 0), 0, &gauge[1]);
-        fsdem_pic_add_gauge(pic, FSDEM_PIC_GAUGE_LEVEL, fsdem_v3(xc + 0.10, 0.01, 0), 0, &gauge[2]);
+        fsdem_pic_add_gauge(pic, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(xc, pipe_bottom + 0.01, 0), 0, &gauge[0]);
+        fsdem_pic_add_gauge(pic, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(xc - 0.10, 0.01, 0), 0, &gauge[1]);
+        fsdem_pic_add_gauge(pic, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(xc + 0.10, 0.01, 0), 0, &gauge[2]);
         for (k = 0;; ++k) {
             const double x = (floor((xc - pipe_w / 2) / dx + 1e-9) + k + 0.5) * dx;
             if (x > xc + pipe_w / 2 || n_in == MAX_COLUMNS) break;
-            fsdem_pic_add_gauge(pic, FSDEM_PIC_GAUGE_LEVEL, fsdem_v3(x, pipe_bottom + 0.01, 0), 0, &gauge[3 + n_in]);
+            fsdem_pic_add_gauge(pic, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(x, pipe_bottom + 0.01, 0), 0, &gauge[3 + n_in]);
             n_in++;
         }
 

@@ -176,7 +176,7 @@ static outcome run(const setup *S) {
     fsdem_csv_open(&csv, path, "t,height,w,pressure_force,viscous_force,faces_volume,particle_volume");
     for (k = 0; fsdem_pic_dem_time(cpl) < S->t_end - 1e-9; ++k) {
         fsdem_dem_particles P;
-        fsdem_pic_dem_body B;
+        fsdem_pic_dem_force B;
         fsdem_real row[7];
         double t_before = fsdem_pic_dem_time(cpl), t, dtk, h, vol;
         fsdem_result r = fsdem_pic_dem_step(cpl);
@@ -188,7 +188,7 @@ static outcome run(const setup *S) {
         t = fsdem_pic_dem_time(cpl);
         dtk = t - t_before;
         P = fsdem_dem_get_particles(dem);
-        fsdem_pic_dem_get_body(cpl, 0, &B);
+        fsdem_pic_dem_get_force(cpl, 0, &B);
         h = up(P.position[0], dim);
         vol = (double)fsdem_pic_get_stats(pic).particle_volume;
         if (fabs(vol / v0 - 1) > o.volume_drift) o.volume_drift = fabs(vol / v0 - 1);

@@ -171,7 +171,7 @@ int main(int argc, char **argv) {
     ns = 1;
     for (k = 0; fsdem_pic_dem_time(cpl) < t_end - 1e-9; ++k) {
         fsdem_dem_particles P;
-        fsdem_pic_dem_body B;
+        fsdem_pic_dem_force B;
         fsdem_pic_dem_stats cs;
         fsdem_real row[6];
         double t;
@@ -187,7 +187,7 @@ int main(int argc, char **argv) {
         }
         t = fsdem_pic_dem_time(cpl);
         P = fsdem_dem_get_particles(dem);
-        fsdem_pic_dem_get_body(cpl, 0, &B);
+        fsdem_pic_dem_get_force(cpl, 0, &B);
         cs = fsdem_pic_dem_get_stats(cpl);
         if (ns < MAX_SAMPLES) {
             st[ns] = t;
