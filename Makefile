@@ -20,7 +20,7 @@ EXAMPLES   := $(patsubst examples/%.c,$(BUILD)/examples/%,$(wildcard examples/*.
 VALIDATION := $(patsubst validation/%/main.c,%,$(wildcard validation/*/main.c))
 BENCHES    := $(patsubst bench/%/main.c,%,$(wildcard bench/*/main.c))
 
-.PHONY: all help test check-deps gnuplot-deps compile-checks map-check determinism valgrind sanitize examples demo validate bench install clean
+.PHONY: all help test check-deps gnuplot-deps compile-checks map-check determinism valgrind sanitize examples demo bench install clean
 
 all: $(BUILD)/check_fsdem examples
 
@@ -32,8 +32,13 @@ help:
 	@echo "make sanitize   the suite with AddressSanitizer and UndefinedBehaviorSanitizer"
 	@echo "make demo       the headline example (cylinder-layer collapse) in under a minute"
 	@echo "make examples   all examples"
-	@echo "make validate   every validation case; report and plots in build/validation/REPORT.md"
+	@echo "make validate   the default tier of validation (within 20 min with -j2): every case at a resolution"
+	@echo "                 that fits; build/validation/REPORT.md and validation/REPORT-default.md"
 	@echo "                 (installs gnuplot-nox with apt-get when missing and run as root)"
+	@echo "make validate-full  the full tier (the seeds' resolutions, fine runs: hours): build/validation-full/"
+	@echo "                 REPORT.md and validation/REPORT-full.md; CASES=\"a b\" runs some cases (either tier)"
+	@echo "make validate-status  which cases of the committed reports are stale (their code changed since)"
+	@echo "make validate-report  render validation/REPORT-default.md and REPORT-full.md again from their records"
 	@echo "make bench      throughput benchmarks (BENCH lines); BENCH_FLAGS=-march=native for this CPU"
 	@echo "make install    fsdem.h, pkg-config file, CMake package to PREFIX (/usr/local); DESTDIR stages"
 	@echo "make install-check  install to a temporary prefix, build via pkg-config and CMake, run"
@@ -116,7 +121,7 @@ demo: $(BUILD)/examples/01_cylinder_collapse
 	cd $(BUILD)/examples && ./01_cylinder_collapse
 
 # gnuplot draws the validation plots. Install it when we can, otherwise say exactly how; the cases
-# still run without it and validation/report.sh says that the plots were not drawn.
+# still run without it and the report says that the plots were not drawn.
 gnuplot-deps:
 	@if ! command -v gnuplot >/dev/null 2>&1; then \
 	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
@@ -126,24 +131,73 @@ gnuplot-deps:
 	  else echo "gnuplot is missing; the report will have no plots; run: sudo apt-get install -y gnuplot-nox"; fi; \
 	fi
 
-# The cases read their reference data from VALIDATION_DATA (passed as the first argument; compiled in
-# as the default, so build/validation/<case>/run works on its own).
-$(BUILD)/validation/%/run: validation/%/main.c validation/common.h validation/pic_dambreak.h validation/dambreak_protocol.h fsdem.h | $(BUILD)
+# ---- validation (validation/README.md) ----
+# The implementation is compiled once (build/validation/fsdem_impl.o); each case's main.c includes
+# fsdem.h without FSDEM_IMPLEMENTATION and links against it. The cases read their reference data from
+# VALIDATION_DATA (passed as the first argument; compiled in as the default, so
+# build/validation/<case>/run works on its own).
+VALIDATION_HEADERS := validation/common.h validation/pic_dambreak.h validation/dambreak_protocol.h \
+                      $(wildcard validation/*/case.h)
+$(BUILD)/validation/fsdem_impl.o: validation/fsdem_impl.c fsdem.h | $(BUILD)
+	$(CC) $(STD) $(WARN) -O2 -I. -c $< -o $@
+
+$(BUILD)/validation/%/main.o: validation/%/main.c $(VALIDATION_HEADERS) fsdem.h | $(BUILD)
 	@mkdir -p $(dir $@)
-	$(CC) $(STD) $(WARN) -O2 -I. -Ivalidation -DVC_DATA_DIR='"$(abspath $(VALIDATION_DATA))"' $< -o $@ $(LDLIBS)
+	$(CC) $(STD) $(WARN) -O2 -I. -Ivalidation -DVC_DATA_DIR='"$(abspath $(VALIDATION_DATA))"' -c $< -o $@
 
-# the MPS-DEM dam break's case is shared by its validation case and its bench
-$(BUILD)/validation/mpsdem_dambreak/run $(BUILD)/bench/mpsdem_dambreak: validation/mpsdem_dambreak/case.h
-# the PIC-DEM cylinder dam break's case is shared by its validation case and its bench
-$(BUILD)/validation/picdem_cylinder_dambreak/run $(BUILD)/bench/picdem_dambreak: validation/picdem_cylinder_dambreak/case.h
+$(BUILD)/validation/%/run: $(BUILD)/validation/%/main.o $(BUILD)/validation/fsdem_impl.o
+	$(CC) $^ -o $@ $(LDLIBS)
 
-validate: SHELL := /bin/bash
-validate: $(foreach v,$(VALIDATION),$(BUILD)/validation/$(v)/run) | gnuplot-deps
-	@status=0; for v in $(VALIDATION); do \
-	  echo "== validation/$$v"; \
-	  (cd $(BUILD)/validation/$$v && ./run $(abspath $(VALIDATION_DATA))) | tee $(BUILD)/validation/$$v/checks.txt; \
-	  [ $${PIPESTATUS[0]} -eq 0 ] || status=1; \
-	done; sh validation/report.sh $(BUILD)/validation; exit $$status
+.PRECIOUS: $(BUILD)/validation/%/main.o
+
+# `make validate` runs the default tier, `make validate-full` the full one; CASES="a b" names some
+# cases. One make target per case, longest first (by the last recorded run), so `make -j2 validate`
+# runs two at a time. Each case's output goes to build/validation[-full]/<case>/ and its record to
+# validation/report-<tier>/<case>/; then both reports are written. The status is non-zero when a
+# case failed (a CHECK FAIL or a crash), after the reports are written.
+CASES ?= $(VALIDATION)
+VALIDATE_ORDER_default = $(shell sh validation/tiers.sh order default $(CASES))
+VALIDATE_ORDER_full = $(shell sh validation/tiers.sh order full $(CASES))
+VALIDATE_RUNS_default = $(addprefix validate-run-default/,$(VALIDATE_ORDER_default))
+VALIDATE_RUNS_full = $(addprefix validate-run-full/,$(VALIDATE_ORDER_full))
+VALIDATE_OUT_default := $(BUILD)/validation
+VALIDATE_OUT_full := $(BUILD)/validation-full
+
+.PHONY: validate validate-full validate-runs-default validate-runs-full validate-report validate-status
+validate-runs-default: $(VALIDATE_RUNS_default)
+validate-runs-full: $(VALIDATE_RUNS_full)
+validate-run-default/%: $(BUILD)/validation/%/run FORCE
+	@sh validation/tiers.sh run default $* $(VALIDATE_OUT_default) $(abspath $(VALIDATION_DATA))
+validate-run-full/%: $(BUILD)/validation/%/run FORCE
+	@sh validation/tiers.sh run full $* $(VALIDATE_OUT_full) $(abspath $(VALIDATION_DATA))
+FORCE:
+
+validate validate-full: SHELL := /bin/bash
+validate validate-full: | $(BUILD) gnuplot-deps
+	@tier=$(if $(filter validate-full,$@),full,default); out=$(VALIDATE_OUT_$(if $(filter validate-full,$@),full,default)); \
+	cases="$(strip $(CASES))"; start=$$(date +%s); mkdir -p $$out; \
+	for c in $$cases; do [ -f validation/$$c/main.c ] || { echo "no validation case '$$c'"; exit 2; }; done; \
+	$(MAKE) --no-print-directory validate-runs-$$tier CASES="$$cases"; made=$$?; \
+	wall=$$(( $$(date +%s) - start )); \
+	if [ "$$cases" = "$(strip $(VALIDATION))" ] && [ $$made = 0 ]; then \
+	  echo "$$(date -u +%Y-%m-%d) on $$(git rev-parse --short HEAD 2>/dev/null || echo unknown), all $(words $(VALIDATION)) cases," \
+	    "make $(filter -j%,$(MAKEFLAGS)) on $$(nproc) cores: $$wall s of wall time, compilation included" \
+	    > validation/report-$$tier/run.txt; fi; \
+	sh validation/tiers.sh render $$tier $$out $$out/REPORT.md; \
+	$(MAKE) --no-print-directory validate-report; \
+	echo "validate ($$tier tier): $$(sh validation/tiers.sh verdict $$out $$cases)$${made:+}; total wall time $$wall s"; \
+	echo "report: $$out/REPORT.md, validation/REPORT-$$tier.md"; \
+	[ $$made = 0 ] && sh validation/tiers.sh verdict $$out $$cases >/dev/null
+
+# The committed reports, rendered again from their records (validation/report-<tier>/<case>/): after
+# a run, or to mark blocks stale after fsdem.h changed.
+validate-report:
+	@for t in default full; do mkdir -p validation/report-$$t; \
+	  sh validation/tiers.sh render $$t validation/report-$$t validation/REPORT-$$t.md report-$$t/; done
+
+# Which cases of the committed reports are stale: run on code that has changed since.
+validate-status:
+	@sh validation/tiers.sh status
 
 # Benchmarks are built for any x86-64 (SSE2) by default; BENCH_FLAGS=-march=native builds them for
 # this CPU (wider SIMD lanes in the DEM contact kernel). Rebuild with `make -B bench BENCH_FLAGS=...`.
@@ -151,6 +205,10 @@ BENCH_FLAGS ?=
 $(BUILD)/bench/%: bench/%/main.c fsdem.h | $(BUILD)
 	@mkdir -p $(dir $@)
 	$(CC) $(STD) $(WARN) -O3 -DNDEBUG $(BENCH_FLAGS) -I. $< -o $@ $(LDLIBS)
+
+# the MPS-DEM and PIC-DEM dam breaks' cases are shared by their validation cases and their benches
+$(BUILD)/bench/mpsdem_dambreak: validation/mpsdem_dambreak/case.h
+$(BUILD)/bench/picdem_dambreak: validation/picdem_cylinder_dambreak/case.h
 
 bench: $(foreach b,$(BENCHES),$(BUILD)/bench/$(b))
 	@for b in $(BENCHES); do echo "== bench/$$b"; (cd $(BUILD)/bench && ./$$b) || exit 1; done

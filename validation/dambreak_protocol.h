@@ -27,11 +27,11 @@ typedef struct db_series {
 } db_series;
 
 /* The column width of a run (m). */
-static double db_width(const db_series *s) { return s->a > 0 ? s->a : DB_A; }
+static inline double db_width(const db_series *s) { return s->a > 0 ? s->a : DB_A; }
 
 
 /* Linear interpolation of a series column at time t (clamped). */
-static double db_at(const db_series *s, const double *col, double t) {
+static inline double db_at(const db_series *s, const double *col, double t) {
     int lo = 0, hi = s->n - 1;
     if (s->n == 0) return NAN;
     if (t <= s->t[0]) return col[0];
@@ -63,7 +63,7 @@ typedef struct db_ref {
 } db_ref;
 
 /* Reads columns `cx`, `cy` of a reference CSV into x[], y[]; returns the row count or -1. */
-static int db_load_columns(const char *dir, const char *file, const char *cx, const char *cy, double *x, double *y) {
+static inline int db_load_columns(const char *dir, const char *file, const char *cx, const char *cy, double *x, double *y) {
     vc_table t;
     char path[512];
     int i, c0, c1, n = 0;
@@ -79,7 +79,7 @@ static int db_load_columns(const char *dir, const char *file, const char *cx, co
     return c0 >= 0 && c1 >= 0 && n > 0 ? n : -1;
 }
 
-static int db_load_front_table(const char *dir, const char *file, const char *tag, const char *name, db_front_table *f) {
+static inline int db_load_front_table(const char *dir, const char *file, const char *tag, const char *name, db_front_table *f) {
     memset(f, 0, sizeof *f);
     snprintf(f->tag, sizeof f->tag, "%s", tag);
     snprintf(f->name, sizeof f->name, "%s", name);
@@ -88,7 +88,7 @@ static int db_load_front_table(const char *dir, const char *file, const char *ta
 }
 
 /* The three tables from `dir` (validation/data by default: see common.h). */
-static int db_load_ref(const char *dir, db_ref *r) {
+static inline int db_load_ref(const char *dir, db_ref *r) {
     memset(r, 0, sizeof *r);
     if (db_load_front_table(dir, "martin_moyce_1952_front_n2_2_table_ocellaris.csv", "MM", "Martin & Moyce (1952)",
                             &r->mm) != 0 ||
@@ -100,7 +100,7 @@ static int db_load_ref(const char *dir, db_ref *r) {
 }
 
 /* Writes a front table in SI units (t in s, x_front in m) for a column `a` wide, for the plots. */
-static void db_write_front_table(const db_front_table *f, double a, const char *csv_name) {
+static inline void db_write_front_table(const db_front_table *f, double a, const char *csv_name) {
     fsdem_csv rf;
     int i;
     if (fsdem_csv_open(&rf, csv_name, "t,x_front") != FSDEM_OK) return;
@@ -114,7 +114,7 @@ static void db_write_front_table(const db_front_table *f, double a, const char *
 }
 
 /* ref_front.csv (Martin & Moyce) and ref_front_ko.csv (Koshizuka & Oka). */
-static void db_write_ref_front(const db_ref *r) {
+static inline void db_write_ref_front(const db_ref *r) {
     fsdem_csv c;
     int i;
     db_write_front_table(&r->mm, DB_A, "ref_front.csv");
@@ -131,14 +131,14 @@ static void db_write_ref_front(const db_ref *r) {
 
 /* Simulated time (s) long enough for both Martin & Moyce tables (the residual height runs to
    tau = 7.4). */
-static double db_end_time(const db_ref *r) {
+static inline double db_end_time(const db_ref *r) {
     double t = r->tau[r->ne - 1] * sqrt(DB_A / DB_G) + 0.01;
     if (r->mm.T[r->mm.n - 1] * sqrt(DB_A / (2 * DB_G)) > t) t = r->mm.T[r->mm.n - 1] * sqrt(DB_A / (2 * DB_G)) + 0.01;
     return t;
 }
 
 /* Writes run `s` delayed by dT (in T) as `csv_name` (t,x_front in s, m), for the plots. */
-static void db_write_shifted(const db_series *s, double dT, const char *csv_name) {
+static inline void db_write_shifted(const db_series *s, double dT, const char *csv_name) {
     fsdem_csv c;
     int i;
     if (fsdem_csv_open(&c, csv_name, "t,x_front") != FSDEM_OK) return;
@@ -152,13 +152,13 @@ static void db_write_shifted(const db_series *s, double dT, const char *csv_name
 }
 
 /* Simulated Z at T (in the table's variables; clamped to the run: Z = 1 before the release). */
-static double db_Z(const db_series *s, double T) {
+static inline double db_Z(const db_series *s, double T) {
     return db_at(s, s->x, T * sqrt(db_width(s) / (2 * DB_G))) / db_width(s);
 }
 
 /* RMS of Z_sim(T - dT) - Z(T) over a front table: dT > 0 delays the simulation, i.e. dT is the delay
    of the experiment's front behind an instantaneous release. */
-static double db_rms_front(const db_series *s, const db_front_table *f, double dT) {
+static inline double db_rms_front(const db_series *s, const db_front_table *f, double dT) {
     double sum = 0;
     int i;
     for (i = 0; i < f->n; ++i) {
@@ -169,7 +169,7 @@ static double db_rms_front(const db_series *s, const db_front_table *f, double d
 }
 
 /* RMS of eta_sim(tau) - eta over the residual-height table entries up to the run's end. */
-static double db_rms_height(const db_series *s, const db_ref *r) {
+static inline double db_rms_height(const db_series *s, const db_ref *r) {
     double sum = 0, k = sqrt(db_width(s) / DB_G);
     int i, n = 0;
     for (i = 0; i < r->ne; ++i) {
@@ -209,7 +209,7 @@ typedef struct db_front_cmp {
 } db_front_cmp;
 
 /* Least-squares slope of y against x. */
-static double db_slope(const double *x, const double *y, int n) {
+static inline double db_slope(const double *x, const double *y, int n) {
     double mx = 0, my = 0, sxy = 0, sxx = 0;
     int i;
     for (i = 0; i < n; ++i) {
@@ -223,7 +223,7 @@ static double db_slope(const double *x, const double *y, int n) {
     return sxx > 0 ? sxy / sxx : NAN;
 }
 
-static db_front_cmp db_compare_front(const db_series *s, const db_front_table *f) {
+static inline db_front_cmp db_compare_front(const db_series *s, const db_front_table *f) {
     db_front_cmp c;
     double T[DB_MAX_TABLE], Zt[DB_MAX_TABLE], Zs[DB_MAX_TABLE];
     int i, k;
@@ -267,7 +267,7 @@ static db_front_cmp db_compare_front(const db_series *s, const db_front_table *f
 
 /* Prints the comparison of run `s` (named `run`, "" for none) with table `f`: as CHECK lines when
    `as_checks`, otherwise as one INFO line with the same figures and bounds. Returns the figures. */
-static db_front_cmp db_report_front(const char *case_name, const char *run, const db_series *s, const db_front_table *f,
+static inline db_front_cmp db_report_front(const char *case_name, const char *run, const db_series *s, const db_front_table *f,
                                     int as_checks) {
     db_front_cmp c = db_compare_front(s, f);
     char metric[128];

@@ -11,7 +11,7 @@
 /* Front and column height from the solver's own surface: the rightmost fluid cell of the bottom row
    (of the middle slice in 3D) plus the interface fraction of the ghost-fluid method, and the
    topmost fluid cell of the first column likewise. */
-static void db_measure(const fsdem_pic *s, double *front, double *hcol) {
+static inline void db_measure(const fsdem_pic *s, double *front, double *hcol) {
     fsdem_pic_fields g = fsdem_pic_get_fields(s);
     int up = g.dim - 1, i, j, nx = g.n[0], mid = g.dim == 3 ? g.n[1] / 2 : 0;
     int sx = 1, sup = up == 1 ? nx : nx * g.n[1], base = g.dim == 3 ? mid * nx : 0, nup = g.n[up];
@@ -46,7 +46,7 @@ static void db_measure(const fsdem_pic *s, double *front, double *hcol) {
 
 /* Runs the column collapse: n cells across a, width w (m; 3D only), until t_end, with or without
    the density projection. Writes `csv_name` (t,x_front,h_column) when not NULL. */
-static void db_run_opt(int dim, int n, double width, double t_end, const char *csv_name, int density_projection,
+static inline void db_run_opt(int dim, int n, double width, double t_end, const char *csv_name, int density_projection,
                        db_series *out) {
     fsdem_pic_desc d = fsdem_pic_desc_default(dim);
     fsdem_pic *s;
@@ -106,7 +106,7 @@ static void db_run_opt(int dim, int n, double width, double t_end, const char *c
     fsdem_pic_destroy(s);
 }
 
-static void db_run(int dim, int n, double width, double t_end, const char *csv_name, db_series *out) {
+static inline void db_run(int dim, int n, double width, double t_end, const char *csv_name, db_series *out) {
     db_run_opt(dim, n, width, t_end, csv_name, 1, out);
 }
 

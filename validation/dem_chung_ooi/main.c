@@ -1,8 +1,7 @@
 /* Chung & Ooi (2011) DEM benchmark, tests 1-4, with the Hertz-Mindlin law of fsdem.h.
-   Usage: run [DATA_DIR]   (validation/data by default; writes test1.csv .. test4.csv and ref_*.csv into
-   the working directory)
+   Usage: run [DATA_DIR] [--tier=default|full]   (validation/data by default; both tiers run the same
+   impacts; writes test1.csv .. test4.csv and ref_*.csv into the working directory)
    See README.md next to this file for the physics, the references, the metrics and the tolerances. */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -355,10 +354,13 @@ static void test_4(const material *m, const vc_table *ref) {
 }
 
 int main(int argc, char **argv) {
-    const char *refdir = vc_data_dir(argc, argv);
+    const char *refdir;
     char path[1024];
     vc_table params, hertz, curves, oblique_ref;
     material t1[2], t2[2], t3[2], t4[2];
+    vc_begin(CASE, argc, argv, NULL);
+    vc_tier("single impacts of tests 1-4, every tier");
+    refdir = vc_data_dir();
     if (vc_table_load(&params, vc_path(path, sizeof path, refdir, "chung_ooi2011_test_parameters.csv")) ||
         vc_table_load(&hertz, vc_path(path, sizeof path, refdir, "chung_ooi2011_tests1_2_hertz_analytic.csv")) ||
         vc_table_load(&curves, vc_path(path, sizeof path, refdir, "chung_ooi2011_test1_test2_curves.csv")) ||

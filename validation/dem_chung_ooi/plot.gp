@@ -1,4 +1,4 @@
-# Plots of the Chung & Ooi validation; run by validation/report.sh inside build/validation/dem_chung_ooi.
+# Plots of the Chung & Ooi validation; run by validation/tiers.sh inside build/validation/dem_chung_ooi.
 set datafile separator ','
 set key autotitle columnhead
 set terminal pngcairo size 1200,500 font ",11"

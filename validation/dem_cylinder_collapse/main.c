@@ -1,9 +1,9 @@
 /* Collapse of six layers of aluminium cylinders (seed 000 section 3.1, after Zhang et al. 2009), 2D,
    with the linear law of seed 000 (Table 1) and, as a second run, with Hertz-Mindlin.
-   Usage: run [DATA_DIR]   (no reference file is read: no digitised data exist, see README.md)
+   Usage: run [DATA_DIR] [--tier=default|full]   (no reference file is read: no digitised data exist,
+   see README.md; both tiers run the same)
    Writes mass_centre.csv, mass_centre_hertz.csv, energy.csv, energy_hertz.csv and particle snapshots
    particles_<t>.csv / particles_hertz_<t>.csv into the working directory. */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -206,8 +206,8 @@ static int run(fsdem_dem_law law, const char *tag, result *res) {
 
 int main(int argc, char **argv) {
     result lin, hertz;
-    (void)argc;
-    (void)argv;
+    vc_begin(CASE, argc, argv, NULL);
+    vc_tier("33 cylinders, 1 s, linear and Hertz, every tier");
     memset(&lin, 0, sizeof lin);
     memset(&hertz, 0, sizeof hertz);
     run(FSDEM_DEM_LAW_LINEAR, "linear", &lin);

@@ -1,4 +1,4 @@
-# Plots of the cylinder-layer collapse; run by validation/report.sh inside build/validation/dem_cylinder_collapse.
+# Plots of the cylinder-layer collapse; run by validation/tiers.sh inside build/validation/dem_cylinder_collapse.
 # No digitised experiment exists (seed 000 Fig. 7 is not available as data), so the two laws are
 # compared with each other and the snapshots show the deposit.
 set datafile separator ','

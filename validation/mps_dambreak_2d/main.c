@@ -1,8 +1,9 @@
 /* Collapse of a water column, MPS in 2D: the Martin & Moyce (1952) column n^2 = 2 (a = 0.05715 m,
    a x 2a, tank 8a long; checked) and the Koshizuka & Oka (1996) column (L = 0.146 m, L x 2L, tank
    4L long, as in their MPS paper; reported).
-   Usage: run [DATA_DIR [particles_across_a]]   (DATA_DIR: validation/data by default; 40 particles
-   across a by default; the same column at half that is reported as a convergence figure)
+   Usage: run [DATA_DIR] [--tier=default|full] [--cells=N]   (DATA_DIR: validation/data by default;
+   N particles across a: 40 in both tiers; the same column at N/2 is reported as a convergence
+   figure)
    Reads martin_moyce_1952_front_n2_2_table_ocellaris.csv,
    martin_moyce_1952_residual_height_n2_2_table_ocellaris.csv and koshizuka_oka_1996_front_pysph.csv.
    Writes front.csv (t,x_front,h_column in m) of the checked run, front_n<N>.csv (the coarser run),
@@ -12,7 +13,6 @@
    a = 0.05715 m, ref_front_ko_L.csv for L = 0.146 m, ref_height.csv) for the plots.
    The front is compared with the experiments by the protocol of dambreak_protocol.h
    (db_report_front), the one the PIC dam-break cases use. */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 #include "dambreak_protocol.h"
@@ -187,9 +187,13 @@ static db_series mm, mm_coarse, ko;
 int main(int argc, char **argv) {
     db_ref ref;
     mb_extra ex, ex_coarse, ex_ko;
-    const char *dir = vc_data_dir(argc, argv);
-    int n = argc > 2 ? atoi(argv[2]) : 40, i;
+    const char *dir;
+    int n, i;
     double t_end;
+    vc_begin(CASE, argc, argv, NULL);
+    n = vc_option_int("--cells", 40);
+    vc_tier("r0 = a/%d (and a/%d reported), Koshizuka & Oka column at L/%d", n, n / 2, n);
+    dir = vc_data_dir();
     char name[64];
     if (db_load_ref(dir, &ref) != 0) {
         vc_check(CASE, "reference_loaded", 0, 1, 0);

@@ -1,4 +1,4 @@
-# Plots of mps_dambreak_2d; run by validation/report.sh inside build/validation/mps_dambreak_2d.
+# Plots of mps_dambreak_2d; run by validation/tiers.sh inside build/validation/mps_dambreak_2d.
 set datafile separator ','
 set terminal pngcairo size 1500,500 font ",11"
 set grid

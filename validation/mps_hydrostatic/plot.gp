@@ -1,4 +1,4 @@
-# Plots of mps_hydrostatic; run by validation/report.sh inside build/validation/mps_hydrostatic.
+# Plots of mps_hydrostatic; run by validation/tiers.sh inside build/validation/mps_hydrostatic.
 set datafile separator ','
 set terminal pngcairo size 1200,500 font ",11"
 set grid

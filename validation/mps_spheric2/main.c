@@ -1,11 +1,11 @@
 /* SPHERIC benchmark test 2 (Kleefsman et al. 2005; MARIN experiment), MPS in 3D at a coarse spacing:
    a water column 1.228 m long, 1 m wide and 0.55 m deep at the right end of a tank 3.22 m x 1 m
    (open at the top, walls 1 m high) collapses onto a box 0.161 x 0.403 x 0.161 m.
-   Usage: run [DATA_DIR [tank_length_in_r0]]   (default 53: r0 = 3.22/53 = 0.0608 m)
+   Usage: run [DATA_DIR] [--tier=default|full] [--cells=N]   (N: the tank's length in r0; default
+   tier CELLS_DEFAULT, full tier 53: r0 = 3.22/53 = 0.0608 m)
    Reads spheric_test2_kleefsman2005_water_heights.csv and spheric_test2_kleefsman2005_pressures.csv.
    Writes heights.csv (t and the level at the four gauges, m), pressure.csv (t, P1 in Pa) and
    ref_heights.csv / ref_pressure.csv (the measured records, for the plots). */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -15,6 +15,7 @@
 #define MAX_SAMPLES 20000
 #define WET 0.02          /* m: a gauge is wetted when its level first exceeds this (refdata README) */
 #define P_IMPACT 1000.0   /* Pa: the first impact at P1 is the first time it exceeds this */
+#define CELLS_DEFAULT 53  /* the default tier's tank length in r0 (README.md, "Tiers") */
 
 static const double tank_len = 3.22, tank_w = 1.0, tank_h = 1.0, col_len = 1.228, col_h = 0.55;
 static const double gauge_x[NG] = {0.496, 0.992, 1.488, 2.638}; /* at y = 0.5, by position (README) */
@@ -85,16 +86,21 @@ static int load(const char *dir, const char *file, const char **cols, int ncols,
 }
 
 int main(int argc, char **argv) {
-    const char *dir = vc_data_dir(argc, argv);
+    const char *dir;
     const char *p_cols[1] = {"P1_Pa"};
-    int cells = argc > 2 ? atoi(argv[2]) : 53, k, i, nw, ny, nz, nx_col, id = -1, fluid = 0, solids = 0, failed = 0;
-    double r0 = tank_len / cells, W, Hcol, Lcol;
+    int cells, k, i, nw, ny, nz, nx_col, id = -1, fluid = 0, solids = 0, failed = 0;
+    double r0, W, Hcol, Lcol;
     fsdem_mps_desc d = fsdem_mps_desc_default(3);
     fsdem_mps *s = NULL;
     fsdem_mps_stats st;
     fsdem_csv hc, pc;
     char metric[96], err[800] = "";
     const fsdem_vec3 p1 = fsdem_v3(0.8245, 0.471, 0.021);
+    vc_begin(CASE, argc, argv, NULL);
+    cells = vc_option_int("--cells", vc_full() ? 53 : CELLS_DEFAULT);
+    r0 = tank_len / cells;
+    vc_tier("r0 = %.4f m (tank %d r0 long)", r0, cells);
+    dir = vc_data_dir();
     if (load(dir, "spheric_test2_kleefsman2005_water_heights.csv", gauge_col, NG, &ref_h) != 0 ||
         load(dir, "spheric_test2_kleefsman2005_pressures.csv", p_cols, 1, &ref_p) != 0) {
         vc_check(CASE, "reference_loaded", 0, 1, 0);

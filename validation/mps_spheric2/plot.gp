@@ -1,4 +1,4 @@
-# Plots of mps_spheric2; run by validation/report.sh inside build/validation/mps_spheric2.
+# Plots of mps_spheric2; run by validation/tiers.sh inside build/validation/mps_spheric2.
 set datafile separator ','
 set terminal pngcairo size 1400,800 font ",11"
 set grid

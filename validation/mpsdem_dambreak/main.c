@@ -3,13 +3,13 @@
    the same column of clear water. Geometry and solver settings: case.h; sources and choices:
    README.md.
 
-   Runs (each to T_END, fronts sampled every 0.005 s):
-     default   B at 0.003 and 0.0027 m, clear water at 0.003 m (about 19 min of CPU on one core,
-               the budget of `make validate`; README.md has the measured costs);
-     --all     also A at 0.003, 0.0027 and 0.002 m, clear water at 0.0027 m and B at 0.002 m;
-     --only <model> <r0>   one run (model A, B or W for clear water), for timing.
-   Usage: run [data_dir] [--all | --only B 0.002]   (data_dir is unused: this case has no
-   reference data; `make validate` passes it).
+   Runs (each to T_END, fronts sampled every 0.005 s; README.md has the measured costs):
+     --tier=default  the runs of default_runs below;
+     --tier=full     B and clear water at 0.003 and 0.0027 m, B at 0.002 m and A at all three
+                     (--all is the same);
+     --only M:R      one run (model M = A, B or W for clear water, r0 = R m), for timing.
+   Usage: run [data_dir] [--tier=default|full] [--only B:0.002]   (data_dir is unused: this case has
+   no reference data; `make validate` passes it).
 
    Output: fronts.csv (long form: run,model,r0,sediment,t,water_front,sediment_front,water_q,
    sediment_q), fronts_<run>.csv per run (t,water_front,sediment_front,water_q,sediment_q), CHECK
@@ -28,7 +28,6 @@
                                            the same for clear water, in [1, 5] (with T_END
                                            for a front that never gets there: a lower bound)                      */
 #define _POSIX_C_SOURCE 200809L
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 
 #include "common.h"
@@ -157,11 +156,11 @@ static run *find(run *runs, int n, char model, double r0) {
 
 /* Resolution checks of one model: every completed run against the finest completed one. */
 static void check_resolution(run *runs, int n, char model) {
-    static const double r0s[3] = {0.002, 0.0027, 0.003};
     run *fine = NULL;
     double t_win, travel_w, travel_s;
     int i, j;
-    for (i = 0; i < 3 && !fine; ++i) fine = find(runs, n, model, r0s[i]);
+    for (i = 0; i < n; ++i)
+        if (runs[i].model == model && runs[i].done && runs[i].completed && (!fine || runs[i].r0 < fine->r0)) fine = &runs[i];
     if (!fine) return;
     t_win = reach(fine, fine->water, 0.19);
     if (t_win < 0 || t_win > fine->t[fine->n - 1]) t_win = fine->t[fine->n - 1];
@@ -169,11 +168,11 @@ static void check_resolution(run *runs, int n, char model) {
     travel_s = at(fine, fine->sediment, t_win) - SD_COLUMN_X;
     vc_info(CASE, "model %c: finest run r0 = %.4f m; window 0..%.3f s; travel water %.4f m, sediment %.4f m", model, fine->r0, t_win,
             travel_w, travel_s);
-    for (i = 0; i < 3; ++i) {
-        run *r = find(runs, n, model, r0s[i]);
+    for (i = 0; i < n; ++i) {
+        run *r = &runs[i];
         double ew = 0, es = 0, ewq = 0, esq = 0;
         char metric[96];
-        if (!r || r == fine) continue;
+        if (r->model != model || !r->done || !r->completed || r == fine) continue;
         for (j = 0; j < fine->n && fine->t[j] <= t_win + 1e-9; ++j) {
             const double t = fine->t[j];
             ew = fmax(ew, fabs(at(r, r->water, t) - fine->water[j]));
@@ -191,29 +190,33 @@ static void check_resolution(run *runs, int n, char model) {
 }
 
 int main(int argc, char **argv) {
+    /* the tiers' runs (model, r0 in m); README.md, "Runs and cost" */
+    static const struct { char model; double r0; } default_runs[] = {{'B', 0.003}, {'W', 0.003}, {'B', 0.0027}},
+                                                     full_runs[] = {{'B', 0.003}, {'W', 0.003}, {'B', 0.0027}, {'A', 0.003},
+                                                                    {'A', 0.0027}, {'W', 0.0027}, {'B', 0.002}, {'A', 0.002}};
     run runs[MAX_RUNS];
-    int n = 0, i, all = 0;
+    int n = 0, i;
     double wall0 = now();
+    const char *only;
+    char list[256] = "";
     FILE *f;
     memset(runs, 0, sizeof runs);
-    if (argc > 2 && strcmp(argv[2], "--only") == 0 && argc > 4) {
-        runs[n].model = argv[3][0];
-        runs[n++].r0 = atof(argv[4]);
-    } else {
-        all = argc > 2 && strcmp(argv[2], "--all") == 0;
-        runs[n].model = 'B', runs[n++].r0 = 0.003;
-        runs[n].model = 'W', runs[n++].r0 = 0.003;
-        runs[n].model = 'B', runs[n++].r0 = 0.0027;
-        if (all) {
-            runs[n].model = 'A', runs[n++].r0 = 0.003;
-            runs[n].model = 'A', runs[n++].r0 = 0.0027;
-            runs[n].model = 'W', runs[n++].r0 = 0.0027;
-            runs[n].model = 'B', runs[n++].r0 = 0.002;
-            runs[n].model = 'A', runs[n++].r0 = 0.002;
+    vc_begin(CASE, argc, argv, "--all");
+    if ((only = vc_option("--only")) != NULL) {
+        runs[n].model = only[0];
+        runs[n++].r0 = only[0] && only[1] == ':' ? atof(only + 2) : 0;
+        if (!strchr("ABW", runs[0].model) || !(runs[0].r0 > 0)) {
+            fprintf(stderr, "--only takes model:r0, e.g. --only B:0.002\n");
+            return 2;
         }
-    }
-    vc_info(CASE, "%s: %d runs to t = %.2f s (Model A, B; W = clear water)",
-            all ? "--all" : argc > 2 && strcmp(argv[2], "--only") == 0 ? "--only" : "default set", n, T_END);
+    } else if (vc_full())
+        for (i = 0; i < (int)(sizeof full_runs / sizeof full_runs[0]); ++i) runs[n].model = full_runs[i].model, runs[n++].r0 = full_runs[i].r0;
+    else
+        for (i = 0; i < (int)(sizeof default_runs / sizeof default_runs[0]); ++i)
+            runs[n].model = default_runs[i].model, runs[n++].r0 = default_runs[i].r0;
+    for (i = 0; i < n; ++i)
+        snprintf(list + strlen(list), sizeof list - strlen(list), "%s%c %g", i ? ", " : "", runs[i].model, 1e3 * runs[i].r0);
+    vc_tier("r0 (mm): %s; to %.2f s", list, T_END);
     for (i = 0; i < n; ++i) {
         char name[64];
         run_name(&runs[i], name, sizeof name);
@@ -244,19 +247,17 @@ int main(int argc, char **argv) {
     }
     check_resolution(runs, n, 'B');
     check_resolution(runs, n, 'A');
-    {
-        static const double r0s[3] = {0.002, 0.0027, 0.003};
-        for (i = 0; i < 3; ++i) {
-            run *b = find(runs, n, 'B', r0s[i]), *w = find(runs, n, 'W', r0s[i]);
-            char metric[96];
-            double tb, tw;
-            if (!b || !w) continue;
-            tb = reach(b, b->water, 0.15);
-            tw = reach(w, w->water, 0.15);
-            vc_info(CASE, "r0 %.4f: water front at 0.15 m at t = %.4f s with sediment (B), %.4f s clear", r0s[i], tb, tw);
-            snprintf(metric, sizeof metric, "water_front_slowed_by_sediment_%.4f", r0s[i]);
-            vc_check(CASE, metric, tw > 0 ? (tb > 0 ? tb : T_END) / tw : NAN, 3, 2);
-        }
+    /* at every r0 with a clear-water run and a Model B run */
+    for (i = 0; i < n; ++i) {
+        run *w = &runs[i], *b = find(runs, n, 'B', w->r0);
+        char metric[96];
+        double tb, tw;
+        if (w->model != 'W' || !w->done || !w->completed || !b) continue;
+        tb = reach(b, b->water, 0.15);
+        tw = reach(w, w->water, 0.15);
+        vc_info(CASE, "r0 %.4f: water front at 0.15 m at t = %.4f s with sediment (B), %.4f s clear", w->r0, tb, tw);
+        snprintf(metric, sizeof metric, "water_front_slowed_by_sediment_%.4f", w->r0);
+        vc_check(CASE, metric, tw > 0 ? (tb > 0 ? tb : T_END) / tw : NAN, 3, 2);
     }
     vc_info(CASE, "total wall time %.0f s", now() - wall0);
     return vc_exit_code();

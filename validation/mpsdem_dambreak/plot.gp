@@ -1,4 +1,4 @@
-# Plots of mpsdem_dambreak; run by validation/report.sh inside build/validation/mpsdem_dambreak.
+# Plots of mpsdem_dambreak; run by validation/tiers.sh inside build/validation/mpsdem_dambreak.
 # Each run wrote fronts_<model>_<r0>.csv (t,water_front,sediment_front,water_q,sediment_q); runs that
 # were not made (the default set leaves some out, see README.md) are skipped.
 set datafile separator ','

@@ -1,6 +1,7 @@
 /* Pressure drop through a packed bed of FIXED DEM spheres moving down at U through MPS water
    (unresolved MPS-DEM coupling, seed 002 §2.3, Model B, Eq. 26) against Ergun (1952).
-   Usage: run [DATA_DIR] [--t-end=S] [--t-start=S]   (the reference is analytic; no file is read)
+   Usage: run [DATA_DIR] [--tier=default|full] [--t-end=S] [--t-start=S]   (the reference is
+   analytic; no file is read; both tiers run the same window)
    The tank is made tall enough for the bed's travel in t_end; the average is over [t_start, t_end].
    Writes pressure.csv (t, bed bottom z, p_below, p_above, dP_dyn = p_below - p_above - rho g dz,
    dP_dyn / L_pack, the drag on the bed sum F^d_z and sum F^d_z / eps_k per cross-section area, the
@@ -10,7 +11,6 @@
    FLUID particles in slabs r0/2 thick: over the whole cross-section and over the core r_e from the
    walls; at the end of the run) and porosity_eq31.csv (Eq. 31 with the open-kernel normaliser on a
    r0/4 grid, cross-section mean). */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -72,14 +72,14 @@ int main(int argc, char **argv) {
     double z, top, sum = 0, sum2 = 0, T = 0, next = 0, next_prof = 0, eps_core = 0;
     double s_drag = 0, s_drag_eps = 0, s_us_core = 0, s_us_wall = 0, s_eps_bed = 0;
     double prof_axis[NPROF] = {0}, prof_wall[NPROF] = {0};
-    for (i = 1; i < argc; ++i) {
-        if (!strncmp(argv[i], "--t-end=", 8)) t_end = atof(argv[i] + 8);
-        else if (!strncmp(argv[i], "--t-start=", 10)) t_start = atof(argv[i] + 10);
-    }
+    vc_begin(CASE, argc, argv, NULL);
+    t_end = vc_option_num("--t-end", t_end);
+    t_start = vc_option_num("--t-start", t_start);
     if (!(t_end > 0 && t_start >= 0 && t_start < t_end)) {
-        printf("usage: run [DATA_DIR] [--t-end=S] [--t-start=S] (0 <= t_start < t_end)\n");
+        fprintf(stderr, "usage: run [DATA_DIR] [--tier=default|full] [--t-end=S] [--t-start=S] (0 <= t_start < t_end)\n");
         return 2;
     }
+    vc_tier("r0 %g m, bed of %d layers of d = %g m, window %g-%g s", r0, BED_LAYERS, d, t_start, t_end);
     /* the bed travels U t_end: start it high enough to keep BELOW_END r0 of water under it */
     below = BELOW_END + (int)ceil(U * t_end / r0);
     z_bed0 = below * r0;

@@ -1,4 +1,4 @@
-# Plots of mpsdem_fixed_bed; run by validation/report.sh inside build/validation/mpsdem_fixed_bed.
+# Plots of mpsdem_fixed_bed; run by validation/tiers.sh inside build/validation/mpsdem_fixed_bed.
 set datafile separator ','
 set terminal pngcairo size 1200,500 font ",11"
 set grid

@@ -1,4 +1,4 @@
-# Plots of mpsdem_obstacle; run by validation/report.sh inside build/validation/mpsdem_obstacle.
+# Plots of mpsdem_obstacle; run by validation/tiers.sh inside build/validation/mpsdem_obstacle.
 set datafile separator ','
 set terminal pngcairo size 1400,900 font ",11"
 set grid

@@ -1,10 +1,10 @@
 /* Sedimentation of a block of 7425 spheres in a water tank, unresolved MPS-DEM, Models A and B
    (seed 002 §3.1, Xie et al. 2025, Figs. 3-5). See README.md for the set-up and the derivation.
-   Usage: run [DATA_DIR] [options]   (the reference is analytic; no file is read)
-     --seed        the seed's resolution: r0 = 2.7 mm, R = 1.35 mm, 15 x 33 x 15 = 7425 spheres (about 25 min
-                   of CPU for both models, at the limit of make validate's budget: not the default)
-     --coarse      twice coarser: r0 = 5.4 mm, R = 2.7 mm, 7 x 16 x 7 = 784 spheres, same tank and depth
-                   (the default; about 3 min of CPU for both models)
+   Usage: run [DATA_DIR] [--tier=default|full] [options]   (the reference is analytic; no file is read)
+     --tier=full   the seed's resolution: r0 = 2.7 mm, R = 1.35 mm, 15 x 33 x 15 = 7425 spheres (about
+                   25 min of CPU for both models); --seed is the same
+     --tier=default  twice coarser: r0 = 5.4 mm, R = 2.7 mm, 7 x 16 x 7 = 784 spheres, same tank and
+                   depth (about 3 min of CPU for both models); --coarse chooses it in either tier
      --t-end=T     simulated time (s); default 0.5
      --model=A|B|AB   which models to run; default AB
      --dem-dt=DT   DEM step (s); default 0 = the library's stable estimate (Rayleigh rule x 0.2);
@@ -16,7 +16,6 @@
    (m, mean centre height), vmax (m/s, fastest sphere), umax (m/s, fastest fluid particle), dt (s,
    last coupled step), substeps (DEM substeps of that step). */
 #define _POSIX_C_SOURCE 199309L
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 #include <time.h>
@@ -365,22 +364,20 @@ static void report(char tag, const outcome *o) {
 }
 
 int main(int argc, char **argv) {
-    setup S = {0.0054, 0.0027, 0.5, 0, 7, 16, 7}; /* --coarse */
-    int run_a = 1, run_b = 1, a;
+    static const setup seed = {0.0027, 0.00135, 0.5, 0, 15, 33, 15}, coarse = {0.0054, 0.0027, 0.5, 0, 7, 16, 7};
+    setup S;
+    const char *models;
+    int run_a, run_b, want_coarse;
     double t_total;
-    for (a = 1; a < argc; ++a) {
-        if (strcmp(argv[a], "--seed") == 0) S.r0 = 0.0027, S.R = 0.00135, S.bx = 15, S.by = 33, S.bz = 15;
-        else if (strcmp(argv[a], "--coarse") == 0) S.r0 = 0.0054, S.R = 0.0027, S.bx = 7, S.by = 16, S.bz = 7;
-        else if (strncmp(argv[a], "--t-end=", 8) == 0) S.t_end = atof(argv[a] + 8);
-        else if (strncmp(argv[a], "--dem-dt=", 9) == 0) S.dem_dt = atof(argv[a] + 9);
-        else if (strncmp(argv[a], "--model=", 8) == 0) {
-            run_a = strchr(argv[a] + 8, 'A') != NULL;
-            run_b = strchr(argv[a] + 8, 'B') != NULL;
-        } else if (strncmp(argv[a], "--", 2) == 0) {
-            fprintf(stderr, "unknown option %s\n", argv[a]);
-            return 2;
-        } /* otherwise the data folder of make validate: not used */
-    }
+    vc_begin(CASE, argc, argv, "--seed");
+    want_coarse = vc_flag("--coarse");
+    S = vc_full() && !want_coarse ? seed : coarse;
+    S.t_end = vc_option_num("--t-end", S.t_end);
+    S.dem_dt = vc_option_num("--dem-dt", S.dem_dt);
+    models = vc_option("--model");
+    run_a = !models || strchr(models, 'A') != NULL;
+    run_b = !models || strchr(models, 'B') != NULL;
+    vc_tier("r0 %.2f mm, %d spheres of R %.3f mm, %g s", 1e3 * S.r0, S.bx * S.by * S.bz, 1e3 * S.R, S.t_end);
     vc_info(CASE, "r0 %.4g m, R %.4g m, block %d x %d x %d, t_end %.3f s, models %s%s", S.r0, S.R, S.bx, S.by, S.bz,
             S.t_end, run_a ? "A" : "", run_b ? "B" : "");
     t_total = now();

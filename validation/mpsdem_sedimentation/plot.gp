@@ -1,4 +1,4 @@
-# Plots of mpsdem_sedimentation (seed 002 Figs. 3-5); run by validation/report.sh inside
+# Plots of mpsdem_sedimentation (seed 002 Figs. 3-5); run by validation/tiers.sh inside
 # build/validation/mpsdem_sedimentation, where checks.txt (the program's output) gives the analytic values.
 set datafile separator ','
 set terminal pngcairo size 1000,600 font ",11"

@@ -1,8 +1,9 @@
 /* Hindered settling of a uniform suspension of DEM spheres in MPS water (unresolved MPS-DEM coupling,
    seed 002 §2.3, Model B, drag law of Eq. 26) against Richardson-Zaki: U = u_t eps^n.
-   Usage: run [DATA_DIR] [--phi=F] [--t-end=S] [--t-start=S]   (the reference is analytic; no file
-   is read). Default: phi 0.1 to T_END (about 3 min CPU); --phi=0.2 or 0.3 runs another, --phi=all
-   the three (0.2 and 0.3 have 2 and 3 times the particles: longer than 10 min together).
+   Usage: run [DATA_DIR] [--tier=default|full] [--phi=F] [--t-end=S] [--t-start=S]   (the reference
+   is analytic; no file is read). Default tier: phi 0.1 to T_END (about 3 min CPU); full tier: the
+   three fractions 0.1, 0.2, 0.3 (0.2 and 0.3 have 2 and 3 times the particles: longer than 10 min
+   together; --phi=all is the same); --phi=0.2 or 0.3 runs that one.
    Writes settling_<law>_phi<phi>.csv per run: t, v_band (mean vertical velocity of the particles in
    the measuring box, m/s), u_band (mean vertical velocity of the FLUID particles there), eps_band
    (mean porosity eps_k of the particles there), n_band, z_top (99th percentile of the particles'
@@ -14,7 +15,6 @@
    particle velocity in the core and within r_e of the side walls, FLUID particles per slab and the
    whole cross-section's volume flux), lateral_phi<phi>.csv (the same at the box's heights against
    the distance to the nearest side wall, r0/2 bins). */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -383,24 +383,27 @@ int main(int argc, char **argv) {
     static const double fractions[] = {0.1, 0.2, 0.3};
     const fsdem_drag_law law = FSDEM_DRAG_LAW_ERGUN_WEN_YU;
     const double ut = terminal(law), Re_t = rho * d * ut / mu(), n = rz_exponent(Re_t);
-    int f, only = 0; /* default phi 0.1 alone (163 s CPU); --phi=all for the three (not timed) */
-    for (f = 1; f < argc; ++f) {
-        if (!strncmp(argv[f], "--t-end=", 8)) T_END = atof(argv[f] + 8);
-        else if (!strncmp(argv[f], "--t-start=", 10)) T_START = atof(argv[f] + 10);
-        else if (!strcmp(argv[f], "--phi=all")) only = -1;
-        else if (!strncmp(argv[f], "--phi=", 6)) {
-            const double p = atof(argv[f] + 6);
-            for (only = 0; only < 3 && fabs(fractions[only] - p) > 1e-6; ++only) continue;
-            if (only == 3) {
-                printf("--phi: 0.1, 0.2, 0.3 or all\n");
-                return 2;
-            }
+    int f, only; /* the fraction run (index), or -1 for the three */
+    const char *phi;
+    vc_begin(CASE, argc, argv, NULL);
+    only = vc_full() ? -1 : 0; /* default tier: phi 0.1 alone (163 s CPU); full tier: the three */
+    T_END = vc_option_num("--t-end", T_END);
+    T_START = vc_option_num("--t-start", T_START);
+    if ((phi = vc_option("--phi")) != NULL) {
+        if (!strcmp(phi, "all")) only = -1;
+        else
+            for (only = 0; only < 3 && fabs(fractions[only] - atof(phi)) > 1e-6; ++only) continue;
+        if (only == 3) {
+            fprintf(stderr, "--phi: 0.1, 0.2, 0.3 or all\n");
+            return 2;
         }
     }
     if (!(T_END > 0 && T_START >= 0 && T_START < T_END)) {
-        printf("usage: run [DATA_DIR] [--phi=F] [--t-end=S] [--t-start=S] (0 <= t_start < t_end)\n");
+        fprintf(stderr, "usage: run [DATA_DIR] [--tier=default|full] [--phi=F] [--t-end=S] [--t-start=S] (0 <= t_start < t_end)\n");
         return 2;
     }
+    if (only < 0) vc_tier("r0 %g m, phi 0.1, 0.2, 0.3, window %g-%g s", r0, T_START, T_END);
+    else vc_tier("r0 %g m, phi %.1f, window %g-%g s", r0, fractions[only], T_START, T_END);
     vc_info(CASE, "d %g m, r0 %g m (d = r0/%g), rho_s %g, rho %g kg/m^3, nu %g m^2/s; %s: u_t %.5f m/s (Stokes %.5f), Re_t %.3f, "
                   "Rowe's n %.4f",
             d, r0, r0 / d, rho_s, rho, nu, fsdem_drag_law_name(law), ut, (rho_s - rho) * g * d * d / (18 * mu()), Re_t, n);

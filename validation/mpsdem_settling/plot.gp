@@ -1,4 +1,4 @@
-# Plots of mpsdem_settling; run by validation/report.sh inside build/validation/mpsdem_settling.
+# Plots of mpsdem_settling; run by validation/tiers.sh inside build/validation/mpsdem_settling.
 set datafile separator ','
 set terminal pngcairo size 1200,500 font ",11"
 set grid

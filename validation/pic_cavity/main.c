@@ -1,11 +1,11 @@
 /* Lid-driven cavity (Ghia, Ghia & Shin 1982) with the PIC solver: a completely filled unit box
    (free_surface = 0, pressure defined up to a constant), no-slip walls, lid u = 1 at y = 1.
-   Usage: run [DATA_DIR [N]]   (N cells per side for Re 100, default 128; N/2 for Re 400 and 1000)
+   Usage: run [DATA_DIR] [--tier=default|full] [--cells=N]   (N cells per side for Re 100, 128 in
+   both tiers; N/2 for Re 400 and 1000)
    Reads ghia1982_u_vertical_centerline.csv and ghia1982_v_horizontal_centerline.csv from DATA_DIR
    (validation/data by default).
    Writes centreline_Re<Re>.csv (y,u_sim,u_ref,x,v_sim,v_ref: u on x = 0.5, v on y = 0.5 at the table points)
    and history_Re<Re>.csv (kinetic energy, max errors) into the working directory. */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -135,10 +135,14 @@ int main(int argc, char **argv) {
     double eu, ev;
     /* Re 100 is checked on n x n cells; Re 400 and 1000 are reported on n/2 x n/2 cells with longer
        runs (their spin-up is slower), which keeps the case at about two minutes */
-    int n = argc > 2 ? atoi(argv[2]) : 128, k;
+    int n, k;
     static const double t_end[3] = {10, 30, 40};
     static const int re[3] = {100, 400, 1000};
-    const char *dir = vc_data_dir(argc, argv);
+    const char *dir;
+    vc_begin(CASE, argc, argv, NULL);
+    n = vc_option_int("--cells", 128);
+    vc_tier("Re 100 on %d^2 cells, Re 400 and 1000 on %d^2", n, n / 2);
+    dir = vc_data_dir();
     if (load(dir, "ghia1982_u_vertical_centerline.csv", "y", "u", &u) ||
         load(dir, "ghia1982_v_horizontal_centerline.csv", "x", "v", &v)) {
         vc_check(CASE, "reference_loaded", 0, 1, 0);

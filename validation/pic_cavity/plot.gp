@@ -1,4 +1,4 @@
-# Plots of pic_cavity; run by validation/report.sh inside build/validation/pic_cavity.
+# Plots of pic_cavity; run by validation/tiers.sh inside build/validation/pic_cavity.
 set datafile separator ','
 set terminal pngcairo size 1200,500 font ",11"
 set grid

@@ -1,7 +1,7 @@
 /* Martin & Moyce (1952) collapse of a water column, 2D: column a x 2a (a = 0.05715 m) against the
    left wall of a closed tank 8a x 3a, inviscid water, FLIP 0.97 with density projection.
-   Usage: run [DATA_DIR [cells_across_a]]   (DATA_DIR: validation/data by default; cells: 40 by default;
-   two coarser runs, 20 and 10, are reported)
+   Usage: run [DATA_DIR] [--tier=default|full] [--cells=N]   (DATA_DIR: validation/data by default;
+   N cells across a: 40 in both tiers; two coarser runs, N/2 and N/4, are reported)
    Reads martin_moyce_1952_front_n2_2_table_ocellaris.csv,
    martin_moyce_1952_residual_height_n2_2_table_ocellaris.csv and koshizuka_oka_1996_front_pysph.csv.
    Writes front.csv (t,x_front,h_column in m) of the checked run, front_n20.csv, front_n10.csv,
@@ -9,7 +9,6 @@
    best-fit time shift against Martin & Moyce) and the reference tables in SI units
    (ref_front.csv, ref_front_ko.csv, ref_height.csv) for the plots.
    The front is compared with the experiments by the protocol of pic_dambreak.h (db_report_front). */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 #include "pic_dambreak.h"
@@ -20,9 +19,13 @@ static db_series runs[3], plain;
 
 int main(int argc, char **argv) {
     db_ref ref;
-    const char *dir = vc_data_dir(argc, argv);
-    int n0 = argc > 2 ? atoi(argv[2]) : 40, level, i;
+    const char *dir;
+    int n0, level, i;
     double t_end;
+    vc_begin(CASE, argc, argv, NULL);
+    n0 = vc_option_int("--cells", 40);
+    vc_tier("dx = a/%d (and a/%d, a/%d reported)", n0, n0 / 2, n0 / 4);
+    dir = vc_data_dir();
     if (db_load_ref(dir, &ref) != 0) {
         vc_check(CASE, "reference_loaded", 0, 1, 0);
         return vc_exit_code();

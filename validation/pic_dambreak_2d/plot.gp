@@ -1,4 +1,4 @@
-# Plots of pic_dambreak_2d; run by validation/report.sh inside build/validation/pic_dambreak_2d.
+# Plots of pic_dambreak_2d; run by validation/tiers.sh inside build/validation/pic_dambreak_2d.
 set datafile separator ','
 set key autotitle columnhead
 set terminal pngcairo size 1200,500 font ",11"

@@ -5,10 +5,10 @@
    (best time shift in [0, 0.3] and RMS(Z) after it <= 0.05; slope dZ/dT over 1 <= T <= 3 within 5%).
    Information: Koshizuka & Oka's front the same way, and the deviation from the library's own 2D run
    at the same resolution (a consistency figure, not a validation).
-   Usage: run [DATA_DIR [cells_across_a]]   (DATA_DIR: validation/data by default; cells: 20 by default)
+   Usage: run [DATA_DIR] [--tier=default|full] [--cells=N]   (DATA_DIR: validation/data by default;
+   N cells across a: 20 in both tiers)
    Writes front_2d.csv, front_thin.csv, front_wide.csv (t,x_front,h_column in m), front_<tank>_shifted.csv
    (delayed by the best-fit time shift against Martin & Moyce), ref_front.csv and ref_front_ko.csv. */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 #include "pic_dambreak.h"
@@ -30,9 +30,13 @@ static double max_rel_vs(const db_series *a, const db_series *b, const db_front_
 
 int main(int argc, char **argv) {
     db_ref ref;
-    const char *dir = vc_data_dir(argc, argv);
-    int n = argc > 2 ? atoi(argv[2]) : 20, w;
+    const char *dir;
+    int n, w;
     double t_end;
+    vc_begin(CASE, argc, argv, NULL);
+    n = vc_option_int("--cells", 20);
+    vc_tier("dx = a/%d, thin (a/4) and wide (a) tanks", n);
+    dir = vc_data_dir();
     if (db_load_ref(dir, &ref) != 0) {
         vc_check(CASE, "reference_loaded", 0, 1, 0);
         return vc_exit_code();

@@ -1,4 +1,4 @@
-# Plots of pic_dambreak_3d; run by validation/report.sh inside build/validation/pic_dambreak_3d.
+# Plots of pic_dambreak_3d; run by validation/tiers.sh inside build/validation/pic_dambreak_3d.
 set datafile separator ','
 set key autotitle columnhead
 set terminal pngcairo size 800,600 font ",11"

@@ -1,8 +1,8 @@
 /* Still water in a closed tank, 2D and 3D: hydrostatic pressure, spurious velocity, volume drift.
-   Usage: run [DATA_DIR]   (the reference is analytic: p = rho g (h - y); no file is read)
+   Usage: run [DATA_DIR] [--tier=default|full]   (the reference is analytic: p = rho g (h - y); no
+   file is read; both tiers run the same)
    Writes hydrostatic_2d.csv / hydrostatic_3d.csv (time series) and profile_2d.csv / profile_3d.csv
    (pressure of the middle column against rho g (h - y)) into the working directory. */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -97,8 +97,8 @@ static outcome run(int dim, double dx, double jitter, const char *tag) {
 
 int main(int argc, char **argv) {
     int dim;
-    (void)argc;
-    (void)argv;
+    vc_begin(CASE, argc, argv, NULL);
+    vc_tier("dx 0.02 m (2D), 0.04 m (3D), 2 s, every tier");
     for (dim = 2; dim <= 3; ++dim) {
         const char *tag = dim == 2 ? "2d" : "3d";
         char metric[64];

@@ -1,4 +1,4 @@
-# Plots of pic_hydrostatic; run by validation/report.sh inside build/validation/pic_hydrostatic.
+# Plots of pic_hydrostatic; run by validation/tiers.sh inside build/validation/pic_hydrostatic.
 set datafile separator ','
 set terminal pngcairo size 1200,500 font ",11"
 set grid

@@ -1,9 +1,10 @@
 /* Dam break through layers of aluminium cylinders (seed 000 section 3.2, after Zhang et al. 2009),
    resolved PIC-DEM in 2D: 6, 8, 10 and 12 layers, each with the gap treatment of Eq. 20 (beta = 0.5)
    and without it (beta = 1). The set-up is case.h's (README.md).
-   Usage: run [DATA_DIR] [--seed] [--dx M] [--t-end S] [--layers N]
+   Usage: run [DATA_DIR] [--tier=default|full] [--dx M] [--t-end S] [--layers N] [--beta B]
      DATA_DIR  ignored (no reference file is read: no digitised data exist, see README.md)
-     --seed    the seed's grid, dx = 0.05 cm (default dx = 0.1 cm, four times cheaper per second)
+     --tier=full  the seed's grid, dx = 0.05 cm, 0.6 s per run (--seed is the same); the default
+               tier: dx = 0.1 cm (four times cheaper per second), DEFAULT_T_END s per run
      --dx M    another cell size (m)
      --t-end S simulated time per run (default 0.6 s)
      --layers N only the runs with N layers (the checks that compare layer counts are then skipped)
@@ -11,7 +12,6 @@
    Writes, per run, cylinders_<layers>_b<beta>.csv (t, x_ave, z_ave, x_max, water front, volume
    drift) and, for 6 and 12 layers, snapshots at t = 0, 0.1, 0.2, 0.3, 0.4 s: water_<layers>_b<beta>
    _<t>.csv / .vtp (PIC particles) and cylinders_<layers>_b<beta>_<t>.csv / .vtp (DEM particles). */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 #include "picdem_cylinder_dambreak/case.h"
@@ -20,6 +20,7 @@
 
 #define CASE "picdem_cylinder_dambreak"
 #define NSNAP 5
+#define DEFAULT_T_END 0.6 /* s per run in the default tier (README.md, "Tiers") */
 
 static const double snap_times[NSNAP] = {0, 0.1, 0.2, 0.3, 0.4};
 static const double front_times[3] = {0.1, 0.2, 0.3};
@@ -158,16 +159,15 @@ int main(int argc, char **argv) {
     static const int layer_counts[4] = {6, 8, 10, 12};
     static const double betas[2] = {0.5, 1.0};
     result res[4][2];
-    double dx = 0.001, t_end = 0.6;
-    int only = 0, only_beta = -1, i, j;
+    double dx, t_end;
+    int only, only_beta, i, j;
     char metric[128];
-    for (i = 1; i < argc; ++i) {
-        if (!strcmp(argv[i], "--seed")) dx = WD_SEED_DX;
-        else if (!strcmp(argv[i], "--dx") && i + 1 < argc) dx = atof(argv[++i]);
-        else if (!strcmp(argv[i], "--t-end") && i + 1 < argc) t_end = atof(argv[++i]);
-        else if (!strcmp(argv[i], "--layers") && i + 1 < argc) only = atoi(argv[++i]);
-        else if (!strcmp(argv[i], "--beta") && i + 1 < argc) only_beta = atof(argv[++i]) < 0.75 ? 0 : 1;
-    }
+    vc_begin(CASE, argc, argv, "--seed");
+    dx = vc_option_num("--dx", vc_full() ? WD_SEED_DX : 0.001);
+    t_end = vc_option_num("--t-end", vc_full() ? 0.6 : DEFAULT_T_END);
+    only = vc_option_int("--layers", 0);
+    only_beta = vc_option("--beta") ? (vc_option_num("--beta", 1) < 0.75 ? 0 : 1) : -1;
+    vc_tier("dx = %g mm, %g s per run", 1e3 * dx, t_end);
     vc_info(CASE, "dx = %g m (seed: %g m), %.2f s per run", dx, WD_SEED_DX, t_end);
     memset(res, 0, sizeof res);
     for (i = 0; i < 4; ++i)

@@ -1,4 +1,4 @@
-# Plots of the wet cylinder dam break; run by validation/report.sh inside
+# Plots of the wet cylinder dam break; run by validation/tiers.sh inside
 # build/validation/picdem_cylinder_dambreak. No digitised experiment exists (seed 000 Fig. 8-10 are
 # not available as data), so beta = 0.5 and beta = 1 and the layer counts are compared with each other.
 set datafile separator ','

@@ -3,10 +3,10 @@
    the bottom of a tank full of water; a continuous and a perforated pipe. Resolved PIC-DEM
    (fsdem_pic_dem), 2D. The geometry of the seed's Fig. 11 is not given in its text: README.md states
    the one chosen here.
-   Usage: run [DATA_DIR] [--seed] [--dx M] [--t-max S] [--pipe continuous|perforated] [--dry]
+   Usage: run [DATA_DIR] [--tier=default|full] [--dx M] [--t-max S] [--pipe continuous|perforated] [--dry]
      DATA_DIR is ignored (no reference data exist for this case);
-     --seed   the seed's grid, dx = 0.05 cm, with 0.1 cm holes (default: dx = 0.1 cm, holes of
-              2 cells = 0.2 cm, see README.md);
+     --tier=full  the seed's grid, dx = 0.05 cm, with 0.1 cm holes (--seed is the same; the default
+              tier: dx = 0.1 cm, holes of 2 cells = 0.2 cm, see README.md);
      --dx M   another grid (m; holes of max(0.1 cm, 2 dx));
      --t-max  end of a run when cylinders are still in the pipe (default 4 s);
      --pipe   run one pipe only (the comparison check is then skipped);
@@ -14,7 +14,6 @@
               on water and the comparison are skipped).
    Writes cylinders.csv, levels.csv and cylinders_<pipe>_<t>.csv snapshots into the working
    directory. */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -421,30 +420,25 @@ int main(int argc, char **argv) {
     options o;
     result res[2];
     FILE *cyl, *lev;
-    int i, p;
-    o.dx = 0.001;
+    int p;
+    const char *pipe;
+    vc_begin(CASE, argc, argv, "--seed");
+    o.dx = vc_option_num("--dx", vc_full() ? 0.0005 : 0.001);
     o.hole_w = -1;
-    o.t_max = 4.0;
+    o.t_max = vc_option_num("--t-max", 4.0);
     o.pipes = 3;
-    o.dry = 0;
-    for (i = 1; i < argc; ++i) {
-        if (!strcmp(argv[i], "--seed")) o.dx = 0.0005;
-        else if (!strcmp(argv[i], "--dx") && i + 1 < argc) o.dx = atof(argv[++i]);
-        else if (!strcmp(argv[i], "--t-max") && i + 1 < argc) o.t_max = atof(argv[++i]);
-        else if (!strcmp(argv[i], "--pipe") && i + 1 < argc) {
-            ++i;
-            o.pipes = !strcmp(argv[i], "continuous") ? 1 : !strcmp(argv[i], "perforated") ? 2 : 0;
-            if (!o.pipes) { fprintf(stderr, "--pipe continuous|perforated\n"); return 2; }
-        }
-        else if (!strcmp(argv[i], "--dry")) o.dry = 1;
-        /* anything else: the data directory of `make validate`, not used */
+    if ((pipe = vc_option("--pipe")) != NULL) {
+        o.pipes = !strcmp(pipe, "continuous") ? 1 : !strcmp(pipe, "perforated") ? 2 : 0;
+        if (!o.pipes) { fprintf(stderr, "--pipe continuous|perforated\n"); return 2; }
     }
+    o.dry = vc_flag("--dry");
     if (!(o.dx > 0 && o.dx <= 0.002)) { fprintf(stderr, "--dx must be in (0, 0.002] m\n"); return 2; }
     /* the funnel holds the bottom layer (6 cylinders 2r + 2 dx apart) with a gap to spare: 8 cm for
        dx <= 1 mm, wider on coarser (development) grids */
     funnel_w = fmax(funnel_w0, 5 * (2 * radius + 2 * o.dx) + 2 * (radius + 2 * o.dx) + 0.002);
     funnel_slope_top = pipe_top + (funnel_w - pipe_w) * tan(funnel_angle * DEG);
     o.hole_w = fmax(0.001, 2 * o.dx);
+    vc_tier("dx = %g mm, holes %g mm, runs to %g s at most%s", 1e3 * o.dx, 1e3 * o.hole_w, o.t_max, o.dry ? ", dry" : "");
     cyl = fopen("cylinders.csv", "w");
     lev = fopen("levels.csv", "w");
     if (!cyl || !lev) { fprintf(stderr, "%s: cannot write the CSV files\n", CASE); return 1; }

@@ -1,4 +1,4 @@
-# Plots of the fall-pipe dumping (seed 000 section 3.3); run by validation/report.sh inside
+# Plots of the fall-pipe dumping (seed 000 section 3.3); run by validation/tiers.sh inside
 # build/validation/picdem_fall_pipe. Column 1 of both files is 0 for the continuous pipe, 1 for the
 # perforated one. No reference data exist (seed 000 Fig. 12 shows snapshots only).
 set datafile separator ','

@@ -5,12 +5,12 @@
    Reference: analytical. The submerged segment (2D) or cap (3D) of the body holds the water mass
    m / rho_f; the water it displaces raises the level of the closed tank. Nothing is read from
    validation/data.
-   Usage: run [DATA_DIR] [--quick] [--pic] [--only=TAGS]   (--quick: shorter runs, for trying
+   Usage: run [DATA_DIR] [--tier=default|full] [--quick] [--pic] [--only=TAGS]   (both tiers run the
+   same; --quick: shorter runs, for trying
    things; the checks keep their tolerances; --pic: the PIC transfer instead of FLIP; --only: the
    runs named, of floating_2d, neutral_2d, floating_3d, neutral_3d, comma-separated)
    Writes floating_2d.csv, floating_3d.csv, neutral_2d.csv, neutral_3d.csv: t, centre height, vertical
    velocity, pressure and viscous force, body volume the faces see, particle volume. See README.md. */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -232,13 +232,13 @@ done:
 }
 
 int main(int argc, char **argv) {
-    int quick = 0, pic_transfer = 0, a, dim;
-    const char *only = NULL; /* --only=<tags>: the runs named (floating_2d, neutral_2d, floating_3d, neutral_3d), comma-separated */
-    for (a = 1; a < argc; ++a) {
-        if (!strcmp(argv[a], "--quick")) quick = 1;
-        if (!strcmp(argv[a], "--pic")) pic_transfer = 1;
-        if (!strncmp(argv[a], "--only=", 7)) only = argv[a] + 7;
-    }
+    int quick, pic_transfer, dim;
+    const char *only; /* --only=<tags>: the runs named (floating_2d, neutral_2d, floating_3d, neutral_3d), comma-separated */
+    vc_begin(CASE, argc, argv, NULL);
+    quick = vc_flag("--quick");
+    pic_transfer = vc_flag("--pic");
+    only = vc_option("--only");
+    vc_tier("R = 10 dx (2D), 5 dx (3D)%s%s", quick ? ", --quick" : "", pic_transfer ? ", PIC transfer" : "");
     for (dim = 2; dim <= 3; ++dim) {
         setup S;
         outcome o, n;

@@ -1,4 +1,4 @@
-# Plots of picdem_floating; run by validation/report.sh inside build/validation/picdem_floating.
+# Plots of picdem_floating; run by validation/tiers.sh inside build/validation/picdem_floating.
 set datafile separator ','
 set terminal pngcairo size 1200,500 font ",11"
 set grid

@@ -1,4 +1,4 @@
-# Plots of picdem_ten_cate; run by validation/report.sh inside build/validation/picdem_ten_cate.
+# Plots of picdem_ten_cate; run by validation/tiers.sh inside build/validation/picdem_ten_cate.
 set datafile separator ','
 set terminal pngcairo size 1200,500 font ",11"
 set grid

@@ -3,10 +3,10 @@
    wet bed, h_L = 1 m at t = 1 s, and the two SWASHES cases with h_L = 5 mm at t = 6 s), with
    MUSCL-Hancock, HLL, CFL 0.5 and the MC limiter (checked); the library's default minmod limiter is
    run beside it and reported (INFO).
-   Usage: run [DATA_DIR]   (validation/data by default; writes profile_<case>.csv and
+   Usage: run [DATA_DIR] [--tier=default|full]   (validation/data by default; both tiers run the
+   same; writes profile_<case>.csv and
    profile_<case>_minmod.csv into the working directory)
    See README.md next to this file for the physics, the reference, the metrics and the tolerances. */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -195,7 +195,9 @@ int main(int argc, char **argv) {
     vc_table t;
     char path[512];
     int r, bad = 0;
-    if (vc_table_load(&t, vc_path(path, sizeof path, vc_data_dir(argc, argv),
+    vc_begin(CASE, argc, argv, NULL);
+    vc_tier("1000 cells (Ritter, Stoker), 2000 (SWASHES), every tier");
+    if (vc_table_load(&t, vc_path(path, sizeof path, vc_data_dir(),
                                   "swe_dambreak_ritter_stoker_worked_examples.csv")) != 0) {
         vc_check(CASE, "reference_loaded", 0, 1, 0);
         return vc_exit_code();

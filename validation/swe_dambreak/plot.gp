@@ -1,4 +1,4 @@
-# Plots of the Ritter/Stoker dam breaks; run by validation/report.sh inside build/validation/swe_dambreak.
+# Plots of the Ritter/Stoker dam breaks; run by validation/tiers.sh inside build/validation/swe_dambreak.
 set datafile separator ','
 set terminal pngcairo size 1200,800 font ",11"
 set grid

@@ -8,9 +8,9 @@
    Parameters of the SWASHES 2D planar case: a = 1 m, h0 = 0.1 m, eta = 0.5 m, L = 4 m.
    Runs the default scheme on 100^2 and 200^2 cells for three periods; checks the L1 error of h after
    one and three periods on 200^2, and that it decreases under refinement.
-   Usage: run [DATA_DIR]   (the reference is analytic; writes thacker.csv and profile_T*.csv)
+   Usage: run [DATA_DIR] [--tier=default|full]   (the reference is analytic; both tiers run the same;
+   writes thacker.csv and profile_T*.csv)
    See README.md next to this file. */
-#define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
 #include "common.h"
 
@@ -130,9 +130,11 @@ static int run(int n, int out, result *res) {
     return 0;
 }
 
-int main(void) {
+int main(int argc, char **argv) {
     result coarse, fine;
     double period = 2 * PI / omega();
+    vc_begin(CASE, argc, argv, NULL);
+    vc_tier("100^2 and 200^2 cells, 3 periods, every tier");
     if (run(100, 0, &coarse) != 0 || run(200, 1, &fine) != 0) return 1;
     vc_info(CASE, "period T = %.5f s; 200^2 cells: %lld steps for 3 T; 100^2: %lld steps", period, fine.steps,
             coarse.steps);

@@ -1,4 +1,4 @@
-# Plots of Thacker's planar bowl; run by validation/report.sh inside build/validation/swe_thacker.
+# Plots of Thacker's planar bowl; run by validation/tiers.sh inside build/validation/swe_thacker.
 set datafile separator ','
 set terminal pngcairo size 1200,500 font ",11"
 set grid

@@ -1,0 +1,326 @@
+#!/bin/sh
+# validation/tiers.sh - runs validation cases in a tier, records what each run was run on, and renders
+# the reports (validation/README.md describes the whole scheme). The Makefile calls it; by hand:
+#
+#   sh validation/tiers.sh run TIER CASE OUT_ROOT DATA_DIR
+#       runs build/validation/CASE/run --tier=TIER in OUT_ROOT/CASE/ (emptied first): stdout to
+#       checks.txt, stderr to log.txt, then the plots (validation/CASE/plot.gp, when gnuplot is
+#       installed) and meta.txt (tier, commit, fingerprints, CPU and wall time, exit status); copies
+#       checks.txt, meta.txt and the plots into validation/report-TIER/CASE/ (the committed record
+#       of the tier). Prints a summary of the case; exits 0 whatever the case's result.
+#   sh validation/tiers.sh render TIER SRC_ROOT OUT_MD [IMG_PREFIX]
+#       writes the Markdown report OUT_MD from the cases in SRC_ROOT/*/meta.txt; plots are linked as
+#       IMG_PREFIX<case>/<png> (IMG_PREFIX: the path from OUT_MD's folder to SRC_ROOT, with a slash).
+#   sh validation/tiers.sh verdict OUT_ROOT CASE...
+#       one line of totals for the cases named; exits 1 when one of them failed (a CHECK FAIL, a crash,
+#       or no result).
+#   sh validation/tiers.sh status
+#       every case of both committed reports: current, or stale (and why).
+#   sh validation/tiers.sh fingerprint CASE [FSDEM_H]
+#       prints `solver=<hash> case=<hash>`: the hash (cksum) of the fsdem.h chapters the case
+#       depends on (validation/CASE/DEPENDS: >>tags; each tag's public chapter and its >>impl_tag
+#       chapter, plus the >>impl preamble) and of the case's own code (its .c and .h files, the
+#       validation headers they include, and DEPENDS).
+#   sh validation/tiers.sh order TIER CASE...
+#       the cases, longest first by the wall time of their last run in validation/report-TIER/
+#       (cases without one first): the order `make -j2` starts them in.
+#
+# Run it from the top of the repository (the Makefile does).
+set -u
+here=$(cd "$(dirname "$0")" && pwd)
+top=$(cd "$here/.." && pwd)
+
+die() { echo "tiers.sh: $*" >&2; exit 2; }
+
+# ---- fingerprints ----
+
+# The text of the fsdem.h chapters named in DEPENDS (each tag's chapter and its impl_ chapter) and of
+# the >>impl preamble, in the file's order.
+chapters() { # deps_file fsdem_h
+    awk -v tags=" $(cat "$1") " '
+        /===== >>[a-z_]+ :/ {
+            match($0, />>[a-z_]+/); tag = substr($0, RSTART + 2, RLENGTH - 2); base = tag; sub(/^impl_/, "", base)
+            keep = tag == "impl" || index(tags, " " base " ") > 0
+        }
+        keep' "$2"
+}
+
+# The case's code: its .c and .h files and, transitively, the validation headers they include.
+case_files() { # case
+    todo=$(ls "$here/$1"/*.c "$here/$1"/*.h 2>/dev/null)
+    seen=""
+    while [ -n "$todo" ]; do
+        set -- $todo
+        f=$1
+        shift
+        todo="$*"
+        case " $seen " in *" $f "*) continue ;; esac
+        seen="$seen $f"
+        for inc in $(sed -n 's/^#include "\(.*\)"/\1/p' "$f"); do
+            for cand in "$(dirname "$f")/$inc" "$here/$inc"; do
+                if [ -f "$cand" ]; then
+                    todo="$todo $(cd "$(dirname "$cand")" && pwd)/$(basename "$cand")"
+                    break
+                fi
+            done
+        done
+    done
+    for f in $seen; do echo "$f"; done | sort
+}
+
+fingerprint() { # case [fsdem_h]
+    deps="$here/$1/DEPENDS"
+    [ -f "$deps" ] || die "validation/$1/DEPENDS is missing (the >>tags of fsdem.h the case depends on)"
+    solver=$(chapters "$deps" "${2:-$top/fsdem.h}" | cksum | awk '{ print $1 "-" $2 }')
+    code=$( (for f in $(case_files "$1"); do cat "$f"; done; cat "$deps") | cksum | awk '{ print $1 "-" $2 }')
+    echo "solver=$solver case=$code"
+}
+
+# value of key in a meta.txt
+meta() { sed -n "s/^$2=//p" "$1" | head -n 1; }
+
+# ---- run one case ----
+
+run_case() { # tier case out_root data_dir
+    tier=$1 name=$2 out="$3/$2" data=$4
+    bin="$top/build/validation/$name/run"
+    [ -x "$bin" ] || die "$bin is not built (make $bin)"
+    mkdir -p "$out"
+    # a fresh folder, but the default tier's holds the program itself
+    find "$out" -maxdepth 1 -type f ! -name run ! -name '*.o' -exec rm -f {} +
+    commit=$(cd "$top" && git rev-parse --short HEAD 2>/dev/null || echo unknown)
+    dirty=0
+    if [ "$commit" != unknown ] && [ -n "$(cd "$top" && git status --porcelain -- . ':(exclude)validation/report-default' \
+        ':(exclude)validation/report-full' ':(exclude)validation/REPORT-default.md' ':(exclude)validation/REPORT-full.md' \
+        2>/dev/null)" ]; then dirty=1; fi
+    fp=$(fingerprint "$name")
+    echo "== $name: started ($tier tier)"
+    start=$(date +%s.%N)
+    (cd "$out" && "$bin" "$data" --tier="$tier" >checks.txt 2>log.txt)
+    rc=$?
+    end=$(date +%s.%N)
+    plots=""
+    if [ -f "$here/$name/plot.gp" ]; then
+        if command -v gnuplot >/dev/null 2>&1; then
+            (cd "$out" && gnuplot "$here/$name/plot.gp") >"$out/plot.log" 2>&1 || plots="gnuplot failed (plot.log)"
+        else plots="gnuplot is not installed: no plots (sudo apt-get install -y gnuplot-nox)"; fi
+    fi
+    {
+        echo "case=$name"
+        echo "tier=$tier"
+        echo "commit=$commit"
+        echo "dirty=$dirty"
+        echo "date=$(date -u +%Y-%m-%dT%H:%MZ)"
+        echo "rc=$rc"
+        awk -v s="$start" -v e="$end" 'BEGIN { printf "wall_s=%.1f\n", e - s }'
+        sed -n 's/^TIME [^ ]* cpu_s=\([^ ]*\).*/cpu_s=\1/p' "$out/checks.txt" | tail -n 1
+        sed -n 's/^TIER [^ ]* tier=[^ ]* resolution=/resolution=/p' "$out/checks.txt" | head -n 1
+        echo "depends=$(cat "$here/$name/DEPENDS")"
+        for kv in $fp; do echo "${kv%%=*}_fp=${kv#*=}"; done
+        echo "cores=$(nproc 2>/dev/null || echo unknown)"
+        [ -n "$plots" ] && echo "plots=$plots"
+    } >"$out/meta.txt"
+    # the committed record of the tier
+    rec="$here/report-$tier/$name"
+    rm -rf "$rec"
+    mkdir -p "$rec"
+    cp "$out/checks.txt" "$out/meta.txt" "$rec/"
+    # the plots, in 32 colours when ImageMagick is there (a third of the size: they are committed)
+    for p in "$out"/*.png; do
+        [ -f "$p" ] || continue
+        if command -v convert >/dev/null 2>&1; then convert "$p" -strip -colors 32 "PNG8:$rec/$(basename "$p")" 2>/dev/null; fi
+        [ -s "$rec/$(basename "$p")" ] || cp "$p" "$rec/"
+    done
+    awk -v name="$name" -v rc="$rc" -v wall="$(meta "$out/meta.txt" wall_s)" -v cpu="$(meta "$out/meta.txt" cpu_s)" '
+        $1 == "CHECK" { n++; if ($NF != "PASS") { bad++; fails = fails "   " $0 "\n" } }
+        $1 == "INFO" && / \(full tier\)$/ { full++ }
+        END {
+            printf "== %s: %d of %d checks pass%s, %d full-tier lines; wall %s s, CPU %s s%s\n", name, n - bad, n,
+                   bad ? " (" bad " FAIL)" : "", full, wall, cpu == "" ? "?" : cpu, rc == 0 ? "" : ", exit status " rc
+            printf "%s", fails
+        }' "$out/checks.txt"
+    return 0
+}
+
+# ---- verdict ----
+
+verdict() { # out_root case...
+    root=$1
+    shift
+    bad=0 n=0 checks=0 fails=0
+    for c in "$@"; do
+        n=$((n + 1))
+        m="$root/$c/meta.txt"
+        if [ ! -f "$m" ]; then
+            echo "   $c: no result"
+            bad=1
+            continue
+        fi
+        [ "$(meta "$m" rc)" = 0 ] || bad=1
+        checks=$((checks + $(grep -c '^CHECK ' "$root/$c/checks.txt")))
+        fails=$((fails + $(grep '^CHECK ' "$root/$c/checks.txt" | grep -vc ' PASS$')))
+    done
+    echo "$n cases, $checks checks, $fails FAIL"
+    return $bad
+}
+
+# ---- staleness ----
+
+# "current", or why the record in a case folder is stale
+staleness() { # case_dir
+    m="$1/meta.txt"
+    name=$(meta "$m" case)
+    if [ ! -f "$here/$name/main.c" ]; then echo "stale: the case no longer exists"; return; fi
+    if [ ! -f "$here/$name/DEPENDS" ]; then echo "stale: validation/$name/DEPENDS is missing"; return; fi
+    now=$(fingerprint "$name")
+    why=""
+    [ "solver=$(meta "$m" solver_fp)" = "${now%% *}" ] || why="fsdem.h chapters ($(cat "$here/$name/DEPENDS")) changed"
+    [ "case=$(meta "$m" case_fp)" = "${now#* }" ] || why="${why:+$why; }the case's code changed"
+    if [ -n "$why" ]; then echo "stale: $why since $(meta "$m" commit)"; else echo current; fi
+}
+
+status() {
+    for tier in default full; do
+        echo "== validation/REPORT-$tier.md"
+        found=0
+        for d in "$here/report-$tier"/*/; do
+            [ -f "$d/meta.txt" ] || continue
+            found=1
+            printf '   %-26s %s%s  %s\n' "$(meta "$d/meta.txt" case)" "$(meta "$d/meta.txt" commit)" \
+                "$( [ "$(meta "$d/meta.txt" dirty)" = 1 ] && echo '+' )" "$(staleness "$d")"
+        done
+        [ $found = 1 ] || echo "   (no case recorded)"
+    done
+}
+
+# ---- report ----
+
+render() { # tier src_root out_md [img_prefix]
+    tier=$1 src=$2 out=$3 img=${4:-}
+    tmp="$out.tmp"
+    {
+        echo "# fsdem.h validation report: $tier tier"
+        echo
+        if [ "$tier" = full ]; then
+            echo "The full tier (\`make validate-full\`): every case at the seeds' resolutions and with the fine runs;"
+            echo "hours of CPU, run case by case (\`make validate-full CASES=...\` replaces only those cases' blocks)."
+        else
+            echo "The default tier (\`make validate\`): every case at the resolution that keeps the whole tier within"
+            echo "20 minutes of wall time on 2 cores (\`make -j2 validate\`). A line that needs the full tier's"
+            echo "resolution is printed as \`INFO ... (full tier)\` here, never as PASS."
+        fi
+        echo
+        echo "Each row of a CHECK table passes when |value - ref| <= tol. Case descriptions, references and the"
+        echo "reasons for each tolerance and resolution: validation/<case>/README.md; the scheme: validation/README.md."
+        echo "Each case's block names the commit it ran on (\"+\": with uncommitted changes). A block is **stale**"
+        echo "when the fsdem.h chapters its case depends on (validation/<case>/DEPENDS) or the case's own code"
+        echo "changed since that run (\`make validate-status\` lists them)."
+        echo
+        if [ -f "$src/run.txt" ]; then
+            echo "Last complete run of the tier: $(cat "$src/run.txt")."
+            echo
+        fi
+        if ! ls "$src"/*/meta.txt >/dev/null 2>&1; then
+            echo "No case has been run in this tier yet."
+        else
+            echo "| case | resolution | commit | CPU s | wall s | checks | status |"
+            echo "|---|---|---|---|---|---|---|"
+        fi
+    } >"$tmp"
+    total_cpu=0 total_wall=0 ncase=0
+    for d in "$src"/*/; do
+        m="$d/meta.txt"
+        [ -f "$m" ] || continue
+        name=$(meta "$m" case)
+        st=$(staleness "$d")
+        commit="$(meta "$m" commit)$( [ "$(meta "$m" dirty)" = 1 ] && echo ' +' )"
+        counts=$(awk '$1 == "CHECK" { n++; if ($NF != "PASS") f++ } END { printf "%d/%d%s", n - f, n, f ? " (**" f " FAIL**)" : "" }' "$d/checks.txt")
+        rc=$(meta "$m" rc)
+        [ "$rc" = 0 ] || [ -n "$(grep '^CHECK ' "$d/checks.txt" | grep -v ' PASS$')" ] || counts="$counts, **exit status $rc**"
+        case "$st" in current) sst=current ;; *) sst="**stale**" ;; esac
+        echo "| [$name](#$name) | $(meta "$m" resolution) | $commit | $(meta "$m" cpu_s) | $(meta "$m" wall_s) | $counts | $sst |" >>"$tmp"
+        total_cpu=$(awk -v a="$total_cpu" -v b="$(meta "$m" cpu_s)" 'BEGIN { print a + (b == "" ? 0 : b) }')
+        total_wall=$(awk -v a="$total_wall" -v b="$(meta "$m" wall_s)" 'BEGIN { print a + b }')
+        ncase=$((ncase + 1))
+    done
+    [ $ncase -gt 0 ] && {
+        echo
+        cat "$src"/*/checks.txt 2>/dev/null | awk -v n="$ncase" -v cpu="$total_cpu" -v wall="$total_wall" '
+            $1 == "CHECK" { c++; if ($NF == "PASS") p++ }
+            $1 == "INFO" && / \(full tier\)$/ { full++ }
+            END { printf "**%d cases: %d of %d checks pass**; %d lines need the full tier. CPU %.0f s, wall %.0f s (case by case, summed).\n", n, p, c, full, cpu, wall }'
+        fails=$(grep -h '^CHECK ' "$src"/*/checks.txt 2>/dev/null | grep -v ' PASS$')
+        if [ -n "$fails" ]; then
+            echo
+            echo "Failing checks:"
+            echo
+            echo "$fails" | awk '{ v = $4; r = $5; t = $6; sub(/^value=/, "", v); sub(/^ref=/, "", r); sub(/^tol=/, "", t)
+                printf "- %s `%s`: %s (ref %s, tol %s)\n", $2, $3, v, r, t }'
+        fi
+    } >>"$tmp"
+    for d in "$src"/*/; do
+        m="$d/meta.txt"
+        [ -f "$m" ] || continue
+        name=$(meta "$m" case)
+        st=$(staleness "$d")
+        {
+            echo
+            echo "## $name"
+            echo
+            printf 'Ran on %s%s, %s, %s tier: %s. CPU %s s, wall %s s, exit status %s. Depends on fsdem.h: %s.\n' \
+                "$(meta "$m" commit)" "$( [ "$(meta "$m" dirty)" = 1 ] && echo ' (+ uncommitted changes)' )" \
+                "$(meta "$m" date)" "$(meta "$m" tier)" "$(meta "$m" resolution)" "$(meta "$m" cpu_s)" \
+                "$(meta "$m" wall_s)" "$(meta "$m" rc)" "$(meta "$m" depends)"
+            [ "$st" = current ] || { echo; echo "**${st%%:*}**:${st#*:}; re-run it (\`make validate$( [ "$tier" = full ] && echo -full) CASES=$name\`)."; }
+            [ -n "$(meta "$m" plots)" ] && { echo; echo "Plots: $(meta "$m" plots)."; }
+            echo
+            echo "| metric | value | ref | tol | result |"
+            echo "|---|---|---|---|---|"
+            awk '$1 == "CHECK" { v = $4; r = $5; t = $6; sub(/^value=/, "", v); sub(/^ref=/, "", r); sub(/^tol=/, "", t)
+                    printf "| %s | %s | %s | %s | %s |\n", $3, v, r, t, $NF == "PASS" ? "PASS" : "**" $NF "**" }' "$d/checks.txt"
+            if grep -q '^INFO .* (full tier)$' "$d/checks.txt"; then
+                echo
+                echo "Lines of the full tier, with this tier's figures:"
+                echo
+                awk '$1 == "INFO" && / \(full tier\)$/ { v = $4; r = $5; t = $6; sub(/^value=/, "", v); sub(/^ref=/, "", r); sub(/^tol=/, "", t)
+                    printf "- `%s`: %s (ref %s, tol %s)\n", $3, v, r, t }' "$d/checks.txt"
+            fi
+            if grep '^INFO ' "$d/checks.txt" | grep -qv ' (full tier)$'; then
+                echo
+                grep '^INFO ' "$d/checks.txt" | grep -v ' (full tier)$' | sed 's/^INFO [^ ]* /- /'
+            fi
+            first=1
+            for p in "$d"/*.png; do
+                [ -f "$p" ] || continue
+                [ $first = 1 ] && echo && first=0
+                echo "![$name $(basename "$p")]($img$name/$(basename "$p"))"
+            done
+        } >>"$tmp"
+    done
+    mv "$tmp" "$out"
+}
+
+# ---- order ----
+
+order() { # tier case...
+    tier=$1
+    shift
+    for c in "$@"; do
+        m="$here/report-$tier/$c/meta.txt"
+        w=1e9
+        [ -f "$m" ] && w=$(meta "$m" wall_s)
+        echo "$w $c"
+    done | sort -g -r | awk '{ printf "%s ", $2 } END { print "" }'
+}
+
+cmd=${1:-}
+[ $# -gt 0 ] && shift
+case "$cmd" in
+run) [ $# -eq 4 ] || die "usage: run TIER CASE OUT_ROOT DATA_DIR"; run_case "$@" ;;
+render) [ $# -ge 3 ] || die "usage: render TIER SRC_ROOT OUT_MD [IMG_PREFIX]"; render "$@" ;;
+verdict) [ $# -ge 1 ] || die "usage: verdict OUT_ROOT CASE..."; verdict "$@" ;;
+status) status ;;
+fingerprint) [ $# -ge 1 ] || die "usage: fingerprint CASE [FSDEM_H]"; fingerprint "$@" ;;
+order) [ $# -ge 1 ] || die "usage: order TIER CASE..."; order "$@" ;;
+*) die "usage: tiers.sh run|render|verdict|status|fingerprint|order ... (see the comment at its top)" ;;
+esac
