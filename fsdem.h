@@ -597,6 +597,52 @@ typedef enum fsdem_dem_law {
     FSDEM_DEM_LAW_GIC = 2
 } fsdem_dem_law;
 
+/* Contact options (LIGGGHTS users set them in their pair_style). Hand calculations of a two-sphere
+   contact for each: tests/test_dem.c, "contact options". */
+
+/* How a tangential spring carries its history from step to step (Hertz-Mindlin, and the linear law
+   with seed 002's stiffness; seed 000's linear law has a one-step spring, Eq. 8, and no history). */
+typedef enum fsdem_dem_tangential_history {
+    /* the spring of the last step turned into the current tangent plane with its length kept, plus
+       the increment v_t dt: a contact that rolls round its partner carries its spring with it
+       (Luding 2008, Granular Matter 10:235, the projection of the tangential spring; LIGGGHTS
+       `tangential history`); the default */
+    FSDEM_DEM_TANGENTIAL_HISTORY_INCREMENTAL = 0,
+    /* the total relative tangential displacement since first touch: the increments v_t dt summed in
+       the fixed frame, never turned, and projected on the current tangent plane where the force is
+       taken (the shear displacement of Cundall and Strack 1979); the same as INCREMENTAL while the
+       contact normal keeps its direction */
+    FSDEM_DEM_TANGENTIAL_HISTORY_TOTAL = 1
+} fsdem_dem_tangential_history;
+
+/* What Coulomb's limit mu |F_n| caps, while the contact slides the spring is reset to the capped
+   force. LIGGGHTS' own `limitForce` keyword is another matter: it keeps the normal force from
+   turning attractive, which Hertz-Mindlin here always does and the linear laws, as their seeds
+   print them (seed 000 Eq. 7, seed 002 Eq. 19), do not. */
+typedef enum fsdem_dem_coulomb_limit {
+    /* spring plus dashpot: |F_t| <= mu |F_n| (seed 000 Eq. 15, seed 002 Eq. 20); the default */
+    FSDEM_DEM_COULOMB_LIMIT_TOTAL = 0,
+    /* the spring alone, the dashpot added after: |k_t xi| <= mu |F_n| ("Ft and Fn are the tangential
+       spring and normal force components" of LIGGGHTS `tangential history`); a sliding contact's
+       force then exceeds mu |F_n| by its dashpot */
+    FSDEM_DEM_COULOMB_LIMIT_SPRING = 1
+} fsdem_dem_coulomb_limit;
+
+/* Stiffness and damping of FSDEM_DEM_LAW_LINEAR. */
+typedef enum fsdem_dem_linear_stiffness {
+    /* seed 000 Eq. 10-13: k_n from theta, dx and ||g|| per unit of the mean mass, damping from the
+       materials' alpha, a one-step tangential spring (Eq. 8); the default */
+    FSDEM_DEM_LINEAR_STIFFNESS_SEED000 = 0,
+    /* seed 002 Eq. 19-24 from the materials: chi^n = (sqrt 2 / 3) E sqrt(R) / (1 - nu^2) (Eq. 21),
+       written for a pair as (4/3) E* sqrt(R*), to which it reduces for two equal spheres;
+       chi^t = chi^n / (2 + nu) (Eq. 22); eta = -2 ln(e) sqrt(chi m* / (ln^2 e + pi^2)) (Eq. 23-24,
+       with the reduced mass m*, which makes the normal restitution exactly e); a tangential spring
+       with history (desc.tangential_history); no tension cut-off, as printed. Eq. 21 has the units of
+       a Hertz coefficient (N m^-3/2), and the seed uses it as a linear stiffness (N/m) in SI units:
+       so does this option. The dt rule AUTO is then the Rayleigh time (seed 002 Eq. 38). */
+    FSDEM_DEM_LINEAR_STIFFNESS_SEED002 = 1
+} fsdem_dem_linear_stiffness;
+
 typedef enum fsdem_dem_integrator {
     /* Velocity Verlet (kick-drift-kick), one force evaluation per step: second order for elastic
        forces; dashpots see the half-step velocity, which makes damping first order in dt (resolve
@@ -615,14 +661,29 @@ typedef struct fsdem_dem_material {
     fsdem_real friction;         /* -; Coulomb sliding coefficient mu (tan phi for GIC); default 0.3 */
     fsdem_real rolling_friction; /* -; constant-torque rolling resistance mu_r; default 0 (off) */
     fsdem_real damping_alpha;    /* -; alpha of seed 000 Eq. 11, linear law; default 0.4 */
+    fsdem_real cohesion;         /* J/m^3; cohesion energy density k of the simplified JKR model: */
+                                 /*    an attraction k A, A the area of the circle where the two */
+                                 /*    spheres (with the contact offset) intersect (3D), or the */
+                                 /*    chord times disc_length (2D) (LIGGGHTS `cohesion sjkr`); */
+                                 /*    default 0 (off) */
 } fsdem_dem_material;
 
 FSDEM_API fsdem_dem_material fsdem_dem_material_default(void);
 
+/* The contact properties of one pair of materials (LIGGGHTS' peratomtypepair tables). Unless set
+   with fsdem_dem_set_material_pair, a pair takes the arithmetic mean of its two materials' values
+   (their own values for a material with itself). */
+typedef struct fsdem_dem_material_pair {
+    fsdem_real restitution;      /* -; in [1e-6, 1] */
+    fsdem_real friction;         /* -; >= 0 */
+    fsdem_real rolling_friction; /* -; >= 0 */
+    fsdem_real cohesion;         /* J/m^3; >= 0 */
+} fsdem_dem_material_pair;
+
 /* Rule of fsdem_dem_stable_dt (and of the dt warning, fsdem_dem_stats.dt_ratio). */
 typedef enum fsdem_dem_dt_rule {
-    /* the rule of the contact law: LINEAR_SEED000 for FSDEM_DEM_LAW_LINEAR, RAYLEIGH for
-       FSDEM_DEM_LAW_HERTZ_MINDLIN, GIC for FSDEM_DEM_LAW_GIC */
+    /* the rule of the contact law: LINEAR_SEED000 for FSDEM_DEM_LAW_LINEAR (RAYLEIGH with seed 002's
+       stiffness), RAYLEIGH for FSDEM_DEM_LAW_HERTZ_MINDLIN, GIC for FSDEM_DEM_LAW_GIC */
     FSDEM_DEM_DT_RULE_AUTO = 0,
     /* seed 000 Eq. 18: (2 pi / gamma) sqrt(m_ij / k), k from Eq. 10; dt_param is gamma (default 150) */
     FSDEM_DEM_DT_RULE_LINEAR_SEED000 = 1,
@@ -651,6 +712,11 @@ typedef struct fsdem_dem_desc {
     fsdem_real linear_accel;        /* m/s^2; ||g|| of Eq. 10; default 0: use |gravity| */
     fsdem_real disc_length;         /* m; out-of-plane length of 2D discs; default 1 */
     int rotation;                   /* 1: integrate angular velocity; 0: translation only (seed 004) */
+    int tangential_damping;         /* 1: tangential dashpot on (Hertz-Mindlin, linear laws); */
+                                    /*    default 1 (LIGGGHTS `tangential_damping`) */
+    fsdem_dem_tangential_history tangential_history; /* default INCREMENTAL (see the enum) */
+    fsdem_dem_coulomb_limit coulomb_limit;   /* default TOTAL (see the enum) */
+    fsdem_dem_linear_stiffness linear_stiffness; /* linear law only; default SEED000 */
     int capacity;                   /* initial particle capacity (grows as needed); default 1024 */
     fsdem_allocator allocator;      /* default: FSDEM_MALLOC/FSDEM_FREE */
     fsdem_log_fn log;               /* optional; default NULL */
@@ -673,6 +739,12 @@ FSDEM_API const char *fsdem_dem_last_error(const fsdem_dem *dem);
 /* Adds a material; its index goes to *index (may be NULL). FSDEM_ERR_INVALID_ARG names the field. */
 FSDEM_API fsdem_result fsdem_dem_add_material(fsdem_dem *dem, const fsdem_dem_material *material,
                                               int *index);
+/* Sets the contact properties of the pair of materials a and b (either order, a == b allowed),
+   replacing their mean. FSDEM_ERR_NOT_FOUND for a bad index, FSDEM_ERR_INVALID_ARG names a bad
+   field (nothing changes then). */
+FSDEM_API fsdem_result fsdem_dem_set_material_pair(fsdem_dem *dem, int a, int b, const fsdem_dem_material_pair *values);
+/* The contact properties of the pair a, b in force (zeros for a bad index). */
+FSDEM_API fsdem_dem_material_pair fsdem_dem_get_material_pair(const fsdem_dem *dem, int a, int b);
 
 typedef struct fsdem_dem_particle_desc {
     fsdem_vec3 position;         /* m; inside the domain */
@@ -2503,7 +2575,7 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
    Model. Create the object from the desc it was saved with (the allocator, log and callbacks are
    yours), then restore the state into it. What can change after creation comes from the save and
    replaces what the object holds:
-     fsdem_dem      materials, walls (positions, velocities, forces, impulses), particles (ids,
+     fsdem_dem      materials with their pair tables, walls (positions, velocities, forces, impulses), particles (ids,
                     kinematics, the contact forces of the last evaluation, external loads), the
                     neighbour lists with their tangential springs, dt, time, counters;
      fsdem_pic      particles (APIC matrices too) and their capacity, the random-number state,
@@ -2526,7 +2598,7 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
                     created with, and its own counters and per-body load records.
    What must match (else FSDEM_ERR_INVALID_ARG naming the field): the desc fields that steps read.
    DEM: dim, domain, gravity, law, integrator, dt_rule, dt_param, skin, contact_offset, linear_*,
-   disc_length, rotation. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,
+   disc_length, rotation, the contact options (tangential_*, coulomb_limit), periodic. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,
    viscosity, gravity, boundaries, transfer, kernel, seeding and reseeding, advection, cfl,
    dt_max, ghost-fluid, extrapolation and solver settings. SWE: dim, nx, ny, extent, width,
    gravity, density, cfl, dt_max, order, limiter, dry_depth, manning, eddy_viscosity. Coupler:
@@ -2554,7 +2626,7 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
    is written in place: one cut short by a crash is refused by its checksum, so alternate between
    two paths to always keep a good checkpoint.
 
-   Format (version 1): a 64-byte header, then the payload.
+   Format (version 2): a 64-byte header, then the payload.
      offset  bytes  field
           0      8  magic "FSDEMRST"
           8      4  format version (unsigned)
@@ -3699,13 +3771,17 @@ typedef struct fsdem__dem_pair {
     fsdem_real friction; /* -, mean mu */
     fsdem_real rolling;  /* -, mean mu_r */
     fsdem_real restitution; /* -, mean e */
+    fsdem_real cohesion; /* J/m^3, mean cohesion energy density */
     fsdem_real tsuji;    /* -, damping coefficient giving that restitution (>>dem_law) */
     /* The law's coefficients in the form the contact kernel evaluates (fsdem__dem_batch_law):
          law      kn                  cn                      kt                 ct
          Hertz    (4/3) E* (Pa)       tsuji^2 (4/3) E* (Pa)   8 G* (Pa)          sqrt(4 G* / E*)
          linear   ||g||/(theta dx)    2 alpha sqrt(kn)        1/(2(1+psi))       1/sqrt(2(1+psi))
                   (1/s^2)             (1/s)                   seed 000 Eq. 10-13 per unit m_ij
-         GIC      2 E_pair (Pa)       0                       1/(2(1+nu))        0 */
+         seed 002 (4/3) E* (Pa)       2 zeta, zeta =          1/(2+nu)           sqrt(kt)
+         linear                       -ln e/sqrt(ln^2 e + pi^2)   (Eq. 21-24, times sqrt(R*))
+         GIC      2 E_pair (Pa)       0                       1/(2(1+nu))        0
+       ct is 0 without tangential damping (desc.tangential_damping). */
     fsdem_real kn, cn, kt, ct;
 } fsdem__dem_pair;
 
@@ -3785,6 +3861,7 @@ struct fsdem_dem {
     fsdem_real skin, r_max, max_disp2, k0_linear;
     int need_rebuild, forces_valid;
     int rolling;  /* some material pair has rolling resistance */
+    int cohesive; /* some material pair has cohesion */
     int external; /* fext/text may be nonzero (fsdem_dem_get_coupling handed them out, or a coupler wrote them) */
     int forces_cleared; /* f and t were zeroed by the last Verlet pass, for the force evaluation */
     int contacts, wall_contacts;
@@ -3802,6 +3879,7 @@ fsdem_dem_material fsdem_dem_material_default(void) {
     m.friction = (fsdem_real)0.3;
     m.rolling_friction = 0;
     m.damping_alpha = (fsdem_real)0.4;
+    m.cohesion = 0;
     return m;
 }
 
@@ -3824,8 +3902,17 @@ fsdem_dem_desc fsdem_dem_desc_default(int dim) {
     d.linear_accel = 0;
     d.disc_length = 1;
     d.rotation = 1;
+    d.tangential_damping = 1;
+    d.tangential_history = FSDEM_DEM_TANGENTIAL_HISTORY_INCREMENTAL;
+    d.coulomb_limit = FSDEM_DEM_COULOMB_LIMIT_TOTAL;
+    d.linear_stiffness = FSDEM_DEM_LINEAR_STIFFNESS_SEED000;
     d.capacity = 1024;
     return d;
+}
+
+/* The linear law with the stiffness of seed 000 Eq. 10 (theta, dx, ||g||). */
+static int fsdem__dem_seed000_stiffness(const fsdem_dem_desc *d) {
+    return d->law == FSDEM_DEM_LAW_LINEAR && d->linear_stiffness == FSDEM_DEM_LINEAR_STIFFNESS_SEED000;
 }
 
 fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t size) {
@@ -3853,11 +3940,22 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
     if (!(d->dt_param >= 0) || !fsdem__finite(d->dt_param))
         return fsdem__reject(msg, size, "fsdem_dem_desc.dt_param must be >= 0 (got %g)", (double)d->dt_param);
     if (d->dt_param > 1 && d->dt_rule != FSDEM_DEM_DT_RULE_LINEAR_SEED000 &&
-        !(d->dt_rule == FSDEM_DEM_DT_RULE_AUTO && d->law == FSDEM_DEM_LAW_LINEAR))
+        !(d->dt_rule == FSDEM_DEM_DT_RULE_AUTO && fsdem__dem_seed000_stiffness(d)))
         return fsdem__reject(msg, size, "fsdem_dem_desc.dt_param: a safety fraction must be in (0, 1] (got %g)",
                              (double)d->dt_param);
-    if (d->dt_rule == FSDEM_DEM_DT_RULE_LINEAR_SEED000 && d->law != FSDEM_DEM_LAW_LINEAR)
-        return fsdem__reject(msg, size, "fsdem_dem_desc.dt_rule FSDEM_DEM_DT_RULE_LINEAR_SEED000 needs the linear law");
+    if (d->tangential_damping != 0 && d->tangential_damping != 1)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.tangential_damping must be 0 or 1 (got %d)", d->tangential_damping);
+    if ((int)d->tangential_history < 0 || (int)d->tangential_history > 1)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.tangential_history is not a fsdem_dem_tangential_history (%d)",
+                             (int)d->tangential_history);
+    if ((int)d->coulomb_limit < 0 || (int)d->coulomb_limit > 1)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.coulomb_limit is not a fsdem_dem_coulomb_limit (%d)", (int)d->coulomb_limit);
+    if ((int)d->linear_stiffness < 0 || (int)d->linear_stiffness > 1)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.linear_stiffness is not a fsdem_dem_linear_stiffness (%d)",
+                             (int)d->linear_stiffness);
+    if (d->dt_rule == FSDEM_DEM_DT_RULE_LINEAR_SEED000 && !fsdem__dem_seed000_stiffness(d))
+        return fsdem__reject(msg, size,
+                             "fsdem_dem_desc.dt_rule FSDEM_DEM_DT_RULE_LINEAR_SEED000 needs the linear law with seed 000's stiffness");
     if (!fsdem__finite(d->skin)) return fsdem__reject(msg, size, "fsdem_dem_desc.skin is not finite");
     if (!(d->contact_offset >= 0) || !fsdem__finite(d->contact_offset))
         return fsdem__reject(msg, size, "fsdem_dem_desc.contact_offset must be >= 0 (got %g m)",
@@ -3867,7 +3965,7 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
     if (d->capacity < 0) return fsdem__reject(msg, size, "fsdem_dem_desc.capacity must be >= 0");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return fsdem__reject(msg, size, "fsdem_dem_desc.allocator: set both alloc and free, or neither");
-    if (d->law == FSDEM_DEM_LAW_LINEAR) {
+    if (fsdem__dem_seed000_stiffness(d)) {
         fsdem_real accel = d->linear_accel > 0 ? d->linear_accel : fsdem__norm(d->gravity);
         if (!(d->linear_theta > 0) || !fsdem__finite(d->linear_theta))
             return fsdem__reject(msg, size, "fsdem_dem_desc.linear_theta must be > 0 (got %g)", (double)d->linear_theta);
@@ -3903,6 +4001,8 @@ static fsdem_result fsdem__dem_material_check(const fsdem_dem_material *m, char 
                              (double)m->rolling_friction);
     if (!(m->damping_alpha >= 0) || !fsdem__finite(m->damping_alpha))
         return fsdem__reject(msg, size, "fsdem_dem_material.damping_alpha must be >= 0 (got %g)", (double)m->damping_alpha);
+    if (!(m->cohesion >= 0) || !fsdem__finite(m->cohesion))
+        return fsdem__reject(msg, size, "fsdem_dem_material.cohesion must be >= 0 (got %g J/m^3)", (double)m->cohesion);
     return FSDEM_OK;
 }
 
@@ -4019,15 +4119,51 @@ static fsdem_real fsdem__dem_tsuji_coefficient(fsdem_real e) {
     return (fsdem_real)(0.5 * (lo + hi));
 }
 
-static void fsdem__dem_pair_setup(fsdem__dem_pair *p, const fsdem_dem_material *a, const fsdem_dem_material *b, fsdem_dem_law law,
-                              fsdem_real k0_linear, const fsdem__dem_pair *known, int known_count) {
+/* The law's coefficients of a pair from its moduli and its (mixed or set) properties. `known`
+   (known_count pairs) are pairs set up before, whose Hertz damping calibration is reused for a
+   restitution seen before: it costs a few milliseconds. */
+static void fsdem__dem_pair_coefficients(fsdem__dem_pair *p, const fsdem_dem_desc *desc, fsdem_real k0_linear,
+                                         const fsdem__dem_pair *known, int known_count) {
+    const fsdem_real e = p->restitution;
+    int k;
+    p->tsuji = 0;
+    if (desc->law == FSDEM_DEM_LAW_HERTZ_MINDLIN) {
+        for (k = 0; k < known_count && known[k].restitution != e; ++k) {
+        }
+        p->tsuji = k < known_count ? known[k].tsuji : fsdem__dem_tsuji_coefficient(e);
+    }
+    if (fsdem__dem_seed000_stiffness(desc)) {
+        p->kn = k0_linear;
+        p->cn = 2 * p->alpha * (fsdem_real)sqrt(k0_linear);
+        p->kt = 1 / (2 * (1 + p->nu));
+        p->ct = 1 / (fsdem_real)sqrt(2 * (1 + p->nu));
+    } else if (desc->law == FSDEM_DEM_LAW_LINEAR) { /* seed 002 Eq. 21-24 */
+        const double ln_e = log((double)e);
+        p->kn = (fsdem_real)(4.0 / 3.0) * p->e_star;
+        p->cn = (fsdem_real)(-2 * ln_e / sqrt(ln_e * ln_e + FSDEM__PI * FSDEM__PI));
+        p->kt = 1 / (2 + p->nu);
+        p->ct = (fsdem_real)sqrt(p->kt);
+    } else if (desc->law == FSDEM_DEM_LAW_GIC) {
+        p->kn = 2 * p->e_pair;
+        p->cn = p->ct = 0;
+        p->kt = 1 / (2 * (1 + p->nu));
+    } else {
+        p->kn = (fsdem_real)(4.0 / 3.0) * p->e_star;
+        p->cn = p->tsuji * p->tsuji * p->kn;
+        p->kt = 8 * p->g_star;
+        p->ct = (fsdem_real)sqrt(4 * p->g_star / p->e_star);
+    }
+    if (!desc->tangential_damping && desc->law != FSDEM_DEM_LAW_GIC) p->ct = 0;
+}
+
+/* A pair of materials: moduli, and the means of their contact properties (fsdem_dem_material_pair). */
+static void fsdem__dem_pair_setup(fsdem__dem_pair *p, const fsdem_dem_material *a, const fsdem_dem_material *b, const fsdem_dem_desc *desc,
+                                  fsdem_real k0_linear, const fsdem__dem_pair *known, int known_count) {
     fsdem_real ea = a->young_modulus, eb = b->young_modulus, na = a->poisson_ratio, nb = b->poisson_ratio;
-    fsdem_real e = (a->restitution + b->restitution) / 2;
     const fsdem_real ia = 1 / ea, ib = 1 / eb;
     fsdem_real inv_e = (1 - na * na) * ia + (1 - nb * nb) * ib;
     fsdem_real inv_g = 2 * (2 - na) * (1 + na) * ia + 2 * (2 - nb) * (1 + nb) * ib;
     fsdem_real inv_ep = ia + ib;
-    int k;
     p->e_star = 1 / inv_e;
     p->g_star = 1 / inv_g;
     p->e_pair = 2 / inv_ep;
@@ -4035,33 +4171,9 @@ static void fsdem__dem_pair_setup(fsdem__dem_pair *p, const fsdem_dem_material *
     p->alpha = (a->damping_alpha + b->damping_alpha) / 2;
     p->friction = (a->friction + b->friction) / 2;
     p->rolling = (a->rolling_friction + b->rolling_friction) / 2;
-    p->restitution = e;
-    p->tsuji = 0;
-    if (law == FSDEM_DEM_LAW_HERTZ_MINDLIN) {
-        /* The calibration costs a few milliseconds; reuse it for a restitution seen before. */
-        for (k = 0; k < known_count && known[k].restitution != e; ++k) {
-        }
-        p->tsuji = k < known_count ? known[k].tsuji : fsdem__dem_tsuji_coefficient(e);
-    }
-    switch (law) {
-    case FSDEM_DEM_LAW_LINEAR:
-        p->kn = k0_linear;
-        p->cn = 2 * p->alpha * (fsdem_real)sqrt(k0_linear);
-        p->kt = 1 / (2 * (1 + p->nu));
-        p->ct = 1 / (fsdem_real)sqrt(2 * (1 + p->nu));
-        break;
-    case FSDEM_DEM_LAW_GIC:
-        p->kn = 2 * p->e_pair;
-        p->cn = p->ct = 0;
-        p->kt = 1 / (2 * (1 + p->nu));
-        break;
-    default:
-        p->kn = (fsdem_real)(4.0 / 3.0) * p->e_star;
-        p->cn = p->tsuji * p->tsuji * p->kn;
-        p->kt = 8 * p->g_star;
-        p->ct = (fsdem_real)sqrt(4 * p->g_star / p->e_star);
-        break;
-    }
+    p->restitution = (a->restitution + b->restitution) / 2;
+    p->cohesion = (a->cohesion + b->cohesion) / 2;
+    fsdem__dem_pair_coefficients(p, desc, k0_linear, known, known_count);
 }
 
 /* Contacts in structure-of-arrays form, up to FSDEM__DEM_BATCH at a time, for the vector kernel below
@@ -4091,6 +4203,7 @@ typedef struct fsdem__dem_batch {
     fsdem_real arm_i[FSDEM__DEM_BATCH];   /* m, centre of i to the contact point */
     fsdem_real kn[FSDEM__DEM_BATCH], cn[FSDEM__DEM_BATCH], kt[FSDEM__DEM_BATCH], ct[FSDEM__DEM_BATCH]; /* fsdem__dem_pair */
     fsdem_real mu[FSDEM__DEM_BATCH];      /* -, Coulomb coefficient */
+    fsdem_real coh[FSDEM__DEM_BATCH];     /* J/m^3, cohesion energy density */
     fsdem_real spring[3][FSDEM__DEM_BATCH]; /* m, tangential spring: held value in, new value out */
     /* output */
     fsdem_real force[3][FSDEM__DEM_BATCH];    /* N, on i */
@@ -4135,6 +4248,7 @@ static void fsdem__dem_batch_pad(fsdem__dem_batch *b, int pairs, int uniform) {
             b->kt[c] = b->kt[0];
             b->ct[c] = b->ct[0];
             b->mu[c] = b->mu[0];
+            b->coh[c] = b->coh[0];
         }
     }
 }
@@ -4154,6 +4268,19 @@ static void fsdem__dem_batch_pad(fsdem__dem_batch *b, int pairs, int uniform) {
 typedef struct fsdem__dem_lanes {
     fsdem__lane nx, ny, nz, vx, vy, vz, vn, delta, m_eff, r_eff, kn, cn, kt, ct, mu;
 } fsdem__dem_lanes;
+
+/* The contact options of a simulation as the kernels read them (fsdem_dem_desc, >>dem). */
+typedef struct fsdem__dem_rules {
+    int total_history;      /* FSDEM_DEM_TANGENTIAL_HISTORY_TOTAL */
+    int cap_spring;         /* FSDEM_DEM_COULOMB_LIMIT_SPRING */
+    int cohesion;           /* some material pair is cohesive: add the attraction k A */
+    fsdem_real offset;      /* m, the contact offset: the spheres of the cohesive area are r + offset/2 */
+    fsdem_real area_depth;  /* m, 2D: the disc length (the area is the chord times it); 3D: 0 (pi a^2) */
+} fsdem__dem_rules;
+
+/* The linear law with seed 002's stiffness, as the kernels are instantiated for it (not public: a
+   fsdem_dem_linear_stiffness of FSDEM_DEM_LAW_LINEAR). */
+#define FSDEM__DEM_LAW_SEED002 ((fsdem_dem_law)3)
 
 /* Coulomb cap |F_t| <= ft_max on a tangential force (seed 000 Eq. 15, seed 004 Eq. 1b), for the laws
    without a tangential history. */
@@ -4192,42 +4319,64 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_gic(const fsdem__dem_lanes *k, fs
     return fn;
 }
 
-/* Hertz-Mindlin. With s = sqrt(R* d): normal stiffness S_n = 2 E* s, elastic force (2/3) S_n d =
-   (4/3) E* s d; tangential stiffness S_t = 8 G* s on the accumulated tangential displacement (seed
-   002 Eq. 20, Coulomb sliding Eq. 22) held in the batch's spring of lane group c, updated in place.
-   Damping eta = a sqrt((2/3) m* S), Tsuji's a sqrt(m* k) d^(1/4) with a calibrated from e
-   (fsdem__dem_tsuji_coefficient), so eta_n = sqrt(cn m* s) and eta_t = ct eta_n. */
-FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_hertz(const fsdem__dem_lanes *k, fsdem__dem_batch *b, int c, fsdem_real h,
-                                                    fsdem__lane *tx, fsdem__lane *ty, fsdem__lane *tz) {
-    const fsdem__lane one = fsdem__lane_set(1), zero = fsdem__lane_set(0);
-    const fsdem__lane s = fsdem__lane_sqrt(k->r_eff * k->delta);
-    const fsdem__lane eta_n = fsdem__lane_sqrt(k->cn * k->m_eff * s), st = k->kt * s;
-    fsdem__lane sx, sy, sz, sn, len2, proj2, scale, fn, ft_max, ft2, inv;
+/* The tangential force of a spring with history (Hertz-Mindlin, seed 002's linear law): stiffness
+   st, dashpot eta_t, Coulomb's limit ft_max = mu |F_n|; the spring of lane group c of the batch is
+   updated in place by the rules of desc.tangential_history and desc.coulomb_limit (>>dem). While
+   the contact slides, the spring carries the capped force alone: folding the dashpot term into the
+   spring (-(F_t + eta_t v_t)/S_t) would store energy along the slip at first touch, where Hertz's
+   eta_t ~ d^(1/4) outgrows mu F_n ~ d^(3/2). */
+FSDEM__FORCE_INLINE void fsdem__dem_tangential_spring(const fsdem__dem_lanes *k, fsdem__dem_batch *b, int c, fsdem_real h,
+                                                      const fsdem__dem_rules *rules, fsdem__lane st, fsdem__lane eta_t,
+                                                      fsdem__lane ft_max, fsdem__lane *tx, fsdem__lane *ty, fsdem__lane *tz) {
+    const fsdem__lane one = fsdem__lane_set(1);
+    fsdem__lane sx, sy, sz, px, py, pz, sn, scale, ft2, inv;
     fsdem__mask slide;
-    /* the held spring, turned into the current tangent plane with its length kept */
     FSDEM__DEM_LOAD3(s, b->spring, c);
-    len2 = sx * sx + sy * sy + sz * sz;
-    sn = sx * k->nx + sy * k->ny + sz * k->nz;
-    sx -= sn * k->nx;
-    sy -= sn * k->ny;
-    sz -= sn * k->nz;
-    proj2 = sx * sx + sy * sy + sz * sz;
-    /* proj2 = 0 leaves a zero spring, whatever finite scale multiplies it */
-    scale = fsdem__lane_sqrt(len2 / fsdem__lane_select(proj2 > 0, proj2, one));
-    sx = sx * scale + k->vx * h;
-    sy = sy * scale + k->vy * h;
-    sz = sz * scale + k->vz * h;
-    fn = fsdem__lane_max(k->kn * s * k->delta - eta_n * k->vn, zero);
-    *tx = -st * sx - k->ct * eta_n * k->vx;
-    *ty = -st * sy - k->ct * eta_n * k->vy;
-    *tz = -st * sz - k->ct * eta_n * k->vz;
-    ft_max = k->mu * fn;
+    if (rules->total_history) {
+        /* the total displacement: the increment added in the fixed frame, its tangential part taken */
+        sx += k->vx * h;
+        sy += k->vy * h;
+        sz += k->vz * h;
+        sn = sx * k->nx + sy * k->ny + sz * k->nz;
+        px = sx - sn * k->nx;
+        py = sy - sn * k->ny;
+        pz = sz - sn * k->nz;
+    } else {
+        /* the held spring, turned into the current tangent plane with its length kept; proj2 = 0
+           leaves a zero spring, whatever finite scale multiplies it */
+        const fsdem__lane len2 = sx * sx + sy * sy + sz * sz;
+        fsdem__lane proj2;
+        sn = sx * k->nx + sy * k->ny + sz * k->nz;
+        sx -= sn * k->nx;
+        sy -= sn * k->ny;
+        sz -= sn * k->nz;
+        proj2 = sx * sx + sy * sy + sz * sz;
+        scale = fsdem__lane_sqrt(len2 / fsdem__lane_select(proj2 > 0, proj2, one));
+        px = sx = sx * scale + k->vx * h;
+        py = sy = sy * scale + k->vy * h;
+        pz = sz = sz * scale + k->vz * h;
+    }
+    if (rules->cap_spring) {
+        /* the spring alone within mu |F_n|, the dashpot added after */
+        const fsdem__lane fs2 = st * st * (px * px + py * py + pz * pz);
+        slide = fs2 > ft_max * ft_max;
+        scale = fsdem__lane_select(slide, ft_max / fsdem__lane_sqrt(fsdem__lane_select(slide, fs2, one)), one);
+        px *= scale;
+        py *= scale;
+        pz *= scale;
+        *tx = -st * px - eta_t * k->vx;
+        *ty = -st * py - eta_t * k->vy;
+        *tz = -st * pz - eta_t * k->vz;
+        FSDEM__DEM_STORE3(b->spring, c, fsdem__lane_select(slide, px, sx), fsdem__lane_select(slide, py, sy),
+                          fsdem__lane_select(slide, pz, sz));
+        return;
+    }
+    *tx = -st * px - eta_t * k->vx;
+    *ty = -st * py - eta_t * k->vy;
+    *tz = -st * pz - eta_t * k->vz;
     ft2 = *tx * *tx + *ty * *ty + *tz * *tz;
     slide = ft2 > ft_max * ft_max;
-    /* Sliding: cap at Coulomb and let the spring carry the capped force alone. Folding the damping
-       term into the spring (-(F_t + eta_t v_t)/S_t) would store energy along the slip at first
-       touch, where eta_t ~ d^(1/4) outgrows mu F_n ~ d^(3/2). One division gives both 1/|F_t| and
-       1/S_t. */
+    /* sliding: cap at Coulomb, the spring -F_t / S_t; one division gives both 1/|F_t| and 1/S_t */
     ft2 = fsdem__lane_sqrt(fsdem__lane_select(slide, ft2, one)); /* |F_t| where sliding */
     inv = 1 / (ft2 * fsdem__lane_select(slide, st, one));        /* a sliding contact has S_t > 0 */
     scale = fsdem__lane_select(slide, ft_max * st * inv, one);
@@ -4237,22 +4386,60 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_hertz(const fsdem__dem_lanes *k, 
     inv = -ft2 * inv; /* -1/S_t where sliding */
     FSDEM__DEM_STORE3(b->spring, c, fsdem__lane_select(slide, *tx * inv, sx), fsdem__lane_select(slide, *ty * inv, sy),
                       fsdem__lane_select(slide, *tz * inv, sz));
+}
+
+/* Hertz-Mindlin. With s = sqrt(R* d): normal stiffness S_n = 2 E* s, elastic force (2/3) S_n d =
+   (4/3) E* s d; tangential stiffness S_t = 8 G* s on the spring (seed 002 Eq. 20, Coulomb sliding).
+   Damping eta = a sqrt((2/3) m* S), Tsuji's a sqrt(m* k) d^(1/4) with a calibrated from e
+   (fsdem__dem_tsuji_coefficient), so eta_n = sqrt(cn m* s) and eta_t = ct eta_n. The normal force
+   never turns attractive. */
+FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_hertz(const fsdem__dem_lanes *k, fsdem__dem_batch *b, int c, fsdem_real h,
+                                                    const fsdem__dem_rules *rules, fsdem__lane *tx, fsdem__lane *ty, fsdem__lane *tz) {
+    const fsdem__lane s = fsdem__lane_sqrt(k->r_eff * k->delta);
+    const fsdem__lane eta_n = fsdem__lane_sqrt(k->cn * k->m_eff * s);
+    const fsdem__lane fn = fsdem__lane_max(k->kn * s * k->delta - eta_n * k->vn, fsdem__lane_set(0));
+    fsdem__dem_tangential_spring(k, b, c, h, rules, k->kt * s, k->ct * eta_n, k->mu * fn, tx, ty, tz);
     return fn;
+}
+
+/* The linear spring-dashpot of seed 002 Eq. 19-24 (fsdem_dem_linear_stiffness): chi^n = kn sqrt(R*),
+   eta^n = cn sqrt(chi^n m*), chi^t = kt chi^n, eta^t = ct eta^n, the spring with history; no
+   tension cut-off, as printed, so Coulomb's limit takes |F_n|. */
+FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_seed002(const fsdem__dem_lanes *k, fsdem__dem_batch *b, int c, fsdem_real h,
+                                                      const fsdem__dem_rules *rules, fsdem__lane *tx, fsdem__lane *ty, fsdem__lane *tz) {
+    const fsdem__lane chi = k->kn * fsdem__lane_sqrt(k->r_eff);
+    const fsdem__lane eta_n = k->cn * fsdem__lane_sqrt(chi * k->m_eff);
+    const fsdem__lane fn = chi * k->delta - eta_n * k->vn;
+    fsdem__dem_tangential_spring(k, b, c, h, rules, k->kt * chi, k->ct * eta_n, k->mu * fsdem__lane_max(fn, -fn), tx, ty, tz);
+    return fn;
+}
+
+/* The cohesive attraction k A of the simplified JKR model (fsdem_dem_material.cohesion): A is the
+   area of the circle where two spheres of radii r1, r2 whose centres are `dist` apart intersect,
+   pi a^2 with a^2 = r1^2 - x^2, x = (dist^2 + r1^2 - r2^2) / (2 dist) the distance from the first
+   centre to the circle's plane (a plane wall: r2 = infinity, x = r1 - overlap, given as `x`); in
+   2D the area is the chord 2a times the disc length. */
+FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_cohesion(fsdem__lane coh, fsdem__lane r1, fsdem__lane x, const fsdem__dem_rules *rules) {
+    const fsdem__lane a2 = fsdem__lane_max(r1 * r1 - x * x, fsdem__lane_set(0));
+    return coh * (rules->area_depth > 0 ? 2 * fsdem__lane_sqrt(a2) * fsdem__lane_set(rules->area_depth)
+                                       : (fsdem_real)FSDEM__PI * a2);
 }
 
 /* The contact law on every contact of a batch: force and torques, normal force, new spring (laws
    with history). With `pairs`, the contacts are first made from the particle-pair input: normal,
    overlap (offset `off` included), velocity of the contact point, effective mass and radius, lever
    arms (each body's radius less half the overlap). With `uniform`, every contact has that material
-   pair and the batch holds no coefficients. Written once, branch-free, and inlined with a constant
-   `law` and `pairs`. h is the step the spring and seed 000's one-step tangential spring (Eq. 8) use. */
+   pair and the batch holds no coefficients. `rules` are the contact options. Written once,
+   branch-free, and inlined with a constant `law` and `pairs`. h is the step the spring and seed
+   000's one-step tangential spring (Eq. 8) use. The normal force the law gives goes to b->fn
+   (rolling resistance and Coulomb's limit take it); cohesion is added to the force after. */
 FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_dem_law law, fsdem_real h, const int pairs,
-                                          fsdem_real off, const fsdem__dem_pair *uniform) {
+                                          fsdem_real off, const fsdem__dem_pair *uniform, const fsdem__dem_rules *rules) {
     const fsdem__lane one = fsdem__lane_set(1), zero = fsdem__lane_set(0);
     int c;
     for (c = 0; c < b->count; c += FSDEM__LANES) {
         fsdem__dem_lanes k;
-        fsdem__lane tx, ty, tz, mx, my, mz, arm_i, arm_j, fn;
+        fsdem__lane tx, ty, tz, mx, my, mz, arm_i, arm_j, fn, pull = zero;
         if (pairs) {
             fsdem__lane dxx, dxy, dxz, wix, wiy, wiz, wjx, wjy, wjz, ax, ay, az, dist, q, safe, inv, vx, vy, vz;
             const fsdem__lane ri = fsdem__lane_load(&b->ri[c]), rj = fsdem__lane_load(&b->rj[c]);
@@ -4288,6 +4475,11 @@ FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_d
             k.vz = vz - (ax * k.ny - ay * k.nx);
             fsdem__lane_store(&b->delta[c], k.delta);
             fsdem__lane_store(&b->r_eff[c], k.r_eff);
+            if (rules->cohesion) {
+                const fsdem__lane r1 = ri + (fsdem_real)0.5 * off, r2 = rj + (fsdem_real)0.5 * off;
+                const fsdem__lane coh = uniform ? fsdem__lane_set(uniform->cohesion) : fsdem__lane_load(&b->coh[c]);
+                pull = fsdem__dem_cohesion(coh, r1, (dist * dist + r1 * r1 - r2 * r2) / (2 * safe), rules);
+            }
         } else {
             FSDEM__DEM_LOAD3(k.n, b->n, c);
             FSDEM__DEM_LOAD3(k.v, b->vrel, c);
@@ -4296,6 +4488,11 @@ FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_d
             k.r_eff = fsdem__lane_load(&b->r_eff[c]);
             arm_i = fsdem__lane_load(&b->arm_i[c]);
             arm_j = zero;
+            if (rules->cohesion) {
+                const fsdem__lane r1 = k.r_eff + rules->offset;
+                const fsdem__lane coh = uniform ? fsdem__lane_set(uniform->cohesion) : fsdem__lane_load(&b->coh[c]);
+                pull = fsdem__dem_cohesion(coh, r1, r1 - k.delta, rules);
+            }
         }
         if (uniform) {
             k.kn = fsdem__lane_set(uniform->kn);
@@ -4316,9 +4513,11 @@ FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_d
         k.vz -= k.vn * k.nz;
         if (law == FSDEM_DEM_LAW_LINEAR) fn = fsdem__dem_law_linear(&k, fsdem__lane_load(&b->m_mean[c]), h, &tx, &ty, &tz);
         else if (law == FSDEM_DEM_LAW_GIC) fn = fsdem__dem_law_gic(&k, &tx, &ty, &tz);
-        else fn = fsdem__dem_law_hertz(&k, b, c, h, &tx, &ty, &tz);
-        FSDEM__DEM_STORE3(b->force, c, tx + fn * k.nx, ty + fn * k.ny, tz + fn * k.nz);
+        else if (law == FSDEM__DEM_LAW_SEED002) fn = fsdem__dem_law_seed002(&k, b, c, h, rules, &tx, &ty, &tz);
+        else fn = fsdem__dem_law_hertz(&k, b, c, h, rules, &tx, &ty, &tz);
         fsdem__lane_store(&b->fn[c], fn);
+        if (rules->cohesion) fn -= pull;
+        FSDEM__DEM_STORE3(b->force, c, tx + fn * k.nx, ty + fn * k.ny, tz + fn * k.nz);
         /* torques: the arms point along -n from i and +n from the partner, torque = arm x F, and
            n x F = n x F_t */
         mx = k.ny * tz - k.nz * ty;
@@ -4423,9 +4622,9 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     if (!d) return res;
     d->desc = *desc;
     if (desc->dt_rule == FSDEM_DEM_DT_RULE_AUTO)
-        d->desc.dt_rule = desc->law == FSDEM_DEM_LAW_LINEAR  ? FSDEM_DEM_DT_RULE_LINEAR_SEED000
-                          : desc->law == FSDEM_DEM_LAW_GIC ? FSDEM_DEM_DT_RULE_GIC
-                                                           : FSDEM_DEM_DT_RULE_RAYLEIGH;
+        d->desc.dt_rule = fsdem__dem_seed000_stiffness(desc) ? FSDEM_DEM_DT_RULE_LINEAR_SEED000
+                          : desc->law == FSDEM_DEM_LAW_GIC   ? FSDEM_DEM_DT_RULE_GIC
+                                                             : FSDEM_DEM_DT_RULE_RAYLEIGH;
     if (desc->dt_param == 0)
         d->desc.dt_param = d->desc.dt_rule == FSDEM_DEM_DT_RULE_LINEAR_SEED000 ? 150
                            : d->desc.dt_rule == FSDEM_DEM_DT_RULE_RAYLEIGH   ? (fsdem_real)0.2
@@ -4438,7 +4637,7 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     d->need_rebuild = 1;
     {
         fsdem_real accel = desc->linear_accel > 0 ? desc->linear_accel : fsdem__norm(desc->gravity);
-        d->k0_linear = desc->law == FSDEM_DEM_LAW_LINEAR ? accel / (desc->linear_theta * desc->linear_dx) : 0;
+        d->k0_linear = fsdem__dem_seed000_stiffness(desc) ? accel / (desc->linear_theta * desc->linear_dx) : 0;
     }
     res = fsdem__dem_reserve_particles(d, desc->capacity > 0 ? desc->capacity : 1);
     if (res != FSDEM_OK) {
@@ -4476,6 +4675,16 @@ void fsdem_dem_destroy(fsdem_dem *d) {
 
 const char *fsdem_dem_last_error(const fsdem_dem *d) { return d ? d->status.message : "fsdem_dem is NULL"; }
 
+/* Whether some pair of materials has rolling resistance or cohesion (the force loop adds them only then). */
+static void fsdem__dem_pair_flags(fsdem_dem *d) {
+    int k;
+    d->rolling = d->cohesive = 0;
+    for (k = 0; k < d->material_count * d->material_count; ++k) {
+        d->rolling |= d->pairs[k].rolling > 0;
+        d->cohesive |= d->pairs[k].cohesion > 0;
+    }
+}
+
 fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_dem_material *mat, int *index) {
     char msg[FSDEM__MESSAGE_SIZE];
     int nm, a, b;
@@ -4494,7 +4703,7 @@ fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_dem_material *mat,
         for (b = 0; b < nm; ++b) {
             if (a < nm - 1 && b < nm - 1) pairs[a * nm + b] = d->pairs[a * (nm - 1) + b];
             else if (b < a) pairs[a * nm + b] = pairs[b * nm + a];
-            else fsdem__dem_pair_setup(&pairs[a * nm + b], &d->materials[a], &d->materials[b], d->desc.law, d->k0_linear,
+            else fsdem__dem_pair_setup(&pairs[a * nm + b], &d->materials[a], &d->materials[b], &d->desc, d->k0_linear,
                                    pairs, a * nm + b);
         }
     /* the loop reads earlier rows only, which are already in the new table */
@@ -4502,10 +4711,58 @@ fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_dem_material *mat,
     d->pairs = pairs;
     d->pair_capacity = nm * nm;
     d->material_count = nm;
-    for (a = 0; a < nm * nm; ++a) d->rolling |= pairs[a].rolling > 0;
+    fsdem__dem_pair_flags(d);
     d->forces_valid = 0;
     if (index) *index = nm - 1;
     return fsdem__ok(&d->status);
+}
+
+static fsdem_result fsdem__dem_material_pair_check(const fsdem_dem_material_pair *v, char *msg, size_t size) {
+    if (!v) return fsdem__reject(msg, size, "fsdem_dem_set_material_pair: values is NULL");
+    if (!(v->restitution >= (fsdem_real)1e-6 && v->restitution <= 1))
+        return fsdem__reject(msg, size, "fsdem_dem_material_pair.restitution must be in [1e-6, 1] (got %g)", (double)v->restitution);
+    if (!(v->friction >= 0) || !fsdem__finite(v->friction))
+        return fsdem__reject(msg, size, "fsdem_dem_material_pair.friction must be >= 0 (got %g)", (double)v->friction);
+    if (!(v->rolling_friction >= 0) || !fsdem__finite(v->rolling_friction))
+        return fsdem__reject(msg, size, "fsdem_dem_material_pair.rolling_friction must be >= 0 (got %g)", (double)v->rolling_friction);
+    if (!(v->cohesion >= 0) || !fsdem__finite(v->cohesion))
+        return fsdem__reject(msg, size, "fsdem_dem_material_pair.cohesion must be >= 0 (got %g J/m^3)", (double)v->cohesion);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_dem_set_material_pair(fsdem_dem *d, int a, int b, const fsdem_dem_material_pair *values) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    int k;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    if (a < 0 || a >= d->material_count || b < 0 || b >= d->material_count)
+        return fsdem__fail(&d->status, FSDEM_ERR_NOT_FOUND, "fsdem_dem_set_material_pair: materials %d and %d (%d added)", a, b,
+                           d->material_count);
+    if (fsdem__dem_material_pair_check(values, msg, sizeof msg) != FSDEM_OK)
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "%s", msg);
+    for (k = 0; k < 2; ++k) {
+        fsdem__dem_pair *p = &d->pairs[k ? b * d->material_count + a : a * d->material_count + b];
+        p->restitution = values->restitution;
+        p->friction = values->friction;
+        p->rolling = values->rolling_friction;
+        p->cohesion = values->cohesion;
+        fsdem__dem_pair_coefficients(p, &d->desc, d->k0_linear, d->pairs, d->material_count * d->material_count);
+    }
+    fsdem__dem_pair_flags(d);
+    d->forces_valid = 0;
+    return fsdem__ok(&d->status);
+}
+
+fsdem_dem_material_pair fsdem_dem_get_material_pair(const fsdem_dem *d, int a, int b) {
+    fsdem_dem_material_pair v;
+    memset(&v, 0, sizeof v);
+    if (d && a >= 0 && a < d->material_count && b >= 0 && b < d->material_count) {
+        const fsdem__dem_pair *p = &d->pairs[a * d->material_count + b];
+        v.restitution = p->restitution;
+        v.friction = p->friction;
+        v.rolling_friction = p->rolling;
+        v.cohesion = p->cohesion;
+    }
+    return v;
 }
 
 static int fsdem__dem_inside_domain(const fsdem_dem *d, fsdem_vec3 p) {
@@ -5191,6 +5448,22 @@ static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
 
 /* ---- >>dem_forces : contact force evaluation ---- */
 
+/* The law the kernels are instantiated with: the desc's, or seed 002's linear law. */
+static fsdem_dem_law fsdem__dem_kernel_law(const fsdem_dem *d) {
+    return d->desc.law == FSDEM_DEM_LAW_LINEAR && !fsdem__dem_seed000_stiffness(&d->desc) ? FSDEM__DEM_LAW_SEED002 : d->desc.law;
+}
+
+/* The contact options as the kernels read them. */
+static fsdem__dem_rules fsdem__dem_rules_of(const fsdem_dem *d) {
+    fsdem__dem_rules r;
+    r.total_history = d->desc.tangential_history == FSDEM_DEM_TANGENTIAL_HISTORY_TOTAL;
+    r.cap_spring = d->desc.coulomb_limit == FSDEM_DEM_COULOMB_LIMIT_SPRING;
+    r.cohesion = d->cohesive;
+    r.offset = d->desc.contact_offset;
+    r.area_depth = d->desc.dim == 2 ? d->desc.disc_length : 0;
+    return r;
+}
+
 /* Material pair `pair`'s coefficients into lane c of a batch. */
 static void fsdem__dem_gather_pair_coefficients(const fsdem_dem *d, fsdem__dem_batch *b, int c, int pair) {
     const fsdem__dem_pair *p = d->pairs + pair;
@@ -5200,6 +5473,7 @@ static void fsdem__dem_gather_pair_coefficients(const fsdem_dem *d, fsdem__dem_b
     b->kt[c] = p->kt;
     b->ct[c] = p->ct;
     b->mu[c] = p->friction;
+    b->coh[c] = p->cohesion;
 }
 
 /* Contact `k` of the particle-pair list into lane c of a batch; the coefficients of its material
@@ -5329,12 +5603,12 @@ FSDEM__FORCE_INLINE int fsdem__dem_touching(fsdem_dem *d, int *FSDEM__RESTRICT t
 /* Runs the kernels on a filled batch (particle pairs or, with `walls`, wall contacts), applies it
    and empties it; returns the number of contacts it held. */
 FSDEM__FORCE_INLINE int fsdem__dem_drain(fsdem_dem *d, fsdem__dem_batch *b, int walls, const fsdem_dem_law law, fsdem_real h,
-                                     int keep) {
+                                     int keep, const fsdem__dem_rules *rules) {
     const int count = b->count;
     const fsdem__dem_pair *uniform = d->material_count == 1 ? d->pairs : NULL;
     fsdem__dem_batch_pad(b, !walls, uniform != NULL);
-    if (walls) fsdem__dem_batch_law(b, law, h, 0, 0, uniform);
-    else fsdem__dem_batch_law(b, law, h, 1, d->desc.contact_offset, uniform);
+    if (walls) fsdem__dem_batch_law(b, law, h, 0, 0, uniform, rules);
+    else fsdem__dem_batch_law(b, law, h, 1, d->desc.contact_offset, uniform, rules);
     fsdem__dem_scatter(d, b, walls, keep, h);
     b->count = 0;
     return count;
@@ -5347,7 +5621,9 @@ FSDEM__FORCE_INLINE int fsdem__dem_drain(fsdem_dem *d, fsdem__dem_batch *b, int 
    contacts then go through the vector kernels a batch at a time. Written once, instantiated per
    contact law (fsdem__dem_compute_forces). */
 FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real h, int commit, const fsdem_dem_law law) {
-    const int n = d->n, keep = commit && law == FSDEM_DEM_LAW_HERTZ_MINDLIN, uniform = d->material_count == 1;
+    const int n = d->n, keep = commit && (law == FSDEM_DEM_LAW_HERTZ_MINDLIN || law == FSDEM__DEM_LAW_SEED002);
+    const int uniform = d->material_count == 1;
+    const fsdem__dem_rules rules = fsdem__dem_rules_of(d);
     fsdem__dem_batch *b;
     int *touching, i, k, c, nt = 0, nw = 0;
     fsdem__arena_reset(&d->arena);
@@ -5364,7 +5640,7 @@ FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real 
     b->count = 0;
     for (k = 0; k < nt; ++k) {
         fsdem__dem_gather_pair(d, b, b->count++, touching[k], law, uniform);
-        if (b->count == FSDEM__DEM_BATCH || k == nt - 1) fsdem__dem_drain(d, b, 0, law, h, keep);
+        if (b->count == FSDEM__DEM_BATCH || k == nt - 1) fsdem__dem_drain(d, b, 0, law, h, keep, &rules);
     }
     for (k = 0; k < d->pw.count; k = d->pw.start[i + 1]) {
         /* row to row through the particles with wall entries */
@@ -5374,19 +5650,20 @@ FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real 
         nh = fsdem__dem_wall_hits(d, i, commit);
         for (c = 0; c < nh; ++c) {
             fsdem__dem_gather_wall(d, b, b->count++, i, &d->hits[c], uniform);
-            if (b->count == FSDEM__DEM_BATCH) nw += fsdem__dem_drain(d, b, 1, law, h, keep);
+            if (b->count == FSDEM__DEM_BATCH) nw += fsdem__dem_drain(d, b, 1, law, h, keep, &rules);
         }
     }
-    if (b->count) nw += fsdem__dem_drain(d, b, 1, law, h, keep);
+    if (b->count) nw += fsdem__dem_drain(d, b, 1, law, h, keep, &rules);
     d->contacts = nt;
     d->wall_contacts = nw;
     d->forces_valid = 1;
 }
 
 static void fsdem__dem_compute_forces(fsdem_dem *d, fsdem_real h, int commit) {
-    switch (d->desc.law) {
+    switch ((int)fsdem__dem_kernel_law(d)) {
     case FSDEM_DEM_LAW_LINEAR: fsdem__dem_compute_forces_law(d, h, commit, FSDEM_DEM_LAW_LINEAR); break;
     case FSDEM_DEM_LAW_GIC: fsdem__dem_compute_forces_law(d, h, commit, FSDEM_DEM_LAW_GIC); break;
+    case FSDEM__DEM_LAW_SEED002: fsdem__dem_compute_forces_law(d, h, commit, FSDEM__DEM_LAW_SEED002); break;
     default: fsdem__dem_compute_forces_law(d, h, commit, FSDEM_DEM_LAW_HERTZ_MINDLIN); break;
     }
 }
@@ -5788,9 +6065,13 @@ fsdem_result fsdem_dem_stable_dt(const fsdem_dem *d, fsdem_real *dt) {
    and effective radius as the force kernels see them (fsdem__dem_batch). */
 static fsdem_real fsdem__dem_contact_energy(const fsdem_dem *d, const fsdem__dem_pair *p, fsdem_real delta, fsdem_real m_mean,
                                         fsdem_real r_eff, fsdem_vec3 history) {
-    switch (d->desc.law) {
+    switch ((int)fsdem__dem_kernel_law(d)) {
     case FSDEM_DEM_LAW_LINEAR: return (fsdem_real)0.5 * m_mean * d->k0_linear * delta * delta;
     case FSDEM_DEM_LAW_GIC: return (fsdem_real)0.5 * p->e_pair * 2 * r_eff * delta * delta;
+    case FSDEM__DEM_LAW_SEED002: { /* chi^n d^2 / 2 + chi^t |xi|^2 / 2 (Eq. 19-22) */
+        const fsdem_real chi = p->kn * (fsdem_real)sqrt(r_eff);
+        return (fsdem_real)0.5 * chi * (delta * delta + p->kt * fsdem__dot(history, history));
+    }
     default: {
         fsdem_real srd = (fsdem_real)sqrt(r_eff * delta);
         /* integral of (4/3) E* sqrt(R*) d^1.5 = (8/15) E* sqrt(R*) d^2.5, plus the Mindlin spring */
@@ -15761,7 +16042,7 @@ fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
 
 /* ---- >>restart_format : header, checksum, cursor ---- */
 
-#define FSDEM__RESTART_VERSION 1u
+#define FSDEM__RESTART_VERSION 2u /* 2: DEM contact options and material-pair tables (issue 23) */
 #define FSDEM__RESTART_HEADER 64
 #define FSDEM__RESTART_BOM 0x01020304u
 #define FSDEM__RESTART_FNV_BASIS 0xcbf29ce484222325ull
@@ -16106,6 +16387,10 @@ static void fsdem__restart_dem(fsdem__restart *io, void *object) {
     fsdem__restart_same_real(io, dd->linear_accel, "linear_accel");
     fsdem__restart_same_real(io, dd->disc_length, "disc_length");
     fsdem__restart_same_int(io, dd->rotation, "rotation");
+    fsdem__restart_same_int(io, dd->tangential_damping, "tangential_damping");
+    fsdem__restart_same_int(io, (int)dd->tangential_history, "tangential_history");
+    fsdem__restart_same_int(io, (int)dd->coulomb_limit, "coulomb_limit");
+    fsdem__restart_same_int(io, (int)dd->linear_stiffness, "linear_stiffness");
 
     fsdem__restart_data(io, &d->dt, sizeof d->dt);
     fsdem__restart_data(io, &d->time, sizeof d->time);
@@ -16138,7 +16423,10 @@ static void fsdem__restart_dem(fsdem__restart *io, void *object) {
     }
     fsdem__restart_data(io, d->materials, sizeof(fsdem_dem_material) * (size_t)nm);
     fsdem__restart_data(io, d->pairs, sizeof(fsdem__dem_pair) * (size_t)nm * (size_t)nm);
-    if (commit) d->material_count = nm;
+    if (commit) {
+        d->material_count = nm;
+        fsdem__dem_pair_flags(d);
+    }
 
     /* walls: geometry where it has moved to, velocity, forces and impulses */
     fsdem__restart_count(io, &nw, FSDEM__DEM_HELD / 8, 4 * sizeof(int) + 6 * sizeof(fsdem_vec3), "wall count");
@@ -18177,8 +18465,8 @@ typedef struct fsdem__io_contacts {
 /* The contact law on a filled batch, as fsdem__dem_drain runs it, with the law chosen at run time
    (one more instantiation of the kernel; the step's are per law). */
 static void fsdem__io_dem_batch_law(fsdem__dem_batch *b, fsdem_dem_law law, fsdem_real h, int pairs, fsdem_real off,
-                                    const fsdem__dem_pair *uniform) {
-    fsdem__dem_batch_law(b, law, h, pairs, off, uniform);
+                                    const fsdem__dem_pair *uniform, const fsdem__dem_rules *rules) {
+    fsdem__dem_batch_law(b, law, h, pairs, off, uniform, rules);
 }
 
 /* Runs the law on a batch of particle pairs or (`walls`) wall contacts and appends its contacts to
@@ -18187,9 +18475,10 @@ static void fsdem__io_dem_drain(const fsdem_dem *d, fsdem__dem_batch *batch, int
     const fsdem__dem_pair *uniform = d->material_count == 1 ? d->pairs : NULL;
     const fsdem__dem_batch *b = batch; /* read only after the law */
     const fsdem_real off = d->desc.contact_offset;
+    const fsdem__dem_rules rules = fsdem__dem_rules_of(d);
     int k;
     fsdem__dem_batch_pad(batch, !walls, uniform != NULL);
-    fsdem__io_dem_batch_law(batch, d->desc.law, h, !walls, walls ? 0 : off, uniform);
+    fsdem__io_dem_batch_law(batch, fsdem__dem_kernel_law(d), h, !walls, walls ? 0 : off, uniform, &rules);
     for (k = 0; k < b->count; ++k) {
         const int i = b->i[k], e = c->count++;
         c->points[2 * e] = d->x[i];
@@ -18215,8 +18504,8 @@ static void fsdem__io_dem_drain(const fsdem_dem *d, fsdem__dem_batch *batch, int
    their number. */
 static int fsdem__io_dem_contacts(const fsdem_dem *d, fsdem__dem_batch *b, fsdem__dem_wall_hit *hits, fsdem__io_contacts *c) {
     const fsdem_real off = d->desc.contact_offset;
-    /* Hertz-Mindlin: the held springs as committed, not advanced again; linear: its one-step spring */
-    const fsdem_real h = d->desc.law == FSDEM_DEM_LAW_LINEAR ? d->dt : 0;
+    /* springs with history: as committed, not advanced again; seed 000's linear law: its one-step spring */
+    const fsdem_real h = fsdem__dem_kernel_law(d) == FSDEM_DEM_LAW_LINEAR ? d->dt : 0;
     const int uniform = d->material_count == 1;
     int i, k, nh, count = 0;
     if (c) {
@@ -18232,7 +18521,7 @@ static int fsdem__io_dem_contacts(const fsdem_dem *d, fsdem__dem_batch *b, fsdem
         if (!(ex * ex + ey * ey + ez * ez < reach * reach)) continue;
         count++;
         if (!c) continue;
-        fsdem__dem_gather_pair(d, b, b->count++, k, d->desc.law, uniform);
+        fsdem__dem_gather_pair(d, b, b->count++, k, fsdem__dem_kernel_law(d), uniform);
         if (b->count == FSDEM__DEM_BATCH) fsdem__io_dem_drain(d, b, 0, h, c);
     }
     if (c && b->count) fsdem__io_dem_drain(d, b, 0, h, c);
