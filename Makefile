@@ -179,13 +179,13 @@ validate validate-full: | $(BUILD) gnuplot-deps
 	for c in $$cases; do [ -f validation/$$c/main.c ] || { echo "no validation case '$$c'"; exit 2; }; done; \
 	$(MAKE) --no-print-directory validate-runs-$$tier CASES="$$cases"; made=$$?; \
 	wall=$$(( $$(date +%s) - start )); \
-	if [ "$$cases" = "$(strip $(VALIDATION))" ] && [ $$made = 0 ]; then \
+	if [ "$$(echo $$cases | tr ' ' '\n' | LC_ALL=C sort | paste -s -d' ')" = "$(sort $(VALIDATION))" ] && [ $$made = 0 ]; then \
 	  echo "$$(date -u +%Y-%m-%d) on $$(git rev-parse --short HEAD 2>/dev/null || echo unknown), all $(words $(VALIDATION)) cases," \
-	    "make $(filter -j%,$(MAKEFLAGS)) on $$(nproc) cores: $$wall s of wall time, compilation included" \
+	    "make $(or $(filter -j%,$(MAKEFLAGS)),-j1) on $$(nproc) cores: $$wall s of wall time, compilation included" \
 	    > validation/report-$$tier/run.txt; fi; \
 	sh validation/tiers.sh render $$tier $$out $$out/REPORT.md; \
 	$(MAKE) --no-print-directory validate-report; \
-	echo "validate ($$tier tier): $$(sh validation/tiers.sh verdict $$out $$cases)$${made:+}; total wall time $$wall s"; \
+	echo "validate ($$tier tier): $$(sh validation/tiers.sh verdict $$out $$cases); total wall time $$wall s"; \
 	echo "report: $$out/REPORT.md, validation/REPORT-$$tier.md"; \
 	[ $$made = 0 ] && sh validation/tiers.sh verdict $$out $$cases >/dev/null
 

@@ -23,7 +23,7 @@
 #       validation headers they include, and DEPENDS).
 #   sh validation/tiers.sh order TIER CASE...
 #       the cases, longest first by the wall time of their last run in validation/report-TIER/
-#       (cases without one first): the order `make -j2` starts them in.
+#       (cases without one first, in the order given): the order `make -j2` starts them in.
 #
 # Run it from the top of the repository (the Makefile does).
 set -u
@@ -31,18 +31,25 @@ here=$(cd "$(dirname "$0")" && pwd)
 top=$(cd "$here/.." && pwd)
 
 die() { echo "tiers.sh: $*" >&2; exit 2; }
+trap 'rm -f "${TMPDIR:-/tmp}/tiers.$$.chapters"' EXIT
 
 # ---- fingerprints ----
 
-# The text of the fsdem.h chapters named in DEPENDS (each tag's chapter and its impl_ chapter) and of
-# the >>impl preamble, in the file's order.
-chapters() { # deps_file fsdem_h
-    awk -v tags=" $(cat "$1") " '
+# The text of one chapter of fsdem.h: >>tag and >>impl_tag (for "impl": the >>impl preamble alone).
+chapter() { # tag fsdem_h
+    awk -v want="$1" '
         /===== >>[a-z_]+ :/ {
-            match($0, />>[a-z_]+/); tag = substr($0, RSTART + 2, RLENGTH - 2); base = tag; sub(/^impl_/, "", base)
-            keep = tag == "impl" || index(tags, " " base " ") > 0
+            match($0, />>[a-z_]+/); tag = substr($0, RSTART + 2, RLENGTH - 2)
+            keep = tag == want || tag == "impl_" want
         }
         keep' "$2"
+}
+
+# "tag:hash" for the >>impl preamble and each tag of DEPENDS, comma-separated.
+chapter_hashes() { # deps_file fsdem_h
+    for t in impl $(cat "$1"); do
+        printf '%s:%s\n' "$t" "$(chapter "$t" "$2" | cksum | awk '{ print $1 "-" $2 }')"
+    done | paste -s -d, -
 }
 
 # The case's code: its .c and .h files and, transitively, the validation headers they include.
@@ -71,13 +78,20 @@ case_files() { # case
 fingerprint() { # case [fsdem_h]
     deps="$here/$1/DEPENDS"
     [ -f "$deps" ] || die "validation/$1/DEPENDS is missing (the >>tags of fsdem.h the case depends on)"
-    solver=$(chapters "$deps" "${2:-$top/fsdem.h}" | cksum | awk '{ print $1 "-" $2 }')
+    chapters=$(chapter_hashes "$deps" "${2:-$top/fsdem.h}")
+    solver=$(echo "$chapters" | cksum | awk '{ print $1 "-" $2 }')
     code=$( (for f in $(case_files "$1"); do cat "$f"; done; cat "$deps") | cksum | awk '{ print $1 "-" $2 }')
-    echo "solver=$solver case=$code"
+    echo "solver=$solver case=$code chapters=$chapters"
 }
 
 # value of key in a meta.txt
 meta() { sed -n "s/^$2=//p" "$1" | head -n 1; }
+
+# a file with the recorded "tag:hash" entries of a meta.txt, one a line (for grep -f)
+meta_list() {
+    meta "$1" chapters_fp | tr , '\n' >"${TMPDIR:-/tmp}/tiers.$$.chapters"
+    echo "${TMPDIR:-/tmp}/tiers.$$.chapters"
+}
 
 # ---- run one case ----
 
@@ -174,8 +188,13 @@ staleness() { # case_dir
     if [ ! -f "$here/$name/DEPENDS" ]; then echo "stale: validation/$name/DEPENDS is missing"; return; fi
     now=$(fingerprint "$name")
     why=""
-    [ "solver=$(meta "$m" solver_fp)" = "${now%% *}" ] || why="fsdem.h chapters ($(cat "$here/$name/DEPENDS")) changed"
-    [ "case=$(meta "$m" case_fp)" = "${now#* }" ] || why="${why:+$why; }the case's code changed"
+    if [ "solver=$(meta "$m" solver_fp)" != "$(echo "$now" | cut -d' ' -f1)" ]; then
+        # name the chapters that changed (or, when the list of chapters changed, all of them)
+        changed=$(echo "$now" | cut -d' ' -f3 | sed 's/^chapters=//' | tr , '\n' | grep -vxF -f "$(meta_list "$m")" |
+            sed 's/:.*//; s/^/>>/' | paste -s -d' ' -)
+        why="fsdem.h changed (${changed:-the chapters of DEPENDS})"
+    fi
+    [ "case=$(meta "$m" case_fp)" = "$(echo "$now" | cut -d' ' -f2)" ] || why="${why:+$why; }the case's code changed"
     if [ -n "$why" ]; then echo "stale: $why since $(meta "$m" commit)"; else echo current; fi
 }
 
@@ -245,10 +264,11 @@ render() { # tier src_root out_md [img_prefix]
     done
     [ $ncase -gt 0 ] && {
         echo
-        cat "$src"/*/checks.txt 2>/dev/null | awk -v n="$ncase" -v cpu="$total_cpu" -v wall="$total_wall" '
+        cat "$src"/*/checks.txt 2>/dev/null | awk -v n="$ncase" -v cpu="$total_cpu" -v wall="$total_wall" -v tier="$tier" '
             $1 == "CHECK" { c++; if ($NF == "PASS") p++ }
             $1 == "INFO" && / \(full tier\)$/ { full++ }
-            END { printf "**%d cases: %d of %d checks pass**; %d lines need the full tier. CPU %.0f s, wall %.0f s (case by case, summed).\n", n, p, c, full, cpu, wall }'
+            END { printf "**%d case%s: %d of %d checks pass**%s. CPU %.0f s, wall %.0f s (case by case, summed).\n", n, n == 1 ? "" : "s",
+                          p, c, tier == "default" ? sprintf("; %d full-tier lines (INFO here)", full) : "", cpu, wall }'
         fails=$(grep -h '^CHECK ' "$src"/*/checks.txt 2>/dev/null | grep -v ' PASS$')
         if [ -n "$fails" ]; then
             echo
@@ -310,7 +330,7 @@ order() { # tier case...
         w=1e9
         [ -f "$m" ] && w=$(meta "$m" wall_s)
         echo "$w $c"
-    done | sort -g -r | awk '{ printf "%s ", $2 } END { print "" }'
+    done | sort -s -g -r -k1,1 | awk '{ printf "%s ", $2 } END { print "" }'
 }
 
 cmd=${1:-}
