@@ -359,7 +359,7 @@ int main(int argc, char **argv) {
     vc_table params, hertz, curves, oblique_ref;
     material t1[2], t2[2], t3[2], t4[2];
     vc_begin(CASE, argc, argv, NULL);
-    vc_tier("single impacts of tests 1-4, every tier");
+    vc_tier("single impacts of tests 1-4");
     refdir = vc_data_dir();
     if (vc_table_load(&params, vc_path(path, sizeof path, refdir, "chung_ooi2011_test_parameters.csv")) ||
         vc_table_load(&hertz, vc_path(path, sizeof path, refdir, "chung_ooi2011_tests1_2_hertz_analytic.csv")) ||

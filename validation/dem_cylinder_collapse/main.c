@@ -207,7 +207,7 @@ static int run(fsdem_dem_law law, const char *tag, result *res) {
 int main(int argc, char **argv) {
     result lin, hertz;
     vc_begin(CASE, argc, argv, NULL);
-    vc_tier("33 cylinders, 1 s, linear and Hertz, every tier");
+    vc_tier("33 cylinders, 1 s, linear and Hertz");
     memset(&lin, 0, sizeof lin);
     memset(&hertz, 0, sizeof hertz);
     run(FSDEM_DEM_LAW_LINEAR, "linear", &lin);

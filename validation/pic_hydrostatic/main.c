@@ -98,7 +98,7 @@ static outcome run(int dim, double dx, double jitter, const char *tag) {
 int main(int argc, char **argv) {
     int dim;
     vc_begin(CASE, argc, argv, NULL);
-    vc_tier("dx 0.02 m (2D), 0.04 m (3D), 2 s, every tier");
+    vc_tier("dx 0.02 m (2D), 0.04 m (3D), 2 s");
     for (dim = 2; dim <= 3; ++dim) {
         const char *tag = dim == 2 ? "2d" : "3d";
         char metric[64];

