@@ -303,6 +303,7 @@ render() { # tier src_root out_md [img_prefix]
                 echo "Lines of the full tier, with this tier's figures:"
                 echo
                 awk '$1 == "INFO" && / \(full tier\)$/ { v = $4; r = $5; t = $6; sub(/^value=/, "", v); sub(/^ref=/, "", r); sub(/^tol=/, "", t)
+                    if (v == "nan") v = "not evaluated (it needs the full tier'"'"'s runs)"
                     printf "- `%s`: %s (ref %s, tol %s)\n", $3, v, r, t }' "$d/checks.txt"
             fi
             if grep '^INFO ' "$d/checks.txt" | grep -qv ' (full tier)$'; then

@@ -2,7 +2,7 @@
    a water column 1.228 m long, 1 m wide and 0.55 m deep at the right end of a tank 3.22 m x 1 m
    (open at the top, walls 1 m high) collapses onto a box 0.161 x 0.403 x 0.161 m.
    Usage: run [DATA_DIR] [--tier=default|full] [--cells=N]   (N: the tank's length in r0; default
-   tier CELLS_DEFAULT, full tier 53: r0 = 3.22/53 = 0.0608 m)
+   tier 40: r0 = 0.0805 m; full tier 53: r0 = 3.22/53 = 0.0608 m)
    Reads spheric_test2_kleefsman2005_water_heights.csv and spheric_test2_kleefsman2005_pressures.csv.
    Writes heights.csv (t and the level at the four gauges, m), pressure.csv (t, P1 in Pa) and
    ref_heights.csv / ref_pressure.csv (the measured records, for the plots). */
@@ -15,10 +15,13 @@
 #define MAX_SAMPLES 20000
 #define WET 0.02          /* m: a gauge is wetted when its level first exceeds this (refdata README) */
 #define P_IMPACT 1000.0   /* Pa: the first impact at P1 is the first time it exceeds this */
-#define CELLS_DEFAULT 53  /* the default tier's tank length in r0 (README.md, "Tiers") */
+#define CELLS_DEFAULT 40  /* the default tier's tank length in r0 (README.md, "Tiers") */
 
 static const double tank_len = 3.22, tank_w = 1.0, tank_h = 1.0, col_len = 1.228, col_h = 0.55;
 static const double gauge_x[NG] = {0.496, 0.992, 1.488, 2.638}; /* at y = 0.5, by position (README) */
+/* gauges whose height RMS is within the tolerance at the full tier's r0 only: full-tier lines
+   (README.md, "Tiers": 0.047 and 0.053 m at r0 = 0.0805 m, 0.041 and 0.042 m at 0.0608 m) */
+static const int gauge_rms_full_tier[NG] = {0, 1, 1, 0};
 static const char *gauge_col[NG] = {"h_x0.496_m", "h_x0.992_m", "h_x1.488_m", "h_x2.638_reservoir_m"};
 
 typedef struct series {
@@ -191,7 +194,7 @@ int main(int argc, char **argv) {
             n++;
         }
         snprintf(metric, sizeof metric, "height_rms_m_x%.3f", gauge_x[k]);
-        vc_check(CASE, metric, sqrt(sum / n), 0, 0.05);
+        (gauge_rms_full_tier[k] ? vc_check_full : vc_check)(CASE, metric, sqrt(sum / n), 0, 0.05);
         if (k == NG - 1) continue; /* the reservoir gauge starts wet */
         ta = first_above(&sim_h, k, WET);
         tr = first_above(&ref_h, k, WET);

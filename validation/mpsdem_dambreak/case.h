@@ -55,10 +55,13 @@ typedef struct sd_case {
 } sd_case;
 
 static inline void sd_destroy(sd_case *c) {
+    char error[sizeof c->error];
+    memcpy(error, c->error, sizeof error); /* a failed sd_create's reason stays readable */
     fsdem_mps_dem_destroy(c->cpl);
     fsdem_dem_destroy(c->dem);
     fsdem_mps_destroy(c->mps);
     memset(c, 0, sizeof *c);
+    memcpy(c->error, error, sizeof error);
 }
 
 /* Builds the case at MPS spacing r0 (m), model A or B, with (sediment = 1) or without the bed.

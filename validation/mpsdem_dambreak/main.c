@@ -4,7 +4,8 @@
    README.md.
 
    Runs (each to T_END, fronts sampled every 0.005 s; README.md has the measured costs):
-     --tier=default  the runs of default_runs below;
+     --tier=default  B and clear water at 0.004 m (the resolution lines are the full tier's: INFO
+                     (full tier) without a value);
      --tier=full     B and clear water at 0.003 and 0.0027 m, B at 0.002 m and A at all three
                      (--all is the same);
      --only M:R      one run (model M = A, B or W for clear water, r0 = R m), for timing.
@@ -154,6 +155,28 @@ static run *find(run *runs, int n, char model, double r0) {
     return NULL;
 }
 
+typedef struct spec {
+    char model; /* as run.model */
+    double r0;  /* m */
+} spec;
+
+/* The full tier's resolution lines of one model, for the default tier, which runs one spacing per
+   model: INFO (full tier) lines without a value (they compare the seed's spacings). */
+static void resolution_lines_of_full_tier(const spec *full, int nf, char model) {
+    double fine = 1;
+    int i;
+    char metric[96];
+    for (i = 0; i < nf; ++i)
+        if (full[i].model == model && full[i].r0 < fine) fine = full[i].r0;
+    for (i = 0; i < nf; ++i) {
+        if (full[i].model != model || full[i].r0 == fine) continue;
+        snprintf(metric, sizeof metric, "%c_water_front_resolution_%.4f_vs_%.4f", model, full[i].r0, fine);
+        vc_check_full(CASE, metric, NAN, 0.025, 0.025);
+        snprintf(metric, sizeof metric, "%c_sediment_front_resolution_%.4f_vs_%.4f", model, full[i].r0, fine);
+        vc_check_full(CASE, metric, NAN, 0.025, 0.025);
+    }
+}
+
 /* Resolution checks of one model: every completed run against the finest completed one. */
 static void check_resolution(run *runs, int n, char model) {
     run *fine = NULL;
@@ -190,10 +213,11 @@ static void check_resolution(run *runs, int n, char model) {
 }
 
 int main(int argc, char **argv) {
-    /* the tiers' runs (model, r0 in m); README.md, "Runs and cost" */
-    static const struct { char model; double r0; } default_runs[] = {{'B', 0.003}, {'W', 0.003}, {'B', 0.0027}},
-                                                     full_runs[] = {{'B', 0.003}, {'W', 0.003}, {'B', 0.0027}, {'A', 0.003},
-                                                                    {'A', 0.0027}, {'W', 0.0027}, {'B', 0.002}, {'A', 0.002}};
+    /* the tiers' runs (model, r0 in m); README.md, "Tiers" */
+    static const spec default_runs[] = {{'B', 0.004}, {'W', 0.004}},
+                      full_runs[] = {{'B', 0.003}, {'W', 0.003}, {'B', 0.0027}, {'A', 0.003},
+                                     {'A', 0.0027}, {'W', 0.0027}, {'B', 0.002}, {'A', 0.002}};
+    const int n_full = (int)(sizeof full_runs / sizeof full_runs[0]);
     run runs[MAX_RUNS];
     int n = 0, i;
     double wall0 = now();
@@ -210,7 +234,7 @@ int main(int argc, char **argv) {
             return 2;
         }
     } else if (vc_full())
-        for (i = 0; i < (int)(sizeof full_runs / sizeof full_runs[0]); ++i) runs[n].model = full_runs[i].model, runs[n++].r0 = full_runs[i].r0;
+        for (i = 0; i < n_full; ++i) runs[n].model = full_runs[i].model, runs[n++].r0 = full_runs[i].r0;
     else
         for (i = 0; i < (int)(sizeof default_runs / sizeof default_runs[0]); ++i)
             runs[n].model = default_runs[i].model, runs[n++].r0 = default_runs[i].r0;
@@ -247,6 +271,10 @@ int main(int argc, char **argv) {
     }
     check_resolution(runs, n, 'B');
     check_resolution(runs, n, 'A');
+    if (!vc_full() && !only) {
+        resolution_lines_of_full_tier(full_runs, n_full, 'B');
+        resolution_lines_of_full_tier(full_runs, n_full, 'A');
+    }
     /* at every r0 with a clear-water run and a Model B run */
     for (i = 0; i < n; ++i) {
         run *w = &runs[i], *b = find(runs, n, 'B', w->r0);

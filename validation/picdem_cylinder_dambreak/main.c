@@ -4,7 +4,7 @@
    Usage: run [DATA_DIR] [--tier=default|full] [--dx M] [--t-end S] [--layers N] [--beta B]
      DATA_DIR  ignored (no reference file is read: no digitised data exist, see README.md)
      --tier=full  the seed's grid, dx = 0.05 cm, 0.6 s per run (--seed is the same); the default
-               tier: dx = 0.1 cm (four times cheaper per second), DEFAULT_T_END s per run
+               tier: dx = 0.125 cm, 0.4 s per run (README.md, "Tiers")
      --dx M    another cell size (m)
      --t-end S simulated time per run (default 0.6 s)
      --layers N only the runs with N layers (the checks that compare layer counts are then skipped)
@@ -20,7 +20,8 @@
 
 #define CASE "picdem_cylinder_dambreak"
 #define NSNAP 5
-#define DEFAULT_T_END 0.6 /* s per run in the default tier (README.md, "Tiers") */
+#define DEFAULT_DX 0.00125 /* m, the default tier's grid (README.md, "Tiers") */
+#define DEFAULT_T_END 0.4  /* s per run in the default tier: after every arrival (README.md, "Tiers") */
 
 static const double snap_times[NSNAP] = {0, 0.1, 0.2, 0.3, 0.4};
 static const double front_times[3] = {0.1, 0.2, 0.3};
@@ -163,7 +164,7 @@ int main(int argc, char **argv) {
     int only, only_beta, i, j;
     char metric[128];
     vc_begin(CASE, argc, argv, "--seed");
-    dx = vc_option_num("--dx", vc_full() ? WD_SEED_DX : 0.001);
+    dx = vc_option_num("--dx", vc_full() ? WD_SEED_DX : DEFAULT_DX);
     t_end = vc_option_num("--t-end", vc_full() ? 0.6 : DEFAULT_T_END);
     only = vc_option_int("--layers", 0);
     only_beta = vc_option("--beta") ? (vc_option_num("--beta", 1) < 0.75 ? 0 : 1) : -1;

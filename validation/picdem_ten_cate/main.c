@@ -6,7 +6,7 @@
    Reference: the sphere's velocity and gap against time measured by ten Cate et al. (2002)
    (validation/data/ten_cate2002_E1_Re1.5_velocity.csv and _gap.csv; sources in their headers).
    Usage: run [DATA_DIR] [--tier=default|full] [--cells=N] [--t-end=S]
-     --tier=default: dx = 20 mm / CELLS_DEFAULT (README.md, "Tiers");
+     --tier=default: dx = 20 mm / 8 (6 cells per diameter, to landing; README.md, "Tiers");
      --tier=full: dx = 20 mm / 18 (13.5 cells per diameter, 90 x 90 x 144 cells; --fine is the same);
      --cells=N: dx = 20 mm / N; --t-end=S: stop at S seconds (default 4 s, or once the sphere rests);
      --ppc=N particles per cell (default 1), --vfrac=F viscous_dt_fraction (default 1),
