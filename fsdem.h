@@ -4740,12 +4740,14 @@ fsdem_result fsdem_dem_set_material_pair(fsdem_dem *d, int a, int b, const fsdem
     if (fsdem__dem_material_pair_check(values, msg, sizeof msg) != FSDEM_OK)
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "%s", msg);
     for (k = 0; k < 2; ++k) {
-        fsdem__dem_pair *p = &d->pairs[k ? b * d->material_count + a : a * d->material_count + b];
-        p->restitution = values->restitution;
-        p->friction = values->friction;
-        p->rolling = values->rolling_friction;
-        p->cohesion = values->cohesion;
-        fsdem__dem_pair_coefficients(p, &d->desc, d->k0_linear, d->pairs, d->material_count * d->material_count);
+        /* set up aside: the table, searched for a known Hertz calibration, still holds the old pair */
+        fsdem__dem_pair *p = &d->pairs[k ? b * d->material_count + a : a * d->material_count + b], q = *p;
+        q.restitution = values->restitution;
+        q.friction = values->friction;
+        q.rolling = values->rolling_friction;
+        q.cohesion = values->cohesion;
+        fsdem__dem_pair_coefficients(&q, &d->desc, d->k0_linear, d->pairs, d->material_count * d->material_count);
+        *p = q;
     }
     fsdem__dem_pair_flags(d);
     d->forces_valid = 0;
