@@ -151,7 +151,9 @@
      Fallible calls return fsdem_result: FSDEM_OK (0) or a negative code; fsdem_result_string()
      names it. The object keeps a message with the detail (which field, which particle), read with
      fsdem_<object>_last_error(). Bad input is rejected before anything changes, so the object stays
-     as it was and usable. A step that produces a non-finite value or moves a particle out of the
+     as it was and usable. Beyond NaN and infinity, values no flow could have are bad input too: the
+     plausibility bounds of >>core (FSDEM_MAX_SPEED, FSDEM_MAX_ACCELERATION, FSDEM_MAX_LENGTH,
+     FSDEM_MAX_MODULUS) refuse a speed of 1e200 m/s at the call instead of a NaN steps later. A step that produces a non-finite value or moves a particle out of the
      domain completes, returns FSDEM_ERR_NAN or FSDEM_ERR_OUT_OF_DOMAIN and names the particle; the
      caller may remove it and go on. The library never prints and never exits; an optional log
      callback in each desc receives the same messages. FSDEM_ASSERT guards programmer errors only
@@ -2812,9 +2814,11 @@ FSDEM_API fsdem_result fsdem_dem_write_walls_vtp(const fsdem_dem *dem, const cha
    first in neighbour-list order, then wall contacts by particle; the same contacts as the last force
    evaluation (fsdem_dem_stats.contacts + wall_contacts after a Verlet step): pairs that are both
    fixed exert nothing and are left out, as are wall contacts of fixed particles. Cell data: force
-   (N, on particle i, from the partner; normal plus tangential), normal_force (N, the normal part
-   along the unit normal from the partner to i, positive in compression), overlap (m, contact offset
-   included), particle (Int32, id of i) and partner (Int32, id of j, or -1 - wall id).
+   (N, on particle i, from the partner; normal plus tangential, and a cohesive pull), normal_force
+   (N, the contact law's normal part along the unit normal from the partner to i, positive in
+   compression, without the cohesive pull), overlap (m, contact offset included), particle (Int32,
+   id of i) and partner (Int32, id of j, or -1 - wall id). Across a periodic seam the line ends at
+   the partner's image nearest i.
    The forces come from the contact law evaluated on the current state, as the step evaluates it,
    without changing anything: positions, velocities and the tangential springs the last step
    committed, with no further spring increment (Hertz-Mindlin) and the current dt for the linear
@@ -4456,12 +4460,14 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_seed002(const fsdem__dem_lanes *k
 }
 
 /* The cohesive attraction k A of the simplified JKR model (fsdem_dem_material.cohesion): A is the
-   area of the circle where two spheres of radii r1, r2 whose centres are `dist` apart intersect,
-   pi a^2 with a^2 = r1^2 - x^2, x = (dist^2 + r1^2 - r2^2) / (2 dist) the distance from the first
-   centre to the circle's plane (a plane wall: r2 = infinity, x = r1 - overlap, given as `x`); in
-   2D the area is the chord 2a times the disc length. */
-FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_cohesion(fsdem__lane coh, fsdem__lane r1, fsdem__lane x, const fsdem__dem_rules *rules) {
-    const fsdem__lane a2 = fsdem__lane_max(r1 * r1 - x * x, fsdem__lane_set(0));
+   area of the circle where a sphere of radius r1 meets its partner, pi a^2 with a^2 = h (2 r1 - h),
+   h the height of the sphere's cap beyond the circle's plane: for two spheres of radii r1, r2 whose
+   centres are d apart, overlapping by delta = r1 + r2 - d, h = delta (d + r2 - r1) / (2 d) (from the
+   plane's distance to the first centre, (d^2 + r1^2 - r2^2) / (2 d)); for a plane wall h = delta.
+   Written with h, a^2 is well conditioned where the overlap is a small difference of large
+   positions. In 2D the area is the chord 2a times the disc length. */
+FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_cohesion(fsdem__lane coh, fsdem__lane r1, fsdem__lane h, const fsdem__dem_rules *rules) {
+    const fsdem__lane a2 = fsdem__lane_max(h * (2 * r1 - h), fsdem__lane_set(0));
     return coh * (rules->area_depth > 0 ? 2 * fsdem__lane_sqrt(a2) * fsdem__lane_set(rules->area_depth)
                                        : (fsdem_real)FSDEM__PI * a2);
 }
@@ -4519,7 +4525,7 @@ FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_d
             if (rules->cohesion) {
                 const fsdem__lane r1 = ri + (fsdem_real)0.5 * off, r2 = rj + (fsdem_real)0.5 * off;
                 const fsdem__lane coh = uniform ? fsdem__lane_set(uniform->cohesion) : fsdem__lane_load(&b->coh[c]);
-                pull = fsdem__dem_cohesion(coh, r1, (dist * dist + r1 * r1 - r2 * r2) / (2 * safe), rules);
+                pull = fsdem__dem_cohesion(coh, r1, k.delta * (dist + r2 - r1) / (2 * safe), rules);
             }
         } else {
             FSDEM__DEM_LOAD3(k.n, b->n, c);
@@ -4532,7 +4538,7 @@ FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_d
             if (rules->cohesion) {
                 const fsdem__lane r1 = k.r_eff + rules->offset;
                 const fsdem__lane coh = uniform ? fsdem__lane_set(uniform->cohesion) : fsdem__lane_load(&b->coh[c]);
-                pull = fsdem__dem_cohesion(coh, r1, r1 - k.delta, rules);
+                pull = fsdem__dem_cohesion(coh, r1, k.delta, rules);
             }
         }
         if (uniform) {
@@ -4608,7 +4614,7 @@ static fsdem_vec3 fsdem__dem_min_image(const fsdem_dem *d, fsdem_vec3 e) {
 
 /* Where particle i sees particle j: j's image nearest i. */
 static fsdem_vec3 fsdem__dem_image_of(const fsdem_dem *d, int i, int j) {
-    return fsdem__sub(d->x[i], fsdem__dem_min_image(d, fsdem__sub(d->x[i], d->x[j])));
+    return d->periodic ? fsdem__sub(d->x[i], fsdem__dem_min_image(d, fsdem__sub(d->x[i], d->x[j]))) : d->x[j];
 }
 
 /* Brings every position into [domain_min, domain_max) along the periodic axes, moving x_ref along. */
