@@ -338,6 +338,48 @@ START_TEST(test_mps_dem_bad_input) {
 }
 END_TEST
 
+/* The record of fsdem_mps_dem_get_force as a row of fsdem_mps_dem_write_csv (its documented columns). */
+static void test_force_row(double *r, int id, const fsdem_mps_dem_force *f) {
+    const fsdem_vec3 v[4] = {f->drag, f->pressure, f->total, f->fluid_velocity};
+    int k;
+    r[0] = id;
+    for (k = 0; k < 4; ++k) r[1 + 3 * k] = v[k].x, r[2 + 3 * k] = v[k].y, r[3 + 3 * k] = v[k].z;
+    r[13] = f->porosity, r[14] = f->reynolds, r[15] = f->wet;
+}
+
+/* fsdem_mps_dem_write_csv: the header alone before the first update (when fsdem_mps_dem_get_force has
+   no record either), then one row per DEM particle of the last update, equal to its record and id: a
+   disc sinking in the water and a dry one above it; a disc added since the update has no record and
+   no row; an unwritable path is FSDEM_ERR_IO naming the path. */
+START_TEST(test_mps_dem_csv_rows_are_the_force_records) {
+    static const char header[] = "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,fluid_u,"
+                                 "fluid_v,fluid_w,porosity,reynolds,wet";
+    test_pair t = test_pair_new(2, 0.01, FSDEM_MPS_MODEL_B, 1e-6, fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.15f, 0), 0.08, 2500);
+    fsdem_mps_dem_force f;
+    double e[2 * 16];
+    int i;
+    test_add_sphere(&t, fsdem_v3(0.052f, 0.04f, 0), fsdem_v3(0.01f, -0.02f, 0), 0.002);
+    test_add_sphere(&t, fsdem_v3(0.05f, 0.14f, 0), fsdem_v3(0, 0, 0), 0.002);
+    ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, 0, &f), FSDEM_ERR_NOT_FOUND);
+    ck_assert_int_eq(fsdem_mps_dem_write_csv(t.cpl, "build/test_mps_dem_empty.csv"), FSDEM_OK);
+    test_csv_expect("build/test_mps_dem_empty.csv", header, 0, NULL);
+    for (i = 0; i < 3; ++i) ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
+    test_add_sphere(&t, fsdem_v3(0.03f, 0.05f, 0), fsdem_v3(0, 0, 0), 0.002);
+    ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, 2, &f), FSDEM_ERR_NOT_FOUND);
+    for (i = 0; i < 2; ++i) {
+        ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, i, &f), FSDEM_OK);
+        test_force_row(e + 16 * i, fsdem_dem_get_particles(t.dem).id[i], &f);
+    }
+    ck_assert_msg(e[15] == 1 && e[16 + 15] == 0 && e[1] != 0, "a wet disc with drag and a dry one");
+    ck_assert_int_eq(fsdem_mps_dem_write_csv(t.cpl, "build/test_mps_dem.csv"), FSDEM_OK);
+    test_csv_expect("build/test_mps_dem.csv", header, 2, e);
+    ck_assert_int_eq(fsdem_mps_dem_write_csv(t.cpl, "build/no/such/dir/x.csv"), FSDEM_ERR_IO);
+    ck_assert_ptr_nonnull(strstr(fsdem_mps_dem_last_error(t.cpl), "build/no/such/dir/x.csv"));
+    test_pair_free(&t);
+}
+END_TEST
+
 Suite *couple_mps_suite(void) {
     Suite *s = suite_create("couple_mps");
     TCase *tc = tcase_create("mps_dem");
@@ -347,6 +389,7 @@ Suite *couple_mps_suite(void) {
     tcase_add_test(tc, test_mps_dem_rest_in_still_water);
     tcase_add_test(tc, test_mps_dem_terminal_velocity);
     tcase_add_test(tc, test_mps_dem_bad_input);
+    tcase_add_test(tc, test_mps_dem_csv_rows_are_the_force_records);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -450,6 +450,48 @@ START_TEST(neutral_disc_stays_put) {
 }
 END_TEST
 
+/* fsdem_pic_dem_write_csv: the header alone before the first step (when fsdem_pic_dem_get_force has no
+   record either), then one row per body of the last step, equal to its record and id (a disc held
+   under water and a free one moving through it); a disc added since the step has no record and no row; an
+   unwritable path is FSDEM_ERR_IO naming the path. */
+START_TEST(csv_rows_are_the_force_records) {
+    static const char header[] = "id,pressure_x,pressure_y,pressure_z,viscous_x,viscous_y,viscous_z,torque_x,torque_y,torque_z,"
+                                 "weight_correction_x,weight_correction_y,weight_correction_z,volume,faces";
+    tank t = make_tank(2, 0.3, 0.25, 0, G, 0.01, fsdem_v3(0.08, 0.1, 0), 0.03, 2000, 1, fsdem_v3(0, 0, 0), 1e-3);
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    fsdem_pic_dem_force b;
+    double e[2 * 15];
+    int i;
+    p.position = fsdem_v3(0.2, 0.1, 0);
+    p.radius = 0.03;
+    p.velocity = fsdem_v3(0.05, 0, 0);
+    ck_assert_int_eq(fsdem_dem_add_particle(t.dem, &p, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 0, &b), FSDEM_ERR_NOT_FOUND);
+    ck_assert_int_eq(fsdem_pic_dem_write_csv(t.cp, "build/test_pic_dem_empty.csv"), FSDEM_OK);
+    test_csv_expect("build/test_pic_dem_empty.csv", header, 0, NULL);
+    for (i = 0; i < 3; ++i) ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)1e-3), FSDEM_OK);
+    p.position = fsdem_v3(0.15, 0.2, 0);
+    ck_assert_int_eq(fsdem_dem_add_particle(t.dem, &p, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 2, &b), FSDEM_ERR_NOT_FOUND);
+    for (i = 0; i < 2; ++i) {
+        double *r = e + 15 * i;
+        fsdem_vec3 v[4];
+        int k;
+        ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, i, &b), FSDEM_OK);
+        v[0] = b.pressure_force, v[1] = b.viscous_force, v[2] = b.torque, v[3] = b.weight_correction;
+        r[0] = fsdem_dem_get_particles(t.dem).id[i];
+        for (k = 0; k < 4; ++k) r[1 + 3 * k] = v[k].x, r[2 + 3 * k] = v[k].y, r[3 + 3 * k] = v[k].z;
+        r[13] = b.volume, r[14] = b.faces;
+    }
+    ck_assert_msg(e[2] > 0 && e[15 + 2] > 0 && e[14] > 0, "two bodies under water");
+    ck_assert_int_eq(fsdem_pic_dem_write_csv(t.cp, "build/test_pic_dem.csv"), FSDEM_OK);
+    test_csv_expect("build/test_pic_dem.csv", header, 2, e);
+    ck_assert_int_eq(fsdem_pic_dem_write_csv(t.cp, "build/no/such/dir/x.csv"), FSDEM_ERR_IO);
+    ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "build/no/such/dir/x.csv"));
+    free_tank(&t);
+}
+END_TEST
+
 Suite *couple_pic_suite(void) {
     Suite *s = suite_create("couple_pic");
     TCase *tc = tcase_create("core");
@@ -461,6 +503,7 @@ Suite *couple_pic_suite(void) {
     tcase_add_test(tc, neutral_disc_stays_put);
     tcase_add_test(tc, contact_area_dissipation_is_eq_20);
     tcase_add_test(tc, bad_input_is_refused);
+    tcase_add_test(tc, csv_rows_are_the_force_records);
     suite_add_tcase(s, tc);
     return s;
 }

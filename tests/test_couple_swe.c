@@ -2,6 +2,7 @@
    exact momentum exchange with the water, input validation. */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 #include "fsdem_tests.h"
 
 #define PI 3.14159265358979323846
@@ -295,6 +296,46 @@ START_TEST(wet_dry_edge_exchanges_momentum) {
 }
 END_TEST
 
+/* fsdem_swe_dem_write_csv: the header alone before the first update (when fsdem_swe_dem_get_force has
+   no record either), then one row per particle with a record, equal to fsdem_swe_dem_get_force and
+   the particle's id: a floating sphere in a stream, a fixed one (a row of zeros) and, added after the
+   step, one with no record yet (no row); an unwritable path is FSDEM_ERR_IO naming the path. */
+START_TEST(csv_rows_are_the_force_records) {
+    static const char header[] = "id,buoyancy_z,hydrostatic_x,hydrostatic_y,dynamic_x,dynamic_y,heave_z,submerged_volume,"
+                                 "frontal_area,surface,in_water";
+    world w = world_new(4, 40, 0.5, 0.4, 0.05, 500, 2, 0.5, 0.5, 1);
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    fsdem_swe_dem_force f;
+    double e[3 * 11];
+    int i, n;
+    p.position = fsdem_v3(3, 0, 0.45);
+    p.radius = 0.04;
+    p.fixed = 1;
+    ck_assert_int_eq(fsdem_dem_add_particle(w.dem, &p, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_swe_dem_get_force(w.cpl, 0, &f), FSDEM_ERR_NOT_FOUND);
+    ck_assert_int_eq(fsdem_swe_dem_write_csv(w.cpl, "build/test_swe_dem_empty.csv"), FSDEM_OK);
+    test_csv_expect("build/test_swe_dem_empty.csv", header, 0, NULL);
+    for (i = 0; i < 3; ++i) ck_assert_int_eq(capped_step(w.cpl, 5e-3, NULL), FSDEM_OK);
+    p.position = fsdem_v3(1, 0, 0.5);
+    p.fixed = 0;
+    ck_assert_int_eq(fsdem_dem_add_particle(w.dem, &p, NULL), FSDEM_OK); /* no record until the next update */
+    ck_assert_int_eq(fsdem_swe_dem_get_force(w.cpl, 2, &f), FSDEM_ERR_NOT_FOUND);
+    for (n = 0; n < 2; ++n) {
+        double *r = e + 11 * n;
+        ck_assert_int_eq(fsdem_swe_dem_get_force(w.cpl, n, &f), FSDEM_OK);
+        r[0] = fsdem_dem_get_particles(w.dem).id[n];
+        r[1] = f.buoyancy.z, r[2] = f.hydrostatic.x, r[3] = f.hydrostatic.y, r[4] = f.dynamic.x, r[5] = f.dynamic.y;
+        r[6] = f.heave.z, r[7] = f.submerged_volume, r[8] = f.frontal_area, r[9] = f.surface, r[10] = f.in_water;
+    }
+    ck_assert_msg(e[1] > 0 && e[10] == 1 && e[11 + 10] == 0, "the floating sphere in water, the fixed one a row of zeros");
+    ck_assert_int_eq(fsdem_swe_dem_write_csv(w.cpl, "build/test_swe_dem.csv"), FSDEM_OK);
+    test_csv_expect("build/test_swe_dem.csv", header, 2, e);
+    ck_assert_int_eq(fsdem_swe_dem_write_csv(w.cpl, "build/no/such/dir/x.csv"), FSDEM_ERR_IO);
+    ck_assert_ptr_nonnull(strstr(fsdem_swe_dem_last_error(w.cpl), "build/no/such/dir/x.csv"));
+    world_free(&w);
+}
+END_TEST
+
 Suite *couple_swe_suite(void) {
     Suite *s = suite_create("couple_swe");
     TCase *tc = tcase_create("couple_swe");
@@ -305,6 +346,7 @@ Suite *couple_swe_suite(void) {
     tcase_add_test(tc, invalid_coupler_desc_is_rejected);
     tcase_add_test(tc, undamped_bobbing_does_not_grow);
     tcase_add_test(tc, wet_dry_edge_exchanges_momentum);
+    tcase_add_test(tc, csv_rows_are_the_force_records);
     suite_add_tcase(s, tc);
     return s;
 }
