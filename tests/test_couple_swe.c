@@ -148,7 +148,14 @@ END_TEST
 
 /* A sphere thrown at 1 m/s through still water: the water gains exactly the momentum the sphere
    loses (two-way, Eq. 8 in force-per-area form), before any wave reaches the walls. One-way coupling
-   leaves the water's momentum untouched. */
+   leaves the water's momentum untouched, so the water stays at rest and flat and the sphere (500
+   kg/m^3, floating half immersed at its start, the centre on the surface) obeys
+   m dv/dt = -rho v^2 S, the dynamic pressure rho (beta u - w)^2 with u = 0 on its immersed half
+   disc S = pi r^2 / 2 (seed 003 Eq. 6-7; the hydrostatic parts cancel on flat water): the reference
+   is that equation's exact solution v(t) = v0 / (1 + k v0 t), k = rho S / m = 0.75 / r = 15 /m,
+   0.1176 m/s at 0.5 s. The coupler holds the force over each step of 5 ms, an explicit Euler step
+   of the equation (k v0 dt = 0.075 at the start), whose first-order error leaves v 1.9% low at
+   0.5 s: 3%. */
 START_TEST(momentum_is_exchanged_not_created) {
     int two_way, s;
     for (two_way = 0; two_way <= 1; ++two_way) {
@@ -167,8 +174,9 @@ START_TEST(momentum_is_exchanged_not_created) {
         p = fsdem_dem_get_particles(w.dem);
         pw = fsdem_swe_momentum(w.swe);
         pd = p.mass[0] * p.velocity[0].x;
-        ck_assert_msg(pd < 0.9 * pd0, "the water must slow the sphere (%g -> %g)", pd0, pd);
         if (two_way) {
+            /* something was exchanged (the balance below is relative to it) */
+            ck_assert_msg(pd < 0.9 * pd0, "the water must slow the sphere (%g -> %g)", pd0, pd);
             /* flux-form finite volumes on a flat frictionless bed conserve momentum to rounding; the
                exchange is exact, so the total changes by rounding only (1e-12 of what moved). In
                float the rounding that counts is the debris velocity's, eps |v| at each of the K DEM
@@ -176,8 +184,13 @@ START_TEST(momentum_is_exchanged_not_created) {
             const double k_round = 4 * sqrt((double)fsdem_swe_dem_get_stats(w.cpl).substeps_total) * fabs(pd0) / fabs(pd - pd0);
             ck_assert_msg(fabs((pw.x - pw0.x) + (pd - pd0)) < TOL(1e-12, k_round) * fabs(pd - pd0) + 1e-15,
                           "water %g + debris %g", (double)(pw.x - pw0.x), pd - pd0);
-        } else
+        } else {
+            const double k = 1000 * (PI * 0.05 * 0.05 / 2) / p.mass[0], t = fsdem_swe_dem_time(w.cpl), exact = 1 / (1 + k * t);
+            TEST_REPORT("one-way: v = %.6f m/s at %.3f s, exact solution %.6f m/s (%+.2f%%)", p.velocity[0].x, t, exact,
+                        100 * (p.velocity[0].x / exact - 1));
             ck_assert_msg(fabs(pw.x - pw0.x) < 1e-15, "one-way: water momentum changed by %g", (double)(pw.x - pw0.x));
+            ck_assert_msg(fabs(p.velocity[0].x / exact - 1) < 0.03, "one-way: v = %g m/s, exact %g m/s", (double)p.velocity[0].x, exact);
+        }
         world_free(&w);
     }
 }
