@@ -471,6 +471,17 @@ typedef enum fsdem_result {
     FSDEM_ERR_NOT_FOUND = -8      /* an index or id does not name an existing item */
 } fsdem_result;
 
+/* Plausibility bounds: a value beyond them describes no flow these solvers can resolve and would
+   only come back steps later as an overflow or a NaN, so the call that gives it refuses it with
+   FSDEM_ERR_INVALID_ARG and a message naming it (as it refuses a NaN). */
+#define FSDEM_MAX_SPEED ((fsdem_real)1e4)        /* m/s: every velocity given (particles, fills, walls,
+                                                    boundaries); ten times a rifle bullet's */
+#define FSDEM_MAX_ACCELERATION ((fsdem_real)1e4) /* m/s^2: |gravity| (about 1000 g; geotechnical
+                                                    centrifuges reach a few hundred g) */
+#define FSDEM_MAX_LENGTH ((fsdem_real)1e7)       /* m: depths, water levels, radii and lengths (the
+                                                    size of the Earth) */
+#define FSDEM_MAX_MODULUS ((fsdem_real)1e13)     /* Pa: Young's moduli (diamond: 1.2e12 Pa) */
+
 /* Short constant name of a result code, e.g. "FSDEM_ERR_INVALID_ARG". Never NULL. */
 FSDEM_API const char *fsdem_result_string(fsdem_result result);
 
@@ -586,6 +597,52 @@ typedef enum fsdem_dem_law {
     FSDEM_DEM_LAW_GIC = 2
 } fsdem_dem_law;
 
+/* Contact options (LIGGGHTS users set them in their pair_style). Hand calculations of a two-sphere
+   contact for each: tests/test_dem.c, "contact options". */
+
+/* How a tangential spring carries its history from step to step (Hertz-Mindlin, and the linear law
+   with seed 002's stiffness; seed 000's linear law has a one-step spring, Eq. 8, and no history). */
+typedef enum fsdem_dem_tangential_history {
+    /* the spring of the last step turned into the current tangent plane with its length kept, plus
+       the increment v_t dt: a contact that rolls round its partner carries its spring with it
+       (Luding 2008, Granular Matter 10:235, the projection of the tangential spring; LIGGGHTS
+       `tangential history`); the default */
+    FSDEM_DEM_TANGENTIAL_HISTORY_INCREMENTAL = 0,
+    /* the total relative tangential displacement since first touch: the increments v_t dt summed in
+       the fixed frame, never turned, and projected on the current tangent plane where the force is
+       taken (the shear displacement of Cundall and Strack 1979); the same as INCREMENTAL while the
+       contact normal keeps its direction */
+    FSDEM_DEM_TANGENTIAL_HISTORY_TOTAL = 1
+} fsdem_dem_tangential_history;
+
+/* What Coulomb's limit mu |F_n| caps, while the contact slides the spring is reset to the capped
+   force. LIGGGHTS' own `limitForce` keyword is another matter: it keeps the normal force from
+   turning attractive, which Hertz-Mindlin here always does and the linear laws, as their seeds
+   print them (seed 000 Eq. 7, seed 002 Eq. 19), do not. */
+typedef enum fsdem_dem_coulomb_limit {
+    /* spring plus dashpot: |F_t| <= mu |F_n| (seed 000 Eq. 15, seed 002 Eq. 20); the default */
+    FSDEM_DEM_COULOMB_LIMIT_TOTAL = 0,
+    /* the spring alone, the dashpot added after: |k_t xi| <= mu |F_n| ("Ft and Fn are the tangential
+       spring and normal force components" of LIGGGHTS `tangential history`); a sliding contact's
+       force then exceeds mu |F_n| by its dashpot */
+    FSDEM_DEM_COULOMB_LIMIT_SPRING = 1
+} fsdem_dem_coulomb_limit;
+
+/* Stiffness and damping of FSDEM_DEM_LAW_LINEAR. */
+typedef enum fsdem_dem_linear_stiffness {
+    /* seed 000 Eq. 10-13: k_n from theta, dx and ||g|| per unit of the mean mass, damping from the
+       materials' alpha, a one-step tangential spring (Eq. 8); the default */
+    FSDEM_DEM_LINEAR_STIFFNESS_SEED000 = 0,
+    /* seed 002 Eq. 19-24 from the materials: chi^n = (sqrt 2 / 3) E sqrt(R) / (1 - nu^2) (Eq. 21),
+       written for a pair as (4/3) E* sqrt(R*), to which it reduces for two equal spheres;
+       chi^t = chi^n / (2 + nu) (Eq. 22); eta = -2 ln(e) sqrt(chi m* / (ln^2 e + pi^2)) (Eq. 23-24,
+       with the reduced mass m*, which makes the normal restitution exactly e); a tangential spring
+       with history (desc.tangential_history); no tension cut-off, as printed. Eq. 21 has the units of
+       a Hertz coefficient (N m^-3/2), and the seed uses it as a linear stiffness (N/m) in SI units:
+       so does this option. The dt rule AUTO is then the Rayleigh time (seed 002 Eq. 38). */
+    FSDEM_DEM_LINEAR_STIFFNESS_SEED002 = 1
+} fsdem_dem_linear_stiffness;
+
 typedef enum fsdem_dem_integrator {
     /* Velocity Verlet (kick-drift-kick), one force evaluation per step: second order for elastic
        forces; dashpots see the half-step velocity, which makes damping first order in dt (resolve
@@ -604,14 +661,29 @@ typedef struct fsdem_dem_material {
     fsdem_real friction;         /* -; Coulomb sliding coefficient mu (tan phi for GIC); default 0.3 */
     fsdem_real rolling_friction; /* -; constant-torque rolling resistance mu_r; default 0 (off) */
     fsdem_real damping_alpha;    /* -; alpha of seed 000 Eq. 11, linear law; default 0.4 */
+    fsdem_real cohesion;         /* J/m^3; cohesion energy density k of the simplified JKR model: */
+                                 /*    an attraction k A, A the area of the circle where the two */
+                                 /*    spheres (with the contact offset) intersect (3D), or the */
+                                 /*    chord times disc_length (2D) (LIGGGHTS `cohesion sjkr`); */
+                                 /*    default 0 (off) */
 } fsdem_dem_material;
 
 FSDEM_API fsdem_dem_material fsdem_dem_material_default(void);
 
+/* The contact properties of one pair of materials (LIGGGHTS' peratomtypepair tables). Unless set
+   with fsdem_dem_set_material_pair, a pair takes the arithmetic mean of its two materials' values
+   (their own values for a material with itself). */
+typedef struct fsdem_dem_material_pair {
+    fsdem_real restitution;      /* -; in [1e-6, 1] */
+    fsdem_real friction;         /* -; >= 0 */
+    fsdem_real rolling_friction; /* -; >= 0 */
+    fsdem_real cohesion;         /* J/m^3; >= 0 */
+} fsdem_dem_material_pair;
+
 /* Rule of fsdem_dem_stable_dt (and of the dt warning, fsdem_dem_stats.dt_ratio). */
 typedef enum fsdem_dem_dt_rule {
-    /* the rule of the contact law: LINEAR_SEED000 for FSDEM_DEM_LAW_LINEAR, RAYLEIGH for
-       FSDEM_DEM_LAW_HERTZ_MINDLIN, GIC for FSDEM_DEM_LAW_GIC */
+    /* the rule of the contact law: LINEAR_SEED000 for FSDEM_DEM_LAW_LINEAR (RAYLEIGH with seed 002's
+       stiffness), RAYLEIGH for FSDEM_DEM_LAW_HERTZ_MINDLIN, GIC for FSDEM_DEM_LAW_GIC */
     FSDEM_DEM_DT_RULE_AUTO = 0,
     /* seed 000 Eq. 18: (2 pi / gamma) sqrt(m_ij / k), k from Eq. 10; dt_param is gamma (default 150) */
     FSDEM_DEM_DT_RULE_LINEAR_SEED000 = 1,
@@ -640,6 +712,11 @@ typedef struct fsdem_dem_desc {
     fsdem_real linear_accel;        /* m/s^2; ||g|| of Eq. 10; default 0: use |gravity| */
     fsdem_real disc_length;         /* m; out-of-plane length of 2D discs; default 1 */
     int rotation;                   /* 1: integrate angular velocity; 0: translation only (seed 004) */
+    int tangential_damping;         /* 1: tangential dashpot on (Hertz-Mindlin, linear laws); */
+                                    /*    default 1 (LIGGGHTS `tangential_damping`) */
+    fsdem_dem_tangential_history tangential_history; /* default INCREMENTAL (see the enum) */
+    fsdem_dem_coulomb_limit coulomb_limit;   /* default TOTAL (see the enum) */
+    fsdem_dem_linear_stiffness linear_stiffness; /* linear law only; default SEED000 */
     int capacity;                   /* initial particle capacity (grows as needed); default 1024 */
     fsdem_allocator allocator;      /* default: FSDEM_MALLOC/FSDEM_FREE */
     fsdem_log_fn log;               /* optional; default NULL */
@@ -662,6 +739,12 @@ FSDEM_API const char *fsdem_dem_last_error(const fsdem_dem *dem);
 /* Adds a material; its index goes to *index (may be NULL). FSDEM_ERR_INVALID_ARG names the field. */
 FSDEM_API fsdem_result fsdem_dem_add_material(fsdem_dem *dem, const fsdem_dem_material *material,
                                               int *index);
+/* Sets the contact properties of the pair of materials a and b (either order, a == b allowed),
+   replacing their mean. FSDEM_ERR_NOT_FOUND for a bad index, FSDEM_ERR_INVALID_ARG names a bad
+   field (nothing changes then). */
+FSDEM_API fsdem_result fsdem_dem_set_material_pair(fsdem_dem *dem, int a, int b, const fsdem_dem_material_pair *values);
+/* The contact properties of the pair a, b in force (zeros for a bad index). */
+FSDEM_API fsdem_dem_material_pair fsdem_dem_get_material_pair(const fsdem_dem *dem, int a, int b);
 
 typedef struct fsdem_dem_particle_desc {
     fsdem_vec3 position;         /* m; inside the domain */
@@ -2187,9 +2270,11 @@ typedef enum fsdem_drag_law {
 
 /* Coefficient of the drag on one particle: F = c V (u - v) as above. Writes c (kg m^-3 s^-1) to
    *per_volume and beta = c (1 - eps) to *beta; either pointer may be NULL. porosity in (0, 1],
-   diameter > 0 (m), slip_speed = |u - v| >= 0 (m/s), density rho_f > 0 (kg/m^3), viscosity mu_f > 0
-   (dynamic, Pa s), all finite, and a known law; otherwise FSDEM_ERR_INVALID_ARG, nothing written, and
-   `message` (may be NULL) names the argument. FSDEM_ERR_NAN (nothing written) where c overflows. */
+   diameter > 0 (m), slip_speed = |u - v| in [0, FSDEM_MAX_SPEED] (m/s), density rho_f > 0 (kg/m^3),
+   viscosity mu_f > 0 (dynamic, Pa s), all finite, and a known law; otherwise FSDEM_ERR_INVALID_ARG,
+   nothing written, and `message` (may be NULL) names the argument. Every law is finite for any
+   Reynolds number; FSDEM_ERR_NAN (nothing written, the message gives porosity, d and Re) only where
+   c itself exceeds the largest fsdem_real (a vanishing diameter or porosity). */
 FSDEM_API fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsdem_real diameter,
                                               fsdem_real slip_speed, fsdem_real density, fsdem_real viscosity,
                                               fsdem_real *per_volume, fsdem_real *beta, char *message,
@@ -2490,7 +2575,7 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
    Model. Create the object from the desc it was saved with (the allocator, log and callbacks are
    yours), then restore the state into it. What can change after creation comes from the save and
    replaces what the object holds:
-     fsdem_dem      materials, walls (positions, velocities, forces, impulses), particles (ids,
+     fsdem_dem      materials with their pair tables, walls (positions, velocities, forces, impulses), particles (ids,
                     kinematics, the contact forces of the last evaluation, external loads), the
                     neighbour lists with their tangential springs, dt, time, counters;
      fsdem_pic      particles (APIC matrices too) and their capacity, the random-number state,
@@ -2513,7 +2598,7 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
                     created with, and its own counters and per-body load records.
    What must match (else FSDEM_ERR_INVALID_ARG naming the field): the desc fields that steps read.
    DEM: dim, domain, gravity, law, integrator, dt_rule, dt_param, skin, contact_offset, linear_*,
-   disc_length, rotation. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,
+   disc_length, rotation, the contact options (tangential_*, coulomb_limit), periodic. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,
    viscosity, gravity, boundaries, transfer, kernel, seeding and reseeding, advection, cfl,
    dt_max, ghost-fluid, extrapolation and solver settings. SWE: dim, nx, ny, extent, width,
    gravity, density, cfl, dt_max, order, limiter, dry_depth, manning, eddy_viscosity. Coupler:
@@ -2541,7 +2626,7 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
    is written in place: one cut short by a crash is refused by its checksum, so alternate between
    two paths to always keep a good checkpoint.
 
-   Format (version 1): a 64-byte header, then the payload.
+   Format (version 2): a 64-byte header, then the payload.
      offset  bytes  field
           0      8  magic "FSDEMRST"
           8      4  format version (unsigned)
@@ -2883,6 +2968,36 @@ static fsdem_result fsdem__grow(const fsdem_allocator *a, void **ptr, int *capac
     return FSDEM_OK;
 }
 
+/* Grows `count` arrays that share one capacity (*capacity elements, `used` live; array k has
+   elements of elem[k] bytes) to at least `need` elements, by doubling: all of them or, on failure,
+   none (so each array keeps the size the shared capacity says, and frees it with that size). */
+static fsdem_result fsdem__grow_set(const fsdem_allocator *a, void **const *arrays, const size_t *elem, int count, int *capacity,
+                                    int used, int need) {
+    enum { MAX_SET = 8 };
+    void *fresh[MAX_SET];
+    int cap = *capacity > 0 ? *capacity : 16, k;
+    FSDEM_ASSERT(count <= MAX_SET);
+    if (need <= *capacity) return FSDEM_OK;
+    while (cap < need) {
+        if (cap > (1 << 29)) return FSDEM_ERR_OUT_OF_MEMORY;
+        cap *= 2;
+    }
+    for (k = 0; k < count; ++k) {
+        fresh[k] = (size_t)cap <= ((size_t)-1) / elem[k] ? fsdem__alloc(a, (size_t)cap * elem[k]) : NULL;
+        if (!fresh[k]) {
+            while (k-- > 0) fsdem__free(a, fresh[k], (size_t)cap * elem[k]);
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        }
+    }
+    for (k = 0; k < count; ++k) {
+        if (*arrays[k] && used > 0) memcpy(fresh[k], *arrays[k], (size_t)used * elem[k]);
+        fsdem__free(a, *arrays[k], (size_t)(*capacity) * elem[k]);
+        *arrays[k] = fresh[k];
+    }
+    *capacity = cap;
+    return FSDEM_OK;
+}
+
 /* Per-step scratch arena: one block that a step carves up and gives back whole at its end. It is
    reserved, growing only when a step needs more than any step before (when the lists it serves grew),
    so a steady run allocates nothing; pushes within a reservation cannot fail. Blocks are aligned for
@@ -2963,6 +3078,17 @@ static void fsdem__log_oom(fsdem_log_fn log, void *log_user, const char *what, s
     if (!log) return;
     snprintf(msg, sizeof msg, "%s: out of memory (%lu bytes)", what, (unsigned long)bytes);
     log(log_user, FSDEM_LOG_LEVEL_ERROR, msg);
+}
+
+/* Writes "why" to msg and returns FSDEM_ERR_INVALID_ARG. */
+static fsdem_result fsdem__reject(char *msg, size_t size, const char *fmt, ...) {
+    va_list ap;
+    if (msg && size) {
+        va_start(ap, fmt);
+        vsnprintf(msg, size, fmt, ap);
+        va_end(ap);
+    }
+    return FSDEM_ERR_INVALID_ARG;
 }
 
 static fsdem_result fsdem__ok(fsdem__status *s) {
@@ -3089,6 +3215,12 @@ static double fsdem__tolerance(double floor) {
 static int fsdem__finite3(fsdem_vec3 v) {
     return fsdem__finite(v.x) && fsdem__finite(v.y) && fsdem__finite(v.z);
 }
+/* |v| <= bound (>>core plausibility bounds), NaN refused; each component is bounded before the
+   norm, which then cannot overflow */
+static int fsdem__within(fsdem_vec3 v, fsdem_real bound) {
+    if (!(fabs(v.x) <= bound && fabs(v.y) <= bound && fabs(v.z) <= bound)) return 0;
+    return v.x * v.x + v.y * v.y + v.z * v.z <= bound * bound;
+}
 
 static fsdem_vec3 fsdem__add(fsdem_vec3 a, fsdem_vec3 b) { return fsdem_v3(a.x + b.x, a.y + b.y, a.z + b.z); }
 static fsdem_vec3 fsdem__sub(fsdem_vec3 a, fsdem_vec3 b) { return fsdem_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
@@ -3107,6 +3239,27 @@ static void fsdem__set_comp(fsdem_vec3 *v, int axis, fsdem_real value) {
     if (axis == 0) v->x = value;
     else if (axis == 1) v->y = value;
     else v->z = value;
+}
+
+/* The gravity of a desc named `desc` (e.g. "fsdem_mps_desc"): finite, in the plane in 2D (z = 0),
+   and |g| <= FSDEM_MAX_ACCELERATION. */
+static fsdem_result fsdem__check_gravity(const char *desc, fsdem_vec3 g, int dim, char *msg, size_t size) {
+    if (!fsdem__within(g, FSDEM_MAX_ACCELERATION))
+        return fsdem__reject(msg, size, "%s.gravity (%g, %g, %g) m/s^2 must be finite and at most FSDEM_MAX_ACCELERATION (%g m/s^2)",
+                             desc, (double)g.x, (double)g.y, (double)g.z, (double)FSDEM_MAX_ACCELERATION);
+    if (dim == 2 && g.z != 0)
+        return fsdem__reject(msg, size, "%s.gravity.z = %g m/s^2 must be 0 in 2D (the motion is in the x-y plane)", desc, (double)g.z);
+    return FSDEM_OK;
+}
+
+/* The longest step dt_max of a fluid desc: > 0, and short enough that gravity alone cannot take a
+   particle at rest past FSDEM_MAX_SPEED in one step (|g| dt_max <= FSDEM_MAX_SPEED). */
+static fsdem_result fsdem__check_dt_max(const char *desc, fsdem_real dt_max, fsdem_vec3 g, char *msg, size_t size) {
+    const fsdem_real g_norm = fsdem__norm(g);
+    if (!(dt_max > 0) || !fsdem__finite(dt_max) || g_norm * dt_max > FSDEM_MAX_SPEED)
+        return fsdem__reject(msg, size, "%s.dt_max = %g s must be > 0 and |gravity| dt_max at most FSDEM_MAX_SPEED (%g m/s)", desc,
+                             (double)dt_max, (double)FSDEM_MAX_SPEED);
+    return FSDEM_OK;
 }
 
 /* ---- >>core_gauges : the point gauges of the particle solvers ---- */
@@ -3130,7 +3283,7 @@ typedef struct fsdem__gauges {
 static fsdem_result fsdem__gauges_add(fsdem__gauges *g, fsdem__status *st, const fsdem_allocator *al, const char *fn, int kind,
                                       fsdem_vec3 at, fsdem_real radius, int dim, fsdem_vec3 lo, fsdem_vec3 hi, int *id) {
     const int n = g->count;
-    int cap, a;
+    int a;
     if (id) *id = -1;
     if (g->series.file) return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: close the gauge file first", fn);
     if (kind < FSDEM__GAUGE_LEVEL || kind > FSDEM__GAUGE_PRESSURE || !fsdem__finite3(at) || !(radius >= 0) || !fsdem__finite(radius))
@@ -3139,13 +3292,11 @@ static fsdem_result fsdem__gauges_add(fsdem__gauges *g, fsdem__status *st, const
         if (!(fsdem__comp(at, a) >= fsdem__comp(lo, a) && fsdem__comp(at, a) <= fsdem__comp(hi, a)))
             return fsdem__fail(st, FSDEM_ERR_OUT_OF_DOMAIN, "%s: (%g, %g, %g) is outside the domain", fn, (double)at.x, (double)at.y,
                                (double)at.z);
-    if (n == g->capacity) {
-        cap = g->capacity;
-        if (fsdem__grow(al, (void **)&g->at, &cap, n, n + 1, sizeof(fsdem_vec3)) != FSDEM_OK ||
-            (cap = g->capacity, fsdem__grow(al, (void **)&g->kind, &cap, n, n + 1, sizeof(int))) != FSDEM_OK ||
-            (cap = g->capacity, fsdem__grow(al, (void **)&g->radius, &cap, n, n + 1, sizeof(fsdem_real))) != FSDEM_OK)
-            return fsdem__fail(st, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory", fn);
-        g->capacity = cap;
+    {
+        void **const arrays[3] = {(void **)&g->at, (void **)&g->kind, (void **)&g->radius};
+        const size_t elem[3] = {sizeof(fsdem_vec3), sizeof(int), sizeof(fsdem_real)};
+        if (fsdem__grow_set(al, arrays, elem, 3, &g->capacity, n, n + 1) != FSDEM_OK)
+            return fsdem__fail(st, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory for gauge %d", fn, n);
     }
     g->at[n] = at;
     g->kind[n] = kind;
@@ -3620,13 +3771,17 @@ typedef struct fsdem__dem_pair {
     fsdem_real friction; /* -, mean mu */
     fsdem_real rolling;  /* -, mean mu_r */
     fsdem_real restitution; /* -, mean e */
+    fsdem_real cohesion; /* J/m^3, mean cohesion energy density */
     fsdem_real tsuji;    /* -, damping coefficient giving that restitution (>>dem_law) */
     /* The law's coefficients in the form the contact kernel evaluates (fsdem__dem_batch_law):
          law      kn                  cn                      kt                 ct
          Hertz    (4/3) E* (Pa)       tsuji^2 (4/3) E* (Pa)   8 G* (Pa)          sqrt(4 G* / E*)
          linear   ||g||/(theta dx)    2 alpha sqrt(kn)        1/(2(1+psi))       1/sqrt(2(1+psi))
                   (1/s^2)             (1/s)                   seed 000 Eq. 10-13 per unit m_ij
-         GIC      2 E_pair (Pa)       0                       1/(2(1+nu))        0 */
+         seed 002 (4/3) E* (Pa)       2 zeta, zeta =          1/(2+nu)           sqrt(kt)
+         linear                       -ln e/sqrt(ln^2 e + pi^2)   (Eq. 21-24, times sqrt(R*))
+         GIC      2 E_pair (Pa)       0                       1/(2(1+nu))        0
+       ct is 0 without tangential damping (desc.tangential_damping). */
     fsdem_real kn, cn, kt, ct;
 } fsdem__dem_pair;
 
@@ -3706,6 +3861,7 @@ struct fsdem_dem {
     fsdem_real skin, r_max, max_disp2, k0_linear;
     int need_rebuild, forces_valid;
     int rolling;  /* some material pair has rolling resistance */
+    int cohesive; /* some material pair has cohesion */
     int external; /* fext/text may be nonzero (fsdem_dem_get_coupling handed them out, or a coupler wrote them) */
     int forces_cleared; /* f and t were zeroed by the last Verlet pass, for the force evaluation */
     int contacts, wall_contacts;
@@ -3723,6 +3879,7 @@ fsdem_dem_material fsdem_dem_material_default(void) {
     m.friction = (fsdem_real)0.3;
     m.rolling_friction = 0;
     m.damping_alpha = (fsdem_real)0.4;
+    m.cohesion = 0;
     return m;
 }
 
@@ -3745,19 +3902,17 @@ fsdem_dem_desc fsdem_dem_desc_default(int dim) {
     d.linear_accel = 0;
     d.disc_length = 1;
     d.rotation = 1;
+    d.tangential_damping = 1;
+    d.tangential_history = FSDEM_DEM_TANGENTIAL_HISTORY_INCREMENTAL;
+    d.coulomb_limit = FSDEM_DEM_COULOMB_LIMIT_TOTAL;
+    d.linear_stiffness = FSDEM_DEM_LINEAR_STIFFNESS_SEED000;
     d.capacity = 1024;
     return d;
 }
 
-/* Writes "why" to msg and returns FSDEM_ERR_INVALID_ARG. */
-static fsdem_result fsdem__reject(char *msg, size_t size, const char *fmt, ...) {
-    va_list ap;
-    if (msg && size) {
-        va_start(ap, fmt);
-        vsnprintf(msg, size, fmt, ap);
-        va_end(ap);
-    }
-    return FSDEM_ERR_INVALID_ARG;
+/* The linear law with the stiffness of seed 000 Eq. 10 (theta, dx, ||g||). */
+static int fsdem__dem_seed000_stiffness(const fsdem_dem_desc *d) {
+    return d->law == FSDEM_DEM_LAW_LINEAR && d->linear_stiffness == FSDEM_DEM_LINEAR_STIFFNESS_SEED000;
 }
 
 fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t size) {
@@ -3772,7 +3927,7 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
             !fsdem__finite(fsdem__comp(d->domain_max, axis) - fsdem__comp(d->domain_min, axis)))
             return fsdem__reject(msg, size, "fsdem_dem_desc.domain_max must exceed domain_min by a finite extent on axis %d",
                                  axis);
-    if (!fsdem__finite3(d->gravity)) return fsdem__reject(msg, size, "fsdem_dem_desc.gravity is not finite");
+    if (fsdem__check_gravity("fsdem_dem_desc", d->gravity, d->dim, msg, size) != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     if (d->law != FSDEM_DEM_LAW_LINEAR && d->law != FSDEM_DEM_LAW_HERTZ_MINDLIN && d->law != FSDEM_DEM_LAW_GIC)
         return fsdem__reject(msg, size, "fsdem_dem_desc.law is not a fsdem_dem_law (%d)", (int)d->law);
     if (d->integrator != FSDEM_DEM_INTEGRATOR_VERLET && d->integrator != FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR)
@@ -3785,11 +3940,22 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
     if (!(d->dt_param >= 0) || !fsdem__finite(d->dt_param))
         return fsdem__reject(msg, size, "fsdem_dem_desc.dt_param must be >= 0 (got %g)", (double)d->dt_param);
     if (d->dt_param > 1 && d->dt_rule != FSDEM_DEM_DT_RULE_LINEAR_SEED000 &&
-        !(d->dt_rule == FSDEM_DEM_DT_RULE_AUTO && d->law == FSDEM_DEM_LAW_LINEAR))
+        !(d->dt_rule == FSDEM_DEM_DT_RULE_AUTO && fsdem__dem_seed000_stiffness(d)))
         return fsdem__reject(msg, size, "fsdem_dem_desc.dt_param: a safety fraction must be in (0, 1] (got %g)",
                              (double)d->dt_param);
-    if (d->dt_rule == FSDEM_DEM_DT_RULE_LINEAR_SEED000 && d->law != FSDEM_DEM_LAW_LINEAR)
-        return fsdem__reject(msg, size, "fsdem_dem_desc.dt_rule FSDEM_DEM_DT_RULE_LINEAR_SEED000 needs the linear law");
+    if (d->tangential_damping != 0 && d->tangential_damping != 1)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.tangential_damping must be 0 or 1 (got %d)", d->tangential_damping);
+    if ((int)d->tangential_history < 0 || (int)d->tangential_history > 1)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.tangential_history is not a fsdem_dem_tangential_history (%d)",
+                             (int)d->tangential_history);
+    if ((int)d->coulomb_limit < 0 || (int)d->coulomb_limit > 1)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.coulomb_limit is not a fsdem_dem_coulomb_limit (%d)", (int)d->coulomb_limit);
+    if ((int)d->linear_stiffness < 0 || (int)d->linear_stiffness > 1)
+        return fsdem__reject(msg, size, "fsdem_dem_desc.linear_stiffness is not a fsdem_dem_linear_stiffness (%d)",
+                             (int)d->linear_stiffness);
+    if (d->dt_rule == FSDEM_DEM_DT_RULE_LINEAR_SEED000 && !fsdem__dem_seed000_stiffness(d))
+        return fsdem__reject(msg, size,
+                             "fsdem_dem_desc.dt_rule FSDEM_DEM_DT_RULE_LINEAR_SEED000 needs the linear law with seed 000's stiffness");
     if (!fsdem__finite(d->skin)) return fsdem__reject(msg, size, "fsdem_dem_desc.skin is not finite");
     if (!(d->contact_offset >= 0) || !fsdem__finite(d->contact_offset))
         return fsdem__reject(msg, size, "fsdem_dem_desc.contact_offset must be >= 0 (got %g m)",
@@ -3799,7 +3965,7 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
     if (d->capacity < 0) return fsdem__reject(msg, size, "fsdem_dem_desc.capacity must be >= 0");
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return fsdem__reject(msg, size, "fsdem_dem_desc.allocator: set both alloc and free, or neither");
-    if (d->law == FSDEM_DEM_LAW_LINEAR) {
+    if (fsdem__dem_seed000_stiffness(d)) {
         fsdem_real accel = d->linear_accel > 0 ? d->linear_accel : fsdem__norm(d->gravity);
         if (!(d->linear_theta > 0) || !fsdem__finite(d->linear_theta))
             return fsdem__reject(msg, size, "fsdem_dem_desc.linear_theta must be > 0 (got %g)", (double)d->linear_theta);
@@ -3819,9 +3985,10 @@ static fsdem_result fsdem__dem_material_check(const fsdem_dem_material *m, char 
     if (!m) return fsdem__reject(msg, size, "fsdem_dem_material is NULL");
     if (!(m->density > 0) || !fsdem__finite(m->density))
         return fsdem__reject(msg, size, "fsdem_dem_material.density must be > 0 (got %g kg/m^3)", (double)m->density);
-    /* An infinite modulus is allowed: a rigid wall material. */
-    if (!(m->young_modulus > 0))
-        return fsdem__reject(msg, size, "fsdem_dem_material.young_modulus must be > 0 (got %g Pa)", (double)m->young_modulus);
+    /* a rigid wall is a stiff finite material: two infinite moduli would meet in a NaN */
+    if (!(m->young_modulus > 0 && m->young_modulus <= FSDEM_MAX_MODULUS))
+        return fsdem__reject(msg, size, "fsdem_dem_material.young_modulus must be in (0, %g] Pa (got %g Pa)",
+                             (double)FSDEM_MAX_MODULUS, (double)m->young_modulus);
     if (!(m->poisson_ratio > -1 && m->poisson_ratio <= (fsdem_real)0.5))
         return fsdem__reject(msg, size, "fsdem_dem_material.poisson_ratio must be in (-1, 0.5] (got %g)",
                              (double)m->poisson_ratio);
@@ -3834,6 +4001,8 @@ static fsdem_result fsdem__dem_material_check(const fsdem_dem_material *m, char 
                              (double)m->rolling_friction);
     if (!(m->damping_alpha >= 0) || !fsdem__finite(m->damping_alpha))
         return fsdem__reject(msg, size, "fsdem_dem_material.damping_alpha must be >= 0 (got %g)", (double)m->damping_alpha);
+    if (!(m->cohesion >= 0) || !fsdem__finite(m->cohesion))
+        return fsdem__reject(msg, size, "fsdem_dem_material.cohesion must be >= 0 (got %g J/m^3)", (double)m->cohesion);
     return FSDEM_OK;
 }
 
@@ -3950,51 +4119,61 @@ static fsdem_real fsdem__dem_tsuji_coefficient(fsdem_real e) {
     return (fsdem_real)(0.5 * (lo + hi));
 }
 
-static fsdem_real fsdem__dem_inv_or_zero(fsdem_real x) { return fsdem__finite(x) ? 1 / x : 0; }
-
-static void fsdem__dem_pair_setup(fsdem__dem_pair *p, const fsdem_dem_material *a, const fsdem_dem_material *b, fsdem_dem_law law,
-                              fsdem_real k0_linear, const fsdem__dem_pair *known, int known_count) {
-    fsdem_real ea = a->young_modulus, eb = b->young_modulus, na = a->poisson_ratio, nb = b->poisson_ratio;
-    fsdem_real e = (a->restitution + b->restitution) / 2;
-    fsdem_real inv_e = (1 - na * na) * fsdem__dem_inv_or_zero(ea) + (1 - nb * nb) * fsdem__dem_inv_or_zero(eb);
-    fsdem_real inv_g = 2 * (2 - na) * (1 + na) * fsdem__dem_inv_or_zero(ea) + 2 * (2 - nb) * (1 + nb) * fsdem__dem_inv_or_zero(eb);
-    fsdem_real inv_ep = fsdem__dem_inv_or_zero(ea) + fsdem__dem_inv_or_zero(eb);
+/* The law's coefficients of a pair from its moduli and its (mixed or set) properties. `known`
+   (known_count pairs) are pairs set up before, whose Hertz damping calibration is reused for a
+   restitution seen before: it costs a few milliseconds. */
+static void fsdem__dem_pair_coefficients(fsdem__dem_pair *p, const fsdem_dem_desc *desc, fsdem_real k0_linear,
+                                         const fsdem__dem_pair *known, int known_count) {
+    const fsdem_real e = p->restitution;
     int k;
-    p->e_star = inv_e > 0 ? 1 / inv_e : (fsdem_real)HUGE_VAL;
-    p->g_star = inv_g > 0 ? 1 / inv_g : (fsdem_real)HUGE_VAL;
-    p->e_pair = inv_ep > 0 ? 2 / inv_ep : (fsdem_real)HUGE_VAL;
-    p->nu = (na + nb) / 2;
-    p->alpha = (a->damping_alpha + b->damping_alpha) / 2;
-    p->friction = (a->friction + b->friction) / 2;
-    p->rolling = (a->rolling_friction + b->rolling_friction) / 2;
-    p->restitution = e;
     p->tsuji = 0;
-    if (law == FSDEM_DEM_LAW_HERTZ_MINDLIN) {
-        /* The calibration costs a few milliseconds; reuse it for a restitution seen before. */
+    if (desc->law == FSDEM_DEM_LAW_HERTZ_MINDLIN) {
         for (k = 0; k < known_count && known[k].restitution != e; ++k) {
         }
         p->tsuji = k < known_count ? known[k].tsuji : fsdem__dem_tsuji_coefficient(e);
     }
-    switch (law) {
-    case FSDEM_DEM_LAW_LINEAR:
+    if (fsdem__dem_seed000_stiffness(desc)) {
         p->kn = k0_linear;
         p->cn = 2 * p->alpha * (fsdem_real)sqrt(k0_linear);
         p->kt = 1 / (2 * (1 + p->nu));
         p->ct = 1 / (fsdem_real)sqrt(2 * (1 + p->nu));
-        break;
-    case FSDEM_DEM_LAW_GIC:
+    } else if (desc->law == FSDEM_DEM_LAW_LINEAR) { /* seed 002 Eq. 21-24 */
+        const double ln_e = log((double)e);
+        p->kn = (fsdem_real)(4.0 / 3.0) * p->e_star;
+        p->cn = (fsdem_real)(-2 * ln_e / sqrt(ln_e * ln_e + FSDEM__PI * FSDEM__PI));
+        p->kt = 1 / (2 + p->nu);
+        p->ct = (fsdem_real)sqrt(p->kt);
+    } else if (desc->law == FSDEM_DEM_LAW_GIC) {
         p->kn = 2 * p->e_pair;
         p->cn = p->ct = 0;
         p->kt = 1 / (2 * (1 + p->nu));
-        break;
-    default:
+    } else {
         p->kn = (fsdem_real)(4.0 / 3.0) * p->e_star;
         p->cn = p->tsuji * p->tsuji * p->kn;
         p->kt = 8 * p->g_star;
-        /* both moduli are infinite only for two rigid materials, which never meet a finite contact */
-        p->ct = fsdem__finite(p->e_star) ? (fsdem_real)sqrt(4 * p->g_star / p->e_star) : 1;
-        break;
+        p->ct = (fsdem_real)sqrt(4 * p->g_star / p->e_star);
     }
+    if (!desc->tangential_damping && desc->law != FSDEM_DEM_LAW_GIC) p->ct = 0;
+}
+
+/* A pair of materials: moduli, and the means of their contact properties (fsdem_dem_material_pair). */
+static void fsdem__dem_pair_setup(fsdem__dem_pair *p, const fsdem_dem_material *a, const fsdem_dem_material *b, const fsdem_dem_desc *desc,
+                                  fsdem_real k0_linear, const fsdem__dem_pair *known, int known_count) {
+    fsdem_real ea = a->young_modulus, eb = b->young_modulus, na = a->poisson_ratio, nb = b->poisson_ratio;
+    const fsdem_real ia = 1 / ea, ib = 1 / eb;
+    fsdem_real inv_e = (1 - na * na) * ia + (1 - nb * nb) * ib;
+    fsdem_real inv_g = 2 * (2 - na) * (1 + na) * ia + 2 * (2 - nb) * (1 + nb) * ib;
+    fsdem_real inv_ep = ia + ib;
+    p->e_star = 1 / inv_e;
+    p->g_star = 1 / inv_g;
+    p->e_pair = 2 / inv_ep;
+    p->nu = (na + nb) / 2;
+    p->alpha = (a->damping_alpha + b->damping_alpha) / 2;
+    p->friction = (a->friction + b->friction) / 2;
+    p->rolling = (a->rolling_friction + b->rolling_friction) / 2;
+    p->restitution = (a->restitution + b->restitution) / 2;
+    p->cohesion = (a->cohesion + b->cohesion) / 2;
+    fsdem__dem_pair_coefficients(p, desc, k0_linear, known, known_count);
 }
 
 /* Contacts in structure-of-arrays form, up to FSDEM__DEM_BATCH at a time, for the vector kernel below
@@ -4024,6 +4203,7 @@ typedef struct fsdem__dem_batch {
     fsdem_real arm_i[FSDEM__DEM_BATCH];   /* m, centre of i to the contact point */
     fsdem_real kn[FSDEM__DEM_BATCH], cn[FSDEM__DEM_BATCH], kt[FSDEM__DEM_BATCH], ct[FSDEM__DEM_BATCH]; /* fsdem__dem_pair */
     fsdem_real mu[FSDEM__DEM_BATCH];      /* -, Coulomb coefficient */
+    fsdem_real coh[FSDEM__DEM_BATCH];     /* J/m^3, cohesion energy density */
     fsdem_real spring[3][FSDEM__DEM_BATCH]; /* m, tangential spring: held value in, new value out */
     /* output */
     fsdem_real force[3][FSDEM__DEM_BATCH];    /* N, on i */
@@ -4068,6 +4248,7 @@ static void fsdem__dem_batch_pad(fsdem__dem_batch *b, int pairs, int uniform) {
             b->kt[c] = b->kt[0];
             b->ct[c] = b->ct[0];
             b->mu[c] = b->mu[0];
+            b->coh[c] = b->coh[0];
         }
     }
 }
@@ -4087,6 +4268,19 @@ static void fsdem__dem_batch_pad(fsdem__dem_batch *b, int pairs, int uniform) {
 typedef struct fsdem__dem_lanes {
     fsdem__lane nx, ny, nz, vx, vy, vz, vn, delta, m_eff, r_eff, kn, cn, kt, ct, mu;
 } fsdem__dem_lanes;
+
+/* The contact options of a simulation as the kernels read them (fsdem_dem_desc, >>dem). */
+typedef struct fsdem__dem_rules {
+    int total_history;      /* FSDEM_DEM_TANGENTIAL_HISTORY_TOTAL */
+    int cap_spring;         /* FSDEM_DEM_COULOMB_LIMIT_SPRING */
+    int cohesion;           /* some material pair is cohesive: add the attraction k A */
+    fsdem_real offset;      /* m, the contact offset: the spheres of the cohesive area are r + offset/2 */
+    fsdem_real area_depth;  /* m, 2D: the disc length (the area is the chord times it); 3D: 0 (pi a^2) */
+} fsdem__dem_rules;
+
+/* The linear law with seed 002's stiffness, as the kernels are instantiated for it (not public: a
+   fsdem_dem_linear_stiffness of FSDEM_DEM_LAW_LINEAR). */
+#define FSDEM__DEM_LAW_SEED002 ((fsdem_dem_law)3)
 
 /* Coulomb cap |F_t| <= ft_max on a tangential force (seed 000 Eq. 15, seed 004 Eq. 1b), for the laws
    without a tangential history. */
@@ -4125,42 +4319,64 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_gic(const fsdem__dem_lanes *k, fs
     return fn;
 }
 
-/* Hertz-Mindlin. With s = sqrt(R* d): normal stiffness S_n = 2 E* s, elastic force (2/3) S_n d =
-   (4/3) E* s d; tangential stiffness S_t = 8 G* s on the accumulated tangential displacement (seed
-   002 Eq. 20, Coulomb sliding Eq. 22) held in the batch's spring of lane group c, updated in place.
-   Damping eta = a sqrt((2/3) m* S), Tsuji's a sqrt(m* k) d^(1/4) with a calibrated from e
-   (fsdem__dem_tsuji_coefficient), so eta_n = sqrt(cn m* s) and eta_t = ct eta_n. */
-FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_hertz(const fsdem__dem_lanes *k, fsdem__dem_batch *b, int c, fsdem_real h,
-                                                    fsdem__lane *tx, fsdem__lane *ty, fsdem__lane *tz) {
-    const fsdem__lane one = fsdem__lane_set(1), zero = fsdem__lane_set(0);
-    const fsdem__lane s = fsdem__lane_sqrt(k->r_eff * k->delta);
-    const fsdem__lane eta_n = fsdem__lane_sqrt(k->cn * k->m_eff * s), st = k->kt * s;
-    fsdem__lane sx, sy, sz, sn, len2, proj2, scale, fn, ft_max, ft2, inv;
+/* The tangential force of a spring with history (Hertz-Mindlin, seed 002's linear law): stiffness
+   st, dashpot eta_t, Coulomb's limit ft_max = mu |F_n|; the spring of lane group c of the batch is
+   updated in place by the rules of desc.tangential_history and desc.coulomb_limit (>>dem). While
+   the contact slides, the spring carries the capped force alone: folding the dashpot term into the
+   spring (-(F_t + eta_t v_t)/S_t) would store energy along the slip at first touch, where Hertz's
+   eta_t ~ d^(1/4) outgrows mu F_n ~ d^(3/2). */
+FSDEM__FORCE_INLINE void fsdem__dem_tangential_spring(const fsdem__dem_lanes *k, fsdem__dem_batch *b, int c, fsdem_real h,
+                                                      const fsdem__dem_rules *rules, fsdem__lane st, fsdem__lane eta_t,
+                                                      fsdem__lane ft_max, fsdem__lane *tx, fsdem__lane *ty, fsdem__lane *tz) {
+    const fsdem__lane one = fsdem__lane_set(1);
+    fsdem__lane sx, sy, sz, px, py, pz, sn, scale, ft2, inv;
     fsdem__mask slide;
-    /* the held spring, turned into the current tangent plane with its length kept */
     FSDEM__DEM_LOAD3(s, b->spring, c);
-    len2 = sx * sx + sy * sy + sz * sz;
-    sn = sx * k->nx + sy * k->ny + sz * k->nz;
-    sx -= sn * k->nx;
-    sy -= sn * k->ny;
-    sz -= sn * k->nz;
-    proj2 = sx * sx + sy * sy + sz * sz;
-    /* proj2 = 0 leaves a zero spring, whatever finite scale multiplies it */
-    scale = fsdem__lane_sqrt(len2 / fsdem__lane_select(proj2 > 0, proj2, one));
-    sx = sx * scale + k->vx * h;
-    sy = sy * scale + k->vy * h;
-    sz = sz * scale + k->vz * h;
-    fn = fsdem__lane_max(k->kn * s * k->delta - eta_n * k->vn, zero);
-    *tx = -st * sx - k->ct * eta_n * k->vx;
-    *ty = -st * sy - k->ct * eta_n * k->vy;
-    *tz = -st * sz - k->ct * eta_n * k->vz;
-    ft_max = k->mu * fn;
+    if (rules->total_history) {
+        /* the total displacement: the increment added in the fixed frame, its tangential part taken */
+        sx += k->vx * h;
+        sy += k->vy * h;
+        sz += k->vz * h;
+        sn = sx * k->nx + sy * k->ny + sz * k->nz;
+        px = sx - sn * k->nx;
+        py = sy - sn * k->ny;
+        pz = sz - sn * k->nz;
+    } else {
+        /* the held spring, turned into the current tangent plane with its length kept; proj2 = 0
+           leaves a zero spring, whatever finite scale multiplies it */
+        const fsdem__lane len2 = sx * sx + sy * sy + sz * sz;
+        fsdem__lane proj2;
+        sn = sx * k->nx + sy * k->ny + sz * k->nz;
+        sx -= sn * k->nx;
+        sy -= sn * k->ny;
+        sz -= sn * k->nz;
+        proj2 = sx * sx + sy * sy + sz * sz;
+        scale = fsdem__lane_sqrt(len2 / fsdem__lane_select(proj2 > 0, proj2, one));
+        px = sx = sx * scale + k->vx * h;
+        py = sy = sy * scale + k->vy * h;
+        pz = sz = sz * scale + k->vz * h;
+    }
+    if (rules->cap_spring) {
+        /* the spring alone within mu |F_n|, the dashpot added after */
+        const fsdem__lane fs2 = st * st * (px * px + py * py + pz * pz);
+        slide = fs2 > ft_max * ft_max;
+        scale = fsdem__lane_select(slide, ft_max / fsdem__lane_sqrt(fsdem__lane_select(slide, fs2, one)), one);
+        px *= scale;
+        py *= scale;
+        pz *= scale;
+        *tx = -st * px - eta_t * k->vx;
+        *ty = -st * py - eta_t * k->vy;
+        *tz = -st * pz - eta_t * k->vz;
+        FSDEM__DEM_STORE3(b->spring, c, fsdem__lane_select(slide, px, sx), fsdem__lane_select(slide, py, sy),
+                          fsdem__lane_select(slide, pz, sz));
+        return;
+    }
+    *tx = -st * px - eta_t * k->vx;
+    *ty = -st * py - eta_t * k->vy;
+    *tz = -st * pz - eta_t * k->vz;
     ft2 = *tx * *tx + *ty * *ty + *tz * *tz;
     slide = ft2 > ft_max * ft_max;
-    /* Sliding: cap at Coulomb and let the spring carry the capped force alone. Folding the damping
-       term into the spring (-(F_t + eta_t v_t)/S_t) would store energy along the slip at first
-       touch, where eta_t ~ d^(1/4) outgrows mu F_n ~ d^(3/2). One division gives both 1/|F_t| and
-       1/S_t. */
+    /* sliding: cap at Coulomb, the spring -F_t / S_t; one division gives both 1/|F_t| and 1/S_t */
     ft2 = fsdem__lane_sqrt(fsdem__lane_select(slide, ft2, one)); /* |F_t| where sliding */
     inv = 1 / (ft2 * fsdem__lane_select(slide, st, one));        /* a sliding contact has S_t > 0 */
     scale = fsdem__lane_select(slide, ft_max * st * inv, one);
@@ -4170,22 +4386,60 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_hertz(const fsdem__dem_lanes *k, 
     inv = -ft2 * inv; /* -1/S_t where sliding */
     FSDEM__DEM_STORE3(b->spring, c, fsdem__lane_select(slide, *tx * inv, sx), fsdem__lane_select(slide, *ty * inv, sy),
                       fsdem__lane_select(slide, *tz * inv, sz));
+}
+
+/* Hertz-Mindlin. With s = sqrt(R* d): normal stiffness S_n = 2 E* s, elastic force (2/3) S_n d =
+   (4/3) E* s d; tangential stiffness S_t = 8 G* s on the spring (seed 002 Eq. 20, Coulomb sliding).
+   Damping eta = a sqrt((2/3) m* S), Tsuji's a sqrt(m* k) d^(1/4) with a calibrated from e
+   (fsdem__dem_tsuji_coefficient), so eta_n = sqrt(cn m* s) and eta_t = ct eta_n. The normal force
+   never turns attractive. */
+FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_hertz(const fsdem__dem_lanes *k, fsdem__dem_batch *b, int c, fsdem_real h,
+                                                    const fsdem__dem_rules *rules, fsdem__lane *tx, fsdem__lane *ty, fsdem__lane *tz) {
+    const fsdem__lane s = fsdem__lane_sqrt(k->r_eff * k->delta);
+    const fsdem__lane eta_n = fsdem__lane_sqrt(k->cn * k->m_eff * s);
+    const fsdem__lane fn = fsdem__lane_max(k->kn * s * k->delta - eta_n * k->vn, fsdem__lane_set(0));
+    fsdem__dem_tangential_spring(k, b, c, h, rules, k->kt * s, k->ct * eta_n, k->mu * fn, tx, ty, tz);
     return fn;
+}
+
+/* The linear spring-dashpot of seed 002 Eq. 19-24 (fsdem_dem_linear_stiffness): chi^n = kn sqrt(R*),
+   eta^n = cn sqrt(chi^n m*), chi^t = kt chi^n, eta^t = ct eta^n, the spring with history; no
+   tension cut-off, as printed, so Coulomb's limit takes |F_n|. */
+FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_law_seed002(const fsdem__dem_lanes *k, fsdem__dem_batch *b, int c, fsdem_real h,
+                                                      const fsdem__dem_rules *rules, fsdem__lane *tx, fsdem__lane *ty, fsdem__lane *tz) {
+    const fsdem__lane chi = k->kn * fsdem__lane_sqrt(k->r_eff);
+    const fsdem__lane eta_n = k->cn * fsdem__lane_sqrt(chi * k->m_eff);
+    const fsdem__lane fn = chi * k->delta - eta_n * k->vn;
+    fsdem__dem_tangential_spring(k, b, c, h, rules, k->kt * chi, k->ct * eta_n, k->mu * fsdem__lane_max(fn, -fn), tx, ty, tz);
+    return fn;
+}
+
+/* The cohesive attraction k A of the simplified JKR model (fsdem_dem_material.cohesion): A is the
+   area of the circle where two spheres of radii r1, r2 whose centres are `dist` apart intersect,
+   pi a^2 with a^2 = r1^2 - x^2, x = (dist^2 + r1^2 - r2^2) / (2 dist) the distance from the first
+   centre to the circle's plane (a plane wall: r2 = infinity, x = r1 - overlap, given as `x`); in
+   2D the area is the chord 2a times the disc length. */
+FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_cohesion(fsdem__lane coh, fsdem__lane r1, fsdem__lane x, const fsdem__dem_rules *rules) {
+    const fsdem__lane a2 = fsdem__lane_max(r1 * r1 - x * x, fsdem__lane_set(0));
+    return coh * (rules->area_depth > 0 ? 2 * fsdem__lane_sqrt(a2) * fsdem__lane_set(rules->area_depth)
+                                       : (fsdem_real)FSDEM__PI * a2);
 }
 
 /* The contact law on every contact of a batch: force and torques, normal force, new spring (laws
    with history). With `pairs`, the contacts are first made from the particle-pair input: normal,
    overlap (offset `off` included), velocity of the contact point, effective mass and radius, lever
    arms (each body's radius less half the overlap). With `uniform`, every contact has that material
-   pair and the batch holds no coefficients. Written once, branch-free, and inlined with a constant
-   `law` and `pairs`. h is the step the spring and seed 000's one-step tangential spring (Eq. 8) use. */
+   pair and the batch holds no coefficients. `rules` are the contact options. Written once,
+   branch-free, and inlined with a constant `law` and `pairs`. h is the step the spring and seed
+   000's one-step tangential spring (Eq. 8) use. The normal force the law gives goes to b->fn
+   (rolling resistance and Coulomb's limit take it); cohesion is added to the force after. */
 FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_dem_law law, fsdem_real h, const int pairs,
-                                          fsdem_real off, const fsdem__dem_pair *uniform) {
+                                          fsdem_real off, const fsdem__dem_pair *uniform, const fsdem__dem_rules *rules) {
     const fsdem__lane one = fsdem__lane_set(1), zero = fsdem__lane_set(0);
     int c;
     for (c = 0; c < b->count; c += FSDEM__LANES) {
         fsdem__dem_lanes k;
-        fsdem__lane tx, ty, tz, mx, my, mz, arm_i, arm_j, fn;
+        fsdem__lane tx, ty, tz, mx, my, mz, arm_i, arm_j, fn, pull = zero;
         if (pairs) {
             fsdem__lane dxx, dxy, dxz, wix, wiy, wiz, wjx, wjy, wjz, ax, ay, az, dist, q, safe, inv, vx, vy, vz;
             const fsdem__lane ri = fsdem__lane_load(&b->ri[c]), rj = fsdem__lane_load(&b->rj[c]);
@@ -4221,6 +4475,11 @@ FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_d
             k.vz = vz - (ax * k.ny - ay * k.nx);
             fsdem__lane_store(&b->delta[c], k.delta);
             fsdem__lane_store(&b->r_eff[c], k.r_eff);
+            if (rules->cohesion) {
+                const fsdem__lane r1 = ri + (fsdem_real)0.5 * off, r2 = rj + (fsdem_real)0.5 * off;
+                const fsdem__lane coh = uniform ? fsdem__lane_set(uniform->cohesion) : fsdem__lane_load(&b->coh[c]);
+                pull = fsdem__dem_cohesion(coh, r1, (dist * dist + r1 * r1 - r2 * r2) / (2 * safe), rules);
+            }
         } else {
             FSDEM__DEM_LOAD3(k.n, b->n, c);
             FSDEM__DEM_LOAD3(k.v, b->vrel, c);
@@ -4229,6 +4488,11 @@ FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_d
             k.r_eff = fsdem__lane_load(&b->r_eff[c]);
             arm_i = fsdem__lane_load(&b->arm_i[c]);
             arm_j = zero;
+            if (rules->cohesion) {
+                const fsdem__lane r1 = k.r_eff + rules->offset;
+                const fsdem__lane coh = uniform ? fsdem__lane_set(uniform->cohesion) : fsdem__lane_load(&b->coh[c]);
+                pull = fsdem__dem_cohesion(coh, r1, r1 - k.delta, rules);
+            }
         }
         if (uniform) {
             k.kn = fsdem__lane_set(uniform->kn);
@@ -4249,9 +4513,11 @@ FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_d
         k.vz -= k.vn * k.nz;
         if (law == FSDEM_DEM_LAW_LINEAR) fn = fsdem__dem_law_linear(&k, fsdem__lane_load(&b->m_mean[c]), h, &tx, &ty, &tz);
         else if (law == FSDEM_DEM_LAW_GIC) fn = fsdem__dem_law_gic(&k, &tx, &ty, &tz);
-        else fn = fsdem__dem_law_hertz(&k, b, c, h, &tx, &ty, &tz);
-        FSDEM__DEM_STORE3(b->force, c, tx + fn * k.nx, ty + fn * k.ny, tz + fn * k.nz);
+        else if (law == FSDEM__DEM_LAW_SEED002) fn = fsdem__dem_law_seed002(&k, b, c, h, rules, &tx, &ty, &tz);
+        else fn = fsdem__dem_law_hertz(&k, b, c, h, rules, &tx, &ty, &tz);
         fsdem__lane_store(&b->fn[c], fn);
+        if (rules->cohesion) fn -= pull;
+        FSDEM__DEM_STORE3(b->force, c, tx + fn * k.nx, ty + fn * k.ny, tz + fn * k.nz);
         /* torques: the arms point along -n from i and +n from the partner, torque = arm x F, and
            n x F = n x F_t */
         mx = k.ny * tz - k.nz * ty;
@@ -4356,9 +4622,9 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     if (!d) return res;
     d->desc = *desc;
     if (desc->dt_rule == FSDEM_DEM_DT_RULE_AUTO)
-        d->desc.dt_rule = desc->law == FSDEM_DEM_LAW_LINEAR  ? FSDEM_DEM_DT_RULE_LINEAR_SEED000
-                          : desc->law == FSDEM_DEM_LAW_GIC ? FSDEM_DEM_DT_RULE_GIC
-                                                           : FSDEM_DEM_DT_RULE_RAYLEIGH;
+        d->desc.dt_rule = fsdem__dem_seed000_stiffness(desc) ? FSDEM_DEM_DT_RULE_LINEAR_SEED000
+                          : desc->law == FSDEM_DEM_LAW_GIC   ? FSDEM_DEM_DT_RULE_GIC
+                                                             : FSDEM_DEM_DT_RULE_RAYLEIGH;
     if (desc->dt_param == 0)
         d->desc.dt_param = d->desc.dt_rule == FSDEM_DEM_DT_RULE_LINEAR_SEED000 ? 150
                            : d->desc.dt_rule == FSDEM_DEM_DT_RULE_RAYLEIGH   ? (fsdem_real)0.2
@@ -4371,7 +4637,7 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     d->need_rebuild = 1;
     {
         fsdem_real accel = desc->linear_accel > 0 ? desc->linear_accel : fsdem__norm(desc->gravity);
-        d->k0_linear = desc->law == FSDEM_DEM_LAW_LINEAR ? accel / (desc->linear_theta * desc->linear_dx) : 0;
+        d->k0_linear = fsdem__dem_seed000_stiffness(desc) ? accel / (desc->linear_theta * desc->linear_dx) : 0;
     }
     res = fsdem__dem_reserve_particles(d, desc->capacity > 0 ? desc->capacity : 1);
     if (res != FSDEM_OK) {
@@ -4409,6 +4675,16 @@ void fsdem_dem_destroy(fsdem_dem *d) {
 
 const char *fsdem_dem_last_error(const fsdem_dem *d) { return d ? d->status.message : "fsdem_dem is NULL"; }
 
+/* Whether some pair of materials has rolling resistance or cohesion (the force loop adds them only then). */
+static void fsdem__dem_pair_flags(fsdem_dem *d) {
+    int k;
+    d->rolling = d->cohesive = 0;
+    for (k = 0; k < d->material_count * d->material_count; ++k) {
+        d->rolling |= d->pairs[k].rolling > 0;
+        d->cohesive |= d->pairs[k].cohesion > 0;
+    }
+}
+
 fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_dem_material *mat, int *index) {
     char msg[FSDEM__MESSAGE_SIZE];
     int nm, a, b;
@@ -4427,7 +4703,7 @@ fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_dem_material *mat,
         for (b = 0; b < nm; ++b) {
             if (a < nm - 1 && b < nm - 1) pairs[a * nm + b] = d->pairs[a * (nm - 1) + b];
             else if (b < a) pairs[a * nm + b] = pairs[b * nm + a];
-            else fsdem__dem_pair_setup(&pairs[a * nm + b], &d->materials[a], &d->materials[b], d->desc.law, d->k0_linear,
+            else fsdem__dem_pair_setup(&pairs[a * nm + b], &d->materials[a], &d->materials[b], &d->desc, d->k0_linear,
                                    pairs, a * nm + b);
         }
     /* the loop reads earlier rows only, which are already in the new table */
@@ -4435,10 +4711,60 @@ fsdem_result fsdem_dem_add_material(fsdem_dem *d, const fsdem_dem_material *mat,
     d->pairs = pairs;
     d->pair_capacity = nm * nm;
     d->material_count = nm;
-    for (a = 0; a < nm * nm; ++a) d->rolling |= pairs[a].rolling > 0;
+    fsdem__dem_pair_flags(d);
     d->forces_valid = 0;
     if (index) *index = nm - 1;
     return fsdem__ok(&d->status);
+}
+
+static fsdem_result fsdem__dem_material_pair_check(const fsdem_dem_material_pair *v, char *msg, size_t size) {
+    if (!v) return fsdem__reject(msg, size, "fsdem_dem_set_material_pair: values is NULL");
+    if (!(v->restitution >= (fsdem_real)1e-6 && v->restitution <= 1))
+        return fsdem__reject(msg, size, "fsdem_dem_material_pair.restitution must be in [1e-6, 1] (got %g)", (double)v->restitution);
+    if (!(v->friction >= 0) || !fsdem__finite(v->friction))
+        return fsdem__reject(msg, size, "fsdem_dem_material_pair.friction must be >= 0 (got %g)", (double)v->friction);
+    if (!(v->rolling_friction >= 0) || !fsdem__finite(v->rolling_friction))
+        return fsdem__reject(msg, size, "fsdem_dem_material_pair.rolling_friction must be >= 0 (got %g)", (double)v->rolling_friction);
+    if (!(v->cohesion >= 0) || !fsdem__finite(v->cohesion))
+        return fsdem__reject(msg, size, "fsdem_dem_material_pair.cohesion must be >= 0 (got %g J/m^3)", (double)v->cohesion);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_dem_set_material_pair(fsdem_dem *d, int a, int b, const fsdem_dem_material_pair *values) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    int k;
+    if (!d) return FSDEM_ERR_INVALID_ARG;
+    if (a < 0 || a >= d->material_count || b < 0 || b >= d->material_count)
+        return fsdem__fail(&d->status, FSDEM_ERR_NOT_FOUND, "fsdem_dem_set_material_pair: materials %d and %d (%d added)", a, b,
+                           d->material_count);
+    if (fsdem__dem_material_pair_check(values, msg, sizeof msg) != FSDEM_OK)
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "%s", msg);
+    for (k = 0; k < 2; ++k) {
+        /* set up aside: the table, searched for a known Hertz calibration, still holds the old pair */
+        fsdem__dem_pair *p = &d->pairs[k ? b * d->material_count + a : a * d->material_count + b], q = *p;
+        q.restitution = values->restitution;
+        q.friction = values->friction;
+        q.rolling = values->rolling_friction;
+        q.cohesion = values->cohesion;
+        fsdem__dem_pair_coefficients(&q, &d->desc, d->k0_linear, d->pairs, d->material_count * d->material_count);
+        *p = q;
+    }
+    fsdem__dem_pair_flags(d);
+    d->forces_valid = 0;
+    return fsdem__ok(&d->status);
+}
+
+fsdem_dem_material_pair fsdem_dem_get_material_pair(const fsdem_dem *d, int a, int b) {
+    fsdem_dem_material_pair v;
+    memset(&v, 0, sizeof v);
+    if (d && a >= 0 && a < d->material_count && b >= 0 && b < d->material_count) {
+        const fsdem__dem_pair *p = &d->pairs[a * d->material_count + b];
+        v.restitution = p->restitution;
+        v.friction = p->friction;
+        v.rolling_friction = p->rolling;
+        v.cohesion = p->cohesion;
+    }
+    return v;
 }
 
 static int fsdem__dem_inside_domain(const fsdem_dem *d, fsdem_vec3 p) {
@@ -4447,11 +4773,17 @@ static int fsdem__dem_inside_domain(const fsdem_dem *d, fsdem_vec3 p) {
     return d->desc.dim == 2 || (p.z >= lo.z && p.z <= hi.z);
 }
 
-/* Checks a kinematic state; writes the reason and returns the code, or FSDEM_OK. */
-static fsdem_result fsdem__dem_state_check(fsdem_dem *d, const char *what, fsdem_vec3 x, fsdem_vec3 v, fsdem_vec3 w) {
+/* Checks a kinematic state of a particle of radius r; writes the reason and returns the code, or
+   FSDEM_OK. Speeds, of the centre and of the surface by the spin, are bounded by FSDEM_MAX_SPEED. */
+static fsdem_result fsdem__dem_state_check(fsdem_dem *d, const char *what, fsdem_vec3 x, fsdem_vec3 v, fsdem_vec3 w, fsdem_real r) {
     if (!fsdem__finite3(x) || !fsdem__finite3(v) || !fsdem__finite3(w))
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "%s: position, velocity and angular velocity must be finite",
                            what);
+    if (!fsdem__within(v, FSDEM_MAX_SPEED) || !fsdem__within(fsdem__scale(w, r), FSDEM_MAX_SPEED))
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
+                           "%s: velocity (%g, %g, %g) m/s or the surface speed of angular velocity (%g, %g, %g) rad/s is above "
+                           "FSDEM_MAX_SPEED (%g m/s)",
+                           what, (double)v.x, (double)v.y, (double)v.z, (double)w.x, (double)w.y, (double)w.z, (double)FSDEM_MAX_SPEED);
     if (!fsdem__dem_inside_domain(d, x))
         return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_DOMAIN, "%s: position (%g, %g, %g) m is outside the domain", what,
                            (double)x.x, (double)x.y, (double)x.z);
@@ -4480,14 +4812,14 @@ fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_dem_particle_desc 
     if (!d) return FSDEM_ERR_INVALID_ARG;
     i = d->n;
     if (!p) return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_add_particle: desc is NULL");
-    if (!(p->radius > 0) || !fsdem__finite(p->radius))
-        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_particle_desc.radius must be > 0 (got %g m)",
-                           (double)p->radius);
+    if (!(p->radius > 0 && p->radius <= FSDEM_MAX_LENGTH))
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_particle_desc.radius must be in (0, %g] m (got %g m)",
+                           (double)FSDEM_MAX_LENGTH, (double)p->radius);
     if (p->material < 0 || p->material >= d->material_count)
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
                            "fsdem_dem_particle_desc.material %d is not a material of this simulation (%d added)",
                            p->material, d->material_count);
-    res = fsdem__dem_state_check(d, "fsdem_dem_particle_desc", p->position, p->velocity, p->angular_velocity);
+    res = fsdem__dem_state_check(d, "fsdem_dem_particle_desc", p->position, p->velocity, p->angular_velocity, p->radius);
     if (res != FSDEM_OK) return res;
     if (d->desc.dim == 2) {
         volume = (fsdem_real)FSDEM__PI * p->radius * p->radius * d->desc.disc_length;
@@ -4557,7 +4889,7 @@ fsdem_result fsdem_dem_set_particle_state(fsdem_dem *d, int index, fsdem_vec3 x,
     if (index < 0 || index >= d->n)
         return fsdem__fail(&d->status, FSDEM_ERR_NOT_FOUND, "fsdem_dem_set_particle_state: index %d not in [0, %d)",
                            index, d->n);
-    res = fsdem__dem_state_check(d, "fsdem_dem_set_particle_state", x, v, w);
+    res = fsdem__dem_state_check(d, "fsdem_dem_set_particle_state", x, v, w, d->r[index]);
     if (res != FSDEM_OK) return res;
     fsdem__dem_planar(d, &x, &v, &w);
     d->x[index] = x;
@@ -4696,8 +5028,10 @@ fsdem_result fsdem_dem_add_wall(fsdem_dem *d, const fsdem_dem_wall_desc *desc, i
     if (g.material < 0 || g.material >= d->material_count)
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_desc.material %d is not a material of this simulation",
                            g.material);
-    if (!fsdem__finite3(g.a) || !fsdem__finite3(g.b) || !fsdem__finite3(g.c) || !fsdem__finite3(g.velocity))
-        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_wall_desc: geometry and velocity must be finite");
+    if (!fsdem__finite3(g.a) || !fsdem__finite3(g.b) || !fsdem__finite3(g.c) || !fsdem__within(g.velocity, FSDEM_MAX_SPEED))
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_dem_wall_desc: the geometry must be finite and the velocity at most FSDEM_MAX_SPEED (%g m/s)",
+                           (double)FSDEM_MAX_SPEED);
     if (d->desc.dim == 2) {
         g.a.z = g.b.z = g.c.z = g.velocity.z = 0;
     }
@@ -4787,8 +5121,10 @@ fsdem_result fsdem_dem_remove_wall(fsdem_dem *d, int id) {
 fsdem_result fsdem_dem_set_wall_velocity(fsdem_dem *d, int id, fsdem_vec3 velocity) {
     fsdem__dem_wall *w = d ? fsdem__dem_wall_by_id(d, id, "fsdem_dem_set_wall_velocity") : NULL;
     if (!w) return d ? FSDEM_ERR_NOT_FOUND : FSDEM_ERR_INVALID_ARG;
-    if (!fsdem__finite3(velocity))
-        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_set_wall_velocity: velocity must be finite");
+    if (!fsdem__within(velocity, FSDEM_MAX_SPEED))
+        return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_dem_set_wall_velocity: velocity (%g, %g, %g) m/s must be finite and at most FSDEM_MAX_SPEED (%g m/s)",
+                           (double)velocity.x, (double)velocity.y, (double)velocity.z, (double)FSDEM_MAX_SPEED);
     if (w->d.type == FSDEM_DEM_WALL_TYPE_SDF && fsdem__norm(velocity) > 0)
         return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG, "fsdem_dem_set_wall_velocity: an SDF wall moves in its callback");
     if (d->desc.dim == 2) velocity.z = 0;
@@ -5114,6 +5450,22 @@ static int fsdem__dem_wall_hits(fsdem_dem *d, int i, int reset) {
 
 /* ---- >>dem_forces : contact force evaluation ---- */
 
+/* The law the kernels are instantiated with: the desc's, or seed 002's linear law. */
+static fsdem_dem_law fsdem__dem_kernel_law(const fsdem_dem *d) {
+    return d->desc.law == FSDEM_DEM_LAW_LINEAR && !fsdem__dem_seed000_stiffness(&d->desc) ? FSDEM__DEM_LAW_SEED002 : d->desc.law;
+}
+
+/* The contact options as the kernels read them. */
+static fsdem__dem_rules fsdem__dem_rules_of(const fsdem_dem *d) {
+    fsdem__dem_rules r;
+    r.total_history = d->desc.tangential_history == FSDEM_DEM_TANGENTIAL_HISTORY_TOTAL;
+    r.cap_spring = d->desc.coulomb_limit == FSDEM_DEM_COULOMB_LIMIT_SPRING;
+    r.cohesion = d->cohesive;
+    r.offset = d->desc.contact_offset;
+    r.area_depth = d->desc.dim == 2 ? d->desc.disc_length : 0;
+    return r;
+}
+
 /* Material pair `pair`'s coefficients into lane c of a batch. */
 static void fsdem__dem_gather_pair_coefficients(const fsdem_dem *d, fsdem__dem_batch *b, int c, int pair) {
     const fsdem__dem_pair *p = d->pairs + pair;
@@ -5123,6 +5475,7 @@ static void fsdem__dem_gather_pair_coefficients(const fsdem_dem *d, fsdem__dem_b
     b->kt[c] = p->kt;
     b->ct[c] = p->ct;
     b->mu[c] = p->friction;
+    b->coh[c] = p->cohesion;
 }
 
 /* Contact `k` of the particle-pair list into lane c of a batch; the coefficients of its material
@@ -5252,12 +5605,12 @@ FSDEM__FORCE_INLINE int fsdem__dem_touching(fsdem_dem *d, int *FSDEM__RESTRICT t
 /* Runs the kernels on a filled batch (particle pairs or, with `walls`, wall contacts), applies it
    and empties it; returns the number of contacts it held. */
 FSDEM__FORCE_INLINE int fsdem__dem_drain(fsdem_dem *d, fsdem__dem_batch *b, int walls, const fsdem_dem_law law, fsdem_real h,
-                                     int keep) {
+                                     int keep, const fsdem__dem_rules *rules) {
     const int count = b->count;
     const fsdem__dem_pair *uniform = d->material_count == 1 ? d->pairs : NULL;
     fsdem__dem_batch_pad(b, !walls, uniform != NULL);
-    if (walls) fsdem__dem_batch_law(b, law, h, 0, 0, uniform);
-    else fsdem__dem_batch_law(b, law, h, 1, d->desc.contact_offset, uniform);
+    if (walls) fsdem__dem_batch_law(b, law, h, 0, 0, uniform, rules);
+    else fsdem__dem_batch_law(b, law, h, 1, d->desc.contact_offset, uniform, rules);
     fsdem__dem_scatter(d, b, walls, keep, h);
     b->count = 0;
     return count;
@@ -5270,7 +5623,9 @@ FSDEM__FORCE_INLINE int fsdem__dem_drain(fsdem_dem *d, fsdem__dem_batch *b, int 
    contacts then go through the vector kernels a batch at a time. Written once, instantiated per
    contact law (fsdem__dem_compute_forces). */
 FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real h, int commit, const fsdem_dem_law law) {
-    const int n = d->n, keep = commit && law == FSDEM_DEM_LAW_HERTZ_MINDLIN, uniform = d->material_count == 1;
+    const int n = d->n, keep = commit && (law == FSDEM_DEM_LAW_HERTZ_MINDLIN || law == FSDEM__DEM_LAW_SEED002);
+    const int uniform = d->material_count == 1;
+    const fsdem__dem_rules rules = fsdem__dem_rules_of(d);
     fsdem__dem_batch *b;
     int *touching, i, k, c, nt = 0, nw = 0;
     fsdem__arena_reset(&d->arena);
@@ -5287,7 +5642,7 @@ FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real 
     b->count = 0;
     for (k = 0; k < nt; ++k) {
         fsdem__dem_gather_pair(d, b, b->count++, touching[k], law, uniform);
-        if (b->count == FSDEM__DEM_BATCH || k == nt - 1) fsdem__dem_drain(d, b, 0, law, h, keep);
+        if (b->count == FSDEM__DEM_BATCH || k == nt - 1) fsdem__dem_drain(d, b, 0, law, h, keep, &rules);
     }
     for (k = 0; k < d->pw.count; k = d->pw.start[i + 1]) {
         /* row to row through the particles with wall entries */
@@ -5297,19 +5652,20 @@ FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real 
         nh = fsdem__dem_wall_hits(d, i, commit);
         for (c = 0; c < nh; ++c) {
             fsdem__dem_gather_wall(d, b, b->count++, i, &d->hits[c], uniform);
-            if (b->count == FSDEM__DEM_BATCH) nw += fsdem__dem_drain(d, b, 1, law, h, keep);
+            if (b->count == FSDEM__DEM_BATCH) nw += fsdem__dem_drain(d, b, 1, law, h, keep, &rules);
         }
     }
-    if (b->count) nw += fsdem__dem_drain(d, b, 1, law, h, keep);
+    if (b->count) nw += fsdem__dem_drain(d, b, 1, law, h, keep, &rules);
     d->contacts = nt;
     d->wall_contacts = nw;
     d->forces_valid = 1;
 }
 
 static void fsdem__dem_compute_forces(fsdem_dem *d, fsdem_real h, int commit) {
-    switch (d->desc.law) {
+    switch ((int)fsdem__dem_kernel_law(d)) {
     case FSDEM_DEM_LAW_LINEAR: fsdem__dem_compute_forces_law(d, h, commit, FSDEM_DEM_LAW_LINEAR); break;
     case FSDEM_DEM_LAW_GIC: fsdem__dem_compute_forces_law(d, h, commit, FSDEM_DEM_LAW_GIC); break;
+    case FSDEM__DEM_LAW_SEED002: fsdem__dem_compute_forces_law(d, h, commit, FSDEM__DEM_LAW_SEED002); break;
     default: fsdem__dem_compute_forces_law(d, h, commit, FSDEM_DEM_LAW_HERTZ_MINDLIN); break;
     }
 }
@@ -5527,21 +5883,21 @@ fsdem_result fsdem_dem_step_dt(fsdem_dem *d, fsdem_real dt) {
 /* Substeps of an outer step (seed 000): K = INT(dt/dt_DEM), dt_DEM = dt/K, and Eq. 25: one substep of
    dt when dt_DEM > dt. The relative tolerance (1e-9, more in float) keeps an exact multiple
    (3e-4/1e-4 = 2.9999999999999996, or 1000 dt rounded to float) from losing a step. */
-fsdem_result fsdem_dem_substep_count(const fsdem_dem *d, fsdem_real duration, long long *count) {
-    fsdem__status *st;
-    double ratio;
-    if (!d || !count) return FSDEM_ERR_INVALID_ARG;
-    st = (fsdem__status *)&d->status; /* the message is the object's only mutable part here */
-    ratio = (double)duration / d->dt * (1 + fsdem__tolerance(1e-9));
+static fsdem_result fsdem__dem_substeps(const fsdem_dem *d, fsdem_real duration, long long *count, const char *who) {
+    fsdem__status *st = (fsdem__status *)&d->status; /* the message is the object's only mutable part here */
+    const double ratio = (double)duration / d->dt * (1 + fsdem__tolerance(1e-9));
     if (!(duration > 0) || !fsdem__finite(duration))
-        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "fsdem_dem_advance: the duration must be > 0 (got %g s)",
-                           (double)duration);
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: the duration must be > 0 (got %g s)", who, (double)duration);
     if (ratio > (double)FSDEM_DEM_MAX_SUBSTEPS)
-        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG,
-                           "fsdem_dem_advance: %g s / dt %g s = %g substeps is more than FSDEM_DEM_MAX_SUBSTEPS (%lld)",
-                           (double)duration, (double)d->dt, ratio, FSDEM_DEM_MAX_SUBSTEPS);
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "%s: %g s / dt %g s = %g substeps is more than FSDEM_DEM_MAX_SUBSTEPS (%lld)",
+                           who, (double)duration, (double)d->dt, ratio, FSDEM_DEM_MAX_SUBSTEPS);
     *count = ratio < 1 ? 1 : (long long)ratio;
     return FSDEM_OK;
+}
+
+fsdem_result fsdem_dem_substep_count(const fsdem_dem *d, fsdem_real duration, long long *count) {
+    if (!d || !count) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__dem_substeps(d, duration, count, "fsdem_dem_substep_count");
 }
 
 /* `count` Verlet steps of h as leapfrog: the closing half kick of a step and the opening one of the
@@ -5576,6 +5932,27 @@ static fsdem_result fsdem__dem_advance_verlet(fsdem_dem *d, fsdem_real h, long l
             if (called != FSDEM_OK) return called;
         }
     }
+    return FSDEM_OK;
+}
+
+/* The smallest extent (m) of the box [lo, hi] along the first `dim` axes. */
+static fsdem_real fsdem__smallest_extent(fsdem_vec3 lo, fsdem_vec3 hi, int dim) {
+    fsdem_real e = hi.x - lo.x;
+    if (hi.y - lo.y < e) e = hi.y - lo.y;
+    if (dim == 3 && hi.z - lo.z < e) e = hi.z - lo.z;
+    return e;
+}
+
+/* A coupler's check that every DEM particle fits in the fluid's domain [lo, hi] (a sphere wider
+   than the domain's smallest extent leaves no fluid around it); the particle goes to `status`. */
+static fsdem_result fsdem__dem_particles_fit(const fsdem_dem *d, fsdem_vec3 lo, fsdem_vec3 hi, fsdem__status *status, const char *who) {
+    const fsdem_real extent = fsdem__smallest_extent(lo, hi, d->desc.dim);
+    int i;
+    for (i = 0; i < d->n; ++i)
+        if (!(2 * d->r[i] < extent))
+            return fsdem__fail(status, FSDEM_ERR_INVALID_ARG,
+                               "%s: DEM particle %d (id %d) of radius %g m does not fit in the fluid's domain (smallest extent %g m)",
+                               who, i, d->id[i], (double)d->r[i], (double)extent);
     return FSDEM_OK;
 }
 
@@ -5623,13 +6000,14 @@ static fsdem_result fsdem__coupled_advance(void *c, fsdem__status *status, const
     return res;
 }
 
-fsdem_result fsdem_dem_advance_with(fsdem_dem *d, fsdem_real duration, fsdem_dem_substep_fn fn, void *user,
-                                    long long *steps) {
+/* fsdem_dem_advance_with, its errors under the public name `who` */
+static fsdem_result fsdem__dem_advance(fsdem_dem *d, fsdem_real duration, fsdem_dem_substep_fn fn, void *user, long long *steps,
+                                       const char *who) {
     long long k, count = 0;
     fsdem_result res;
     if (steps) *steps = 0;
     if (!d) return FSDEM_ERR_INVALID_ARG;
-    res = fsdem_dem_substep_count(d, duration, &count);
+    res = fsdem__dem_substeps(d, duration, &count, who);
     if (res != FSDEM_OK) return res;
     if (steps) *steps = count;
     if (d->desc.integrator == FSDEM_DEM_INTEGRATOR_VERLET)
@@ -5643,8 +6021,13 @@ fsdem_result fsdem_dem_advance_with(fsdem_dem *d, fsdem_real duration, fsdem_dem
     return res == FSDEM_OK ? fsdem__ok(&d->status) : res;
 }
 
+fsdem_result fsdem_dem_advance_with(fsdem_dem *d, fsdem_real duration, fsdem_dem_substep_fn fn, void *user,
+                                    long long *steps) {
+    return fsdem__dem_advance(d, duration, fn, user, steps, "fsdem_dem_advance_with");
+}
+
 fsdem_result fsdem_dem_advance(fsdem_dem *d, fsdem_real duration, long long *steps) {
-    return fsdem_dem_advance_with(d, duration, NULL, NULL, steps);
+    return fsdem__dem_advance(d, duration, NULL, NULL, steps, "fsdem_dem_advance");
 }
 
 fsdem_result fsdem_dem_set_dt(fsdem_dem *d, fsdem_real dt) {
@@ -5684,9 +6067,13 @@ fsdem_result fsdem_dem_stable_dt(const fsdem_dem *d, fsdem_real *dt) {
    and effective radius as the force kernels see them (fsdem__dem_batch). */
 static fsdem_real fsdem__dem_contact_energy(const fsdem_dem *d, const fsdem__dem_pair *p, fsdem_real delta, fsdem_real m_mean,
                                         fsdem_real r_eff, fsdem_vec3 history) {
-    switch (d->desc.law) {
+    switch ((int)fsdem__dem_kernel_law(d)) {
     case FSDEM_DEM_LAW_LINEAR: return (fsdem_real)0.5 * m_mean * d->k0_linear * delta * delta;
     case FSDEM_DEM_LAW_GIC: return (fsdem_real)0.5 * p->e_pair * 2 * r_eff * delta * delta;
+    case FSDEM__DEM_LAW_SEED002: { /* chi^n d^2 / 2 + chi^t |xi|^2 / 2 (Eq. 19-22) */
+        const fsdem_real chi = p->kn * (fsdem_real)sqrt(r_eff);
+        return (fsdem_real)0.5 * chi * (delta * delta + p->kt * fsdem__dot(history, history));
+    }
     default: {
         fsdem_real srd = (fsdem_real)sqrt(r_eff * delta);
         /* integral of (4/3) E* sqrt(R*) d^1.5 = (8/15) E* sqrt(R*) d^2.5, plus the Mindlin spring */
@@ -7589,13 +7976,14 @@ static fsdem_result fsdem__pic_check(const fsdem_pic_desc *d, char *msg, size_t 
         FSDEM__PIC_BAD("fsdem_pic_desc.density = %g kg/m^3 must be > 0", (double)d->density);
     if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
         FSDEM__PIC_BAD("fsdem_pic_desc.viscosity = %g m^2/s must be >= 0", (double)d->viscosity);
-    if (!fsdem__finite3(d->gravity)) FSDEM__PIC_BAD("fsdem_pic_desc.gravity must be finite");
+    if (fsdem__check_gravity("fsdem_pic_desc", d->gravity, d->dim, msg, size) != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     for (k = 0; k < 2 * d->dim; ++k) {
         if ((int)d->boundary[k] < 0 || (int)d->boundary[k] > 3)
             FSDEM__PIC_BAD("fsdem_pic_desc.boundary[%d] (%s side) = %d is not a fsdem_pic_bc", k,
                            fsdem__pic_side_name(k), (int)d->boundary[k]);
-        if (!fsdem__finite3(d->boundary_velocity[k]))
-            FSDEM__PIC_BAD("fsdem_pic_desc.boundary_velocity[%d] must be finite", k);
+        if (!fsdem__within(d->boundary_velocity[k], FSDEM_MAX_SPEED))
+            FSDEM__PIC_BAD("fsdem_pic_desc.boundary_velocity[%d] must be finite and at most FSDEM_MAX_SPEED (%g m/s)", k,
+                           (double)FSDEM_MAX_SPEED);
     }
     if ((int)d->transfer < 0 || (int)d->transfer > 2)
         FSDEM__PIC_BAD("fsdem_pic_desc.transfer = %d is not a fsdem_pic_transfer", (int)d->transfer);
@@ -7619,8 +8007,7 @@ static fsdem_result fsdem__pic_check(const fsdem_pic_desc *d, char *msg, size_t 
         FSDEM__PIC_BAD("fsdem_pic_desc.cfl = %g must be > 0", (double)d->cfl);
     if (!(d->cfl_max >= d->cfl) || !fsdem__finite(d->cfl_max))
         FSDEM__PIC_BAD("fsdem_pic_desc.cfl_max = %g must be >= cfl = %g", (double)d->cfl_max, (double)d->cfl);
-    if (!(d->dt_max > 0) || !fsdem__finite(d->dt_max))
-        FSDEM__PIC_BAD("fsdem_pic_desc.dt_max = %g s must be > 0", (double)d->dt_max);
+    if (fsdem__check_dt_max("fsdem_pic_desc", d->dt_max, d->gravity, msg, size) != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     if (!(d->ghost_theta_min > 0 && d->ghost_theta_min <= 1))
         FSDEM__PIC_BAD("fsdem_pic_desc.ghost_theta_min = %g must be in (0, 1]", (double)d->ghost_theta_min);
     if (d->extrapolation_layers < 0 || d->extrapolation_layers > 1000)
@@ -8661,8 +9048,11 @@ fsdem_result fsdem_pic_fill_box(fsdem_pic *s, fsdem_vec3 lo, fsdem_vec3 hi, fsde
     int b;
     if (added) *added = 0;
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    if (!fsdem__finite3(lo) || !fsdem__finite3(hi) || !fsdem__finite3(velocity))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_box: non-finite corner or velocity");
+    if (!fsdem__finite3(lo) || !fsdem__finite3(hi) || !fsdem__within(velocity, FSDEM_MAX_SPEED))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_pic_fill_box: a non-finite corner, or a velocity (%g, %g, %g) m/s that is not finite or above "
+                           "FSDEM_MAX_SPEED (%g m/s)",
+                           (double)velocity.x, (double)velocity.y, (double)velocity.z, (double)FSDEM_MAX_SPEED);
     for (b = 0; b < s->dim; ++b) {
         if (!(fsdem__comp(hi, b) > fsdem__comp(lo, b)))
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_box: hi.%c must exceed lo.%c", "xyz"[b], "xyz"[b]);
@@ -8679,7 +9069,10 @@ fsdem_result fsdem_pic_fill_sdf(fsdem_pic *s, fsdem_sdf_fn region, void *user, f
     if (added) *added = 0;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!region) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_sdf: NULL region");
-    if (!fsdem__finite3(velocity)) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_sdf: non-finite velocity");
+    if (!fsdem__within(velocity, FSDEM_MAX_SPEED))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_pic_fill_sdf: the velocity (%g, %g, %g) m/s must be finite and at most FSDEM_MAX_SPEED (%g m/s)",
+                           (double)velocity.x, (double)velocity.y, (double)velocity.z, (double)FSDEM_MAX_SPEED);
     return fsdem__pic_fill(s, s->lo, s->hi, region, user, velocity, added, "fill_sdf");
 }
 
@@ -8690,9 +9083,11 @@ fsdem_result fsdem_pic_add_particles(fsdem_pic *s, const fsdem_vec3 *x, const fs
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_particles: bad count %d or NULL positions", count);
     for (i = 0; i < count; ++i) {
         fsdem_vec3 p = x[i];
-        if (!fsdem__finite3(p) || (v && !fsdem__finite3(v[i])))
+        if (!fsdem__finite3(p) || (v && !fsdem__within(v[i], FSDEM_MAX_SPEED)))
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
-                               "fsdem_pic_add_particles: particle %d has a non-finite position or velocity", i);
+                               "fsdem_pic_add_particles: particle %d has a non-finite position, or a velocity that is not finite or "
+                               "above FSDEM_MAX_SPEED (%g m/s)",
+                               i, (double)FSDEM_MAX_SPEED);
         if (s->dim == 2) p.z = 0;
         if (!fsdem__pic_open_at(s, p))
             return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN,
@@ -10048,6 +10443,15 @@ fsdem_result fsdem_pic_add_force(fsdem_pic *s, fsdem_vec3 point, fsdem_real radi
     hw = radius > s->dx ? radius : s->dx;
     if (!fsdem__finite3(point) || !fsdem__finite3(force) || !(radius >= 0) || !fsdem__finite(radius))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_force: point, force and radius >= 0 must be finite");
+    {
+        /* more than would accelerate a domain full of liquid at FSDEM_MAX_ACCELERATION */
+        const fsdem_real most = s->desc.density * FSDEM_MAX_ACCELERATION * (fsdem_real)s->ncell * s->dx * s->dx * (s->dim == 3 ? s->dx : 1);
+        if (!fsdem__within(force, most))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                               "fsdem_pic_add_force: the force (%g, %g, %g) N would accelerate a domain full of liquid at more than "
+                               "FSDEM_MAX_ACCELERATION (|F| <= %g N)",
+                               (double)force.x, (double)force.y, (double)force.z, (double)most);
+    }
     if (s->dim == 2) point.z = 0;
     /* all components or none, so the momentum given is exactly force x dt */
     for (a = 0; a < s->dim; ++a)
@@ -10461,7 +10865,9 @@ static const char *fsdem__swe_side_name(int side) {
     return side >= 0 && side < 4 ? names[side] : "?";
 }
 
-static fsdem_result fsdem__swe_series_check(const fsdem_real *t, const fsdem_real *v, int n, int non_negative,
+/* A time series: increasing finite times, values finite within +-bound (in [0, bound] when
+   non_negative). */
+static fsdem_result fsdem__swe_series_check(const fsdem_real *t, const fsdem_real *v, int n, int non_negative, fsdem_real bound,
                                             const char *what, char *msg, size_t size) {
     int k;
     if (n == 0 && !t && !v) return FSDEM_OK;
@@ -10474,8 +10880,9 @@ static fsdem_result fsdem__swe_series_check(const fsdem_real *t, const fsdem_rea
         if (k > 0 && !(t[k] > t[k - 1]))
             return fsdem__reject(msg, size, "%s: series times must increase strictly (point %d: %g after %g s)",
                                  what, k, (double)t[k], (double)t[k - 1]);
-        if (non_negative && v[k] < 0)
-            return fsdem__reject(msg, size, "%s: series value %d must be >= 0 (got %g)", what, k, (double)v[k]);
+        if (!(v[k] >= (non_negative ? 0 : -bound) && v[k] <= bound))
+            return fsdem__reject(msg, size, "%s: series value %d must be in [%g, %g] (got %g)", what, k,
+                                 non_negative ? 0.0 : -(double)bound, (double)bound, (double)v[k]);
     }
     return FSDEM_OK;
 }
@@ -10487,19 +10894,22 @@ static fsdem_result fsdem__swe_boundary_check(const fsdem_swe_boundary *b, int s
     if (b->type != FSDEM_SWE_BC_WALL && b->type != FSDEM_SWE_BC_TRANSMISSIVE && b->type != FSDEM_SWE_BC_DISCHARGE &&
         b->type != FSDEM_SWE_BC_STAGE)
         return fsdem__reject(msg, size, "%s.type is not a fsdem_swe_bc (%d)", what, (int)b->type);
-    if (!fsdem__finite(b->value)) return fsdem__reject(msg, size, "%s.value is not finite", what);
-    if (b->type == FSDEM_SWE_BC_DISCHARGE && b->value < 0)
-        return fsdem__reject(msg, size, "%s.value: an inflow discharge must be >= 0 (got %g m^2/s)", what,
-                             (double)b->value);
-    return fsdem__swe_series_check(b->series_time, b->series_value, b->series_count,
-                                   b->type == FSDEM_SWE_BC_DISCHARGE, what, msg, size);
+    {
+        /* a stage is an elevation; a unit discharge is at most FSDEM_MAX_SPEED through FSDEM_MAX_LENGTH of depth */
+        const int discharge = b->type == FSDEM_SWE_BC_DISCHARGE;
+        const fsdem_real bound = discharge ? FSDEM_MAX_SPEED * FSDEM_MAX_LENGTH : FSDEM_MAX_LENGTH;
+        if (!(b->value >= (discharge ? 0 : -bound) && b->value <= bound))
+            return fsdem__reject(msg, size, "%s.value must be in [%g, %g] %s (got %g)", what, discharge ? 0.0 : -(double)bound,
+                                 (double)bound, discharge ? "m^2/s (an inflow discharge)" : "m", (double)b->value);
+        return fsdem__swe_series_check(b->series_time, b->series_value, b->series_count, discharge, bound, what, msg, size);
+    }
 }
 
-/* First bad value of a per-cell array: returns its index or -1. */
-static int fsdem__swe_first_bad(const fsdem_real *a, int n, int non_negative) {
+/* The first value that is not in [-bound, bound] (in [0, bound] when non_negative), or -1. */
+static int fsdem__swe_first_bad(const fsdem_real *a, int n, int non_negative, fsdem_real bound) {
     int k;
     for (k = 0; k < n; ++k)
-        if (!fsdem__finite(a[k]) || (non_negative && a[k] < 0)) return k;
+        if (!(a[k] >= (non_negative ? 0 : -bound) && a[k] <= bound)) return k;
     return -1;
 }
 
@@ -10531,23 +10941,23 @@ fsdem_result fsdem_swe_desc_check(const fsdem_swe_desc *d, char *msg, size_t siz
             return fsdem__reject(msg, size, "fsdem_swe_desc: cells of %g x %g m (extent / cell count) are not of a finite, "
                                             "representable size", (double)dx, (double)dy);
     }
-    if (d->gravity.x != 0 || d->gravity.y != 0 || !(d->gravity.z < 0) || !fsdem__finite(d->gravity.z))
-        return fsdem__reject(msg, size, "fsdem_swe_desc.gravity must be (0, 0, -g) with g > 0 (got (%g, %g, %g) m/s^2)",
-                             (double)d->gravity.x, (double)d->gravity.y, (double)d->gravity.z);
+    if (d->gravity.x != 0 || d->gravity.y != 0 || !(d->gravity.z < 0 && d->gravity.z >= -FSDEM_MAX_ACCELERATION))
+        return fsdem__reject(msg, size,
+                             "fsdem_swe_desc.gravity must be (0, 0, -g) with 0 < g <= FSDEM_MAX_ACCELERATION (%g m/s^2) (got (%g, %g, %g) m/s^2)",
+                             (double)FSDEM_MAX_ACCELERATION, (double)d->gravity.x, (double)d->gravity.y, (double)d->gravity.z);
     if (!(d->density > 0) || !fsdem__finite(d->density))
         return fsdem__reject(msg, size, "fsdem_swe_desc.density must be > 0 (got %g kg/m^3)", (double)d->density);
     if (!(d->cfl > 0 && d->cfl <= 1))
         return fsdem__reject(msg, size, "fsdem_swe_desc.cfl must be in (0, 1] (got %g)", (double)d->cfl);
-    if (!(d->dt_max > 0) || !fsdem__finite(d->dt_max))
-        return fsdem__reject(msg, size, "fsdem_swe_desc.dt_max must be > 0 (got %g s)", (double)d->dt_max);
+    if (fsdem__check_dt_max("fsdem_swe_desc", d->dt_max, d->gravity, msg, size) != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     if (d->order != 1 && d->order != 2)
         return fsdem__reject(msg, size, "fsdem_swe_desc.order must be 1 or 2 (got %d)", d->order);
     if ((int)d->limiter < 0 || (int)d->limiter > 3)
         return fsdem__reject(msg, size, "fsdem_swe_desc.limiter is not a fsdem_swe_limiter (%d)", (int)d->limiter);
     if (!(d->dry_depth > 0) || !fsdem__finite(d->dry_depth))
         return fsdem__reject(msg, size, "fsdem_swe_desc.dry_depth must be > 0 (got %g m)", (double)d->dry_depth);
-    if (!(d->manning >= 0) || !fsdem__finite(d->manning))
-        return fsdem__reject(msg, size, "fsdem_swe_desc.manning must be >= 0 (got %g s/m^(1/3))", (double)d->manning);
+    if (!(d->manning >= 0 && d->manning <= 1)) /* the bound of fsdem_swe_set_manning */
+        return fsdem__reject(msg, size, "fsdem_swe_desc.manning must be in [0, 1] (got %g s/m^(1/3))", (double)d->manning);
     if (!(d->eddy_viscosity >= 0) || !fsdem__finite(d->eddy_viscosity))
         return fsdem__reject(msg, size, "fsdem_swe_desc.eddy_viscosity must be >= 0 (got %g m^2/s)",
                              (double)d->eddy_viscosity);
@@ -10560,11 +10970,11 @@ fsdem_result fsdem_swe_desc_check(const fsdem_swe_desc *d, char *msg, size_t siz
     if ((d->allocator.alloc == NULL) != (d->allocator.free == NULL))
         return fsdem__reject(msg, size, "fsdem_swe_desc.allocator: set both alloc and free, or neither");
     n = d->nx * d->ny;
-    if (d->bed && (k = fsdem__swe_first_bad(d->bed, n, 0)) >= 0)
-        return fsdem__reject(msg, size, "fsdem_swe_desc.bed[%d] (cell i=%d, j=%d) is not finite (got %g m)", k,
+    if (d->bed && (k = fsdem__swe_first_bad(d->bed, n, 0, FSDEM_MAX_LENGTH)) >= 0)
+        return fsdem__reject(msg, size, "fsdem_swe_desc.bed[%d] (cell i=%d, j=%d) must be finite, |bed| <= FSDEM_MAX_LENGTH (got %g m)", k,
                              k % d->nx, k / d->nx, (double)d->bed[k]);
-    if (d->depth && (k = fsdem__swe_first_bad(d->depth, n, 1)) >= 0)
-        return fsdem__reject(msg, size, "fsdem_swe_desc.depth[%d] (cell i=%d, j=%d) must be finite and >= 0 (got %g m)",
+    if (d->depth && (k = fsdem__swe_first_bad(d->depth, n, 1, FSDEM_MAX_LENGTH)) >= 0)
+        return fsdem__reject(msg, size, "fsdem_swe_desc.depth[%d] (cell i=%d, j=%d) must be in [0, FSDEM_MAX_LENGTH] (got %g m)",
                              k, k % d->nx, k / d->nx, (double)d->depth[k]);
     return FSDEM_OK;
 }
@@ -10739,6 +11149,8 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
     for (k = 0; k < 4; ++k) {
         s->bnd[k].type = FSDEM_SWE_BC_WALL;
         if (k < (s->dim == 2 ? 4 : 2) && fsdem__swe_store_boundary(s, k, &desc->boundary[k]) != FSDEM_OK) {
+            fsdem__log_oom(desc->log, desc->log_user, "fsdem_swe_create",
+                           2 * sizeof(fsdem_real) * (size_t)desc->boundary[k].series_count);
             fsdem_swe_destroy(s);
             return FSDEM_ERR_OUT_OF_MEMORY;
         }
@@ -10785,22 +11197,23 @@ fsdem_swe_grid fsdem_swe_get_grid(const fsdem_swe *s) {
     return g;
 }
 
-/* Rejects a per-cell input array: NULL, or its first bad value named. */
-static fsdem_result fsdem__swe_array_check(fsdem_swe *s, const fsdem_real *a, int non_negative, const char *what,
+/* Rejects a per-cell input array: NULL, or its first bad value (beyond +-bound, or < 0 when
+   non_negative) named. */
+static fsdem_result fsdem__swe_array_check(fsdem_swe *s, const fsdem_real *a, int non_negative, fsdem_real bound, const char *what,
                                            const char *unit) {
     int k;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!a) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: array is NULL", what);
-    k = fsdem__swe_first_bad(a, s->n, non_negative);
+    k = fsdem__swe_first_bad(a, s->n, non_negative, bound);
     if (k >= 0)
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: value %d (cell i=%d, j=%d) must be finite%s (got %g %s)",
-                           what, k, k % s->nx, k / s->nx, non_negative ? " and >= 0" : "", (double)a[k], unit);
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: value %d (cell i=%d, j=%d) must be in [%g, %g] %s (got %g %s)", what,
+                           k, k % s->nx, k / s->nx, non_negative ? 0.0 : -(double)bound, (double)bound, unit, (double)a[k], unit);
     return FSDEM_OK;
 }
 
 fsdem_result fsdem_swe_set_bed(fsdem_swe *s, const fsdem_real *bed) {
     int k;
-    if (fsdem__swe_array_check(s, bed, 0, "fsdem_swe_set_bed", "m") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
+    if (fsdem__swe_array_check(s, bed, 0, FSDEM_MAX_LENGTH, "fsdem_swe_set_bed", "m") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     for (k = 0; k < s->n; ++k) {
         fsdem_real h = s->eta[k] - s->bed[k];
         s->bed[k] = bed[k];
@@ -10812,7 +11225,7 @@ fsdem_result fsdem_swe_set_bed(fsdem_swe *s, const fsdem_real *bed) {
 
 fsdem_result fsdem_swe_set_depth(fsdem_swe *s, const fsdem_real *depth) {
     int k;
-    if (fsdem__swe_array_check(s, depth, 1, "fsdem_swe_set_depth", "m") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
+    if (fsdem__swe_array_check(s, depth, 1, FSDEM_MAX_LENGTH, "fsdem_swe_set_depth", "m") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     for (k = 0; k < s->n; ++k) {
         s->eta[k] = s->bed[k] + depth[k];
         if (depth[k] < s->desc.dry_depth) s->qx[k] = s->qy[k] = 0;
@@ -10823,7 +11236,7 @@ fsdem_result fsdem_swe_set_depth(fsdem_swe *s, const fsdem_real *depth) {
 
 fsdem_result fsdem_swe_set_surface(fsdem_swe *s, const fsdem_real *eta) {
     int k;
-    if (fsdem__swe_array_check(s, eta, 0, "fsdem_swe_set_surface", "m") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
+    if (fsdem__swe_array_check(s, eta, 0, FSDEM_MAX_LENGTH, "fsdem_swe_set_surface", "m") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     for (k = 0; k < s->n; ++k) {
         s->eta[k] = eta[k] > s->bed[k] ? eta[k] : s->bed[k];
         if (s->eta[k] - s->bed[k] < s->desc.dry_depth) s->qx[k] = s->qy[k] = 0;
@@ -10834,8 +11247,8 @@ fsdem_result fsdem_swe_set_surface(fsdem_swe *s, const fsdem_real *eta) {
 
 fsdem_result fsdem_swe_set_velocity(fsdem_swe *s, const fsdem_real *u, const fsdem_real *v) {
     int k;
-    if (fsdem__swe_array_check(s, u, 0, "fsdem_swe_set_velocity (u)", "m/s") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
-    if (v && s->dim == 2 && fsdem__swe_array_check(s, v, 0, "fsdem_swe_set_velocity (v)", "m/s") != FSDEM_OK)
+    if (fsdem__swe_array_check(s, u, 0, FSDEM_MAX_SPEED, "fsdem_swe_set_velocity (u)", "m/s") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
+    if (v && s->dim == 2 && fsdem__swe_array_check(s, v, 0, FSDEM_MAX_SPEED, "fsdem_swe_set_velocity (v)", "m/s") != FSDEM_OK)
         return FSDEM_ERR_INVALID_ARG;
     for (k = 0; k < s->n; ++k) {
         fsdem_real h = s->eta[k] - s->bed[k];
@@ -10868,11 +11281,12 @@ fsdem_result fsdem_swe_set_cells(fsdem_swe *s, fsdem_swe_init_fn fn, void *user)
             c.u = c.v = 0;
             fn(user, x, y, &c);
             if (pass == 0) {
-                if (!fsdem__finite(c.bed) || !fsdem__finite(c.depth) || c.depth < 0 || !fsdem__finite(c.u) ||
-                    !fsdem__finite(c.v))
+                if (!(fabs(c.bed) <= FSDEM_MAX_LENGTH) || !(c.depth >= 0 && c.depth <= FSDEM_MAX_LENGTH) ||
+                    !(fabs(c.u) <= FSDEM_MAX_SPEED) || !(fabs(c.v) <= FSDEM_MAX_SPEED))
                     return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
                                        "fsdem_swe_set_cells: cell %d (i=%d, j=%d, x=%g, y=%g) has bed %g m, depth %g m, "
-                                       "u %g, v %g m/s: all must be finite and the depth >= 0",
+                                       "u %g, v %g m/s: bed and depth (>= 0) must be within FSDEM_MAX_LENGTH, the speeds within "
+                                       "FSDEM_MAX_SPEED",
                                        k, k % s->nx, k / s->nx, (double)x, (double)y, (double)c.bed, (double)c.depth,
                                        (double)c.u, (double)c.v);
                 continue;
@@ -11085,6 +11499,16 @@ fsdem_result fsdem_swe_add_force(fsdem_swe *s, fsdem_vec3 point, fsdem_real radi
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!fsdem__finite3(point) || !fsdem__finite3(force) || !(radius >= 0) || !fsdem__finite(radius))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_force: point, force and radius >= 0 must be finite");
+    {
+        /* more than would accelerate all the water the grid can hold (FSDEM_MAX_LENGTH deep) at
+           FSDEM_MAX_ACCELERATION */
+        const fsdem_real most = s->desc.density * FSDEM_MAX_ACCELERATION * (fsdem_real)s->n * s->area * FSDEM_MAX_LENGTH;
+        if (!fsdem__within(force, most))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                               "fsdem_swe_add_force: the force (%g, %g) N would accelerate the deepest water the grid can hold at "
+                               "more than FSDEM_MAX_ACCELERATION (|F| <= %g N)",
+                               (double)force.x, (double)force.y, (double)most);
+    }
     if (fsdem_swe_cell_at(s, point.x, point.y) < 0)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_swe_add_force: point (%g, %g) is outside the grid",
                            (double)point.x, (double)point.y);
@@ -11128,7 +11552,8 @@ fsdem_result fsdem_swe_set_manning(fsdem_swe *s, const fsdem_real *manning) {
         s->manning = NULL;
         return fsdem__ok(&s->status);
     }
-    if (fsdem__swe_array_check(s, manning, 1, "fsdem_swe_set_manning", "s/m^(1/3)") != FSDEM_OK)
+    /* at most 1: five times the roughest floodplain of Chow's (1959) table (dense brush, 0.2) */
+    if (fsdem__swe_array_check(s, manning, 1, 1, "fsdem_swe_set_manning", "s/m^(1/3)") != FSDEM_OK)
         return FSDEM_ERR_INVALID_ARG;
     if (!s->manning) {
         s->manning = (fsdem_real *)fsdem__alloc(&s->allocator, sizeof(fsdem_real) * (size_t)s->n);
@@ -11252,9 +11677,12 @@ fsdem_result fsdem_swe_add_point_source(fsdem_swe *s, const fsdem_swe_point_sour
     int k;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!p) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_point_source: source is NULL");
-    if (!fsdem__finite(p->discharge))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_point_source: discharge is not finite");
-    if (fsdem__swe_series_check(p->series_time, p->series_value, p->series_count, 0, "point source", msg, sizeof msg) !=
+    /* at most FSDEM_MAX_SPEED through a FSDEM_MAX_LENGTH square */
+    if (!(fabs(p->discharge) <= FSDEM_MAX_SPEED * FSDEM_MAX_LENGTH * FSDEM_MAX_LENGTH))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_point_source: discharge %g m^3/s is not finite or beyond %g",
+                           (double)p->discharge, (double)(FSDEM_MAX_SPEED * FSDEM_MAX_LENGTH * FSDEM_MAX_LENGTH));
+    if (fsdem__swe_series_check(p->series_time, p->series_value, p->series_count, 0,
+                                FSDEM_MAX_SPEED * FSDEM_MAX_LENGTH * FSDEM_MAX_LENGTH, "point source", msg, sizeof msg) !=
         FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_add_point_source: %s", msg);
     k = fsdem_swe_cell_at(s, p->x, p->y);
@@ -12755,7 +13183,7 @@ static fsdem_result fsdem__mps_check(const fsdem_mps_desc *d, char *msg, size_t 
         return fsdem__reject(msg, size, "fsdem_mps_desc.density = %g kg/m^3 must be > 0", (double)d->density);
     if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
         return fsdem__reject(msg, size, "fsdem_mps_desc.viscosity = %g m^2/s must be >= 0", (double)d->viscosity);
-    if (!fsdem__finite3(d->gravity)) return fsdem__reject(msg, size, "fsdem_mps_desc.gravity must be finite");
+    if (fsdem__check_gravity("fsdem_mps_desc", d->gravity, d->dim, msg, size) != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     if (!(d->gamma >= 0 && d->gamma <= 1))
         return fsdem__reject(msg, size, "fsdem_mps_desc.gamma = %g must be in [0, 1]", (double)d->gamma);
     if (!(d->beta > 0 && d->beta < 1))
@@ -12764,14 +13192,17 @@ static fsdem_result fsdem__mps_check(const fsdem_mps_desc *d, char *msg, size_t 
         return fsdem__reject(msg, size, "fsdem_mps_desc.alpha = %g must be > 0", (double)d->alpha);
     if (!(d->cfl > 0 && d->cfl <= 1))
         return fsdem__reject(msg, size, "fsdem_mps_desc.cfl = %g must be in (0, 1]", (double)d->cfl);
-    if (!(d->dt_max > 0) || !fsdem__finite(d->dt_max))
-        return fsdem__reject(msg, size, "fsdem_mps_desc.dt_max = %g s must be > 0", (double)d->dt_max);
+    if (fsdem__check_dt_max("fsdem_mps_desc", d->dt_max, d->gravity, msg, size) != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     if (!fsdem__finite3(d->domain_min) || !fsdem__finite3(d->domain_max))
         return fsdem__reject(msg, size, "fsdem_mps_desc.domain_min/domain_max must be finite");
-    for (a = 0; a < d->dim; ++a)
+    for (a = 0; a < d->dim; ++a) {
         if (!(fsdem__comp(d->domain_max, a) > fsdem__comp(d->domain_min, a)))
             return fsdem__reject(msg, size, "fsdem_mps_desc.domain_max.%c = %g must exceed domain_min.%c = %g", "xyz"[a],
                                  (double)fsdem__comp(d->domain_max, a), "xyz"[a], (double)fsdem__comp(d->domain_min, a));
+        if (!(d->r0 <= fsdem__comp(d->domain_max, a) - fsdem__comp(d->domain_min, a)))
+            return fsdem__reject(msg, size, "fsdem_mps_desc.r0 = %g m is larger than the domain along %c (%g m)", (double)d->r0,
+                                 "xyz"[a], (double)(fsdem__comp(d->domain_max, a) - fsdem__comp(d->domain_min, a)));
+    }
     if ((int)d->gradient < 0 || (int)d->gradient > 2)
         return fsdem__reject(msg, size, "fsdem_mps_desc.gradient = %d is not a fsdem_mps_gradient_model", (int)d->gradient);
     if ((int)d->model < 0 || (int)d->model > 1)
@@ -12989,8 +13420,10 @@ static fsdem_result fsdem__mps_reserve(fsdem_mps *s, int need) {
 /* Checks particle j of a list for fsdem_mps_add_particles and its fills (`fn` names the caller). */
 static fsdem_result fsdem__mps_check_point(fsdem_mps *s, const char *fn, int j, fsdem_vec3 x, fsdem_vec3 v) {
     int a;
-    if (!fsdem__finite3(x) || !fsdem__finite3(v))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: particle %d has a non-finite position or velocity", fn, j);
+    if (!fsdem__finite3(x) || !fsdem__within(v, FSDEM_MAX_SPEED))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "%s: particle %d has a non-finite position or a velocity (%g, %g, %g) m/s above FSDEM_MAX_SPEED (%g m/s)", fn,
+                           j, (double)v.x, (double)v.y, (double)v.z, (double)FSDEM_MAX_SPEED);
     for (a = 0; a < s->dim; ++a)
         if (!(fsdem__comp(x, a) >= fsdem__comp(s->desc.domain_min, a) && fsdem__comp(x, a) <= fsdem__comp(s->desc.domain_max, a)))
             return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "%s: particle %d at (%g, %g, %g) m is outside the domain", fn,
@@ -13166,6 +13599,10 @@ fsdem_result fsdem_mps_add_box_walls(fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3 hi,
     if (added) *added = 0;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((r = fsdem__mps_check_box(s, "fsdem_mps_add_box_walls", lo, hi)) != FSDEM_OK) return r;
+    if (open_sides >> (2 * s->dim))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_mps_add_box_walls: open_sides = 0x%x has bits beyond the %d sides of a %dD box (1 << fsdem_side)",
+                           open_sides, 2 * s->dim, s->dim);
     w.box[0] = lo;
     w.box[1] = hi;
     w.open = open_sides;
@@ -14187,12 +14624,15 @@ static fsdem_real fsdem__drag_per_volume(fsdem_drag_law law, fsdem_real eps, fsd
     }
     case FSDEM_DRAG_LAW_BEETSTRA: {
         /* the Re term Re / (24 eps^2) (A + 8.4 Re^-0.343) / (1 + 10^(3 phi) Re^-a), a = (1 + 4 phi) / 2,
-           multiplied through by Re^a: (Re A + 8.4 Re^0.657) Re^a / (24 eps^2 (Re^a + 10^(3 phi))), which
-           is 0 at Re = 0 (like Re^(1.157 + 2 phi)) instead of 0 * inf / inf */
+           written (Re A + 8.4 Re^0.657) / (24 eps^2 (1 + 10^(3 phi) Re^-a)): Re^-a overflows to
+           infinity as Re -> 0, where the term is 0, and vanishes as Re grows, where it tends to
+           (Re A + 8.4 Re^0.657) / (24 eps^2); multiplied through by Re^a instead, both Re^a and its
+           denominator overflow for large Re and give inf / inf */
         const fsdem_real phi = 1 - eps, re = eps * rho * d * slip / mu;
-        const fsdem_real ra = (fsdem_real)pow(re, 0.5 + 2 * phi);
-        const fsdem_real inertial = (re * (1 / eps + 3 * phi * eps) + (fsdem_real)8.4 * (fsdem_real)pow(re, 0.657)) * ra /
-                                    (24 * eps * eps * (ra + (fsdem_real)pow(10.0, 3 * phi)));
+        const fsdem_real inertial =
+            re > 0 ? (re * (1 / eps + 3 * phi * eps) + (fsdem_real)8.4 * (fsdem_real)pow(re, 0.657)) /
+                         (24 * eps * eps * (1 + (fsdem_real)pow(10.0, 3 * phi) * (fsdem_real)pow(re, -(0.5 + 2 * phi))))
+                   : 0;
         const fsdem_real f = 10 * phi / (eps * eps) + eps * eps * (1 + (fsdem_real)1.5 * (fsdem_real)sqrt(phi)) +
                              (fsdem_real)0.413 * inertial;
         return 18 * mu * eps * f / (d * d);
@@ -14224,9 +14664,9 @@ fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsd
         return fsdem__reject(message, message_size, "%s: porosity must be in (0, 1], got %g", fn, (double)porosity);
     if (!(diameter > 0) || !fsdem__finite(diameter))
         return fsdem__reject(message, message_size, "%s: diameter must be > 0 and finite, got %g m", fn, (double)diameter);
-    if (!(slip_speed >= 0) || !fsdem__finite(slip_speed))
-        return fsdem__reject(message, message_size, "%s: slip_speed must be >= 0 and finite, got %g m/s", fn,
-                             (double)slip_speed);
+    if (!(slip_speed >= 0 && slip_speed <= FSDEM_MAX_SPEED))
+        return fsdem__reject(message, message_size, "%s: slip_speed must be in [0, FSDEM_MAX_SPEED = %g] m/s, got %g m/s", fn,
+                             (double)FSDEM_MAX_SPEED, (double)slip_speed);
     if (!(density > 0) || !fsdem__finite(density))
         return fsdem__reject(message, message_size, "%s: density must be > 0 and finite, got %g kg/m^3", fn, (double)density);
     if (!(viscosity > 0) || !fsdem__finite(viscosity))
@@ -14235,8 +14675,8 @@ fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsd
     c = fsdem__drag_per_volume(law, porosity, diameter, slip_speed, density, viscosity);
     if (!fsdem__finite(c)) {
         if (message && message_size)
-            snprintf(message, message_size, "%s: c = %g kg m^-3 s^-1 is not finite (d = %g m too small?)", fn, (double)c,
-                     (double)diameter);
+            snprintf(message, message_size, "%s: c = %g kg m^-3 s^-1 overflows for porosity %g, d = %g m, Re = %g", fn, (double)c,
+                     (double)porosity, (double)diameter, (double)(porosity * density * diameter * slip_speed / viscosity));
         return FSDEM_ERR_NAN;
     }
     if (per_volume) *per_volume = c;
@@ -14312,8 +14752,9 @@ fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, si
                              (double)md.gravity.y, (double)md.gravity.z);
     if (strcmp(fsdem_drag_law_name(d->drag), "unknown") == 0)
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
-    if (!(d->radius == 0 || (d->radius > 0 && fsdem__finite(d->radius))))
-        return fsdem__reject(msg, size, "fsdem_mps_dem_desc.radius must be 0 (the MPS re) or > 0 (got %g m)", (double)d->radius);
+    if (!(d->radius == 0 || (d->radius > 0 && d->radius <= fsdem__smallest_extent(md.domain_min, md.domain_max, md.dim))))
+        return fsdem__reject(msg, size, "fsdem_mps_dem_desc.radius must be 0 (the MPS re) or in (0, %g] m, the MPS domain's smallest extent (got %g m)",
+                             (double)fsdem__smallest_extent(md.domain_min, md.domain_max, md.dim), (double)d->radius);
     if (!(d->min_porosity > 0 && d->min_porosity < 1))
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc.min_porosity must be in (0, 1) (got %g)", (double)d->min_porosity);
     if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
@@ -14535,6 +14976,11 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
     clock_t t0 = clock();
     int i, k, e;
     if (!c) return FSDEM_ERR_INVALID_ARG;
+    {
+        const fsdem_mps_desc md = fsdem_mps_get_desc(c->desc.mps);
+        if (fsdem__dem_particles_fit(c->desc.dem, md.domain_min, md.domain_max, &c->status, "fsdem_mps_dem_update") != FSDEM_OK)
+            return FSDEM_ERR_INVALID_ARG;
+    }
     dv = fsdem_dem_get_particles(c->desc.dem);
     mv = fsdem_mps_get_particles(c->desc.mps);
     if (fsdem__mps_dem_room(c, dv.count, mv.count) != FSDEM_OK || fsdem__mps_dem_pairs(c, &dv, &mv) != FSDEM_OK)
@@ -14786,9 +15232,10 @@ fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *d, char *msg, si
                              (double)pd.gravity.y, (double)pd.gravity.z);
     if (!(d->dissipation >= 0 && d->dissipation <= 1))
         return fsdem__reject(msg, size, "fsdem_pic_dem_desc.dissipation must be in [0, 1] (got %g)", (double)d->dissipation);
-    if (!(d->contact_length >= 0) || !fsdem__finite(d->contact_length))
-        return fsdem__reject(msg, size, "fsdem_pic_dem_desc.contact_length must be 0 (4 dx) or > 0 (got %g m)",
-                             (double)d->contact_length);
+    if (!(d->contact_length >= 0 && d->contact_length <= fsdem__smallest_extent(pd.domain_min, pd.domain_max, pd.dim)))
+        return fsdem__reject(msg, size,
+                             "fsdem_pic_dem_desc.contact_length must be 0 (4 dx) or in (0, %g] m, the PIC domain's smallest extent (got %g m)",
+                             (double)fsdem__smallest_extent(pd.domain_min, pd.domain_max, pd.dim), (double)d->contact_length);
     if (!(d->viscous_dt_fraction > 0 && d->viscous_dt_fraction <= 1))
         return fsdem__reject(msg, size, "fsdem_pic_dem_desc.viscous_dt_fraction must be in (0, 1] (got %g)",
                              (double)d->viscous_dt_fraction);
@@ -14909,6 +15356,11 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
     c->depth = pd.dim == 2 ? fsdem_dem_get_desc(desc->dem).disc_length : 1;
     if (!(desc->contact_length > 0)) c->desc.contact_length = 4 * pd.cell_size; /* seed 000 §2.2.2 */
     ncell = desc->pic->ncell;
+    if (fsdem__dem_particles_fit(desc->dem, pd.domain_min, pd.domain_max, &c->status, "fsdem_pic_dem_create") != FSDEM_OK) {
+        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, c->status.message);
+        fsdem__free(&al, c, sizeof *c);
+        return FSDEM_ERR_INVALID_ARG;
+    }
     c->slot = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)ncell);
     c->body_map.start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)(ncell + 1));
     c->contact_map.start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)(ncell + 1));
@@ -14975,18 +15427,10 @@ static void fsdem__pic_dem_range(const fsdem_pic *s, int q, fsdem_real off, fsde
 static fsdem_result fsdem__pic_dem_jac_add(fsdem_pic_dem *c, int cell, fsdem_vec3 v, fsdem_vec3 w) {
     int e = c->slot[cell];
     if (e < 0) {
-        int cap = c->jac_cap;
-        if (c->jac_count == c->jac_cap) {
-            if (fsdem__grow(&c->allocator, (void **)&c->jac_cell, &cap, c->jac_count, c->jac_count + 1, sizeof(int)) != FSDEM_OK)
-                return FSDEM_ERR_OUT_OF_MEMORY;
-            cap = c->jac_cap;
-            if (fsdem__grow(&c->allocator, (void **)&c->jac_v, &cap, c->jac_count, c->jac_count + 1, sizeof(fsdem_vec3)) != FSDEM_OK)
-                return FSDEM_ERR_OUT_OF_MEMORY;
-            cap = c->jac_cap;
-            if (fsdem__grow(&c->allocator, (void **)&c->jac_w, &cap, c->jac_count, c->jac_count + 1, sizeof(fsdem_vec3)) != FSDEM_OK)
-                return FSDEM_ERR_OUT_OF_MEMORY;
-            c->jac_cap = cap;
-        }
+        void **const arrays[3] = {(void **)&c->jac_cell, (void **)&c->jac_v, (void **)&c->jac_w};
+        const size_t elem[3] = {sizeof(int), sizeof(fsdem_vec3), sizeof(fsdem_vec3)};
+        if (fsdem__grow_set(&c->allocator, arrays, elem, 3, &c->jac_cap, c->jac_count, c->jac_count + 1) != FSDEM_OK)
+            return FSDEM_ERR_OUT_OF_MEMORY;
         e = c->slot[cell] = c->jac_count++;
         c->jac_cell[e] = cell;
         c->jac_v[e] = c->jac_w[e] = fsdem__zero3();
@@ -14997,19 +15441,10 @@ static fsdem_result fsdem__pic_dem_jac_add(fsdem_pic_dem *c, int cell, fsdem_vec
 }
 
 static fsdem_result fsdem__pic_dem_face_add(fsdem_pic_dem *c, int a, int f, fsdem_real closed) {
-    if (c->face_count == c->face_cap) {
-        int cap = c->face_cap;
-        if (fsdem__grow(&c->allocator, (void **)&c->face, &cap, c->face_count, c->face_count + 1, sizeof(int)) != FSDEM_OK)
-            return FSDEM_ERR_OUT_OF_MEMORY;
-        cap = c->face_cap;
-        if (fsdem__grow(&c->allocator, (void **)&c->face_axis, &cap, c->face_count, c->face_count + 1, 1) != FSDEM_OK)
-            return FSDEM_ERR_OUT_OF_MEMORY;
-        cap = c->face_cap;
-        if (fsdem__grow(&c->allocator, (void **)&c->face_closed, &cap, c->face_count, c->face_count + 1, sizeof(fsdem_real)) !=
-            FSDEM_OK)
-            return FSDEM_ERR_OUT_OF_MEMORY;
-        c->face_cap = cap;
-    }
+    void **const arrays[3] = {(void **)&c->face, (void **)&c->face_axis, (void **)&c->face_closed};
+    const size_t elem[3] = {sizeof(int), 1, sizeof(fsdem_real)};
+    if (fsdem__grow_set(&c->allocator, arrays, elem, 3, &c->face_cap, c->face_count, c->face_count + 1) != FSDEM_OK)
+        return FSDEM_ERR_OUT_OF_MEMORY;
     c->face[c->face_count] = f;
     c->face_axis[c->face_count] = (unsigned char)a;
     c->face_closed[c->face_count] = closed;
@@ -15153,7 +15588,8 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
     const fsdem_real cell = s->dx * s->dx * (s->dim == 3 ? s->dx : 1), g2 = fsdem__dot(c->gravity, c->gravity);
     int b, e, q;
     fsdem_result res;
-    if ((res = fsdem__pic_dem_reserve_bodies(c, P.count)) != FSDEM_OK) return res;
+    if ((res = fsdem__pic_dem_reserve_bodies(c, P.count)) != FSDEM_OK)
+        return fsdem__fail(&c->status, res, "fsdem_pic_dem: out of memory for the records of %d bodies", P.count);
     fsdem__pic_dem_clear_faces(c);
     c->bodies = P.count;
     for (b = 0; b < P.count; ++b)
@@ -15503,6 +15939,7 @@ static fsdem_result fsdem__pic_dem_run(fsdem_pic_dem *c, fsdem_real dt) {
     clock_t t0 = clock(), t1, t2;
     fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_pic_dem");
     if (res != FSDEM_OK) return res;
+    if ((res = fsdem__dem_particles_fit(c->desc.dem, pd.domain_min, pd.domain_max, &c->status, "fsdem_pic_dem")) != FSDEM_OK) return res;
     for (b = 0; b < P.count; ++b) {
         const fsdem_real v = fsdem__norm(P.velocity[b]) + fsdem__norm(P.angular_velocity[b]) * P.radius[b];
         if (v * dt > pd.cfl_max * pd.cell_size)
@@ -15607,7 +16044,7 @@ fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
 
 /* ---- >>restart_format : header, checksum, cursor ---- */
 
-#define FSDEM__RESTART_VERSION 1u
+#define FSDEM__RESTART_VERSION 2u /* 2: DEM contact options and material-pair tables (issue 23) */
 #define FSDEM__RESTART_HEADER 64
 #define FSDEM__RESTART_BOM 0x01020304u
 #define FSDEM__RESTART_FNV_BASIS 0xcbf29ce484222325ull
@@ -15952,6 +16389,10 @@ static void fsdem__restart_dem(fsdem__restart *io, void *object) {
     fsdem__restart_same_real(io, dd->linear_accel, "linear_accel");
     fsdem__restart_same_real(io, dd->disc_length, "disc_length");
     fsdem__restart_same_int(io, dd->rotation, "rotation");
+    fsdem__restart_same_int(io, dd->tangential_damping, "tangential_damping");
+    fsdem__restart_same_int(io, (int)dd->tangential_history, "tangential_history");
+    fsdem__restart_same_int(io, (int)dd->coulomb_limit, "coulomb_limit");
+    fsdem__restart_same_int(io, (int)dd->linear_stiffness, "linear_stiffness");
 
     fsdem__restart_data(io, &d->dt, sizeof d->dt);
     fsdem__restart_data(io, &d->time, sizeof d->time);
@@ -15984,7 +16425,10 @@ static void fsdem__restart_dem(fsdem__restart *io, void *object) {
     }
     fsdem__restart_data(io, d->materials, sizeof(fsdem_dem_material) * (size_t)nm);
     fsdem__restart_data(io, d->pairs, sizeof(fsdem__dem_pair) * (size_t)nm * (size_t)nm);
-    if (commit) d->material_count = nm;
+    if (commit) {
+        d->material_count = nm;
+        fsdem__dem_pair_flags(d);
+    }
 
     /* walls: geometry where it has moved to, velocity, forces and impulses */
     fsdem__restart_count(io, &nw, FSDEM__DEM_HELD / 8, 4 * sizeof(int) + 6 * sizeof(fsdem_vec3), "wall count");
@@ -17060,8 +17504,11 @@ static fsdem_result fsdem__restart_load_file(const fsdem__restart_object *o, con
     fsdem__restart_begin(&io, o, "restore", FSDEM__RESTART_CHECK);
     if (!path) fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "path is NULL");
     else if (!fp) fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot open '%s'", path);
-    else if (fseek(fp, 0, SEEK_END) != 0 || (length = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET) != 0)
-        fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot read '%s'", path);
+    /* a directory opens and seeks on some systems (its "length" is then LONG_MAX): read a byte
+       before trusting the length */
+    else if (fseek(fp, 0, SEEK_END) != 0 || (length = ftell(fp)) < 0 || fseek(fp, 0, SEEK_SET) != 0 ||
+             (length > 0 && (getc(fp) == EOF || fseek(fp, 0, SEEK_SET) != 0)))
+        fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot read '%s' (not a readable file)", path);
     else if (!(data = (unsigned char *)fsdem__alloc(o->allocator, (size_t)length)))
         fsdem__restart_fail(&io, FSDEM_ERR_OUT_OF_MEMORY, "out of memory for the %ld bytes of '%s'", length, path);
     else if (fread(data, 1, (size_t)length, fp) != (size_t)length)
@@ -18020,8 +18467,8 @@ typedef struct fsdem__io_contacts {
 /* The contact law on a filled batch, as fsdem__dem_drain runs it, with the law chosen at run time
    (one more instantiation of the kernel; the step's are per law). */
 static void fsdem__io_dem_batch_law(fsdem__dem_batch *b, fsdem_dem_law law, fsdem_real h, int pairs, fsdem_real off,
-                                    const fsdem__dem_pair *uniform) {
-    fsdem__dem_batch_law(b, law, h, pairs, off, uniform);
+                                    const fsdem__dem_pair *uniform, const fsdem__dem_rules *rules) {
+    fsdem__dem_batch_law(b, law, h, pairs, off, uniform, rules);
 }
 
 /* Runs the law on a batch of particle pairs or (`walls`) wall contacts and appends its contacts to
@@ -18030,9 +18477,10 @@ static void fsdem__io_dem_drain(const fsdem_dem *d, fsdem__dem_batch *batch, int
     const fsdem__dem_pair *uniform = d->material_count == 1 ? d->pairs : NULL;
     const fsdem__dem_batch *b = batch; /* read only after the law */
     const fsdem_real off = d->desc.contact_offset;
+    const fsdem__dem_rules rules = fsdem__dem_rules_of(d);
     int k;
     fsdem__dem_batch_pad(batch, !walls, uniform != NULL);
-    fsdem__io_dem_batch_law(batch, d->desc.law, h, !walls, walls ? 0 : off, uniform);
+    fsdem__io_dem_batch_law(batch, fsdem__dem_kernel_law(d), h, !walls, walls ? 0 : off, uniform, &rules);
     for (k = 0; k < b->count; ++k) {
         const int i = b->i[k], e = c->count++;
         c->points[2 * e] = d->x[i];
@@ -18058,8 +18506,8 @@ static void fsdem__io_dem_drain(const fsdem_dem *d, fsdem__dem_batch *batch, int
    their number. */
 static int fsdem__io_dem_contacts(const fsdem_dem *d, fsdem__dem_batch *b, fsdem__dem_wall_hit *hits, fsdem__io_contacts *c) {
     const fsdem_real off = d->desc.contact_offset;
-    /* Hertz-Mindlin: the held springs as committed, not advanced again; linear: its one-step spring */
-    const fsdem_real h = d->desc.law == FSDEM_DEM_LAW_LINEAR ? d->dt : 0;
+    /* springs with history: as committed, not advanced again; seed 000's linear law: its one-step spring */
+    const fsdem_real h = fsdem__dem_kernel_law(d) == FSDEM_DEM_LAW_LINEAR ? d->dt : 0;
     const int uniform = d->material_count == 1;
     int i, k, nh, count = 0;
     if (c) {
@@ -18075,7 +18523,7 @@ static int fsdem__io_dem_contacts(const fsdem_dem *d, fsdem__dem_batch *b, fsdem
         if (!(ex * ex + ey * ey + ez * ez < reach * reach)) continue;
         count++;
         if (!c) continue;
-        fsdem__dem_gather_pair(d, b, b->count++, k, d->desc.law, uniform);
+        fsdem__dem_gather_pair(d, b, b->count++, k, fsdem__dem_kernel_law(d), uniform);
         if (b->count == FSDEM__DEM_BATCH) fsdem__io_dem_drain(d, b, 0, h, c);
     }
     if (c && b->count) fsdem__io_dem_drain(d, b, 0, h, c);

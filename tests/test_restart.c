@@ -1019,6 +1019,56 @@ START_TEST(pic_dem_continues_bit_exact) {
 }
 END_TEST
 
+/* Issue 23: a directory opens and seeks on Linux, and ftell gave its "length" as LONG_MAX: every
+   restore then asked the allocator for 2^63 - 1 bytes and answered FSDEM_ERR_OUT_OF_MEMORY. It is an
+   I/O error naming the path, and the object is left as it was (it still saves the same bytes). */
+static void refuses_directory(fsdem_result got, const char *message) {
+    ck_assert_int_eq(got, FSDEM_ERR_IO);
+    ck_assert_ptr_nonnull(strstr(message, "'build'"));
+}
+
+START_TEST(restore_from_a_directory_is_an_io_error) {
+    fsdem_dem_desc dd = dem_desc(FSDEM_DEM_INTEGRATOR_VERLET);
+    fsdem_pic_desc pd = pic_desc(2, 0, 0.05);
+    fsdem_swe_desc sd = swe_desc();
+    fsdem_mps_desc md = mps_desc();
+    fsdem_dem *dem = dem_scene(&dd);
+    fsdem_pic *pic = pic_scene(&pd, 0);
+    fsdem_swe *swe = swe_scene(&sd);
+    fsdem_mps *mps = NULL;
+    world w = world_new(0);
+    mps_world mw = mps_world_new(0);
+    pic_world pw = pic_world_new(0);
+    size_t before = 0, after = 0;
+    unsigned char *a, *b;
+    ck_assert_int_eq(fsdem_mps_create(&md, &mps), FSDEM_OK);
+    mps_setup(mps);
+    ck_assert_int_eq(fsdem_dem_save_memory(dem, NULL, 0, &before), FSDEM_OK);
+    a = (unsigned char *)malloc(before);
+    ck_assert_int_eq(fsdem_dem_save_memory(dem, a, before, &before), FSDEM_OK);
+    refuses_directory(fsdem_dem_restore(dem, "build"), fsdem_dem_last_error(dem));
+    ck_assert_int_eq(fsdem_dem_save_memory(dem, NULL, 0, &after), FSDEM_OK);
+    b = (unsigned char *)malloc(after);
+    ck_assert_int_eq(fsdem_dem_save_memory(dem, b, after, &after), FSDEM_OK);
+    same_bytes(a, before, b, after, "DEM after a refused restore");
+    refuses_directory(fsdem_pic_restore(pic, "build"), fsdem_pic_last_error(pic));
+    refuses_directory(fsdem_swe_restore(swe, "build"), fsdem_swe_last_error(swe));
+    refuses_directory(fsdem_mps_restore(mps, "build"), fsdem_mps_last_error(mps));
+    refuses_directory(fsdem_swe_dem_restore(w.cpl, "build"), fsdem_swe_dem_last_error(w.cpl));
+    refuses_directory(fsdem_mps_dem_restore(mw.cpl, "build"), fsdem_mps_dem_last_error(mw.cpl));
+    refuses_directory(fsdem_pic_dem_restore(pw.cpl, "build"), fsdem_pic_dem_last_error(pw.cpl));
+    free(a);
+    free(b);
+    fsdem_dem_destroy(dem);
+    fsdem_pic_destroy(pic);
+    fsdem_swe_destroy(swe);
+    fsdem_mps_destroy(mps);
+    world_free(&w);
+    mps_world_free(&mw);
+    pic_world_free(&pw);
+}
+END_TEST
+
 Suite *restart_suite(void) {
     Suite *s = suite_create("restart");
     TCase *tc = tcase_create("restart");
@@ -1036,6 +1086,7 @@ Suite *restart_suite(void) {
     tcase_add_test(tc, bad_data_is_refused_and_changes_nothing);
     tcase_add_test(tc, out_of_memory_changes_nothing);
     tcase_add_test(tc, swe_gauge_file_blocks_restore);
+    tcase_add_test(tc, restore_from_a_directory_is_an_io_error);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -1,0 +1,462 @@
+/* What a hostile user found at main 25f1947 (issue 23 §5): frees of the wrong size and silent
+   out-of-memory results, values that were accepted and came back later as NaN or nonsense, a drag
+   law that turned NaN at a finite Reynolds number, and messages naming the wrong function. Each test
+   failed before its fix. (Restoring from a directory: test_restart.c.) */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "fsdem_tests.h"
+
+/* ---- an allocator that fails on demand and checks every free's size -------------------------- */
+
+/* Each block carries the size it was allocated with in a header; a free with another size is
+   counted (a pool allocator keyed by size would corrupt), and so is every block still live. The
+   allocation numbered `fail_at` (counted from 1 after arming) returns NULL. */
+typedef struct sized {
+    long count, fail_at, bad_frees, live;
+} sized;
+
+#define SIZED_HEADER 16 /* keeps the blocks aligned for any fsdem type */
+
+static void *sized_alloc(void *user, size_t size) {
+    sized *h = (sized *)user;
+    size_t *block;
+    if (++h->count == h->fail_at) return NULL;
+    block = (size_t *)malloc(size + SIZED_HEADER);
+    if (!block) return NULL;
+    block[0] = size;
+    h->live++;
+    return (char *)block + SIZED_HEADER;
+}
+
+static void sized_free(void *user, void *ptr, size_t size) {
+    sized *h = (sized *)user;
+    size_t *block = (size_t *)(void *)((char *)ptr - SIZED_HEADER);
+    if (block[0] != size) h->bad_frees++;
+    h->live--;
+    free(block);
+}
+
+static fsdem_allocator sized_allocator(sized *h) {
+    fsdem_allocator a;
+    a.alloc = sized_alloc;
+    a.free = sized_free;
+    a.user = h;
+    return a;
+}
+
+/* Fails the allocation `n` counted from now. */
+static void arm(sized *h, long n) { h->fail_at = h->count + n; }
+
+/* After a run that failed its allocation `armed`: every free had the size allocated and nothing
+   leaked; a run that met the failure said so in a message. Returns 0 once a run no longer reaches
+   the failing allocation (the loops below stop there). */
+static int audited(const sized *h, fsdem_result res, const char *message, const char *what) {
+    ck_assert_msg(h->bad_frees == 0, "%s (allocation %ld failed): %ld frees of another size", what, h->fail_at, h->bad_frees);
+    ck_assert_msg(h->live == 0, "%s (allocation %ld failed): %ld blocks leaked", what, h->fail_at, h->live);
+    if (res == FSDEM_ERR_OUT_OF_MEMORY) ck_assert_msg(strstr(message, "out of memory") != NULL, "%s: no message (\"%s\")", what, message);
+    return h->count >= h->fail_at;
+}
+
+typedef struct log_capture {
+    char last[512];
+} log_capture;
+
+static void capture(void *user, fsdem_log_level level, const char *message) {
+    (void)level;
+    snprintf(((log_capture *)user)->last, sizeof((log_capture *)user)->last, "%s", message);
+}
+
+/* ---- frees of the wrong size -------------------------------------------------------------------- */
+
+/* The gauges keep three arrays of one capacity; the first grew and the second failed, so the first
+   was later freed with the old capacity's size. Every failure point of forty gauges, MPS and PIC. */
+static int gauges_run(int pic, long n) {
+    sized h = {0, 0, 0, 0};
+    fsdem_result res = FSDEM_OK;
+    char message[512];
+    int k;
+    if (pic) {
+        fsdem_pic_desc d = fsdem_pic_desc_default(2);
+        fsdem_pic *s = NULL;
+        d.cell_size = (fsdem_real)0.1;
+        d.allocator = sized_allocator(&h);
+        ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+        arm(&h, n);
+        for (k = 0; k < 40 && res == FSDEM_OK; ++k) res = fsdem_pic_add_gauge(s, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(0.5, 0.5, 0), 0, NULL);
+        snprintf(message, sizeof message, "%s", fsdem_pic_last_error(s));
+        fsdem_pic_destroy(s);
+    } else {
+        fsdem_mps_desc d = fsdem_mps_desc_default(2);
+        fsdem_mps *s = NULL;
+        d.allocator = sized_allocator(&h);
+        ck_assert_int_eq(fsdem_mps_create(&d, &s), FSDEM_OK);
+        arm(&h, n);
+        for (k = 0; k < 40 && res == FSDEM_OK; ++k) res = fsdem_mps_add_gauge(s, FSDEM_MPS_GAUGE_KIND_LEVEL, fsdem_v3(0.5, 0.5, 0), 0, NULL);
+        snprintf(message, sizeof message, "%s", fsdem_mps_last_error(s));
+        fsdem_mps_destroy(s);
+    }
+    return audited(&h, res, message, pic ? "fsdem_pic_add_gauge" : "fsdem_mps_add_gauge");
+}
+
+START_TEST(gauge_growth_failure_frees_at_the_size_allocated) {
+    long n;
+    for (n = 1; gauges_run(0, n); ++n) {
+    }
+    for (n = 1; gauges_run(1, n); ++n) {
+    }
+}
+END_TEST
+
+/* A 2D water tank with one disc; `late`: then a step, two more discs added to the DEM, and the
+   step that cuts them is the one that fails. The coupler's face and J arrays grew one by one (frees
+   of the wrong size), and the body records' failure left the step's result without a message. */
+static int pic_dem_run(int late, long n) {
+    sized h = {0, 0, 0, 0};
+    log_capture log;
+    fsdem_pic_desc pd = fsdem_pic_desc_default(2);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    fsdem_pic_dem_desc cd = fsdem_pic_dem_desc_default();
+    fsdem_pic *pic = NULL;
+    fsdem_dem *dem = NULL;
+    fsdem_pic_dem *c = NULL;
+    fsdem_result res;
+    char message[512];
+    log.last[0] = '\0';
+    pd.cell_size = (fsdem_real)0.02;
+    pd.domain_max = fsdem_v3(0.4f, 0.4f, 0);
+    pd.dt_max = (fsdem_real)1e-3;
+    pd.allocator = sized_allocator(&h);
+    ck_assert_int_eq(fsdem_pic_create(&pd, &pic), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_fill_box(pic, fsdem_v3(0, 0, 0), fsdem_v3(0.4f, 0.3f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    dd.domain_min = fsdem_v3(0, 0, 0);
+    dd.domain_max = pd.domain_max;
+    dd.dt = (fsdem_real)1e-4;
+    dd.allocator = sized_allocator(&h);
+    ck_assert_int_eq(fsdem_dem_create(&dd, &dem), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_add_material(dem, &m, NULL), FSDEM_OK);
+    p.radius = (fsdem_real)0.05;
+    p.position = fsdem_v3(0.2f, 0.15f, 0);
+    ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+    cd.pic = pic;
+    cd.dem = dem;
+    cd.log = capture;
+    cd.log_user = &log;
+    if (!late) {
+        arm(&h, n);
+        res = fsdem_pic_dem_create(&cd, &c);
+        snprintf(message, sizeof message, "%s", log.last);
+    } else {
+        ck_assert_int_eq(fsdem_pic_dem_create(&cd, &c), FSDEM_OK);
+        ck_assert_int_eq(fsdem_pic_dem_step(c), FSDEM_OK);
+        p.radius = (fsdem_real)0.03;
+        p.position = fsdem_v3(0.1f, 0.15f, 0);
+        ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+        p.position = fsdem_v3(0.3f, 0.15f, 0);
+        ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+        arm(&h, n);
+        res = fsdem_pic_dem_step(c);
+        snprintf(message, sizeof message, "%s", fsdem_pic_dem_last_error(c));
+    }
+    fsdem_pic_dem_destroy(c);
+    fsdem_dem_destroy(dem);
+    fsdem_pic_destroy(pic);
+    return audited(&h, res, message, late ? "fsdem_pic_dem_step after late bodies" : "fsdem_pic_dem_create");
+}
+
+START_TEST(pic_dem_out_of_memory_frees_at_size_and_says_so) {
+    long n;
+    for (n = 1; pic_dem_run(0, n); ++n) {
+    }
+    for (n = 1; pic_dem_run(1, n); ++n) {
+    }
+}
+END_TEST
+
+/* fsdem_swe_create returned FSDEM_ERR_OUT_OF_MEMORY without a message when it could not copy a
+   boundary's series (its third and fourth allocations). */
+static int swe_run(long n) {
+    static const fsdem_real t[2] = {0, 1}, q[2] = {0.1f, 0.2f};
+    sized h = {0, 0, 0, 0};
+    log_capture log;
+    fsdem_swe_desc d = fsdem_swe_desc_default(1);
+    fsdem_swe *s = NULL;
+    fsdem_result res;
+    log.last[0] = '\0';
+    d.allocator = sized_allocator(&h);
+    d.log = capture;
+    d.log_user = &log;
+    d.boundary[FSDEM_SIDE_XMIN].type = FSDEM_SWE_BC_DISCHARGE;
+    d.boundary[FSDEM_SIDE_XMIN].series_time = t;
+    d.boundary[FSDEM_SIDE_XMIN].series_value = q;
+    d.boundary[FSDEM_SIDE_XMIN].series_count = 2;
+    arm(&h, n);
+    res = fsdem_swe_create(&d, &s);
+    ck_assert(res == FSDEM_OK || res == FSDEM_ERR_OUT_OF_MEMORY);
+    ck_assert((res == FSDEM_OK) == (s != NULL));
+    fsdem_swe_destroy(s);
+    return audited(&h, res, log.last, "fsdem_swe_create");
+}
+
+START_TEST(swe_create_out_of_memory_is_logged) {
+    long n;
+    for (n = 1; swe_run(n); ++n) {
+    }
+}
+END_TEST
+
+/* ---- values that cannot be right are refused at the call ----------------------------------------- */
+
+/* The call returned FSDEM_ERR_INVALID_ARG and its message names `word`. */
+#define REFUSED(call, message, word)                                                                                     \
+    do {                                                                                                                 \
+        ck_assert_int_eq((call), FSDEM_ERR_INVALID_ARG);                                                                 \
+        ck_assert_msg(strstr((message), (word)) != NULL, "message \"%s\" does not name %s", (message), (word));          \
+    } while (0)
+
+START_TEST(implausible_mps_input_is_refused) {
+    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps *s = NULL;
+    char msg[512];
+    const fsdem_vec3 x = {0.5f, 0.5f, 0}, fast = {(fsdem_real)1e20, 0, 0};
+    d.gravity = fsdem_v3(0, (fsdem_real)-9.81, 1);
+    REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "gravity.z");
+    d = fsdem_mps_desc_default(2);
+    d.gravity = fsdem_v3(0, (fsdem_real)-1e20, 0);
+    REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "FSDEM_MAX_ACCELERATION");
+    d = fsdem_mps_desc_default(2);
+    d.r0 = 5; /* the domain is 1 m wide */
+    REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "r0");
+    d = fsdem_mps_desc_default(2);
+    d.dt_max = (fsdem_real)1e20; /* g dt_max would be 1e21 m/s */
+    REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "dt_max");
+    d.dt_max = 1; /* 9.81 m/s of free fall in a step is plausible, if not stable: the CFL limit takes over */
+    ck_assert_int_eq(fsdem_mps_desc_check(&d, msg, sizeof msg), FSDEM_OK);
+    d = fsdem_mps_desc_default(2);
+    ck_assert_int_eq(fsdem_mps_create(&d, &s), FSDEM_OK);
+    REFUSED(fsdem_mps_add_particles(s, FSDEM_MPS_KIND_FLUID, 1, &x, &fast), fsdem_mps_last_error(s), "FSDEM_MAX_SPEED");
+    REFUSED(fsdem_mps_fill_box(s, fsdem_v3(0.1f, 0.1f, 0), fsdem_v3(0.2f, 0.2f, 0), fast, NULL), fsdem_mps_last_error(s),
+            "FSDEM_MAX_SPEED");
+    REFUSED(fsdem_mps_add_box_walls(s, fsdem_v3(0.1f, 0.1f, 0), fsdem_v3(0.3f, 0.3f, 0), 1u << 4, NULL), fsdem_mps_last_error(s),
+            "open_sides");
+    ck_assert_int_eq(fsdem_mps_get_particles(s).count, 0);
+    fsdem_mps_destroy(s);
+}
+END_TEST
+
+START_TEST(implausible_dem_input_is_refused) {
+    fsdem_dem_desc d = fsdem_dem_desc_default(3);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    fsdem_dem_contact c[2];
+    fsdem_dem *dem = NULL, *unit = NULL;
+    fsdem_dem_wall_desc w;
+    char msg[512];
+    int mat;
+    d.dim = 2;
+    d.gravity = fsdem_v3(0, (fsdem_real)-9.81, (fsdem_real)-1);
+    REFUSED(fsdem_dem_desc_check(&d, msg, sizeof msg), msg, "gravity.z");
+    d = fsdem_dem_desc_default(3);
+    ck_assert_int_eq(fsdem_dem_create(&d, &dem), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_create(&d, &unit), FSDEM_OK);
+    m.young_modulus = (fsdem_real)INFINITY; /* two such materials met in an infinite contact stiffness */
+    REFUSED(fsdem_dem_add_material(dem, &m, NULL), fsdem_dem_last_error(dem), "young_modulus");
+    m = fsdem_dem_material_default();
+    ck_assert_int_eq(fsdem_dem_add_material(dem, &m, &mat), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_add_material(unit, &m, NULL), FSDEM_OK);
+    p.radius = (fsdem_real)0.1;
+    p.velocity = fsdem_v3((fsdem_real)1e20, 0, 0);
+    REFUSED(fsdem_dem_add_particle(dem, &p, NULL), fsdem_dem_last_error(dem), "FSDEM_MAX_SPEED");
+    p.velocity = fsdem_v3(0, 0, 0);
+    p.angular_velocity = fsdem_v3(0, 0, (fsdem_real)1e6); /* its surface would move at 1e5 m/s */
+    REFUSED(fsdem_dem_add_particle(dem, &p, NULL), fsdem_dem_last_error(dem), "FSDEM_MAX_SPEED");
+    ck_assert_int_eq(fsdem_dem_get_particles(dem).count, 0);
+    /* a plane normal of (0, 0, 1e30) is the plane of normal (0, 0, 1): the same contact */
+    w = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, (fsdem_real)1e30), mat);
+    ck_assert_int_eq(fsdem_dem_add_wall(dem, &w, NULL), FSDEM_OK);
+    w = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), mat);
+    ck_assert_int_eq(fsdem_dem_add_wall(unit, &w, NULL), FSDEM_OK);
+    p.angular_velocity = fsdem_v3(0, 0, 0);
+    p.position = fsdem_v3(0, 0, (fsdem_real)0.09);
+    ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_add_particle(unit, &p, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_contacts(dem, c, 1), 1);
+    ck_assert_int_eq(fsdem_dem_contacts(unit, c + 1, 1), 1);
+    ck_assert(c[0].normal.z == c[1].normal.z && c[0].overlap == c[1].overlap);
+    w.velocity = fsdem_v3(0, (fsdem_real)1e20, 0);
+    REFUSED(fsdem_dem_add_wall(dem, &w, NULL), fsdem_dem_last_error(dem), "FSDEM_MAX_SPEED");
+    REFUSED(fsdem_dem_set_wall_velocity(dem, 0, fsdem_v3((fsdem_real)1e20, 0, 0)), fsdem_dem_last_error(dem), "FSDEM_MAX_SPEED");
+    fsdem_dem_destroy(dem);
+    fsdem_dem_destroy(unit);
+}
+END_TEST
+
+START_TEST(implausible_pic_and_swe_input_is_refused) {
+    fsdem_pic_desc pd = fsdem_pic_desc_default(2);
+    fsdem_swe_desc sd = fsdem_swe_desc_default(1);
+    fsdem_pic *pic = NULL;
+    fsdem_swe *swe = NULL;
+    fsdem_swe_boundary b;
+    fsdem_real a[100];
+    const fsdem_vec3 fast = {(fsdem_real)1e20, 0, 0};
+    char msg[512];
+    int k;
+    pd.cell_size = (fsdem_real)0.1;
+    ck_assert_int_eq(fsdem_pic_create(&pd, &pic), FSDEM_OK);
+    REFUSED(fsdem_pic_fill_box(pic, fsdem_v3(0, 0, 0), fsdem_v3(0.5f, 0.5f, 0), fast, NULL), fsdem_pic_last_error(pic),
+            "FSDEM_MAX_SPEED");
+    REFUSED(fsdem_pic_add_force(pic, fsdem_v3(0.5f, 0.5f, 0), 0, fast, NULL), fsdem_pic_last_error(pic), "FSDEM_MAX_ACCELERATION");
+    ck_assert_int_eq(fsdem_pic_get_particles(pic).count, 0);
+    fsdem_pic_destroy(pic);
+    sd.gravity = fsdem_v3(0, 0, (fsdem_real)-1e20);
+    REFUSED(fsdem_swe_desc_check(&sd, msg, sizeof msg), msg, "gravity");
+    sd = fsdem_swe_desc_default(1);
+    ck_assert_int_eq(fsdem_swe_create(&sd, &swe), FSDEM_OK);
+    for (k = 0; k < 100; ++k) a[k] = (fsdem_real)1e20;
+    REFUSED(fsdem_swe_set_depth(swe, a), fsdem_swe_last_error(swe), "fsdem_swe_set_depth");
+    REFUSED(fsdem_swe_set_velocity(swe, a, NULL), fsdem_swe_last_error(swe), "fsdem_swe_set_velocity");
+    for (k = 0; k < 100; ++k) a[k] = 1;
+    ck_assert_int_eq(fsdem_swe_set_depth(swe, a), FSDEM_OK);
+    REFUSED(fsdem_swe_add_force(swe, fsdem_v3(0.5f, 0, 0), 0, fast, NULL), fsdem_swe_last_error(swe), "FSDEM_MAX_ACCELERATION");
+    memset(&b, 0, sizeof b);
+    b.type = FSDEM_SWE_BC_STAGE;
+    b.value = (fsdem_real)1e20;
+    REFUSED(fsdem_swe_set_boundary(swe, FSDEM_SIDE_XMIN, &b), fsdem_swe_last_error(swe), "value");
+    ck_assert(fsdem_swe_get_fields(swe).eta[0] == 1); /* unchanged */
+    fsdem_swe_destroy(swe);
+}
+END_TEST
+
+/* MPS-DEM's averaging radius and PIC-DEM's contact length of 1e30 m were accepted; so was a sphere
+   wider than the fluid's domain (PIC-DEM: a body that leaves no open cell). */
+START_TEST(implausible_coupler_input_is_refused) {
+    fsdem_mps_desc md = fsdem_mps_desc_default(2);
+    fsdem_pic_desc pd = fsdem_pic_desc_default(2);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    fsdem_mps_dem_desc mc = fsdem_mps_dem_desc_default();
+    fsdem_pic_dem_desc pc = fsdem_pic_dem_desc_default();
+    fsdem_mps *mps = NULL;
+    fsdem_pic *pic = NULL;
+    fsdem_dem *dem = NULL;
+    fsdem_mps_dem *c = NULL;
+    fsdem_pic_dem *cp = NULL;
+    char msg[512];
+    pd.cell_size = (fsdem_real)0.05;
+    ck_assert_int_eq(fsdem_mps_create(&md, &mps), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_create(&pd, &pic), FSDEM_OK);
+    dd.domain_min = fsdem_v3(-10, -10, 0);
+    dd.domain_max = fsdem_v3(10, 10, 0);
+    ck_assert_int_eq(fsdem_dem_create(&dd, &dem), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_add_material(dem, &m, NULL), FSDEM_OK);
+    mc.mps = mps;
+    mc.dem = dem;
+    mc.radius = (fsdem_real)1e30;
+    REFUSED(fsdem_mps_dem_desc_check(&mc, msg, sizeof msg), msg, "radius");
+    pc.pic = pic;
+    pc.dem = dem;
+    pc.contact_length = (fsdem_real)1e30;
+    REFUSED(fsdem_pic_dem_desc_check(&pc, msg, sizeof msg), msg, "contact_length");
+    /* a disc of 2 m diameter in the 1 m fluid domains */
+    p.radius = 1;
+    p.position = fsdem_v3(0.5f, 0.5f, 0);
+    ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+    pc.contact_length = 0;
+    ck_assert_int_eq(fsdem_pic_dem_create(&pc, &cp), FSDEM_ERR_INVALID_ARG);
+    ck_assert_ptr_null(cp);
+    mc.radius = 0;
+    ck_assert_int_eq(fsdem_mps_dem_create(&mc, &c), FSDEM_OK);
+    REFUSED(fsdem_mps_dem_update(c), fsdem_mps_dem_last_error(c), "does not fit");
+    fsdem_mps_dem_destroy(c);
+    fsdem_dem_destroy(dem);
+    fsdem_pic_destroy(pic);
+    fsdem_mps_destroy(mps);
+}
+END_TEST
+
+/* ---- drag laws over their range ------------------------------------------------------------------ */
+
+/* Every law is finite from Re = 0 to the largest slip (FSDEM_MAX_SPEED) for grains of 1 um to
+   1 m in water and in a light gas, at porosities from 0.2 to 1. Beetstra's inertial term was
+   multiplied through by Re^a and turned inf / inf = NaN where Re^a overflowed; a slip beyond the
+   bound is refused, naming it, and an overflow of c itself names Re (it blamed "d too small"). */
+START_TEST(drag_laws_are_finite_over_their_range) {
+    static const double eps[5] = {0.2, 0.4, 0.6, 0.8, 1}, d[4] = {1e-6, 1e-3, 0.1, 1}, slip[5] = {0, 1e-9, 1e-3, 1, 1e4};
+    static const double fluid[2][2] = {{1000, 1e-3}, {1, 1.8e-5}}; /* density, dynamic viscosity */
+    char msg[512];
+    fsdem_real c;
+    int law, a, b, e, f;
+    for (law = FSDEM_DRAG_LAW_STOKES; law <= FSDEM_DRAG_LAW_BEETSTRA; ++law)
+        for (a = 0; a < 5; ++a)
+            for (b = 0; b < 4; ++b)
+                for (e = 0; e < 5; ++e)
+                    for (f = 0; f < 2; ++f) {
+                        ck_assert_int_eq(fsdem_drag_coefficient((fsdem_drag_law)law, (fsdem_real)eps[a], (fsdem_real)d[b], (fsdem_real)slip[e],
+                                                                (fsdem_real)fluid[f][0], (fsdem_real)fluid[f][1], &c, NULL, msg,
+                                                                sizeof msg),
+                                         FSDEM_OK);
+                        ck_assert(isfinite(c) && c > 0);
+                    }
+    REFUSED(fsdem_drag_coefficient(FSDEM_DRAG_LAW_BEETSTRA, (fsdem_real)0.4, (fsdem_real)1e-3, (fsdem_real)1e20, 1000, (fsdem_real)1e-3, &c,
+                                   NULL, msg, sizeof msg),
+            msg, "slip_speed");
+    if (!TEST_FLOAT) { /* a density of 1e306 overflows c (Re = 4e305) */
+        ck_assert_int_eq(fsdem_drag_coefficient(FSDEM_DRAG_LAW_BEETSTRA, (fsdem_real)0.4, (fsdem_real)1e-3, 1, (fsdem_real)1e306,
+                                                (fsdem_real)1e-3, &c, NULL, msg, sizeof msg),
+                         FSDEM_ERR_NAN);
+        ck_assert_ptr_nonnull(strstr(msg, "Re = "));
+    }
+}
+END_TEST
+
+/* At Re = 5e7 Beetstra's hindrance 1 + 10^(3 phi) Re^-a differs from 1 by 1e-10 (phi = 0.5, a =
+   1.5), so c is the published form's large-Re limit 18 mu eps/d^2 [10 phi/eps^2 + eps^2 (1 + 1.5
+   sqrt(phi)) + 0.413 (Re (1/eps + 3 phi eps) + 8.4 Re^0.657) / (24 eps^2)] to 1e-9. */
+START_TEST(beetstra_reaches_its_large_reynolds_limit) {
+    const double eps = 0.5, phi = 0.5, d = 0.01, mu = 1e-3, rho = 1000, slip = 1e4, re = eps * rho * d * slip / mu;
+    const double limit = 18 * mu * eps / (d * d) *
+                         (10 * phi / (eps * eps) + eps * eps * (1 + 1.5 * sqrt(phi)) +
+                          0.413 * (re * (1 / eps + 3 * phi * eps) + 8.4 * pow(re, 0.657)) / (24 * eps * eps));
+    fsdem_real c;
+    ck_assert_int_eq(fsdem_drag_coefficient(FSDEM_DRAG_LAW_BEETSTRA, (fsdem_real)eps, (fsdem_real)d, (fsdem_real)slip, (fsdem_real)rho,
+                                            (fsdem_real)mu, &c, NULL, NULL, 0),
+                     FSDEM_OK);
+    ck_assert(fabs(c / limit - 1) < TOL(1e-9, 100));
+}
+END_TEST
+
+/* ---- messages name the function called ---------------------------------------------------------- */
+
+START_TEST(dem_messages_name_the_function_called) {
+    fsdem_dem_desc d = fsdem_dem_desc_default(3);
+    fsdem_dem *dem = NULL;
+    long long k;
+    ck_assert_int_eq(fsdem_dem_create(&d, &dem), FSDEM_OK);
+    REFUSED(fsdem_dem_substep_count(dem, -1, &k), fsdem_dem_last_error(dem), "fsdem_dem_substep_count:");
+    REFUSED(fsdem_dem_advance_with(dem, -1, NULL, NULL, NULL), fsdem_dem_last_error(dem), "fsdem_dem_advance_with:");
+    REFUSED(fsdem_dem_advance(dem, (fsdem_real)1e30, NULL), fsdem_dem_last_error(dem), "fsdem_dem_advance:");
+    fsdem_dem_destroy(dem);
+}
+END_TEST
+
+Suite *probing_suite(void) {
+    Suite *s = suite_create("probing");
+    TCase *tc = tcase_create("probing");
+    tcase_set_timeout(tc, 60);
+    tcase_add_test(tc, gauge_growth_failure_frees_at_the_size_allocated);
+    tcase_add_test(tc, pic_dem_out_of_memory_frees_at_size_and_says_so);
+    tcase_add_test(tc, swe_create_out_of_memory_is_logged);
+    tcase_add_test(tc, implausible_mps_input_is_refused);
+    tcase_add_test(tc, implausible_dem_input_is_refused);
+    tcase_add_test(tc, implausible_pic_and_swe_input_is_refused);
+    tcase_add_test(tc, implausible_coupler_input_is_refused);
+    tcase_add_test(tc, drag_laws_are_finite_over_their_range);
+    tcase_add_test(tc, beetstra_reaches_its_large_reynolds_limit);
+    tcase_add_test(tc, dem_messages_name_the_function_called);
+    suite_add_tcase(s, tc);
+    return s;
+}
