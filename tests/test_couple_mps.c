@@ -409,6 +409,36 @@ START_TEST(test_mps_dem_csv_rows_are_the_force_records) {
 }
 END_TEST
 
+/* fails until fsdem.h fixes the coupler records after a DEM particle removal (fsdem_mps_dem_get_force
+   and fsdem__io_mps_dem_row index the last update's records with today's particle indices).
+   A coupled run may remove a DEM particle (one that left the domain, >>doc ERRORS) between an
+   update and the CSV snapshot. The records are the last update's, made for the particles then in
+   the DEM; fsdem_dem_remove_particle shifts the later particles down. Each row must still name the
+   particle its record was computed for, and a removed particle has neither a row nor a record.
+   Now: the rows read (id 1, record of id 0), (id 2, record of id 1), and a third row takes its id
+   from past the end of the DEM's id array; get_force(2) answers FSDEM_OK with the count at 2.
+   Registered only with FSDEM_TEST_KNOWN_DEFECTS set. */
+START_TEST(test_mps_dem_csv_after_a_removal) {
+    static const char header[] = "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,fluid_u,"
+                                 "fluid_v,fluid_w,porosity,reynolds,wet";
+    test_pair t = test_pair_new(2, 0.01, FSDEM_MPS_MODEL_B, 1e-6, fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.15f, 0), 0.08, 2500);
+    fsdem_mps_dem_force f[3];
+    double e[2 * 16];
+    int i;
+    for (i = 0; i < 3; ++i) test_add_sphere(&t, fsdem_v3((fsdem_real)(0.02 + 0.03 * i), (fsdem_real)(0.02 + 0.02 * i), 0),
+                                            fsdem_v3(0, -0.01f * (fsdem_real)i, 0), 0.002);
+    ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
+    for (i = 0; i < 3; ++i) ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, i, &f[i]), FSDEM_OK); /* ids 0, 1, 2 */
+    ck_assert_int_eq(fsdem_dem_remove_particle(t.dem, 0), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_get_particles(t.dem).count, 2);
+    ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, 2, &f[0]), FSDEM_ERR_NOT_FOUND);
+    for (i = 0; i < 2; ++i) test_force_row(e + 16 * i, i + 1, &f[i + 1]);
+    ck_assert_int_eq(fsdem_mps_dem_write_csv(t.cpl, "build/test_mps_dem_removal.csv"), FSDEM_OK);
+    test_csv_expect("build/test_mps_dem_removal.csv", header, 2, e);
+    test_pair_free(&t);
+}
+END_TEST
+
 Suite *couple_mps_suite(void) {
     Suite *s = suite_create("couple_mps");
     TCase *tc = tcase_create("mps_dem");
@@ -419,6 +449,7 @@ Suite *couple_mps_suite(void) {
     tcase_add_test(tc, test_mps_dem_terminal_velocity);
     tcase_add_test(tc, test_mps_dem_bad_input);
     tcase_add_test(tc, test_mps_dem_csv_rows_are_the_force_records);
+    if (getenv("FSDEM_TEST_KNOWN_DEFECTS")) tcase_add_test(tc, test_mps_dem_csv_after_a_removal); /* a known defect, above */
     suite_add_tcase(s, tc);
     return s;
 }

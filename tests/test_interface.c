@@ -761,6 +761,7 @@ START_TEST(null_objects_are_refused) {
     {
         fsdem_dem_desc d = fsdem_dem_desc_default(3);
         fsdem_dem_material m = fsdem_dem_material_default();
+        fsdem_dem_material_pair pair = {1, 1, 1, 1};
         fsdem_dem_particle_desc pd = fsdem_dem_particle_desc_default();
         fsdem_dem_wall_desc w = fsdem_dem_wall_plane(v, fsdem_v3(0, 0, 1), 0);
         fsdem_dem *dem = (fsdem_dem *)&p;
@@ -780,6 +781,11 @@ START_TEST(null_objects_are_refused) {
         text = fsdem_dem_last_error(NULL);
         IF_TRUE(&p, "fsdem_dem_last_error(NULL)", text && strstr(text, "fsdem_dem") && strstr(text, "NULL"));
         IF_REFUSED(&p, fsdem_dem_add_material(NULL, &m, &idx));
+        IF_REFUSED(&p, fsdem_dem_set_material_pair(NULL, 0, 0, &pair));
+        mark_point();
+        pair = fsdem_dem_get_material_pair(NULL, 0, 0);
+        IF_ZERO(&p, "fsdem_dem_get_material_pair(NULL, 0, 0)", fabs(pair.restitution) + fabs(pair.friction) +
+                                                                   fabs(pair.rolling_friction) + fabs(pair.cohesion));
         IF_REFUSED(&p, fsdem_dem_add_particle(NULL, &pd, &idx));
         IF_REFUSED(&p, fsdem_dem_remove_particle(NULL, 0));
         IF_REFUSED(&p, fsdem_dem_set_particle_state(NULL, 0, v, v, v));
@@ -913,7 +919,10 @@ START_TEST(null_objects_are_refused) {
         IF_REFUSED(&p, fsdem_pic_add_gauge(NULL, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(0, 0, 0), 0, NULL));
         IF_REFUSED(&p, fsdem_pic_gauges_open(NULL, "build/never_null.csv", 0));
         IF_REFUSED(&p, fsdem_pic_gauges_close(NULL));
+        IF_REFUSED(&p, fsdem_pic_exclude_particles(NULL, if_plane, NULL, 0, &idx));
         IF_REFUSED(&p, fsdem_pic_save(NULL, "build/never_null.rst"));
+        IF_REFUSED(&p, fsdem_pic_restore(NULL, "build/never_null.rst"));
+        IF_REFUSED(&p, fsdem_pic_save_memory(NULL, NULL, 0, NULL));
         IF_REFUSED(&p, fsdem_pic_restore_memory(NULL, NULL, 0));
     }
     /* ---- fsdem_swe ---- */
@@ -991,6 +1000,8 @@ START_TEST(null_objects_are_refused) {
         IF_REFUSED(&p, fsdem_swe_block_box(NULL, 0, 0, 1, 1));
         IF_REFUSED(&p, fsdem_swe_block_polygon(NULL, NULL, 0));
         IF_REFUSED(&p, fsdem_swe_save(NULL, "build/never_null.rst"));
+        IF_REFUSED(&p, fsdem_swe_restore(NULL, "build/never_null.rst"));
+        IF_REFUSED(&p, fsdem_swe_save_memory(NULL, NULL, 0, NULL));
         IF_REFUSED(&p, fsdem_swe_restore_memory(NULL, NULL, 0));
         IF_REFUSED(&p, fsdem_swe_add_gauge(NULL, 0.5, 0, &idx));
         IF_REFUSED(&p, fsdem_swe_gauge(NULL, 0, &cell));
