@@ -178,6 +178,7 @@
 #define fsdem_cellgrid_free fsdem_cellgrid_free_f
 #define fsdem_cellgrid_neighbourhood fsdem_cellgrid_neighbourhood_f
 #define fsdem_cellgrid_setup fsdem_cellgrid_setup_f
+#define fsdem_cellgrid_setup_periodic fsdem_cellgrid_setup_periodic_f
 #define fsdem_csr_apply fsdem_csr_apply_f
 #define fsdem_csr_check fsdem_csr_check_f
 #define fsdem_csv_close fsdem_csv_close_f
@@ -196,6 +197,7 @@
 #define fsdem_dem_get_coupling fsdem_dem_get_coupling_f
 #define fsdem_dem_get_desc fsdem_dem_get_desc_f
 #define fsdem_dem_get_energy fsdem_dem_get_energy_f
+#define fsdem_dem_get_material_pair fsdem_dem_get_material_pair_f
 #define fsdem_dem_get_particles fsdem_dem_get_particles_f
 #define fsdem_dem_get_stats fsdem_dem_get_stats_f
 #define fsdem_dem_last_error fsdem_dem_last_error_f
@@ -208,6 +210,7 @@
 #define fsdem_dem_save fsdem_dem_save_f
 #define fsdem_dem_save_memory fsdem_dem_save_memory_f
 #define fsdem_dem_set_dt fsdem_dem_set_dt_f
+#define fsdem_dem_set_material_pair fsdem_dem_set_material_pair_f
 #define fsdem_dem_set_particle_state fsdem_dem_set_particle_state_f
 #define fsdem_dem_set_wall_velocity fsdem_dem_set_wall_velocity_f
 #define fsdem_dem_stable_dt fsdem_dem_stable_dt_f
@@ -540,13 +543,18 @@ typedef struct fsdem_fluid_sample {
 /* A uniform grid of cubic cells over a box; items (particle indices) are binned by a counting sort,
    so a build is O(n) and a query visits the 3^dim cells around a point. Positions outside the box
    are clamped into its border cells, so every item is found. The cell size is enlarged when the box
-   would need more than `max_cells` cells, which keeps memory bounded for any domain.
-   The struct is public so solvers can embed it; treat its fields as read-only. */
+   would need more than `max_cells` cells, which keeps memory bounded for any domain. Along a
+   periodic axis the cells tile the period exactly (a little wider than cell_size) and the
+   neighbourhoods wrap round, so neighbours across the seam are found; with fewer than 3 cells along
+   it the axis is one cell. The struct is public so solvers can embed it; treat its fields as
+   read-only. */
 typedef struct fsdem_cellgrid {
     int dim;                  /* 2 or 3 */
     fsdem_vec3 origin;        /* m, lower corner */
     fsdem_real cell_size;     /* m, edge of one cell (>= the requested size) */
     fsdem_real inv_cell_size; /* 1/m */
+    fsdem_real inv_width[3];  /* 1/m, per axis: 1/cell_size, or cells per period along a periodic axis */
+    int wrap[3];              /* 1: the neighbourhoods wrap round this (periodic) axis */
     int n[3];                 /* cells per axis (n[2] = 1 in 2D) */
     int cell_count;           /* n[0]*n[1]*n[2] */
     int *cell_start;          /* cell_count + 1 offsets into `items` */
@@ -562,6 +570,11 @@ typedef struct fsdem_cellgrid {
 FSDEM_API fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *grid, const fsdem_allocator *allocator,
                                             int dim, fsdem_vec3 lo, fsdem_vec3 hi,
                                             fsdem_real cell_size, int max_cells);
+/* fsdem_cellgrid_setup with the axes a where periodic[a] != 0 periodic, of period hi - lo
+   (periodic may be NULL: none). */
+FSDEM_API fsdem_result fsdem_cellgrid_setup_periodic(fsdem_cellgrid *grid, const fsdem_allocator *allocator, int dim,
+                                                     fsdem_vec3 lo, fsdem_vec3 hi, fsdem_real cell_size, int max_cells,
+                                                     const int periodic[3]);
 /* Bin `count` (>= 0) points. FSDEM_ERR_INVALID_ARG before a successful setup, for a negative count or
    NULL points; FSDEM_ERR_OUT_OF_MEMORY. */
 FSDEM_API fsdem_result fsdem_cellgrid_build(fsdem_cellgrid *grid, const fsdem_vec3 *points,
@@ -717,6 +730,9 @@ typedef struct fsdem_dem_desc {
     fsdem_dem_tangential_history tangential_history; /* default INCREMENTAL (see the enum) */
     fsdem_dem_coulomb_limit coulomb_limit;   /* default TOTAL (see the enum) */
     fsdem_dem_linear_stiffness linear_stiffness; /* linear law only; default SEED000 */
+    int periodic[3];                /* 1: axis a is periodic, of period domain_max - domain_min */
+                                    /*    (LIGGGHTS `boundary p`): contacts act across the seam, */
+                                    /*    positions wrap; z must be 0 in 2D; default 0, 0, 0 */
     int capacity;                   /* initial particle capacity (grows as needed); default 1024 */
     fsdem_allocator allocator;      /* default: FSDEM_MALLOC/FSDEM_FREE */
     fsdem_log_fn log;               /* optional; default NULL */
@@ -3618,6 +3634,11 @@ static inline fsdem_real fsdem__kernel_mps(fsdem_real r, fsdem_real re) {
 
 fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *g, const fsdem_allocator *allocator, int dim,
                                   fsdem_vec3 lo, fsdem_vec3 hi, fsdem_real cell_size, int max_cells) {
+    return fsdem_cellgrid_setup_periodic(g, allocator, dim, lo, hi, cell_size, max_cells, NULL);
+}
+
+fsdem_result fsdem_cellgrid_setup_periodic(fsdem_cellgrid *g, const fsdem_allocator *allocator, int dim, fsdem_vec3 lo,
+                                           fsdem_vec3 hi, fsdem_real cell_size, int max_cells, const int periodic[3]) {
     double extent[3], cells = 1;
     int axis, tries;
     if (!g) return FSDEM_ERR_INVALID_ARG;
@@ -3644,8 +3665,15 @@ fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *g, const fsdem_allocator *allo
     g->origin = lo;
     g->cell_size = cell_size;
     g->inv_cell_size = 1 / cell_size;
-    for (axis = 0; axis < 3; ++axis)
-        g->n[axis] = axis < dim ? (int)floor(extent[axis] / cell_size) + 1 : 1;
+    for (axis = 0; axis < 3; ++axis) {
+        const int tiles = axis < dim ? (int)floor(extent[axis] / cell_size) : 0;
+        g->wrap[axis] = periodic && axis < dim && periodic[axis] && tiles >= 3;
+        g->n[axis] = g->wrap[axis] ? tiles : periodic && axis < dim && periodic[axis] ? 1 : axis < dim ? tiles + 1 : 1;
+        /* a periodic axis of one cell bins everything in it */
+        g->inv_width[axis] = g->wrap[axis] ? (fsdem_real)(tiles / extent[axis])
+                             : periodic && axis < dim && periodic[axis] ? 0
+                                                                        : g->inv_cell_size;
+    }
     g->cell_count = g->n[0] * g->n[1] * g->n[2];
     if (g->cell_count + 1 > g->cell_capacity) {
         fsdem__free(&g->allocator, g->cell_start, sizeof(int) * (size_t)g->cell_capacity);
@@ -3659,7 +3687,7 @@ fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *g, const fsdem_allocator *allo
 }
 
 static int fsdem__cellgrid_coord(const fsdem_cellgrid *g, fsdem_real x, int axis) {
-    fsdem_real s = (x - fsdem__comp(g->origin, axis)) * g->inv_cell_size;
+    fsdem_real s = (x - fsdem__comp(g->origin, axis)) * g->inv_width[axis];
     int c;
     if (!(s > 0)) return 0; /* also catches NaN */
     c = s < (fsdem_real)g->n[axis] ? (int)s : g->n[axis] - 1;
@@ -3714,17 +3742,24 @@ fsdem_result fsdem_cellgrid_build(fsdem_cellgrid *g, const fsdem_vec3 *points, i
     return FSDEM_OK;
 }
 
+/* Coordinate c + step along an axis: wrapped round a periodic one, -1 off the grid otherwise. */
+static int fsdem__cellgrid_step(const fsdem_cellgrid *g, int axis, int c, int step) {
+    c += step;
+    if (g->wrap[axis]) return c < 0 ? c + g->n[axis] : c >= g->n[axis] ? c - g->n[axis] : c;
+    return c >= 0 && c < g->n[axis] ? c : -1;
+}
+
 int fsdem_cellgrid_neighbourhood(const fsdem_cellgrid *g, const int coord[3], int cells[27]) {
     int count = 0, dx, dy, dz, zr = g->dim == 3 ? 1 : 0;
     for (dz = -zr; dz <= zr; ++dz) {
-        int z = coord[2] + dz;
-        if (z < 0 || z >= g->n[2]) continue;
+        const int z = fsdem__cellgrid_step(g, 2, coord[2], dz);
+        if (z < 0) continue;
         for (dy = -1; dy <= 1; ++dy) {
-            int y = coord[1] + dy;
-            if (y < 0 || y >= g->n[1]) continue;
+            const int y = fsdem__cellgrid_step(g, 1, coord[1], dy);
+            if (y < 0) continue;
             for (dx = -1; dx <= 1; ++dx) {
-                int x = coord[0] + dx;
-                if (x < 0 || x >= g->n[0]) continue;
+                const int x = fsdem__cellgrid_step(g, 0, coord[0], dx);
+                if (x < 0) continue;
                 cells[count++] = (z * g->n[1] + y) * g->n[0] + x;
             }
         }
@@ -3737,8 +3772,9 @@ int fsdem_cellgrid_forward(const fsdem_cellgrid *g, const int coord[3], int cell
     for (dz = 0; dz <= zr; ++dz)
         for (dy = dz ? -1 : 0; dy <= 1; ++dy)
             for (dx = dz || dy ? -1 : 0; dx <= 1; ++dx) {
-                const int x = coord[0] + dx, y = coord[1] + dy, z = coord[2] + dz;
-                if (x < 0 || x >= g->n[0] || y < 0 || y >= g->n[1] || z >= g->n[2]) continue;
+                const int x = fsdem__cellgrid_step(g, 0, coord[0], dx), y = fsdem__cellgrid_step(g, 1, coord[1], dy);
+                const int z = fsdem__cellgrid_step(g, 2, coord[2], dz);
+                if (x < 0 || y < 0 || z < 0) continue;
                 cells[count++] = (z * g->n[1] + y) * g->n[0] + x;
             }
     return count;
@@ -3756,8 +3792,8 @@ void fsdem_cellgrid_free(fsdem_cellgrid *g) {
 
 /* Contents: the object and its private types; >>dem_desc (defaults, validation, the time-step
    rule), >>dem_law (contact laws: pair constants, the batched law kernel, rolling resistance),
-   >>dem_object (creation, materials, particles), >>dem_wall (wall geometry and distances),
-   >>dem_neighbours (neighbour lists with contact history), >>dem_forces (force evaluation),
+   >>dem_periodic (minimum images and wrapping), >>dem_object (creation, materials, particles),
+   >>dem_wall (wall geometry and distances), >>dem_neighbours (neighbour lists with contact history), >>dem_forces (force evaluation),
    >>dem_integrate (Verlet, predictor-corrector, advance), >>dem_diagnostics (stable dt, energy,
    statistics, contacts). */
 
@@ -3862,6 +3898,8 @@ struct fsdem_dem {
     int need_rebuild, forces_valid;
     int rolling;  /* some material pair has rolling resistance */
     int cohesive; /* some material pair has cohesion */
+    int periodic; /* some axis is periodic (>>dem_periodic) */
+    fsdem_real period[3], inv_period[3]; /* m, 1/m; 0 along the other axes */
     int external; /* fext/text may be nonzero (fsdem_dem_get_coupling handed them out, or a coupler wrote them) */
     int forces_cleared; /* f and t were zeroed by the last Verlet pass, for the force evaluation */
     int contacts, wall_contacts;
@@ -3950,6 +3988,9 @@ fsdem_result fsdem_dem_desc_check(const fsdem_dem_desc *d, char *msg, size_t siz
                              (int)d->tangential_history);
     if ((int)d->coulomb_limit < 0 || (int)d->coulomb_limit > 1)
         return fsdem__reject(msg, size, "fsdem_dem_desc.coulomb_limit is not a fsdem_dem_coulomb_limit (%d)", (int)d->coulomb_limit);
+    for (axis = 0; axis < 3; ++axis)
+        if (d->periodic[axis] != 0 && (d->periodic[axis] != 1 || axis >= d->dim))
+            return fsdem__reject(msg, size, "fsdem_dem_desc.periodic[%d] = %d must be 0 or 1 (0 for z in 2D)", axis, d->periodic[axis]);
     if ((int)d->linear_stiffness < 0 || (int)d->linear_stiffness > 1)
         return fsdem__reject(msg, size, "fsdem_dem_desc.linear_stiffness is not a fsdem_dem_linear_stiffness (%d)",
                              (int)d->linear_stiffness);
@@ -4544,6 +4585,69 @@ static fsdem_vec3 fsdem__dem_rolling_torque(fsdem_vec3 w_rel, fsdem_real mu_r, f
     return fsdem__scale(w_rel, -tau / wlen);
 }
 
+/* ---- >>dem_periodic : periodic axes ----
+
+   Along a periodic axis (desc.periodic) of period L, a pair interacts through its minimum image:
+   the separation e loses the multiple of L nearest e / L. The neighbour lists are built on a cell
+   grid whose neighbourhoods wrap round (fsdem_cellgrid_setup_periodic), their entries keep the
+   pair and its spring whichever side of the seam the partners are on, and positions are brought
+   back into [domain_min, domain_max) after every drift (with the rebuild reference x_ref, so the
+   displacement since the last rebuild is unchanged). The minimum image is the only image in
+   reach while L exceeds twice the neighbour reach 2 r_max + contact_offset + skin, which
+   fsdem_dem_add_particle checks. */
+
+/* The minimum image of a separation e. */
+static fsdem_vec3 fsdem__dem_min_image(const fsdem_dem *d, fsdem_vec3 e) {
+    if (d->periodic) {
+        e.x -= d->period[0] * (fsdem_real)floor(e.x * d->inv_period[0] + (fsdem_real)0.5);
+        e.y -= d->period[1] * (fsdem_real)floor(e.y * d->inv_period[1] + (fsdem_real)0.5);
+        e.z -= d->period[2] * (fsdem_real)floor(e.z * d->inv_period[2] + (fsdem_real)0.5);
+    }
+    return e;
+}
+
+/* Where particle i sees particle j: j's image nearest i. */
+static fsdem_vec3 fsdem__dem_image_of(const fsdem_dem *d, int i, int j) {
+    return fsdem__sub(d->x[i], fsdem__dem_min_image(d, fsdem__sub(d->x[i], d->x[j])));
+}
+
+/* Brings every position into [domain_min, domain_max) along the periodic axes, moving x_ref along. */
+static void fsdem__dem_wrap(fsdem_dem *d) {
+    int a, i;
+    for (a = 0; a < 3; ++a) {
+        const fsdem_real lo = fsdem__comp(d->desc.domain_min, a), hi = fsdem__comp(d->desc.domain_max, a), L = d->period[a];
+        if (!(L > 0)) continue;
+        for (i = 0; i < d->n; ++i) {
+            const fsdem_real x = fsdem__comp(d->x[i], a);
+            fsdem_real shift, wrapped;
+            if (x >= lo && x < hi) continue;
+            shift = L * (fsdem_real)floor((x - lo) * d->inv_period[a]);
+            wrapped = x - shift;
+            if (wrapped >= hi) { /* x - shift rounded up to the top */
+                wrapped -= L;
+                shift += L;
+            }
+            fsdem__set_comp(&d->x[i], a, wrapped);
+            fsdem__set_comp(&d->x_ref[i], a, fsdem__comp(d->x_ref[i], a) - shift);
+        }
+    }
+}
+
+/* A particle of radius r keeps every minimum image unique: each period exceeds twice the reach of
+   the neighbour lists with it. */
+static fsdem_result fsdem__dem_period_check(fsdem_dem *d, fsdem_real r) {
+    const fsdem_real r_max = r > d->r_max ? r : d->r_max, skin = d->desc.skin >= 0 ? d->desc.skin : (fsdem_real)0.25 * r_max;
+    const fsdem_real reach = 2 * r_max + d->desc.contact_offset + skin;
+    int a;
+    for (a = 0; a < 3; ++a)
+        if (d->period[a] > 0 && !(d->period[a] > 2 * reach))
+            return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
+                               "fsdem_dem_particle_desc.radius %g m: the period %g m along %c must exceed twice the neighbour reach "
+                               "2 r_max + contact_offset + skin = %g m",
+                               (double)r, (double)d->period[a], "xyz"[a], (double)reach);
+    return FSDEM_OK;
+}
+
 /* ---- >>dem_object : creation, materials, particles ---- */
 
 /* Every per-particle array with its element size, so growth and removal treat them alike. */
@@ -4635,6 +4739,14 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     d->dt = desc->dt;
     d->grid.allocator = desc->allocator;
     d->need_rebuild = 1;
+    {
+        int a;
+        for (a = 0; a < 3; ++a) {
+            d->period[a] = desc->periodic[a] ? fsdem__comp(desc->domain_max, a) - fsdem__comp(desc->domain_min, a) : 0;
+            d->inv_period[a] = desc->periodic[a] ? 1 / d->period[a] : 0;
+            d->periodic |= desc->periodic[a];
+        }
+    }
     {
         fsdem_real accel = desc->linear_accel > 0 ? desc->linear_accel : fsdem__norm(desc->gravity);
         d->k0_linear = fsdem__dem_seed000_stiffness(desc) ? accel / (desc->linear_theta * desc->linear_dx) : 0;
@@ -4837,8 +4949,10 @@ fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_dem_particle_desc 
                            "fsdem_dem_particle_desc.radius %g m gives mass %g kg and moment of inertia %g kg m^2, "
                            "which are not positive finite numbers",
                            (double)p->radius, (double)mass, (double)inertia);
+    if (d->periodic && (res = fsdem__dem_period_check(d, p->radius)) != FSDEM_OK) return res;
     if (fsdem__dem_reserve_particles(d, d->n + 1) != FSDEM_OK)
         return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_particle: out of memory adding particle %d", d->n);
+    if (p->radius > d->r_max) d->r_max = p->radius; /* the periodic check's; a rebuild sets it anew */
     x = p->position;
     v = p->velocity;
     w = p->angular_velocity;
@@ -5222,7 +5336,7 @@ static void fsdem__dem_swap_lists(fsdem__dem_list *a, fsdem__dem_list *b) {
    itself and its forward neighbours (fsdem_cellgrid_forward), into d->found as pairs of cell-order
    indices; xs and reach_s are the positions and radii plus half the offset and skin in cell order, so
    the scan reads them in sequence. Returns the number of pairs, or -1 when d->found cannot grow. */
-static int fsdem__dem_find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_real *reach_s) {
+FSDEM__FORCE_INLINE int fsdem__dem_find_pairs_in(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_real *reach_s, const int periodic) {
     const fsdem_cellgrid *g = &d->grid;
     int c, f, a, b, count = 0;
     for (c = 0; c < g->cell_count; ++c) {
@@ -5242,7 +5356,8 @@ static int fsdem__dem_find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem
                     return -1;
                 for (b = b0; b < b1; ++b) {
                     /* arithmetic, not branches, which would mispredict */
-                    const fsdem_real ex = xs[a].x - xs[b].x, ey = xs[a].y - xs[b].y, ez = xs[a].z - xs[b].z;
+                    const fsdem_vec3 e = periodic ? fsdem__dem_min_image(d, fsdem__sub(xs[a], xs[b])) : fsdem__sub(xs[a], xs[b]);
+                    const fsdem_real ex = e.x, ey = e.y, ez = e.z;
                     const fsdem_real reach = reach_s[a] + reach_s[b];
                     d->found[2 * count] = a;
                     d->found[2 * count + 1] = b;
@@ -5252,6 +5367,10 @@ static int fsdem__dem_find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem
         }
     }
     return count;
+}
+
+static int fsdem__dem_find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_real *reach_s) {
+    return d->periodic ? fsdem__dem_find_pairs_in(d, xs, reach_s, 1) : fsdem__dem_find_pairs_in(d, xs, reach_s, 0);
 }
 
 /* The particle-pair list from the `count` pairs in d->found: row min(i, j), partner max(i, j), each
@@ -5313,8 +5432,9 @@ static fsdem_result fsdem__dem_rebuild(fsdem_dem *d) {
     d->skin = skin;
     d->r_max = r_max;
     max_cells = 8 * d->n > 65536 ? 8 * d->n : 65536;
-    if (fsdem_cellgrid_setup(&d->grid, NULL, dim, d->desc.domain_min, d->desc.domain_max,
-                             r_max > 0 ? 2 * r_max + off + skin : 1, max_cells) != FSDEM_OK ||
+    fsdem__dem_wrap(d);
+    if (fsdem_cellgrid_setup_periodic(&d->grid, NULL, dim, d->desc.domain_min, d->desc.domain_max,
+                                      r_max > 0 ? 2 * r_max + off + skin : 1, max_cells, d->desc.periodic) != FSDEM_OK ||
         fsdem_cellgrid_build(&d->grid, d->x, d->n) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
     /* scratch: positions and reaches (half each: r + (offset + skin)/2) in cell order, row cursors */
@@ -5483,14 +5603,15 @@ static void fsdem__dem_gather_pair_coefficients(const fsdem_dem *d, fsdem__dem_b
 FSDEM__FORCE_INLINE void fsdem__dem_gather_pair(const fsdem_dem *d, fsdem__dem_batch *FSDEM__RESTRICT b, int c, int k, const fsdem_dem_law law,
                                             int uniform) {
     const int i = d->pp.first[k], key = d->pp.key[k], j = FSDEM__DEM_PARTNER(key);
-    const fsdem_vec3 xi = d->x[i], xj = d->x[j], vi = d->v[i], vj = d->v[j], wi = d->w[i], wj = d->w[j];
+    const fsdem_vec3 vi = d->v[i], vj = d->v[j], wi = d->w[i], wj = d->w[j];
+    const fsdem_vec3 e = fsdem__dem_min_image(d, fsdem__sub(d->x[i], d->x[j]));
     const fsdem_vec3 spring = key & FSDEM__DEM_HELD ? d->pp.history[k] : fsdem__zero3();
     b->i[c] = i;
     b->other[c] = j;
     b->entry[c] = k;
-    b->dx[0][c] = xi.x - xj.x;
-    b->dx[1][c] = xi.y - xj.y;
-    b->dx[2][c] = xi.z - xj.z;
+    b->dx[0][c] = e.x;
+    b->dx[1][c] = e.y;
+    b->dx[2][c] = e.z;
     b->dv[0][c] = vi.x - vj.x;
     b->dv[1][c] = vi.y - vj.y;
     b->dv[2][c] = vi.z - vj.z;
@@ -5583,7 +5704,7 @@ FSDEM__FORCE_INLINE void fsdem__dem_scatter(fsdem_dem *d, const fsdem__dem_batch
 /* The entries of the particle-pair list whose pair touches, into `touching`; returns their number.
    With `commit`, the pairs that do not touch lose their spring. Branch-free, and instantiated with
    and without `commit`. */
-FSDEM__FORCE_INLINE int fsdem__dem_touching(fsdem_dem *d, int *FSDEM__RESTRICT touching, const int commit) {
+FSDEM__FORCE_INLINE int fsdem__dem_touching(fsdem_dem *d, int *FSDEM__RESTRICT touching, const int commit, const int periodic) {
     const fsdem_real off = d->desc.contact_offset;
     const fsdem_vec3 *FSDEM__RESTRICT x = d->x;
     const fsdem_real *FSDEM__RESTRICT r = d->r;
@@ -5593,7 +5714,8 @@ FSDEM__FORCE_INLINE int fsdem__dem_touching(fsdem_dem *d, int *FSDEM__RESTRICT t
     int k, count = 0;
     for (k = 0; k < pairs; ++k) {
         const int key = keys[k], i = first[k], j = FSDEM__DEM_PARTNER(key);
-        const fsdem_real ex = x[i].x - x[j].x, ey = x[i].y - x[j].y, ez = x[i].z - x[j].z, reach = r[i] + r[j] + off;
+        const fsdem_vec3 e = periodic ? fsdem__dem_min_image(d, fsdem__sub(x[i], x[j])) : fsdem__sub(x[i], x[j]);
+        const fsdem_real ex = e.x, ey = e.y, ez = e.z, reach = r[i] + r[j] + off;
         const int touch = ex * ex + ey * ey + ez * ez < reach * reach;
         touching[count] = k;
         count += touch;
@@ -5638,7 +5760,8 @@ FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real 
     d->forces_cleared = 0;
     for (k = 0; k < d->wall_count; ++k) d->walls[k].force = fsdem__zero3();
     d->max_overlap = 0;
-    nt = commit ? fsdem__dem_touching(d, touching, 1) : fsdem__dem_touching(d, touching, 0);
+    if (d->periodic) nt = commit ? fsdem__dem_touching(d, touching, 1, 1) : fsdem__dem_touching(d, touching, 0, 1);
+    else nt = commit ? fsdem__dem_touching(d, touching, 1, 0) : fsdem__dem_touching(d, touching, 0, 0);
     b->count = 0;
     for (k = 0; k < nt; ++k) {
         fsdem__dem_gather_pair(d, b, b->count++, touching[k], law, uniform);
@@ -5804,6 +5927,7 @@ static fsdem_result fsdem__dem_step_verlet(fsdem_dem *d, fsdem_real h, int *susp
     if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     if (!d->forces_valid) fsdem__dem_compute_forces(d, h, 0);
     *suspect = fsdem__dem_kick_drift(d, h / 2, h);
+    if (d->periodic) fsdem__dem_wrap(d);
     fsdem__dem_move_walls(d, h);
     if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     fsdem__dem_compute_forces(d, h, 1);
@@ -5850,6 +5974,7 @@ static fsdem_result fsdem__dem_step_predictor_corrector(fsdem_dem *d, fsdem_real
     }
     for (k = 0; k < d->wall_count; ++k)
         d->walls[k].impulse = fsdem__madd(d->walls[k].impulse, fsdem__add(d->walls[k].force_a, d->walls[k].force), -h / 2);
+    if (d->periodic) fsdem__dem_wrap(d); /* the predicted positions need none: pairs take minimum images */
     d->forces_valid = 0; /* the last forces belong to the predicted state, not the final one */
     return FSDEM_OK;
 }
@@ -5917,6 +6042,7 @@ static fsdem_result fsdem__dem_advance_verlet(fsdem_dem *d, fsdem_real h, long l
     for (k = 0; k < count; ++k) {
         fsdem_result called = FSDEM_OK;
         suspect = fsdem__dem_kick_drift(d, open ? h : h / 2, h);
+        if (d->periodic) fsdem__dem_wrap(d);
         fsdem__dem_move_walls(d, h);
         if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
         fsdem__dem_compute_forces(d, h, 1);
@@ -6101,7 +6227,7 @@ fsdem_dem_energy fsdem_dem_get_energy(const fsdem_dem *d) {
         const fsdem__dem_pair *row = d->pairs + d->material[i] * nm;
         for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
             int j = FSDEM__DEM_PARTNER(d->pp.key[k]);
-            fsdem_real delta = d->r[i] + d->r[j] + d->desc.contact_offset - fsdem__norm(fsdem__sub(d->x[i], d->x[j]));
+            fsdem_real delta = d->r[i] + d->r[j] + d->desc.contact_offset - fsdem__norm(fsdem__dem_min_image(d, fsdem__sub(d->x[i], d->x[j])));
             if (delta <= 0) continue;
             e.elastic += fsdem__dem_contact_energy(d, row + d->material[j], delta, (d->m[i] + d->m[j]) / 2,
                                                d->r[i] * d->r[j] / (d->r[i] + d->r[j]), fsdem__dem_spring(&d->pp, k));
@@ -6156,7 +6282,7 @@ static void fsdem__dem_report_contact(fsdem_dem_contact *out, int capacity, int 
 /* Reports particles i < j as contact `count` when they overlap; returns the new count. */
 static int fsdem__dem_report_pair(const fsdem_dem *d, fsdem_dem_contact *out, int capacity, int count, int i, int j) {
     fsdem_real dist;
-    fsdem_vec3 n = fsdem__geom_direction(d->x[i], d->x[j], fsdem_v3(1, 0, 0), &dist);
+    fsdem_vec3 n = fsdem__geom_direction(d->x[i], fsdem__dem_image_of(d, i, j), fsdem_v3(1, 0, 0), &dist);
     const fsdem_real overlap = d->r[i] + d->r[j] + d->desc.contact_offset - dist;
     if (overlap <= 0) return count;
     fsdem__dem_report_contact(out, capacity, count, i, j, n, overlap);
@@ -16393,6 +16519,9 @@ static void fsdem__restart_dem(fsdem__restart *io, void *object) {
     fsdem__restart_same_int(io, (int)dd->tangential_history, "tangential_history");
     fsdem__restart_same_int(io, (int)dd->coulomb_limit, "coulomb_limit");
     fsdem__restart_same_int(io, (int)dd->linear_stiffness, "linear_stiffness");
+    fsdem__restart_same_int(io, dd->periodic[0], "periodic[0]");
+    fsdem__restart_same_int(io, dd->periodic[1], "periodic[1]");
+    fsdem__restart_same_int(io, dd->periodic[2], "periodic[2]");
 
     fsdem__restart_data(io, &d->dt, sizeof d->dt);
     fsdem__restart_data(io, &d->time, sizeof d->time);
@@ -18490,7 +18619,7 @@ static void fsdem__io_dem_drain(const fsdem_dem *d, fsdem__dem_batch *batch, int
             c->points[2 * e + 1] = fsdem__madd(d->x[i], n, -(d->r[i] + off - b->delta[k]));
             c->partner[e] = -1 - b->other[k];
         } else {
-            c->points[2 * e + 1] = d->x[b->other[k]];
+            c->points[2 * e + 1] = fsdem__dem_image_of(d, i, b->other[k]); /* across a periodic seam: its image */
             c->partner[e] = d->id[b->other[k]];
         }
         c->force[e] = fsdem__dem_batch_vec(b->force, k);
@@ -18518,7 +18647,8 @@ static int fsdem__io_dem_contacts(const fsdem_dem *d, fsdem__dem_batch *b, fsdem
     for (k = 0; k < d->pp.count; ++k) {
         const int key = d->pp.key[k];
         const int p = d->pp.first[k], q = FSDEM__DEM_PARTNER(key);
-        const fsdem_real ex = d->x[p].x - d->x[q].x, ey = d->x[p].y - d->x[q].y, ez = d->x[p].z - d->x[q].z;
+        const fsdem_vec3 e = fsdem__dem_min_image(d, fsdem__sub(d->x[p], d->x[q]));
+        const fsdem_real ex = e.x, ey = e.y, ez = e.z;
         const fsdem_real reach = d->r[p] + d->r[q] + off;
         if (!(ex * ex + ey * ey + ez * ez < reach * reach)) continue;
         count++;

@@ -24,6 +24,7 @@ Suite *couple_mps_suite(void);
 Suite *couple_pic_suite(void);
 Suite *probing_suite(void);
 Suite *dem_contact_suite(void);
+Suite *dem_periodic_suite(void);
 
 /* ---- tolerances that follow the precision of fsdem_real ----
 
