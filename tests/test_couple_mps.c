@@ -409,15 +409,13 @@ START_TEST(test_mps_dem_csv_rows_are_the_force_records) {
 }
 END_TEST
 
-/* fails until fsdem.h fixes the coupler records after a DEM particle removal (fsdem_mps_dem_get_force
-   and fsdem__io_mps_dem_row index the last update's records with today's particle indices).
-   A coupled run may remove a DEM particle (one that left the domain, >>doc ERRORS) between an
+/* A coupled run may remove a DEM particle (one that left the domain, >>doc ERRORS) between an
    update and the CSV snapshot. The records are the last update's, made for the particles then in
    the DEM; fsdem_dem_remove_particle shifts the later particles down. Each row must still name the
    particle its record was computed for, and a removed particle has neither a row nor a record.
-   Now: the rows read (id 1, record of id 0), (id 2, record of id 1), and a third row takes its id
-   from past the end of the DEM's id array; get_force(2) answers FSDEM_OK with the count at 2.
-   Registered only with FSDEM_TEST_KNOWN_DEFECTS set. */
+   Before the records carried their ids, the rows read (id 1, record of id 0), (id 2, record of
+   id 1), and a third row took its id from past the end of the DEM's id array; get_force(2) answered
+   FSDEM_OK with the count at 2. */
 START_TEST(test_mps_dem_csv_after_a_removal) {
     static const char header[] = "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,fluid_u,"
                                  "fluid_v,fluid_w,porosity,reynolds,wet";
@@ -449,7 +447,7 @@ Suite *couple_mps_suite(void) {
     tcase_add_test(tc, test_mps_dem_terminal_velocity);
     tcase_add_test(tc, test_mps_dem_bad_input);
     tcase_add_test(tc, test_mps_dem_csv_rows_are_the_force_records);
-    if (getenv("FSDEM_TEST_KNOWN_DEFECTS")) tcase_add_test(tc, test_mps_dem_csv_after_a_removal); /* a known defect, above */
+    tcase_add_test(tc, test_mps_dem_csv_after_a_removal);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -1452,10 +1452,7 @@ Suite *io_suite(void) {
     tcase_add_test(tc, io_dem_walls_read_back_2d);
     tcase_add_test(tc, io_dem_contacts_sum_to_particle_forces_3d);
     tcase_add_test(tc, io_dem_contacts_sum_to_particle_forces_2d);
-    /* fails until fsdem.h fixes fsdem__dem_image_of (43a45c9): the partner point it writes,
-       x_i - (x_i - x_j), is x_j only to rounding without a periodic axis; registered with
-       FSDEM_TEST_KNOWN_DEFECTS until then (drop the condition with the fix) */
-    if (getenv("FSDEM_TEST_KNOWN_DEFECTS")) tcase_add_test(tc, io_dem_contacts_other_laws_leave_the_object_unchanged);
+    tcase_add_test(tc, io_dem_contacts_other_laws_leave_the_object_unchanged);
     tcase_add_test(tc, io_dem_contacts_empty_before_a_step);
     tcase_add_test(tc, io_pic_read_back_2d);
     tcase_add_test(tc, io_pic_read_back_3d);
