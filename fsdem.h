@@ -2565,7 +2565,7 @@ FSDEM_API fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *coupler, fsdem_real 
 FSDEM_API fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *coupler, fsdem_real duration, long long *steps);
 /* Stable coupled step (s): the PIC's, the bodies' speed over the PIC's cfl (cfl dx / (|V| + |w| r +
    sqrt(|g| dx))) and the viscous limit. FSDEM_ERR_NAN when a velocity is not finite. */
-FSDEM_API fsdem_result fsdem_pic_dem_stable_dt(fsdem_pic_dem *coupler, fsdem_real *dt);
+FSDEM_API fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *coupler, fsdem_real *dt);
 /* The PIC time (s). */
 FSDEM_API double fsdem_pic_dem_time(const fsdem_pic_dem *coupler);
 
@@ -16097,17 +16097,18 @@ static fsdem_result fsdem__pic_dem_gap(fsdem_pic_dem *c) {
 /* ---- >>couple_pic_step : coupled time stepping ---- */
 
 /* The stable coupled step (>>couple_pic, fsdem_pic_dem_stable_dt). */
-static fsdem_result fsdem__pic_dem_stable(fsdem_pic_dem *c, fsdem_real *dt) {
+static fsdem_result fsdem__pic_dem_stable(const fsdem_pic_dem *c, fsdem_real *dt) {
+    fsdem__status *st = (fsdem__status *)&c->status; /* the message is the object's only mutable part here */
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     const fsdem_pic_desc pd = fsdem_pic_get_desc(c->desc.pic);
     const fsdem_real dx = pd.cell_size;
     fsdem_real vmax = 0;
     int b;
     fsdem_result res = fsdem_pic_stable_dt(c->desc.pic, dt);
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
+    if (res != FSDEM_OK) return fsdem__fail(st, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
     for (b = 0; b < P.count; ++b) {
         const fsdem_real v = fsdem__norm(P.velocity[b]) + fsdem__norm(P.angular_velocity[b]) * P.radius[b];
-        if (!fsdem__finite(v)) return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_pic_dem: body %d has a non-finite velocity", b);
+        if (!fsdem__finite(v)) return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_pic_dem: body %d has a non-finite velocity", b);
         if (v > vmax) vmax = v;
     }
     {
@@ -16192,7 +16193,7 @@ fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *c, fsdem_real duration, long l
     return fsdem__coupled_advance(c, &c->status, "fsdem_pic_dem_advance", &verbs, duration, steps);
 }
 
-fsdem_result fsdem_pic_dem_stable_dt(fsdem_pic_dem *c, fsdem_real *dt) {
+fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *c, fsdem_real *dt) {
     if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
     return fsdem__pic_dem_stable(c, dt);
 }
