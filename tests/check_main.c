@@ -19,6 +19,8 @@ int main(void) {
     srunner_add_suite(runner, couple_mps_suite());
     srunner_add_suite(runner, couple_pic_suite());
     srunner_add_suite(runner, probing_suite());
+    srunner_add_suite(runner, dem_contact_suite());
+    srunner_add_suite(runner, dem_periodic_suite());
     srunner_run_all(runner, CK_NORMAL);
     failed = srunner_ntests_failed(runner);
     srunner_free(runner);

@@ -1,5 +1,6 @@
-/* Cross-compiler determinism: each solver runs a small scene and prints a hash of its complete saved
-   state (fsdem_X_save_memory). `make determinism` builds this program with gcc and clang at -O0,
+/* Cross-compiler determinism: each solver (DEM, PIC, SWE, MPS) and each coupler (SWE-DEM, MPS-DEM,
+   PIC-DEM) runs a small scene and prints a hash of its complete saved state (fsdem_X_save_memory; a
+   coupler's holds its solvers' states). `make determinism` builds this program with gcc and clang at -O0,
    -O2, -O2 -march=native and -O2 -DFSDEM_NO_SIMD and checks every build prints the pinned hashes of
    tests/determinism.expected: the results do not depend on the compiler, the optimisation level or
    the SIMD lane width (the DEM contact kernel runs 1, 2, 4 or 8 contacts per instruction).
@@ -23,6 +24,16 @@ typedef fsdem_result (*save_fn)(const void *object, void *buffer, size_t capacit
 static fsdem_result save_dem(const void *o, void *b, size_t c, size_t *s) { return fsdem_dem_save_memory((const fsdem_dem *)o, b, c, s); }
 static fsdem_result save_pic(const void *o, void *b, size_t c, size_t *s) { return fsdem_pic_save_memory((const fsdem_pic *)o, b, c, s); }
 static fsdem_result save_swe(const void *o, void *b, size_t c, size_t *s) { return fsdem_swe_save_memory((const fsdem_swe *)o, b, c, s); }
+static fsdem_result save_mps(const void *o, void *b, size_t c, size_t *s) { return fsdem_mps_save_memory((const fsdem_mps *)o, b, c, s); }
+static fsdem_result save_swe_dem(const void *o, void *b, size_t c, size_t *s) {
+    return fsdem_swe_dem_save_memory((const fsdem_swe_dem *)o, b, c, s);
+}
+static fsdem_result save_mps_dem(const void *o, void *b, size_t c, size_t *s) {
+    return fsdem_mps_dem_save_memory((const fsdem_mps_dem *)o, b, c, s);
+}
+static fsdem_result save_pic_dem(const void *o, void *b, size_t c, size_t *s) {
+    return fsdem_pic_dem_save_memory((const fsdem_pic_dem *)o, b, c, s);
+}
 
 static int print_hash(const char *name, const void *object, save_fn save) {
     size_t size = 0;
@@ -106,8 +117,149 @@ static int swe_scene(void) {
     return bad;
 }
 
+/* A 2D MPS dam break (Model A): a column of 10 x 20 spacings in a walled tank of 40 x 30, 0.1 s:
+   the pressure solve (MIC(0)-PCG), collisions, surface detection. */
+static int mps_scene(void) {
+    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps *mps;
+    int bad;
+    d.domain_min = fsdem_v3(-0.05, -0.05, 0);
+    d.domain_max = fsdem_v3(0.45, 0.4, 0);
+    if (fsdem_mps_create(&d, &mps) != FSDEM_OK) return 1;
+    bad = fsdem_mps_add_box_walls(mps, fsdem_v3(0, 0, 0), fsdem_v3(0.4, 0.3, 0), 1u << FSDEM_SIDE_YMAX, NULL) != FSDEM_OK ||
+          fsdem_mps_fill_box(mps, fsdem_v3(0, 0, 0), fsdem_v3(0.1, 0.2, 0), fsdem_v3(0, 0, 0), NULL) != FSDEM_OK ||
+          fsdem_mps_advance(mps, 0.1, NULL) != FSDEM_OK || print_hash("mps", mps, save_mps);
+    fsdem_mps_destroy(mps);
+    return bad;
+}
+
+/* Adds `count` particles of radius r and material 0 in a row from `first` along `step`. */
+static int add_row(fsdem_dem *dem, int count, fsdem_real r, fsdem_vec3 first, fsdem_vec3 step, fsdem_vec3 velocity) {
+    int i;
+    for (i = 0; i < count; ++i) {
+        fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+        p.radius = r;
+        p.position = fsdem_v3(first.x + i * step.x, first.y + i * step.y, first.z + i * step.z);
+        p.velocity = velocity;
+        if (fsdem_dem_add_particle(dem, &p, NULL) != FSDEM_OK) return 1;
+    }
+    return 0;
+}
+
+/* Six light spheres carried by a 2D shallow-water dam break (Manning friction), 0.3 s: buoyancy
+   refreshed in the substeps, hydrostatic and dynamic pressure, the reactions on the water. */
+static int swe_dem_scene(void) {
+    fsdem_swe_desc sd = fsdem_swe_desc_default(2);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(3);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_swe_dem_desc cd = fsdem_swe_dem_desc_default();
+    fsdem_swe *swe = NULL;
+    fsdem_dem *dem = NULL;
+    fsdem_swe_dem *c = NULL;
+    int bad;
+    sd.nx = 48;
+    sd.ny = 16;
+    sd.x_max = 3;
+    sd.manning = (fsdem_real)0.01;
+    dd.domain_min = fsdem_v3(0, 0, -1);
+    dd.domain_max = fsdem_v3(3, 1, 2);
+    dd.dt = 1e-4;
+    m.density = 400;
+    cd.heave_damping = (fsdem_real)0.5;
+    bad = fsdem_swe_create(&sd, &swe) != FSDEM_OK || fsdem_dem_create(&dd, &dem) != FSDEM_OK;
+    if (!bad) {
+        fsdem_swe_set_cells(swe, swe_initial, NULL);
+        cd.swe = swe;
+        cd.dem = dem;
+        bad = fsdem_dem_add_material(dem, &m, NULL) != FSDEM_OK ||
+              add_row(dem, 6, (fsdem_real)0.04, fsdem_v3(0.15, 0.2, 0.5), fsdem_v3(0.05, 0.12, 0.2), fsdem_v3(0.3, 0, 0)) ||
+              fsdem_swe_dem_create(&cd, &c) != FSDEM_OK || fsdem_swe_dem_advance(c, 0.3, NULL) != FSDEM_OK ||
+              print_hash("swe_dem", c, save_swe_dem);
+    }
+    fsdem_swe_dem_destroy(c);
+    fsdem_dem_destroy(dem);
+    fsdem_swe_destroy(swe);
+    return bad;
+}
+
+/* Twelve sand discs falling into a 2D MPS tank (Model B, Ergun/Wen-Yu drag), 0.04 s: porosity,
+   drag, the reactions (Eq. 36), DEM substeps and wall contacts. */
+static int mps_dem_scene(void) {
+    fsdem_mps_desc md = fsdem_mps_desc_default(2);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_dem_wall_desc w;
+    fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
+    fsdem_mps *mps = NULL;
+    fsdem_dem *dem = NULL;
+    fsdem_mps_dem *c = NULL;
+    int bad, mat = 0;
+    md.model = FSDEM_MPS_MODEL_B;
+    md.domain_min = fsdem_v3(-0.05, -0.05, 0);
+    md.domain_max = fsdem_v3(0.2, 0.25, 0);
+    dd.domain_min = fsdem_v3(-0.05, -0.05, -1);
+    dd.domain_max = fsdem_v3(0.2, 0.25, 1);
+    dd.dt = 5e-5;
+    m.density = 2600;
+    m.friction = (fsdem_real)0.5;
+    bad = fsdem_mps_create(&md, &mps) != FSDEM_OK || fsdem_dem_create(&dd, &dem) != FSDEM_OK;
+    if (!bad) {
+        w = fsdem_dem_wall_box(fsdem_v3(0, 0, -1), fsdem_v3(0.15, 0.3, 1), 1, 0);
+        cd.mps = mps;
+        cd.dem = dem;
+        bad = fsdem_mps_add_box_walls(mps, fsdem_v3(0, 0, 0), fsdem_v3(0.15, 0.2, 0), 1u << FSDEM_SIDE_YMAX, NULL) != FSDEM_OK ||
+              fsdem_mps_fill_box(mps, fsdem_v3(0, 0, 0), fsdem_v3(0.15, 0.1, 0), fsdem_v3(0, 0, 0), NULL) != FSDEM_OK ||
+              fsdem_dem_add_material(dem, &m, &mat) != FSDEM_OK || fsdem_dem_add_wall(dem, &w, NULL) != FSDEM_OK ||
+              add_row(dem, 6, (fsdem_real)0.003, fsdem_v3(0.03, 0.12, 0), fsdem_v3(0.017, 0.002, 0), fsdem_v3(0, -0.5, 0)) ||
+              add_row(dem, 6, (fsdem_real)0.002, fsdem_v3(0.04, 0.09, 0), fsdem_v3(0.015, -0.001, 0), fsdem_v3(0.1, 0, 0)) ||
+              fsdem_mps_dem_create(&cd, &c) != FSDEM_OK || fsdem_mps_dem_advance(c, 0.04, NULL) != FSDEM_OK ||
+              print_hash("mps_dem", c, save_mps_dem);
+    }
+    fsdem_mps_dem_destroy(c);
+    fsdem_dem_destroy(dem);
+    fsdem_mps_destroy(mps);
+    return bad;
+}
+
+/* Two discs, one heavy and one light, in a 2D FLIP tank of 1/32 m cells, 25 steps of 2 ms: cut
+   faces, the implicit solid velocity in the pressure solve, forces, particle exclusion, a contact
+   with the gap dissipation of Eq. 20. */
+static int pic_dem_scene(void) {
+    fsdem_pic_desc pd = fsdem_pic_desc_default(2);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_pic_dem_desc cd = fsdem_pic_dem_desc_default();
+    fsdem_pic *pic = NULL;
+    fsdem_dem *dem = NULL;
+    fsdem_pic_dem *c = NULL;
+    int k, bad;
+    pd.cell_size = (fsdem_real)(1.0 / 32);
+    pd.dt_max = (fsdem_real)2e-3;
+    pd.viscosity = (fsdem_real)1e-3;
+    dd.domain_max = fsdem_v3(1, 1, 0);
+    dd.integrator = FSDEM_DEM_INTEGRATOR_PREDICTOR_CORRECTOR;
+    dd.contact_offset = 2 * pd.cell_size;
+    dd.dt = 1e-4;
+    m.density = 1500;
+    bad = fsdem_pic_create(&pd, &pic) != FSDEM_OK || fsdem_dem_create(&dd, &dem) != FSDEM_OK;
+    if (!bad) {
+        cd.pic = pic;
+        cd.dem = dem;
+        bad = fsdem_pic_fill_box(pic, fsdem_v3(0, 0, 0), fsdem_v3(1, 0.4, 0), fsdem_v3(0, 0, 0), NULL) != FSDEM_OK ||
+              fsdem_dem_add_material(dem, &m, NULL) != FSDEM_OK ||
+              add_row(dem, 2, (fsdem_real)0.08, fsdem_v3(0.4, 0.3, 0), fsdem_v3(0.2, 0.05, 0), fsdem_v3(0.3, -0.5, 0)) ||
+              fsdem_pic_dem_create(&cd, &c) != FSDEM_OK;
+        for (k = 0; k < 25 && !bad; ++k) bad = fsdem_pic_dem_step_dt(c, (fsdem_real)2e-3) != FSDEM_OK;
+        bad = bad || print_hash("pic_dem", c, save_pic_dem);
+    }
+    fsdem_pic_dem_destroy(c);
+    fsdem_dem_destroy(dem);
+    fsdem_pic_destroy(pic);
+    return bad;
+}
+
 int main(void) {
-    const int bad = dem_scene() | pic_scene() | swe_scene();
+    const int bad = dem_scene() | pic_scene() | swe_scene() | mps_scene() | swe_dem_scene() | mps_dem_scene() | pic_dem_scene();
     if (bad) printf("determinism: a scene failed\n");
     return bad;
 }

@@ -23,6 +23,8 @@ Suite *drag_suite(void);
 Suite *couple_mps_suite(void);
 Suite *couple_pic_suite(void);
 Suite *probing_suite(void);
+Suite *dem_contact_suite(void);
+Suite *dem_periodic_suite(void);
 
 /* ---- tolerances that follow the precision of fsdem_real ----
 
@@ -67,6 +69,11 @@ static inline double test_tol(double tol, double k, const char *file, int line) 
             fflush(stdout);                                                                        \
         }                                                                                          \
     } while (0)
+
+/* Reads a CSV snapshot written by a fsdem_X_write_csv (tests/test_io.c): its header line must be
+   `header`, then exactly `rows` rows equal bit for bit to `expected` (row-major, the header's column
+   count per row; may be NULL when rows is 0). */
+void test_csv_expect(const char *path, const char *header, int rows, const double *expected);
 
 /* True when every component is finite. */
 static inline int test_finite3(fsdem_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }

@@ -10,7 +10,8 @@
 #   - the float build's precision-suffixed symbol list (>>config) differs from the FSDEM_API functions;
 #   - a public enum value breaks FSDEM_<ENUM>_<VALUE> (fsdem_result's codes excepted, as >>doc says);
 #   - the objects of the verb table in >>doc ("ONE DIALECT FOR EVERY SOLVER") are not exactly those
-#     with a create and a step, or one of them lacks a verb of the table (couplers: and get_force).
+#     with a create and a step, or one of them lacks a verb of the table (couplers: and get_force);
+#   - a stable_dt takes a non-const object.
 # Usage: sh tests/map_check.sh [fsdem.h]          check
 #        sh tests/map_check.sh --symbols [fsdem.h] print the symbol block for >>config
 set -u
@@ -121,5 +122,9 @@ for o in $stepping; do
     done
     echo "$api" | grep -qE "^${o}_write_([a-z]+_)?csv\$" || { echo "map_check: ${o} writes no CSV (${o}_write_csv or _write_<what>_csv)"; exit 1; }
 done
+
+# queries take a const object: every stable_dt (the state is read, never written; only the message)
+nonconst=$(awk '/^FSDEM_API fsdem_result fsdem_[a-z_]+_stable_dt\(/ && !/_stable_dt\(const / { print }' "$file")
+if [ -n "$nonconst" ]; then echo "map_check: a stable_dt that takes a non-const object: $nonconst"; exit 1; fi
 
 echo "map check: $(grep -c '>>' "$file") map lines, banners unique, order and references resolve, contents listed, symbols complete, enum names and verb table hold"

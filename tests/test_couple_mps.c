@@ -186,10 +186,16 @@ START_TEST(test_mps_dem_momentum_exchange) {
 }
 END_TEST
 
-/* A particle at rest in water at rest: no slip, so no drag (exactly: u_k and v_k are zero), and the
-   pressure part is its buoyancy: -V rho g exactly in Model B (Eq. 35); in Model A (Eq. 34) -V grad P
-   from the pressure the MPS solved, hydrostatic in still water to its accuracy (the MPS tests hold
-   the pressure to 5%: the same bound here). */
+/* A particle at rest in water at rest: no slip, so no drag (exactly: u_k and v_k are zero). In
+   Model A (Eq. 34) the pressure part is -V grad P from the pressure the MPS solved, hydrostatic in
+   still water to its accuracy: Archimedes' rho g V within the 5% to which the MPS tests hold the
+   pressure. In Model B (Eq. 35) the reference is Archimedes' law seen through the motion, not the
+   force record: with no drag, a sphere of density rho_s released from rest falls with the reduced
+   gravity g (1 - rho/rho_s), so after one coupled step of dt (the force held over the DEM
+   substeps, each a kick of constant acceleration) its velocity is -g (1 - rho/rho_s) dt exactly:
+   2500 kg/m^3 gives -0.6 g dt; a sphere of the water's density stays at rest. Rounding only: the
+   DEM's mass rho_s V and the coupler's rho V g are rounded separately and each of the K substeps
+   rounds the velocity once (K + 16 eps of g dt). */
 START_TEST(test_mps_dem_rest_in_still_water) {
     const double r0 = 0.01, R = 0.002, rho = 1000, g = 9.81;
     int model;
@@ -205,17 +211,40 @@ START_TEST(test_mps_dem_rest_in_still_water) {
         ck_assert_int_eq(f.wet, 1);
         ck_assert_msg(f.drag.x == 0 && f.drag.y == 0 && f.drag.z == 0, "drag at rest (%g, %g, %g)", (double)f.drag.x, (double)f.drag.y,
                       (double)f.drag.z);
+        if (model == 1) {
+            /* a second sphere of the water's density, far from the first */
+            fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+            fsdem_dem_material m = fsdem_dem_material_default();
+            fsdem_dem_particles dv;
+            double dt, k;
+            int neutral;
+            m.density = (fsdem_real)rho;
+            ck_assert_int_eq(fsdem_dem_add_material(t.dem, &m, &neutral), FSDEM_OK);
+            p.position = fsdem_v3(0.031f, 0.089f, 0.1f);
+            p.radius = (fsdem_real)R;
+            p.material = neutral;
+            ck_assert_int_eq(fsdem_dem_add_particle(t.dem, &p, NULL), FSDEM_OK);
+            ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK);
+            dt = fsdem_mps_dem_get_stats(t.cpl).dt;
+            k = (double)fsdem_mps_dem_get_stats(t.cpl).substeps + 16;
+            dv = fsdem_dem_get_particles(t.dem);
+            TEST_REPORT("model B, one step of %.3e s in %lld substeps: v = %.9e m/s (Archimedes %.9e), neutral %.2e m/s", dt,
+                        fsdem_mps_dem_get_stats(t.cpl).substeps, (double)dv.velocity[0].z, -g * (1 - rho / 2500) * dt,
+                        (double)dv.velocity[1].z);
+            ck_assert_msg(fabs(dv.velocity[0].z + 0.6 * g * dt) <= k * TEST_EPS * g * dt, "sphere of 2500 kg/m^3: %.9e m/s",
+                          (double)dv.velocity[0].z);
+            ck_assert_msg(fabs(dv.velocity[1].z) <= k * TEST_EPS * g * dt, "neutral sphere: %.3e m/s", (double)dv.velocity[1].z);
+            ck_assert(dv.velocity[0].x == 0 && dv.velocity[0].y == 0 && dv.velocity[1].x == 0 && dv.velocity[1].y == 0);
+            test_pair_free(&t);
+            continue;
+        }
         for (step = 0; step < 3; ++step) {
             ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK); /* Model A needs a pressure field */
             ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
             ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, 0, &f), FSDEM_OK);
-            TEST_REPORT("model %c step %d: drag %.3e N, pressure part %.6e N vs rho g V %.6e N (%.2f%%)", "AB"[model], step,
-                        (double)f.drag.z, (double)f.pressure.z, rho * g * V, 100 * (f.pressure.z / (rho * g * V) - 1));
-            if (model == 1)
-                ck_assert_msg(fabs(f.pressure.z - rho * g * V) < TOL(1e-12, 8) * rho * g * V, "Model B buoyancy %g", (double)f.pressure.z);
-            else
-                ck_assert_msg(fabs(f.pressure.z / (rho * g * V) - 1) < 0.05, "Model A buoyancy %g vs %g", (double)f.pressure.z,
-                              rho * g * V);
+            TEST_REPORT("model A step %d: drag %.3e N, pressure part %.6e N vs rho g V %.6e N (%.2f%%)", step, (double)f.drag.z,
+                        (double)f.pressure.z, rho * g * V, 100 * (f.pressure.z / (rho * g * V) - 1));
+            ck_assert_msg(fabs(f.pressure.z / (rho * g * V) - 1) < 0.05, "Model A buoyancy %g vs %g", (double)f.pressure.z, rho * g * V);
             ck_assert_msg(fabs(f.pressure.x) + fabs(f.pressure.y) < 0.05 * rho * g * V, "sideways pressure force");
         }
         test_pair_free(&t);
@@ -338,6 +367,76 @@ START_TEST(test_mps_dem_bad_input) {
 }
 END_TEST
 
+/* The record of fsdem_mps_dem_get_force as a row of fsdem_mps_dem_write_csv (its documented columns). */
+static void test_force_row(double *r, int id, const fsdem_mps_dem_force *f) {
+    const fsdem_vec3 v[4] = {f->drag, f->pressure, f->total, f->fluid_velocity};
+    int k;
+    r[0] = id;
+    for (k = 0; k < 4; ++k) r[1 + 3 * k] = v[k].x, r[2 + 3 * k] = v[k].y, r[3 + 3 * k] = v[k].z;
+    r[13] = f->porosity, r[14] = f->reynolds, r[15] = f->wet;
+}
+
+/* fsdem_mps_dem_write_csv: the header alone before the first update (when fsdem_mps_dem_get_force has
+   no record either), then one row per DEM particle of the last update, equal to its record and id: a
+   disc sinking in the water and a dry one above it; a disc added since the update has no record and
+   no row; an unwritable path is FSDEM_ERR_IO naming the path. */
+START_TEST(test_mps_dem_csv_rows_are_the_force_records) {
+    static const char header[] = "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,fluid_u,"
+                                 "fluid_v,fluid_w,porosity,reynolds,wet";
+    test_pair t = test_pair_new(2, 0.01, FSDEM_MPS_MODEL_B, 1e-6, fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.15f, 0), 0.08, 2500);
+    fsdem_mps_dem_force f;
+    double e[2 * 16];
+    int i;
+    test_add_sphere(&t, fsdem_v3(0.052f, 0.04f, 0), fsdem_v3(0.01f, -0.02f, 0), 0.002);
+    test_add_sphere(&t, fsdem_v3(0.05f, 0.14f, 0), fsdem_v3(0, 0, 0), 0.002);
+    ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, 0, &f), FSDEM_ERR_NOT_FOUND);
+    ck_assert_int_eq(fsdem_mps_dem_write_csv(t.cpl, "build/test_mps_dem_empty.csv"), FSDEM_OK);
+    test_csv_expect("build/test_mps_dem_empty.csv", header, 0, NULL);
+    for (i = 0; i < 3; ++i) ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
+    test_add_sphere(&t, fsdem_v3(0.03f, 0.05f, 0), fsdem_v3(0, 0, 0), 0.002);
+    ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, 2, &f), FSDEM_ERR_NOT_FOUND);
+    for (i = 0; i < 2; ++i) {
+        ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, i, &f), FSDEM_OK);
+        test_force_row(e + 16 * i, fsdem_dem_get_particles(t.dem).id[i], &f);
+    }
+    ck_assert_msg(e[15] == 1 && e[16 + 15] == 0 && e[1] != 0, "a wet disc with drag and a dry one");
+    ck_assert_int_eq(fsdem_mps_dem_write_csv(t.cpl, "build/test_mps_dem.csv"), FSDEM_OK);
+    test_csv_expect("build/test_mps_dem.csv", header, 2, e);
+    ck_assert_int_eq(fsdem_mps_dem_write_csv(t.cpl, "build/no/such/dir/x.csv"), FSDEM_ERR_IO);
+    ck_assert_ptr_nonnull(strstr(fsdem_mps_dem_last_error(t.cpl), "build/no/such/dir/x.csv"));
+    test_pair_free(&t);
+}
+END_TEST
+
+/* A coupled run may remove a DEM particle (one that left the domain, >>doc ERRORS) between an
+   update and the CSV snapshot. The records are the last update's, made for the particles then in
+   the DEM; fsdem_dem_remove_particle shifts the later particles down. Each row must still name the
+   particle its record was computed for, and a removed particle has neither a row nor a record.
+   Before the records carried their ids, the rows read (id 1, record of id 0), (id 2, record of
+   id 1), and a third row took its id from past the end of the DEM's id array; get_force(2) answered
+   FSDEM_OK with the count at 2. */
+START_TEST(test_mps_dem_csv_after_a_removal) {
+    static const char header[] = "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,fluid_u,"
+                                 "fluid_v,fluid_w,porosity,reynolds,wet";
+    test_pair t = test_pair_new(2, 0.01, FSDEM_MPS_MODEL_B, 1e-6, fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.15f, 0), 0.08, 2500);
+    fsdem_mps_dem_force f[3];
+    double e[2 * 16];
+    int i;
+    for (i = 0; i < 3; ++i) test_add_sphere(&t, fsdem_v3((fsdem_real)(0.02 + 0.03 * i), (fsdem_real)(0.02 + 0.02 * i), 0),
+                                            fsdem_v3(0, -0.01f * (fsdem_real)i, 0), 0.002);
+    ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
+    for (i = 0; i < 3; ++i) ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, i, &f[i]), FSDEM_OK); /* ids 0, 1, 2 */
+    ck_assert_int_eq(fsdem_dem_remove_particle(t.dem, 0), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_get_particles(t.dem).count, 2);
+    ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, 2, &f[0]), FSDEM_ERR_NOT_FOUND);
+    for (i = 0; i < 2; ++i) test_force_row(e + 16 * i, i + 1, &f[i + 1]);
+    ck_assert_int_eq(fsdem_mps_dem_write_csv(t.cpl, "build/test_mps_dem_removal.csv"), FSDEM_OK);
+    test_csv_expect("build/test_mps_dem_removal.csv", header, 2, e);
+    test_pair_free(&t);
+}
+END_TEST
+
 Suite *couple_mps_suite(void) {
     Suite *s = suite_create("couple_mps");
     TCase *tc = tcase_create("mps_dem");
@@ -347,6 +446,8 @@ Suite *couple_mps_suite(void) {
     tcase_add_test(tc, test_mps_dem_rest_in_still_water);
     tcase_add_test(tc, test_mps_dem_terminal_velocity);
     tcase_add_test(tc, test_mps_dem_bad_input);
+    tcase_add_test(tc, test_mps_dem_csv_rows_are_the_force_records);
+    tcase_add_test(tc, test_mps_dem_csv_after_a_removal);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -651,8 +651,8 @@ END_TEST
 
 /* ---- the NULL-object policy ---- */
 
-/* Every public function that takes an object (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_swe_dem,
-   fsdem_pcg), or the desc or output pointer of a create, refuses NULL with FSDEM_ERR_INVALID_ARG;
+/* Every public function that takes an object (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_mps, the
+   couplers fsdem_swe_dem, fsdem_mps_dem and fsdem_pic_dem, fsdem_pcg), or the desc or output pointer of a create, refuses NULL with FSDEM_ERR_INVALID_ARG;
    getters return zeros (cell_at: -1, "outside"); last_error says which object is NULL; destroy
    accepts NULL. Wrong answers are collected and reported together (a crash stops the test at the
    call). */
@@ -685,6 +685,47 @@ static void if_expect(if_policy *p, const char *name, int ok) {
     do {                                                                                           \
         mark_point();                                                                              \
         if_expect((p), name, (value) == 0);                                                        \
+    } while (0)
+
+/* The verbs every coupler fsdem_X (X = swe_dem, mps_dem, pic_dem; its fluid pointer F in the desc)
+   shares (>>doc, ONE DIALECT FOR EVERY SOLVER), called with a NULL coupler. */
+#define IF_COUPLER_DIALECT(p, X, F)                                                                \
+    do {                                                                                           \
+        fsdem_##X##_desc d_ = fsdem_##X##_desc_default(), dd_;                                     \
+        fsdem_##X *c_ = (fsdem_##X *)(p);                                                          \
+        fsdem_##X##_force f_;                                                                      \
+        fsdem_##X##_stats st_;                                                                     \
+        fsdem_real dt_ = 1;                                                                        \
+        long long steps_ = 7;                                                                      \
+        char msg_[64];                                                                             \
+        const char *text_;                                                                         \
+        size_t size_ = 0;                                                                          \
+        IF_REFUSED(p, fsdem_##X##_desc_check(NULL, msg_, sizeof msg_));                            \
+        IF_REFUSED(p, fsdem_##X##_create(NULL, &c_));                                              \
+        IF_TRUE(p, "fsdem_" #X "_create(NULL, &c) sets c to NULL", c_ == NULL);                    \
+        IF_REFUSED(p, fsdem_##X##_create(&d_, NULL));                                              \
+        mark_point();                                                                              \
+        fsdem_##X##_destroy(NULL);                                                                 \
+        mark_point();                                                                              \
+        text_ = fsdem_##X##_last_error(NULL);                                                      \
+        IF_TRUE(p, "fsdem_" #X "_last_error(NULL)", text_ && strstr(text_, "fsdem_" #X) && strstr(text_, "NULL")); \
+        mark_point();                                                                              \
+        dd_ = fsdem_##X##_get_desc(NULL);                                                          \
+        IF_ZERO(p, "fsdem_" #X "_get_desc(NULL)", (dd_.F != NULL) + (dd_.dem != NULL) + dd_.max_substeps + (dd_.log != NULL)); \
+        IF_REFUSED(p, fsdem_##X##_get_force(NULL, 0, &f_));                                        \
+        IF_REFUSED(p, fsdem_##X##_step(NULL));                                                     \
+        IF_REFUSED(p, fsdem_##X##_step_dt(NULL, 1e-3));                                            \
+        IF_REFUSED(p, fsdem_##X##_advance(NULL, 1e-3, &steps_));                                   \
+        IF_REFUSED(p, fsdem_##X##_stable_dt(NULL, &dt_));                                          \
+        IF_ZERO(p, "fsdem_" #X "_time(NULL)", fsdem_##X##_time(NULL));                             \
+        mark_point();                                                                              \
+        st_ = fsdem_##X##_get_stats(NULL);                                                         \
+        IF_ZERO(p, "fsdem_" #X "_get_stats(NULL)", st_.steps + st_.time + st_.dt + st_.substeps + st_.substeps_total); \
+        IF_REFUSED(p, fsdem_##X##_write_csv(NULL, "build/never_null.csv"));                        \
+        IF_REFUSED(p, fsdem_##X##_save(NULL, "build/never_null.rst"));                             \
+        IF_REFUSED(p, fsdem_##X##_restore(NULL, "build/never_null.rst"));                          \
+        IF_REFUSED(p, fsdem_##X##_save_memory(NULL, NULL, 0, &size_));                             \
+        IF_REFUSED(p, fsdem_##X##_restore_memory(NULL, NULL, 0));                                  \
     } while (0)
 
 static int if_zero_bytes(const void *x, size_t n) {
@@ -720,6 +761,7 @@ START_TEST(null_objects_are_refused) {
     {
         fsdem_dem_desc d = fsdem_dem_desc_default(3);
         fsdem_dem_material m = fsdem_dem_material_default();
+        fsdem_dem_material_pair pair = {1, 1, 1, 1};
         fsdem_dem_particle_desc pd = fsdem_dem_particle_desc_default();
         fsdem_dem_wall_desc w = fsdem_dem_wall_plane(v, fsdem_v3(0, 0, 1), 0);
         fsdem_dem *dem = (fsdem_dem *)&p;
@@ -739,6 +781,11 @@ START_TEST(null_objects_are_refused) {
         text = fsdem_dem_last_error(NULL);
         IF_TRUE(&p, "fsdem_dem_last_error(NULL)", text && strstr(text, "fsdem_dem") && strstr(text, "NULL"));
         IF_REFUSED(&p, fsdem_dem_add_material(NULL, &m, &idx));
+        IF_REFUSED(&p, fsdem_dem_set_material_pair(NULL, 0, 0, &pair));
+        mark_point();
+        pair = fsdem_dem_get_material_pair(NULL, 0, 0);
+        IF_ZERO(&p, "fsdem_dem_get_material_pair(NULL, 0, 0)", fabs(pair.restitution) + fabs(pair.friction) +
+                                                                   fabs(pair.rolling_friction) + fabs(pair.cohesion));
         IF_REFUSED(&p, fsdem_dem_add_particle(NULL, &pd, &idx));
         IF_REFUSED(&p, fsdem_dem_remove_particle(NULL, 0));
         IF_REFUSED(&p, fsdem_dem_set_particle_state(NULL, 0, v, v, v));
@@ -872,7 +919,10 @@ START_TEST(null_objects_are_refused) {
         IF_REFUSED(&p, fsdem_pic_add_gauge(NULL, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(0, 0, 0), 0, NULL));
         IF_REFUSED(&p, fsdem_pic_gauges_open(NULL, "build/never_null.csv", 0));
         IF_REFUSED(&p, fsdem_pic_gauges_close(NULL));
+        IF_REFUSED(&p, fsdem_pic_exclude_particles(NULL, if_plane, NULL, 0, &idx));
         IF_REFUSED(&p, fsdem_pic_save(NULL, "build/never_null.rst"));
+        IF_REFUSED(&p, fsdem_pic_restore(NULL, "build/never_null.rst"));
+        IF_REFUSED(&p, fsdem_pic_save_memory(NULL, NULL, 0, NULL));
         IF_REFUSED(&p, fsdem_pic_restore_memory(NULL, NULL, 0));
     }
     /* ---- fsdem_swe ---- */
@@ -950,6 +1000,8 @@ START_TEST(null_objects_are_refused) {
         IF_REFUSED(&p, fsdem_swe_block_box(NULL, 0, 0, 1, 1));
         IF_REFUSED(&p, fsdem_swe_block_polygon(NULL, NULL, 0));
         IF_REFUSED(&p, fsdem_swe_save(NULL, "build/never_null.rst"));
+        IF_REFUSED(&p, fsdem_swe_restore(NULL, "build/never_null.rst"));
+        IF_REFUSED(&p, fsdem_swe_save_memory(NULL, NULL, 0, NULL));
         IF_REFUSED(&p, fsdem_swe_restore_memory(NULL, NULL, 0));
         IF_REFUSED(&p, fsdem_swe_add_gauge(NULL, 0.5, 0, &idx));
         IF_REFUSED(&p, fsdem_swe_gauge(NULL, 0, &cell));
@@ -958,36 +1010,72 @@ START_TEST(null_objects_are_refused) {
         /* the bed callback of a DEM wall with no solver: no crash, a finite distance */
         IF_TRUE(&p, "fsdem_swe_bed_sdf(NULL, ...) is finite", isfinite(fsdem_swe_bed_sdf(NULL, v, &mom)));
     }
-    /* ---- fsdem_swe_dem ---- */
+    /* ---- fsdem_mps ---- */
     {
-        fsdem_swe_dem_desc d = fsdem_swe_dem_desc_default();
-        fsdem_swe_dem *c = (fsdem_swe_dem *)&p;
-        fsdem_swe_dem_force f;
-        fsdem_swe_dem_desc dd;
-        fsdem_swe_dem_stats st;
-        IF_REFUSED(&p, fsdem_swe_dem_desc_check(NULL, msg, sizeof msg));
-        IF_REFUSED(&p, fsdem_swe_dem_create(NULL, &c));
-        IF_TRUE(&p, "fsdem_swe_dem_create(NULL, &c) sets c to NULL", c == NULL);
-        IF_REFUSED(&p, fsdem_swe_dem_create(&d, NULL));
+        fsdem_mps_desc d = fsdem_mps_desc_default(2);
+        fsdem_mps *mps = (fsdem_mps *)&p;
+        fsdem_mps_particles pp;
+        fsdem_mps_coupling cp;
+        fsdem_mps_desc dd;
+        fsdem_mps_stats st;
+        fsdem_csr a;
+        const int *rows = (const int *)&p;
+        IF_REFUSED(&p, fsdem_mps_desc_check(NULL, msg, sizeof msg));
+        IF_REFUSED(&p, fsdem_mps_create(NULL, &mps));
+        IF_TRUE(&p, "fsdem_mps_create(NULL, &mps) sets mps to NULL", mps == NULL);
+        IF_REFUSED(&p, fsdem_mps_create(&d, NULL));
         mark_point();
-        fsdem_swe_dem_destroy(NULL);
+        fsdem_mps_destroy(NULL);
         mark_point();
-        text = fsdem_swe_dem_last_error(NULL);
-        IF_TRUE(&p, "fsdem_swe_dem_last_error(NULL)", text && strstr(text, "fsdem_swe_dem") && strstr(text, "NULL"));
-        IF_REFUSED(&p, fsdem_swe_dem_update_forces(NULL));
-        IF_REFUSED(&p, fsdem_swe_dem_get_force(NULL, 0, &f));
-        IF_REFUSED(&p, fsdem_swe_dem_step(NULL));
-        IF_REFUSED(&p, fsdem_swe_dem_step_dt(NULL, 1e-3));
-        IF_REFUSED(&p, fsdem_swe_dem_advance(NULL, 1e-3, &steps));
-        IF_REFUSED(&p, fsdem_swe_dem_stable_dt(NULL, &dt));
-        IF_ZERO(&p, "fsdem_swe_dem_time(NULL)", fsdem_swe_dem_time(NULL));
+        text = fsdem_mps_last_error(NULL);
+        IF_TRUE(&p, "fsdem_mps_last_error(NULL)", text && strstr(text, "fsdem_mps") && strstr(text, "NULL"));
         mark_point();
-        dd = fsdem_swe_dem_get_desc(NULL);
-        IF_ZERO(&p, "fsdem_swe_dem_get_desc(NULL)", (dd.swe != NULL) + (dd.dem != NULL) + fabs(dd.beta));
+        dd = fsdem_mps_get_desc(NULL);
+        IF_ZERO(&p, "fsdem_mps_get_desc(NULL)", dd.dim + fabs(dd.r0) + (dd.allocator.alloc != NULL));
+        IF_REFUSED(&p, fsdem_mps_add_particles(NULL, FSDEM_MPS_KIND_FLUID, 1, &v, NULL));
+        IF_REFUSED(&p, fsdem_mps_fill_box(NULL, v, fsdem_v3(1, 1, 0), v, &idx));
+        IF_REFUSED(&p, fsdem_mps_add_box_walls(NULL, v, fsdem_v3(1, 1, 0), 0, &idx));
+        IF_REFUSED(&p, fsdem_mps_add_box_obstacle(NULL, v, fsdem_v3(1, 1, 0), &idx));
         mark_point();
-        st = fsdem_swe_dem_get_stats(NULL);
-        IF_ZERO(&p, "fsdem_swe_dem_get_stats(NULL)", st.steps + st.time + st.substeps_total + st.in_water);
+        pp = fsdem_mps_get_particles(NULL);
+        IF_ZERO(&p, "fsdem_mps_get_particles(NULL)", pp.count + pp.dim + (pp.position != NULL) + (pp.velocity != NULL));
+        mark_point();
+        cp = fsdem_mps_get_coupling(NULL);
+        IF_ZERO(&p, "fsdem_mps_get_coupling(NULL)", cp.count + (cp.force != NULL) + (cp.porosity != NULL));
+        IF_REFUSED(&p, fsdem_mps_gradient(NULL, r, &v));
+        IF_REFUSED(&p, fsdem_mps_divergence(NULL, &v, r));
+        IF_REFUSED(&p, fsdem_mps_laplacian(NULL, r, r));
+        mark_point();
+        a = fsdem_mps_pressure_matrix(NULL, &rows);
+        IF_ZERO(&p, "fsdem_mps_pressure_matrix(NULL, &rows)", a.rows + (a.row_start != NULL) + (a.col != NULL) + (rows != NULL));
+        IF_REFUSED(&p, fsdem_mps_stable_dt(NULL, &dt));
+        IF_REFUSED(&p, fsdem_mps_step(NULL));
+        IF_REFUSED(&p, fsdem_mps_step_dt(NULL, 1e-3));
+        IF_REFUSED(&p, fsdem_mps_advance(NULL, 1e-3, &steps));
+        IF_ZERO(&p, "fsdem_mps_time(NULL)", fsdem_mps_time(NULL));
+        mark_point();
+        st = fsdem_mps_get_stats(NULL);
+        IF_ZERO(&p, "fsdem_mps_get_stats(NULL)", st.steps + st.time + st.dt);
+        IF_REFUSED(&p, fsdem_mps_probe_pressure(NULL, v, 0.1, &dt));
+        IF_REFUSED(&p, fsdem_mps_probe_height(NULL, v, &dt));
+        IF_REFUSED(&p, fsdem_mps_add_gauge(NULL, FSDEM_MPS_GAUGE_KIND_LEVEL, v, 0, &idx));
+        IF_REFUSED(&p, fsdem_mps_gauge(NULL, 0, &dt));
+        IF_REFUSED(&p, fsdem_mps_gauges_open(NULL, "build/never_null.csv", 0));
+        IF_REFUSED(&p, fsdem_mps_gauges_close(NULL));
+        IF_REFUSED(&p, fsdem_mps_obstacle_force(NULL, 0, &v));
+        IF_REFUSED(&p, fsdem_mps_write_vtp(NULL, "build/never_null.vtp", FSDEM_VTK_FORMAT_ASCII));
+        IF_REFUSED(&p, fsdem_mps_write_csv(NULL, "build/never_null.csv"));
+        IF_REFUSED(&p, fsdem_mps_save(NULL, "build/never_null.rst"));
+        IF_REFUSED(&p, fsdem_mps_restore(NULL, "build/never_null.rst"));
+        IF_REFUSED(&p, fsdem_mps_save_memory(NULL, NULL, 0, NULL));
+        IF_REFUSED(&p, fsdem_mps_restore_memory(NULL, NULL, 0));
     }
+    /* ---- the couplers: the verbs they share, then their own ---- */
+    IF_COUPLER_DIALECT(&p, swe_dem, swe);
+    IF_REFUSED(&p, fsdem_swe_dem_update_forces(NULL));
+    IF_COUPLER_DIALECT(&p, mps_dem, mps);
+    IF_REFUSED(&p, fsdem_mps_dem_update(NULL));
+    IF_COUPLER_DIALECT(&p, pic_dem, pic);
     TEST_REPORT("%d calls with a NULL object, %d answered wrong", p.calls, p.count);
     ck_assert_msg(p.count == 0, "%d of %d calls with a NULL object answered wrong: %s", p.count, p.calls, p.failed);
 }

@@ -1319,6 +1319,82 @@ START_TEST(io_pvd_series_of_snapshots) {
 }
 END_TEST
 
+/* ---- CSV snapshots -------------------------------------------------------------------------------- */
+
+/* Declared in fsdem_tests.h for the couplers' tests. Reads the CSV file `path` with its own parser
+   (fgets and strtod, no library code): the first line must be `header`, then exactly `rows` lines of
+   as many comma-separated numbers as the header has names, equal bit for bit to `expected` (row after
+   row). The writers print 17 significant digits, which strtod reads back to the same double, and a
+   float build's values are exact doubles, so nothing is compared with a tolerance. */
+void test_csv_expect(const char *path, const char *header, int rows, const double *expected) {
+    FILE *fp = fopen(path, "r");
+    char line[4096];
+    int columns = 1, row = 0, k;
+    const char *h;
+    for (h = header; *h; ++h) columns += *h == ',';
+    ck_assert_msg(fp != NULL, "%s was not written", path);
+    ck_assert_msg(fgets(line, sizeof line, fp) != NULL, "%s is empty", path);
+    line[strcspn(line, "\r\n")] = '\0';
+    ck_assert_msg(strcmp(line, header) == 0, "%s: header '%s', expected '%s'", path, line, header);
+    while (fgets(line, sizeof line, fp)) {
+        char *p = line, *end;
+        ck_assert_msg(row < rows, "%s: more than %d rows", path, rows);
+        for (k = 0; k < columns; ++k) {
+            const double v = strtod(p, &end), e = expected[(size_t)row * (size_t)columns + (size_t)k];
+            ck_assert_msg(end != p, "%s row %d: column %d is not a number", path, row, k);
+            ck_assert_msg(v == e || (isnan(v) && isnan(e)), "%s row %d column %d: %.17g, expected %.17g", path, row, k, v, e);
+            ck_assert_msg(*end == (k + 1 < columns ? ',' : '\n'), "%s row %d: '%c' after column %d", path, row, *end, k);
+            p = end + 1;
+        }
+        row++;
+    }
+    fclose(fp);
+    ck_assert_msg(row == rows, "%s: %d rows, expected %d", path, row, rows);
+}
+
+/* fsdem_mps_write_csv: one row per particle of every kind, in index order, equal to the particle view
+   (after a step, so pressures, number densities and surface flags are set); an unwritable path is
+   FSDEM_ERR_IO with the path in the message. */
+static void check_mps_csv(int dim) {
+    fsdem_mps_desc desc = fsdem_mps_desc_default(dim);
+    fsdem_mps *mps = NULL;
+    const fsdem_vec3 hi = dim == 2 ? fsdem_v3(0.2, 0.2, 0) : fsdem_v3(0.1, 0.1, 0.1);
+    fsdem_mps_particles p;
+    double *e;
+    int i;
+    desc.r0 = dim == 2 ? 0.02 : 0.025;
+    desc.domain_min = fsdem_v3(-0.2, -0.2, -0.2);
+    ck_assert_int_eq(fsdem_mps_create(&desc, &mps), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_write_csv(mps, "build/test_io_mps_empty.csv"), FSDEM_OK);
+    test_csv_expect("build/test_io_mps_empty.csv", "kind,surface,x,y,z,vx,vy,vz,pressure,number_density,porosity", 0, NULL);
+    ck_assert_int_eq(fsdem_mps_add_box_walls(mps, fsdem_v3(0, 0, 0), hi, 1u << (dim == 2 ? FSDEM_SIDE_YMAX : FSDEM_SIDE_ZMAX), NULL),
+                     FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(mps, fsdem_v3(0, 0, 0), hi, fsdem_v3(0.1f, 0, 0), NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_step(mps), FSDEM_OK);
+    p = fsdem_mps_get_particles(mps);
+    e = (double *)malloc(sizeof(double) * 11 * (size_t)p.count);
+    for (i = 0; i < p.count; ++i) {
+        double *r = e + 11 * i;
+        r[0] = p.kind[i], r[1] = p.surface[i];
+        r[2] = p.position[i].x, r[3] = p.position[i].y, r[4] = p.position[i].z;
+        r[5] = p.velocity[i].x, r[6] = p.velocity[i].y, r[7] = p.velocity[i].z;
+        r[8] = p.pressure[i], r[9] = p.number_density[i], r[10] = p.porosity[i];
+    }
+    ck_assert_int_eq(fsdem_mps_write_csv(mps, "build/test_io_mps.csv"), FSDEM_OK);
+    test_csv_expect("build/test_io_mps.csv", "kind,surface,x,y,z,vx,vy,vz,pressure,number_density,porosity", p.count, e);
+    free(e);
+    ck_assert_int_eq(fsdem_mps_write_csv(mps, "build/no/such/dir/x.csv"), FSDEM_ERR_IO);
+    ck_assert_ptr_nonnull(strstr(fsdem_mps_last_error(mps), "build/no/such/dir/x.csv"));
+    ck_assert_int_eq(fsdem_mps_write_csv(mps, NULL), FSDEM_ERR_INVALID_ARG);
+    fsdem_mps_destroy(mps);
+}
+
+START_TEST(io_mps_csv_read_back_2d) { check_mps_csv(2); }
+END_TEST
+
+START_TEST(io_mps_csv_read_back_3d) { check_mps_csv(3); }
+END_TEST
+
 /* ---- errors ------------------------------------------------------------------------------------- */
 
 START_TEST(io_writers_refuse_bad_arguments) {
@@ -1382,6 +1458,8 @@ Suite *io_suite(void) {
     tcase_add_test(tc, io_pic_read_back_3d);
     tcase_add_test(tc, io_mps_read_back_2d);
     tcase_add_test(tc, io_mps_read_back_3d);
+    tcase_add_test(tc, io_mps_csv_read_back_2d);
+    tcase_add_test(tc, io_mps_csv_read_back_3d);
     tcase_add_test(tc, io_swe_read_back_1d);
     tcase_add_test(tc, io_swe_read_back_2d);
     tcase_add_test(tc, io_pvd_valid_after_every_add);

@@ -472,9 +472,29 @@ START_TEST(dam_break_against_a_building) {
     ck_assert_msg(fabs(v1 - v0) < (sizeof(fsdem_real) == 8 ? 1e-12 : 1e-4) * v0, "volume %g -> %g", v0, v1);
     ck_assert(inside == 0);
     ck_assert_int_eq(fsdem_swe_sample_state(s, 2.3, 1.1, &c), FSDEM_ERR_OUT_OF_DOMAIN);
-    /* beside the wall the sample takes only the open cells: the depth is a mean of theirs */
-    ck_assert_int_eq(fsdem_swe_sample_state(s, 1.96, 1.1, &c), FSDEM_OK);
-    ck_assert(c.depth > 0);
+    /* Sampling by hand (cells of 0.05 m, centres at 0.025 + 0.05 i; the building covers the
+       centres of columns i >= 40, rows 16..27). At (1.96, 1.1) the four centres around the point,
+       columns 38 and 39 (x = 1.925, 1.975) and rows 21 and 22 (y = 1.075, 1.125), are open: the
+       bilinear weights are 0.3 and 0.7 along x, 0.5 and 0.5 along y. At (1.99, 1.1), still in the
+       open column 39, the centres of column 40 (x = 2.025, weight 0.3) are blocked and leave: the
+       two open ones share the weight, 0.5 each. Rounding: the four depths and weights in fsdem_real
+       (8 eps of the 1 m column). */
+    {
+        const int row = 21 * d.nx;
+        double h[4];
+        int q;
+        for (q = 0; q < 4; ++q) {
+            const int k = row + (q & 1 ? 39 : 38) + (q & 2 ? d.nx : 0);
+            h[q] = (double)f.eta[k] - (double)f.bed[k];
+        }
+        ck_assert_msg(h[1] > 0.01 && h[3] > 0.01, "the water reached the building (%g, %g m)", h[1], h[3]);
+        ck_assert_int_eq(fsdem_swe_sample_state(s, 1.96, 1.1, &c), FSDEM_OK);
+        ck_assert_msg(fabs(c.depth - (0.5 * (0.3 * h[0] + 0.7 * h[1]) + 0.5 * (0.3 * h[2] + 0.7 * h[3]))) < 8 * TEST_EPS,
+                      "depth %.9g m at (1.96, 1.1)", (double)c.depth);
+        ck_assert_int_eq(fsdem_swe_sample_state(s, 1.99, 1.1, &c), FSDEM_OK);
+        ck_assert_msg(fabs(c.depth - 0.5 * (h[1] + h[3])) < 8 * TEST_EPS, "depth %.9g m at (1.99, 1.1), open cells %.9g, %.9g m",
+                      (double)c.depth, h[1], h[3]);
+    }
     memset(&src, 0, sizeof src);
     src.x = 2.3;
     src.y = 1.1;
