@@ -148,7 +148,7 @@ $(BUILD)/validation/%/main.o: validation/%/main.c $(VALIDATION_HEADERS) fsdem.h 
 $(BUILD)/validation/%/run: $(BUILD)/validation/%/main.o $(BUILD)/validation/fsdem_impl.o
 	$(CC) $^ -o $@ $(LDLIBS)
 
-.PRECIOUS: $(BUILD)/validation/%/main.o
+.PRECIOUS: $(BUILD)/validation/%/main.o $(BUILD)/validation/%/run
 
 # `make validate` runs the default tier, `make validate-full` the full one; CASES="a b" names some
 # cases. One make target per case, longest first (by the last recorded run), so `make -j2 validate`
@@ -185,7 +185,8 @@ validate validate-full: | $(BUILD) gnuplot-deps
 	    > validation/report-$$tier/run.txt; fi; \
 	sh validation/tiers.sh render $$tier $$out $$out/REPORT.md; \
 	$(MAKE) --no-print-directory validate-report; \
-	echo "validate ($$tier tier): $$(sh validation/tiers.sh verdict $$out $$cases); total wall time $$wall s"; \
+	echo "validate ($$tier tier): $$(sh validation/tiers.sh verdict $$out $$cases); total wall time" \
+	  "$$(( $$(date +%s) - start )) s ($$wall s to the end of the runs, compilation included)"; \
 	echo "report: $$out/REPORT.md, validation/REPORT-$$tier.md"; \
 	[ $$made = 0 ] && sh validation/tiers.sh verdict $$out $$cases >/dev/null
 

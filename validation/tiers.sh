@@ -31,25 +31,38 @@ here=$(cd "$(dirname "$0")" && pwd)
 top=$(cd "$here/.." && pwd)
 
 die() { echo "tiers.sh: $*" >&2; exit 2; }
-trap 'rm -f "${TMPDIR:-/tmp}/tiers.$$.chapters"' EXIT
+scratch=$(mktemp -d "${TMPDIR:-/tmp}/tiers.XXXXXX") || die "cannot make a scratch folder"
+trap 'rm -rf "$scratch"' EXIT
 
 # ---- fingerprints ----
 
-# The text of one chapter of fsdem.h: >>tag and >>impl_tag (for "impl": the >>impl preamble alone).
-chapter() { # tag fsdem_h
-    awk -v want="$1" '
-        /===== >>[a-z_]+ :/ {
-            match($0, />>[a-z_]+/); tag = substr($0, RSTART + 2, RLENGTH - 2)
-            keep = tag == want || tag == "impl_" want
-        }
-        keep' "$2"
+# "tag hash" for every chapter tag of fsdem.h (the hash of the text of >>tag and >>impl_tag; for
+# "impl", of the >>impl preamble alone), computed once per fsdem.h into the scratch folder.
+hash_chapters() { # fsdem_h
+    out="$scratch/hashes.$(echo "$1" | cksum | cut -d' ' -f1)"
+    if [ ! -f "$out" ]; then
+        mkdir -p "$scratch/chapters"
+        rm -f "$scratch/chapters"/*
+        awk -v dir="$scratch/chapters" '
+            /===== >>[a-z_]+ :/ {
+                if (file != "") close(file)
+                match($0, />>[a-z_]+/); tag = substr($0, RSTART + 2, RLENGTH - 2)
+                base = tag; if (tag != "impl") sub(/^impl_/, "", base)
+                file = dir "/" base
+            }
+            file != "" { print >> file }' "$1"
+        for f in "$scratch/chapters"/*; do
+            echo "$(basename "$f") $(cksum <"$f" | awk '{ print $1 "-" $2 }')"
+        done >"$out"
+    fi
+    echo "$out"
 }
 
 # "tag:hash" for the >>impl preamble and each tag of DEPENDS, comma-separated.
 chapter_hashes() { # deps_file fsdem_h
-    for t in impl $(cat "$1"); do
-        printf '%s:%s\n' "$t" "$(chapter "$t" "$2" | cksum | awk '{ print $1 "-" $2 }')"
-    done | paste -s -d, -
+    awk -v tags="impl $(cat "$1")" 'NR == FNR { h[$1] = $2; next }
+        END { n = split(tags, t, " "); for (i = 1; i <= n; i++) printf "%s%s:%s", (i > 1 ? "," : ""), t[i], h[t[i]]; print "" }' \
+        "$(hash_chapters "$2")" /dev/null
 }
 
 # The case's code: its .c and .h files and, transitively, the validation headers they include.
@@ -89,8 +102,8 @@ meta() { sed -n "s/^$2=//p" "$1" | head -n 1; }
 
 # a file with the recorded "tag:hash" entries of a meta.txt, one a line (for grep -f)
 meta_list() {
-    meta "$1" chapters_fp | tr , '\n' >"${TMPDIR:-/tmp}/tiers.$$.chapters"
-    echo "${TMPDIR:-/tmp}/tiers.$$.chapters"
+    meta "$1" chapters_fp | tr , '\n' >"$scratch/recorded"
+    echo "$scratch/recorded"
 }
 
 # ---- run one case ----
@@ -180,8 +193,14 @@ verdict() { # out_root case...
 
 # ---- staleness ----
 
-# "current", or why the record in a case folder is stale
+# "current", or why the record in a case folder is stale (computed once per record and call)
 staleness() { # case_dir
+    cache="$scratch/stale.$(echo "$1" | cksum | cut -d' ' -f1)"
+    [ -f "$cache" ] || staleness_of "$1" >"$cache"
+    cat "$cache"
+}
+
+staleness_of() { # case_dir
     m="$1/meta.txt"
     name=$(meta "$m" case)
     if [ ! -f "$here/$name/main.c" ]; then echo "stale: the case no longer exists"; return; fi
@@ -213,6 +232,53 @@ status() {
 }
 
 # ---- report ----
+
+# One case of a report, from its meta.txt and checks.txt: its row of the summary table (mode=row) or
+# its section (mode=block). Variables: st (staleness), tier, img (the plots' path prefix), pngs.
+case_awk='
+function value(line, k,   a, v) { split(line, a, " "); v = a[k]; sub(/^[a-z]+=/, "", v); return v }
+FNR == NR { i = index($0, "="); if (i) m[substr($0, 1, i - 1)] = substr($0, i + 1); next }
+$1 == "CHECK" { nc++; if ($NF != "PASS") f++; check[nc] = $0; next }
+$1 == "INFO" && / \(full tier\)$/ { full[++nf] = $0; next }
+$1 == "INFO" { sub(/^INFO [^ ]* /, ""); info[++ni] = $0 }
+END {
+    name = m["case"]
+    if (mode == "row") {
+        counts = sprintf("%d/%d%s", nc - f, nc, f ? " (**" f " FAIL**)" : "")
+        if (m["rc"] != "0" && !f) counts = counts ", **exit status " m["rc"] "**"
+        printf "| [%s](#%s) | %s | %s%s | %s | %s | %s | %s |\n", name, name, m["resolution"], m["commit"],
+               m["dirty"] == "1" ? " +" : "", m["cpu_s"], m["wall_s"], counts, st == "current" ? "current" : "**stale**"
+        exit
+    }
+    printf "\n## %s\n\n", name
+    printf "Ran on %s%s, %s, %s tier: %s. CPU %s s, wall %s s, exit status %s. Depends on fsdem.h: %s.\n", m["commit"],
+           m["dirty"] == "1" ? " (+ uncommitted changes)" : "", m["date"], m["tier"], m["resolution"], m["cpu_s"], m["wall_s"],
+           m["rc"], m["depends"]
+    if (st != "current") {
+        i = index(st, ":")
+        printf "\n**%s**:%s; re-run it (`make validate%s CASES=%s`).\n", substr(st, 1, i - 1), substr(st, i + 1),
+               tier == "full" ? "-full" : "", name
+    }
+    if (m["plots"] != "") printf "\nPlots: %s.\n", m["plots"]
+    printf "\n| metric | value | ref | tol | result |\n|---|---|---|---|---|\n"
+    for (k = 1; k <= nc; k++) {
+        split(check[k], a, " ")
+        printf "| %s | %s | %s | %s | %s |\n", a[3], value(check[k], 4), value(check[k], 5), value(check[k], 6),
+               a[7] == "PASS" ? "PASS" : "**" a[7] "**"
+    }
+    if (nf) printf "\nLines of the full tier, with this tier%ss figures:\n\n", "\047"
+    for (k = 1; k <= nf; k++) {
+        split(full[k], a, " ")
+        v = value(full[k], 4)
+        if (v == "nan") v = "not evaluated (it needs the full tier\047s runs)"
+        printf "- `%s`: %s (ref %s, tol %s)\n", a[3], v, value(full[k], 5), value(full[k], 6)
+    }
+    if (ni) printf "\n"
+    for (k = 1; k <= ni; k++) printf "- %s\n", info[k]
+    np = split(pngs, p, "\n")
+    if (np) printf "\n"
+    for (k = 1; k <= np; k++) printf "![%s %s](%s%s/%s)\n", name, p[k], img, name, p[k]
+}'
 
 render() { # tier src_root out_md [img_prefix]
     tier=$1 src=$2 out=$3 img=${4:-}
@@ -246,29 +312,21 @@ render() { # tier src_root out_md [img_prefix]
             echo "|---|---|---|---|---|---|---|"
         fi
     } >"$tmp"
-    total_cpu=0 total_wall=0 ncase=0
+    ncase=0
     for d in "$src"/*/; do
-        m="$d/meta.txt"
-        [ -f "$m" ] || continue
-        name=$(meta "$m" case)
-        st=$(staleness "$d")
-        commit="$(meta "$m" commit)$( [ "$(meta "$m" dirty)" = 1 ] && echo ' +' )"
-        counts=$(awk '$1 == "CHECK" { n++; if ($NF != "PASS") f++ } END { printf "%d/%d%s", n - f, n, f ? " (**" f " FAIL**)" : "" }' "$d/checks.txt")
-        rc=$(meta "$m" rc)
-        [ "$rc" = 0 ] || [ -n "$(grep '^CHECK ' "$d/checks.txt" | grep -v ' PASS$')" ] || counts="$counts, **exit status $rc**"
-        case "$st" in current) sst=current ;; *) sst="**stale**" ;; esac
-        echo "| [$name](#$name) | $(meta "$m" resolution) | $commit | $(meta "$m" cpu_s) | $(meta "$m" wall_s) | $counts | $sst |" >>"$tmp"
-        total_cpu=$(awk -v a="$total_cpu" -v b="$(meta "$m" cpu_s)" 'BEGIN { print a + (b == "" ? 0 : b) }')
-        total_wall=$(awk -v a="$total_wall" -v b="$(meta "$m" wall_s)" 'BEGIN { print a + b }')
+        [ -f "$d/meta.txt" ] || continue
+        awk -v mode=row -v st="$(staleness "$d")" "$case_awk" "$d/meta.txt" "$d/checks.txt" >>"$tmp"
         ncase=$((ncase + 1))
     done
     [ $ncase -gt 0 ] && {
         echo
-        cat "$src"/*/checks.txt 2>/dev/null | awk -v n="$ncase" -v cpu="$total_cpu" -v wall="$total_wall" -v tier="$tier" '
+        awk -v n="$ncase" -v tier="$tier" '
+            FILENAME ~ /meta.txt$/ { if (sub(/^cpu_s=/, "")) cpu += $0; else if (sub(/^wall_s=/, "")) wall += $0; next }
             $1 == "CHECK" { c++; if ($NF == "PASS") p++ }
             $1 == "INFO" && / \(full tier\)$/ { full++ }
             END { printf "**%d case%s: %d of %d checks pass**%s. CPU %.0f s, wall %.0f s (case by case, summed).\n", n, n == 1 ? "" : "s",
-                          p, c, tier == "default" ? sprintf("; %d full-tier lines (INFO here)", full) : "", cpu, wall }'
+                          p, c, tier == "default" ? sprintf("; %d full-tier lines (INFO here)", full) : "", cpu, wall }' \
+            "$src"/*/meta.txt "$src"/*/checks.txt
         fails=$(grep -h '^CHECK ' "$src"/*/checks.txt 2>/dev/null | grep -v ' PASS$')
         if [ -n "$fails" ]; then
             echo
@@ -279,44 +337,9 @@ render() { # tier src_root out_md [img_prefix]
         fi
     } >>"$tmp"
     for d in "$src"/*/; do
-        m="$d/meta.txt"
-        [ -f "$m" ] || continue
-        name=$(meta "$m" case)
-        st=$(staleness "$d")
-        {
-            echo
-            echo "## $name"
-            echo
-            printf 'Ran on %s%s, %s, %s tier: %s. CPU %s s, wall %s s, exit status %s. Depends on fsdem.h: %s.\n' \
-                "$(meta "$m" commit)" "$( [ "$(meta "$m" dirty)" = 1 ] && echo ' (+ uncommitted changes)' )" \
-                "$(meta "$m" date)" "$(meta "$m" tier)" "$(meta "$m" resolution)" "$(meta "$m" cpu_s)" \
-                "$(meta "$m" wall_s)" "$(meta "$m" rc)" "$(meta "$m" depends)"
-            [ "$st" = current ] || { echo; echo "**${st%%:*}**:${st#*:}; re-run it (\`make validate$( [ "$tier" = full ] && echo -full) CASES=$name\`)."; }
-            [ -n "$(meta "$m" plots)" ] && { echo; echo "Plots: $(meta "$m" plots)."; }
-            echo
-            echo "| metric | value | ref | tol | result |"
-            echo "|---|---|---|---|---|"
-            awk '$1 == "CHECK" { v = $4; r = $5; t = $6; sub(/^value=/, "", v); sub(/^ref=/, "", r); sub(/^tol=/, "", t)
-                    printf "| %s | %s | %s | %s | %s |\n", $3, v, r, t, $NF == "PASS" ? "PASS" : "**" $NF "**" }' "$d/checks.txt"
-            if grep -q '^INFO .* (full tier)$' "$d/checks.txt"; then
-                echo
-                echo "Lines of the full tier, with this tier's figures:"
-                echo
-                awk '$1 == "INFO" && / \(full tier\)$/ { v = $4; r = $5; t = $6; sub(/^value=/, "", v); sub(/^ref=/, "", r); sub(/^tol=/, "", t)
-                    if (v == "nan") v = "not evaluated (it needs the full tier'"'"'s runs)"
-                    printf "- `%s`: %s (ref %s, tol %s)\n", $3, v, r, t }' "$d/checks.txt"
-            fi
-            if grep '^INFO ' "$d/checks.txt" | grep -qv ' (full tier)$'; then
-                echo
-                grep '^INFO ' "$d/checks.txt" | grep -v ' (full tier)$' | sed 's/^INFO [^ ]* /- /'
-            fi
-            first=1
-            for p in "$d"/*.png; do
-                [ -f "$p" ] || continue
-                [ $first = 1 ] && echo && first=0
-                echo "![$name $(basename "$p")]($img$name/$(basename "$p"))"
-            done
-        } >>"$tmp"
+        [ -f "$d/meta.txt" ] || continue
+        awk -v mode=block -v st="$(staleness "$d")" -v tier="$tier" -v img="$img" \
+            -v pngs="$(cd "$d" && ls *.png 2>/dev/null)" "$case_awk" "$d/meta.txt" "$d/checks.txt" >>"$tmp"
     done
     mv "$tmp" "$out"
 }

@@ -61,8 +61,12 @@ static void run_impact(impact *im, int two) {
     mat.friction = im->m.mu;
     rigid = mat;
     rigid.young_modulus = INFINITY; /* rigid plane: its 1/E term drops out of E* and G* */
-    fsdem_dem_add_material(dem, &mat, &sphere);
-    fsdem_dem_add_material(dem, &rigid, &plane_mat);
+    if (fsdem_dem_add_material(dem, &mat, &sphere) != FSDEM_OK ||
+        (!two && fsdem_dem_add_material(dem, &rigid, &plane_mat) != FSDEM_OK)) {
+        vc_info(CASE, "%s: %s", im->m.name, fsdem_dem_last_error(dem)); /* the impact's checks then fail */
+        fsdem_dem_destroy(dem);
+        return;
+    }
     p.radius = R;
     p.material = sphere;
     if (two) { /* touching at t = 0, closing at 2 vn */
