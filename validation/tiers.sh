@@ -269,9 +269,10 @@ END {
     if (nf) printf "\nLines of the full tier, with this tier%ss figures:\n\n", "\047"
     for (k = 1; k <= nf; k++) {
         split(full[k], a, " ")
-        v = value(full[k], 4)
-        if (v == "nan") v = "not evaluated (it needs the full tier\047s runs)"
-        printf "- `%s`: %s (ref %s, tol %s)\n", a[3], v, value(full[k], 5), value(full[k], 6)
+        if (value(full[k], 4) == "nan")
+            printf "- `%s`: not evaluated in this tier (it needs the full tier\047s runs); ref %s, tol %s\n", a[3],
+                   value(full[k], 5), value(full[k], 6)
+        else printf "- `%s`: %s (ref %s, tol %s)\n", a[3], value(full[k], 4), value(full[k], 5), value(full[k], 6)
     }
     if (ni) printf "\n"
     for (k = 1; k <= ni; k++) printf "- %s\n", info[k]
@@ -305,9 +306,15 @@ render() { # tier src_root out_md [img_prefix]
             echo "Last complete run of the tier: $(cat "$src/run.txt")."
             echo
         fi
+        missing=""
+        for c in "$here"/*/main.c; do
+            c=$(basename "$(dirname "$c")")
+            [ -f "$src/$c/meta.txt" ] || missing="$missing${missing:+, }$c"
+        done
         if ! ls "$src"/*/meta.txt >/dev/null 2>&1; then
             echo "No case has been run in this tier yet."
         else
+            [ -z "$missing" ] || { echo "Not run in this tier yet: $missing."; echo; }
             echo "| case | resolution | commit | CPU s | wall s | checks | status |"
             echo "|---|---|---|---|---|---|---|"
         fi
