@@ -485,7 +485,8 @@ typedef enum fsdem_result {
                                                     centrifuges reach a few hundred g) */
 #define FSDEM_MAX_LENGTH ((fsdem_real)1e7)       /* m: depths, water levels, radii and lengths (the
                                                     size of the Earth) */
-#define FSDEM_MAX_MODULUS ((fsdem_real)1e13)     /* Pa: Young's moduli (diamond: 1.2e12 Pa) */
+#define FSDEM_MAX_MODULUS ((fsdem_real)1e16)     /* Pa: Young's moduli (diamond: 1.2e12 Pa; room for a
+                                                    wall idealised as a thousand times stiffer) */
 
 /* Short constant name of a result code, e.g. "FSDEM_ERR_INVALID_ARG". Never NULL. */
 FSDEM_API const char *fsdem_result_string(fsdem_result result);
