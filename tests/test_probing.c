@@ -264,9 +264,14 @@ START_TEST(implausible_dem_input_is_refused) {
     ck_assert_int_eq(fsdem_dem_create(&d, &unit), FSDEM_OK);
     m.young_modulus = (fsdem_real)INFINITY; /* two such materials met in an infinite contact stiffness */
     REFUSED(fsdem_dem_add_material(dem, &m, NULL), fsdem_dem_last_error(dem), "young_modulus");
+    m.young_modulus = (fsdem_real)1e20; /* finite but no material: beyond FSDEM_MAX_MODULUS */
+    REFUSED(fsdem_dem_add_material(dem, &m, NULL), fsdem_dem_last_error(dem), "young_modulus");
     m = fsdem_dem_material_default();
     ck_assert_int_eq(fsdem_dem_add_material(dem, &m, &mat), FSDEM_OK);
     ck_assert_int_eq(fsdem_dem_add_material(unit, &m, NULL), FSDEM_OK);
+    m.young_modulus = (fsdem_real)1.2e15; /* a wall a thousand times stiffer than diamond is allowed */
+    ck_assert_int_eq(fsdem_dem_add_material(dem, &m, NULL), FSDEM_OK);
+    m = fsdem_dem_material_default();
     p.radius = (fsdem_real)0.1;
     p.velocity = fsdem_v3((fsdem_real)1e20, 0, 0);
     REFUSED(fsdem_dem_add_particle(dem, &p, NULL), fsdem_dem_last_error(dem), "FSDEM_MAX_SPEED");
