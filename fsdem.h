@@ -1980,6 +1980,19 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
    0.2 drifts 6.8 r0); both stay behind desc switches, off by default. Mid-depth pressure is within
    2% whenever the tank survives. A cure needs consistent operators at the free surface (e.g. ghost
    values above it) and a wall condition that resists shear; not done.
+   Laplacian radius (desc.re_laplacian, after MPS codes that use 2.1-3.1 r0 for Eq. 10 while Eq. 7
+   keeps 4.1 r0). The pressure matrix holds the pairs within it, so its cost falls fast; its
+   physics, measured (fsdem.h of the amg branch, 3D tank 0.8 x 0.4 m, column 0.2 x 0.4 x 0.4 m at
+   r0 = 0.01 m, 34,110 rows; the 2D Martin & Moyce case of validation/mps_dambreak_2d at a/40):
+       re_laplacian            4.1 r0        3.1 r0        2.1 r0
+       3D entries per row      219           108           30.5
+       3D MIC(0) setup+solve   1.27 s (19)   0.43 s (20)   0.086 s (25 iterations)
+       3D AMG setup+solve      0.96 s (6)    0.70 s (6)    0.13 s (7 iterations)
+       2D front slope dZ/dT    1.255         1.254         1.252 (table 1.261; all within 5 %)
+       2D inner n/n0 drift     0.40 %        0.57 %        1.77 % (the case's line is 1 %)
+       2D still water drift    0.86 r0       0.70 r0       0.89 r0 (largest, at 0.5 s)
+   so 3.1 r0 halves the matrix at no measured loss and 2.1 r0 lets the volume drift; the default
+   stays the seed's re.
    Units: m, s, kg/m^3, m^2/s (kinematic viscosity), Pa. In 2D the problem lies in the x-y plane.
    One step allocates nothing once its lists have reached their size (the neighbour list and the
    matrix grow by doubling when the particle arrangement needs more room than ever before). */
@@ -2027,6 +2040,9 @@ typedef struct fsdem_mps_desc {
     fsdem_real r0;                  /* m; initial particle spacing, > 0; default 0.01 */
     fsdem_real re;                  /* m; interaction radius, >= 2 r0; 0 = 4.1 r0 (seed 002 §2.1); */
                                     /*    default 0 */
+    fsdem_real re_laplacian;        /* m; radius of the Laplacian (Eq. 10-11: the pressure equation */
+                                    /*    and viscosity), in [1.5 r0, re]; 0 = re (the seed's); */
+                                    /*    default 0 (see the notes on its cost) */
     fsdem_real density;             /* kg/m^3; rho_f; default 1000 */
     fsdem_real viscosity;           /* m^2/s; kinematic viscosity nu = mu_f/rho_f; default 1e-6 */
     fsdem_vec3 gravity;             /* m/s^2; default (0,-9.81,0) in 2D, (0,0,-9.81) in 3D */
@@ -13761,8 +13777,9 @@ struct fsdem_mps {
     fsdem_allocator allocator;
     size_t bytes;                 /* held, besides the pcg */
     int dim;
-    fsdem_real r0, re;
-    fsdem_real n0, lambda, f0;    /* lattice constants (>>mps_desc) */
+    fsdem_real r0, re, re_lap;    /* spacing, radius of Eq. 7-9 and of the Laplacian (Eq. 10-11) */
+    fsdem_real n0, lambda, f0;    /* lattice constants (>>mps_desc): lambda with re_lap */
+    fsdem_real n0_lap;            /* sum of the Laplacian's weights on the full lattice */
     int layers;                   /* WALL + DUMMY layers of a solid: ceil(re/r0) */
     /* particles, structure of arrays, `cap` allocated */
     int n, cap;
@@ -13785,6 +13802,7 @@ struct fsdem_mps {
     int *tmp_start, *cursor;      /* n + 1 each: rows by column and fill cursors of the build */
     int *nb, *tmp_nb, nb_cap;     /* neighbour indices */
     fsdem_real *nbw, *tmp_w;      /* w_ij (Eq. 6) */
+    fsdem_real *nbl, *tmp_l;      /* w_ij of the Laplacian (Eq. 6 with re_laplacian; 0 beyond it) */
     long long pair_count;
     /* pressure matrix */
     int *a_start, *a_col, a_cap;
@@ -13849,6 +13867,10 @@ static fsdem_result fsdem__mps_check(const fsdem_mps_desc *d, char *msg, size_t 
     if (d->re > 20 * d->r0)
         return fsdem__reject(msg, size, "fsdem_mps_desc.re = %g m must be <= 20 r0 = %g m", (double)d->re,
                              (double)(20 * d->r0));
+    if (d->re_laplacian != 0 && !(d->re_laplacian >= (fsdem_real)1.5 * d->r0 &&
+                                  d->re_laplacian <= (d->re > 0 ? d->re : (fsdem_real)4.1 * d->r0) * (1 + (fsdem_real)1e-6)))
+        return fsdem__reject(msg, size, "fsdem_mps_desc.re_laplacian = %g m must be 0 (re) or in [1.5 r0, re] = [%g, %g] m",
+                             (double)d->re_laplacian, (double)(1.5 * d->r0), (double)(d->re > 0 ? d->re : 4.1 * d->r0));
     if (!(d->density > 0) || !fsdem__finite(d->density))
         return fsdem__reject(msg, size, "fsdem_mps_desc.density = %g kg/m^3 must be > 0", (double)d->density);
     if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
@@ -13908,21 +13930,24 @@ fsdem_result fsdem_mps_desc_check(const fsdem_mps_desc *desc, char *message, siz
    reference values of the PPE source, the Laplacian and the surface test (Eq. 14-16). */
 static void fsdem__mps_lattice(fsdem_mps *s) {
     const int m = (int)ceil((double)(s->re / s->r0)), kz = s->dim == 3 ? m : 0;
-    double n0 = 0, l = 0, f = 0;
+    double n0 = 0, nl = 0, l = 0, f = 0;
     int i, j, k;
     for (k = -kz; k <= kz; ++k)
         for (j = -m; j <= m; ++j)
             for (i = -m; i <= m; ++i) {
                 const fsdem_real r = s->r0 * (fsdem_real)sqrt((double)(i * i + j * j + k * k));
                 const fsdem_real w = fsdem__kernel_mps(r, s->re);
+                const fsdem_real wl = r < s->re_lap ? fsdem__kernel_mps(r, s->re_lap) : 0;
                 const int up = s->dim == 3 ? k : j;
                 if (i == 0 && j == 0 && k == 0) continue;
                 n0 += w;
-                l += w * r * r;
+                nl += wl;
+                l += wl * r * r;
                 if (up <= 0) f += w * (double)up * s->r0 / r;
             }
     s->n0 = (fsdem_real)n0;
-    s->lambda = (fsdem_real)(l / n0);
+    s->n0_lap = (fsdem_real)nl;
+    s->lambda = (fsdem_real)(l / nl);
     s->f0 = (fsdem_real)(fabs(f) * s->dim / n0);
 }
 
@@ -13945,6 +13970,8 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     s->r0 = desc->r0;
     s->re = desc->re > 0 ? desc->re : (fsdem_real)4.1 * desc->r0;
     s->desc.re = s->re;
+    s->re_lap = desc->re_laplacian > 0 ? desc->re_laplacian : s->re;
+    s->desc.re_laplacian = s->re_lap;
     s->layers = (int)ceil((double)(s->re / s->r0) - 1e-9);
     fsdem__mps_lattice(s);
     pd = fsdem_pcg_desc_default();
@@ -14025,6 +14052,8 @@ void fsdem_mps_destroy(fsdem_mps *s) {
     fsdem__free(&s->allocator, s->tmp_nb, sizeof(int) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->nbw, sizeof(fsdem_real) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->tmp_w, sizeof(fsdem_real) * (size_t)s->nb_cap);
+    fsdem__free(&s->allocator, s->nbl, sizeof(fsdem_real) * (size_t)s->nb_cap);
+    fsdem__free(&s->allocator, s->tmp_l, sizeof(fsdem_real) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->a_col, sizeof(int) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->a_val, sizeof(fsdem_real) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
@@ -14387,39 +14416,45 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     }
     if (s->nb_start[s->n] > s->nb_cap) {
         const int cap = fsdem__mps_capacity(s->nb_cap, s->nb_start[s->n]);
-        void **arrays[4];
-        size_t elem[4];
-        void *fresh[4];
-        int k;
+        void **arrays[6];
+        size_t elem[6];
+        void *fresh[6];
+        int k, ok = 1;
         arrays[0] = (void **)&s->nb;
         arrays[1] = (void **)&s->tmp_nb;
         arrays[2] = (void **)&s->nbw;
         arrays[3] = (void **)&s->tmp_w;
+        arrays[4] = (void **)&s->nbl;
+        arrays[5] = (void **)&s->tmp_l;
         elem[0] = elem[1] = sizeof(int);
-        elem[2] = elem[3] = sizeof(fsdem_real);
+        elem[2] = elem[3] = elem[4] = elem[5] = sizeof(fsdem_real);
         if (!cap) return FSDEM_ERR_OUT_OF_MEMORY;
-        for (k = 0; k < 4; ++k) fresh[k] = fsdem__alloc(&s->allocator, elem[k] * (size_t)cap);
-        if (!fresh[0] || !fresh[1] || !fresh[2] || !fresh[3]) {
-            for (k = 0; k < 4; ++k) fsdem__free(&s->allocator, fresh[k], elem[k] * (size_t)cap);
+        for (k = 0; k < 6; ++k) ok &= (fresh[k] = fsdem__alloc(&s->allocator, elem[k] * (size_t)cap)) != NULL;
+        if (!ok) {
+            for (k = 0; k < 6; ++k) fsdem__free(&s->allocator, fresh[k], elem[k] * (size_t)cap);
             return FSDEM_ERR_OUT_OF_MEMORY;
         }
-        for (k = 0; k < 4; ++k) {
+        for (k = 0; k < 6; ++k) {
             fsdem__free(&s->allocator, *arrays[k], elem[k] * (size_t)s->nb_cap);
             *arrays[k] = fresh[k];
         }
-        s->bytes += 2 * (sizeof(int) + sizeof(fsdem_real)) * (size_t)(cap - s->nb_cap);
+        s->bytes += 2 * (sizeof(int) + 2 * sizeof(fsdem_real)) * (size_t)(cap - s->nb_cap);
         s->nb_cap = cap;
     }
     memcpy(s->cursor, s->tmp_start, sizeof(int) * (size_t)s->n);
     for (e = 0; e < count; ++e) {
         const int pa = s->pairs[2 * e], pb = s->pairs[2 * e + 1];
-        const fsdem_real w = fsdem__kernel_mps(fsdem__norm(fsdem__sub(s->x[pa], s->x[pb])), s->re);
+        const fsdem_real r = fsdem__norm(fsdem__sub(s->x[pa], s->x[pb]));
+        const fsdem_real w = fsdem__kernel_mps(r, s->re);
+        const fsdem_real wl = s->re_lap == s->re ? w : r < s->re_lap ? fsdem__kernel_mps(r, s->re_lap) : 0;
         if (s->kind[pa] != FSDEM_MPS_KIND_DUMMY) {
             s->tmp_nb[s->cursor[pb]] = pa;
+            s->tmp_l[s->cursor[pb]] = wl;
             s->tmp_w[s->cursor[pb]++] = w;
         }
         if (s->kind[pb] != FSDEM_MPS_KIND_DUMMY) {
             s->tmp_nb[s->cursor[pa]] = pb;
+            s->tmp_l[s->cursor[pa]] = wl;
             s->tmp_w[s->cursor[pa]++] = w;
         }
     }
@@ -14428,6 +14463,7 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
         for (e = s->tmp_start[c]; e < s->tmp_start[c + 1]; ++e) {
             const int r = s->tmp_nb[e];
             s->nb[s->cursor[r]] = c;
+            s->nbl[s->cursor[r]] = s->tmp_l[e];
             s->nbw[s->cursor[r]++] = s->tmp_w[e];
         }
     return FSDEM_OK;
@@ -14565,12 +14601,12 @@ static fsdem_vec3 fsdem__mps_lap_at(const fsdem_mps *s, const fsdem_real *phi, c
     int e;
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
-        const fsdem_real we = s->nbw[e] / s->eps[j];
+        const fsdem_real we = s->nbl[e] / s->eps[j];
         if (s->kind[j] == FSDEM_MPS_KIND_DUMMY) continue;
         if (phi) l.x += (phi[j] - phi[i]) * we;
         else l = fsdem__madd(l, fsdem__sub(u[j], u[i]), we);
     }
-    return fsdem__scale(l, 2 * (fsdem_real)s->dim / (s->n0 * s->lambda));
+    return fsdem__scale(l, 2 * (fsdem_real)s->dim / (s->n0_lap * s->lambda));
 }
 
 /* Rebuilds the neighbours and the number density at the current positions for a public operator
@@ -14790,14 +14826,15 @@ static void fsdem__mps_obstacle_forces(fsdem_mps *s) {
    pressure (their known terms on the right). The right-hand side goes to s->b. */
 static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
     const fsdem_real rho = s->desc.density, gamma = s->desc.gamma;
-    const fsdem_real scale = -s->n0 * s->lambda / (2 * (fsdem_real)s->dim);
+    const fsdem_real scale = -s->n0_lap * s->lambda / (2 * (fsdem_real)s->dim);
     long long nnz = 0;
     int i, e, rows = 0;
     for (i = 0; i < s->n; ++i) {
         int solid_only = 1;
         s->unknown[i] = -1;
         if (s->kind[i] == FSDEM_MPS_KIND_DUMMY || s->surf[i]) continue;
-        for (e = s->nb_start[i]; e < s->nb_start[i + 1] && solid_only; ++e) solid_only = s->kind[s->nb[e]] == FSDEM_MPS_KIND_DUMMY;
+        for (e = s->nb_start[i]; e < s->nb_start[i + 1] && solid_only; ++e)
+            solid_only = s->kind[s->nb[e]] == FSDEM_MPS_KIND_DUMMY || s->nbl[e] == 0;
         if (solid_only) continue;
         s->row_particle[rows] = i;
         s->unknown[i] = rows++;
@@ -14805,7 +14842,7 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
     for (i = 0; i < s->n; ++i)
         if (s->unknown[i] >= 0) {
             nnz++;
-            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) nnz += s->unknown[s->nb[e]] >= 0;
+            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) nnz += s->unknown[s->nb[e]] >= 0 && s->nbl[e] > 0;
         }
     if (fsdem__mps_matrix_room(s, nnz) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     nnz = 0;
@@ -14817,8 +14854,8 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
         if (row < 0) continue;
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
-            const fsdem_real a = s->nbw[e] / (s->eps[i] * s->eps[j]);
-            if (s->kind[j] == FSDEM_MPS_KIND_DUMMY) continue;
+            const fsdem_real a = s->nbl[e] / (s->eps[i] * s->eps[j]);
+            if (s->kind[j] == FSDEM_MPS_KIND_DUMMY || !(a > 0)) continue;
             diag += a;
             if (s->unknown[j] < 0) continue;
             if (at < 0 && j > i) at = nnz++; /* the diagonal's place among ascending columns */
@@ -14841,7 +14878,7 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
             if (s->kind[j] != FSDEM_MPS_KIND_DUMMY) continue;
-            s->b[row] += rho * fsdem__dot(s->desc.gravity, fsdem__sub(s->x[j], s->x[i])) * s->nbw[e] / (s->eps[i] * s->eps[j]);
+            s->b[row] += rho * fsdem__dot(s->desc.gravity, fsdem__sub(s->x[j], s->x[i])) * s->nbl[e] / (s->eps[i] * s->eps[j]);
         }
         s->sol[row] = s->p[i];
     }
@@ -17674,10 +17711,11 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
     int no = s->obst_n, n = s->n, cap = s->cap, i, a;
     fsdem__mps_obst *obst;
-    fsdem__restart_tag(io, "MPS2");
+    fsdem__restart_tag(io, "MPS3");
     fsdem__restart_same_int(io, d->dim, "dim");
     fsdem__restart_same_real(io, d->r0, "r0");
     fsdem__restart_same_real(io, d->re, "re");
+    fsdem__restart_same_real(io, d->re_laplacian, "re_laplacian");
     fsdem__restart_same_real(io, d->density, "density");
     fsdem__restart_same_real(io, d->viscosity, "viscosity");
     fsdem__restart_same_vec3(io, d->gravity, "gravity");
