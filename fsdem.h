@@ -1982,7 +1982,7 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
    values above it) and a wall condition that resists shear; not done.
    Laplacian radius (desc.re_laplacian, after MPS codes that use 2.1-3.1 r0 for Eq. 10 while Eq. 7
    keeps 4.1 r0). The pressure matrix holds the pairs within it, so its cost falls fast; its
-   physics, measured (fsdem.h of the amg branch, 3D tank 0.8 x 0.4 m, column 0.2 x 0.4 x 0.4 m at
+   physics, measured when the option came (3D tank 0.8 x 0.4 m, column 0.2 x 0.4 x 0.4 m at
    r0 = 0.01 m, 34,110 rows; the 2D Martin & Moyce case of validation/mps_dambreak_2d at a/40):
        re_laplacian            4.1 r0        3.1 r0        2.1 r0
        3D entries per row      219           108           30.5
