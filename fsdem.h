@@ -2211,6 +2211,12 @@ typedef struct fsdem_mps_stats {
     fsdem_real max_pressure;      /* Pa */
     double seconds_total;         /* CPU seconds in steps (clock()) */
     double seconds_pressure;      /* CPU seconds in the pressure equation: assembly, setup, solve */
+    double seconds_search;        /* CPU seconds of seconds_total in the neighbour search, number */
+                                  /*    density and surface detection (step 1) */
+    double seconds_assembly;      /* ... in assembling the pressure equation */
+    double seconds_solve;         /* ... in its preconditioner setup and solve (the rest of */
+                                  /*    seconds_total: the operators of steps 2 and 6) */
+    long long candidate_pairs;    /* pairs the last neighbour search examined (neighbours: kept) */
     size_t memory_bytes;          /* bytes held by the solver, its pcg included */
 } fsdem_mps_stats;
 
@@ -13797,6 +13803,7 @@ struct fsdem_mps {
     int counts[3];                /* particles per kind */
     /* neighbours: rows of every non-DUMMY particle (DUMMY rows are empty), columns ascending */
     fsdem_cellgrid grid;
+    int *cell_split;              /* per cell: where its DUMMY items start (they come last) */
     int *pairs, pair_cap;         /* 2 per pair found by the cell scan */
     int *nb_start;                /* n + 1 */
     int *tmp_start, *cursor;      /* n + 1 each: rows by column and fill cursors of the build */
@@ -13818,7 +13825,8 @@ struct fsdem_mps {
     long long steps, iters_total;
     fsdem_real dt_last, residual;
     int iters, surface_count;
-    double sec_total, sec_pressure;
+    double sec_total, sec_pressure, sec_search, sec_assembly, sec_solve;
+    long long candidates;         /* pairs the last cell scan examined */
 };
 
 /* ---- >>mps_desc : defaults, validation, lattice constants, creation ---- */
@@ -13988,6 +13996,11 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     r = fsdem_pcg_create(&pd, &s->pcg);
     if (r == FSDEM_OK)
         r = fsdem_cellgrid_setup(&s->grid, &s->allocator, s->dim, desc->domain_min, desc->domain_max, s->re, 0);
+    if (r == FSDEM_OK) {
+        s->cell_split = (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)s->grid.cell_count);
+        if (!s->cell_split) r = FSDEM_ERR_OUT_OF_MEMORY;
+        else s->bytes += sizeof(int) * (size_t)s->grid.cell_count;
+    }
     if (r != FSDEM_OK) {
         fsdem__log_oom(desc->log, desc->log_user, "fsdem_mps_create", sizeof *s);
         fsdem_mps_destroy(s);
@@ -14058,6 +14071,7 @@ void fsdem_mps_destroy(fsdem_mps *s) {
     fsdem__free(&s->allocator, s->a_val, sizeof(fsdem_real) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
     fsdem__gauges_free(&s->gauges, &s->allocator);
+    fsdem__free(&s->allocator, s->cell_split, sizeof(int) * (size_t)s->grid.cell_count);
     fsdem_cellgrid_free(&s->grid);
     if (s->pcg) fsdem_pcg_destroy(s->pcg);
     al = s->allocator;
@@ -14360,8 +14374,23 @@ static int fsdem__mps_capacity(int have, long long need) {
 static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     const fsdem_cellgrid *g = &s->grid;
     const fsdem_real re2 = s->re * s->re;
+    long long examined = 0;
     int c, f, a, b, i, e, count = 0;
     if (fsdem_cellgrid_build(&s->grid, s->x, s->n) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    /* DUMMY items last in every cell (a stable partition; s->cursor is free until the rows are
+       built), so that a DUMMY particle is only ever paired with the non-DUMMY items of a cell: the
+       DUMMY-DUMMY pairs, most of those a solid's layers would give, are never examined. The rows
+       come out sorted by column whatever the pair order, so the neighbour list is unchanged. */
+    for (c = 0; c < g->cell_count; ++c) {
+        int k = g->cell_start[c], t = 0;
+        for (a = g->cell_start[c]; a < g->cell_start[c + 1]; ++a) {
+            const int p = g->items[a];
+            if (s->kind[p] == FSDEM_MPS_KIND_DUMMY) s->cursor[t++] = p;
+            else s->grid.items[k++] = p;
+        }
+        s->cell_split[c] = k;
+        if (t) memcpy(s->grid.items + k, s->cursor, sizeof(int) * (size_t)t);
+    }
     for (c = 0; c < g->cell_count; ++c) {
         int coord[3], cells[14], nf;
         if (g->cell_start[c] == g->cell_start[c + 1]) continue;
@@ -14369,10 +14398,12 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
         coord[1] = c / g->n[0] % g->n[1];
         coord[2] = c / (g->n[0] * g->n[1]);
         nf = fsdem_cellgrid_forward(g, coord, cells);
-        for (f = 0; f < nf; ++f) {
-            const int b1 = g->cell_start[cells[f] + 1];
+        for (f = 0; f < nf; ++f)
             for (a = g->cell_start[c]; a < g->cell_start[c + 1]; ++a) {
-                const int pa = g->items[a], b0 = f == 0 ? a + 1 : g->cell_start[cells[f]];
+                const int pa = g->items[a], dummy = a >= s->cell_split[c];
+                const int b0 = f == 0 ? a + 1 : g->cell_start[cells[f]];
+                const int b1 = dummy ? s->cell_split[cells[f]] : g->cell_start[cells[f] + 1];
+                if (b1 <= b0) continue;
                 if (2 * ((long long)count + b1 - b0) > s->pair_cap) {
                     const int cap = fsdem__mps_capacity(s->pair_cap, 2 * ((long long)count + b1 - b0));
                     int *fresh = cap ? (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)cap) : NULL;
@@ -14383,17 +14414,18 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
                     s->pairs = fresh;
                     s->pair_cap = cap;
                 }
+                examined += b1 - b0;
                 for (b = b0; b < b1; ++b) {
                     const int pb = g->items[b];
                     const fsdem_vec3 d = fsdem__sub(s->x[pa], s->x[pb]);
                     s->pairs[2 * count] = pa;
                     s->pairs[2 * count + 1] = pb;
-                    count += fsdem__dot(d, d) < re2 && (s->kind[pa] != FSDEM_MPS_KIND_DUMMY || s->kind[pb] != FSDEM_MPS_KIND_DUMMY);
+                    count += fsdem__dot(d, d) < re2;
                 }
             }
-        }
     }
     s->pair_count = count;
+    s->candidates = examined;
     /* directed entries (r, c): c in the row of r, for every non-DUMMY r; first bucketed by column c
        (counting sort into tmp_nb/tmp_w, rows r), then scattered by row in column order, which
        leaves every row sorted */
@@ -14894,7 +14926,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     fsdem_pcg_info info;
     fsdem_csr A;
     fsdem_result r;
-    clock_t t0 = clock(), t1, tp;
+    clock_t t0 = clock(), t1, tp, ts, ta;
     int i, a, bad = -1;
     if (s->counts[FSDEM_MPS_KIND_FLUID] == 0)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: no FLUID particles to step");
@@ -14907,6 +14939,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     if (fsdem__mps_neighbours(s) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory building the neighbour list");
     s->surface_count = fsdem__mps_density(s);
+    ts = clock();
     fsdem__mps_shift(s);
     /* 2. predictor: u* = u + dt (nu lap u + g) (seed 002 Eq. A.6 with eps = 1). WALL and DUMMY
        particles take u* = dt g, their velocity (0) plus the same body force: a uniform field has no
@@ -14932,6 +14965,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     tp = clock();
     if (fsdem__mps_assemble(s, dt) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory assembling the pressure matrix");
+    ta = clock();
     memset(&info, 0, sizeof info);
     s->iters = 0;
     s->residual = 0;
@@ -14956,6 +14990,9 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         }
     }
     t1 = clock();
+    s->sec_search += (double)(ts - t0) / CLOCKS_PER_SEC;
+    s->sec_assembly += (double)(ta - tp) / CLOCKS_PER_SEC;
+    s->sec_solve += (double)(t1 - ta) / CLOCKS_PER_SEC;
     /* 4. pressures (clamped where asked), then the corrector: u = u* - dt/rho grad p, r += dt u */
     for (i = 0; i < s->n; ++i) {
         fsdem_real p = s->unknown[i] >= 0 ? s->sol[s->unknown[i]] : 0;
@@ -15129,6 +15166,10 @@ fsdem_mps_stats fsdem_mps_get_stats(const fsdem_mps *s) {
         if (s->p[i] > st.max_pressure) st.max_pressure = s->p[i];
     st.seconds_total = s->sec_total;
     st.seconds_pressure = s->sec_pressure;
+    st.seconds_search = s->sec_search;
+    st.seconds_assembly = s->sec_assembly;
+    st.seconds_solve = s->sec_solve;
+    st.candidate_pairs = s->candidates;
     st.memory_bytes = s->bytes;
     return st;
 }
