@@ -13803,8 +13803,10 @@ struct fsdem_mps {
     int counts[3];                /* particles per kind */
     /* neighbours: rows of every non-DUMMY particle (DUMMY rows are empty), columns ascending */
     fsdem_cellgrid grid;
-    int *cell_split;              /* per cell: where its DUMMY items start (they come last) */
+    int *cell_wall, *cell_dummy;  /* per cell: where its WALL and its DUMMY items start */
     int *pairs, pair_cap;         /* 2 per pair found by the cell scan */
+    int *solid_pairs, solid_pair_cap, solid_pair_n; /* the WALL-WALL and WALL-DUMMY pairs */
+    int solid_pairs_of;           /* WALL + DUMMY particles when they were found (-1: never) */
     int *nb_start;                /* n + 1 */
     int *tmp_start, *cursor;      /* n + 1 each: rows by column and fill cursors of the build */
     int *nb, *tmp_nb, nb_cap;     /* neighbour indices */
@@ -13997,10 +13999,12 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     if (r == FSDEM_OK)
         r = fsdem_cellgrid_setup(&s->grid, &s->allocator, s->dim, desc->domain_min, desc->domain_max, s->re, 0);
     if (r == FSDEM_OK) {
-        s->cell_split = (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)s->grid.cell_count);
-        if (!s->cell_split) r = FSDEM_ERR_OUT_OF_MEMORY;
-        else s->bytes += sizeof(int) * (size_t)s->grid.cell_count;
+        s->cell_wall = (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)s->grid.cell_count);
+        s->cell_dummy = (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)s->grid.cell_count);
+        if (!s->cell_wall || !s->cell_dummy) r = FSDEM_ERR_OUT_OF_MEMORY;
+        else s->bytes += 2 * sizeof(int) * (size_t)s->grid.cell_count;
     }
+    s->solid_pairs_of = -1;
     if (r != FSDEM_OK) {
         fsdem__log_oom(desc->log, desc->log_user, "fsdem_mps_create", sizeof *s);
         fsdem_mps_destroy(s);
@@ -14071,7 +14075,9 @@ void fsdem_mps_destroy(fsdem_mps *s) {
     fsdem__free(&s->allocator, s->a_val, sizeof(fsdem_real) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
     fsdem__gauges_free(&s->gauges, &s->allocator);
-    fsdem__free(&s->allocator, s->cell_split, sizeof(int) * (size_t)s->grid.cell_count);
+    fsdem__free(&s->allocator, s->cell_wall, sizeof(int) * (size_t)s->grid.cell_count);
+    fsdem__free(&s->allocator, s->cell_dummy, sizeof(int) * (size_t)s->grid.cell_count);
+    fsdem__free(&s->allocator, s->solid_pairs, sizeof(int) * (size_t)s->solid_pair_cap);
     fsdem_cellgrid_free(&s->grid);
     if (s->pcg) fsdem_pcg_destroy(s->pcg);
     al = s->allocator;
@@ -14371,26 +14377,16 @@ static int fsdem__mps_capacity(int have, long long need) {
    scan of the cell grid (as the DEM's pair search), put into unsorted rows, then copied column by
    column into the final rows, which leaves each sorted. Allocates only when the lists outgrow every
    earlier one. */
-static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
+/* Pairs within re from the cell scan, appended to *list (2 ints each, from pair *count on, the
+   array grown as needed; *examined counts the candidates). Every cell holds its FLUID items, then
+   its WALL items (from s->cell_wall[c]), then its DUMMY items (from s->cell_dummy[c]), so each kind
+   of pair is one range of a neighbouring cell: with `solid` = 0 the pairs with a FLUID particle,
+   with `solid` = 1 the WALL-WALL and WALL-DUMMY pairs. DUMMY-DUMMY pairs are never examined.
+   Returns FSDEM_ERR_OUT_OF_MEMORY when the list cannot grow. */
+static fsdem_result fsdem__mps_scan(fsdem_mps *s, int solid, int **list, int *cap, int *count, long long *examined) {
     const fsdem_cellgrid *g = &s->grid;
     const fsdem_real re2 = s->re * s->re;
-    long long examined = 0;
-    int c, f, a, b, i, e, count = 0;
-    if (fsdem_cellgrid_build(&s->grid, s->x, s->n) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
-    /* DUMMY items last in every cell (a stable partition; s->cursor is free until the rows are
-       built), so that a DUMMY particle is only ever paired with the non-DUMMY items of a cell: the
-       DUMMY-DUMMY pairs, most of those a solid's layers would give, are never examined. The rows
-       come out sorted by column whatever the pair order, so the neighbour list is unchanged. */
-    for (c = 0; c < g->cell_count; ++c) {
-        int k = g->cell_start[c], t = 0;
-        for (a = g->cell_start[c]; a < g->cell_start[c + 1]; ++a) {
-            const int p = g->items[a];
-            if (s->kind[p] == FSDEM_MPS_KIND_DUMMY) s->cursor[t++] = p;
-            else s->grid.items[k++] = p;
-        }
-        s->cell_split[c] = k;
-        if (t) memcpy(s->grid.items + k, s->cursor, sizeof(int) * (size_t)t);
-    }
+    int c, f, a, b;
     for (c = 0; c < g->cell_count; ++c) {
         int coord[3], cells[14], nf;
         if (g->cell_start[c] == g->cell_start[c + 1]) continue;
@@ -14399,31 +14395,80 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
         coord[2] = c / (g->n[0] * g->n[1]);
         nf = fsdem_cellgrid_forward(g, coord, cells);
         for (f = 0; f < nf; ++f)
-            for (a = g->cell_start[c]; a < g->cell_start[c + 1]; ++a) {
-                const int pa = g->items[a], dummy = a >= s->cell_split[c];
-                const int b0 = f == 0 ? a + 1 : g->cell_start[cells[f]];
-                const int b1 = dummy ? s->cell_split[cells[f]] : g->cell_start[cells[f] + 1];
+            for (a = solid ? s->cell_wall[c] : g->cell_start[c]; a < g->cell_start[c + 1]; ++a) {
+                const int pa = g->items[a], cf = cells[f], fluid = a < s->cell_wall[c], dummy = a >= s->cell_dummy[c];
+                int b0, b1;
+                if (!solid && fluid) b0 = f == 0 ? a + 1 : g->cell_start[cf], b1 = g->cell_start[cf + 1];
+                else if (!solid) b0 = f == 0 ? a : g->cell_start[cf], b1 = f == 0 ? a : s->cell_wall[cf];
+                else if (!dummy) b0 = f == 0 ? a + 1 : s->cell_wall[cf], b1 = g->cell_start[cf + 1];
+                else b0 = f == 0 ? a : s->cell_wall[cf], b1 = f == 0 ? a : s->cell_dummy[cf];
                 if (b1 <= b0) continue;
-                if (2 * ((long long)count + b1 - b0) > s->pair_cap) {
-                    const int cap = fsdem__mps_capacity(s->pair_cap, 2 * ((long long)count + b1 - b0));
-                    int *fresh = cap ? (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)cap) : NULL;
+                if (2 * ((long long)*count + b1 - b0) > *cap) {
+                    const int fresh_cap = fsdem__mps_capacity(*cap, 2 * ((long long)*count + b1 - b0));
+                    int *fresh = fresh_cap ? (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)fresh_cap) : NULL;
                     if (!fresh) return FSDEM_ERR_OUT_OF_MEMORY;
-                    if (count) memcpy(fresh, s->pairs, sizeof(int) * 2 * (size_t)count);
-                    fsdem__free(&s->allocator, s->pairs, sizeof(int) * (size_t)s->pair_cap);
-                    s->bytes += sizeof(int) * (size_t)(cap - s->pair_cap);
-                    s->pairs = fresh;
-                    s->pair_cap = cap;
+                    if (*count) memcpy(fresh, *list, sizeof(int) * 2 * (size_t)*count);
+                    fsdem__free(&s->allocator, *list, sizeof(int) * (size_t)*cap);
+                    s->bytes += sizeof(int) * (size_t)(fresh_cap - *cap);
+                    *list = fresh;
+                    *cap = fresh_cap;
                 }
-                examined += b1 - b0;
+                *examined += b1 - b0;
                 for (b = b0; b < b1; ++b) {
                     const int pb = g->items[b];
                     const fsdem_vec3 d = fsdem__sub(s->x[pa], s->x[pb]);
-                    s->pairs[2 * count] = pa;
-                    s->pairs[2 * count + 1] = pb;
-                    count += fsdem__dot(d, d) < re2;
+                    (*list)[2 * *count] = pa;
+                    (*list)[2 * *count + 1] = pb;
+                    *count += fsdem__dot(d, d) < re2;
                 }
             }
     }
+    return FSDEM_OK;
+}
+
+static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
+    const fsdem_cellgrid *g = &s->grid;
+    const int solids = s->counts[FSDEM_MPS_KIND_WALL] + s->counts[FSDEM_MPS_KIND_DUMMY];
+    long long examined = 0;
+    int c, a, i, e, count = 0;
+    if (fsdem_cellgrid_build(&s->grid, s->x, s->n) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    /* each cell's items in the order FLUID, WALL, DUMMY (stable; s->cursor and s->tmp_start are
+       free until the rows are built) */
+    for (c = 0; c < g->cell_count; ++c) {
+        int k = g->cell_start[c], nw = 0, nd = 0;
+        for (a = g->cell_start[c]; a < g->cell_start[c + 1]; ++a) {
+            const int p = g->items[a];
+            if (s->kind[p] == FSDEM_MPS_KIND_WALL) s->cursor[nw++] = p;
+            else if (s->kind[p] == FSDEM_MPS_KIND_DUMMY) s->tmp_start[nd++] = p;
+            else s->grid.items[k++] = p;
+        }
+        s->cell_wall[c] = k;
+        s->cell_dummy[c] = k + nw;
+        if (nw) memcpy(s->grid.items + k, s->cursor, sizeof(int) * (size_t)nw);
+        if (nd) memcpy(s->grid.items + k + nw, s->tmp_start, sizeof(int) * (size_t)nd);
+    }
+    /* WALL-WALL and WALL-DUMMY pairs: solids never move, so they are found once (again only after
+       solids were added or restored) and copied into every step's list */
+    if (s->solid_pairs_of != solids) {
+        long long once = 0;
+        s->solid_pair_n = 0;
+        if (fsdem__mps_scan(s, 1, &s->solid_pairs, &s->solid_pair_cap, &s->solid_pair_n, &once) != FSDEM_OK)
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        s->solid_pairs_of = solids;
+    }
+    if (fsdem__mps_scan(s, 0, &s->pairs, &s->pair_cap, &count, &examined) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    if (2 * ((long long)count + s->solid_pair_n) > s->pair_cap) {
+        const int cap = fsdem__mps_capacity(s->pair_cap, 2 * ((long long)count + s->solid_pair_n));
+        int *fresh = cap ? (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)cap) : NULL;
+        if (!fresh) return FSDEM_ERR_OUT_OF_MEMORY;
+        if (count) memcpy(fresh, s->pairs, sizeof(int) * 2 * (size_t)count);
+        fsdem__free(&s->allocator, s->pairs, sizeof(int) * (size_t)s->pair_cap);
+        s->bytes += sizeof(int) * (size_t)(cap - s->pair_cap);
+        s->pairs = fresh;
+        s->pair_cap = cap;
+    }
+    if (s->solid_pair_n) memcpy(s->pairs + 2 * (size_t)count, s->solid_pairs, sizeof(int) * 2 * (size_t)s->solid_pair_n);
+    count += s->solid_pair_n;
     s->pair_count = count;
     s->candidates = examined;
     /* directed entries (r, c): c in the row of r, for every non-DUMMY r; first bucketed by column c
@@ -17844,6 +17889,7 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
             s->us[i] = s->shift[i] = fsdem__zero3();
             s->unknown[i] = -1;
         }
+        s->solid_pairs_of = -1; /* the solids may be others: their pairs are found again */
     }
     fsdem__restart_tag(io, "MPS.");
 }

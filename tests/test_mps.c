@@ -282,6 +282,47 @@ START_TEST(test_mps_laplacian_radius) {
 }
 END_TEST
 
+/* WALL-WALL and WALL-DUMMY pairs are found once and reused while the solids stay: a restore brings
+   other solids under the same indices (here the same tank built after its water instead of
+   before, so the indices of the kinds are swapped and their counts equal); the object that had
+   stepped with its own solids continues exactly as the saved one does. */
+START_TEST(test_mps_restore_other_solids) {
+    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps *a, *b;
+    fsdem_mps_particles pa, pb;
+    void *buf;
+    size_t size = 0;
+    int k;
+    d.r0 = 0.02f;
+    d.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
+    d.domain_max = fsdem_v3(0.3f, 0.5f, 0);
+    ck_assert_int_eq(fsdem_mps_create(&d, &a), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_create(&d, &b), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_box_walls(a, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.4f, 0), 1u << FSDEM_SIDE_YMAX, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(a, fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.2f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(b, fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.2f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_box_walls(b, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.4f, 0), 1u << FSDEM_SIDE_YMAX, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_step(a), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_step(b), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_save_memory(a, NULL, 0, &size), FSDEM_OK);
+    buf = malloc(size);
+    ck_assert_int_eq(fsdem_mps_save_memory(a, buf, size, &size), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_restore_memory(b, buf, size), FSDEM_OK);
+    for (k = 0; k < 10; ++k) {
+        ck_assert_int_eq(fsdem_mps_step(a), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_step(b), FSDEM_OK);
+    }
+    pa = fsdem_mps_get_particles(a);
+    pb = fsdem_mps_get_particles(b);
+    ck_assert_int_eq(pa.count, pb.count);
+    ck_assert(memcmp(pa.position, pb.position, sizeof(fsdem_vec3) * (size_t)pa.count) == 0);
+    ck_assert_int_eq(fsdem_mps_get_stats(a).neighbours, fsdem_mps_get_stats(b).neighbours);
+    free(buf);
+    fsdem_mps_destroy(a);
+    fsdem_mps_destroy(b);
+}
+END_TEST
+
 /* The pressure matrix of a step is a valid symmetric CSR matrix (fsdem_csr_check) with a
    positive diagonal that dominates its row weakly everywhere and strictly somewhere (a row next
    to the free surface): irreducibly diagonally dominant, hence positive definite; checked also
@@ -725,6 +766,7 @@ Suite *mps_suite(void) {
     tcase_add_test(tc, test_mps_operators_exact);
     tcase_add_test(tc, test_mps_pressure_matrix_spd);
     tcase_add_test(tc, test_mps_laplacian_radius);
+    tcase_add_test(tc, test_mps_restore_other_solids);
     tcase_add_test(tc, test_mps_still_water);
     tcase_add_test(tc, test_mps_bad_input);
     tcase_add_test(tc, test_mps_null_policy);
