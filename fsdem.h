@@ -1930,7 +1930,9 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
    re = 4.1 r0). Fluid fills boxes on the same lattice (fsdem_mps_fill_box) or comes from a list.
 
    Step of dt (all sums at the positions r^m of the start of the step, over neighbours j within re):
-     1. neighbours (cell list on fsdem_cellgrid, cells of edge re), number density n_i (Eq. 7);
+     1. neighbours (cell list on fsdem_cellgrid, cells of edge re: the pairs with a FLUID particle
+        every step, the WALL-WALL and WALL-DUMMY pairs once, as solids never move, DUMMY-DUMMY
+        pairs never), number density n_i (Eq. 7);
      2. predictor u* = u + dt (nu lap(u) + g) for FLUID particles (Eq. 10 on u; solids u* = dt g, so
         a uniform body force makes no source of Eq. 12 at the walls: see step 4);
      3. free surface (FLUID and WALL particles): n_i < beta n0 (Eq. 14) or |F_i| > alpha |F0| (Eq.
