@@ -7378,7 +7378,8 @@ static void fsdem__stencil_ic_apply(const fsdem_pcg *s, const fsdem_real *r, fsd
 }
 
 /* CSR IC(0)/MIC(0), right-looking on the upper factor U (row k of U is column k of L). */
-static void fsdem__csr_ic_build(fsdem_pcg *s, fsdem_real tau) {
+/* The factor of A with its diagonal times (1 + shift); returns 0 when it overflowed. */
+static int fsdem__csr_ic_factor(fsdem_pcg *s, fsdem_real tau, fsdem_real shift) {
     const fsdem_csr *m = &s->csr;
     int n = m->rows, i, k, e, f, cnt = 0;
     fsdem_real safety = s->desc.ic_safety;
@@ -7387,9 +7388,9 @@ static void fsdem__csr_ic_build(fsdem_pcg *s, fsdem_real tau) {
         s->u_start[i] = cnt;
         for (e = m->row_start[i]; e < m->row_start[i + 1]; ++e)
             if (m->col[e] >= i) {
-                if (m->col[e] == i) diag0[i] = m->val[e];
+                if (m->col[e] == i) diag0[i] = m->val[e] * (1 + shift);
                 s->u_col[cnt] = m->col[e];
-                s->u_val[cnt++] = m->val[e];
+                s->u_val[cnt++] = m->col[e] == i ? m->val[e] * (1 + shift) : m->val[e];
             }
         s->u_pos[i] = -1;
     }
@@ -7418,6 +7419,26 @@ static void fsdem__csr_ic_build(fsdem_pcg *s, fsdem_real tau) {
             for (f = rb; f < re; ++f) s->u_pos[s->u_col[f]] = -1;
         }
     }
+    for (e = 0; e < cnt; ++e)
+        if (!fsdem__finite(s->u_val[e])) return 0;
+    return 1;
+}
+
+/* Incomplete Cholesky of a CSR matrix (MIC with tau > 0). A matrix that is positive definite but
+   not an M-matrix (positive off-diagonal entries, e.g. normal equations G^T G) can make the
+   factor's entries grow until they overflow, the pivot floor notwithstanding (MIC(0) on the
+   normal equations of a least-squares gradient did); then it is refactored with the diagonal
+   raised by a shift that grows fourfold from 1e-3 until the factor is finite (Manteuffel 1980,
+   Math. Comp. 34:473), as the last resort the diagonal alone (Jacobi). Matrices that factor as they
+   are get the factor they always had. */
+static void fsdem__csr_ic_build(fsdem_pcg *s, fsdem_real tau) {
+    fsdem_real shift = (fsdem_real)1e-3;
+    int e, k;
+    if (fsdem__csr_ic_factor(s, tau, 0)) return;
+    for (; shift < (fsdem_real)1e4; shift *= 4)
+        if (fsdem__csr_ic_factor(s, tau, shift)) return;
+    for (k = 0; k < s->csr.rows; ++k) /* Jacobi in the factor's form: U = diag^(1/2) (diagonal first) */
+        for (e = s->u_start[k]; e < s->u_start[k + 1]; ++e) s->u_val[e] = e == s->u_start[k] ? (fsdem_real)sqrt((double)s->ic[k]) : 0;
 }
 
 static void fsdem__csr_ic_apply(const fsdem_pcg *s, const fsdem_real *r, fsdem_real *z) {

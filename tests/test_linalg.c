@@ -1123,6 +1123,84 @@ START_TEST(failed_setup_keeps_previous_and_zero_rhs) {
 END_TEST
 
 
+/* Normal equations G^T G of the least-squares (corrected) gradient on an n x n lattice, radius 4.1
+   spacings, weight R/r - 1, the top row a Dirichlet boundary: symmetric positive definite with
+   positive off-diagonal entries (not an M-matrix). Dense assembly; n is small. */
+static void la_gradient_normal_equations(la_csr *a, int n) {
+    const double R = 4.1;
+    const int N = n * n, rows = N - n;
+    double *A = (double *)calloc((size_t)rows * (size_t)rows, sizeof(double));
+    int i, j, k, u, v;
+    for (i = 0; i < N; ++i) {
+        const double xi = i % n, yi = i / n;
+        double m00 = 0, m01 = 0, m11 = 0, det, gx = 0, gy = 0, cx[64], cy[64];
+        int nb[64], nn = 0, col[65];
+        double vx[65], vy[65];
+        for (k = 0; k < N; ++k) {
+            const double dx = k % n - xi, dy = k / n - yi, r2 = dx * dx + dy * dy;
+            double w;
+            if (k == i || r2 >= R * R) continue;
+            w = R / sqrt(r2) - 1;
+            m00 += w * dx * dx / r2;
+            m01 += w * dx * dy / r2;
+            m11 += w * dy * dy / r2;
+            nb[nn++] = k;
+        }
+        det = m00 * m11 - m01 * m01;
+        for (u = 0; u < nn; ++u) {
+            const double dx = nb[u] % n - xi, dy = nb[u] / n - yi, r2 = dx * dx + dy * dy, w = R / sqrt(r2) - 1;
+            cx[u] = (m11 * dx - m01 * dy) / det * w / r2;
+            cy[u] = (-m01 * dx + m00 * dy) / det * w / r2;
+            gx -= cx[u];
+            gy -= cy[u];
+        }
+        col[0] = i < rows ? i : -1; /* rows numbered from the bottom; the top row is Dirichlet */
+        vx[0] = gx;
+        vy[0] = gy;
+        for (u = 0; u < nn; ++u) {
+            col[u + 1] = nb[u] < rows ? nb[u] : -1;
+            vx[u + 1] = cx[u];
+            vy[u + 1] = cy[u];
+        }
+        for (u = 0; u <= nn; ++u)
+            for (v = 0; v <= nn; ++v)
+                if (col[u] >= 0 && col[v] >= 0) A[(size_t)col[u] * rows + col[v]] += vx[u] * vx[v] + vy[u] * vy[v];
+    }
+    la_csr_init(a, rows, rows * rows);
+    for (i = 0; i < rows; ++i) {
+        for (j = 0; j < rows; ++j)
+            if (A[(size_t)i * rows + j] != 0 || i == j) la_csr_push(a, j, (fsdem_real)A[(size_t)i * rows + j]);
+        a->row_start[i + 1] = a->nnz;
+    }
+    free(A);
+}
+
+/* IC(0) and MIC(0) on a positive definite matrix that is not an M-matrix: MIC(0)'s factor overflowed
+   there (the solve answered FSDEM_ERR_NAN); the shifted refactorisation converges, to the solution
+   of the other preconditioners. */
+START_TEST(ic_survives_normal_equations) {
+    la_csr a;
+    fsdem_real *x_ref;
+    int i, e, p, positive = 0;
+    static const fsdem_precond pcs[4] = {FSDEM_PRECOND_JACOBI, FSDEM_PRECOND_IC0, FSDEM_PRECOND_MIC0, FSDEM_PRECOND_AMG};
+    la_gradient_normal_equations(&a, 16);
+    for (i = 0; i < a.m.rows; ++i)
+        for (e = a.row_start[i]; e < a.row_start[i + 1]; ++e) positive += a.val[e] > 0 && a.col[e] != i;
+    ck_assert_int_gt(positive, a.m.rows); /* not an M-matrix */
+    x_ref = (fsdem_real *)calloc((size_t)a.m.rows, sizeof(fsdem_real));
+    {
+        fsdem_real *b = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)a.m.rows);
+        fsdem_pcg_info info;
+        for (i = 0; i < a.m.rows; ++i) b[i] = (fsdem_real)(1 + sin(0.1 * i) + 0.3 * cos(2.9 * i));
+        ck_assert_int_eq(la_solve_csr(&a.m, FSDEM_PRECOND_NONE, LA_POISSON_TOL, b, x_ref, &info), FSDEM_OK);
+        free(b);
+    }
+    for (p = 0; p < 4; ++p) la_csr_iterations(&a.m, pcs[p], x_ref);
+    free(x_ref);
+    la_csr_free(&a);
+}
+END_TEST
+
 /* ---- algebraic multigrid (CSR) ---- */
 
 /* Smoothed aggregation on the 2D Poisson matrix: the iteration count does not grow with the grid
@@ -1292,6 +1370,7 @@ Suite *linalg_suite(void) {
     TCase *amg = tcase_create("linalg_amg");
     tcase_add_test(csr, csr_random_spd_converges);
     tcase_add_test(csr, csr_and_stencil_agree);
+    tcase_add_test(csr, ic_survives_normal_equations);
     tcase_add_test(op, stencil_is_symmetric_positive_definite);
     tcase_add_test(op, stencil_poisson_eigenvector_is_recovered);
     tcase_add_test(mg, mg_iterations_are_mesh_independent);
