@@ -182,6 +182,21 @@ static fsdem_mps *test_tank(double r0, int max_iterations) {
     return m;
 }
 
+/* Steps two solvers `steps` times and asserts the same particles, positions and pressures, bit for bit. */
+static void test_same_run(fsdem_mps *a, fsdem_mps *b, int steps) {
+    fsdem_mps_particles pa, pb;
+    int k;
+    for (k = 0; k < steps; ++k) {
+        ck_assert_int_eq(fsdem_mps_step(a), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_step(b), FSDEM_OK);
+    }
+    pa = fsdem_mps_get_particles(a);
+    pb = fsdem_mps_get_particles(b);
+    ck_assert_int_eq(pa.count, pb.count);
+    ck_assert(memcmp(pa.position, pb.position, sizeof(fsdem_vec3) * (size_t)pa.count) == 0);
+    ck_assert(memcmp(pa.pressure, pb.pressure, sizeof(fsdem_real) * (size_t)pa.count) == 0);
+}
+
 /* desc.re_laplacian: the Laplacian (Eq. 10-11) on its own radius. On the lattice, lambda is that
    of the smaller radius by hand (re_laplacian = 2.1 r0, the figures of test_mps_lattice_constants)
    while n0 (Eq. 7) keeps re = 4.1 r0; the Laplacian of a quadratic field stays exact at interior
@@ -195,7 +210,7 @@ START_TEST(test_mps_laplacian_radius) {
     fsdem_mps *m, *ref;
     fsdem_mps_stats st, st_ref;
     fsdem_csr A;
-    fsdem_mps_particles p, q;
+    fsdem_mps_particles p;
     int i, dim, k;
     /* lattice constants */
     d.r0 = (fsdem_real)r0;
@@ -263,15 +278,7 @@ START_TEST(test_mps_laplacian_radius) {
     ck_assert_int_eq(fsdem_mps_create(&d, &ref), FSDEM_OK);
     ck_assert_int_eq(fsdem_mps_add_box_walls(ref, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.4f, 0), 1u << FSDEM_SIDE_YMAX, NULL), FSDEM_OK);
     ck_assert_int_eq(fsdem_mps_fill_box(ref, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.2f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
-    for (k = 0; k < 20; ++k) {
-        ck_assert_int_eq(fsdem_mps_step(m), FSDEM_OK);
-        ck_assert_int_eq(fsdem_mps_step(ref), FSDEM_OK);
-    }
-    p = fsdem_mps_get_particles(m);
-    q = fsdem_mps_get_particles(ref);
-    ck_assert_int_eq(p.count, q.count);
-    ck_assert(memcmp(p.position, q.position, sizeof(fsdem_vec3) * (size_t)p.count) == 0);
-    ck_assert(memcmp(p.pressure, q.pressure, sizeof(fsdem_real) * (size_t)p.count) == 0);
+    test_same_run(m, ref, 20);
     fsdem_mps_destroy(ref);
     /* refused radii */
     d.re_laplacian = (fsdem_real)(1.4 * r0);
@@ -289,10 +296,8 @@ END_TEST
 START_TEST(test_mps_restore_other_solids) {
     fsdem_mps_desc d = fsdem_mps_desc_default(2);
     fsdem_mps *a, *b;
-    fsdem_mps_particles pa, pb;
     void *buf;
     size_t size = 0;
-    int k;
     d.r0 = 0.02f;
     d.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
     d.domain_max = fsdem_v3(0.3f, 0.5f, 0);
@@ -308,14 +313,7 @@ START_TEST(test_mps_restore_other_solids) {
     buf = malloc(size);
     ck_assert_int_eq(fsdem_mps_save_memory(a, buf, size, &size), FSDEM_OK);
     ck_assert_int_eq(fsdem_mps_restore_memory(b, buf, size), FSDEM_OK);
-    for (k = 0; k < 10; ++k) {
-        ck_assert_int_eq(fsdem_mps_step(a), FSDEM_OK);
-        ck_assert_int_eq(fsdem_mps_step(b), FSDEM_OK);
-    }
-    pa = fsdem_mps_get_particles(a);
-    pb = fsdem_mps_get_particles(b);
-    ck_assert_int_eq(pa.count, pb.count);
-    ck_assert(memcmp(pa.position, pb.position, sizeof(fsdem_vec3) * (size_t)pa.count) == 0);
+    test_same_run(a, b, 10);
     ck_assert_int_eq(fsdem_mps_get_stats(a).neighbours, fsdem_mps_get_stats(b).neighbours);
     free(buf);
     fsdem_mps_destroy(a);
