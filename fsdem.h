@@ -1995,6 +1995,20 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
        2D still water drift    0.86 r0       0.70 r0       0.89 r0 (largest, at 0.5 s)
    so 3.1 r0 halves the matrix at no measured loss and 2.1 r0 lets the volume drift; the default
    stays the seed's re.
+   Periodic axes (desc.periodic): along them a pair interacts through its minimum image (the
+   cell grid's neighbourhoods wrap, every separation r_j - r_i of the operators, the DUMMY ghosts
+   and the probes is taken modulo the period), positions are wrapped into the domain after each
+   move and as particles are added, and tank walls are built with those sides open
+   (fsdem_mps_add_box_walls stops them at the box's faces, so they meet across the seam). The
+   period must be a whole number of r0 and exceed 2 re. Obstacles must not cross the seam; the
+   MPS-DEM coupler refuses a periodic MPS (its averaging does not wrap).
+   A liquid with no free surface (a closed or periodic box full of it) has a singular pressure
+   equation: the source's mean is removed and the lowest pressure set to 0 (fsdem__mps_assemble).
+   Viscosity at walls (desc.wall_viscosity): the no-slip ghost velocities of Adami, Hu and Adams
+   (2012) by default; with the old rule (WALL particles at rest, DUMMY ones out of Eq. 10) the wall
+   drags too little. The explicit viscous term limits the step to dt nu <= 0.8 lambda eps_min/(2d)
+   besides Eq. 37 (fsdem__mps_dt_viscous); for water at r0 = 1 cm that is 80 s, so only viscous
+   flows feel it.
    Units: m, s, kg/m^3, m^2/s (kinematic viscosity), Pa. In 2D the problem lies in the x-y plane.
    One step allocates nothing once its lists have reached their size (the neighbour list and the
    matrix grow by doubling when the particle arrangement needs more room than ever before). */
@@ -2031,6 +2045,21 @@ typedef enum fsdem_mps_gradient_model {
     FSDEM_MPS_GRADIENT_MODEL_CORRECTED = 2
 } fsdem_mps_gradient_model;
 
+/* The velocity the solids' particles carry into the viscous term (Eq. 10 on u, step 2). */
+typedef enum fsdem_mps_wall_viscosity {
+    /* no-slip by the ghost velocity of Adami, Hu and Adams (2012, J. Comput. Phys. 231:7057, Eq.
+       22-23): each WALL and DUMMY particle takes 2 u_w - u~ with u~ the kernel average (Shepard
+       sum, weights w_ij/eps_i of Eq. 7) of the FLUID velocities within re of it and u_w = 0
+       (solids are fixed), so the velocity passes through zero at the solid surface; the discrete
+       steady plane Poiseuille flow (2D, re = 4.1 r0) is then within 6.2 / 1.8 / 0.6 % of the
+       parabola at 10 / 20 / 40 rows (tests/test_mps.c measures it); the default */
+    FSDEM_MPS_WALL_VISCOSITY_NO_SLIP = 0,
+    /* WALL particles at rest, DUMMY particles left out (Eq. 10 over the non-DUMMY neighbours, as
+       the pressure equation): the wall drags too little, the steady Poiseuille centre speed 70 /
+       34 / 17 % above the parabola's at 10 / 20 / 40 rows; kept to reproduce older results */
+    FSDEM_MPS_WALL_VISCOSITY_AT_REST = 1
+} fsdem_mps_wall_viscosity;
+
 /* Form of the pressure equation's source with a porosity field (seed 002 §2.1). */
 typedef enum fsdem_mps_model {
     FSDEM_MPS_MODEL_A = 0, /* Eq. 12: rho_f in both terms of the mixed source */
@@ -2058,7 +2087,11 @@ typedef struct fsdem_mps_desc {
     fsdem_real dt_max;              /* s; longest step (taken while nothing moves); default 1e-3 */
     fsdem_vec3 domain_min;          /* m; every particle must stay inside; default (0,0,0) */
     fsdem_vec3 domain_max;          /* m; default (1,1,1) (z unused in 2D) */
+    int periodic[3];                /* 1: axis a is periodic, of period domain_max - domain_min: a */
+                                    /*    whole number of r0 (lattice fills meet without a seam) */
+                                    /*    and more than 2 re; default 0 (see the section notes) */
     fsdem_mps_gradient_model gradient; /* default FSDEM_MPS_GRADIENT_MODEL_MIN (see the enum) */
+    fsdem_mps_wall_viscosity wall_viscosity; /* default FSDEM_MPS_WALL_VISCOSITY_NO_SLIP (see the enum) */
     int clamp_negative_pressure;    /* 1: p < 0 is set to 0 after the solve; default 1 */
     fsdem_real collision_distance;  /* -; in units of r0: approaching FLUID particles that would */
                                     /*    come closer collide (step 6b), in [0, 1); 0 = off; */
@@ -3836,6 +3869,54 @@ void fsdem_cellgrid_free(fsdem_cellgrid *g) {
     g->cell_capacity = g->item_capacity = 0;
 }
 
+/* Periodic axes (DEM and MPS): along an axis of period L a pair interacts through its minimum
+   image, the separation e less the multiple of L nearest e / L, and positions are kept in
+   [lo, lo + L). Axes of length 0 are not periodic. */
+typedef struct fsdem__periods {
+    int any;                      /* some axis is periodic */
+    fsdem_real length[3], inv[3]; /* m, 1/m; 0 along the other axes */
+} fsdem__periods;
+
+/* The periods of the axes a < dim with periodic[a] set, those of the box [lo, hi]. */
+static fsdem__periods fsdem__periods_of(const int periodic[3], int dim, fsdem_vec3 lo, fsdem_vec3 hi) {
+    fsdem__periods p;
+    int a;
+    memset(&p, 0, sizeof p);
+    for (a = 0; a < dim; ++a)
+        if (periodic[a]) {
+            p.length[a] = fsdem__comp(hi, a) - fsdem__comp(lo, a);
+            p.inv[a] = 1 / p.length[a];
+            p.any = 1;
+        }
+    return p;
+}
+
+/* The minimum image of a separation e. */
+static fsdem_vec3 fsdem__min_image(const fsdem__periods *p, fsdem_vec3 e) {
+    if (p->any) {
+        e.x -= p->length[0] * (fsdem_real)floor(e.x * p->inv[0] + (fsdem_real)0.5);
+        e.y -= p->length[1] * (fsdem_real)floor(e.y * p->inv[1] + (fsdem_real)0.5);
+        e.z -= p->length[2] * (fsdem_real)floor(e.z * p->inv[2] + (fsdem_real)0.5);
+    }
+    return e;
+}
+
+/* Brings coordinate a of *x into [lo, hi) of a periodic axis (hi - lo its period); returns the
+   multiple of the period taken off (0 when it was inside). */
+static fsdem_real fsdem__wrap_axis(const fsdem__periods *p, int a, fsdem_real lo, fsdem_real hi, fsdem_vec3 *x) {
+    const fsdem_real L = p->length[a], c = fsdem__comp(*x, a);
+    fsdem_real shift, wrapped;
+    if (!(L > 0) || (c >= lo && c < hi)) return 0;
+    shift = L * (fsdem_real)floor((c - lo) * p->inv[a]);
+    wrapped = c - shift;
+    if (wrapped >= hi) { /* c - shift rounded up to the top */
+        wrapped -= L;
+        shift += L;
+    }
+    fsdem__set_comp(x, a, wrapped);
+    return shift;
+}
+
 /* ===== >>impl_dem : discrete element method ======================================================== */
 
 /* Contents: the object and its private types; >>dem_desc (defaults, validation, the time-step
@@ -3946,8 +4027,7 @@ struct fsdem_dem {
     int need_rebuild, forces_valid;
     int rolling;  /* some material pair has rolling resistance */
     int cohesive; /* some material pair has cohesion */
-    int periodic; /* some axis is periodic (>>dem_periodic) */
-    fsdem_real period[3], inv_period[3]; /* m, 1/m; 0 along the other axes */
+    fsdem__periods periods; /* the periodic axes (>>dem_periodic) */
     int external; /* fext/text may be nonzero (fsdem_dem_get_coupling handed them out, or a coupler wrote them) */
     int forces_cleared; /* f and t were zeroed by the last Verlet pass, for the force evaluation */
     int contacts, wall_contacts;
@@ -4646,43 +4726,23 @@ static fsdem_vec3 fsdem__dem_rolling_torque(fsdem_vec3 w_rel, fsdem_real mu_r, f
    reach while L exceeds twice the neighbour reach 2 r_max + contact_offset + skin, which
    fsdem_dem_add_particle checks. */
 
-/* The minimum image of a separation e. */
-static fsdem_vec3 fsdem__dem_min_image(const fsdem_dem *d, fsdem_vec3 e) {
-    if (d->periodic) {
-        e.x -= d->period[0] * (fsdem_real)floor(e.x * d->inv_period[0] + (fsdem_real)0.5);
-        e.y -= d->period[1] * (fsdem_real)floor(e.y * d->inv_period[1] + (fsdem_real)0.5);
-        e.z -= d->period[2] * (fsdem_real)floor(e.z * d->inv_period[2] + (fsdem_real)0.5);
-    }
-    return e;
-}
-
 /* Where particle i sees particle j: j's image nearest i; j itself, bit for bit, along the axes no
    period separates them (x_i - (x_i - x_j) is x_j only to rounding). */
 static fsdem_vec3 fsdem__dem_image_of(const fsdem_dem *d, int i, int j) {
     const fsdem_vec3 e = fsdem__sub(d->x[i], d->x[j]);
-    return fsdem__add(d->x[j], fsdem__sub(e, fsdem__dem_min_image(d, e)));
+    return fsdem__add(d->x[j], fsdem__sub(e, fsdem__min_image(&d->periods, e)));
 }
 
 /* Brings every position into [domain_min, domain_max) along the periodic axes, moving x_ref along. */
 static void fsdem__dem_wrap(fsdem_dem *d) {
     int a, i;
-    for (a = 0; a < 3; ++a) {
-        const fsdem_real lo = fsdem__comp(d->desc.domain_min, a), hi = fsdem__comp(d->desc.domain_max, a), L = d->period[a];
-        if (!(L > 0)) continue;
-        for (i = 0; i < d->n; ++i) {
-            const fsdem_real x = fsdem__comp(d->x[i], a);
-            fsdem_real shift, wrapped;
-            if (x >= lo && x < hi) continue;
-            shift = L * (fsdem_real)floor((x - lo) * d->inv_period[a]);
-            wrapped = x - shift;
-            if (wrapped >= hi) { /* x - shift rounded up to the top */
-                wrapped -= L;
-                shift += L;
+    for (a = 0; a < 3; ++a)
+        if (d->periods.length[a] > 0)
+            for (i = 0; i < d->n; ++i) {
+                const fsdem_real shift = fsdem__wrap_axis(&d->periods, a, fsdem__comp(d->desc.domain_min, a),
+                                                              fsdem__comp(d->desc.domain_max, a), &d->x[i]);
+                if (shift != 0) fsdem__set_comp(&d->x_ref[i], a, fsdem__comp(d->x_ref[i], a) - shift);
             }
-            fsdem__set_comp(&d->x[i], a, wrapped);
-            fsdem__set_comp(&d->x_ref[i], a, fsdem__comp(d->x_ref[i], a) - shift);
-        }
-    }
 }
 
 /* A particle of radius r keeps every minimum image unique: each period exceeds twice the reach of
@@ -4692,11 +4752,11 @@ static fsdem_result fsdem__dem_period_check(fsdem_dem *d, fsdem_real r) {
     const fsdem_real reach = 2 * r_max + d->desc.contact_offset + skin;
     int a;
     for (a = 0; a < 3; ++a)
-        if (d->period[a] > 0 && !(d->period[a] > 2 * reach))
+        if (d->periods.length[a] > 0 && !(d->periods.length[a] > 2 * reach))
             return fsdem__fail(&d->status, FSDEM_ERR_INVALID_ARG,
                                "fsdem_dem_particle_desc.radius %g m: the period %g m along %c must exceed twice the neighbour reach "
                                "2 r_max + contact_offset + skin = %g m",
-                               (double)r, (double)d->period[a], "xyz"[a], (double)reach);
+                               (double)r, (double)d->periods.length[a], "xyz"[a], (double)reach);
     return FSDEM_OK;
 }
 
@@ -4791,14 +4851,7 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     d->dt = desc->dt;
     d->grid.allocator = desc->allocator;
     d->need_rebuild = 1;
-    {
-        int a;
-        for (a = 0; a < 3; ++a) {
-            d->period[a] = desc->periodic[a] ? fsdem__comp(desc->domain_max, a) - fsdem__comp(desc->domain_min, a) : 0;
-            d->inv_period[a] = desc->periodic[a] ? 1 / d->period[a] : 0;
-            d->periodic |= desc->periodic[a];
-        }
-    }
+    d->periods = fsdem__periods_of(desc->periodic, desc->dim, desc->domain_min, desc->domain_max);
     {
         fsdem_real accel = desc->linear_accel > 0 ? desc->linear_accel : fsdem__norm(desc->gravity);
         d->k0_linear = fsdem__dem_seed000_stiffness(desc) ? accel / (desc->linear_theta * desc->linear_dx) : 0;
@@ -5001,7 +5054,7 @@ fsdem_result fsdem_dem_add_particle(fsdem_dem *d, const fsdem_dem_particle_desc 
                            "fsdem_dem_particle_desc.radius %g m gives mass %g kg and moment of inertia %g kg m^2, "
                            "which are not positive finite numbers",
                            (double)p->radius, (double)mass, (double)inertia);
-    if (d->periodic && (res = fsdem__dem_period_check(d, p->radius)) != FSDEM_OK) return res;
+    if (d->periods.any && (res = fsdem__dem_period_check(d, p->radius)) != FSDEM_OK) return res;
     if (fsdem__dem_reserve_particles(d, d->n + 1) != FSDEM_OK)
         return fsdem__fail(&d->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_dem_add_particle: out of memory adding particle %d", d->n);
     if (p->radius > d->r_max) d->r_max = p->radius; /* the periodic check's; a rebuild sets it anew */
@@ -5408,7 +5461,7 @@ FSDEM__FORCE_INLINE int fsdem__dem_find_pairs_in(fsdem_dem *d, const fsdem_vec3 
                     return -1;
                 for (b = b0; b < b1; ++b) {
                     /* arithmetic, not branches, which would mispredict */
-                    const fsdem_vec3 e = periodic ? fsdem__dem_min_image(d, fsdem__sub(xs[a], xs[b])) : fsdem__sub(xs[a], xs[b]);
+                    const fsdem_vec3 e = periodic ? fsdem__min_image(&d->periods, fsdem__sub(xs[a], xs[b])) : fsdem__sub(xs[a], xs[b]);
                     const fsdem_real ex = e.x, ey = e.y, ez = e.z;
                     const fsdem_real reach = reach_s[a] + reach_s[b];
                     d->found[2 * count] = a;
@@ -5422,7 +5475,7 @@ FSDEM__FORCE_INLINE int fsdem__dem_find_pairs_in(fsdem_dem *d, const fsdem_vec3 
 }
 
 static int fsdem__dem_find_pairs(fsdem_dem *d, const fsdem_vec3 *xs, const fsdem_real *reach_s) {
-    return d->periodic ? fsdem__dem_find_pairs_in(d, xs, reach_s, 1) : fsdem__dem_find_pairs_in(d, xs, reach_s, 0);
+    return d->periods.any ? fsdem__dem_find_pairs_in(d, xs, reach_s, 1) : fsdem__dem_find_pairs_in(d, xs, reach_s, 0);
 }
 
 /* The particle-pair list from the `count` pairs in d->found: row min(i, j), partner max(i, j), each
@@ -5656,7 +5709,7 @@ FSDEM__FORCE_INLINE void fsdem__dem_gather_pair(const fsdem_dem *d, fsdem__dem_b
                                             int uniform) {
     const int i = d->pp.first[k], key = d->pp.key[k], j = FSDEM__DEM_PARTNER(key);
     const fsdem_vec3 vi = d->v[i], vj = d->v[j], wi = d->w[i], wj = d->w[j];
-    const fsdem_vec3 e = fsdem__dem_min_image(d, fsdem__sub(d->x[i], d->x[j]));
+    const fsdem_vec3 e = fsdem__min_image(&d->periods, fsdem__sub(d->x[i], d->x[j]));
     const fsdem_vec3 spring = key & FSDEM__DEM_HELD ? d->pp.history[k] : fsdem__zero3();
     b->i[c] = i;
     b->other[c] = j;
@@ -5766,7 +5819,7 @@ FSDEM__FORCE_INLINE int fsdem__dem_touching(fsdem_dem *d, int *FSDEM__RESTRICT t
     int k, count = 0;
     for (k = 0; k < pairs; ++k) {
         const int key = keys[k], i = first[k], j = FSDEM__DEM_PARTNER(key);
-        const fsdem_vec3 e = periodic ? fsdem__dem_min_image(d, fsdem__sub(x[i], x[j])) : fsdem__sub(x[i], x[j]);
+        const fsdem_vec3 e = periodic ? fsdem__min_image(&d->periods, fsdem__sub(x[i], x[j])) : fsdem__sub(x[i], x[j]);
         const fsdem_real ex = e.x, ey = e.y, ez = e.z, reach = r[i] + r[j] + off;
         const int touch = ex * ex + ey * ey + ez * ez < reach * reach;
         touching[count] = k;
@@ -5812,7 +5865,7 @@ FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real 
     d->forces_cleared = 0;
     for (k = 0; k < d->wall_count; ++k) d->walls[k].force = fsdem__zero3();
     d->max_overlap = 0;
-    if (d->periodic) nt = commit ? fsdem__dem_touching(d, touching, 1, 1) : fsdem__dem_touching(d, touching, 0, 1);
+    if (d->periods.any) nt = commit ? fsdem__dem_touching(d, touching, 1, 1) : fsdem__dem_touching(d, touching, 0, 1);
     else nt = commit ? fsdem__dem_touching(d, touching, 1, 0) : fsdem__dem_touching(d, touching, 0, 0);
     b->count = 0;
     for (k = 0; k < nt; ++k) {
@@ -5979,7 +6032,7 @@ static fsdem_result fsdem__dem_step_verlet(fsdem_dem *d, fsdem_real h, int *susp
     if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     if (!d->forces_valid) fsdem__dem_compute_forces(d, h, 0);
     *suspect = fsdem__dem_kick_drift(d, h / 2, h);
-    if (d->periodic) fsdem__dem_wrap(d);
+    if (d->periods.any) fsdem__dem_wrap(d);
     fsdem__dem_move_walls(d, h);
     if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     fsdem__dem_compute_forces(d, h, 1);
@@ -6026,7 +6079,7 @@ static fsdem_result fsdem__dem_step_predictor_corrector(fsdem_dem *d, fsdem_real
     }
     for (k = 0; k < d->wall_count; ++k)
         d->walls[k].impulse = fsdem__madd(d->walls[k].impulse, fsdem__add(d->walls[k].force_a, d->walls[k].force), -h / 2);
-    if (d->periodic) fsdem__dem_wrap(d); /* the predicted positions need none: pairs take minimum images */
+    if (d->periods.any) fsdem__dem_wrap(d); /* the predicted positions need none: pairs take minimum images */
     d->forces_valid = 0; /* the last forces belong to the predicted state, not the final one */
     return FSDEM_OK;
 }
@@ -6094,7 +6147,7 @@ static fsdem_result fsdem__dem_advance_verlet(fsdem_dem *d, fsdem_real h, long l
     for (k = 0; k < count; ++k) {
         fsdem_result called = FSDEM_OK;
         suspect = fsdem__dem_kick_drift(d, open ? h : h / 2, h);
-        if (d->periodic) fsdem__dem_wrap(d);
+        if (d->periods.any) fsdem__dem_wrap(d);
         fsdem__dem_move_walls(d, h);
         if (fsdem__dem_ensure_lists(d) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
         fsdem__dem_compute_forces(d, h, 1);
@@ -6296,7 +6349,7 @@ fsdem_dem_energy fsdem_dem_get_energy(const fsdem_dem *d) {
         const fsdem__dem_pair *row = d->pairs + d->material[i] * nm;
         for (k = d->pp.start[i]; k < d->pp.start[i + 1]; ++k) {
             int j = FSDEM__DEM_PARTNER(d->pp.key[k]);
-            fsdem_real delta = d->r[i] + d->r[j] + d->desc.contact_offset - fsdem__norm(fsdem__dem_min_image(d, fsdem__sub(d->x[i], d->x[j])));
+            fsdem_real delta = d->r[i] + d->r[j] + d->desc.contact_offset - fsdem__norm(fsdem__min_image(&d->periods, fsdem__sub(d->x[i], d->x[j])));
             if (delta <= 0) continue;
             e.elastic += fsdem__dem_contact_energy(d, row + d->material[j], delta, (d->m[i] + d->m[j]) / 2,
                                                d->r[i] * d->r[j] / (d->r[i] + d->r[j]), fsdem__dem_spring(&d->pp, k));
@@ -13810,6 +13863,7 @@ struct fsdem_mps {
     fsdem_real n0, lambda, f0;    /* lattice constants (>>mps_desc): lambda with re_lap */
     fsdem_real n0_lap;            /* sum of the Laplacian's weights on the full lattice */
     int layers;                   /* WALL + DUMMY layers of a solid: ceil(re/r0) */
+    fsdem__periods periods;       /* the periodic axes (desc.periodic) */
     /* particles, structure of arrays, `cap` allocated */
     int n, cap;
     fsdem_vec3 *x, *v, *us;       /* position, velocity, predicted velocity u* */
@@ -13817,6 +13871,8 @@ struct fsdem_mps {
     fsdem_real *p, *eps, *nd;     /* pressure, porosity, number density */
     fsdem_vec3 *fext;             /* external force of a coupler (N; N/m in 2D), FLUID particles */
     fsdem_vec3 *gradp;            /* pressure gradient of the last corrector (Pa/m), FLUID particles */
+    fsdem_vec3 *uvisc;            /* velocity in the viscous term: u of FLUID, the ghost of solids */
+    fsdem_real *ghost_weight;     /* scratch of the ghost velocities: sum of the fluid weights */
     int external;                 /* fext may be nonzero (fsdem_mps_get_coupling handed it out) */
     fsdem_real *div, *b, *sol;    /* divergence of u*, right-hand side and solution (by unknown) */
     unsigned char *kind, *surf;
@@ -13840,6 +13896,7 @@ struct fsdem_mps {
     int *a_start, *a_col, a_cap;
     fsdem_real *a_val;
     int rows;
+    int closed;                   /* the last matrix had no surface neighbour (singular: see assembly) */
     fsdem_pcg *pcg;
     /* obstacles */
     fsdem__mps_obst *obst;
@@ -13873,6 +13930,7 @@ fsdem_mps_desc fsdem_mps_desc_default(int dim) {
     d.domain_min = fsdem_v3(0, 0, 0);
     d.domain_max = fsdem_v3(1, 1, 1);
     d.gradient = FSDEM_MPS_GRADIENT_MODEL_MIN;
+    d.wall_viscosity = FSDEM_MPS_WALL_VISCOSITY_NO_SLIP;
     d.clamp_negative_pressure = 1;
     d.collision_distance = (fsdem_real)0.8;
     d.restitution = (fsdem_real)0.2;
@@ -13928,8 +13986,23 @@ static fsdem_result fsdem__mps_check(const fsdem_mps_desc *d, char *msg, size_t 
             return fsdem__reject(msg, size, "fsdem_mps_desc.r0 = %g m is larger than the domain along %c (%g m)", (double)d->r0,
                                  "xyz"[a], (double)(fsdem__comp(d->domain_max, a) - fsdem__comp(d->domain_min, a)));
     }
+    for (a = 0; a < 3; ++a) {
+        const double period = (double)(fsdem__comp(d->domain_max, a) - fsdem__comp(d->domain_min, a)), spacings = period / (double)d->r0;
+        const double re = d->re > 0 ? (double)d->re : 4.1 * (double)d->r0;
+        if (d->periodic[a] == 0) continue;
+        if (d->periodic[a] != 1 || a >= d->dim)
+            return fsdem__reject(msg, size, "fsdem_mps_desc.periodic[%d] = %d must be 0 or 1 (0 for z in 2D)", a, d->periodic[a]);
+        if (fabs(spacings - floor(spacings + 0.5)) > 1e-6 * spacings)
+            return fsdem__reject(msg, size, "fsdem_mps_desc.periodic[%d]: the period %g m is %g spacings r0; it must be a whole number "
+                                 "of them, or lattice fills leave a seam", a, period, spacings);
+        if (!(period > 2 * re))
+            return fsdem__reject(msg, size, "fsdem_mps_desc.periodic[%d]: the period %g m must exceed 2 re = %g m (one image of a "
+                                 "particle within reach)", a, period, 2 * re);
+    }
     if ((int)d->gradient < 0 || (int)d->gradient > 2)
         return fsdem__reject(msg, size, "fsdem_mps_desc.gradient = %d is not a fsdem_mps_gradient_model", (int)d->gradient);
+    if ((int)d->wall_viscosity < 0 || (int)d->wall_viscosity > 1)
+        return fsdem__reject(msg, size, "fsdem_mps_desc.wall_viscosity = %d is not a fsdem_mps_wall_viscosity", (int)d->wall_viscosity);
     if ((int)d->model < 0 || (int)d->model > 1)
         return fsdem__reject(msg, size, "fsdem_mps_desc.model = %d is not a fsdem_mps_model", (int)d->model);
     if (!(d->collision_distance >= 0 && d->collision_distance < 1))
@@ -14006,6 +14079,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     s->re_lap = desc->re_laplacian > 0 ? desc->re_laplacian : s->re;
     s->desc.re_laplacian = s->re_lap;
     s->layers = (int)ceil((double)(s->re / s->r0) - 1e-9);
+    s->periods = fsdem__periods_of(desc->periodic, desc->dim, desc->domain_min, desc->domain_max);
     fsdem__mps_lattice(s);
     pd = fsdem_pcg_desc_default();
     /* AUTO: MIC(0) in 2D, Jacobi in 3D, where the incomplete factorisation of rows of ~280
@@ -14020,7 +14094,8 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     pd.allocator = desc->allocator;
     r = fsdem_pcg_create(&pd, &s->pcg);
     if (r == FSDEM_OK)
-        r = fsdem_cellgrid_setup(&s->grid, &s->allocator, s->dim, desc->domain_min, desc->domain_max, s->re, 0);
+        r = fsdem_cellgrid_setup_periodic(&s->grid, &s->allocator, s->dim, desc->domain_min, desc->domain_max, s->re, 0,
+                                          desc->periodic);
     if (r == FSDEM_OK) {
         s->cell_wall = (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)s->grid.cell_count);
         s->cell_dummy = (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)s->grid.cell_count);
@@ -14039,7 +14114,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
 
 /* The particle arrays of a capacity `cap`, with their element sizes (one list for allocation,
    copying and release). */
-#define FSDEM__MPS_ARRAYS 17
+#define FSDEM__MPS_ARRAYS 19
 static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     void **p[FSDEM__MPS_ARRAYS];
     size_t e[FSDEM__MPS_ARRAYS];
@@ -14066,6 +14141,8 @@ static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     FSDEM__MPS_ARRAY(body);
     FSDEM__MPS_ARRAY(unknown);
     FSDEM__MPS_ARRAY(row_particle);
+    FSDEM__MPS_ARRAY(uvisc);
+    FSDEM__MPS_ARRAY(ghost_weight);
 #undef FSDEM__MPS_ARRAY
     memcpy(ptr, p, sizeof p);
     memcpy(elem, e, sizeof e);
@@ -14167,16 +14244,25 @@ static fsdem_result fsdem__mps_check_point(fsdem_mps *s, const char *fn, int j, 
                            "%s: particle %d has a non-finite position or a velocity (%g, %g, %g) m/s above FSDEM_MAX_SPEED (%g m/s)", fn,
                            j, (double)v.x, (double)v.y, (double)v.z, (double)FSDEM_MAX_SPEED);
     for (a = 0; a < s->dim; ++a)
-        if (!(fsdem__comp(x, a) >= fsdem__comp(s->desc.domain_min, a) && fsdem__comp(x, a) <= fsdem__comp(s->desc.domain_max, a)))
+        if (!s->desc.periodic[a] &&
+            !(fsdem__comp(x, a) >= fsdem__comp(s->desc.domain_min, a) && fsdem__comp(x, a) <= fsdem__comp(s->desc.domain_max, a)))
             return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "%s: particle %d at (%g, %g, %g) m is outside the domain", fn,
                                j, (double)x.x, (double)x.y, (double)x.z);
     return FSDEM_OK;
 }
 
-/* Appends one particle (room reserved, point checked). */
+/* Brings x into the domain along the periodic axes. */
+static void fsdem__mps_wrap(const fsdem_mps *s, fsdem_vec3 *x) {
+    int a;
+    for (a = 0; a < s->dim; ++a)
+        fsdem__wrap_axis(&s->periods, a, fsdem__comp(s->desc.domain_min, a), fsdem__comp(s->desc.domain_max, a), x);
+}
+
+/* Appends one particle (room reserved, point checked), its position wrapped into the domain. */
 static void fsdem__mps_push(fsdem_mps *s, fsdem_mps_kind kind, fsdem_vec3 x, fsdem_vec3 v) {
     const int i = s->n++;
     if (s->dim == 2) x.z = v.z = 0;
+    fsdem__mps_wrap(s, &x);
     s->x[i] = x;
     s->v[i] = kind == FSDEM_MPS_KIND_FLUID ? v : fsdem__zero3();
     s->us[i] = s->v[i];
@@ -14387,6 +14473,11 @@ fsdem_result fsdem_mps_add_box_obstacle(fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3 
 
 /* ---- >>mps_neighbours : cell-list search into sorted neighbour rows ---- */
 
+/* r_j - r_i, through the minimum image along periodic axes. */
+static fsdem_vec3 fsdem__mps_sep(const fsdem_mps *s, int i, int j) {
+    return fsdem__min_image(&s->periods, fsdem__sub(s->x[j], s->x[i]));
+}
+
 /* Capacity for `need` entries: the next power-of-two multiple of 1024 (0 when it would overflow). */
 static int fsdem__mps_capacity(int have, long long need) {
     long long cap = have > 0 ? have : 1024;
@@ -14439,7 +14530,7 @@ static fsdem_result fsdem__mps_scan(fsdem_mps *s, int solid, int **list, int *ca
                 *examined += b1 - b0;
                 for (b = b0; b < b1; ++b) {
                     const int pb = g->items[b];
-                    const fsdem_vec3 d = fsdem__sub(s->x[pa], s->x[pb]);
+                    const fsdem_vec3 d = fsdem__mps_sep(s, pb, pa);
                     (*list)[2 * *count] = pa;
                     (*list)[2 * *count + 1] = pb;
                     *count += fsdem__dot(d, d) < re2;
@@ -14544,7 +14635,7 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     memcpy(s->cursor, s->tmp_start, sizeof(int) * (size_t)s->n);
     for (e = 0; e < count; ++e) {
         const int pa = s->pairs[2 * e], pb = s->pairs[2 * e + 1];
-        const fsdem_real r = fsdem__norm(fsdem__sub(s->x[pa], s->x[pb]));
+        const fsdem_real r = fsdem__norm(fsdem__mps_sep(s, pb, pa));
         const fsdem_real w = fsdem__kernel_mps(r, s->re);
         const fsdem_real wl = s->re_lap == s->re ? w : r < s->re_lap ? fsdem__kernel_mps(r, s->re_lap) : 0;
         if (s->kind[pa] != FSDEM_MPS_KIND_DUMMY) {
@@ -14587,7 +14678,7 @@ static int fsdem__mps_density(fsdem_mps *s) {
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
             const fsdem_real we = s->nbw[e] / s->eps[j];
-            const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
+            const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
             const fsdem_real len = fsdem__norm(r);
             nd += we;                                           /* seed 002 Eq. 7 */
             if (len > 0) F = fsdem__madd(F, r, we / len);       /* seed 002 Eq. 15 */
@@ -14615,7 +14706,7 @@ static void fsdem__mps_gradient_transform(const fsdem_mps *s, int i, fsdem_vec3 
     if (s->desc.gradient != FSDEM_MPS_GRADIENT_MODEL_CORRECTED) return;
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
-        const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
+        const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
         const double r2 = (double)fsdem__dot(r, r), rv[3] = {(double)r.x, (double)r.y, (double)r.z};
         if (!(r2 > 0)) continue;
         for (a = 0; a < 3; ++a)
@@ -14667,7 +14758,7 @@ static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, 
     fsdem__mps_gradient_transform(s, i, T);
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
-        const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
+        const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
         const fsdem_real r2 = fsdem__dot(r, r);
         fsdem_real pj = phi[j];
         if (s->kind[j] == FSDEM_MPS_KIND_DUMMY) {
@@ -14686,7 +14777,7 @@ static fsdem_real fsdem__mps_div_at(const fsdem_mps *s, const fsdem_vec3 *u, int
     int e;
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
-        const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
+        const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
         const fsdem_real r2 = fsdem__dot(r, r);
         if (s->kind[j] == FSDEM_MPS_KIND_DUMMY || !(r2 > 0)) continue;
         d += fsdem__dot(fsdem__sub(u[j], u[i]), r) * s->nbw[e] / (r2 * s->eps[j]);
@@ -14694,15 +14785,15 @@ static fsdem_real fsdem__mps_div_at(const fsdem_mps *s, const fsdem_vec3 *u, int
     return d * (fsdem_real)s->dim / s->n0;
 }
 
-/* Laplacian at particle i (seed 002 Eq. 10, lambda of Eq. 11) over its non-DUMMY neighbours, of
-   a scalar (phi) or, when phi is NULL, of a vector field u. */
-static fsdem_vec3 fsdem__mps_lap_at(const fsdem_mps *s, const fsdem_real *phi, const fsdem_vec3 *u, int i) {
+/* Laplacian at particle i (seed 002 Eq. 10, lambda of Eq. 11) of a scalar (phi) or, when phi is
+   NULL, of a vector field u, over its non-DUMMY neighbours, or all of them when `dummies`. */
+static fsdem_vec3 fsdem__mps_lap_at(const fsdem_mps *s, const fsdem_real *phi, const fsdem_vec3 *u, int i, int dummies) {
     fsdem_vec3 l = fsdem__zero3();
     int e;
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
         const fsdem_real we = s->nbl[e] / s->eps[j];
-        if (s->kind[j] == FSDEM_MPS_KIND_DUMMY) continue;
+        if (s->kind[j] == FSDEM_MPS_KIND_DUMMY && !dummies) continue;
         if (phi) l.x += (phi[j] - phi[i]) * we;
         else l = fsdem__madd(l, fsdem__sub(u[j], u[i]), we);
     }
@@ -14742,7 +14833,7 @@ fsdem_result fsdem_mps_laplacian(fsdem_mps *s, const fsdem_real *phi, fsdem_real
     int i;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((r = fsdem__mps_operator_setup(s, "fsdem_mps_laplacian", phi, out)) != FSDEM_OK) return r;
-    for (i = 0; i < s->n; ++i) out[i] = s->kind[i] == FSDEM_MPS_KIND_DUMMY ? 0 : fsdem__mps_lap_at(s, phi, NULL, i).x;
+    for (i = 0; i < s->n; ++i) out[i] = s->kind[i] == FSDEM_MPS_KIND_DUMMY ? 0 : fsdem__mps_lap_at(s, phi, NULL, i, 0).x;
     return fsdem__ok(&s->status);
 }
 
@@ -14775,11 +14866,51 @@ static fsdem_real fsdem__mps_mass(const fsdem_mps *s) {
     return s->desc.density * s->r0 * s->r0 * (s->dim == 3 ? s->r0 : 1);
 }
 
-/* The stable step of the CFL rule of seed 002 Eq. 37, u_max dt / r0 <= C, at most dt_max. */
+/* The longest step the explicit viscous term of the predictor (step 2) allows, dt nu <= 0.8
+   lambda eps_min / (2d) (s; infinite without viscosity). Eq. 10 on u at particle i, with
+   S_i = sum_j w_ij / eps_j, has its row in the disc of centre -c S_i and radius c S_i
+   (c = 2d / (lambda n0), Gershgorin; the ghost velocities of FSDEM_MPS_WALL_VISCOSITY_NO_SLIP are averages,
+   so the radius holds), so forward Euler is stable while dt nu c S_i <= 1; S_i = n0 / eps_min on a
+   full lattice, and the 0.8 leaves room for neighbourhoods crowded to 1.25 n0. */
+static fsdem_real fsdem__mps_dt_viscous(const fsdem_mps *s) {
+    fsdem_real eps_min = 1;
+    int i;
+    if (!(s->desc.viscosity > 0)) return (fsdem_real)HUGE_VAL;
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] != FSDEM_MPS_KIND_DUMMY && s->eps[i] < eps_min) eps_min = s->eps[i];
+    return (fsdem_real)0.8 * s->lambda * eps_min / (2 * (fsdem_real)s->dim * s->desc.viscosity);
+}
+
+/* The stable step: the CFL rule of seed 002 Eq. 37, u_max dt / r0 <= C, and the viscous limit,
+   at most dt_max. */
 static fsdem_real fsdem__mps_dt_from(const fsdem_mps *s, fsdem_real umax) {
+    const fsdem_real viscous = fsdem__mps_dt_viscous(s);
     fsdem_real dt = s->desc.dt_max;
     if (umax > 0 && s->desc.cfl * s->r0 / umax < dt) dt = s->desc.cfl * s->r0 / umax;
-    return dt;
+    return viscous < dt ? viscous : dt;
+}
+
+/* The ghost velocities of FSDEM_MPS_WALL_VISCOSITY_NO_SLIP into s->uvisc (see the enum): FLUID particles
+   their own velocity, WALL and DUMMY particles -u~, the Shepard average of the FLUID velocities
+   around them, gathered by scattering from the FLUID rows (the rows of DUMMY particles are empty);
+   0 where no FLUID particle is within re. */
+static void fsdem__mps_wall_ghosts(fsdem_mps *s) {
+    int i, e;
+    for (i = 0; i < s->n; ++i) {
+        s->uvisc[i] = s->kind[i] == FSDEM_MPS_KIND_FLUID ? s->v[i] : fsdem__zero3();
+        s->ghost_weight[i] = 0;
+    }
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
+            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+                const int j = s->nb[e];
+                const fsdem_real w = s->nbw[e] / s->eps[i];
+                if (s->kind[j] == FSDEM_MPS_KIND_FLUID) continue;
+                s->uvisc[j] = fsdem__madd(s->uvisc[j], s->v[i], w);
+                s->ghost_weight[j] += w;
+            }
+    for (i = 0; i < s->n; ++i)
+        if (s->ghost_weight[i] > 0) s->uvisc[i] = fsdem__scale(s->uvisc[i], -1 / s->ghost_weight[i]);
 }
 
 /* Makes room for the pressure matrix of `nnz` entries (by doubling). */
@@ -14833,7 +14964,7 @@ static void fsdem__mps_shift(fsdem_mps *s) {
         if (s->kind[i] != FSDEM_MPS_KIND_FLUID || s->surf[i] || D == 0) continue;
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
-            const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
+            const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
             const fsdem_real r2 = fsdem__dot(r, r);
             if (!(r2 > 0)) continue;
             band |= s->surf[j];
@@ -14872,7 +15003,7 @@ static void fsdem__mps_collide(fsdem_mps *s, fsdem_real dt) {
         if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         for (k = s->nb_start[i]; k < s->nb_start[i + 1]; ++k) {
             const int j = s->nb[k], fluid = s->kind[j] == FSDEM_MPS_KIND_FLUID;
-            const fsdem_vec3 r = fsdem__sub(s->x[j], s->x[i]);
+            const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
             const fsdem_vec3 dv = fsdem__sub(s->v[j], s->v[i]);
             const fsdem_vec3 ahead = fsdem__madd(r, dv, dt);
             fsdem_real len, vn;
@@ -14928,7 +15059,7 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
     const fsdem_real rho = s->desc.density, gamma = s->desc.gamma;
     const fsdem_real scale = -s->n0_lap * s->lambda / (2 * (fsdem_real)s->dim);
     long long nnz = 0;
-    int i, e, rows = 0;
+    int i, e, rows = 0, anchored = 0;
     for (i = 0; i < s->n; ++i) {
         int solid_only = 1;
         s->unknown[i] = -1;
@@ -14957,7 +15088,10 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
             const fsdem_real a = s->nbl[e] / (s->eps[i] * s->eps[j]);
             if (s->kind[j] == FSDEM_MPS_KIND_DUMMY || !(a > 0)) continue;
             diag += a;
-            if (s->unknown[j] < 0) continue;
+            if (s->unknown[j] < 0) { /* a surface neighbour: p = 0 there anchors the level */
+                anchored = 1;
+                continue;
+            }
             if (at < 0 && j > i) at = nnz++; /* the diagonal's place among ascending columns */
             s->a_col[nnz] = s->unknown[j];
             s->a_val[nnz++] = -a;
@@ -14978,11 +15112,23 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
             if (s->kind[j] != FSDEM_MPS_KIND_DUMMY) continue;
-            s->b[row] += rho * fsdem__dot(s->desc.gravity, fsdem__sub(s->x[j], s->x[i])) * s->nbl[e] / (s->eps[i] * s->eps[j]);
+            s->b[row] += rho * fsdem__dot(s->desc.gravity, fsdem__mps_sep(s, i, j)) * s->nbl[e] / (s->eps[i] * s->eps[j]);
         }
         s->sol[row] = s->p[i];
     }
     s->rows = rows;
+    /* No surface particle (a closed or periodic box full of liquid): the matrix is singular, the
+       constant its null space (its rows sum to 0); the source loses its mean, the part no pressure
+       can answer (for a liquid whose volume is fixed by its walls, the density error that
+       compression cannot remove), so that the system has solutions; the solve's level is then
+       set in fsdem__mps_do_step */
+    s->closed = rows > 0 && !anchored;
+    if (s->closed) {
+        double mean = 0;
+        for (i = 0; i < rows; ++i) mean += (double)s->b[i];
+        mean /= rows;
+        for (i = 0; i < rows; ++i) s->b[i] -= (fsdem_real)mean;
+    }
     return FSDEM_OK;
 }
 
@@ -14995,6 +15141,8 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     fsdem_csr A;
     fsdem_result r;
     clock_t t0 = clock(), t1, tp, ts, ta;
+    const int no_slip = s->desc.wall_viscosity == FSDEM_MPS_WALL_VISCOSITY_NO_SLIP && nu > 0;
+    const fsdem_vec3 *visc_u = no_slip ? s->uvisc : s->v;
     int i, a, bad = -1;
     if (s->counts[FSDEM_MPS_KIND_FLUID] == 0)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: no FLUID particles to step");
@@ -15016,14 +15164,16 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
        pressure equation (fsdem__mps_assemble), the discrete Neumann condition dp/dn = rho g.n.
        With u* = 0 at the solids instead, the source of the rows near a wall held only part of the
        weight (one-sided Eq. 9 against the one-sided Eq. 10): still water started with 0.7 rho g h
-       at the bottom and fell at 0.25-0.35 g in its first step. */
+       at the bottom and fell at 0.25-0.35 g in its first step. The viscous term takes the solids'
+       velocities of desc.wall_viscosity. */
+    if (no_slip) fsdem__mps_wall_ghosts(s);
     for (i = 0; i < s->n; ++i) {
         if (s->kind[i] != FSDEM_MPS_KIND_FLUID) {
             s->us[i] = fsdem__scale(s->desc.gravity, dt);
             if (s->dim == 2) s->us[i].z = 0;
             continue;
         }
-        s->us[i] = fsdem__add(s->v[i], fsdem__scale(fsdem__add(fsdem__scale(fsdem__mps_lap_at(s, NULL, s->v, i), nu),
+        s->us[i] = fsdem__add(s->v[i], fsdem__scale(fsdem__add(fsdem__scale(fsdem__mps_lap_at(s, NULL, visc_u, i, no_slip), nu),
                                                                 s->desc.gravity), dt));
         if (s->external) s->us[i] = fsdem__madd(s->us[i], s->fext[i], dt / mass); /* a coupler's force (Eq. 2, 4) */
         if (s->dim == 2) s->us[i].z = 0;
@@ -15061,7 +15211,14 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     s->sec_search += (double)(ts - t0) / CLOCKS_PER_SEC;
     s->sec_assembly += (double)(ta - tp) / CLOCKS_PER_SEC;
     s->sec_solve += (double)(t1 - ta) / CLOCKS_PER_SEC;
-    /* 4. pressures (clamped where asked), then the corrector: u = u* - dt/rho grad p, r += dt u */
+    /* 4. pressures (clamped where asked), then the corrector: u = u* - dt/rho grad p, r += dt u.
+       A closed liquid's pressure is known up to a constant: the lowest is set to 0 */
+    if (s->closed) {
+        fsdem_real low = s->sol[0];
+        for (i = 1; i < s->rows; ++i)
+            if (s->sol[i] < low) low = s->sol[i];
+        for (i = 0; i < s->rows; ++i) s->sol[i] -= low;
+    }
     for (i = 0; i < s->n; ++i) {
         fsdem_real p = s->unknown[i] >= 0 ? s->sol[s->unknown[i]] : 0;
         if (p < 0 && s->desc.clamp_negative_pressure) p = 0;
@@ -15080,7 +15237,10 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     fsdem__mps_obstacle_forces(s);
     fsdem__mps_collide(s, dt);
     for (i = 0; i < s->n; ++i)
-        if (s->kind[i] == FSDEM_MPS_KIND_FLUID) s->x[i] = fsdem__add(fsdem__madd(s->x[i], s->v[i], dt), s->shift[i]);
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID) {
+            s->x[i] = fsdem__add(fsdem__madd(s->x[i], s->v[i], dt), s->shift[i]);
+            fsdem__mps_wrap(s, &s->x[i]);
+        }
     s->time += (double)dt;
     s->dt_last = dt;
     s->steps++;
@@ -15095,7 +15255,8 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     for (i = 0; i < s->n; ++i) {
         if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         for (a = 0; a < s->dim; ++a)
-            if (fsdem__comp(s->x[i], a) < fsdem__comp(s->desc.domain_min, a) || fsdem__comp(s->x[i], a) > fsdem__comp(s->desc.domain_max, a))
+            if (!s->desc.periodic[a] &&
+                (fsdem__comp(s->x[i], a) < fsdem__comp(s->desc.domain_min, a) || fsdem__comp(s->x[i], a) > fsdem__comp(s->desc.domain_max, a)))
                 return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_DOMAIN, "fsdem_mps: step %lld: particle %d left the domain at (%g, %g, %g) m",
                                    s->steps, i, (double)s->x[i].x, (double)s->x[i].y, (double)s->x[i].z);
     }
@@ -15138,6 +15299,11 @@ fsdem_result fsdem_mps_step_dt(fsdem_mps *s, fsdem_real dt) {
                            "dt <= %g s)",
                            (double)dt, (double)(umax * dt / s->r0), (double)s->desc.cfl, who, (double)umax,
                            (double)(s->desc.cfl * s->r0 / umax));
+    if (dt > fsdem__mps_dt_viscous(s) * (1 + (fsdem_real)1e-5))
+        return fsdem__fail(&s->status, FSDEM_ERR_CFL,
+                           "fsdem_mps_step_dt: dt = %g s exceeds the viscous limit %g s of the explicit viscous term (nu = %g m^2/s; "
+                           "dt nu <= 0.8 lambda eps_min / (2d))",
+                           (double)dt, (double)fsdem__mps_dt_viscous(s), (double)s->desc.viscosity);
     return fsdem__mps_do_step(s, dt);
 }
 
@@ -15261,7 +15427,7 @@ static fsdem_real fsdem__mps_pressure_at(const fsdem_mps *s, fsdem_vec3 point, f
         fsdem_vec3 d;
         fsdem_real w;
         if (s->kind[i] == FSDEM_MPS_KIND_DUMMY) continue;
-        d = fsdem__sub(s->x[i], point);
+        d = fsdem__min_image(&s->periods, fsdem__sub(s->x[i], point));
         w = fsdem__mps_probe_weight(s, fsdem__dot(d, d), radius, 0);
         sum += (double)(w * s->p[i]);
         weights += (double)w;
@@ -15289,7 +15455,7 @@ static fsdem_real fsdem__mps_liquid_fraction(const fsdem_mps *s, fsdem_vec3 gaug
     for (i = 0; i < s->n; ++i) {
         fsdem_vec3 d;
         if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
-        d = fsdem__sub(s->x[i], gauge);
+        d = fsdem__min_image(&s->periods, fsdem__sub(s->x[i], gauge));
         f += (double)fsdem__mps_probe_weight(s, fsdem__dot(d, d), R, 1);
     }
     return (fsdem_real)(f * (double)volume);
@@ -15307,7 +15473,7 @@ static fsdem_real fsdem__mps_level(const fsdem_mps *s, fsdem_vec3 gauge) {
         fsdem_vec3 d;
         fsdem_real zi;
         if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
-        d = fsdem__sub(s->x[i], gauge);
+        d = fsdem__min_image(&s->periods, fsdem__sub(s->x[i], gauge));
         fsdem__set_comp(&d, up, 0);
         if (!(fsdem__dot(d, d) < R * R)) continue;
         zi = fsdem__comp(s->x[i], up);
@@ -15562,6 +15728,9 @@ fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, si
     md = fsdem_mps_get_desc(d->mps);
     if (dd.dim != md.dim)
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the DEM is %dD and the MPS %dD", dd.dim, md.dim);
+    if (md.periodic[0] || md.periodic[1] || md.periodic[2]) /* the averaging of Eq. 17-19 does not wrap yet */
+        return fsdem__reject(msg, size, "fsdem_mps_dem_desc: an MPS with periodic axes cannot be coupled yet (the porosity and "
+                             "drag averaging does not wrap)");
     if (fsdem__norm(fsdem__sub(dd.gravity, md.gravity)) > 1e-12 * fsdem__norm(md.gravity))
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the DEM gravity (%g, %g, %g) differs from the MPS's (%g, %g, %g) m/s^2",
                              (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)md.gravity.x,
@@ -17820,7 +17989,7 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
     int no = s->obst_n, n = s->n, cap = s->cap, i, a;
     fsdem__mps_obst *obst;
-    fsdem__restart_tag(io, "MPS3");
+    fsdem__restart_tag(io, "MPS4");
     fsdem__restart_same_int(io, d->dim, "dim");
     fsdem__restart_same_real(io, d->r0, "r0");
     fsdem__restart_same_real(io, d->re, "re");
@@ -17836,7 +18005,11 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_same_real(io, d->dt_max, "dt_max");
     fsdem__restart_same_vec3(io, d->domain_min, "domain_min");
     fsdem__restart_same_vec3(io, d->domain_max, "domain_max");
+    fsdem__restart_same_int(io, d->periodic[0], "periodic[0]");
+    fsdem__restart_same_int(io, d->periodic[1], "periodic[1]");
+    fsdem__restart_same_int(io, d->periodic[2], "periodic[2]");
     fsdem__restart_same_int(io, (int)d->gradient, "gradient");
+    fsdem__restart_same_int(io, (int)d->wall_viscosity, "wall_viscosity");
     fsdem__restart_same_int(io, d->clamp_negative_pressure, "clamp_negative_pressure");
     fsdem__restart_same_real(io, d->collision_distance, "collision_distance");
     fsdem__restart_same_real(io, d->restitution, "restitution");
@@ -19369,7 +19542,7 @@ static int fsdem__io_dem_contacts(const fsdem_dem *d, fsdem__dem_batch *b, fsdem
     for (k = 0; k < d->pp.count; ++k) {
         const int key = d->pp.key[k];
         const int p = d->pp.first[k], q = FSDEM__DEM_PARTNER(key);
-        const fsdem_vec3 e = fsdem__dem_min_image(d, fsdem__sub(d->x[p], d->x[q]));
+        const fsdem_vec3 e = fsdem__min_image(&d->periods, fsdem__sub(d->x[p], d->x[q]));
         const fsdem_real ex = e.x, ey = e.y, ez = e.z;
         const fsdem_real reach = d->r[p] + d->r[q] + off;
         if (!(ex * ex + ey * ey + ez * ez < reach * reach)) continue;

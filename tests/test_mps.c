@@ -182,8 +182,8 @@ static fsdem_mps *test_tank(double r0, int max_iterations) {
     return m;
 }
 
-/* Steps two solvers `steps` times and asserts the same particles, positions and pressures, bit for bit. */
-static void test_same_run(fsdem_mps *a, fsdem_mps *b, int steps) {
+/* Declared in fsdem_tests.h. */
+void test_same_run(fsdem_mps *a, fsdem_mps *b, int steps) {
     fsdem_mps_particles pa, pb;
     int k;
     for (k = 0; k < steps; ++k) {
