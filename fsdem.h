@@ -237,6 +237,8 @@
 #define fsdem_mps_add_box_obstacle fsdem_mps_add_box_obstacle_f
 #define fsdem_mps_add_box_walls fsdem_mps_add_box_walls_f
 #define fsdem_mps_add_gauge fsdem_mps_add_gauge_f
+#define fsdem_mps_add_inflow fsdem_mps_add_inflow_f
+#define fsdem_mps_add_outflow fsdem_mps_add_outflow_f
 #define fsdem_mps_add_particles fsdem_mps_add_particles_f
 #define fsdem_mps_advance fsdem_mps_advance_f
 #define fsdem_mps_create fsdem_mps_create_f
@@ -2153,6 +2155,44 @@ FSDEM_API fsdem_result fsdem_mps_add_box_walls(fsdem_mps *mps, fsdem_vec3 lo, fs
    Errors as fsdem_mps_fill_box. */
 FSDEM_API fsdem_result fsdem_mps_add_box_obstacle(fsdem_mps *mps, fsdem_vec3 lo, fsdem_vec3 hi, int *id);
 
+/* ---- open boundaries ----
+
+   An inflow feeds liquid through a plane at a prescribed velocity from a buffer of particles
+   upstream of it (the buffer zones of open-boundary ISPH and MPS): ceil(re/r0) lattice layers deep,
+   so the liquid next to the plane sees a full neighbourhood. Buffer particles are FLUID particles
+   whose velocity is imposed (speed along the axis; u* = u + dt g in the predictor, as walls take
+   the body force) and whose pressure is solved with the liquid's; one that crosses the plane
+   becomes ordinary liquid, and a new buffer particle takes its place ceil(re/r0) r0 upstream, so
+   the buffer keeps its lattice. An outflow removes liquid beyond a plane: FLUID particles past it
+   have p = 0 (Dirichlet, as the free surface) and keep their own motion; they are removed once
+   ceil(re/r0) r0 past it. Removal renumbers the particles after the removed ones (views and indices
+   are valid until the next step); stats count the particles in and out. Both need the MPS without
+   a coupler (fsdem_mps_dem_desc_check refuses them). Flow back through an inflow plane is not
+   handled (the buffer keeps its imposed velocity). */
+
+/* An inflow plane x_axis = position, liquid entering it moving at `speed` along direction e_axis. */
+typedef struct fsdem_mps_inflow_desc {
+    int axis;            /* 0 .. dim-1: the normal of the plane */
+    int direction;       /* +1: the liquid flows towards +axis (the buffer below `position`); -1: the reverse */
+    fsdem_real position; /* m; the plane */
+    fsdem_vec3 lo, hi;   /* m; the inlet's extent over the other axes, its lattice anchored at lo as */
+                         /*    fsdem_mps_fill_box's (components along `axis` ignored) */
+    fsdem_real speed;    /* m/s, > 0 and finite */
+} fsdem_mps_inflow_desc;
+/* Adds an inflow and fills its buffer (*added particles; may be NULL); the whole buffer, down to
+   ceil(re/r0) r0 upstream of the plane, must lie inside the domain. FSDEM_ERR_INVALID_ARG (a field
+   named), FSDEM_ERR_OUT_OF_DOMAIN, FSDEM_ERR_OUT_OF_MEMORY; nothing is added on error. */
+FSDEM_API fsdem_result fsdem_mps_add_inflow(fsdem_mps *mps, const fsdem_mps_inflow_desc *inflow, int *added);
+/* An outflow plane x_axis = position: liquid moving along direction e_axis leaves through it. */
+typedef struct fsdem_mps_outflow_desc {
+    int axis;            /* 0 .. dim-1 */
+    int direction;       /* +1: particles beyond it along +axis are leaving; -1: the reverse */
+    fsdem_real position; /* m; the plane; the zone ceil(re/r0) r0 past it must lie inside the domain */
+} fsdem_mps_outflow_desc;
+/* Adds an outflow. FSDEM_ERR_INVALID_ARG (a field named, or a zone outside the domain),
+   FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_mps_add_outflow(fsdem_mps *mps, const fsdem_mps_outflow_desc *outflow);
+
 /* Views of the particles (structure of arrays, index order = order of addition), valid until
    particles are added or the solver is destroyed. Steps update them in place. `velocity` of FLUID
    particles and `porosity` (eps_f in (0, 1], 1 by default; the 1/eps_j of Eq. 7-16, for a coupler)
@@ -2170,6 +2210,7 @@ typedef struct fsdem_mps_particles {
     fsdem_real *porosity;             /* -; eps_f per particle */
     const fsdem_vec3 *pressure_gradient; /* Pa/m; grad p of the last corrector at FLUID particles */
                                       /*    (desc.gradient form; 0 elsewhere and before a step) */
+    const int *inflow;                /* the inflow whose buffer holds the particle, or -1 */
     fsdem_real mass;                  /* kg (kg/m in 2D); the fluid of one particle, rho r0^d */
 } fsdem_mps_particles;
 
@@ -2252,6 +2293,8 @@ typedef struct fsdem_mps_stats {
     double seconds_solve;         /* ... in its preconditioner setup and solve (the rest of */
                                   /*    seconds_total: the operators of steps 2 and 6) */
     long long candidate_pairs;    /* pairs the last neighbour search examined (neighbours: kept) */
+    long long inflow_particles;   /* buffer particles that crossed an inflow plane, since creation */
+    long long outflow_particles;  /* particles removed past an outflow plane, since creation */
     size_t memory_bytes;          /* bytes held by the solver, its pcg included */
 } fsdem_mps_stats;
 
@@ -13842,7 +13885,8 @@ fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
 /* ===== >>impl_mps : MPS solver ===================================================================== */
 
 /* Contents: the object below; >>mps_desc (defaults, validation, lattice constants, creation),
-   >>mps_particles (storage, lattice fills, walls, obstacles), >>mps_neighbours (cell-list search
+   >>mps_particles (storage, lattice fills, walls, obstacles), >>mps_open (inflow and outflow
+   planes), >>mps_neighbours (cell-list search
    into sorted neighbour rows), >>mps_operators (number density, gradient, divergence, Laplacian,
    surface), >>mps_step (predictor, pressure equation, corrector, collisions, time stepping),
    >>mps_views (views, statistics), >>mps_probes (pressure, water level, obstacle force, gauges). */
@@ -13901,6 +13945,14 @@ struct fsdem_mps {
     /* obstacles */
     fsdem__mps_obst *obst;
     int obst_n, obst_cap;
+    /* open boundaries (>>mps_open) */
+    fsdem_mps_inflow_desc *inflows;
+    int inflow_n, inflow_cap;
+    fsdem_mps_outflow_desc *outflows;
+    int outflow_n, outflow_cap;
+    int *inlet;                   /* the inflow whose buffer holds each particle, or -1 */
+    int buffered;                 /* particles in inflow buffers */
+    long long inflow_total, outflow_total;
     fsdem__gauges gauges;
     /* time and statistics */
     double time;
@@ -14114,7 +14166,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
 
 /* The particle arrays of a capacity `cap`, with their element sizes (one list for allocation,
    copying and release). */
-#define FSDEM__MPS_ARRAYS 19
+#define FSDEM__MPS_ARRAYS 20
 static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     void **p[FSDEM__MPS_ARRAYS];
     size_t e[FSDEM__MPS_ARRAYS];
@@ -14143,6 +14195,7 @@ static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     FSDEM__MPS_ARRAY(row_particle);
     FSDEM__MPS_ARRAY(uvisc);
     FSDEM__MPS_ARRAY(ghost_weight);
+    FSDEM__MPS_ARRAY(inlet);
 #undef FSDEM__MPS_ARRAY
     memcpy(ptr, p, sizeof p);
     memcpy(elem, e, sizeof e);
@@ -14174,6 +14227,8 @@ void fsdem_mps_destroy(fsdem_mps *s) {
     fsdem__free(&s->allocator, s->a_col, sizeof(int) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->a_val, sizeof(fsdem_real) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
+    fsdem__free(&s->allocator, s->inflows, sizeof *s->inflows * (size_t)s->inflow_cap);
+    fsdem__free(&s->allocator, s->outflows, sizeof *s->outflows * (size_t)s->outflow_cap);
     fsdem__gauges_free(&s->gauges, &s->allocator);
     fsdem__free(&s->allocator, s->cell_wall, sizeof(int) * (size_t)s->grid.cell_count);
     fsdem__free(&s->allocator, s->cell_dummy, sizeof(int) * (size_t)s->grid.cell_count);
@@ -14274,6 +14329,7 @@ static void fsdem__mps_push(fsdem_mps *s, fsdem_mps_kind kind, fsdem_vec3 x, fsd
     s->kind[i] = (unsigned char)kind;
     s->surf[i] = 0;
     s->body[i] = -1;
+    s->inlet[i] = -1;
     s->unknown[i] = -1;
     s->counts[kind]++;
 }
@@ -14372,6 +14428,21 @@ static int fsdem__mps_layer_inside(const fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3
     return (int)ceil((double)(depth / s->r0) - 1e-6);
 }
 
+/* Room for one more entry in a list of n entries of `elem` bytes (obstacles, inflows, outflows),
+   grown by doubling; 0 when out of memory. */
+static int fsdem__mps_list_room(fsdem_mps *s, void **list, int *cap, int n, size_t elem) {
+    const int fresh_cap = *cap ? 2 * *cap : 4;
+    void *fresh;
+    if (n < *cap) return 1;
+    if (!(fresh = fsdem__alloc(&s->allocator, elem * (size_t)fresh_cap))) return 0;
+    if (n) memcpy(fresh, *list, elem * (size_t)n);
+    fsdem__free(&s->allocator, *list, elem * (size_t)*cap);
+    s->bytes += elem * (size_t)(fresh_cap - *cap);
+    *list = fresh;
+    *cap = fresh_cap;
+    return 1;
+}
+
 /* Fluid: inside the fill box and outside every obstacle. */
 static int fsdem__mps_classify_fluid(const fsdem_mps *s, const void *user, fsdem_vec3 p) {
     int o;
@@ -14447,16 +14518,8 @@ fsdem_result fsdem_mps_add_box_obstacle(fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3 
     if (id) *id = -1;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((r = fsdem__mps_check_box(s, "fsdem_mps_add_box_obstacle", lo, hi)) != FSDEM_OK) return r;
-    if (s->obst_n == s->obst_cap) {
-        const int cap = s->obst_cap ? 2 * s->obst_cap : 4;
-        fsdem__mps_obst *o = (fsdem__mps_obst *)fsdem__alloc(&s->allocator, sizeof *o * (size_t)cap);
-        if (!o) return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_box_obstacle: out of memory");
-        if (s->obst_n) memcpy(o, s->obst, sizeof *o * (size_t)s->obst_n);
-        fsdem__free(&s->allocator, s->obst, sizeof *o * (size_t)s->obst_cap);
-        s->bytes += sizeof *o * (size_t)(cap - s->obst_cap);
-        s->obst = o;
-        s->obst_cap = cap;
-    }
+    if (!fsdem__mps_list_room(s, (void **)&s->obst, &s->obst_cap, s->obst_n, sizeof *s->obst))
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_box_obstacle: out of memory");
     box.lo = lo;
     box.hi = hi;
     box.force = fsdem__zero3();
@@ -14469,6 +14532,140 @@ fsdem_result fsdem_mps_add_box_obstacle(fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3 
     if (id) *id = s->obst_n;
     s->obst_n++;
     return fsdem__ok(&s->status);
+}
+
+/* ---- >>mps_open : inflow and outflow planes ---- */
+
+/* The signed distance of particle i past an open plane along its direction (m). */
+static fsdem_real fsdem__mps_past(const fsdem_mps *s, int i, int axis, int direction, fsdem_real position) {
+    return (fsdem__comp(s->x[i], axis) - position) * (fsdem_real)direction;
+}
+
+/* Depth of an inflow buffer and of an outflow zone: the reach of the kernel, ceil(re/r0) r0. */
+static fsdem_real fsdem__mps_open_depth(const fsdem_mps *s) { return (fsdem_real)s->layers * s->r0; }
+
+/* Checks the axis, direction and plane of an open boundary (`what` names the desc): the zone
+   `depth` behind (`upstream`) or past the plane inside the domain, the axis not periodic. */
+static fsdem_result fsdem__mps_check_plane(fsdem_mps *s, const char *what, int axis, int direction, fsdem_real position,
+                                           int upstream) {
+    fsdem_real far;
+    if (axis < 0 || axis >= s->dim)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s.axis = %d must be in [0, %d)", what, axis, s->dim);
+    if (direction != 1 && direction != -1)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s.direction = %d must be +1 or -1", what, direction);
+    if (s->desc.periodic[axis])
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s.axis = %d is periodic", what, axis);
+    far = position + (fsdem_real)(upstream ? -direction : direction) * fsdem__mps_open_depth(s);
+    if (!fsdem__finite(position) || !(far >= fsdem__comp(s->desc.domain_min, axis) && far <= fsdem__comp(s->desc.domain_max, axis)) ||
+        !(position >= fsdem__comp(s->desc.domain_min, axis) && position <= fsdem__comp(s->desc.domain_max, axis)))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "%s.position = %g m: the plane and its zone, %g m %s it, must lie inside the domain along %c", what,
+                           (double)position, (double)fsdem__mps_open_depth(s), upstream ? "upstream of" : "past", "xyz"[axis]);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in, int *added) {
+    fsdem_vec3 anchor, from, to, u = fsdem__zero3();
+    fsdem_result r;
+    int first, i, count = 0;
+    if (added) *added = 0;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!in) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_inflow: inflow is NULL");
+    if (s->external) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_inflow: the MPS is coupled");
+    if ((r = fsdem__mps_check_plane(s, "fsdem_mps_inflow_desc", in->axis, in->direction, in->position, 1)) != FSDEM_OK) return r;
+    if (!(in->speed > 0 && in->speed <= FSDEM_MAX_SPEED))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_inflow_desc.speed = %g m/s must be in (0, FSDEM_MAX_SPEED]",
+                           (double)in->speed);
+    anchor = in->lo;
+    from = in->lo;
+    to = in->hi;
+    fsdem__set_comp(&anchor, in->axis, in->position);
+    fsdem__set_comp(&from, in->axis, in->position - (in->direction > 0 ? fsdem__mps_open_depth(s) : 0));
+    fsdem__set_comp(&to, in->axis, in->position + (in->direction < 0 ? fsdem__mps_open_depth(s) : 0));
+    if ((r = fsdem__mps_check_box(s, "fsdem_mps_add_inflow", from, to)) != FSDEM_OK) return r;
+    fsdem__set_comp(&u, in->axis, in->speed * (fsdem_real)in->direction);
+    if (!fsdem__mps_list_room(s, (void **)&s->inflows, &s->inflow_cap, s->inflow_n, sizeof *s->inflows))
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_inflow: out of memory");
+    first = s->n;
+    r = fsdem__mps_lattice_fill(s, "fsdem_mps_add_inflow", anchor, from, to, fsdem__mps_classify_fluid, NULL, u, &count);
+    if (r != FSDEM_OK) return r;
+    for (i = first; i < s->n; ++i) s->inlet[i] = s->inflow_n;
+    s->inflows[s->inflow_n++] = *in;
+    s->buffered += count;
+    if (added) *added = count;
+    return fsdem__ok(&s->status);
+}
+
+fsdem_result fsdem_mps_add_outflow(fsdem_mps *s, const fsdem_mps_outflow_desc *out) {
+    fsdem_result r;
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (!out) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_outflow: outflow is NULL");
+    if (s->external) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_outflow: the MPS is coupled");
+    if ((r = fsdem__mps_check_plane(s, "fsdem_mps_outflow_desc", out->axis, out->direction, out->position, 0)) != FSDEM_OK) return r;
+    if (!fsdem__mps_list_room(s, (void **)&s->outflows, &s->outflow_cap, s->outflow_n, sizeof *s->outflows))
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_outflow: out of memory");
+    s->outflows[s->outflow_n++] = *out;
+    return fsdem__ok(&s->status);
+}
+
+/* How far FLUID particle i is past the outflow planes it has crossed (the largest), or 0. */
+static fsdem_real fsdem__mps_outflowing(const fsdem_mps *s, int i) {
+    fsdem_real most = 0;
+    int k;
+    for (k = 0; k < s->outflow_n; ++k) {
+        const fsdem_mps_outflow_desc *o = &s->outflows[k];
+        const fsdem_real past = fsdem__mps_past(s, i, o->axis, o->direction, o->position);
+        if (past > most) most = past;
+    }
+    return most;
+}
+
+/* The imposed velocity of the buffer particles of inflow k. */
+static fsdem_vec3 fsdem__mps_inflow_velocity(const fsdem_mps *s, int k) {
+    fsdem_vec3 u = fsdem__zero3();
+    fsdem__set_comp(&u, s->inflows[k].axis, s->inflows[k].speed * (fsdem_real)s->inflows[k].direction);
+    return u;
+}
+
+/* After a move: buffer particles past their plane become liquid, each replaced by a new one the
+   buffer's depth upstream (room reserved at the start of the step); FLUID particles the zone's
+   depth past an outflow plane are removed, the others keeping their order. */
+static void fsdem__mps_open_update(fsdem_mps *s) {
+    const fsdem_real depth = fsdem__mps_open_depth(s);
+    const int n = s->n;
+    void **ptr[FSDEM__MPS_ARRAYS];
+    size_t elem[FSDEM__MPS_ARRAYS];
+    int i, k, kept = 0, solids_after = 0, arrays;
+    for (i = 0; i < n; ++i) {
+        const int in = s->inlet[i];
+        fsdem_vec3 x;
+        if (in < 0 || fsdem__mps_past(s, i, s->inflows[in].axis, s->inflows[in].direction, s->inflows[in].position) < 0) continue;
+        s->inlet[i] = -1;
+        s->buffered--;
+        s->inflow_total++;
+        x = s->x[i];
+        fsdem__set_comp(&x, s->inflows[in].axis, fsdem__comp(x, s->inflows[in].axis) - (fsdem_real)s->inflows[in].direction * depth);
+        fsdem__mps_push(s, FSDEM_MPS_KIND_FLUID, x, fsdem__mps_inflow_velocity(s, in));
+        s->inlet[s->n - 1] = in;
+        s->buffered++;
+    }
+    if (s->outflow_n == 0) return;
+    arrays = fsdem__mps_arrays(s, ptr, elem);
+    for (i = 0; i < s->n; ++i) {
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID && s->inlet[i] < 0 && fsdem__mps_outflowing(s, i) >= depth) {
+            s->counts[FSDEM_MPS_KIND_FLUID]--;
+            s->outflow_total++;
+            continue;
+        }
+        if (kept < i) {
+            for (k = 0; k < arrays; ++k)
+                memcpy((char *)*ptr[k] + elem[k] * (size_t)kept, (char *)*ptr[k] + elem[k] * (size_t)i, elem[k]);
+            solids_after |= s->kind[kept] != FSDEM_MPS_KIND_FLUID;
+        }
+        ++kept;
+    }
+    s->n = kept;
+    if (solids_after) s->solid_pairs_of = -1; /* solids renumbered: their pairs are found again */
 }
 
 /* ---- >>mps_neighbours : cell-list search into sorted neighbour rows ---- */
@@ -14961,7 +15158,7 @@ static void fsdem__mps_shift(fsdem_mps *s) {
         fsdem_real len;
         int band = 0;
         s->shift[i] = fsdem__zero3();
-        if (s->kind[i] != FSDEM_MPS_KIND_FLUID || s->surf[i] || D == 0) continue;
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID || s->surf[i] || s->inlet[i] >= 0 || D == 0) continue;
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
             const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
@@ -15064,6 +15261,7 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
         int solid_only = 1;
         s->unknown[i] = -1;
         if (s->kind[i] == FSDEM_MPS_KIND_DUMMY || s->surf[i]) continue;
+        if (s->outflow_n && s->kind[i] == FSDEM_MPS_KIND_FLUID && fsdem__mps_outflowing(s, i) > 0) continue; /* p = 0 */
         for (e = s->nb_start[i]; e < s->nb_start[i + 1] && solid_only; ++e)
             solid_only = s->kind[s->nb[e]] == FSDEM_MPS_KIND_DUMMY || s->nbl[e] == 0;
         if (solid_only) continue;
@@ -15150,6 +15348,8 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         if (!(s->eps[i] > 0 && s->eps[i] <= 1))
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: particle %d has porosity %g outside (0, 1]", i,
                                (double)s->eps[i]);
+    if (fsdem__mps_reserve(s, s->n + s->buffered) != FSDEM_OK) /* the inflows' new particles of this step */
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory for the inflows' particles");
     fsdem__series_begin(&s->gauges.series);
     /* 1. neighbours, number density, free surface */
     if (fsdem__mps_neighbours(s) != FSDEM_OK)
@@ -15168,8 +15368,8 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
        velocities of desc.wall_viscosity. */
     if (no_slip) fsdem__mps_wall_ghosts(s);
     for (i = 0; i < s->n; ++i) {
-        if (s->kind[i] != FSDEM_MPS_KIND_FLUID) {
-            s->us[i] = fsdem__scale(s->desc.gravity, dt);
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID || s->inlet[i] >= 0) { /* solids at rest, inflow buffers at their speed */
+            s->us[i] = fsdem__madd(s->v[i], s->desc.gravity, dt);
             if (s->dim == 2) s->us[i].z = 0;
             continue;
         }
@@ -15237,10 +15437,16 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     fsdem__mps_obstacle_forces(s);
     fsdem__mps_collide(s, dt);
     for (i = 0; i < s->n; ++i)
+        if (s->inlet[i] >= 0) { /* inflow buffers move at their imposed velocity */
+            s->v[i] = fsdem__mps_inflow_velocity(s, s->inlet[i]);
+            s->gradp[i] = fsdem__zero3();
+        }
+    for (i = 0; i < s->n; ++i)
         if (s->kind[i] == FSDEM_MPS_KIND_FLUID) {
             s->x[i] = fsdem__add(fsdem__madd(s->x[i], s->v[i], dt), s->shift[i]);
             fsdem__mps_wrap(s, &s->x[i]);
         }
+    fsdem__mps_open_update(s);
     s->time += (double)dt;
     s->dt_last = dt;
     s->steps++;
@@ -15347,6 +15553,7 @@ fsdem_mps_particles fsdem_mps_get_particles(fsdem_mps *s) {
     v.number_density = s->nd;
     v.porosity = s->eps;
     v.pressure_gradient = s->gradp;
+    v.inflow = s->inlet;
     v.mass = fsdem__mps_mass(s);
     return v;
 }
@@ -15404,6 +15611,8 @@ fsdem_mps_stats fsdem_mps_get_stats(const fsdem_mps *s) {
     st.seconds_assembly = s->sec_assembly;
     st.seconds_solve = s->sec_solve;
     st.candidate_pairs = s->candidates;
+    st.inflow_particles = s->inflow_total;
+    st.outflow_particles = s->outflow_total;
     st.memory_bytes = s->bytes;
     return st;
 }
@@ -15731,6 +15940,8 @@ fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, si
     if (md.periodic[0] || md.periodic[1] || md.periodic[2]) /* the averaging of Eq. 17-19 does not wrap yet */
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: an MPS with periodic axes cannot be coupled yet (the porosity and "
                              "drag averaging does not wrap)");
+    if (d->mps->inflow_n || d->mps->outflow_n) /* the coupler's per-particle records do not follow removals */
+        return fsdem__reject(msg, size, "fsdem_mps_dem_desc: an MPS with inflows or outflows cannot be coupled yet");
     if (fsdem__norm(fsdem__sub(dd.gravity, md.gravity)) > 1e-12 * fsdem__norm(md.gravity))
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the DEM gravity (%g, %g, %g) differs from the MPS's (%g, %g, %g) m/s^2",
                              (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)md.gravity.x,
@@ -17987,9 +18198,11 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     const fsdem_mps_desc *d = &s->desc;
     const fsdem_allocator *al = &s->allocator;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
-    int no = s->obst_n, n = s->n, cap = s->cap, i, a;
+    int no = s->obst_n, nin = s->inflow_n, nout = s->outflow_n, n = s->n, cap = s->cap, i, a;
     fsdem__mps_obst *obst;
-    fsdem__restart_tag(io, "MPS4");
+    fsdem_mps_inflow_desc *inflows;
+    fsdem_mps_outflow_desc *outflows;
+    fsdem__restart_tag(io, "MPS5");
     fsdem__restart_same_int(io, d->dim, "dim");
     fsdem__restart_same_real(io, d->r0, "r0");
     fsdem__restart_same_real(io, d->re, "re");
@@ -18038,6 +18251,26 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     }
     fsdem__restart_data(io, s->obst, sizeof *s->obst * (size_t)no);
 
+    /* open boundaries, into fresh arrays */
+    fsdem__restart_count(io, &nin, 1 << 24, sizeof(fsdem_mps_inflow_desc), "inflow count");
+    inflows = (fsdem_mps_inflow_desc *)fsdem__restart_block(io, al, sizeof *inflows * (size_t)nin);
+    fsdem__restart_count(io, &nout, 1 << 24, sizeof(fsdem_mps_outflow_desc), "outflow count");
+    outflows = (fsdem_mps_outflow_desc *)fsdem__restart_block(io, al, sizeof *outflows * (size_t)nout);
+    if (commit) {
+        fsdem__free(al, s->inflows, sizeof *s->inflows * (size_t)s->inflow_cap);
+        fsdem__free(al, s->outflows, sizeof *s->outflows * (size_t)s->outflow_cap);
+        s->bytes += sizeof *inflows * (size_t)nin - sizeof *s->inflows * (size_t)s->inflow_cap;
+        s->bytes += sizeof *outflows * (size_t)nout - sizeof *s->outflows * (size_t)s->outflow_cap;
+        s->inflows = inflows;
+        s->inflow_n = s->inflow_cap = nin;
+        s->outflows = outflows;
+        s->outflow_n = s->outflow_cap = nout;
+    }
+    fsdem__restart_data(io, s->inflows, sizeof *s->inflows * (size_t)nin);
+    fsdem__restart_data(io, s->outflows, sizeof *s->outflows * (size_t)nout);
+    fsdem__restart_data(io, &s->inflow_total, sizeof s->inflow_total);
+    fsdem__restart_data(io, &s->outflow_total, sizeof s->outflow_total);
+
     /* particles, into fresh arrays of the saved capacity */
     fsdem__restart_count(io, &cap, 1 << 29, 0, "particle capacity");
     fsdem__restart_count(io, &n, cap, 2 * sizeof(fsdem_vec3), "particle count");
@@ -18077,11 +18310,14 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_flags(io, s->kind, n, FSDEM_MPS_KIND_DUMMY, "kind of particle");
     fsdem__restart_flags(io, s->surf, n, 1, "surface flag of particle");
     fsdem__restart_ints(io, s->body, n, -1, no - 1, "obstacle of particle");
+    fsdem__restart_ints(io, s->inlet, n, -1, nin - 1, "inflow of particle");
     fsdem__restart_gauges(io, &s->gauges, al, "fsdem_mps_gauges_close");
     if (commit) {
         s->counts[0] = s->counts[1] = s->counts[2] = 0;
+        s->buffered = 0;
         for (i = 0; i < n; ++i) {
             s->counts[s->kind[i]]++;
+            s->buffered += s->inlet[i] >= 0;
             s->us[i] = s->shift[i] = fsdem__zero3();
             s->unknown[i] = -1;
         }
