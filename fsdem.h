@@ -2060,7 +2060,8 @@ typedef enum fsdem_mps_wall_viscosity {
        sum, weights w_ij/eps_i of Eq. 7) of the FLUID velocities within re of it and u_w = 0
        (solids are fixed), so the velocity passes through zero at the solid surface; the discrete
        steady plane Poiseuille flow (2D, re = 4.1 r0) is then within 6.2 / 1.8 / 0.6 % of the
-       parabola at 10 / 20 / 40 rows (tests/test_mps.c measures it); the default */
+       parabola at 10 / 20 / 40 rows (the lattice's discrete steady state; tests/test_mps_periodic.c
+       runs 30 rows in 2D, 24 in 3D); the default */
     FSDEM_MPS_WALL_VISCOSITY_NO_SLIP = 0,
     /* WALL particles at rest, DUMMY particles left out (Eq. 10 over the non-DUMMY neighbours, as
        the pressure equation): the wall drags too little, the steady Poiseuille centre speed 70 /
@@ -2151,8 +2152,9 @@ FSDEM_API fsdem_result fsdem_mps_fill_box(fsdem_mps *mps, fsdem_vec3 lo, fsdem_v
    anchored at lo: the lattice points outside the box within one spacing of it are WALL particles,
    the next ceil(re/r0) - 1 layers DUMMY particles. A side whose bit (1 << fsdem_side) is set in
    `open_sides` has no wall, and the walls next to it stop at the box's face there (a tank open
-   at the top: 1 << FSDEM_SIDE_YMAX in 2D, 1 << FSDEM_SIDE_ZMAX in 3D). *added (may be NULL) counts
-   the particles. Errors as fsdem_mps_fill_box. */
+   at the top: 1 << FSDEM_SIDE_YMAX in 2D, 1 << FSDEM_SIDE_ZMAX in 3D); the sides across a periodic
+   axis (desc.periodic) are always open. *added (may be NULL) counts the particles. Errors as
+   fsdem_mps_fill_box. */
 FSDEM_API fsdem_result fsdem_mps_add_box_walls(fsdem_mps *mps, fsdem_vec3 lo, fsdem_vec3 hi,
                                                unsigned open_sides, int *added);
 /* Adds a solid box [lo, hi] inside the flow: lattice points lo + (i + 1/2) r0 inside it, the outer
@@ -2194,13 +2196,17 @@ typedef struct fsdem_mps_outflow_desc {
     int axis;            /* 0 .. dim-1 */
     int direction;       /* +1: particles beyond it along +axis are leaving; -1: the reverse */
     fsdem_real position; /* m; the plane; the zone ceil(re/r0) r0 past it must lie inside the domain */
+    fsdem_vec3 lo, hi;   /* m; the outlet's extent over the other axes (components along `axis` */
+                         /*    ignored): liquid past the plane outside it is not touched */
 } fsdem_mps_outflow_desc;
 /* Adds an outflow. FSDEM_ERR_INVALID_ARG (a field named, or a zone outside the domain),
    FSDEM_ERR_OUT_OF_MEMORY. */
 FSDEM_API fsdem_result fsdem_mps_add_outflow(fsdem_mps *mps, const fsdem_mps_outflow_desc *outflow);
 
 /* Views of the particles (structure of arrays, index order = order of addition), valid until
-   particles are added or the solver is destroyed. Steps update them in place. `velocity` of FLUID
+   particles are added or the solver is destroyed. Steps update them in place; with inflows or
+   outflows a step also adds particles (at the end) and removes some (the later ones move down),
+   so the views and indices are then valid until the next step. `velocity` of FLUID
    particles and `porosity` (eps_f in (0, 1], 1 by default; the 1/eps_j of Eq. 7-16, for a coupler)
    may be edited between steps. `number_density` and `surface` are those of the last step (or of
    the last operator call). */
@@ -2226,7 +2232,8 @@ FSDEM_API fsdem_mps_particles fsdem_mps_get_particles(fsdem_mps *mps);
    depth in 2D), held over later steps and applied to FLUID particles in the predictor (step 2:
    u* += dt force / mass), and the porosity eps of Eq. 7-16 (the same array as the view's). The
    forces start at zero; steps read them only once this function has handed them out. Valid until
-   particles are added. With desc.model = FSDEM_MPS_MODEL_B the corrector divides the pressure
+   particles are added (an MPS with inflows or outflows, whose steps add and remove particles, cannot
+   be coupled). With desc.model = FSDEM_MPS_MODEL_B the corrector divides the pressure
    acceleration by eps_i (seed 002 Eq. 5: the fluid takes the whole pressure gradient of the
    mixture), with Model A it does not (Eq. 2: -eps grad P on a volume of mixture, i.e. -grad P on
    the fluid's own volume). */
@@ -2249,8 +2256,9 @@ FSDEM_API fsdem_result fsdem_mps_gradient(fsdem_mps *mps, const fsdem_real *phi,
 FSDEM_API fsdem_result fsdem_mps_divergence(fsdem_mps *mps, const fsdem_vec3 *field, fsdem_real *out);
 FSDEM_API fsdem_result fsdem_mps_laplacian(fsdem_mps *mps, const fsdem_real *phi, fsdem_real *out);
 /* The pressure matrix of the last step (fsdem_csr, rows = unknowns in particle order; see the
-   section's step 4) and in *rows_particle (may be NULL) the particle of each row. Valid until the
-   next step. rows = 0 before the first step. */
+   section's step 4) and in *rows_particle (may be NULL) the particle of each row (in the numbering
+   after that step's outflow removals). Valid until the next step. rows = 0 before the first
+   step. */
 FSDEM_API fsdem_csr fsdem_mps_pressure_matrix(const fsdem_mps *mps, const int **rows_particle);
 
 /* ---- time stepping ---- */
@@ -14501,6 +14509,7 @@ fsdem_result fsdem_mps_add_box_walls(fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3 hi,
     fsdem__mps_walls w;
     fsdem_real reach;
     fsdem_result r;
+    int a;
     if (added) *added = 0;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if ((r = fsdem__mps_check_box(s, "fsdem_mps_add_box_walls", lo, hi)) != FSDEM_OK) return r;
@@ -14511,6 +14520,8 @@ fsdem_result fsdem_mps_add_box_walls(fsdem_mps *s, fsdem_vec3 lo, fsdem_vec3 hi,
     w.box[0] = lo;
     w.box[1] = hi;
     w.open = open_sides;
+    for (a = 0; a < s->dim; ++a) /* a wall across a periodic axis would wrap into the liquid */
+        if (s->desc.periodic[a]) w.open |= 3u << (2 * a);
     reach = (fsdem_real)s->layers * s->r0;
     return fsdem__mps_lattice_fill(s, "fsdem_mps_add_box_walls", lo, fsdem__sub(lo, fsdem_v3(reach, reach, reach)),
                                    fsdem__add(hi, fsdem_v3(reach, reach, reach)), fsdem__mps_classify_walls, &w,
@@ -14570,6 +14581,22 @@ static fsdem_result fsdem__mps_check_plane(fsdem_mps *s, const char *what, int a
     return FSDEM_OK;
 }
 
+/* The zone of an open plane: its extent lo-hi over the other axes, the buffer's depth behind
+   (`upstream`) or past the plane along `axis`, checked (`what` names the fields) as a fill box;
+   the lattice anchor (lo, the plane along `axis`) and the box into *anchor, *from, *to when given. */
+static fsdem_result fsdem__mps_check_zone(fsdem_mps *s, const char *what, int axis, int direction, fsdem_real position, int upstream,
+                                          fsdem_vec3 lo, fsdem_vec3 hi, fsdem_vec3 *anchor, fsdem_vec3 *from, fsdem_vec3 *to) {
+    const fsdem_real depth = fsdem__mps_open_depth(s), far = position + (fsdem_real)(upstream ? -direction : direction) * depth;
+    fsdem_vec3 a = lo, f = lo, t = hi;
+    fsdem__set_comp(&a, axis, position);
+    fsdem__set_comp(&f, axis, position < far ? position : far);
+    fsdem__set_comp(&t, axis, position < far ? far : position);
+    if (anchor) *anchor = a;
+    if (from) *from = f;
+    if (to) *to = t;
+    return fsdem__mps_check_box(s, what, f, t);
+}
+
 fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in, int *added) {
     fsdem_vec3 anchor, from, to, u = fsdem__zero3();
     fsdem_result r;
@@ -14582,13 +14609,9 @@ fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in,
     if (!(in->speed > 0 && in->speed <= FSDEM_MAX_SPEED))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_inflow_desc.speed = %g m/s must be in (0, FSDEM_MAX_SPEED]",
                            (double)in->speed);
-    anchor = in->lo;
-    from = in->lo;
-    to = in->hi;
-    fsdem__set_comp(&anchor, in->axis, in->position);
-    fsdem__set_comp(&from, in->axis, in->position - (in->direction > 0 ? fsdem__mps_open_depth(s) : 0));
-    fsdem__set_comp(&to, in->axis, in->position + (in->direction < 0 ? fsdem__mps_open_depth(s) : 0));
-    if ((r = fsdem__mps_check_box(s, "fsdem_mps_add_inflow", from, to)) != FSDEM_OK) return r;
+    if ((r = fsdem__mps_check_zone(s, "fsdem_mps_inflow_desc.lo/hi", in->axis, in->direction, in->position, 1, in->lo, in->hi,
+                                   &anchor, &from, &to)) != FSDEM_OK)
+        return r;
     fsdem__set_comp(&u, in->axis, in->speed * (fsdem_real)in->direction);
     if (!fsdem__mps_list_room(s, (void **)&s->inflows, &s->inflow_cap, s->inflow_n, sizeof *s->inflows))
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_inflow: out of memory");
@@ -14608,20 +14631,29 @@ fsdem_result fsdem_mps_add_outflow(fsdem_mps *s, const fsdem_mps_outflow_desc *o
     if (!out) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_outflow: outflow is NULL");
     if (s->external) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_outflow: the MPS is coupled");
     if ((r = fsdem__mps_check_plane(s, "fsdem_mps_outflow_desc", out->axis, out->direction, out->position, 0)) != FSDEM_OK) return r;
+    if ((r = fsdem__mps_check_zone(s, "fsdem_mps_outflow_desc.lo/hi", out->axis, out->direction, out->position, 0, out->lo, out->hi,
+                                   NULL, NULL, NULL)) != FSDEM_OK)
+        return r;
     if (!fsdem__mps_list_room(s, (void **)&s->outflows, &s->outflow_cap, s->outflow_n, sizeof *s->outflows))
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_outflow: out of memory");
     s->outflows[s->outflow_n++] = *out;
     return fsdem__ok(&s->status);
 }
 
-/* How far FLUID particle i is past the outflow planes it has crossed (the largest), or 0. */
+/* How far FLUID particle i is past the outflow planes it has crossed within their extent (the
+   largest), or 0. */
 static fsdem_real fsdem__mps_outflowing(const fsdem_mps *s, int i) {
     fsdem_real most = 0;
-    int k;
+    int k, a;
     for (k = 0; k < s->outflow_n; ++k) {
         const fsdem_mps_outflow_desc *o = &s->outflows[k];
         const fsdem_real past = fsdem__mps_past(s, i, o->axis, o->direction, o->position);
-        if (past > most) most = past;
+        int inside = 1;
+        if (!(past > most)) continue;
+        for (a = 0; a < s->dim; ++a)
+            if (a != o->axis && !(fsdem__comp(s->x[i], a) >= fsdem__comp(o->lo, a) && fsdem__comp(s->x[i], a) <= fsdem__comp(o->hi, a)))
+                inside = 0;
+        if (inside) most = past;
     }
     return most;
 }
@@ -14661,15 +14693,20 @@ static void fsdem__mps_open_update(fsdem_mps *s) {
         if (s->kind[i] == FSDEM_MPS_KIND_FLUID && s->inlet[i] < 0 && fsdem__mps_outflowing(s, i) >= depth) {
             s->counts[FSDEM_MPS_KIND_FLUID]--;
             s->outflow_total++;
+            s->cursor[i] = -1; /* old index -> new index (s->cursor is free between steps) */
             continue;
         }
+        s->cursor[i] = kept;
         if (kept < i) {
-            for (k = 0; k < arrays; ++k)
-                memcpy((char *)*ptr[k] + elem[k] * (size_t)kept, (char *)*ptr[k] + elem[k] * (size_t)i, elem[k]);
+            for (k = 0; k < arrays; ++k) /* the arrays by pressure row are not the particles' */
+                if (*ptr[k] != (void *)s->b && *ptr[k] != (void *)s->sol && *ptr[k] != (void *)s->row_particle)
+                    memcpy((char *)*ptr[k] + elem[k] * (size_t)kept, (char *)*ptr[k] + elem[k] * (size_t)i, elem[k]);
             solids_after |= s->kind[kept] != FSDEM_MPS_KIND_FLUID;
         }
         ++kept;
     }
+    if (kept < s->n)
+        for (k = 0; k < s->rows; ++k) s->row_particle[k] = s->cursor[s->row_particle[k]];
     s->n = kept;
     if (solids_after) s->solid_pairs_of = -1; /* solids renumbered: their pairs are found again */
 }
@@ -15072,9 +15109,10 @@ static fsdem_real fsdem__mps_mass(const fsdem_mps *s) {
 /* The longest step the explicit viscous term of the predictor (step 2) allows, dt nu <= 0.8
    lambda eps_min / (2d) (s; infinite without viscosity). Eq. 10 on u at particle i, with
    S_i = sum_j w_ij / eps_j, has its row in the disc of centre -c S_i and radius c S_i
-   (c = 2d / (lambda n0), Gershgorin; the ghost velocities of FSDEM_MPS_WALL_VISCOSITY_NO_SLIP are averages,
-   so the radius holds), so forward Euler is stable while dt nu c S_i <= 1; S_i = n0 / eps_min on a
-   full lattice, and the 0.8 leaves room for neighbourhoods crowded to 1.25 n0. */
+   (c = 2d / (lambda n0_lap), Gershgorin, with the Laplacian's weights; the ghost velocities of
+   FSDEM_MPS_WALL_VISCOSITY_NO_SLIP are averages, so the radius holds), so forward Euler is stable
+   while dt nu c S_i <= 1; S_i = n0_lap / eps_min on a full lattice, and the 0.8 leaves room for
+   neighbourhoods crowded to 1.25 n0_lap. */
 static fsdem_real fsdem__mps_dt_viscous(const fsdem_mps *s) {
     fsdem_real eps_min = 1;
     int i;
@@ -15325,7 +15363,8 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
        constant its null space (its rows sum to 0); the source loses its mean, the part no pressure
        can answer (for a liquid whose volume is fixed by its walls, the density error that
        compression cannot remove), so that the system has solutions; the solve's level is then
-       set in fsdem__mps_do_step */
+       set in fsdem__mps_do_step. Detected for the whole liquid: a sealed pocket beside liquid
+       that has a free surface keeps a singular block (not handled) */
     s->closed = rows > 0 && !anchored;
     if (s->closed) {
         double mean = 0;
@@ -18193,6 +18232,32 @@ static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
 
 /* ---- >>restart_mps : MPS ---- */
 
+/* Checks (in CHECK) the `count` open planes about to be read, inflows or outflows: an axis of the
+   solver's, a direction of +-1, a finite plane (corrupted data otherwise). */
+static void fsdem__restart_mps_planes(fsdem__restart *io, int dim, int count, int inflows) {
+    const size_t size = inflows ? sizeof(fsdem_mps_inflow_desc) : sizeof(fsdem_mps_outflow_desc);
+    const unsigned char *p = io->mode == FSDEM__RESTART_CHECK ? fsdem__restart_peek(io, size * (size_t)count) : NULL;
+    int k;
+    for (k = 0; p && k < count; ++k) {
+        fsdem_mps_inflow_desc in;
+        fsdem_mps_outflow_desc out;
+        int axis, direction;
+        fsdem_real position;
+        if (inflows) {
+            memcpy(&in, p + size * (size_t)k, size);
+            axis = in.axis, direction = in.direction, position = in.position;
+        } else {
+            memcpy(&out, p + size * (size_t)k, size);
+            axis = out.axis, direction = out.direction, position = out.position;
+        }
+        if (axis < 0 || axis >= dim || (direction != 1 && direction != -1) || !fsdem__finite(position)) {
+            fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s %d: axis %d, direction %d, plane %g (corrupted data)",
+                                inflows ? "inflow" : "outflow", k, axis, direction, (double)position);
+            return;
+        }
+    }
+}
+
 /* The particles go into fresh arrays of the saved capacity (all FSDEM__MPS_ARRAYS of them and the
    four row-offset arrays, as fsdem__mps_reserve makes them); of their contents the state that the
    next step reads (positions, velocities, pressures: the pressure solve starts from them, kinds,
@@ -18272,7 +18337,9 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
         s->outflows = outflows;
         s->outflow_n = s->outflow_cap = nout;
     }
+    fsdem__restart_mps_planes(io, s->dim, nin, 1);
     fsdem__restart_data(io, s->inflows, sizeof *s->inflows * (size_t)nin);
+    fsdem__restart_mps_planes(io, s->dim, nout, 0);
     fsdem__restart_data(io, s->outflows, sizeof *s->outflows * (size_t)nout);
     fsdem__restart_data(io, &s->inflow_total, sizeof s->inflow_total);
     fsdem__restart_data(io, &s->outflow_total, sizeof s->outflow_total);

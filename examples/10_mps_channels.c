@@ -105,6 +105,8 @@ static int open_channel(void) {
     out.axis = 0;
     out.direction = 1;
     out.position = (fsdem_real)L;
+    out.lo = fsdem_v3(0, 0, 0);
+    out.hi = fsdem_v3(0, (fsdem_real)H, 0);
     if (fsdem_mps_add_inflow(mps, &in, NULL) != FSDEM_OK || fsdem_mps_add_outflow(mps, &out) != FSDEM_OK) return fail(mps);
     printf("open channel: water in at x = 0, out at x = %.1f m, at %.1f m/s\n", L, U);
     for (k = 1; k <= 4; ++k) {
