@@ -1990,6 +1990,13 @@ FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupl
    p +3.8 %; with the min form 18 r0 at 5 s. Of 24 combinations of gamma (0, 0.01, 0.05), that
    source, the sum or min form and shifting (0, 0.02) none drifts less than 0.5 r0 by 0.5 s; the
    drift is spread over the tank (64-290 of 400 particles move more than 0.3 r0), not a corner's.
+   The CMPS gradient of Khayyer and Gotoh (2008), ((p_i + p_j) - (p^_i + p^_j)) with p^ the
+   smallest pressure around a particle, is not offered: on a full lattice it equals grad p -
+   grad p^ (write p_i + p_j = 2 p_i + (p_j - p_i), and the same for p^; the constant 2 (p_i - p^_i)
+   sums to zero against the odd r_ij), which is zero wherever p^ follows p at a fixed offset, as
+   in hydrostatic water (p^_i is the pressure of the highest neighbour, a fixed height above i).
+   Tried outside the library: still water at mid-depth +86 % (the pressure equation makes up for
+   the missing gradient), against -1.5 % with the min form.
    Laplacian radius (desc.re_laplacian, after MPS codes that use 2.1-3.1 r0 for Eq. 10 while Eq. 7
    keeps 4.1 r0). The pressure matrix holds the pairs within it, so its cost falls fast; its
    physics, measured when the option came (3D tank 0.8 x 0.4 m, column 0.2 x 0.4 x 0.4 m at
