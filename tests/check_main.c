@@ -21,6 +21,7 @@ int main(void) {
     srunner_add_suite(runner, probing_suite());
     srunner_add_suite(runner, dem_contact_suite());
     srunner_add_suite(runner, dem_periodic_suite());
+    srunner_add_suite(runner, mps_periodic_suite());
     srunner_run_all(runner, CK_NORMAL);
     failed = srunner_ntests_failed(runner);
     srunner_free(runner);

@@ -25,6 +25,11 @@ Suite *couple_pic_suite(void);
 Suite *probing_suite(void);
 Suite *dem_contact_suite(void);
 Suite *dem_periodic_suite(void);
+Suite *mps_periodic_suite(void);
+
+/* Steps two MPS solvers `steps` times and asserts the same particles, positions and pressures, bit
+   for bit (tests/test_mps.c). */
+void test_same_run(fsdem_mps *a, fsdem_mps *b, int steps);
 
 /* ---- tolerances that follow the precision of fsdem_real ----
 

@@ -182,6 +182,145 @@ static fsdem_mps *test_tank(double r0, int max_iterations) {
     return m;
 }
 
+/* Declared in fsdem_tests.h. */
+void test_same_run(fsdem_mps *a, fsdem_mps *b, int steps) {
+    fsdem_mps_particles pa, pb;
+    int k;
+    for (k = 0; k < steps; ++k) {
+        ck_assert_int_eq(fsdem_mps_step(a), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_step(b), FSDEM_OK);
+    }
+    pa = fsdem_mps_get_particles(a);
+    pb = fsdem_mps_get_particles(b);
+    ck_assert_int_eq(pa.count, pb.count);
+    ck_assert(memcmp(pa.position, pb.position, sizeof(fsdem_vec3) * (size_t)pa.count) == 0);
+    ck_assert(memcmp(pa.pressure, pb.pressure, sizeof(fsdem_real) * (size_t)pa.count) == 0);
+}
+
+/* desc.re_laplacian: the Laplacian (Eq. 10-11) on its own radius. On the lattice, lambda is that
+   of the smaller radius by hand (re_laplacian = 2.1 r0, the figures of test_mps_lattice_constants)
+   while n0 (Eq. 7) keeps re = 4.1 r0; the Laplacian of a quadratic field stays exact at interior
+   particles (the argument of test_mps_operators_exact holds for any radius); a pressure row holds
+   at most the 12 lattice neighbours within 2.1 r0 and the diagonal; re_laplacian = re given
+   explicitly is the default bit for bit; radii outside [1.5 r0, re] are refused. */
+START_TEST(test_mps_laplacian_radius) {
+    const double w1 = 2.1 / (0.85 + 0.315) - 1, w2 = 2.1 / (0.85 * sqrt(2.0) + 0.315) - 1, w3 = 2.1 / (1.7 + 0.315) - 1;
+    const double lambda_hand = 4 * (w1 + 2 * w2 + 4 * w3) / (4 * (w1 + w2 + w3)), r0 = 0.02;
+    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps *m, *ref;
+    fsdem_mps_stats st, st_ref;
+    fsdem_csr A;
+    fsdem_mps_particles p;
+    int i, dim, k;
+    /* lattice constants */
+    d.r0 = (fsdem_real)r0;
+    d.re_laplacian = (fsdem_real)(2.1 * r0);
+    d.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
+    d.domain_max = fsdem_v3(0.3f, 0.5f, 0);
+    ck_assert_int_eq(fsdem_mps_create(&d, &m), FSDEM_OK);
+    ref = test_mps_new(2, r0, 4.1);
+    st = fsdem_mps_get_stats(m);
+    st_ref = fsdem_mps_get_stats(ref);
+    ck_assert_msg(fabs(st.lambda - lambda_hand * r0 * r0) < TOL(1e-12, 40) * lambda_hand * r0 * r0, "lambda %g, by hand %g",
+                  (double)st.lambda, lambda_hand * r0 * r0);
+    ck_assert(st.n0 == st_ref.n0);
+    fsdem_mps_destroy(ref);
+    /* a step of the tank: rows of at most 13 entries, a valid symmetric matrix */
+    ck_assert_int_eq(fsdem_mps_add_box_walls(m, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.4f, 0), 1u << FSDEM_SIDE_YMAX, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(m, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.2f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_step(m), FSDEM_OK);
+    A = fsdem_mps_pressure_matrix(m, NULL);
+    ck_assert_int_gt(A.rows, 50);
+    ck_assert_int_eq(fsdem_csr_check(&A, NULL, 0), FSDEM_OK);
+    for (i = 0; i < A.rows; ++i) ck_assert_int_le(A.row_start[i + 1] - A.row_start[i], 13);
+    fsdem_mps_destroy(m);
+    /* the Laplacian of a quadratic field at interior particles, 2D and 3D, re_laplacian 2.1 and 3.1 r0 */
+    for (dim = 2; dim <= 3; ++dim)
+        for (k = 0; k < 2; ++k) {
+            const int cells = dim == 2 ? 24 : 12;
+            const double lap_exact = dim == 2 ? 2 + 4 : 2 + 4 + 6;
+            fsdem_mps_desc b = fsdem_mps_desc_default(dim);
+            fsdem_real *quad, *out;
+            double worst = 0;
+            int n, interior = 0;
+            b.r0 = (fsdem_real)0.01;
+            b.re_laplacian = (fsdem_real)(k == 0 ? 0.021 : 0.031);
+            b.domain_min = fsdem_v3(-1, -1, -1);
+            b.domain_max = fsdem_v3(2, 2, 2);
+            ck_assert_int_eq(fsdem_mps_create(&b, &m), FSDEM_OK);
+            ck_assert_int_eq(fsdem_mps_fill_box(m, fsdem_v3(0, 0, 0), fsdem_v3(cells * 0.01f, cells * 0.01f, cells * 0.01f),
+                                                fsdem_v3(0, 0, 0), NULL),
+                             FSDEM_OK);
+            p = fsdem_mps_get_particles(m);
+            n = p.count;
+            quad = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)n);
+            out = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)n);
+            for (i = 0; i < n; ++i) {
+                const fsdem_vec3 x = p.position[i];
+                quad[i] = (fsdem_real)(x.x * x.x + 2 * x.y * x.y + 3 * x.z * x.z + x.x * x.y);
+            }
+            ck_assert_int_eq(fsdem_mps_laplacian(m, quad, out), FSDEM_OK);
+            for (i = 0; i < n; ++i)
+                if (test_interior(p.position[i], dim, cells, 0.01)) {
+                    interior++;
+                    if (fabs(out[i] - lap_exact) > worst) worst = fabs(out[i] - lap_exact);
+                }
+            ck_assert_int_gt(interior, 10);
+            ck_assert_msg(worst < TOL(1e-7, 1e7), "dim %d re_laplacian %g: Laplacian error %g", dim, (double)b.re_laplacian, worst);
+            free(quad);
+            free(out);
+            fsdem_mps_destroy(m);
+        }
+    /* re_laplacian = re is the default, bit for bit */
+    m = test_tank(0.02, 1000);
+    d = fsdem_mps_get_desc(m);
+    d.re_laplacian = d.re;
+    ck_assert_int_eq(fsdem_mps_create(&d, &ref), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_box_walls(ref, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.4f, 0), 1u << FSDEM_SIDE_YMAX, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(ref, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.2f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    test_same_run(m, ref, 20);
+    fsdem_mps_destroy(ref);
+    /* refused radii */
+    d.re_laplacian = (fsdem_real)(1.4 * r0);
+    ck_assert_int_eq(fsdem_mps_desc_check(&d, NULL, 0), FSDEM_ERR_INVALID_ARG);
+    d.re_laplacian = d.re * 1.01f;
+    ck_assert_int_eq(fsdem_mps_desc_check(&d, NULL, 0), FSDEM_ERR_INVALID_ARG);
+    fsdem_mps_destroy(m);
+}
+END_TEST
+
+/* WALL-WALL and WALL-DUMMY pairs are found once and reused while the solids stay: a restore brings
+   other solids under the same indices (here the same tank built after its water instead of
+   before, so the indices of the kinds are swapped and their counts equal); the object that had
+   stepped with its own solids continues exactly as the saved one does. */
+START_TEST(test_mps_restore_other_solids) {
+    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps *a, *b;
+    void *buf;
+    size_t size = 0;
+    d.r0 = 0.02f;
+    d.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
+    d.domain_max = fsdem_v3(0.3f, 0.5f, 0);
+    ck_assert_int_eq(fsdem_mps_create(&d, &a), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_create(&d, &b), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_box_walls(a, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.4f, 0), 1u << FSDEM_SIDE_YMAX, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(a, fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.2f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(b, fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.2f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_box_walls(b, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.4f, 0), 1u << FSDEM_SIDE_YMAX, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_step(a), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_step(b), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_save_memory(a, NULL, 0, &size), FSDEM_OK);
+    buf = malloc(size);
+    ck_assert_int_eq(fsdem_mps_save_memory(a, buf, size, &size), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_restore_memory(b, buf, size), FSDEM_OK);
+    test_same_run(a, b, 10);
+    ck_assert_int_eq(fsdem_mps_get_stats(a).neighbours, fsdem_mps_get_stats(b).neighbours);
+    free(buf);
+    fsdem_mps_destroy(a);
+    fsdem_mps_destroy(b);
+}
+END_TEST
+
 /* The pressure matrix of a step is a valid symmetric CSR matrix (fsdem_csr_check) with a
    positive diagonal that dominates its row weakly everywhere and strictly somewhere (a row next
    to the free surface): irreducibly diagonally dominant, hence positive definite; checked also
@@ -624,6 +763,8 @@ Suite *mps_suite(void) {
     tcase_add_test(tc, test_mps_lattice_constants);
     tcase_add_test(tc, test_mps_operators_exact);
     tcase_add_test(tc, test_mps_pressure_matrix_spd);
+    tcase_add_test(tc, test_mps_laplacian_radius);
+    tcase_add_test(tc, test_mps_restore_other_solids);
     tcase_add_test(tc, test_mps_still_water);
     tcase_add_test(tc, test_mps_bad_input);
     tcase_add_test(tc, test_mps_null_policy);

@@ -70,6 +70,19 @@ static int outside_tank(fsdem_mps *mps, fsdem_vec3 lo, fsdem_vec3 hi) {
     return n;
 }
 
+/* The split of the steps' CPU time (since `before`, when given) and the pairs of the last search. */
+static void print_split(const char *name, const fsdem_mps_stats *st, const fsdem_mps_stats *before) {
+    const double total = st->seconds_total - (before ? before->seconds_total : 0);
+    const double search = st->seconds_search - (before ? before->seconds_search : 0);
+    const double assembly = st->seconds_assembly - (before ? before->seconds_assembly : 0);
+    const double solve = st->seconds_solve - (before ? before->seconds_solve : 0);
+    if (!(total > 0)) return;
+    printf("BENCH %s split search=%.1f%% operators=%.1f%% assembly=%.1f%% solve=%.1f%%\n", name, 100 * search / total,
+           100 * (total - search - assembly - solve) / total, 100 * assembly / total, 100 * solve / total);
+    printf("BENCH %s pairs candidates=%lld kept=%lld (%.1f%%)\n", name, st->candidate_pairs, st->neighbours,
+           st->candidate_pairs > 0 ? 100.0 * (double)st->neighbours / (double)st->candidate_pairs : 0.0);
+}
+
 static void report_error(const char *name, fsdem_mps *mps, const char *what, fsdem_result r) {
     if (mps) {
         fsdem_mps_stats st = fsdem_mps_get_stats(mps);
@@ -150,6 +163,7 @@ static void bench_2d(double t_end) {
            st.steps > 0 ? (double)st.pressure_iterations_total / (double)st.steps : 0.0);
     printf("BENCH %s pressure_share=%.1f %%\n", name,
            st.seconds_total > 0 ? 100 * st.seconds_pressure / st.seconds_total : 0.0);
+    print_split(name, &st, NULL);
     printf("BENCH %s max_speed=%.4g m/s\n", name, (double)st.max_speed);
     printf("BENCH %s fluid_outside_tank=%d 1\n", name, outside_tank(mps, tank_lo, tank_hi));
     printf("BENCH %s memory_bytes=%zu B\n", name, st.memory_bytes);
@@ -222,6 +236,7 @@ static void bench_3d(int steps, double column_length, double column_height) {
            st.seconds_total > st0.seconds_total
                ? 100 * (st.seconds_pressure - st0.seconds_pressure) / (st.seconds_total - st0.seconds_total)
                : 0.0);
+    print_split(name, &st, &st0);
     printf("BENCH %s memory_bytes=%zu B\n", name, st.memory_bytes);
     getrusage(RUSAGE_SELF, &usage);
     printf("BENCH %s peak_rss=%ld KiB\n", name, (long)usage.ru_maxrss);
