@@ -1220,7 +1220,9 @@ START_TEST(amg_iterations_are_size_independent_on_poisson) {
         lo = amg[i] < lo ? amg[i] : lo;
         hi = amg[i] > hi ? amg[i] : hi;
     }
-    ck_assert_int_le(10 * hi, 13 * lo);
+    /* in float the solve stops at LA_POISSON_TOL (2e-3) after 3-5 iterations, where one more is 20-33 %: the
+       30 % line is the double build's (7 at every size), float allows two iterations of spread */
+    ck_assert_int_le(10 * hi, 13 * lo + (TEST_FLOAT ? 20 : 0));
     ck_assert_int_le(hi, 15);
     ck_assert_int_gt(mic, 8 * hi);
 }

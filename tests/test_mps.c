@@ -218,7 +218,8 @@ START_TEST(test_mps_laplacian_radius) {
     d.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
     d.domain_max = fsdem_v3(0.3f, 0.5f, 0);
     ck_assert_int_eq(fsdem_mps_create(&d, &m), FSDEM_OK);
-    ref = test_mps_new(2, r0, 4.1);
+    d.re_laplacian = 0; /* the same desc but the Laplacian's radius: re itself is computed alike */
+    ck_assert_int_eq(fsdem_mps_create(&d, &ref), FSDEM_OK);
     st = fsdem_mps_get_stats(m);
     st_ref = fsdem_mps_get_stats(ref);
     ck_assert_msg(fabs(st.lambda - lambda_hand * r0 * r0) < TOL(1e-12, 40) * lambda_hand * r0 * r0, "lambda %g, by hand %g",
