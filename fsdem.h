@@ -14188,6 +14188,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
 /* The particle arrays of a capacity `cap`, with their element sizes (one list for allocation,
    copying and release). */
 #define FSDEM__MPS_ARRAYS 20
+#define FSDEM__MPS_ROW_ARRAYS 3
 static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     void **p[FSDEM__MPS_ARRAYS];
     size_t e[FSDEM__MPS_ARRAYS];
@@ -14207,16 +14208,17 @@ static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     FSDEM__MPS_ARRAY(fext);
     FSDEM__MPS_ARRAY(gradp);
     FSDEM__MPS_ARRAY(div);
-    FSDEM__MPS_ARRAY(b);
-    FSDEM__MPS_ARRAY(sol);
     FSDEM__MPS_ARRAY(kind);
     FSDEM__MPS_ARRAY(surf);
     FSDEM__MPS_ARRAY(body);
     FSDEM__MPS_ARRAY(unknown);
-    FSDEM__MPS_ARRAY(row_particle);
     FSDEM__MPS_ARRAY(uvisc);
     FSDEM__MPS_ARRAY(ghost_weight);
     FSDEM__MPS_ARRAY(inlet);
+    /* by pressure row, last (FSDEM__MPS_ROW_ARRAYS of them): not moved when particles are removed */
+    FSDEM__MPS_ARRAY(b);
+    FSDEM__MPS_ARRAY(sol);
+    FSDEM__MPS_ARRAY(row_particle);
 #undef FSDEM__MPS_ARRAY
     memcpy(ptr, p, sizeof p);
     memcpy(elem, e, sizeof e);
@@ -14330,7 +14332,7 @@ static fsdem_result fsdem__mps_check_point(fsdem_mps *s, const char *fn, int j, 
 /* Brings x into the domain along the periodic axes. */
 static void fsdem__mps_wrap(const fsdem_mps *s, fsdem_vec3 *x) {
     int a;
-    for (a = 0; a < s->dim; ++a)
+    for (a = 0; a < s->dim && s->periods.any; ++a)
         fsdem__wrap_axis(&s->periods, a, fsdem__comp(s->desc.domain_min, a), fsdem__comp(s->desc.domain_max, a), x);
 }
 
@@ -14568,40 +14570,38 @@ static fsdem_real fsdem__mps_past(const fsdem_mps *s, int i, int axis, int direc
 /* Depth of an inflow buffer and of an outflow zone: the reach of the kernel, ceil(re/r0) r0. */
 static fsdem_real fsdem__mps_open_depth(const fsdem_mps *s) { return (fsdem_real)s->layers * s->r0; }
 
-/* Checks the axis, direction and plane of an open boundary (`what` names the desc): the zone
-   `depth` behind (`upstream`) or past the plane inside the domain, the axis not periodic. */
-static fsdem_result fsdem__mps_check_plane(fsdem_mps *s, const char *what, int axis, int direction, fsdem_real position,
-                                           int upstream) {
+/* Checks an open boundary (`what` names its desc): an axis of the solver's that is not periodic, a
+   direction of +-1, the plane and the zone `depth` behind it (`upstream`) or past it inside the
+   domain, and the zone's extent lo-hi over the other axes as a fill box. The lattice anchor (lo,
+   the plane along `axis`) and the zone's box go to *anchor, *from, *to when given. */
+static fsdem_result fsdem__mps_check_open(fsdem_mps *s, const char *what, int axis, int direction, fsdem_real position, int upstream,
+                                          fsdem_vec3 lo, fsdem_vec3 hi, fsdem_vec3 *anchor, fsdem_vec3 *from, fsdem_vec3 *to) {
+    const fsdem_real depth = fsdem__mps_open_depth(s);
+    char field[64];
     fsdem_real far;
+    fsdem_vec3 f = lo, t = hi;
     if (axis < 0 || axis >= s->dim)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s.axis = %d must be in [0, %d)", what, axis, s->dim);
     if (direction != 1 && direction != -1)
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s.direction = %d must be +1 or -1", what, direction);
     if (s->desc.periodic[axis])
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s.axis = %d is periodic", what, axis);
-    far = position + (fsdem_real)(upstream ? -direction : direction) * fsdem__mps_open_depth(s);
+    far = position + (fsdem_real)(upstream ? -direction : direction) * depth;
     if (!fsdem__finite(position) || !(far >= fsdem__comp(s->desc.domain_min, axis) && far <= fsdem__comp(s->desc.domain_max, axis)) ||
         !(position >= fsdem__comp(s->desc.domain_min, axis) && position <= fsdem__comp(s->desc.domain_max, axis)))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
                            "%s.position = %g m: the plane and its zone, %g m %s it, must lie inside the domain along %c", what,
-                           (double)position, (double)fsdem__mps_open_depth(s), upstream ? "upstream of" : "past", "xyz"[axis]);
-    return FSDEM_OK;
-}
-
-/* The zone of an open plane: its extent lo-hi over the other axes, the buffer's depth behind
-   (`upstream`) or past the plane along `axis`, checked (`what` names the fields) as a fill box;
-   the lattice anchor (lo, the plane along `axis`) and the box into *anchor, *from, *to when given. */
-static fsdem_result fsdem__mps_check_zone(fsdem_mps *s, const char *what, int axis, int direction, fsdem_real position, int upstream,
-                                          fsdem_vec3 lo, fsdem_vec3 hi, fsdem_vec3 *anchor, fsdem_vec3 *from, fsdem_vec3 *to) {
-    const fsdem_real depth = fsdem__mps_open_depth(s), far = position + (fsdem_real)(upstream ? -direction : direction) * depth;
-    fsdem_vec3 a = lo, f = lo, t = hi;
-    fsdem__set_comp(&a, axis, position);
+                           (double)position, (double)depth, upstream ? "upstream of" : "past", "xyz"[axis]);
     fsdem__set_comp(&f, axis, position < far ? position : far);
     fsdem__set_comp(&t, axis, position < far ? far : position);
-    if (anchor) *anchor = a;
+    if (anchor) {
+        *anchor = lo;
+        fsdem__set_comp(anchor, axis, position);
+    }
     if (from) *from = f;
     if (to) *to = t;
-    return fsdem__mps_check_box(s, what, f, t);
+    snprintf(field, sizeof field, "%s.lo/hi", what);
+    return fsdem__mps_check_box(s, field, f, t);
 }
 
 fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in, int *added) {
@@ -14612,13 +14612,12 @@ fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in,
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!in) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_inflow: inflow is NULL");
     if (s->external) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_inflow: the MPS is coupled");
-    if ((r = fsdem__mps_check_plane(s, "fsdem_mps_inflow_desc", in->axis, in->direction, in->position, 1)) != FSDEM_OK) return r;
+    if ((r = fsdem__mps_check_open(s, "fsdem_mps_inflow_desc", in->axis, in->direction, in->position, 1, in->lo, in->hi, &anchor,
+                                   &from, &to)) != FSDEM_OK)
+        return r;
     if (!(in->speed > 0 && in->speed <= FSDEM_MAX_SPEED))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_inflow_desc.speed = %g m/s must be in (0, FSDEM_MAX_SPEED]",
                            (double)in->speed);
-    if ((r = fsdem__mps_check_zone(s, "fsdem_mps_inflow_desc.lo/hi", in->axis, in->direction, in->position, 1, in->lo, in->hi,
-                                   &anchor, &from, &to)) != FSDEM_OK)
-        return r;
     fsdem__set_comp(&u, in->axis, in->speed * (fsdem_real)in->direction);
     if (!fsdem__mps_list_room(s, (void **)&s->inflows, &s->inflow_cap, s->inflow_n, sizeof *s->inflows))
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_inflow: out of memory");
@@ -14637,9 +14636,8 @@ fsdem_result fsdem_mps_add_outflow(fsdem_mps *s, const fsdem_mps_outflow_desc *o
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!out) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_outflow: outflow is NULL");
     if (s->external) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_outflow: the MPS is coupled");
-    if ((r = fsdem__mps_check_plane(s, "fsdem_mps_outflow_desc", out->axis, out->direction, out->position, 0)) != FSDEM_OK) return r;
-    if ((r = fsdem__mps_check_zone(s, "fsdem_mps_outflow_desc.lo/hi", out->axis, out->direction, out->position, 0, out->lo, out->hi,
-                                   NULL, NULL, NULL)) != FSDEM_OK)
+    if ((r = fsdem__mps_check_open(s, "fsdem_mps_outflow_desc", out->axis, out->direction, out->position, 0, out->lo, out->hi, NULL,
+                                   NULL, NULL)) != FSDEM_OK)
         return r;
     if (!fsdem__mps_list_room(s, (void **)&s->outflows, &s->outflow_cap, s->outflow_n, sizeof *s->outflows))
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_outflow: out of memory");
@@ -14681,7 +14679,7 @@ static void fsdem__mps_open_update(fsdem_mps *s) {
     void **ptr[FSDEM__MPS_ARRAYS];
     size_t elem[FSDEM__MPS_ARRAYS];
     int i, k, kept = 0, solids_after = 0, arrays;
-    for (i = 0; i < n; ++i) {
+    for (i = 0; i < n && s->inflow_n; ++i) {
         const int in = s->inlet[i];
         fsdem_vec3 x;
         if (in < 0 || fsdem__mps_past(s, i, s->inflows[in].axis, s->inflows[in].direction, s->inflows[in].position) < 0) continue;
@@ -14695,7 +14693,7 @@ static void fsdem__mps_open_update(fsdem_mps *s) {
         s->buffered++;
     }
     if (s->outflow_n == 0) return;
-    arrays = fsdem__mps_arrays(s, ptr, elem);
+    arrays = fsdem__mps_arrays(s, ptr, elem) - FSDEM__MPS_ROW_ARRAYS; /* the particles' own */
     for (i = 0; i < s->n; ++i) {
         if (s->kind[i] == FSDEM_MPS_KIND_FLUID && s->inlet[i] < 0 && fsdem__mps_outflowing(s, i) >= depth) {
             s->counts[FSDEM_MPS_KIND_FLUID]--;
@@ -14705,9 +14703,8 @@ static void fsdem__mps_open_update(fsdem_mps *s) {
         }
         s->cursor[i] = kept;
         if (kept < i) {
-            for (k = 0; k < arrays; ++k) /* the arrays by pressure row are not the particles' */
-                if (*ptr[k] != (void *)s->b && *ptr[k] != (void *)s->sol && *ptr[k] != (void *)s->row_particle)
-                    memcpy((char *)*ptr[k] + elem[k] * (size_t)kept, (char *)*ptr[k] + elem[k] * (size_t)i, elem[k]);
+            for (k = 0; k < arrays; ++k)
+                memcpy((char *)*ptr[k] + elem[k] * (size_t)kept, (char *)*ptr[k] + elem[k] * (size_t)i, elem[k]);
             solids_after |= s->kind[kept] != FSDEM_MPS_KIND_FLUID;
         }
         ++kept;
