@@ -2314,6 +2314,7 @@ typedef struct fsdem_mps_stats {
     double seconds_solve;         /* ... in its preconditioner setup and solve (the rest of */
                                   /*    seconds_total: the operators of steps 2 and 6) */
     long long candidate_pairs;    /* pairs the last neighbour search examined (neighbours: kept) */
+    int inflow_planes, outflow_planes; /* open boundaries added (fsdem_mps_add_inflow/add_outflow) */
     long long inflow_particles;   /* buffer particles that crossed an inflow plane, since creation */
     long long outflow_particles;  /* particles removed past an outflow plane, since creation */
     size_t memory_bytes;          /* bytes held by the solver, its pcg included */
@@ -15660,6 +15661,8 @@ fsdem_mps_stats fsdem_mps_get_stats(const fsdem_mps *s) {
     st.seconds_assembly = s->sec_assembly;
     st.seconds_solve = s->sec_solve;
     st.candidate_pairs = s->candidates;
+    st.inflow_planes = s->inflow_n;
+    st.outflow_planes = s->outflow_n;
     st.inflow_particles = s->inflow_total;
     st.outflow_particles = s->outflow_total;
     st.memory_bytes = s->bytes;
@@ -15980,16 +15983,18 @@ fsdem_mps_dem_desc fsdem_mps_dem_desc_default(void) {
 fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, size_t size) {
     fsdem_dem_desc dd;
     fsdem_mps_desc md;
+    fsdem_mps_stats st;
     if (!d) return fsdem__reject(msg, size, "fsdem_mps_dem_desc is NULL");
     if (!d->mps || !d->dem) return fsdem__reject(msg, size, "fsdem_mps_dem_desc.mps and .dem must both be set");
     dd = fsdem_dem_get_desc(d->dem);
     md = fsdem_mps_get_desc(d->mps);
+    st = fsdem_mps_get_stats(d->mps);
     if (dd.dim != md.dim)
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the DEM is %dD and the MPS %dD", dd.dim, md.dim);
     if (md.periodic[0] || md.periodic[1] || md.periodic[2]) /* the averaging of Eq. 17-19 does not wrap yet */
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: an MPS with periodic axes cannot be coupled yet (the porosity and "
                              "drag averaging does not wrap)");
-    if (d->mps->inflow_n || d->mps->outflow_n) /* the coupler's per-particle records do not follow removals */
+    if (st.inflow_planes || st.outflow_planes) /* the coupler's per-particle records do not follow removals */
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: an MPS with inflows or outflows cannot be coupled yet");
     if (fsdem__norm(fsdem__sub(dd.gravity, md.gravity)) > 1e-12 * fsdem__norm(md.gravity))
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the DEM gravity (%g, %g, %g) differs from the MPS's (%g, %g, %g) m/s^2",

@@ -350,6 +350,23 @@ START_TEST(test_mps_open_bad_input) {
     ck_assert_int_eq(fsdem_mps_add_outflow(m, &out), FSDEM_ERR_INVALID_ARG);
     ck_assert(strstr(fsdem_mps_last_error(m), "fsdem_mps_outflow_desc.position"));
     ck_assert_int_eq(fsdem_mps_get_particles(m).count, n);
+    ck_assert_int_eq(fsdem_mps_get_stats(m).inflow_planes, 1);
+    ck_assert_int_eq(fsdem_mps_get_stats(m).outflow_planes, 1);
+    {   /* a coupler cannot follow the particles open planes add and remove */
+        fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+        fsdem_dem *dem = NULL;
+        fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
+        char msg[256];
+        dd.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
+        dd.domain_max = fsdem_v3(0.4f, 0.2f, 0);
+        dd.gravity = fsdem_v3(0, 0, 0);
+        ck_assert_int_eq(fsdem_dem_create(&dd, &dem), FSDEM_OK);
+        cd.mps = m;
+        cd.dem = dem;
+        ck_assert_int_eq(fsdem_mps_dem_desc_check(&cd, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+        ck_assert(strstr(msg, "inflows or outflows"));
+        fsdem_dem_destroy(dem);
+    }
     fsdem_mps_destroy(m);
     m = test_periodic_tank(1, 0);
     out.position = 0.125f;
