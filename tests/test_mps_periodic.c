@@ -62,10 +62,10 @@ static double test_poiseuille_error(int dim, int rows, int cells, fsdem_mps_wall
 }
 
 /* Plane Poiseuille flow from rest in a periodic channel (issue 19: within 2 % of the parabola,
-   2D and 3D). With the no-slip ghosts the discrete steady state is 0.9 % (2D, 30 rows) and 1.2 %
-   (3D, 24 rows) off the parabola (the method's second-order wall error: 6.2 / 1.8 / 0.6 % at
-   10 / 20 / 40 rows); at t = 0.6 H^2/nu the slowest transient, exp(-pi^2 0.6) 32/pi^3 of u_max,
-   adds 0.3 %; so the 2 % line holds with room. The old wall (WALL particles at rest, DUMMY
+   2D and 3D). With the no-slip ghosts the discrete steady state of the lattice is 6.2 / 1.8 /
+   0.6 % off the parabola at 10 / 20 / 40 rows (2D; the method's second-order wall error), and at
+   t = 0.6 H^2/nu the slowest transient, exp(-pi^2 0.6) 32/pi^3 of u_max, is within 0.3 %;
+   measured: 0.81 % (2D, 30 rows) and 1.15 % (3D, 24 rows), so the 2 % line holds with room. The old wall (WALL particles at rest, DUMMY
    particles out of Eq. 10) stays 24 % fast: the test tells them apart. The liquid has no free
    surface (the singular pressure equation of a closed box): nothing flows across the channel and
    the pressure stays uniform to a small fraction of rho u_max^2. */
