@@ -2468,7 +2468,9 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
         the solid exchange: F^d (Model A, Eq. 2: the solid's -V grad P is the mixture pressure acting
         on the solid's volume, as -grad P on its own volume acts on each fluid particle) or F^int
         (Model B, Eq. 4: f_B). Each X_k is split into weights that sum to one, so the fluid gets
-        exactly -sum_k X_k: the exchange conserves momentum to rounding. Limitation: next to a wall
+        exactly -sum_k X_k: the exchange conserves momentum to rounding (Shepard: W_k is the sum of
+        the weights actually present, cut by walls, the free surface or nothing, never the analytic
+        n_s), which fsdem_mps_dem_stats audits every update (exchange_residual). Limitation: next to a wall
         the kernel is cut, and in a uniform suspension the water within r0 of a wall gets 0.5-0.7
         of the bulk's reaction per volume (0.9-1.1 at 2-4 r0), which drives a circulation along the
         walls (validation/mpsdem_settling); weighting the shares by the open part of each
@@ -2478,6 +2480,33 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
         (fsdem_dem_advance) with the forces of 3 held: the sequential staggered scheme with the
         MPS step of Eq. 37 and DEM steps of Eq. 38 (Sun et al. 2021's MSS as the seed uses it; here
         the forces are held, not interpolated, over the substeps).
+   Models A and B term by term (seed 002 Eq. 2, 4, 34-35; Zhou, Kuang, Chu & Yu 2010 compare the
+   two formulations):
+     A: the grain gets F^d - V grad P (the whole pressure gradient, hydrostatic and dynamic, as
+        its buoyancy) and the fluid -F^d; the fluid's own pressure term is -eps grad P.
+     B: the grain gets F^d / eps - V rho_f g (Archimedes on the hydrostatic part only; the 1/eps
+        carries the grain's share of the dynamic gradient) and the fluid -(F^d / eps - V rho_f g);
+        the fluid's pressure term is -grad P.
+   Limits, from the grain's and the fluid's momentum per unit volume (n = (1 - eps) / V grains):
+     single grain (eps -> 1, still water, grad P = rho_f g): both give F^d - V rho_f g, drag plus
+        Archimedes, so the same terminal velocity (tests: a grain at rest in still water, terminal
+        velocities);
+     steady uniform suspension over a floor: A: -eps grad P + eps rho_f g - n F^d = 0 and
+        F^d - V grad P + rho_s V g = 0 give F^d = -eps (rho_s - rho_f) V g; B: F^d / eps - V rho_f g
+        + rho_s V g = 0 gives the same. A drag law fitted to hindered settling (Richardson-Zaki)
+        therefore reaches the grain alike in both; mixing the conventions (B's F^d / eps with A's
+        -V grad P) gives F^d = -eps^2 (rho_s - rho_f) V g, off by 1/eps (validation/mpsdem_settling);
+     fixed bed with the fluid driven through it: both give grad P_dynamic = beta w / eps, Ergun's
+        law term by term with the Ergun branch (validation/mpsdem_fixed_bed).
+   Periodic axes: an MPS with periodic axes couples to a DEM periodic along the same axes with the
+   same periods (fsdem_mps_dem_desc_check); pairs, porosities, averages and reactions take minimum
+   images, so a bed or a suspension can be a periodic cell with no side walls.
+   The averaging radius (desc.averaging_radius, the r_e of Eq. 29-36) defaults to the MPS re as the
+   seed has it. Ergun is steep in eps, and the porosity, fluid velocity and reactions are smoothed
+   over r_e: within r_e of a bed's face a grain averages in clear water (a slip of U instead of
+   U / eps), so in a bed not many r_e deep the drag falls short. A radius of 2-3 grain diameters
+   and at most a tenth of the bed's height keeps the faces sharp; below about 2 r0 the averages
+   see too few MPS particles to be smooth.
    The MPS particle velocity is the intrinsic fluid velocity u_f and each MPS particle carries the
    fluid mass rho_f r0^d: in a porous region it stands for a volume of mixture r0^d / eps, which is
    what the 1/eps_j of Eq. 7 counts (so the particles spread where solids are). Eq. 2 and 4 are the
@@ -2497,8 +2526,12 @@ typedef struct fsdem_mps_dem_desc {
     fsdem_mps *mps;               /* water; not owned; must outlive the coupler */
     fsdem_dem *dem;               /* sediment; same dim and gravity as the MPS; not owned */
     fsdem_drag_law drag;          /* default FSDEM_DRAG_LAW_ERGUN_WEN_YU (seed 002 Eq. 26) */
-    fsdem_real radius;            /* m; r_e of w_s (Eq. 29); 0: the MPS re (4.1 r0 by default), */
-                                  /*    which the seed's text implies; default 0 */
+    fsdem_real averaging_radius;  /* m; r_e of w_s (Eq. 29), the reach of the porosity, the fluid */
+                                  /*    velocity at the grains and the reactions; 0: the MPS re */
+                                  /*    (4.1 r0 by default), which the seed's text implies; default 0. */
+                                  /*    Ergun is steep in eps: for a bed, 2-3 grain diameters and at */
+                                  /*    most a tenth of its height keep its faces sharp, and at */
+                                  /*    least about 2 r0 keep the fluid average smooth (see notes) */
     fsdem_real min_porosity;      /* -; floor of eps_i (Eq. 31 can go below 0 where DEM particles */
                                   /*    overlap in a kernel), in (0, 1); default 0.2 */
     fsdem_real drag_dt_fraction;  /* -; coupled step <= this fraction of the shortest drag */
@@ -2510,8 +2543,10 @@ typedef struct fsdem_mps_dem_desc {
 } fsdem_mps_dem_desc;
 
 FSDEM_API fsdem_mps_dem_desc fsdem_mps_dem_desc_default(void);
-/* Checks a desc: both solvers set, the same dim and gravity, the ranges above. FSDEM_OK or
-   FSDEM_ERR_INVALID_ARG with the reason, naming the field, in `message` (may be NULL). */
+/* Checks a desc: both solvers set, the same dim and gravity, the same periodic axes with the same
+   periods (each longer than twice the averaging radius), no open planes in the MPS, the ranges
+   above. FSDEM_OK or FSDEM_ERR_INVALID_ARG with the reason, naming the field, in `message` (may be
+   NULL). */
 FSDEM_API fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *desc, char *message, size_t message_size);
 /* Creates a coupler (its memory from the DEM's allocator). FSDEM_ERR_INVALID_ARG as the check
    (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_mps_dem_destroy leaves the
@@ -2567,6 +2602,10 @@ typedef struct fsdem_mps_dem_stats {
     fsdem_vec3 drag;              /* N; sum of F^d, last update */
     fsdem_vec3 pressure;          /* N; sum of the pressure parts (-V grad P or -V rho g) */
     fsdem_vec3 to_fluid;          /* N; sum of the reactions given to the fluid (= -sum X_k) */
+    fsdem_vec3 exchanged;         /* N; sum of X_k, what the grains take from the fluid (step 4) */
+    fsdem_real exchange_residual; /* N; |to_fluid + exchanged|, the momentum the exchange loses: */
+                                  /*    rounding only, whatever walls, free surface or periodic */
+                                  /*    images cut the kernels (the audit of step 4) */
     fsdem_real drag_dt;           /* s; the drag limit of the last update (0: none) */
     long long pairs;              /* DEM-MPS pairs within the radius, last update */
     double seconds_mps;           /* CPU seconds in MPS steps */
@@ -15941,6 +15980,14 @@ typedef struct fsdem__mps_dem_pair {
     fsdem_real weight;
 } fsdem__mps_dem_pair;
 
+/* What an update writes besides the force records and the solvers' coupling arrays. */
+typedef struct fsdem__mps_dem_tally {
+    long long pairs;               /* DEM-MPS pairs within the averaging radius */
+    fsdem_real drag_dt;            /* s; the shortest drag relaxation time (0: none) */
+    int wet;                       /* DEM particles with FLUID neighbours */
+    fsdem_vec3 drag_sum, pressure_sum, fluid_sum; /* N: sums of F^d, the pressure parts, the reactions */
+} fsdem__mps_dem_tally;
+
 struct fsdem_mps_dem {
     fsdem_mps_dem_desc desc;
     fsdem__status status;
@@ -15952,7 +15999,8 @@ struct fsdem_mps_dem {
     fsdem_real cell_volume;        /* r0^d of the MPS lattice (m^3; m^2 in 2D) */
     fsdem_real depth;              /* m; the DEM's disc_length in 2D (forces per metre on the MPS), 1 in 3D */
     fsdem_vec3 gravity;            /* m/s^2 */
-    fsdem_cellgrid grid;           /* MPS particles, cells of edge radius / 2 (fsdem__mps_dem_ranges) */
+    fsdem__periods periods;        /* the MPS's periodic axes, which the DEM shares */
+    fsdem_cellgrid grid;           /* MPS particles, cells of edge averaging_radius / 2 (fsdem__mps_dem_ranges) */
     /* DEM-MPS pairs within the radius, by DEM particle: start[k] .. start[k+1] */
     int *start, start_cap;
     fsdem__mps_dem_pair *pair;
@@ -15961,11 +16009,17 @@ struct fsdem_mps_dem {
     int solid_cap;
     fsdem_mps_dem_force *force;    /* per DEM particle */
     int force_cap, forces;         /* forces: DEM particles of the last update (0: none yet) */
+    fsdem__mps_dem_tally tally;
+    /* what the update of a step overwrote, put back when the step is refused (fsdem__mps_dem_keep) */
+    fsdem_real *kept_porosity;     /* per MPS particle */
+    fsdem_vec3 *kept_reaction;     /* per MPS particle */
+    fsdem_vec3 *kept_load;         /* per DEM particle: its external force */
+    fsdem_mps_dem_force *kept_force;
+    int kept_mps_cap, kept_dem_cap, kept_forces;
+    fsdem__mps_dem_tally kept_tally;
     /* statistics */
-    long long steps, substeps, substeps_total, pairs;
-    fsdem_real dt_last, drag_dt;
-    int wet;
-    fsdem_vec3 drag_sum, pressure_sum, fluid_sum;
+    long long steps, substeps, substeps_total;
+    fsdem_real dt_last;
     double sec_mps, sec_dem;
 };
 
@@ -15973,7 +16027,7 @@ fsdem_mps_dem_desc fsdem_mps_dem_desc_default(void) {
     fsdem_mps_dem_desc d;
     memset(&d, 0, sizeof d);
     d.drag = FSDEM_DRAG_LAW_ERGUN_WEN_YU;
-    d.radius = 0;
+    d.averaging_radius = 0;
     d.min_porosity = (fsdem_real)0.2;
     d.drag_dt_fraction = (fsdem_real)0.5;
     d.max_substeps = 100000;
@@ -15984,6 +16038,7 @@ fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, si
     fsdem_dem_desc dd;
     fsdem_mps_desc md;
     fsdem_mps_stats st;
+    int a;
     if (!d) return fsdem__reject(msg, size, "fsdem_mps_dem_desc is NULL");
     if (!d->mps || !d->dem) return fsdem__reject(msg, size, "fsdem_mps_dem_desc.mps and .dem must both be set");
     dd = fsdem_dem_get_desc(d->dem);
@@ -15991,9 +16046,18 @@ fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, si
     st = fsdem_mps_get_stats(d->mps);
     if (dd.dim != md.dim)
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the DEM is %dD and the MPS %dD", dd.dim, md.dim);
-    if (md.periodic[0] || md.periodic[1] || md.periodic[2]) /* the averaging of Eq. 17-19 does not wrap yet */
-        return fsdem__reject(msg, size, "fsdem_mps_dem_desc: an MPS with periodic axes cannot be coupled yet (the porosity and "
-                             "drag averaging does not wrap)");
+    for (a = 0; a < md.dim; ++a) { /* grains and water wrap alike, or a grain would leave through the water's wall */
+        const fsdem_real lo = fsdem__comp(md.domain_min, a), hi = fsdem__comp(md.domain_max, a);
+        if (!md.periodic[a] != !dd.periodic[a])
+            return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the %s is periodic along %c and the %s is not", md.periodic[a] ? "MPS" : "DEM",
+                                 "xyz"[a], md.periodic[a] ? "DEM" : "MPS");
+        if (md.periodic[a] && (fsdem__comp(dd.domain_min, a) != lo || fsdem__comp(dd.domain_max, a) != hi))
+            return fsdem__reject(msg, size, "fsdem_mps_dem_desc: along the periodic %c the DEM domain [%g, %g] m differs from the MPS's [%g, %g] m",
+                                 "xyz"[a], (double)fsdem__comp(dd.domain_min, a), (double)fsdem__comp(dd.domain_max, a), (double)lo, (double)hi);
+        if (md.periodic[a] && !(2 * (d->averaging_radius > 0 ? d->averaging_radius : md.re) < hi - lo))
+            return fsdem__reject(msg, size, "fsdem_mps_dem_desc.averaging_radius: the period %g m along %c must exceed twice it (%g m)",
+                                 (double)(hi - lo), "xyz"[a], (double)(d->averaging_radius > 0 ? d->averaging_radius : md.re));
+    }
     if (st.inflow_planes || st.outflow_planes) /* the coupler's per-particle records do not follow removals */
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: an MPS with inflows or outflows cannot be coupled yet");
     if (fsdem__norm(fsdem__sub(dd.gravity, md.gravity)) > 1e-12 * fsdem__norm(md.gravity))
@@ -16002,9 +16066,12 @@ fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, si
                              (double)md.gravity.y, (double)md.gravity.z);
     if (strcmp(fsdem_drag_law_name(d->drag), "unknown") == 0)
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
-    if (!(d->radius == 0 || (d->radius > 0 && d->radius <= fsdem__smallest_extent(md.domain_min, md.domain_max, md.dim))))
-        return fsdem__reject(msg, size, "fsdem_mps_dem_desc.radius must be 0 (the MPS re) or in (0, %g] m, the MPS domain's smallest extent (got %g m)",
-                             (double)fsdem__smallest_extent(md.domain_min, md.domain_max, md.dim), (double)d->radius);
+    if (!(d->averaging_radius == 0 ||
+          (d->averaging_radius > 0 && d->averaging_radius <= fsdem__smallest_extent(md.domain_min, md.domain_max, md.dim))))
+        return fsdem__reject(msg, size,
+                             "fsdem_mps_dem_desc.averaging_radius must be 0 (the MPS re) or in (0, %g] m, the MPS domain's smallest extent "
+                             "(got %g m)",
+                             (double)fsdem__smallest_extent(md.domain_min, md.domain_max, md.dim), (double)d->averaging_radius);
     if (!(d->min_porosity > 0 && d->min_porosity < 1))
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc.min_porosity must be in (0, 1) (got %g)", (double)d->min_porosity);
     if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
@@ -16040,11 +16107,13 @@ fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem 
     c->mu = md.density * md.viscosity;
     c->gravity = md.gravity;
     c->depth = md.dim == 2 ? fsdem_dem_get_desc(desc->dem).disc_length : 1;
-    re = c->desc.radius = desc->radius > 0 ? desc->radius : md.re;
+    re = c->desc.averaging_radius = desc->averaging_radius > 0 ? desc->averaging_radius : md.re;
     /* Eq. 30: n_s = int w_s dV = (10 pi / 21) r_e^3; in the plane the same integral is (10 pi / 21) r_e^2 */
     c->ns = (fsdem_real)(10 * FSDEM__PI / 21) * re * re * (c->dim == 3 ? re : 1);
     c->cell_volume = md.r0 * md.r0 * (c->dim == 3 ? md.r0 : 1);
-    if (fsdem_cellgrid_setup(&c->grid, &c->allocator, c->dim, md.domain_min, md.domain_max, re / 2, 0) != FSDEM_OK) {
+    c->periods = fsdem__periods_of(md.periodic, md.dim, md.domain_min, md.domain_max);
+    if (fsdem_cellgrid_setup_periodic(&c->grid, &c->allocator, c->dim, md.domain_min, md.domain_max, re / 2, 0, md.periodic) !=
+        FSDEM_OK) {
         fsdem__log_oom(desc->log, desc->log_user, "fsdem_mps_dem_create", sizeof c->grid);
         fsdem_mps_dem_destroy(c);
         return FSDEM_ERR_OUT_OF_MEMORY;
@@ -16062,6 +16131,10 @@ void fsdem_mps_dem_destroy(fsdem_mps_dem *c) {
     fsdem__free(&al, c->pair, sizeof *c->pair * (size_t)c->pair_cap);
     fsdem__free(&al, c->solid, sizeof(fsdem_real) * (size_t)c->solid_cap);
     fsdem__free(&al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
+    fsdem__free(&al, c->kept_porosity, sizeof(fsdem_real) * (size_t)c->kept_mps_cap);
+    fsdem__free(&al, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)c->kept_mps_cap);
+    fsdem__free(&al, c->kept_load, sizeof(fsdem_vec3) * (size_t)c->kept_dem_cap);
+    fsdem__free(&al, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_dem_cap);
     fsdem__free(&al, c, sizeof *c);
 }
 
@@ -16088,31 +16161,49 @@ static fsdem_real fsdem__mps_dem_volume(const fsdem_mps_dem *c, fsdem_real r) {
     return c->dim == 3 ? (fsdem_real)(4 * FSDEM__PI / 3) * r * r * r : (fsdem_real)FSDEM__PI * r * r;
 }
 
-/* The grid's items within distance r of p, as ranges of `items`: the cells are r/2 wide and a row
-   of cells along x is contiguous in the grid's order, so the block of 5 cells per axis around p is
-   at most 25 ranges in 3D (5 in 2D); rows whose nearest point is farther than r are left out. This
-   scans about 60% of the candidates of the 3^d block of cells r wide. Returns the number of ranges. */
-static int fsdem__mps_dem_ranges(const fsdem_cellgrid *g, fsdem_vec3 p, fsdem_real r, int range[25][2]) {
-    int lo[3], hi[3], a, y, z, count = 0;
+/* The grid's items within distance r of p, as ranges of `items`: the cells are at least r/2 wide
+   and a row of cells along x is contiguous in the grid's order, so the block of 5 cells per axis
+   around p is at most 25 rows in 3D (5 in 2D), each one range, or two where it wraps round a
+   periodic x; rows whose nearest point is farther than r are left out. This scans about 60% of the
+   candidates of the 3^d block of cells r wide. Along a periodic axis the block wraps (a period of
+   fewer than 5 cells is taken whole, once); separations are then minimum images. Returns the
+   number of ranges. */
+static int fsdem__mps_dem_ranges(const fsdem_cellgrid *g, fsdem_vec3 p, fsdem_real r, int range[50][2]) {
+    int lo[3], hi[3], whole[3], a, y, z, count = 0;
+    fsdem_real x[3], width[3];
     for (a = 0; a < 3; ++a) {
-        const fsdem_real x = fsdem__comp(p, a) - fsdem__comp(g->origin, a);
-        lo[a] = (int)floor((x - r) * g->inv_cell_size);
-        hi[a] = (int)floor((x + r) * g->inv_cell_size);
-        if (a == 2 && g->dim == 2) lo[a] = hi[a] = 0;
-        if (lo[a] < 0) lo[a] = 0;
-        if (hi[a] > g->n[a] - 1) hi[a] = g->n[a] - 1;
-        if (lo[a] > hi[a]) return 0;
+        x[a] = fsdem__comp(p, a) - fsdem__comp(g->origin, a);
+        whole[a] = a >= g->dim || g->inv_width[a] == 0; /* the plane's z, or a periodic axis of one cell */
+        width[a] = g->wrap[a] ? 1 / g->inv_width[a] : g->cell_size;
+        lo[a] = whole[a] ? 0 : (int)floor((x[a] - r) * g->inv_width[a]);
+        hi[a] = whole[a] ? g->n[a] - 1 : (int)floor((x[a] + r) * g->inv_width[a]);
+        if (g->wrap[a] && hi[a] - lo[a] + 1 >= g->n[a]) {
+            whole[a] = 1;
+            lo[a] = 0;
+            hi[a] = g->n[a] - 1;
+        } else if (!g->wrap[a]) {
+            if (lo[a] < 0) lo[a] = 0;
+            if (hi[a] > g->n[a] - 1) hi[a] = g->n[a] - 1;
+            if (lo[a] > hi[a]) return 0;
+        }
     }
     for (z = lo[2]; z <= hi[2]; ++z)
         for (y = lo[1]; y <= hi[1]; ++y) {
-            /* distance from p to the row's slab in y and z (0 inside it) */
-            const fsdem_real cy = fsdem__comp(g->origin, 1) + (fsdem_real)y * g->cell_size, cz = fsdem__comp(g->origin, 2) + (fsdem_real)z * g->cell_size;
-            const fsdem_real dy = p.y < cy ? cy - p.y : p.y > cy + g->cell_size ? p.y - cy - g->cell_size : 0;
-            const fsdem_real dz = g->dim == 2 ? 0 : p.z < cz ? cz - p.z : p.z > cz + g->cell_size ? p.z - cz - g->cell_size : 0;
-            const int row = (z * g->n[1] + y) * g->n[0];
+            /* distance from p to the row's slab in y and z (0 inside it), in unwrapped cell coordinates */
+            const fsdem_real cy = (fsdem_real)y * width[1], cz = (fsdem_real)z * width[2];
+            const fsdem_real dy = whole[1] ? 0 : x[1] < cy ? cy - x[1] : x[1] > cy + width[1] ? x[1] - cy - width[1] : 0;
+            const fsdem_real dz = whole[2] ? 0 : x[2] < cz ? cz - x[2] : x[2] > cz + width[2] ? x[2] - cz - width[2] : 0;
+            const int row = ((z + g->n[2]) % g->n[2] * g->n[1] + (y + g->n[1]) % g->n[1]) * g->n[0];
+            int x0 = lo[0], x1 = hi[0];
             if (dy * dy + dz * dz >= r * r) continue;
-            range[count][0] = g->cell_start[row + lo[0]];
-            range[count++][1] = g->cell_start[row + hi[0] + 1];
+            if (x0 < 0 || x1 >= g->n[0]) { /* a periodic x wraps: the part past either end first */
+                range[count][0] = g->cell_start[row + (x0 < 0 ? x0 + g->n[0] : 0)];
+                range[count++][1] = g->cell_start[row + (x0 < 0 ? g->n[0] : x1 - g->n[0] + 1)];
+                if (x0 < 0) x0 = 0;
+                else x1 = g->n[0] - 1;
+            }
+            range[count][0] = g->cell_start[row + x0];
+            range[count++][1] = g->cell_start[row + x1 + 1];
         }
     return count;
 }
@@ -16124,14 +16215,14 @@ static int fsdem__mps_dem_ranges(const fsdem_cellgrid *g, fsdem_vec3 p, fsdem_re
    Eq. 31 does, read a packed bed as half as dense at the wall and let the water bypass it there
    (a packing of porosity 0.476 in a tank 16 r0 wide averaged 0.546 over the cross-section). */
 static fsdem_real fsdem__mps_dem_open_weight(const fsdem_mps_dem *c, const fsdem_mps_particles *mv, int i) {
-    const fsdem_real re = c->desc.radius, re2 = re * re;
+    const fsdem_real re = c->desc.averaging_radius, re2 = re * re;
     fsdem_real walls = 0;
-    int range[25][2], m, e;
+    int range[50][2], m, e;
     const int nr = fsdem__mps_dem_ranges(&c->grid, mv->position[i], re, range);
     for (m = 0; m < nr; ++m)
         for (e = range[m][0]; e < range[m][1]; ++e) {
             const int j = c->grid.items[e];
-            const fsdem_vec3 d = fsdem__sub(mv->position[j], mv->position[i]);
+            const fsdem_vec3 d = fsdem__min_image(&c->periods, fsdem__sub(mv->position[j], mv->position[i]));
             const fsdem_real r2 = fsdem__dot(d, d);
             if (mv->kind[j] != FSDEM_MPS_KIND_FLUID && r2 < re2) walls += fsdem__mps_dem_weight((fsdem_real)sqrt(r2), re);
         }
@@ -16153,17 +16244,17 @@ static fsdem_result fsdem__mps_dem_room(fsdem_mps_dem *c, int nd, int nm) {
 
 /* The non-DUMMY MPS particles within the radius of every DEM particle, with their w_s. */
 static fsdem_result fsdem__mps_dem_pairs(fsdem_mps_dem *c, const fsdem_dem_particles *dv, const fsdem_mps_particles *mv) {
-    const fsdem_real re = c->desc.radius, re2 = re * re;
+    const fsdem_real re = c->desc.averaging_radius, re2 = re * re;
     int k, m, e, n = 0;
     if (fsdem_cellgrid_build(&c->grid, mv->position, mv->count) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     for (k = 0; k < dv->count; ++k) {
-        int range[25][2];
+        int range[50][2];
         const int nr = fsdem__mps_dem_ranges(&c->grid, dv->position[k], re, range);
         c->start[k] = n;
         for (m = 0; m < nr; ++m)
             for (e = range[m][0]; e < range[m][1]; ++e) {
                 const int i = c->grid.items[e];
-                const fsdem_vec3 d = fsdem__sub(mv->position[i], dv->position[k]);
+                const fsdem_vec3 d = fsdem__min_image(&c->periods, fsdem__sub(mv->position[i], dv->position[k]));
                 const fsdem_real r2 = fsdem__dot(d, d);
                 if (mv->kind[i] == FSDEM_MPS_KIND_DUMMY || !(r2 < re2)) continue;
                 if (n == c->pair_cap &&
@@ -16174,7 +16265,7 @@ static fsdem_result fsdem__mps_dem_pairs(fsdem_mps_dem *c, const fsdem_dem_parti
             }
     }
     c->start[dv->count] = n;
-    c->pairs = n;
+    c->tally.pairs = n;
     return FSDEM_OK;
 }
 
@@ -16208,7 +16299,7 @@ static void fsdem__mps_dem_exchange(fsdem_mps_dem *c, const fsdem_dem_particles 
     }
     if (!dv->fixed[k] && coefficient > 0) {
         const fsdem_real tau = dv->mass[k] / coefficient; /* drag relaxation time */
-        if (c->drag_dt == 0 || tau < c->drag_dt) c->drag_dt = tau;
+        if (c->tally.drag_dt == 0 || tau < c->tally.drag_dt) c->tally.drag_dt = tau;
     }
     /* Eq. 36: the reaction shared in proportion to w_s / W, whose shares sum to one */
     exchanged = fsdem__scale(exchanged, -1 / (W * c->depth));
@@ -16251,9 +16342,7 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
         mc.force[i] = fsdem__zero3();
     }
     /* 2-4. averages at the DEM particles (Eq. 32-33), forces (Eq. 25-28, 34-35), reactions (Eq. 36) */
-    c->wet = 0;
-    c->drag_dt = 0;
-    c->drag_sum = c->pressure_sum = fsdem__zero3();
+    memset(&c->tally, 0, sizeof c->tally);
     for (k = 0; k < dv.count; ++k) {
         fsdem_real W = 0, E = 0;
         fsdem_vec3 U = fsdem__zero3(), G = fsdem__zero3();
@@ -16271,17 +16360,16 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
         c->force[k].porosity = 1;
         if (W > 0) {
             fsdem__mps_dem_exchange(c, &dv, &mv, &mc, k, W, E / W, fsdem__scale(U, 1 / W), fsdem__scale(G, 1 / W));
-            c->wet++;
+            c->tally.wet++;
         }
         if (!fsdem__finite3(c->force[k].total))
             return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_mps_dem_update: the fluid force on DEM particle %d is not finite", k);
         dc.force[k] = c->force[k].total;
-        c->drag_sum = fsdem__add(c->drag_sum, c->force[k].drag);
-        c->pressure_sum = fsdem__add(c->pressure_sum, c->force[k].pressure);
+        c->tally.drag_sum = fsdem__add(c->tally.drag_sum, c->force[k].drag);
+        c->tally.pressure_sum = fsdem__add(c->tally.pressure_sum, c->force[k].pressure);
     }
-    c->fluid_sum = fsdem__zero3();
-    for (i = 0; i < mv.count; ++i) c->fluid_sum = fsdem__add(c->fluid_sum, mc.force[i]);
-    c->fluid_sum = fsdem__scale(c->fluid_sum, c->depth);
+    for (i = 0; i < mv.count; ++i) c->tally.fluid_sum = fsdem__add(c->tally.fluid_sum, mc.force[i]);
+    c->tally.fluid_sum = fsdem__scale(c->tally.fluid_sum, c->depth);
     c->forces = dv.count;
     c->sec_dem += (double)(clock() - t0) / CLOCKS_PER_SEC;
     return fsdem__ok(&c->status);
@@ -16304,28 +16392,79 @@ fsdem_result fsdem_mps_dem_get_force(const fsdem_mps_dem *c, int index, fsdem_mp
 
 /* ---- >>couple_mps_step : coupled time stepping ---- */
 
+/* Keeps what the update of a step overwrites (the MPS's porosities and reactions, the DEM's loads,
+   the force records and the tally), so that a step refused after its update leaves coupler, MPS
+   and DEM as they were (fsdem__mps_dem_undo). */
+static fsdem_result fsdem__mps_dem_keep(fsdem_mps_dem *c) {
+    const fsdem_mps_coupling mc = fsdem_mps_get_coupling(c->desc.mps);
+    const fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
+    void **const fluid[2] = {(void **)&c->kept_porosity, (void **)&c->kept_reaction};
+    void **const grain[2] = {(void **)&c->kept_load, (void **)&c->kept_force};
+    const size_t fluid_size[2] = {sizeof(fsdem_real), sizeof(fsdem_vec3)};
+    const size_t grain_size[2] = {sizeof(fsdem_vec3), sizeof(fsdem_mps_dem_force)};
+    if (fsdem__grow_set(&c->allocator, fluid, fluid_size, 2, &c->kept_mps_cap, 0, mc.count) != FSDEM_OK ||
+        fsdem__grow_set(&c->allocator, grain, grain_size, 2, &c->kept_dem_cap, 0, dc.count > c->forces ? dc.count : c->forces) != FSDEM_OK)
+        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem: out of memory (%d DEM and %d MPS particles)", dc.count,
+                           mc.count);
+    if (mc.count) {
+        memcpy(c->kept_porosity, mc.porosity, sizeof(fsdem_real) * (size_t)mc.count);
+        memcpy(c->kept_reaction, mc.force, sizeof(fsdem_vec3) * (size_t)mc.count);
+    }
+    if (dc.count) memcpy(c->kept_load, dc.force, sizeof(fsdem_vec3) * (size_t)dc.count);
+    if (c->forces) memcpy(c->kept_force, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->forces);
+    c->kept_forces = c->forces;
+    c->kept_tally = c->tally;
+    return FSDEM_OK;
+}
+
+/* Puts back what fsdem__mps_dem_keep kept; passes `res` on. */
+static fsdem_result fsdem__mps_dem_undo(fsdem_mps_dem *c, fsdem_result res) {
+    const fsdem_mps_coupling mc = fsdem_mps_get_coupling(c->desc.mps);
+    const fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
+    if (mc.count) {
+        memcpy(mc.porosity, c->kept_porosity, sizeof(fsdem_real) * (size_t)mc.count);
+        memcpy(mc.force, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)mc.count);
+    }
+    if (dc.count) memcpy(dc.force, c->kept_load, sizeof(fsdem_vec3) * (size_t)dc.count);
+    if (c->kept_forces) memcpy(c->force, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_forces);
+    c->forces = c->kept_forces;
+    c->tally = c->kept_tally;
+    return res;
+}
+
+/* The update of a step, kept to be undone if the step is refused. */
+static fsdem_result fsdem__mps_dem_update_kept(fsdem_mps_dem *c) {
+    fsdem_result res = fsdem__mps_dem_keep(c);
+    if (res == FSDEM_OK && (res = fsdem_mps_dem_update(c)) != FSDEM_OK) fsdem__mps_dem_undo(c, res);
+    return res;
+}
+
 /* The stable coupled step of the last update: the MPS's (Eq. 37) and the drag limit. */
 static fsdem_result fsdem__mps_dem_stable(const fsdem_mps_dem *c, fsdem_real *dt) {
     const fsdem_result res = fsdem_mps_stable_dt(c->desc.mps, dt);
     if (res != FSDEM_OK) return res;
-    if (c->drag_dt > 0 && c->desc.drag_dt_fraction * c->drag_dt < *dt) *dt = c->desc.drag_dt_fraction * c->drag_dt;
+    if (c->tally.drag_dt > 0 && c->desc.drag_dt_fraction * c->tally.drag_dt < *dt) *dt = c->desc.drag_dt_fraction * c->tally.drag_dt;
     return FSDEM_OK;
 }
 
-/* Step 5 of >>couple_mps after an update: the MPS step of dt, then the DEM substeps. */
+/* Step 5 of >>couple_mps after a kept update: the MPS step of dt, then the DEM substeps. A step
+   refused before anything moves (too many substeps, the drag limit, the MPS's CFL limits) undoes
+   the update. */
 static fsdem_result fsdem__mps_dem_run(fsdem_mps_dem *c, fsdem_real dt) {
     long long substeps = 0;
     fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_mps_dem");
     clock_t t0, t1;
-    if (res != FSDEM_OK) return res;
-    if (c->drag_dt > 0 && dt > c->desc.drag_dt_fraction * c->drag_dt * (1 + (fsdem_real)1e-6))
-        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
-                           "fsdem_mps_dem: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s", (double)dt,
-                           (double)c->desc.drag_dt_fraction, (double)c->drag_dt);
+    if (res != FSDEM_OK) return fsdem__mps_dem_undo(c, res);
+    if (c->tally.drag_dt > 0 && dt > c->desc.drag_dt_fraction * c->tally.drag_dt * (1 + (fsdem_real)1e-6))
+        return fsdem__mps_dem_undo(c, fsdem__fail(&c->status, FSDEM_ERR_CFL,
+                                                  "fsdem_mps_dem: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation "
+                                                  "time %g s",
+                                                  (double)dt, (double)c->desc.drag_dt_fraction, (double)c->tally.drag_dt));
     t0 = clock();
     res = fsdem_mps_step_dt(c->desc.mps, dt);
     t1 = clock();
     c->sec_mps += (double)(t1 - t0) / CLOCKS_PER_SEC;
+    if (res == FSDEM_ERR_CFL) fsdem__mps_dem_undo(c, res); /* refused before it moved */
     if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_mps_dem: MPS step: %s", fsdem_mps_last_error(c->desc.mps));
     res = fsdem_dem_advance(c->desc.dem, dt, &substeps);
     c->sec_dem += (double)(clock() - t1) / CLOCKS_PER_SEC;
@@ -16341,9 +16480,9 @@ fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *c) {
     fsdem_real dt = 0;
     fsdem_result res;
     if (!c) return FSDEM_ERR_INVALID_ARG;
-    if ((res = fsdem_mps_dem_update(c)) != FSDEM_OK) return res;
+    if ((res = fsdem__mps_dem_update_kept(c)) != FSDEM_OK) return res;
     if ((res = fsdem__mps_dem_stable(c, &dt)) != FSDEM_OK)
-        return fsdem__fail(&c->status, res, "fsdem_mps_dem_step: %s", fsdem_mps_last_error(c->desc.mps));
+        return fsdem__mps_dem_undo(c, fsdem__fail(&c->status, res, "fsdem_mps_dem_step: %s", fsdem_mps_last_error(c->desc.mps)));
     return fsdem__mps_dem_run(c, dt);
 }
 
@@ -16352,7 +16491,7 @@ fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *c, fsdem_real dt) {
     if (!c) return FSDEM_ERR_INVALID_ARG;
     if (!(dt > 0) || !fsdem__finite(dt))
         return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_dem_step_dt: dt = %g s must be > 0 and finite", (double)dt);
-    if ((res = fsdem_mps_dem_update(c)) != FSDEM_OK) return res;
+    if ((res = fsdem__mps_dem_update_kept(c)) != FSDEM_OK) return res;
     return fsdem__mps_dem_run(c, dt);
 }
 
@@ -16361,9 +16500,9 @@ static double fsdem__mps_dem_now(const void *c) { return fsdem_mps_time(((const 
 
 static fsdem_result fsdem__mps_dem_prepare(void *object, fsdem_real *dt) {
     fsdem_mps_dem *c = (fsdem_mps_dem *)object;
-    fsdem_result res = fsdem_mps_dem_update(c);
+    fsdem_result res = fsdem__mps_dem_update_kept(c);
     if (res == FSDEM_OK && (res = fsdem__mps_dem_stable(c, dt)) != FSDEM_OK)
-        fsdem__fail(&c->status, res, "fsdem_mps_dem_advance: %s", fsdem_mps_last_error(c->desc.mps));
+        fsdem__mps_dem_undo(c, fsdem__fail(&c->status, res, "fsdem_mps_dem_advance: %s", fsdem_mps_last_error(c->desc.mps)));
     return res;
 }
 
@@ -16385,6 +16524,7 @@ double fsdem_mps_dem_time(const fsdem_mps_dem *c) { return c ? fsdem_mps_time(c-
 
 fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *c) {
     fsdem_mps_dem_stats st;
+    int k;
     memset(&st, 0, sizeof st);
     if (!c) return st;
     st.steps = c->steps;
@@ -16392,12 +16532,15 @@ fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *c) {
     st.dt = c->dt_last;
     st.substeps = c->substeps;
     st.substeps_total = c->substeps_total;
-    st.wet = c->wet;
-    st.drag = c->drag_sum;
-    st.pressure = c->pressure_sum;
-    st.to_fluid = c->fluid_sum;
-    st.drag_dt = c->drag_dt;
-    st.pairs = c->pairs;
+    st.wet = c->tally.wet;
+    st.drag = c->tally.drag_sum;
+    st.pressure = c->tally.pressure_sum;
+    st.to_fluid = c->tally.fluid_sum;
+    st.drag_dt = c->tally.drag_dt;
+    st.pairs = c->tally.pairs;
+    for (k = 0; k < c->forces; ++k)
+        st.exchanged = fsdem__add(st.exchanged, c->model == FSDEM_MPS_MODEL_A ? c->force[k].drag : c->force[k].total);
+    st.exchange_residual = fsdem__norm(fsdem__add(st.to_fluid, st.exchanged));
     st.seconds_mps = c->sec_mps;
     st.seconds_dem = c->sec_dem;
     return st;
@@ -18425,20 +18568,20 @@ static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
     fsdem__restart_dem(io, c->desc.dem);
     io->section = NULL;
     fsdem__restart_same_int(io, (int)c->desc.drag, "drag");
-    fsdem__restart_same_real(io, c->desc.radius, "radius");
+    fsdem__restart_same_real(io, c->desc.averaging_radius, "averaging_radius");
     fsdem__restart_same_real(io, c->desc.min_porosity, "min_porosity");
     fsdem__restart_same_real(io, c->desc.drag_dt_fraction, "drag_dt_fraction");
     fsdem__restart_same_ll(io, c->desc.max_substeps, "max_substeps");
     fsdem__restart_data(io, &c->steps, sizeof c->steps);
     fsdem__restart_data(io, &c->substeps, sizeof c->substeps);
     fsdem__restart_data(io, &c->substeps_total, sizeof c->substeps_total);
-    fsdem__restart_data(io, &c->pairs, sizeof c->pairs);
+    fsdem__restart_data(io, &c->tally.pairs, sizeof c->tally.pairs);
     fsdem__restart_data(io, &c->dt_last, sizeof c->dt_last);
-    fsdem__restart_data(io, &c->drag_dt, sizeof c->drag_dt);
-    fsdem__restart_data(io, &c->wet, sizeof c->wet);
-    fsdem__restart_data(io, &c->drag_sum, sizeof c->drag_sum);
-    fsdem__restart_data(io, &c->pressure_sum, sizeof c->pressure_sum);
-    fsdem__restart_data(io, &c->fluid_sum, sizeof c->fluid_sum);
+    fsdem__restart_data(io, &c->tally.drag_dt, sizeof c->tally.drag_dt);
+    fsdem__restart_data(io, &c->tally.wet, sizeof c->tally.wet);
+    fsdem__restart_data(io, &c->tally.drag_sum, sizeof c->tally.drag_sum);
+    fsdem__restart_data(io, &c->tally.pressure_sum, sizeof c->tally.pressure_sum);
+    fsdem__restart_data(io, &c->tally.fluid_sum, sizeof c->tally.fluid_sum);
     fsdem__restart_count(io, &count, 1 << 29, sizeof(int) + 4 * sizeof(fsdem_vec3) + 2 * sizeof(fsdem_real), "force record count");
     force = (fsdem_mps_dem_force *)fsdem__restart_block(io, &c->allocator, sizeof *force * (size_t)count);
     if (commit) {

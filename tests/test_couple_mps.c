@@ -1,6 +1,7 @@
 /* Unresolved MPS-DEM coupling (seed 002 §2.3-2.4): porosity of a packing, exact momentum exchange,
    a particle at rest in still water, terminal velocities against the drag law's force balance. */
 #include "fsdem_tests.h"
+#include <stdlib.h>
 #include <string.h>
 
 #define TEST_PI 3.14159265358979323846
@@ -88,7 +89,7 @@ START_TEST(test_mps_dem_porosity_packing) {
             const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3((fsdem_real)size, (fsdem_real)size, dim == 3 ? (fsdem_real)size : 0);
             test_pair t = test_pair_new(dim, r0, FSDEM_MPS_MODEL_B, 1e-6, lo, hi, 0, 2500);
             const double phi = dim == 3 ? 4.0 / 3.0 * TEST_PI * R * R * R / (a * a * a) : TEST_PI * R * R / (a * a);
-            const double re = fsdem_mps_dem_get_desc(t.cpl).radius;
+            const double re = fsdem_mps_dem_get_desc(t.cpl).averaging_radius;
             const int m = (int)floor(size / a + 0.5);
             fsdem_mps_particles mv;
             double worst = 0;
@@ -146,6 +147,17 @@ static void test_exchange_sums(test_pair *t, fsdem_mps_model model, fsdem_vec3 *
     }
 }
 
+/* The coupler's own audit (fsdem_mps_dem_stats) reports the sums the test made, and a residual
+   of rounding only. */
+static void test_audit_agrees(test_pair *t, fsdem_vec3 fluid, fsdem_vec3 solid, double scale) {
+    const fsdem_mps_dem_stats st = fsdem_mps_dem_get_stats(t->cpl);
+    ck_assert_msg(fabs(st.to_fluid.x - fluid.x) + fabs(st.to_fluid.y - fluid.y) + fabs(st.to_fluid.z - fluid.z) < 64 * TEST_EPS * scale,
+                  "stats.to_fluid is not the sum of the reactions");
+    ck_assert_msg(fabs(st.exchanged.x - solid.x) + fabs(st.exchanged.y - solid.y) + fabs(st.exchanged.z - solid.z) < 64 * TEST_EPS * scale,
+                  "stats.exchanged is not the sum of X_k");
+    ck_assert_msg(st.exchange_residual < 64 * TEST_EPS * scale, "stats.exchange_residual %g N of %g", (double)st.exchange_residual, scale);
+}
+
 /* Eq. 36: every exchanged force is split into shares that sum to one, so the fluid gets exactly
    minus what the solids get, to rounding (a few eps of the sum of magnitudes), at every step, in
    both models and both dims, with moving water and particles of several sizes. */
@@ -176,6 +188,7 @@ START_TEST(test_mps_dem_momentum_exchange) {
                 TEST_REPORT("dim %d model %c step %d: |sum fluid + sum solid| = %.2e N of %.2e", dim, "AB"[model], step,
                             fabs(fluid.x + solid.x) + fabs(fluid.y + solid.y) + fabs(fluid.z + solid.z), scale);
                 ck_assert_msg(scale > 0, "no exchange");
+                test_audit_agrees(&t, fluid, solid, scale);
                 ck_assert_msg(fabs(fluid.x + solid.x) + fabs(fluid.y + solid.y) + fabs(fluid.z + solid.z) < 64 * TEST_EPS * scale,
                               "dim %d model %d: fluid (%g, %g, %g) solid (%g, %g, %g)", dim, model, (double)fluid.x, (double)fluid.y,
                               (double)fluid.z, (double)solid.x, (double)solid.y, (double)solid.z);
@@ -328,6 +341,209 @@ START_TEST(test_mps_dem_terminal_velocity) {
 }
 END_TEST
 
+/* Water filling a box of side `size` periodic along every axis (the plane's in 2D), no gravity, at
+   rest; a DEM periodic alike; their coupler. */
+static test_pair test_periodic_pair(int dim, double r0, fsdem_mps_model model, double size) {
+    test_pair t;
+    fsdem_mps_desc md = fsdem_mps_desc_default(dim);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(dim);
+    fsdem_dem_material mat = fsdem_dem_material_default();
+    fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
+    const fsdem_vec3 hi = fsdem_v3((fsdem_real)size, (fsdem_real)size, dim == 3 ? (fsdem_real)size : 0);
+    memset(&t, 0, sizeof t);
+    md.r0 = (fsdem_real)r0;
+    md.model = model;
+    md.gravity = fsdem_v3(0, 0, 0);
+    md.domain_min = fsdem_v3(0, 0, 0);
+    md.domain_max = hi;
+    md.periodic[0] = md.periodic[1] = 1;
+    md.periodic[2] = dim == 3;
+    ck_assert_int_eq(fsdem_mps_create(&md, &t.mps), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(t.mps, md.domain_min, hi, fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    dd.domain_min = md.domain_min;
+    dd.domain_max = hi;
+    if (dim == 2) dd.domain_min.z = -1, dd.domain_max.z = 1;
+    memcpy(dd.periodic, md.periodic, sizeof dd.periodic);
+    dd.gravity = md.gravity;
+    dd.dt = 1e-4;
+    ck_assert_int_eq(fsdem_dem_create(&dd, &t.dem), FSDEM_OK);
+    mat.density = 2500;
+    ck_assert_int_eq(fsdem_dem_add_material(t.dem, &mat, &t.material), FSDEM_OK);
+    cd.mps = t.mps;
+    cd.dem = t.dem;
+    ck_assert_int_eq(fsdem_mps_dem_create(&cd, &t.cpl), FSDEM_OK);
+    return t;
+}
+
+/* Periodic axes (>>couple_mps with periodic MPS and DEM): a lattice of spheres filling a fully
+   periodic box is uniform, so every FLUID particle, those next to the box's faces too, must read
+   its porosity within the 2% of the packing test (without the images a particle at a face would
+   read about half the solid). Then one sphere near a corner and the same sphere moved by half a
+   period along every axis (a whole number of r0, so it sits alike on the lattice of water) in
+   water whose velocity is periodic and invariant under that move: the same neighbours through the
+   images, so the same porosity, fluid velocity and drag, to rounding. */
+START_TEST(test_mps_dem_periodic_images) {
+    const double r0 = 0.01, size = 0.12;
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        test_pair t = test_periodic_pair(dim, r0, FSDEM_MPS_MODEL_B, size);
+        const int m = 16;
+        const double a = size / m, R = 0.3 * a;
+        const double phi = dim == 3 ? 4.0 / 3.0 * TEST_PI * R * R * R / (a * a * a) : TEST_PI * R * R / (a * a);
+        fsdem_mps_particles mv = fsdem_mps_get_particles(t.mps);
+        fsdem_mps_dem_force f[2];
+        double worst = 0;
+        int i, j, k, shift;
+        for (k = 0; k < (dim == 3 ? m : 1); ++k)
+            for (j = 0; j < m; ++j)
+                for (i = 0; i < m; ++i)
+                    test_add_sphere(&t, fsdem_v3((fsdem_real)((i + 0.37) * a), (fsdem_real)((j + 0.37) * a), dim == 3 ? (fsdem_real)((k + 0.37) * a) : 0),
+                                    fsdem_v3(0, 0, 0), R);
+        ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
+        for (i = 0; i < mv.count; ++i)
+            if (fabs(mv.porosity[i] - (1 - phi)) > worst) worst = fabs(mv.porosity[i] - (1 - phi));
+        TEST_REPORT("dim %d, periodic lattice of solid fraction %.4f: every one of %d particles within %.2e (%.3f%%)", dim, phi, mv.count, worst,
+                    100 * worst / (1 - phi));
+        ck_assert_msg(worst < 0.02 * (1 - phi), "dim %d: porosity off by %g of %g", dim, worst, 1 - phi);
+        test_pair_free(&t);
+        for (shift = 0; shift < 2; ++shift) {
+            const double s0 = 0.013 + shift * size / 2;
+            t = test_periodic_pair(dim, r0, FSDEM_MPS_MODEL_B, size);
+            mv = fsdem_mps_get_particles(t.mps);
+            for (i = 0; i < mv.count; ++i) /* period size / 2 along x: the move leaves it as it was */
+                mv.velocity[i] = fsdem_v3((fsdem_real)(0.02 * sin(4 * TEST_PI * mv.position[i].y / size)),
+                                          (fsdem_real)(0.01 * cos(4 * TEST_PI * mv.position[i].x / size)), 0);
+            test_add_sphere(&t, fsdem_v3((fsdem_real)s0, (fsdem_real)s0, dim == 3 ? (fsdem_real)s0 : 0), fsdem_v3(0, 0, 0), 0.002);
+            ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
+            ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, 0, &f[shift]), FSDEM_OK);
+            test_pair_free(&t);
+        }
+        TEST_REPORT("dim %d: sphere near a corner: eps %.6f u (%.5f, %.5f) m/s; moved half a period: eps %.6f u (%.5f, %.5f) m/s", dim,
+                    (double)f[0].porosity, (double)f[0].fluid_velocity.x, (double)f[0].fluid_velocity.y, (double)f[1].porosity,
+                    (double)f[1].fluid_velocity.x, (double)f[1].fluid_velocity.y);
+        ck_assert(f[0].porosity < 1);
+        ck_assert_msg(fabs(f[0].porosity - f[1].porosity) < 64 * TEST_EPS, "porosity %g vs %g", (double)f[0].porosity, (double)f[1].porosity);
+        ck_assert(fabs(f[0].fluid_velocity.x - f[1].fluid_velocity.x) + fabs(f[0].fluid_velocity.y - f[1].fluid_velocity.y) < 64 * TEST_EPS * 0.03);
+        ck_assert(fabs(f[0].drag.x - f[1].drag.x) + fabs(f[0].drag.y - f[1].drag.y) <
+                  1e3 * TEST_EPS * (fabs(f[0].drag.x) + fabs(f[0].drag.y)));
+    }
+}
+END_TEST
+
+/* The exchange conserves momentum through periodic images too: spheres near the faces and corners
+   of a fully periodic box of moving water, both models, both dims; the audit of the stats agrees. */
+START_TEST(test_mps_dem_periodic_exchange) {
+    int dim, model;
+    for (dim = 2; dim <= 3; ++dim)
+        for (model = 0; model <= 1; ++model) {
+            test_pair t = test_periodic_pair(dim, 0.01, (fsdem_mps_model)model, 0.1);
+            fsdem_mps_particles mv = fsdem_mps_get_particles(t.mps);
+            fsdem_vec3 fluid, solid;
+            double scale;
+            int i;
+            for (i = 0; i < mv.count; ++i)
+                mv.velocity[i] = fsdem_v3((fsdem_real)(0.05 * sin(2 * TEST_PI * mv.position[i].y / 0.1)), 0, 0);
+            for (i = 0; i < 30; ++i) {
+                const double s = i * 0.618034, e = 0.004 + 0.092 * (i % 2); /* alternately next to either face */
+                test_add_sphere(&t, fsdem_v3((fsdem_real)e, (fsdem_real)(0.1 * (s - floor(s))), dim == 3 ? (fsdem_real)(0.1 * fmod(s * 1.7, 1.0)) : 0),
+                                fsdem_v3(0, (fsdem_real)(0.01 * (i % 3)), 0), 0.001);
+            }
+            ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
+            test_exchange_sums(&t, (fsdem_mps_model)model, &fluid, &solid, &scale);
+            TEST_REPORT("periodic, dim %d model %c: |sum fluid + sum solid| = %.2e N of %.2e, audit %.2e N", dim, "AB"[model],
+                        fabs(fluid.x + solid.x) + fabs(fluid.y + solid.y) + fabs(fluid.z + solid.z), scale,
+                        (double)fsdem_mps_dem_get_stats(t.cpl).exchange_residual);
+            ck_assert_msg(scale > 0, "no exchange");
+            ck_assert(fabs(fluid.x + solid.x) + fabs(fluid.y + solid.y) + fabs(fluid.z + solid.z) < 64 * TEST_EPS * scale);
+            test_audit_agrees(&t, fluid, solid, scale);
+            test_pair_free(&t);
+        }
+}
+END_TEST
+
+/* The whole observable state of a coupler: its saved bytes (the solvers with it), the solvers'
+   coupling arrays (porosities, reactions, loads) and the stats. */
+typedef struct test_snapshot {
+    unsigned char *bytes;
+    size_t size;
+    fsdem_mps_dem_stats stats;
+} test_snapshot;
+
+static test_snapshot test_snapshot_take(test_pair *t) {
+    const fsdem_mps_coupling mc = fsdem_mps_get_coupling(t->mps);
+    const fsdem_dem_coupling dc = fsdem_dem_get_coupling(t->dem);
+    const size_t extra = (sizeof(fsdem_real) + sizeof(fsdem_vec3)) * (size_t)mc.count + sizeof(fsdem_vec3) * (size_t)dc.count;
+    test_snapshot s;
+    size_t need = 0;
+    fsdem_mps_dem_save_memory(t->cpl, NULL, 0, &need);
+    s.bytes = (unsigned char *)malloc(need + extra);
+    ck_assert_ptr_nonnull(s.bytes);
+    ck_assert_int_eq(fsdem_mps_dem_save_memory(t->cpl, s.bytes, need, &s.size), FSDEM_OK);
+    memcpy(s.bytes + s.size, mc.porosity, sizeof(fsdem_real) * (size_t)mc.count);
+    memcpy(s.bytes + s.size + sizeof(fsdem_real) * (size_t)mc.count, mc.force, sizeof(fsdem_vec3) * (size_t)mc.count);
+    memcpy(s.bytes + need + extra - sizeof(fsdem_vec3) * (size_t)dc.count, dc.force, sizeof(fsdem_vec3) * (size_t)dc.count);
+    s.size = need + extra;
+    s.stats = fsdem_mps_dem_get_stats(t->cpl);
+    s.stats.seconds_mps = s.stats.seconds_dem = 0; /* CPU time is not state */
+    return s;
+}
+
+static void test_snapshot_same(test_pair *t, test_snapshot *before, const char *what) {
+    test_snapshot after = test_snapshot_take(t);
+    ck_assert_msg(after.size == before->size && memcmp(after.bytes, before->bytes, after.size) == 0, "%s: the state changed", what);
+    ck_assert_msg(memcmp(&after.stats, &before->stats, sizeof after.stats) == 0, "%s: the stats changed", what);
+    free(after.bytes);
+}
+
+/* The house error rule: a step refused after its update (the drag limit, the MPS's CFL limit, too
+   many DEM substeps) leaves coupler, MPS and DEM exactly as they were, saved bytes, coupling
+   arrays and stats, and the objects stay usable: the same step at an allowed dt then runs. */
+START_TEST(test_mps_dem_refused_step_changes_nothing) {
+    int path;
+    for (path = 0; path < 3; ++path) {
+        const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3(0.08f, 0.08f, 0.08f);
+        test_pair t = test_pair_new(3, 0.01, FSDEM_MPS_MODEL_B, 1e-6, lo, hi, 0.06, 2500);
+        fsdem_mps_particles mv = fsdem_mps_get_particles(t.mps);
+        test_snapshot before;
+        fsdem_mps_dem_stats st;
+        fsdem_real dt = 0;
+        int i;
+        /* path 0: fine grains (drag time 1e-2 s) in still water; 1: a coarse grain in water at 0.5 m/s */
+        test_add_sphere(&t, fsdem_v3(0.04f, 0.04f, 0.03f), fsdem_v3(0, 0, -0.01f), path == 0 ? 0.0002 : 0.002);
+        if (path == 1)
+            for (i = 0; i < mv.count; ++i)
+                if (mv.kind[i] == FSDEM_MPS_KIND_FLUID) mv.velocity[i].x = 0.5f;
+        ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK); /* records and loads from a first step */
+        if (path == 2) {
+            fsdem_mps_dem_desc cd = fsdem_mps_dem_get_desc(t.cpl);
+            fsdem_mps_dem_destroy(t.cpl);
+            cd.max_substeps = 3;
+            ck_assert_int_eq(fsdem_mps_dem_create(&cd, &t.cpl), FSDEM_OK);
+            ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
+        }
+        ck_assert_int_eq(fsdem_mps_dem_stable_dt(t.cpl, &dt), FSDEM_OK);
+        st = fsdem_mps_dem_get_stats(t.cpl);
+        before = test_snapshot_take(&t);
+        if (path == 0) {
+            ck_assert(st.drag_dt > 0);
+            ck_assert_int_eq(fsdem_mps_dem_step_dt(t.cpl, (fsdem_real)(2 * fsdem_mps_dem_get_desc(t.cpl).drag_dt_fraction * st.drag_dt)),
+                             FSDEM_ERR_CFL);
+            ck_assert_ptr_nonnull(strstr(fsdem_mps_dem_last_error(t.cpl), "drag"));
+        } else if (path == 1) {
+            ck_assert_int_eq(fsdem_mps_dem_step_dt(t.cpl, (fsdem_real)(0.01 * 0.5 / 0.5)), FSDEM_ERR_CFL); /* u dt = r0 / 2 > cfl r0 */
+            ck_assert_ptr_nonnull(strstr(fsdem_mps_dem_last_error(t.cpl), "cfl"));
+        } else {
+            ck_assert_int_eq(fsdem_mps_dem_step_dt(t.cpl, (fsdem_real)(10 * fsdem_dem_get_desc(t.dem).dt)), FSDEM_ERR_INVALID_ARG);
+            ck_assert_ptr_nonnull(strstr(fsdem_mps_dem_last_error(t.cpl), "max_substeps"));
+        }
+        test_snapshot_same(&t, &before, path == 0 ? "drag limit" : path == 1 ? "MPS CFL" : "max_substeps");
+        free(before.bytes);
+        ck_assert_int_eq(fsdem_mps_dem_step_dt(t.cpl, path == 2 ? (fsdem_real)(2 * fsdem_dem_get_desc(t.dem).dt) : dt), FSDEM_OK);
+        test_pair_free(&t);
+    }
+}
+END_TEST
+
 /* Bad input: a desc without solvers, mismatched dims or gravity, bad ranges; the message names the
    field and nothing is created. */
 START_TEST(test_mps_dem_bad_input) {
@@ -350,10 +566,10 @@ START_TEST(test_mps_dem_bad_input) {
     ck_assert_int_eq(fsdem_mps_dem_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_nonnull(strstr(msg, "drag"));
     d.drag = FSDEM_DRAG_LAW_ERGUN_WEN_YU;
-    d.radius = -1;
+    d.averaging_radius = -1;
     ck_assert_int_eq(fsdem_mps_dem_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_nonnull(strstr(msg, "radius"));
-    d.radius = 0;
+    d.averaging_radius = 0;
     ck_assert_int_eq(fsdem_dem_create(&dd, &dem2), FSDEM_OK);
     d.dem = dem2;
     ck_assert_int_eq(fsdem_mps_dem_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
@@ -445,6 +661,9 @@ Suite *couple_mps_suite(void) {
     tcase_add_test(tc, test_mps_dem_momentum_exchange);
     tcase_add_test(tc, test_mps_dem_rest_in_still_water);
     tcase_add_test(tc, test_mps_dem_terminal_velocity);
+    tcase_add_test(tc, test_mps_dem_periodic_images);
+    tcase_add_test(tc, test_mps_dem_periodic_exchange);
+    tcase_add_test(tc, test_mps_dem_refused_step_changes_nothing);
     tcase_add_test(tc, test_mps_dem_bad_input);
     tcase_add_test(tc, test_mps_dem_csv_rows_are_the_force_records);
     tcase_add_test(tc, test_mps_dem_csv_after_a_removal);

@@ -360,7 +360,7 @@ START_TEST(implausible_coupler_input_is_refused) {
     ck_assert_int_eq(fsdem_dem_add_material(dem, &m, NULL), FSDEM_OK);
     mc.mps = mps;
     mc.dem = dem;
-    mc.radius = (fsdem_real)1e30;
+    mc.averaging_radius = (fsdem_real)1e30;
     REFUSED(fsdem_mps_dem_desc_check(&mc, msg, sizeof msg), msg, "radius");
     pc.pic = pic;
     pc.dem = dem;
@@ -373,7 +373,7 @@ START_TEST(implausible_coupler_input_is_refused) {
     pc.contact_length = 0;
     ck_assert_int_eq(fsdem_pic_dem_create(&pc, &cp), FSDEM_ERR_INVALID_ARG);
     ck_assert_ptr_null(cp);
-    mc.radius = 0;
+    mc.averaging_radius = 0;
     ck_assert_int_eq(fsdem_mps_dem_create(&mc, &c), FSDEM_OK);
     REFUSED(fsdem_mps_dem_update(c), fsdem_mps_dem_last_error(c), "does not fit");
     fsdem_mps_dem_destroy(c);
