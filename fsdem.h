@@ -2513,8 +2513,10 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
    momentum of that volume; their D eps / Dt terms (u_d = eps u_f, eps changing along the path) are
    not included.
    Held forces are explicit: a step longer than the drag relaxation time of a particle, m_k /
-   (c V_k) (with Model B's 1/eps_k), would overshoot, so the coupled stable step is also at most
-   desc.drag_dt_fraction of the shortest one. Virtual mass, lift and lubrication forces are not
+   (c V_k) (with Model B's 1/eps_k), would overshoot, and so would one longer than the water's,
+   rho_f r0^d over its shares of the grains' coefficients (eps rho_f / beta in a uniform bed: 7 ms
+   in a bed of 2 mm grains at Re_p 100, shorter than the MPS's CFL step), so the coupled stable
+   step is also at most desc.drag_dt_fraction of the shortest of both. Virtual mass, lift and lubrication forces are not
    included (the seed leaves them out, §2.3).
    Loads on a structure come in the seed's two parts (Fig. 18-19): the fluid's, the pressure on a
    box obstacle of the MPS (fsdem_mps_obstacle_force), and the sediment's, the contact force on a
@@ -2606,7 +2608,8 @@ typedef struct fsdem_mps_dem_stats {
     fsdem_real exchange_residual; /* N; |to_fluid + exchanged|, the momentum the exchange loses: */
                                   /*    rounding only, whatever walls, free surface or periodic */
                                   /*    images cut the kernels (the audit of step 4) */
-    fsdem_real drag_dt;           /* s; the drag limit of the last update (0: none) */
+    fsdem_real drag_dt;           /* s; the shortest drag relaxation time of the last update, of */
+                                  /*    a grain or of the water (0: none) */
     long long pairs;              /* DEM-MPS pairs within the radius, last update */
     double seconds_mps;           /* CPU seconds in MPS steps */
     double seconds_dem;           /* CPU seconds in DEM substeps and the coupling (updates) */
@@ -15407,14 +15410,23 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
        constant its null space (its rows sum to 0); the source loses its mean, the part no pressure
        can answer (for a liquid whose volume is fixed by its walls, the density error that
        compression cannot remove), so that the system has solutions; the solve's level is then
-       set in fsdem__mps_do_step. Detected for the whole liquid: a sealed pocket beside liquid
-       that has a free surface keeps a singular block (not handled) */
+       set in fsdem__mps_do_step. The first unknown is then pinned to 0 (its row and column
+       reduced to the diagonal): the matrix becomes positive definite, and since the rows sum to 0
+       and the source to 0, the dropped row holds whenever the others do, so the solution is the
+       singular system's. (Unpinned, a uniform flow, whose source is rounding alone, led the
+       preconditioned CG into the null space: non-positive curvature.) Detected for the whole
+       liquid: a sealed pocket beside liquid that has a free surface keeps a singular block (not
+       handled) */
     s->closed = rows > 0 && !anchored;
     if (s->closed) {
         double mean = 0;
         for (i = 0; i < rows; ++i) mean += (double)s->b[i];
         mean /= rows;
         for (i = 0; i < rows; ++i) s->b[i] -= (fsdem_real)mean;
+        for (i = 0; i < rows; ++i)
+            for (e = s->a_start[i]; e < s->a_start[i + 1]; ++e)
+                if ((i == 0) != (s->a_col[e] == 0)) s->a_val[e] = 0;
+        s->b[0] = 0;
     }
     return FSDEM_OK;
 }
@@ -16006,7 +16018,10 @@ struct fsdem_mps_dem {
     fsdem__mps_dem_pair *pair;
     int pair_cap;
     fsdem_real *solid;             /* per MPS particle: sum_k w_s V_k (Eq. 31) */
-    int solid_cap;
+    fsdem_real *rate;              /* per MPS particle: its share of the grains' slip coefficients */
+                                   /*    (kg/s; N/m per m/s in 2D), whose inverse times its mass is */
+                                   /*    the water's drag relaxation time */
+    int solid_cap;                 /* of solid and rate */
     fsdem_mps_dem_force *force;    /* per DEM particle */
     int force_cap, forces;         /* forces: DEM particles of the last update (0: none yet) */
     fsdem__mps_dem_tally tally;
@@ -16130,6 +16145,7 @@ void fsdem_mps_dem_destroy(fsdem_mps_dem *c) {
     fsdem__free(&al, c->start, sizeof(int) * (size_t)c->start_cap);
     fsdem__free(&al, c->pair, sizeof *c->pair * (size_t)c->pair_cap);
     fsdem__free(&al, c->solid, sizeof(fsdem_real) * (size_t)c->solid_cap);
+    fsdem__free(&al, c->rate, sizeof(fsdem_real) * (size_t)c->solid_cap);
     fsdem__free(&al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
     fsdem__free(&al, c->kept_porosity, sizeof(fsdem_real) * (size_t)c->kept_mps_cap);
     fsdem__free(&al, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)c->kept_mps_cap);
@@ -16235,11 +16251,13 @@ static fsdem_real fsdem__mps_dem_open_weight(const fsdem_mps_dem *c, const fsdem
 static fsdem_result fsdem__mps_dem_room(fsdem_mps_dem *c, int nd, int nm) {
     const fsdem_allocator *al = &c->allocator;
     int cap = c->force_cap;
+    void **const fluid[2] = {(void **)&c->solid, (void **)&c->rate};
+    const size_t size[2] = {sizeof(fsdem_real), sizeof(fsdem_real)};
     if (fsdem__grow(al, (void **)&c->start, &c->start_cap, 0, nd + 1, sizeof(int)) != FSDEM_OK ||
         fsdem__grow(al, (void **)&c->force, &cap, 0, nd, sizeof(fsdem_mps_dem_force)) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
     c->force_cap = cap;
-    return fsdem__grow(al, (void **)&c->solid, &c->solid_cap, 0, nm, sizeof(fsdem_real));
+    return fsdem__grow_set(al, fluid, size, 2, &c->solid_cap, 0, nm);
 }
 
 /* The non-DUMMY MPS particles within the radius of every DEM particle, with their w_s. */
@@ -16301,11 +16319,15 @@ static void fsdem__mps_dem_exchange(fsdem_mps_dem *c, const fsdem_dem_particles 
         const fsdem_real tau = dv->mass[k] / coefficient; /* drag relaxation time */
         if (c->tally.drag_dt == 0 || tau < c->tally.drag_dt) c->tally.drag_dt = tau;
     }
-    /* Eq. 36: the reaction shared in proportion to w_s / W, whose shares sum to one */
+    /* Eq. 36: the reaction shared in proportion to w_s / W, whose shares sum to one; the water
+       takes the same shares of the slip coefficient */
     exchanged = fsdem__scale(exchanged, -1 / (W * c->depth));
+    coefficient /= W * c->depth;
     for (e = c->start[k]; e < c->start[k + 1]; ++e) {
         const int i = c->pair[e].particle;
-        if (mv->kind[i] == FSDEM_MPS_KIND_FLUID) mc->force[i] = fsdem__madd(mc->force[i], exchanged, c->pair[e].weight);
+        if (mv->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
+        mc->force[i] = fsdem__madd(mc->force[i], exchanged, c->pair[e].weight);
+        c->rate[i] += coefficient * c->pair[e].weight;
     }
 }
 
@@ -16324,13 +16346,14 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
     }
     dv = fsdem_dem_get_particles(c->desc.dem);
     mv = fsdem_mps_get_particles(c->desc.mps);
+    memset(&c->tally, 0, sizeof c->tally);
     if (fsdem__mps_dem_room(c, dv.count, mv.count) != FSDEM_OK || fsdem__mps_dem_pairs(c, &dv, &mv) != FSDEM_OK)
         return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem_update: out of memory (%d DEM and %d MPS particles)",
                            dv.count, mv.count);
     mc = fsdem_mps_get_coupling(c->desc.mps);
     dc = fsdem_dem_get_coupling(c->desc.dem);
     /* 1. porosity of the MPS particles, Eq. 31 */
-    for (i = 0; i < mv.count; ++i) c->solid[i] = 0;
+    for (i = 0; i < mv.count; ++i) c->solid[i] = c->rate[i] = 0;
     for (k = 0; k < dv.count; ++k) {
         const fsdem_real V = fsdem__mps_dem_volume(c, dv.radius[k]);
         for (e = c->start[k]; e < c->start[k + 1]; ++e) c->solid[c->pair[e].particle] += c->pair[e].weight * V;
@@ -16342,7 +16365,6 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
         mc.force[i] = fsdem__zero3();
     }
     /* 2-4. averages at the DEM particles (Eq. 32-33), forces (Eq. 25-28, 34-35), reactions (Eq. 36) */
-    memset(&c->tally, 0, sizeof c->tally);
     for (k = 0; k < dv.count; ++k) {
         fsdem_real W = 0, E = 0;
         fsdem_vec3 U = fsdem__zero3(), G = fsdem__zero3();
@@ -16368,7 +16390,11 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
         c->tally.drag_sum = fsdem__add(c->tally.drag_sum, c->force[k].drag);
         c->tally.pressure_sum = fsdem__add(c->tally.pressure_sum, c->force[k].pressure);
     }
-    for (i = 0; i < mv.count; ++i) c->tally.fluid_sum = fsdem__add(c->tally.fluid_sum, mc.force[i]);
+    for (i = 0; i < mv.count; ++i) {
+        const fsdem_real tau = c->rate[i] > 0 ? c->rho * c->cell_volume / c->rate[i] : 0; /* the water's drag relaxation */
+        if (tau > 0 && (c->tally.drag_dt == 0 || tau < c->tally.drag_dt)) c->tally.drag_dt = tau;
+        c->tally.fluid_sum = fsdem__add(c->tally.fluid_sum, mc.force[i]);
+    }
     c->tally.fluid_sum = fsdem__scale(c->tally.fluid_sum, c->depth);
     c->forces = dv.count;
     c->sec_dem += (double)(clock() - t0) / CLOCKS_PER_SEC;

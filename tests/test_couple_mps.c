@@ -156,6 +156,7 @@ static void test_audit_agrees(test_pair *t, fsdem_vec3 fluid, fsdem_vec3 solid, 
     ck_assert_msg(fabs(st.exchanged.x - solid.x) + fabs(st.exchanged.y - solid.y) + fabs(st.exchanged.z - solid.z) < 64 * TEST_EPS * scale,
                   "stats.exchanged is not the sum of X_k");
     ck_assert_msg(st.exchange_residual < 64 * TEST_EPS * scale, "stats.exchange_residual %g N of %g", (double)st.exchange_residual, scale);
+    ck_assert_msg(st.pairs > 0 && st.wet > 0, "stats: %lld pairs, %d wet", st.pairs, st.wet);
 }
 
 /* Eq. 36: every exchanged force is split into shares that sum to one, so the fluid gets exactly

@@ -1,5 +1,6 @@
 /* Hindered settling of a uniform suspension of DEM spheres in MPS water (unresolved MPS-DEM coupling,
-   seed 002 §2.3, Model B, drag law of Eq. 26) against Richardson-Zaki: U = u_t eps^n.
+   seed 002 §2.3, Model B, drag law of Eq. 26) against Richardson-Zaki: U = u_t eps^n, in a cell
+   periodic along x and y over a floor (no side walls).
    Usage: run [DATA_DIR] [--tier=default|full] [--phi=F] [--t-end=S] [--t-start=S]   (the reference
    is analytic; no file is read). Default tier: phi 0.1 to T_END (about 3 min CPU); full tier: the
    three fractions 0.1, 0.2, 0.3 (0.2 and 0.3 have 2 and 3 times the particles: longer than 10 min
@@ -148,8 +149,10 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
     md.model = FSDEM_MPS_MODEL_B;
     md.viscosity = (fsdem_real)nu;
     md.density = (fsdem_real)rho;
-    md.domain_min = fsdem_v3((fsdem_real)-pad, (fsdem_real)-pad, (fsdem_real)-pad);
-    md.domain_max = fsdem_v3((fsdem_real)(W + pad), (fsdem_real)(W + pad), (fsdem_real)((SUSP + CLEAR + 10) * r0 + pad));
+    /* laterally periodic (the set-up: no side walls, so no back-flow along them), one floor */
+    md.domain_min = fsdem_v3(0, 0, (fsdem_real)-pad);
+    md.domain_max = fsdem_v3((fsdem_real)W, (fsdem_real)W, (fsdem_real)((SUSP + CLEAR + 10) * r0 + pad));
+    md.periodic[0] = md.periodic[1] = 1;
     if (fsdem_mps_create(&md, &mps) != FSDEM_OK) {
         snprintf(o.error, sizeof o.error, "fsdem_mps_create failed");
         o.failed = 1;
@@ -188,6 +191,7 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
     /* particles: a jittered cubic lattice of spacing a = d (pi / (6 phi))^(1/3) filling the suspension */
     dd.domain_min = md.domain_min;
     dd.domain_max = md.domain_max;
+    dd.periodic[0] = dd.periodic[1] = 1;
     dd.law = FSDEM_DEM_LAW_HERTZ_MINDLIN;
     if (fsdem_dem_create(&dd, &dem) != FSDEM_OK) {
         snprintf(o.error, sizeof o.error, "fsdem_dem_create failed");
@@ -200,8 +204,8 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
     mat.restitution = 0.5f;
     fsdem_dem_add_material(dem, &mat, &material);
     {
-        fsdem_dem_wall_desc box = fsdem_dem_wall_box(fsdem_v3(0, 0, 0), fsdem_v3((fsdem_real)W, (fsdem_real)W, (fsdem_real)((SUSP + CLEAR + 4) * r0)), 1, material);
-        fsdem_dem_add_wall(dem, &box, NULL);
+        fsdem_dem_wall_desc floor = fsdem_dem_wall_plane(fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 1), material);
+        fsdem_dem_add_wall(dem, &floor, NULL);
     }
     ax = W / nx;
     az = z_susp / nz;
