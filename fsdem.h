@@ -2463,19 +2463,25 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
         with FSDEM_DRAG_LAW_ERGUN_WEN_YU) and the force on the particle (held over the DEM substeps):
           Model A (the MPS desc.model):  F^int = F^d - V_k grad P_k            (Eq. 34)
           Model B:                       F^int = F^d / eps_k - V_k rho_f g     (Eq. 35);
-     4. the reaction on the fluid (Eq. 36): FLUID particle i gets -sum_k X_k w_s(r_ki) / W_k with
-        W_k = sum_j w_s(r_kj) over the FLUID particles j, where X_k is the force that the fluid and
-        the solid exchange: F^d (Model A, Eq. 2: the solid's -V grad P is the mixture pressure acting
-        on the solid's volume, as -grad P on its own volume acts on each fluid particle) or F^int
-        (Model B, Eq. 4: f_B). Each X_k is split into weights that sum to one, so the fluid gets
-        exactly -sum_k X_k: the exchange conserves momentum to rounding (Shepard: W_k is the sum of
-        the weights actually present, cut by walls, the free surface or nothing, never the analytic
-        n_s), which fsdem_mps_dem_stats audits every update (exchange_residual). Limitation: next to a wall
-        the kernel is cut, and in a uniform suspension the water within r0 of a wall gets 0.5-0.7
-        of the bulk's reaction per volume (0.9-1.1 at 2-4 r0), which drives a circulation along the
-        walls (validation/mpsdem_settling); weighting the shares by the open part of each
-        particle's kernel evened it to 0.9-1.2 but over-pushed edges and corners and reversed the
-        cell, so Eq. 36 is kept as printed;
+     4. the reaction on the fluid (Eq. 36): FLUID particle i gets -sum_k X_k w_s(r_ki) s_i / W_k
+        with W_k = sum_j w_s(r_kj) s_j over the FLUID particles j, where X_k is the force that the
+        fluid and the solid exchange: F^d (Model A, Eq. 2: the solid's -V grad P is the mixture
+        pressure acting on the solid's volume, as -grad P on its own volume acts on each fluid
+        particle) or F^int (Model B, Eq. 4: f_B). Each X_k is split into weights that sum to one,
+        so the fluid gets exactly -sum_k X_k: the exchange conserves momentum to rounding (Shepard:
+        W_k is the sum of the weights actually present, cut by walls, the free surface or nothing,
+        never the analytic n_s), which fsdem_mps_dem_stats audits every update (exchange_residual).
+        The share factor s_i = n_s / (eps_i n_s,i), with n_s,i the normaliser of step 1, makes the
+        reaction a force density gathered at the particle, as its porosity is: the particle stands
+        for r0^d / eps_i of mixture, and its kernel is cut by walls as n_s,i says. In a uniform bed
+        every particle then gets the same reaction per volume, next to walls too; with Eq. 36 as
+        printed (s_i = 1) the water within r0 of a wall got 0.5-0.7 of the bulk's, which in Model B
+        (whose reaction at rest is the grains' buoyancy, as large as the water's own weight in a
+        packed bed) drove a circulation along the walls: a bed of fixed spheres under still water
+        between walls had its water at 0.25-0.33 m/s and its floor pressure falling to 0.83 rho g H
+        in 0.3 s; with s_i, 0.06-0.14 m/s and 0.97-0.99 rho g H (as Model A, and as the same bed in
+        a laterally periodic cell). In the bulk s_i = 1 / eps_i, the same for all neighbours of a
+        grain in a uniform bed, so the split is Eq. 36's there;
      5. one MPS step of dt, then the DEM over the same dt in K = fsdem_dem_substep_count substeps
         (fsdem_dem_advance) with the forces of 3 held: the sequential staggered scheme with the
         MPS step of Eq. 37 and DEM steps of Eq. 38 (Sun et al. 2021's MSS as the seed uses it; here
@@ -16021,7 +16027,8 @@ struct fsdem_mps_dem {
     fsdem_real *rate;              /* per MPS particle: its share of the grains' slip coefficients */
                                    /*    (kg/s; N/m per m/s in 2D), whose inverse times its mass is */
                                    /*    the water's drag relaxation time */
-    int solid_cap;                 /* of solid and rate */
+    fsdem_real *share;             /* per MPS particle: s_i of step 4 (0 for WALL and DUMMY) */
+    int solid_cap;                 /* of solid, rate and share */
     fsdem_mps_dem_force *force;    /* per DEM particle */
     int force_cap, forces;         /* forces: DEM particles of the last update (0: none yet) */
     fsdem__mps_dem_tally tally;
@@ -16146,6 +16153,7 @@ void fsdem_mps_dem_destroy(fsdem_mps_dem *c) {
     fsdem__free(&al, c->pair, sizeof *c->pair * (size_t)c->pair_cap);
     fsdem__free(&al, c->solid, sizeof(fsdem_real) * (size_t)c->solid_cap);
     fsdem__free(&al, c->rate, sizeof(fsdem_real) * (size_t)c->solid_cap);
+    fsdem__free(&al, c->share, sizeof(fsdem_real) * (size_t)c->solid_cap);
     fsdem__free(&al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
     fsdem__free(&al, c->kept_porosity, sizeof(fsdem_real) * (size_t)c->kept_mps_cap);
     fsdem__free(&al, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)c->kept_mps_cap);
@@ -16251,13 +16259,13 @@ static fsdem_real fsdem__mps_dem_open_weight(const fsdem_mps_dem *c, const fsdem
 static fsdem_result fsdem__mps_dem_room(fsdem_mps_dem *c, int nd, int nm) {
     const fsdem_allocator *al = &c->allocator;
     int cap = c->force_cap;
-    void **const fluid[2] = {(void **)&c->solid, (void **)&c->rate};
-    const size_t size[2] = {sizeof(fsdem_real), sizeof(fsdem_real)};
+    void **const fluid[3] = {(void **)&c->solid, (void **)&c->rate, (void **)&c->share};
+    const size_t size[3] = {sizeof(fsdem_real), sizeof(fsdem_real), sizeof(fsdem_real)};
     if (fsdem__grow(al, (void **)&c->start, &c->start_cap, 0, nd + 1, sizeof(int)) != FSDEM_OK ||
         fsdem__grow(al, (void **)&c->force, &cap, 0, nd, sizeof(fsdem_mps_dem_force)) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
     c->force_cap = cap;
-    return fsdem__grow_set(al, fluid, size, 2, &c->solid_cap, 0, nm);
+    return fsdem__grow_set(al, fluid, size, 3, &c->solid_cap, 0, nm);
 }
 
 /* The non-DUMMY MPS particles within the radius of every DEM particle, with their w_s. */
@@ -16287,8 +16295,9 @@ static fsdem_result fsdem__mps_dem_pairs(fsdem_mps_dem *c, const fsdem_dem_parti
     return FSDEM_OK;
 }
 
-/* Steps 3-4 of >>couple_mps for DEM particle k, whose FLUID neighbours' weights sum to W > 0 with
-   porosity eps, velocity u and pressure gradient gp (w_s averages): its force, and the reactions. */
+/* Steps 3-4 of >>couple_mps for DEM particle k, with porosity eps, velocity u and pressure gradient
+   gp (w_s averages) and W > 0 the sum of w_s s_i over its FLUID neighbours: its force, and the
+   reactions. */
 static void fsdem__mps_dem_exchange(fsdem_mps_dem *c, const fsdem_dem_particles *dv, const fsdem_mps_particles *mv,
                                     const fsdem_mps_coupling *mc, int k, fsdem_real W, fsdem_real eps, fsdem_vec3 u,
                                     fsdem_vec3 gp) {
@@ -16319,15 +16328,16 @@ static void fsdem__mps_dem_exchange(fsdem_mps_dem *c, const fsdem_dem_particles 
         const fsdem_real tau = dv->mass[k] / coefficient; /* drag relaxation time */
         if (c->tally.drag_dt == 0 || tau < c->tally.drag_dt) c->tally.drag_dt = tau;
     }
-    /* Eq. 36: the reaction shared in proportion to w_s / W, whose shares sum to one; the water
+    /* Eq. 36: the reaction shared in proportion to w_s s_i / W, whose shares sum to one; the water
        takes the same shares of the slip coefficient */
     exchanged = fsdem__scale(exchanged, -1 / (W * c->depth));
     coefficient /= W * c->depth;
     for (e = c->start[k]; e < c->start[k + 1]; ++e) {
         const int i = c->pair[e].particle;
+        const fsdem_real share = c->pair[e].weight * c->share[i];
         if (mv->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
-        mc->force[i] = fsdem__madd(mc->force[i], exchanged, c->pair[e].weight);
-        c->rate[i] += coefficient * c->pair[e].weight;
+        mc->force[i] = fsdem__madd(mc->force[i], exchanged, share);
+        c->rate[i] += coefficient * share;
     }
 }
 
@@ -16359,14 +16369,15 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
         for (e = c->start[k]; e < c->start[k + 1]; ++e) c->solid[c->pair[e].particle] += c->pair[e].weight * V;
     }
     for (i = 0; i < mv.count; ++i) {
-        fsdem_real eps = 1;
-        if (mv.kind[i] == FSDEM_MPS_KIND_FLUID && c->solid[i] > 0) eps = 1 - c->solid[i] / fsdem__mps_dem_open_weight(c, &mv, i);
+        fsdem_real eps = 1, open = c->ns;
+        if (mv.kind[i] == FSDEM_MPS_KIND_FLUID && c->solid[i] > 0) eps = 1 - c->solid[i] / (open = fsdem__mps_dem_open_weight(c, &mv, i));
         mc.porosity[i] = eps > c->desc.min_porosity ? eps : c->desc.min_porosity;
+        c->share[i] = mv.kind[i] == FSDEM_MPS_KIND_FLUID ? c->ns / (mc.porosity[i] * open) : 0; /* s_i of step 4 */
         mc.force[i] = fsdem__zero3();
     }
     /* 2-4. averages at the DEM particles (Eq. 32-33), forces (Eq. 25-28, 34-35), reactions (Eq. 36) */
     for (k = 0; k < dv.count; ++k) {
-        fsdem_real W = 0, E = 0;
+        fsdem_real W = 0, E = 0, shares = 0;
         fsdem_vec3 U = fsdem__zero3(), G = fsdem__zero3();
         for (e = c->start[k]; e < c->start[k + 1]; ++e) {
             const int i = c->pair[e].particle;
@@ -16376,12 +16387,13 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
             E += w * mc.porosity[i];
             U = fsdem__madd(U, mv.velocity[i], w);
             G = fsdem__madd(G, mv.pressure_gradient[i], w);
+            shares += w * c->share[i];
         }
         memset(&c->force[k], 0, sizeof c->force[k]);
         c->force[k].id = dv.id[k];
         c->force[k].porosity = 1;
         if (W > 0) {
-            fsdem__mps_dem_exchange(c, &dv, &mv, &mc, k, W, E / W, fsdem__scale(U, 1 / W), fsdem__scale(G, 1 / W));
+            fsdem__mps_dem_exchange(c, &dv, &mv, &mc, k, shares, E / W, fsdem__scale(U, 1 / W), fsdem__scale(G, 1 / W));
             c->tally.wet++;
         }
         if (!fsdem__finite3(c->force[k].total))
