@@ -138,10 +138,11 @@
              (x, y)). The MPS solver, whose fluid is particles, is sampled through its particle view
              (fsdem_mps_get_particles: positions, velocities, pressure gradients) and takes forces
              and porosities through fsdem_mps_get_coupling. The PIC, whose solids are cut faces,
-             takes moving solids through fsdem_pic_get_coupling (open fractions, solid velocities,
-             references; shear read back), fsdem_pic_set_pressure_extra (an implicit term of the
-             pressure operator) and fsdem_pic_exclude_particles, and is read through
-             fsdem_pic_get_fields (pressure, open fractions) and fsdem_pic_get_particles.
+             takes moving solids through fsdem_pic_get_coupling (open fractions, solid velocities
+             at the start and end of the step, references; shear read back),
+             fsdem_pic_set_pressure_extra (an implicit term of the pressure operator, and the
+             solids' answer to the solved pressure) and fsdem_pic_exclude_particles, and is read
+             through fsdem_pic_get_fields (pressure, open fractions) and fsdem_pic_get_particles.
 
    THREAD SAFETY
      No global mutable state. Distinct objects may be used from distinct threads at once; one
@@ -1380,10 +1381,11 @@ FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
    - reference[c]: the part of cell c's fluid-fraction kernel that moving solids leave open (default
      1): the particle count of a full cell is divided by it, as by the static obstacles' own part, so
      that water around a moving body reads full and keeps its pressure;
-   - viscous_velocity[a][f] (NULL without viscosity): the moving solid's velocity on face f at the
-     start of the step, the no-slip value of the implicit viscous solve, which comes before gravity
-     and the accelerations (solid_velocity, the velocity at the end of the step, includes them; a
-     body at rest in water at rest would otherwise be sheared by its own g dt); default 0;
+   - start_velocity[a][f]: the moving solid's velocity on face f at the start of the step (default
+     0): the no-slip value of the implicit viscous solve, which comes before gravity and the
+     accelerations, and the closed faces' value in the FLIP reference (solid_velocity, the
+     velocity at the end of the step, holds the step's gravity: a body at rest in water at rest
+     would otherwise be sheared, and its neighbours kicked, by its own g dt);
    - shear[a][f] (read only; NULL without viscosity): the viscous force component a (N; N/m in 2D)
      that the liquid exerted on the closed face f (E = 0) during the last step's implicit viscous
      solve, rho nu dx^(dim-2) sum (u_nb - us_f) over the liquid faces next to it; the liquid got
@@ -1401,15 +1403,25 @@ typedef struct fsdem_pic_coupling {
     fsdem_real *pressure_rhs;
     fsdem_real *reference;
     const fsdem_real *shear[3];
-    fsdem_real *viscous_velocity[3];
+    fsdem_real *start_velocity[3];
 } fsdem_pic_coupling;
 
 FSDEM_API fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *pic);
+/* The moving solids' answer to a solved pressure p (Pa, cell layout) over a step of dt (s): it
+   sets solid_velocity to their velocity at the end of the step, Q* plus the response that the
+   extra term K p stands for. */
+typedef void (*fsdem_pic_response_fn)(void *user, const fsdem_real *pressure, fsdem_real dt);
+
 /* An optional symmetric positive semi-definite term y += K p added to the pressure operator of the
    equation above (p and y in Pa, vectors in the cell layout; e.g. the implicit solid response
    dt J^T M^-1 J of seed 000 Eq. 6 in these units). It must write only to FLUID cells; the
-   preconditioner does not see it. fn = NULL removes it; `user` must stay valid while it is set. */
-FSDEM_API fsdem_result fsdem_pic_set_pressure_extra(fsdem_pic *pic, fsdem_operator_fn fn, void *user);
+   preconditioner does not see it. `response` (may be NULL) is called after every pressure solve,
+   before the gradient is applied: the face fluxes behind fsdem_pic_stats.max_divergence, the
+   extrapolation and the grid-to-particle transfer then see the solids' final velocity, so water
+   next to a body that the pressure holds at rest stays at rest. fn = NULL removes both; `user`
+   must stay valid while they are set. */
+FSDEM_API fsdem_result fsdem_pic_set_pressure_extra(fsdem_pic *pic, fsdem_operator_fn fn, fsdem_pic_response_fn response,
+                                                   void *user);
 
 /* Samples the grid at `count` points (clamped into the domain): velocity (trilinear from the faces),
    the gradient of the pressure (Pa/m, from the face differences) and the liquid fraction
@@ -1471,8 +1483,10 @@ typedef struct fsdem_pic_stats {
     int particles;
     int fluid_cells;
     fsdem_real fluid_volume;       /* m^3 (m^2 in 2D): liquid volume the solver sees, the sum over */
-                                   /*    open cells of clamp(1/2 - phi/dx, 0, 1) dx^dim (all open */
-                                   /*    cells when free_surface = 0); cut cells count whole */
+                                   /*    open cells of clamp(1/2 - phi/dx, 0, 1) (1 when free_surface */
+                                   /*    = 0) times the cell's open volume: dx^dim times the mean */
+                                   /*    open fraction of its faces under obstacles and moving */
+                                   /*    solids (exact for cuts along the grid's planes) */
     fsdem_real particle_volume;    /* m^3 (m^2 in 2D): particles x particle volume, the volume the */
                                    /*    particles carry (exact at seeding; fluid_volume, from the */
                                    /*    grid's level set, reads up to a few % lower on coarse grids) */
@@ -2645,7 +2659,12 @@ FSDEM_API fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *coupl
         instability however light the body. G is the discrete adjoint of the solid flux: the
         pressure's power on the bodies equals minus the power it spends on the water they
         displace, and in hydrostatic water G = rho g dx^dim sum (1 - E) over the faces normal to
-        gravity, the body volume as the faces see it;
+        gravity, the body volume as the faces see it. Once p is solved, the faces' solid velocity
+        becomes Q^{n+1}'s (the response of fsdem_pic_set_pressure_extra): the PIC's fluxes,
+        extrapolation and grid-to-particle transfer see the body as it ends the step, and its
+        FLIP reference sees it as it started (fsdem_pic_coupling.start_velocity), so water next to
+        a body that the pressure holds at rest stays at rest (Q* holds g dt: read from the closed
+        faces it kicked the water next to the body by about g dt / 2 with the PIC transfer);
      4. one PIC step; then the fluid force on each body is G from the step's pressure plus the
         viscous force, the momentum the implicit viscous solve gave the closed faces of the body
         (fsdem_pic_coupling.shear), with their moments about the centre. The water loses exactly
@@ -2677,11 +2696,12 @@ FSDEM_API fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *coupl
         floating drafts are exact on the grid; the exchange with the water is not touched.
    Forces are per unit depth in the 2D PIC; the DEM's discs of length disc_length receive them
    times that length. Contacts with domain walls are the DEM's walls (add them to the DEM).
-   Next to moving bodies two PIC statistics do not mean what they mean elsewhere: max_divergence
-   takes the solid flux of the predicted velocity Q*, not of the end velocity the pressure was solved
-   with, and fluid_volume counts cut cells whole; particle_volume is the water volume. A dam break
-   from rest wants fsdem_pic_desc.dt_max well below sqrt(dx / g): the PIC's step estimate does not
-   foresee the impulsive start, and its CFL check would end the first step. */
+   Next to moving bodies the PIC's statistics mean what they mean elsewhere: max_divergence takes
+   the solid flux of each body's velocity at the end of the step (the pressure's answer, which the
+   coupler gives the PIC through fsdem_pic_set_pressure_extra's response), and fluid_volume counts
+   a cut cell by its open volume. A dam break from rest wants fsdem_pic_desc.dt_max well below
+   sqrt(dx / g): the PIC's step estimate does not foresee the impulsive start, and its CFL check
+   would end the first step. */
 
 typedef struct fsdem_pic_dem fsdem_pic_dem;
 
@@ -8713,7 +8733,7 @@ struct fsdem_pic {
     fsdem_real *sopen[3], *svel[3];           /* static obstacles: open fraction, solid velocity */
     fsdem_real *copen[3], *cvel[3], *cacc[3]; /* coupler arrays */
     fsdem_real *shear[3];                     /* viscous force on closed faces (viscosity > 0) */
-    fsdem_real *cvisc[3];                     /* coupler: no-slip velocity of moving solids (viscosity > 0) */
+    fsdem_real *cvstart[3];                   /* coupler: moving solids' velocity at the start of the step */
     fsdem_real *E[3], *us[3];                 /* effective open fraction and solid velocity */
     unsigned char *fvalid[3], *fvalid2[3];
     int *fqueue; /* breadth-first front of the extrapolation, max(nface) entries */
@@ -8736,6 +8756,7 @@ struct fsdem_pic {
     fsdem_pcg *pcg_v[3];
     fsdem_pic_coupling coupling;     /* the coupler's arrays (fsdem_pic_get_coupling) */
     fsdem_operator_fn pressure_extra; /* fsdem_pic_set_pressure_extra */
+    fsdem_pic_response_fn pressure_response;
     void *pressure_extra_user;
     fsdem__gauges gauges;
 
@@ -8981,13 +9002,13 @@ static int fsdem__pic_arrays(fsdem_pic *s, fsdem__pic_array t[FSDEM__PIC_MAX_ARR
         FSDEM__PIC_REALS(copen[a], nf, 1);
         FSDEM__PIC_REALS(cvel[a], nf, 0);
         FSDEM__PIC_REALS(cacc[a], nf, 0);
+        FSDEM__PIC_REALS(cvstart[a], nf, 0);
         FSDEM__PIC_REALS(E[a], nf, 1);
         FSDEM__PIC_REALS(us[a], nf, 0);
         FSDEM__PIC_BYTES(fvalid[a], nf);
         FSDEM__PIC_BYTES(fvalid2[a], nf);
         if (s->desc.viscosity > 0) {
             FSDEM__PIC_REALS(shear[a], nf, 0);
-            FSDEM__PIC_REALS(cvisc[a], nf, 0);
             FSDEM__PIC_BYTES(vcell[a], nf);
             for (b = 0; b < s->dim; ++b) {
                 size_t m = 1;
@@ -9221,7 +9242,7 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
         s->coupling.solid_velocity[a] = s->cvel[a];
         s->coupling.acceleration[a] = s->cacc[a];
         s->coupling.shear[a] = s->shear[a];
-        s->coupling.viscous_velocity[a] = s->cvisc[a];
+        s->coupling.start_velocity[a] = s->cvstart[a];
     }
     s->coupling.pressure_rhs = s->crhs;
     s->coupling.reference = s->cref;
@@ -10353,12 +10374,21 @@ static void fsdem__pic_extrapolate(fsdem_pic *s, fsdem_real *const field[3], int
     }
 }
 
-/* Faces fully covered by a solid (E = 0) carry the solid's velocity. */
-static void fsdem__pic_solid_faces(fsdem_pic *s, fsdem_real *const field[3], int zero) {
+/* The velocity of closed face g of axis a at the start of the step: a moving solid's start velocity
+   (fsdem_pic_coupling.start_velocity), else the face's solid velocity. The viscous solve takes it
+   as its no-slip value and the FLIP reference as the face's velocity; the projection takes the
+   velocity at the end of the step (us), which holds the step's gravity and the pressure's answer. */
+static fsdem_real fsdem__pic_solid_start(const fsdem_pic *s, int a, int g) {
+    return s->copen[a][g] < s->sopen[a][g] ? s->cvstart[a][g] : s->us[a][g];
+}
+
+/* Faces fully covered by a solid (E = 0) carry the solid's velocity, at the start of the step or at
+   its end. */
+static void fsdem__pic_solid_faces(fsdem_pic *s, fsdem_real *const field[3], int at_start) {
     int a, f;
     for (a = 0; a < s->dim; ++a)
         for (f = 0; f < s->nface[a]; ++f)
-            if (s->E[a][f] <= 0) field[a][f] = zero ? 0 : s->us[a][f];
+            if (s->E[a][f] <= 0) field[a][f] = at_start ? fsdem__pic_solid_start(s, a, f) : s->us[a][f];
 }
 
 static int fsdem__pic_layers(const fsdem_pic *s) {
@@ -10366,13 +10396,6 @@ static int fsdem__pic_layers(const fsdem_pic *s) {
 }
 
 /* ---- >>pic_viscosity : implicit nu lap(u), one stencil solve per component ---- */
-
-/* No-slip velocity of the closed face g of axis a in the viscous solve: a moving solid's velocity at
-   the start of the step (fsdem_pic_coupling.viscous_velocity; the projection takes its velocity at
-   the end, solid_velocity, which holds the step's gravity too), else the face's solid velocity. */
-static fsdem_real fsdem__pic_noslip(const fsdem_pic *s, int a, int g) {
-    return s->copen[a][g] < s->sopen[a][g] ? s->cvisc[a][g] : s->us[a][g];
-}
 
 /* The viscous force on the closed faces of component a after its solve (fsdem_pic_coupling.shear):
    each unknown face f next to a closed face g lost rho dx^dim (dt nu / dx^2)(u_f - us_g) of
@@ -10397,7 +10420,7 @@ static void fsdem__pic_shear(fsdem_pic *s, int a) {
                         int nc = coord[b] + sg, g;
                         if (nc < 0 || nc >= fn[b]) continue;
                         g = f + sg * s->fstep[a][b];
-                        if (cell[g] != FSDEM_STENCIL_CELL_FLUID && s->E[a][g] <= 0) s->shear[a][g] += c * (s->u[a][f] - fsdem__pic_noslip(s, a, g));
+                        if (cell[g] != FSDEM_STENCIL_CELL_FLUID && s->E[a][g] <= 0) s->shear[a][g] += c * (s->u[a][f] - fsdem__pic_solid_start(s, a, g));
                     }
             }
 }
@@ -10466,7 +10489,7 @@ static fsdem_result fsdem__pic_viscosity(fsdem_pic *s, fsdem_real dt) {
                             if (cell[g] == FSDEM_STENCIL_CELL_FLUID) continue;
                             if (s->E[a][g] <= 0) {
                                 d += 1;
-                                r0 += fsdem__pic_noslip(s, a, g);
+                                r0 += fsdem__pic_solid_start(s, a, g);
                             }
                         }
                     dg[f] = inv_k + d;
@@ -10636,6 +10659,10 @@ static fsdem_result fsdem__pic_project(fsdem_pic *s, fsdem_real dt) {
     info.iterations = 0;
     info.residual = 0;
     if (r == FSDEM_OK && s->fluid_cells > 0) r = fsdem_pcg_solve(s->pcg_p, s->rhs, s->pres, &info);
+    if (r == FSDEM_OK && s->pressure_response) {
+        s->pressure_response(s->pressure_extra_user, s->pres, dt); /* the solids' final velocity, */
+        fsdem__pic_effective_faces(s);                              /* into us (E is unchanged) */
+    }
     s->p_iters = info.iterations;
     s->p_res = info.residual;
     s->sec_pressure += (double)(clock() - t0) / CLOCKS_PER_SEC;
@@ -11039,7 +11066,7 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
     fsdem__pic_types(s);
     fsdem__pic_p2g(s);
     fsdem__pic_extrapolate(s, s->u, layers);
-    fsdem__pic_solid_faces(s, s->u, 0);
+    fsdem__pic_solid_faces(s, s->u, 1);
     for (a = 0; a < s->dim; ++a) memcpy(s->uold[a], s->u[a], sizeof(fsdem_real) * (size_t)s->nface[a]);
 
     /* 2. implicit viscosity, then body forces and coupler accelerations: in that order water at
@@ -11206,9 +11233,10 @@ fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *s) {
     return c;
 }
 
-fsdem_result fsdem_pic_set_pressure_extra(fsdem_pic *s, fsdem_operator_fn fn, void *user) {
+fsdem_result fsdem_pic_set_pressure_extra(fsdem_pic *s, fsdem_operator_fn fn, fsdem_pic_response_fn response, void *user) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
     s->pressure_extra = fn;
+    s->pressure_response = fn ? response : NULL;
     s->pressure_extra_user = fn ? user : NULL;
     return fsdem__ok(&s->status);
 }
@@ -11496,6 +11524,21 @@ fsdem_result fsdem_pic_gauges_close(fsdem_pic *s) {
     return fsdem__gauges_close(&s->gauges, &s->status, &s->allocator, "fsdem_pic_gauges_close");
 }
 
+/* The part of cell c that obstacles and moving solids leave open: the mean open fraction of its
+   faces (the domain's sides count as open; exact for cuts along the grid's planes). */
+static fsdem_real fsdem__pic_open_volume(const fsdem_pic *s, int c) {
+    const int i = c % s->n[0], j = c / s->n[0] % s->n[1], k = c / (s->n[0] * s->n[1]);
+    fsdem_real sum = 0;
+    int a, side;
+    for (a = 0; a < s->dim; ++a)
+        for (side = 0; side < 2; ++side) {
+            const int f = fsdem__pic_face(s, a, i, j, k) + side * s->fstep[a][a];
+            const fsdem_real co = s->copen[a][f] < 0 ? 0 : s->copen[a][f] > 1 ? 1 : s->copen[a][f];
+            sum += s->sopen[a][f] < co ? s->sopen[a][f] : co;
+        }
+    return sum / (fsdem_real)(2 * s->dim);
+}
+
 fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *s) {
     fsdem_pic_stats st;
     int c, p, a;
@@ -11504,14 +11547,13 @@ fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *s) {
     if (!s) return st;
     cellv = pow((double)s->dx, (double)s->dim);
     for (c = 0; c < s->ncell; ++c) {
-        double f;
+        double f = 1;
         if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID) continue;
-        if (!s->desc.free_surface) {
-            vol += 1;
-            continue;
+        if (s->desc.free_surface) {
+            f = 0.5 - (double)s->phi[c] * (double)s->inv_dx;
+            f = f < 0 ? 0 : f > 1 ? 1 : f;
         }
-        f = 0.5 - (double)s->phi[c] * (double)s->inv_dx;
-        vol += f < 0 ? 0 : f > 1 ? 1 : f;
+        vol += f * (double)fsdem__pic_open_volume(s, c);
     }
     for (p = 0; p < s->np; ++p) ke += (double)fsdem__dot(s->pv[p], s->pv[p]);
     st.time = (fsdem_real)s->time;
@@ -16771,6 +16813,7 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt);
 static fsdem_result fsdem__pic_dem_exclude(fsdem_pic_dem *c, int from, int remove);
 static void fsdem__pic_dem_clear_faces(fsdem_pic_dem *c);
 static void fsdem__pic_dem_operator(void *user, const fsdem_real *p, fsdem_real *y);
+static void fsdem__pic_dem_response(void *user, const fsdem_real *p, fsdem_real dt);
 
 fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem **out) {
     char msg[FSDEM__MESSAGE_SIZE];
@@ -16813,7 +16856,7 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
     }
     if (res == FSDEM_OK) res = fsdem__pic_dem_exclude(c, 0, 1);
     if (res == FSDEM_OK) res = fsdem__pic_dem_faces(c, 0);
-    if (res == FSDEM_OK) res = fsdem_pic_set_pressure_extra(desc->pic, fsdem__pic_dem_operator, c);
+    if (res == FSDEM_OK) res = fsdem_pic_set_pressure_extra(desc->pic, fsdem__pic_dem_operator, fsdem__pic_dem_response, c);
     if (res != FSDEM_OK) {
         if (desc->log) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, c->status.message[0] ? c->status.message : "fsdem_pic_dem_create: out of memory");
         fsdem_pic_dem_destroy(c);
@@ -16828,7 +16871,7 @@ void fsdem_pic_dem_destroy(fsdem_pic_dem *c) {
     fsdem_allocator al;
     if (!c) return;
     al = c->allocator;
-    if (c->operator_set) fsdem_pic_set_pressure_extra(c->desc.pic, NULL, NULL);
+    if (c->operator_set) fsdem_pic_set_pressure_extra(c->desc.pic, NULL, NULL, NULL);
     fsdem__pic_dem_clear_faces(c);
     fsdem__pic_dem_release(c);
     fsdem__free(&al, c, sizeof *c);
@@ -16863,6 +16906,14 @@ static void fsdem__pic_dem_range(const fsdem_pic *s, int q, fsdem_real off, fsde
     double a = ceil((double)((x0 - o) * s->inv_dx - off)), b = floor((double)((x1 - o) * s->inv_dx - off));
     *lo = a < 0 ? 0 : a > count ? count : (int)a;
     *hi = b >= count ? count - 1 : b < -1 ? -1 : (int)b;
+}
+
+/* The centre of face entry e relative to `centre` (m). */
+static fsdem_vec3 fsdem__pic_dem_arm(const fsdem_pic_dem *c, int e, fsdem_vec3 centre) {
+    const fsdem_pic *s = c->desc.pic;
+    const int a = c->face_axis[e], f = c->face[e];
+    const int i = f % s->fn[a][0], j = f / s->fn[a][0] % s->fn[a][1], k = f / (s->fn[a][0] * s->fn[a][1]);
+    return fsdem__sub(fsdem__pic_face_pos(s, a, i, j, k), centre);
 }
 
 /* Adds `v`, `w` to cell `cell`'s entry of the J of the body being cut (entries from `first`). */
@@ -16902,7 +16953,7 @@ static void fsdem__pic_dem_clear_faces(fsdem_pic_dem *c) {
     for (a = 0; a < cp.dim; ++a) {
         for (e = 0; e < cp.face_count[a]; ++e) cp.open[a][e] = 1;
         memset(cp.solid_velocity[a], 0, sizeof(fsdem_real) * (size_t)cp.face_count[a]);
-        if (cp.viscous_velocity[a]) memset(cp.viscous_velocity[a], 0, sizeof(fsdem_real) * (size_t)cp.face_count[a]);
+        memset(cp.start_velocity[a], 0, sizeof(fsdem_real) * (size_t)cp.face_count[a]);
     }
     for (e = 0; e < c->desc.pic->ncell; ++e) cp.reference[e] = 1;
     c->face_count = 0;
@@ -17074,19 +17125,12 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
             c->wstar[b].x = c->wstar[b].y = 0;
         }
         /* the solid fluxes: closed part times the body's velocity at the face centre, Q* for the
-           projection and the start velocity for the viscous solve's no-slip */
+           projection and the start velocity for the viscous solve's no-slip and the FLIP reference */
         for (e = c->face_start[b]; e < c->face_start[b + 1]; ++e) {
             const int a = c->face_axis[e], f = c->face[e];
-            int idx[3];
-            fsdem_vec3 arm;
-            idx[0] = f % s->fn[a][0];
-            idx[1] = f / s->fn[a][0] % s->fn[a][1];
-            idx[2] = f / (s->fn[a][0] * s->fn[a][1]);
-            arm = fsdem__sub(fsdem__pic_face_pos(s, a, idx[0], idx[1], idx[2]), P.position[b]);
+            const fsdem_vec3 arm = fsdem__pic_dem_arm(c, e, P.position[b]);
             cp.solid_velocity[a][f] += c->face_closed[e] * fsdem__comp(fsdem__add(c->vstar[b], fsdem__cross(c->wstar[b], arm)), a);
-            if (cp.viscous_velocity[a])
-                cp.viscous_velocity[a][f] +=
-                    c->face_closed[e] * fsdem__comp(fsdem__add(P.velocity[b], fsdem__cross(P.angular_velocity[b], arm)), a);
+            cp.start_velocity[a][f] += c->face_closed[e] * fsdem__comp(fsdem__add(P.velocity[b], fsdem__cross(P.angular_velocity[b], arm)), a);
         }
     }
     /* open fractions, and the solid velocity as the closed-part-weighted mean */
@@ -17095,7 +17139,7 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
         if (*open < 0) {
             const fsdem_real total = -*open, closed = total > 1 - FSDEM__PIC_DEM_MIN_OPEN ? 1 : total;
             cp.solid_velocity[c->face_axis[e]][c->face[e]] /= closed;
-            if (cp.viscous_velocity[c->face_axis[e]]) cp.viscous_velocity[c->face_axis[e]][c->face[e]] /= closed;
+            cp.start_velocity[c->face_axis[e]][c->face[e]] /= closed;
             *open = 1 - closed;
         }
     }
@@ -17137,29 +17181,61 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
 
 /* ---- >>couple_pic_exchange : the implicit pressure term, fluid forces ---- */
 
+/* The accelerations M^-1 G, G = dx^(dim-1) J^T p over the FLUID cells, that the pressure p gives
+   free body b (m/s^2, 1/s^2). */
+static void fsdem__pic_dem_accelerations(const fsdem_pic_dem *c, int b, const fsdem_real *p, fsdem_vec3 *acc, fsdem_vec3 *alpha) {
+    const fsdem_pic *s = c->desc.pic;
+    const unsigned char *type = s->ctype;
+    const fsdem_real area = s->dim == 3 ? s->dx * s->dx : s->dx;
+    fsdem_vec3 G = fsdem__zero3(), T = fsdem__zero3();
+    int e;
+    for (e = c->jac_start[b]; e < c->jac_start[b + 1]; ++e) {
+        const int cell = c->jac_cell[e];
+        if (type[cell] != FSDEM_STENCIL_CELL_FLUID) continue;
+        G = fsdem__madd(G, c->jac_v[e], p[cell]);
+        T = fsdem__madd(T, c->jac_w[e], p[cell]);
+    }
+    *acc = fsdem__scale(G, area * c->inv_m[b]);
+    *alpha = fsdem__scale(T, area * c->inv_i[b]);
+}
+
 /* y += rho dx^dim J M^-1 J^T p over the FLUID cells (step 3 of >>couple_pic), per metre in 2D. */
 static void fsdem__pic_dem_operator(void *user, const fsdem_real *p, fsdem_real *y) {
     const fsdem_pic_dem *c = (const fsdem_pic_dem *)user;
     const fsdem_pic *s = c->desc.pic;
     const unsigned char *type = s->ctype;
-    /* with acc = M^-1 G (G = dx^(dim-1) J^T p) the term is rho dx J . acc */
-    const fsdem_real area = s->dim == 3 ? s->dx * s->dx : s->dx, k = c->rho * s->dx;
+    /* with acc = M^-1 G the term is rho dx J . acc */
+    const fsdem_real k = c->rho * s->dx;
     int b, e;
     for (b = 0; b < c->bodies; ++b) {
-        fsdem_vec3 G = fsdem__zero3(), T = fsdem__zero3(), acc, alpha;
+        fsdem_vec3 acc, alpha;
         if (c->inv_m[b] == 0) continue;
-        for (e = c->jac_start[b]; e < c->jac_start[b + 1]; ++e) {
-            const int cell = c->jac_cell[e];
-            if (type[cell] != FSDEM_STENCIL_CELL_FLUID) continue;
-            G = fsdem__madd(G, c->jac_v[e], p[cell]);
-            T = fsdem__madd(T, c->jac_w[e], p[cell]);
-        }
-        acc = fsdem__scale(G, area * c->inv_m[b]);
-        alpha = fsdem__scale(T, area * c->inv_i[b]);
+        fsdem__pic_dem_accelerations(c, b, p, &acc, &alpha);
         for (e = c->jac_start[b]; e < c->jac_start[b + 1]; ++e) {
             const int cell = c->jac_cell[e];
             if (type[cell] != FSDEM_STENCIL_CELL_FLUID) continue;
             y[cell] += k * (fsdem__dot(c->jac_v[e], acc) + fsdem__dot(c->jac_w[e], alpha));
+        }
+    }
+}
+
+/* The pressure's answer (fsdem_pic_response_fn, step 3 of >>couple_pic): each free body's velocity
+   moves from Q* by dt M^-1 G, the velocity that the implicit term solved for (seed 000 Eq. 6), and
+   its faces' solid velocity with it, so the PIC's fluxes, extrapolation and transfer to the
+   particles see the body as it ends the step (not its Q*, which holds the step's gravity). */
+static void fsdem__pic_dem_response(void *user, const fsdem_real *p, fsdem_real dt) {
+    const fsdem_pic_dem *c = (const fsdem_pic_dem *)user;
+    const fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    int b, e;
+    for (b = 0; b < c->bodies; ++b) {
+        fsdem_vec3 acc, alpha;
+        if (c->inv_m[b] == 0) continue;
+        fsdem__pic_dem_accelerations(c, b, p, &acc, &alpha);
+        for (e = c->face_start[b]; e < c->face_start[b + 1]; ++e) {
+            const int a = c->face_axis[e], f = c->face[e];
+            const fsdem_vec3 dv = fsdem__add(acc, fsdem__cross(alpha, fsdem__pic_dem_arm(c, e, P.position[b])));
+            cp.solid_velocity[a][f] += dt * c->face_closed[e] * fsdem__comp(dv, a) / (1 - cp.open[a][f]);
         }
     }
 }
@@ -17185,15 +17261,10 @@ static fsdem_result fsdem__pic_dem_loads(fsdem_pic_dem *c) {
             const int a = c->face_axis[e], f = c->face[e];
             const fsdem_real closed = 1 - cp.open[a][f], share = closed > c->face_closed[e] ? c->face_closed[e] / closed : 1;
             const fsdem_real v = cp.shear[a][f] * share;
-            fsdem_vec3 force = fsdem__pic_axis_shift(fsdem__zero3(), a, v), arm;
-            int idx[3];
+            const fsdem_vec3 force = fsdem__pic_axis_shift(fsdem__zero3(), a, v);
             if (v == 0) continue;
-            idx[0] = f % s->fn[a][0];
-            idx[1] = f / s->fn[a][0] % s->fn[a][1];
-            idx[2] = f / (s->fn[a][0] * s->fn[a][1]);
-            arm = fsdem__sub(fsdem__pic_face_pos(s, a, idx[0], idx[1], idx[2]), P.position[b]);
             F = fsdem__add(F, force);
-            Tv = fsdem__add(Tv, fsdem__cross(arm, force));
+            Tv = fsdem__add(Tv, fsdem__cross(fsdem__pic_dem_arm(c, e, P.position[b]), force));
         }
         c->fp[b] = fsdem__scale(G, area * c->depth);
         c->fv[b] = fsdem__scale(F, c->depth);
@@ -17495,7 +17566,8 @@ fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
 
 /* ---- >>restart_format : header, checksum, cursor ---- */
 
-#define FSDEM__RESTART_VERSION 2u /* 2: DEM contact options and material-pair tables (issue 23) */
+#define FSDEM__RESTART_VERSION 3u /* 2: DEM contact options and material-pair tables (issue 23); 3: the PIC's start
+                                      velocities of moving solids at any viscosity */
 #define FSDEM__RESTART_HEADER 64
 #define FSDEM__RESTART_BOM 0x01020304u
 #define FSDEM__RESTART_FNV_BASIS 0xcbf29ce484222325ull
@@ -18170,7 +18242,7 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
         fsdem__restart_data(io, s->svel[a], fb);
         fsdem__restart_data(io, s->copen[a], fb);
         fsdem__restart_data(io, s->cvel[a], fb);
-        if (s->cvisc[a]) fsdem__restart_data(io, s->cvisc[a], fb); /* viscosity > 0, as the desc */
+        fsdem__restart_data(io, s->cvstart[a], fb);
         fsdem__restart_data(io, s->cacc[a], fb);
         fsdem__restart_data(io, s->E[a], fb);
         fsdem__restart_data(io, s->us[a], fb);

@@ -20,9 +20,9 @@ typedef struct tank {
 
 /* A closed tank [0, L]^dim of water up to `depth` (free_surface = 0 and depth ignored when `full`)
    holding one body of radius R and density rho_s at `centre` (fixed: kinematic at `velocity`), with
-   cells of dx, gravity g (down the last axis) and kinematic viscosity nu. */
-static tank make_tank(int dim, double L, double depth, int full, double g, double dx, fsdem_vec3 centre, double R, double rho_s,
-                      int fixed, fsdem_vec3 velocity, double nu) {
+   cells of dx, gravity g (down the last axis) and kinematic viscosity nu; FLIP share flip_ratio. */
+static tank make_tank_flip(int dim, double L, double depth, int full, double g, double dx, fsdem_vec3 centre, double R, double rho_s,
+                           int fixed, fsdem_vec3 velocity, double nu, double flip_ratio) {
     tank t;
     fsdem_pic_desc pd = fsdem_pic_desc_default(dim);
     fsdem_dem_desc dd = fsdem_dem_desc_default(dim);
@@ -38,6 +38,7 @@ static tank make_tank(int dim, double L, double depth, int full, double g, doubl
     pd.gravity = dim == 2 ? fsdem_v3(0, (fsdem_real)-g, 0) : fsdem_v3(0, 0, (fsdem_real)-g);
     pd.dt_max = (fsdem_real)1e-3;
     pd.viscosity = (fsdem_real)nu;
+    pd.flip_ratio = (fsdem_real)flip_ratio;
     pd.pressure_tolerance = (fsdem_real)TOL(1e-8, 1e3); /* float: its rounding floor here is about 2e-5 */
     ck_assert_int_eq(fsdem_pic_create(&pd, &t.pic), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_fill_box(t.pic, fsdem_v3(0, 0, 0), top, fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
@@ -58,6 +59,12 @@ static tank make_tank(int dim, double L, double depth, int full, double g, doubl
     cd.dem = t.dem;
     ck_assert_int_eq(fsdem_pic_dem_create(&cd, &t.cp), FSDEM_OK);
     return t;
+}
+
+/* make_tank_flip with the PIC's default FLIP share. */
+static tank make_tank(int dim, double L, double depth, int full, double g, double dx, fsdem_vec3 centre, double R, double rho_s,
+                      int fixed, fsdem_vec3 velocity, double nu) {
+    return make_tank_flip(dim, L, depth, full, g, dx, centre, R, rho_s, fixed, velocity, nu, fsdem_pic_desc_default(dim).flip_ratio);
 }
 
 static void free_tank(tank *t) {
@@ -197,14 +204,17 @@ END_TEST
    (image_added_mass: 1.139 for R = 0.04 m at (0.1, 0.15) m in the 0.3 m box; its neglected
    (R/2h)^4 terms are below 0.5%). The cut faces resolve the disc to first order: at R/dx = 2, 4, 8
    and 16 the measured C was 1.215, 1.187, 1.164 and 1.155; at the test's R/dx = 4, 6% allows the
-   4.2% measured. */
+   4.2% measured. The PIC's fluid_volume counts each cut cell by its open volume, the mean open
+   fraction of its faces, which is exact for straight cuts along the grid and first order in dx/R
+   on a circle: the box less the disc within 6% of pi R^2 (4.7% measured at R/dx = 4; counting cut
+   cells whole, as before, read 36%). */
 START_TEST(moving_disc_keeps_volume_and_balances_impulses) {
     const double R = 0.04, dx = 0.01;
     tank t = make_tank(2, 0.3, 0, 1, 0, dx, fsdem_v3(0.1, 0.15, 0), R, 2000, 1, fsdem_v3(0.5, 0, 0), 0);
     const int count0 = fsdem_pic_get_particles(t.pic).count;
     const double ys[2] = {0.15, -0.15}, ss[2] = {1, 1}; /* mirrors in y = 0 and y = 0.3, period 0.6 */
     const double added = image_added_mass(R, 0.1, 0.15, 0.3, 0.6, ys, ss, 2, 0);
-    double worst = 0, inside = 0, start = 0;
+    double worst = 0, inside = 0, start = 0, volume_error = 0;
     int k, p;
     for (k = 0; k < 100; ++k) {
         fsdem_pic_dem_force b;
@@ -224,13 +234,18 @@ START_TEST(moving_disc_keeps_volume_and_balances_impulses) {
             if (e > worst) worst = e;
         }
         if (k == 0) start = -b.pressure_force.x * 2e-3 / (RHO * PI * R * R * 0.5); /* C of the first impulse */
+        {
+            const double e = fabs(fsdem_pic_get_stats(t.pic).fluid_volume - (0.3 * 0.3 - PI * R * R)) / (PI * R * R);
+            if (e > volume_error) volume_error = e;
+        }
     }
     TEST_REPORT("moving disc: impulse imbalance %.2e of the largest force, deepest particle %.2e m inside, added mass of the "
-                "start %.4f rho pi R^2 (images: %.4f, %+.2f%%)",
-                worst, inside, start, added, 100 * (start / added - 1));
+                "start %.4f rho pi R^2 (images: %.4f, %+.2f%%), fluid_volume off by %.4f pi R^2",
+                worst, inside, start, added, 100 * (start / added - 1), volume_error);
     ck_assert_double_le(inside, 0);       /* every particle outside the disc (pushed to 1e-3 dx) */
     ck_assert(worst < TOL(1e-11, 1e4)); /* an identity of the discrete operators: rounding only */
     ck_assert_msg(fabs(start / added - 1) < 0.06, "added mass %g rho pi R^2, potential flow %g", start, added);
+    ck_assert_msg(volume_error < 0.06, "fluid_volume off by %g pi R^2", volume_error);
     free_tank(&t);
 }
 END_TEST
@@ -304,25 +319,26 @@ START_TEST(light_disc_rises_with_the_implicit_solid_velocity) {
     /* y images of the bottom wall (y = 0) and the free surface (y = 0.35 m), period 4 x 0.35 m */
     const double ys[4] = {0.1, -0.1, 0.7 - 0.1, 0.7 + 0.1}, ss[4] = {1, -1, 1, -1};
     const double added = image_added_mass(R, 0.2, 0.1, 0.4, 1.4, ys, ss, 4, 1);
-    double worst_new = 0, worst_pred = 0, top = 0, first = 0, expected = 0;
+    double worst_new = 0, worst_pic = 0, worst_stat = 0, top = 0, first = 0, expected = 0;
     int k;
     for (k = 0; k < 200; ++k) {
         fsdem_pic_fields g;
         fsdem_dem_particles d;
-        double div_new = 0, div_pred = 0;
+        double div_new = 0, div_pic = 0;
         int i, j, a;
         const fsdem_vec3 x0 = fsdem_dem_get_particles(t.dem).position[0]; /* the faces were cut here */
         ck_assert_msg(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)2e-3) == FSDEM_OK, "step %d: %s", k, fsdem_pic_dem_last_error(t.cp));
         g = fsdem_pic_get_fields(t.pic);
         d = fsdem_dem_get_particles(t.dem);
-        /* the divergence of the projection's cells with the disc's new and predicted velocities
+        /* the divergence of the projection's cells with the disc's new velocity (the DEM's) and with
+           the solid velocity the PIC kept (the pressure's answer, fsdem_pic_response_fn)
            (the cells of the step's projection: cell types are those of the step's end, so only
            cells that are FLUID and full at the end and had a pressure in the projection, and that
            the disc cuts, are measured) */
         for (j = 1; j < g.n[1] - 1; ++j)
             for (i = 1; i < g.n[0] - 1; ++i) {
                 const int c = j * g.n[0] + i;
-                double sn = 0, sp = 0;
+                double sn = 0, sq = 0;
                 int cut = 0;
                 if (g.cell[c] != FSDEM_STENCIL_CELL_FLUID || g.phi[c] > -0.999 * g.cell_size || !(g.pressure[c] > 0)) continue;
                 for (a = 0; a < 2; ++a) {
@@ -337,15 +353,16 @@ START_TEST(light_disc_rises_with_the_implicit_solid_velocity) {
                         const double us = a == 0 ? d.velocity[0].x - w * ry : d.velocity[0].y + w * rx;
                         cut |= e < 1;
                         sn += sgn * (e * g.velocity[a][f] + (1 - e) * us);
-                        sp += sgn * (e * g.velocity[a][f] + (1 - e) * g.solid_velocity[a][f]);
+                        sq += sgn * (e * g.velocity[a][f] + (1 - e) * g.solid_velocity[a][f]);
                     }
                 }
-                if (!cut) continue; /* the cells the disc cuts, where the two velocities differ */
+                if (!cut) continue; /* the cells the disc cuts */
                 if (fabs(sn) > div_new) div_new = fabs(sn);
-                if (fabs(sp) > div_pred) div_pred = fabs(sp);
+                if (fabs(sq) > div_pic) div_pic = fabs(sq);
             }
         if (div_new > worst_new) worst_new = div_new;
-        if (div_pred > worst_pred) worst_pred = div_pred;
+        if (div_pic > worst_pic) worst_pic = div_pic;
+        if (fsdem_pic_get_stats(t.pic).max_divergence > worst_stat) worst_stat = fsdem_pic_get_stats(t.pic).max_divergence;
         ck_assert(test_finite3(d.velocity[0]));
         if (k == 0) {
             const double V = PI * R * R;
@@ -359,14 +376,19 @@ START_TEST(light_disc_rises_with_the_implicit_solid_velocity) {
         /* free acceleration (rho_f / rho_s - 1) g without drag or added mass, over the rise */
         const double rise = fsdem_dem_get_particles(t.dem).position[0].y - 0.1, bound = sqrt(2 * (RHO / rho_s - 1) * G * rise);
         TEST_REPORT("light disc: %d steps, first step %.6e m/s (potential flow, C = %.4f: %.6e, %+.2f%%), top speed %.3f m/s (free "
-                    "bound %.3f), flux imbalance with the new velocity %.2e m/s, with the prediction %.2e m/s",
-                    k, first, added, expected, 100 * (first / expected - 1), top, bound, worst_new, worst_pred);
+                    "bound %.3f), flux imbalance with the new velocity %.2e m/s, with the PIC's solid velocity %.2e m/s, "
+                    "max_divergence %.2e 1/s",
+                    k, first, added, expected, 100 * (first / expected - 1), top, bound, worst_new, worst_pic, worst_stat);
         ck_assert_msg(fabs(first / expected - 1) < 0.05, "first step %g m/s, potential flow %g m/s", first, expected);
         ck_assert(top < bound);
     }
-    /* the new velocity closes the balance to the solver's level; the prediction misses by the
-       pressure's impulse on the disc, orders larger */
-    ck_assert(worst_new < 1e-3 * worst_pred);
+    /* both close the balance to the solver's level: the PCG stops at a relative residual of 1e-8,
+       and 1e-6 of the top speed is two orders above what it leaves and four below the pressure's
+       impulse per step that Q* alone would miss by (g dt = 2e-2 m/s) */
+    ck_assert_msg(worst_new < 1e-6 * top && worst_pic < 1e-6 * top, "flux imbalance %g (DEM) and %g (PIC) m/s, top speed %g m/s",
+                  worst_new, worst_pic, top);
+    /* and so does the PIC's own statistic, the same sums over dx (it took Q*'s flux before) */
+    ck_assert_msg(worst_stat < 1e-6 * top / dx, "max_divergence %g 1/s", worst_stat);
     free_tank(&t);
 }
 END_TEST
@@ -551,6 +573,43 @@ START_TEST(neutral_disc_stays_put) {
 }
 END_TEST
 
+/* Still water stays still next to a body at rest that the pressure holds (issue 21 item 3): a body
+   of the water's density at rest in water at rest, with the PIC transfer (flip_ratio 0, which takes
+   the grid's velocity whole), in 2D and 3D with its centre on a cell centre, on a face and on a
+   node (2D) or an edge (3D). The closed faces the body covers must carry its velocity at the end
+   of the step, the pressure's answer, not its Q* (which holds g dt): a particle next to the body
+   read about g dt / 2 from them (5e-3 m/s here) before. After one step of 1 ms the fastest
+   particle moves at the pressure solve's residue: the discrete hydrostatic state is exact, and the
+   PCG stops at a relative residual tau, so speeds are of order tau g dt; 1e-5 g dt is three orders
+   above it (float: its rounding floor) and 500 times below the defect. */
+START_TEST(still_water_stays_still_next_to_a_body_at_rest) {
+    const double dx = 0.01, R = 0.04, dt = 1e-3;
+    int dim, where;
+    for (dim = 2; dim <= 3; ++dim)
+        for (where = 0; where < 3; ++where) {
+            /* cell centre, then one and two axes moved onto faces */
+            const double off[3] = {where >= 1 ? 0 : dx / 2, where >= 2 ? 0 : dx / 2, dx / 2};
+            const double L = dim == 2 ? 0.4 : 0.2, depth = dim == 2 ? 0.35 : 0.18;
+            const fsdem_vec3 centre = dim == 2 ? fsdem_v3((fsdem_real)(0.2 + off[0]), (fsdem_real)(0.15 + off[1]), 0)
+                                               : fsdem_v3((fsdem_real)(0.1 + off[0]), (fsdem_real)(0.1 + off[1]), (fsdem_real)(0.08 + off[2]));
+            tank t = make_tank_flip(dim, L, depth, 0, G, dx, centre, R, RHO, 0, fsdem_v3(0, 0, 0), 0, 0);
+            fsdem_pic_particles w;
+            double fastest = 0;
+            int p;
+            ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)dt), FSDEM_OK);
+            w = fsdem_pic_get_particles(t.pic);
+            for (p = 0; p < w.count; ++p) {
+                const double v = fsdem_test_norm(w.velocity[p]);
+                if (v > fastest) fastest = v;
+            }
+            TEST_REPORT("%dD body at rest, centre %s: fastest particle after one PIC step %.2e m/s (g dt = %.2e m/s)", dim,
+                        where == 0 ? "on a cell centre" : where == 1 ? "on a face" : dim == 2 ? "on a node" : "on an edge", fastest, G * dt);
+            ck_assert_msg(fastest < 1e-5 * G * dt, "%dD, case %d: a particle moves at %g m/s", dim, where, fastest);
+            free_tank(&t);
+        }
+}
+END_TEST
+
 /* fsdem_pic_dem_write_csv: the header alone before the first step (when fsdem_pic_dem_get_force has no
    record either), then one row per body of the last step, equal to its record and id (a disc held
    under water and a free one moving through it); a disc added since the step has no record and no row; an
@@ -602,6 +661,7 @@ Suite *couple_pic_suite(void) {
     tcase_add_test(tc, fixed_disc_in_a_stream_feels_drag_along_it);
     tcase_add_test(tc, light_disc_rises_with_the_implicit_solid_velocity);
     tcase_add_test(tc, neutral_disc_stays_put);
+    tcase_add_test(tc, still_water_stays_still_next_to_a_body_at_rest);
     tcase_add_test(tc, contact_area_dissipation_is_eq_20);
     tcase_add_test(tc, bad_input_is_refused);
     tcase_add_test(tc, csv_rows_are_the_force_records);

@@ -901,7 +901,7 @@ START_TEST(null_objects_are_refused) {
         mark_point();
         cp = fsdem_pic_get_coupling(NULL);
         IF_ZERO(&p, "fsdem_pic_get_coupling(NULL)", cp.dim + cp.n[0] + (cp.acceleration[0] != NULL));
-        IF_REFUSED(&p, fsdem_pic_set_pressure_extra(NULL, NULL, NULL));
+        IF_REFUSED(&p, fsdem_pic_set_pressure_extra(NULL, NULL, NULL, NULL));
         IF_REFUSED(&p, fsdem_pic_sample(NULL, 1, &v, &out));
         IF_REFUSED(&p, fsdem_pic_add_force(NULL, v, 0, v, &taken));
         IF_REFUSED(&p, fsdem_pic_clear_forces(NULL));

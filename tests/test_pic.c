@@ -675,8 +675,8 @@ START_TEST(steps_do_not_allocate) {
 END_TEST
 
 /* The coupler arrays enter the projection: faces closed by a "moving solid" (open = 0) carry the
-   solid's velocity as flux. A column of faces across the open box closed with solid velocity U
-   leaves the uniform flow U untouched: flux U H through every section, no vertical velocity. */
+   solid's velocity as flux. A column of faces across the open box closed by a solid moving steadily
+   at U (at the start and the end of every step) leaves the uniform flow U untouched: flux U H through every section, no vertical velocity. */
 START_TEST(coupler_faces_carry_solid_flux) {
     fsdem_pic *s;
     fsdem_pic_coupling cp;
@@ -690,6 +690,7 @@ START_TEST(coupler_faces_carry_solid_flux) {
     for (j = 0; j < cp.n[1]; ++j) {
         cp.open[0][j * (cp.n[0] + 1) + col] = 0;
         cp.solid_velocity[0][j * (cp.n[0] + 1) + col] = (fsdem_real)U;
+        cp.start_velocity[0][j * (cp.n[0] + 1) + col] = (fsdem_real)U; /* it moves steadily */
     }
     for (k = 0; k < 5; ++k) ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
     g = fsdem_pic_get_fields(s);
