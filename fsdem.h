@@ -305,6 +305,7 @@
 #define fsdem_pic_add_obstacle fsdem_pic_add_obstacle_f
 #define fsdem_pic_add_particles fsdem_pic_add_particles_f
 #define fsdem_pic_advance fsdem_pic_advance_f
+#define fsdem_pic_check_dt fsdem_pic_check_dt_f
 #define fsdem_pic_clear_forces fsdem_pic_clear_forces_f
 #define fsdem_pic_create fsdem_pic_create_f
 #define fsdem_pic_dem_advance fsdem_pic_dem_advance_f
@@ -1333,6 +1334,9 @@ FSDEM_API fsdem_result fsdem_pic_step(fsdem_pic *pic);
    u_max dt / dx > cfl_max (the message names the fastest particle); in both cases nothing moved.
    Otherwise as fsdem_pic_step. */
 FSDEM_API fsdem_result fsdem_pic_step_dt(fsdem_pic *pic, fsdem_real dt);
+/* FSDEM_OK when fsdem_pic_step_dt would take a step of dt, else the refusal it would return, with
+   its message (a coupler checks before it changes anything). */
+FSDEM_API fsdem_result fsdem_pic_check_dt(const fsdem_pic *pic, fsdem_real dt);
 /* Advances by `duration` (s) with adaptive steps, the last ones shortened to land on the end time.
    Stops at the first error and returns it. Steps taken go to *steps (may be NULL). */
 FSDEM_API fsdem_result fsdem_pic_advance(fsdem_pic *pic, fsdem_real duration, long long *steps);
@@ -2758,9 +2762,10 @@ FSDEM_API fsdem_result fsdem_pic_dem_get_force(const fsdem_pic_dem *coupler, int
    (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of either solver are passed on with their
    message. */
 FSDEM_API fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *coupler);
-/* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite, FSDEM_ERR_CFL
-   when dt exceeds the PIC's cfl_max, a body would move more than cfl_max cells or dt exceeds the
-   viscous limit; nothing moved then. */
+/* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite or above
+   max_substeps DEM substeps, FSDEM_ERR_CFL when dt exceeds the PIC's cfl_max (fsdem_pic_check_dt),
+   a body would move more than cfl_max cells or dt exceeds the viscous limit; then coupler, PIC and
+   DEM are exactly as they were (saved bytes and statistics). */
 FSDEM_API fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *coupler, fsdem_real dt);
 /* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
 FSDEM_API fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *coupler, fsdem_real duration, long long *steps);
@@ -11140,26 +11145,33 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
     return worst;
 }
 
-fsdem_result fsdem_pic_step_dt(fsdem_pic *s, fsdem_real dt) {
+fsdem_result fsdem_pic_check_dt(const fsdem_pic *s, fsdem_real dt) {
+    fsdem__status *st;
     int who;
     fsdem_real umax, cfl;
     if (!s) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&s->status; /* the message is the object's only mutable part here */
     if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_step_dt: dt = %g s must be > 0 and finite", (double)dt);
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "fsdem_pic_step_dt: dt = %g s must be > 0 and finite", (double)dt);
     umax = fsdem__pic_umax(s, &who);
     if (!fsdem__finite(umax))
-        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pic: particle %d has a non-finite velocity", who);
+        return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_pic: particle %d has a non-finite velocity", who);
     cfl = umax * dt * s->inv_dx;
     if (cfl > s->desc.cfl_max) {
         if (who >= 0)
-            return fsdem__fail(&s->status, FSDEM_ERR_CFL,
+            return fsdem__fail(st, FSDEM_ERR_CFL,
                                "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (particle %d at %g m/s; dt <= %g s)", (double)dt,
                                (double)cfl, (double)s->desc.cfl_max, who, (double)umax,
                                (double)(s->desc.cfl_max * s->dx / umax));
-        return fsdem__fail(&s->status, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s side velocity %g m/s)",
+        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s side velocity %g m/s)",
                            (double)dt, (double)cfl, (double)s->desc.cfl_max, fsdem__pic_side_name(-2 - who), (double)umax);
     }
-    return fsdem__pic_do_step(s, dt);
+    return fsdem__ok(st);
+}
+
+fsdem_result fsdem_pic_step_dt(fsdem_pic *s, fsdem_real dt) {
+    const fsdem_result res = fsdem_pic_check_dt(s, dt);
+    return res == FSDEM_OK ? fsdem__pic_do_step(s, dt) : res;
 }
 
 fsdem_result fsdem_pic_step(fsdem_pic *s) {
@@ -17474,6 +17486,9 @@ static fsdem_result fsdem__pic_dem_run(fsdem_pic_dem *c, fsdem_real dt) {
         return fsdem__fail(&c->status, FSDEM_ERR_CFL,
                            "fsdem_pic_dem: dt = %g s exceeds viscous_dt_fraction %g of the shortest viscous relaxation time %g s",
                            (double)dt, (double)c->desc.viscous_dt_fraction, (double)c->viscous_dt);
+    /* the PIC's own refusal too, before the cut below changes its coupling arrays */
+    if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
+        return fsdem__fail(&c->status, res, "fsdem_pic_dem: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
     if (P.count > before && (res = fsdem__pic_dem_exclude(c, before, 1)) != FSDEM_OK) return res;
     if ((res = fsdem__pic_dem_faces(c, dt)) != FSDEM_OK) return res;
     t1 = clock();

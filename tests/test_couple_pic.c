@@ -610,6 +610,76 @@ START_TEST(still_water_stays_still_next_to_a_body_at_rest) {
 }
 END_TEST
 
+/* The coupler's saved bytes and statistics (CPU times excepted: they are not state). */
+typedef struct pic_dem_snapshot {
+    unsigned char *bytes;
+    size_t size;
+    fsdem_pic_dem_stats stats;
+} pic_dem_snapshot;
+
+static pic_dem_snapshot pic_dem_snapshot_take(const tank *t) {
+    pic_dem_snapshot s;
+    size_t need = 0;
+    fsdem_pic_dem_save_memory(t->cp, NULL, 0, &need);
+    s.bytes = (unsigned char *)malloc(need);
+    ck_assert_ptr_nonnull(s.bytes);
+    ck_assert_int_eq(fsdem_pic_dem_save_memory(t->cp, s.bytes, need, &s.size), FSDEM_OK);
+    s.stats = fsdem_pic_dem_get_stats(t->cp);
+    s.stats.seconds_pic = s.stats.seconds_dem = s.stats.seconds_coupling = 0;
+    return s;
+}
+
+/* The house error rule (issue 21 item 6): a step that fsdem_pic_dem_step_dt refuses (the PIC's
+   cfl_max, the viscous limit, too many DEM substeps) leaves coupler, PIC and DEM exactly as they
+   were, saved bytes and statistics, even with a body added since the last step (whose water the
+   coupler removes in the step it takes), and the same dt allowed then runs. Before, the PIC's
+   refusal came after the bodies were cut into its coupling arrays with the refused dt. */
+START_TEST(refused_step_changes_nothing) {
+    int path;
+    for (path = 0; path < 3; ++path) {
+        tank t = make_tank(2, 0.4, 0.3, 0, G, 0.01, fsdem_v3(0.2, 0.1, 0), 0.04, 2000, 0, fsdem_v3(0, 0, 0), path == 1 ? 1e-3 : 0);
+        fsdem_dem_particle_desc extra = fsdem_dem_particle_desc_default();
+        pic_dem_snapshot before, after;
+        fsdem_real dt = (fsdem_real)1e-3;
+        int i;
+        ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, dt), FSDEM_OK);
+        extra.position = fsdem_v3(0.3f, 0.15f, 0);
+        extra.radius = (fsdem_real)0.03;
+        ck_assert_int_eq(fsdem_dem_add_particle(t.dem, &extra, NULL), FSDEM_OK);
+        if (path == 0) { /* water at 5 m/s: 1 ms is half a cell; 50 ms is 25 cells */
+            const fsdem_pic_particles w = fsdem_pic_get_particles(t.pic);
+            for (i = 0; i < w.count; ++i) w.velocity[i].x = 5;
+        } else if (path == 2) {
+            fsdem_pic_dem_desc cd = fsdem_pic_dem_get_desc(t.cp);
+            fsdem_pic_dem_destroy(t.cp);
+            cd.max_substeps = 3;
+            ck_assert_int_eq(fsdem_pic_dem_create(&cd, &t.cp), FSDEM_OK);
+            dt = (fsdem_real)(2 * fsdem_dem_get_desc(t.dem).dt);
+        }
+        before = pic_dem_snapshot_take(&t);
+        if (path == 0) {
+            ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)0.05), FSDEM_ERR_CFL);
+            ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "cfl_max"));
+        } else if (path == 1) {
+            const double limit = fsdem_pic_dem_get_stats(t.cp).viscous_dt;
+            ck_assert(limit > 0);
+            ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)(2 * limit)), FSDEM_ERR_CFL);
+            ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "viscous"));
+        } else {
+            ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)(10 * fsdem_dem_get_desc(t.dem).dt)), FSDEM_ERR_INVALID_ARG);
+            ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "max_substeps"));
+        }
+        after = pic_dem_snapshot_take(&t);
+        ck_assert_msg(after.size == before.size && memcmp(after.bytes, before.bytes, after.size) == 0, "path %d: the state changed", path);
+        ck_assert_msg(memcmp(&after.stats, &before.stats, sizeof after.stats) == 0, "path %d: the statistics changed", path);
+        free(before.bytes);
+        free(after.bytes);
+        ck_assert_msg(fsdem_pic_dem_step_dt(t.cp, dt) == FSDEM_OK, "path %d: %s", path, fsdem_pic_dem_last_error(t.cp));
+        free_tank(&t);
+    }
+}
+END_TEST
+
 /* fsdem_pic_dem_write_csv: the header alone before the first step (when fsdem_pic_dem_get_force has no
    record either), then one row per body of the last step, equal to its record and id (a disc held
    under water and a free one moving through it); a disc added since the step has no record and no row; an
@@ -662,6 +732,7 @@ Suite *couple_pic_suite(void) {
     tcase_add_test(tc, light_disc_rises_with_the_implicit_solid_velocity);
     tcase_add_test(tc, neutral_disc_stays_put);
     tcase_add_test(tc, still_water_stays_still_next_to_a_body_at_rest);
+    tcase_add_test(tc, refused_step_changes_nothing);
     tcase_add_test(tc, contact_area_dissipation_is_eq_20);
     tcase_add_test(tc, bad_input_is_refused);
     tcase_add_test(tc, csv_rows_are_the_force_records);
