@@ -537,7 +537,8 @@ typedef struct fsdem_fluid_sample {
 
 /* Private helpers of the implementation (>>impl_geom), one copy for every user: closest points on
    segments and triangles, signed distances of boxes, spheres, discs, capped cylinders and polygons,
-   distance gradients by central differences. DEM walls, PIC obstacles and the couplers call them. */
+   distance gradients by central differences, the open fractions of cut grid faces. DEM walls, PIC
+   obstacles and the couplers call them. */
 
 /* ===== >>kernel : interpolation weights ============================================================ */
 
@@ -1353,7 +1354,11 @@ FSDEM_API fsdem_pic_desc fsdem_pic_get_desc(const fsdem_pic *pic);
 /* Read-only view of the grid after the last step (valid while the solver lives). `cell`, `phi` and
    `fraction` describe the particles at the end of the step (after advection and reseeding); the
    face velocities and the pressure are those of the step's projection, made with the cells of its
-   start, so a cell the front entered during the step can show a nonzero divergence. */
+   start, so a cell the front entered during the step can show a nonzero divergence. Layout: cell
+   (i, j, k), centred at origin + cell_size (i + 1/2, j + 1/2, k + 1/2), is index
+   i + n[0] (j + n[1] k); face (i, j, k) of axis a is the face on the low side of cell (i, j, k)
+   along a (its coordinate along a runs from 0 to n[a]), index i + m[0] (j + m[1] k) with
+   m[b] = n[b] + (a == b), face_count[a] of them. Couplers index the grid by this layout. */
 typedef struct fsdem_pic_fields {
     int dim;
     int n[3];                      /* cells per axis (n[2] = 1 in 2D) */
@@ -3470,6 +3475,14 @@ static fsdem_vec3 fsdem__cross(fsdem_vec3 a, fsdem_vec3 b) {
 static fsdem_real fsdem__norm(fsdem_vec3 a) { return (fsdem_real)sqrt(fsdem__dot(a, a)); }
 static fsdem_vec3 fsdem__zero3(void) { return fsdem_v3(0, 0, 0); }
 static fsdem_real fsdem__comp(fsdem_vec3 v, int axis) { return axis == 0 ? v.x : axis == 1 ? v.y : v.z; }
+
+/* p moved by h along axis b. */
+static fsdem_vec3 fsdem__axis_shift(fsdem_vec3 p, int b, fsdem_real h) {
+    if (b == 0) p.x += h;
+    else if (b == 1) p.y += h;
+    else p.z += h;
+    return p;
+}
 static void fsdem__set_comp(fsdem_vec3 *v, int axis, fsdem_real value) {
     if (axis == 0) v->x = value;
     else if (axis == 1) v->y = value;
@@ -3665,7 +3678,8 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_set(fsdem_real s) {
 
    Contents: closest points (segment, triangle); the unit direction between two points; signed
    distances (positive outside the solid) of an axis-aligned box (with its outward normal), a sphere
-   or disc, a flat-capped cylinder and a 2D polygon. */
+   or disc, a flat-capped cylinder and a 2D polygon; the cut-cell sampler (the open fraction of a
+   grid face outside a solid given by its signed distance). */
 
 /* Closest point to p on segment a-b. */
 static fsdem_vec3 fsdem__geom_closest_on_segment(fsdem_vec3 p, fsdem_vec3 a, fsdem_vec3 b) {
@@ -3775,6 +3789,74 @@ static fsdem_real fsdem__geom_polygon(fsdem_vec3 p, const fsdem_vec3 *v, int cou
     return inside ? -best : best;
 }
 
+/* Fraction of a segment with end values a, b that lies where the distance is > 0 (linear). */
+static fsdem_real fsdem__geom_frac2(fsdem_real a, fsdem_real b) {
+    if (a > 0 && b > 0) return 1;
+    if (a <= 0 && b <= 0) return 0;
+    return a > 0 ? a / (a - b) : b / (b - a);
+}
+
+/* Same for a triangle with vertex values a, b, c (exact for a linear distance). */
+static fsdem_real fsdem__geom_frac3(fsdem_real a, fsdem_real b, fsdem_real c) {
+    int pos = (a > 0) + (b > 0) + (c > 0);
+    fsdem_real t;
+    if (pos == 3) return 1;
+    if (pos == 0) return 0;
+    if (pos == 1) { /* the lone positive vertex first */
+        if (b > 0) { t = a; a = b; b = t; }
+        else if (c > 0) { t = a; a = c; c = t; }
+        return a * a / ((a - b) * (a - c));
+    }
+    if (b <= 0) { t = a; a = b; b = t; }
+    else if (c <= 0) { t = a; a = c; c = t; }
+    return 1 - a * a / ((a - b) * (a - c));
+}
+
+#define FSDEM__GEOM_FACE_SUB 4 /* sub-segments (sub-squares per side) of a face for its open fraction */
+
+/* A solid's signed distance (m, positive outside) at p. */
+typedef fsdem_real (*fsdem__geom_dist_fn)(const void *solid, fsdem_vec3 p);
+
+/* The distance for the face fractions, 0 within `tol` of the surface. A face lying on a solid's
+   side (a box edge on a grid line) must not depend on the rounding of the two coordinates: left to
+   it, the face could come out open by 1e-15 of its area and leave a chain of cells joined only by
+   such faces, a near-singular pressure operator. Counted as on the surface, a sample point there
+   is solid (fsdem__geom_frac2 opens only d > 0), so a side on a face and a side a hair off it give
+   the same fractions. */
+static fsdem_real fsdem__geom_face_sample(fsdem_real tol, fsdem__geom_dist_fn dist, const void *solid, fsdem_vec3 p) {
+    fsdem_real d = dist(solid, p);
+    return (fsdem_real)fabs(d) <= tol ? 0 : d;
+}
+
+/* The cut-cell sampler: open fraction of the face of axis a with lower corner `c0` (m), spanning
+   one cell of `dx` along the other axes (dim 2 or 3), outside the solid whose signed distance is
+   dist(solid, p) (a PIC's obstacle union, a coupler's moving body), `tol` as above. */
+static fsdem_real fsdem__geom_face_fraction(int dim, int a, fsdem_vec3 c0, fsdem_real dx, fsdem_real tol, fsdem__geom_dist_fn dist,
+                                            const void *solid) {
+    const int S = FSDEM__GEOM_FACE_SUB;
+    fsdem_real h = dx / S, v[FSDEM__GEOM_FACE_SUB + 1][FSDEM__GEOM_FACE_SUB + 1], sum = 0;
+    int b1 = (a + 1) % 3, b2 = (a + 2) % 3, i, j;
+    if (dim == 2) {
+        int b = a == 0 ? 1 : 0;
+        for (i = 0; i <= S; ++i) v[0][i] = fsdem__geom_face_sample(tol, dist, solid, fsdem__axis_shift(c0, b, h * (fsdem_real)i));
+        for (i = 0; i < S; ++i) sum += fsdem__geom_frac2(v[0][i], v[0][i + 1]);
+        return sum / S;
+    }
+    for (j = 0; j <= S; ++j)
+        for (i = 0; i <= S; ++i)
+            v[j][i] = fsdem__geom_face_sample(
+                tol, dist, solid, fsdem__axis_shift(fsdem__axis_shift(c0, b1, h * (fsdem_real)i), b2, h * (fsdem_real)j));
+    for (j = 0; j < S; ++j)
+        for (i = 0; i < S; ++i) {
+            fsdem_vec3 m = fsdem__axis_shift(fsdem__axis_shift(c0, b1, h * ((fsdem_real)i + (fsdem_real)0.5)), b2,
+                                                 h * ((fsdem_real)j + (fsdem_real)0.5));
+            fsdem_real vc = fsdem__geom_face_sample(tol, dist, solid, m);
+            sum += fsdem__geom_frac3(vc, v[j][i], v[j][i + 1]) + fsdem__geom_frac3(vc, v[j][i + 1], v[j + 1][i + 1]) +
+                   fsdem__geom_frac3(vc, v[j + 1][i + 1], v[j + 1][i]) + fsdem__geom_frac3(vc, v[j + 1][i], v[j][i]);
+        }
+    return sum / (4 * S * S);
+}
+
 /* ===== >>impl_kernel : interpolation weights ==========================================================
 
    Contents: fsdem__kernel (per-axis node range, weights, derivatives and clamped node indices) and
@@ -3849,7 +3931,8 @@ static inline fsdem_real fsdem__kernel_mps(fsdem_real r, fsdem_real re) {
 /* ===== >>impl_grid : cell grid ===================================================================== */
 
 /* Contents: setup (cell size enlarged to bound the cell count), binning by counting sort, cell
-   lookup, the 3^dim neighbourhood and the half (forward) neighbourhood. */
+   lookup, the 3^dim neighbourhood and the half (forward) neighbourhood; the MAC layout (private:
+   cell and face indices and positions of the PIC's grid, for the PIC and its couplers). */
 
 fsdem_result fsdem_cellgrid_setup(fsdem_cellgrid *g, const fsdem_allocator *allocator, int dim,
                                   fsdem_vec3 lo, fsdem_vec3 hi, fsdem_real cell_size, int max_cells) {
@@ -4053,6 +4136,86 @@ static fsdem_real fsdem__wrap_axis(const fsdem__periods *p, int a, fsdem_real lo
     }
     fsdem__set_comp(x, a, wrapped);
     return shift;
+}
+
+/* The MAC layout: indices and positions of a MAC grid's cells and faces, as fsdem_pic_fields
+   documents them. The PIC keeps one; a coupler builds its own from that public view, so both index
+   the same way without the coupler reading the PIC's private fields. */
+typedef struct fsdem__mac {
+    int dim, n[3], ncell;  /* cells per axis (n[2] = 1 in 2D) */
+    int fn[3][3];          /* face grid sizes: fn[a][b] = n[b] + (a == b) */
+    int fstep[3][3];       /* face index stride of axis-a faces along b */
+    fsdem_real dx, inv_dx;
+    fsdem_vec3 lo, hi;     /* grid box (z = 0 in 2D) */
+    fsdem_real surface_tol; /* m; solid distances within this count as on the surface (fsdem__geom_face_sample) */
+} fsdem__mac;
+
+static void fsdem__mac_init(fsdem__mac *m, int dim, const int n[3], fsdem_real dx, fsdem_vec3 lo) {
+    fsdem_real extent = dx;
+    int a, b;
+    m->dim = dim;
+    m->dx = dx;
+    m->inv_dx = 1 / dx;
+    for (a = 0; a < 3; ++a) m->n[a] = a < dim ? n[a] : 1;
+    m->ncell = m->n[0] * m->n[1] * m->n[2];
+    m->lo = lo;
+    if (dim == 2) m->lo.z = 0;
+    m->hi = m->lo;
+    m->hi.x = m->lo.x + dx * (fsdem_real)m->n[0];
+    m->hi.y = m->lo.y + dx * (fsdem_real)m->n[1];
+    if (dim == 3) m->hi.z = m->lo.z + dx * (fsdem_real)m->n[2];
+    /* a millionth of the cell or of the largest coordinate, whichever is larger: above the rounding
+       of face positions (float included), far below any geometric detail */
+    for (a = 0; a < 3; ++a) {
+        const fsdem_real lo_a = (fsdem_real)fabs(fsdem__comp(m->lo, a)), hi_a = (fsdem_real)fabs(fsdem__comp(m->hi, a));
+        if (lo_a > extent) extent = lo_a;
+        if (hi_a > extent) extent = hi_a;
+    }
+    m->surface_tol = (fsdem_real)fsdem__tolerance(1e-6) * extent;
+    for (a = 0; a < 3; ++a) {
+        for (b = 0; b < 3; ++b) m->fn[a][b] = m->n[b] + (a == b && a < dim);
+        m->fstep[a][0] = 1;
+        m->fstep[a][1] = m->fn[a][0];
+        m->fstep[a][2] = m->fn[a][0] * m->fn[a][1];
+    }
+}
+
+static int fsdem__mac_cell(const fsdem__mac *m, int i, int j, int k) { return (k * m->n[1] + j) * m->n[0] + i; }
+
+/* Face (i, j, k) of axis a: the face on the low side of cell (i, j, k) along a. */
+static int fsdem__mac_face(const fsdem__mac *m, int a, int i, int j, int k) { return (k * m->fn[a][1] + j) * m->fn[a][0] + i; }
+
+/* The (i, j, k) of face index f of axis a. */
+static void fsdem__mac_face_coords(const fsdem__mac *m, int a, int f, int idx[3]) {
+    idx[0] = f % m->fn[a][0];
+    idx[1] = f / m->fn[a][0] % m->fn[a][1];
+    idx[2] = f / (m->fn[a][0] * m->fn[a][1]);
+}
+
+/* Centre (m) of face (i, j, k) of axis a. */
+static fsdem_vec3 fsdem__mac_face_pos(const fsdem__mac *m, int a, int i, int j, int k) {
+    fsdem_vec3 p;
+    p.x = m->lo.x + m->dx * ((fsdem_real)i + (a == 0 ? 0 : (fsdem_real)0.5));
+    p.y = m->lo.y + m->dx * ((fsdem_real)j + (a == 1 ? 0 : (fsdem_real)0.5));
+    p.z = m->dim == 3 ? m->lo.z + m->dx * ((fsdem_real)k + (a == 2 ? 0 : (fsdem_real)0.5)) : 0;
+    return p;
+}
+
+static fsdem_vec3 fsdem__mac_cell_pos(const fsdem__mac *m, int i, int j, int k) {
+    return fsdem_v3(m->lo.x + m->dx * ((fsdem_real)i + (fsdem_real)0.5), m->lo.y + m->dx * ((fsdem_real)j + (fsdem_real)0.5),
+                    m->dim == 3 ? m->lo.z + m->dx * ((fsdem_real)k + (fsdem_real)0.5) : 0);
+}
+
+/* The cell index along `axis` of coordinate x, clamped to the grid (0 for NaN). */
+static int fsdem__mac_coord(const fsdem__mac *m, fsdem_real x, int axis) {
+    fsdem_real t = (x - fsdem__comp(m->lo, axis)) * m->inv_dx;
+    if (!(t > 0)) return 0; /* also NaN */
+    return t < (fsdem_real)m->n[axis] ? (int)t : m->n[axis] - 1;
+}
+
+/* The cell holding p (clamped into the grid). */
+static int fsdem__mac_cell_of(const fsdem__mac *m, fsdem_vec3 p) {
+    return fsdem__mac_cell(m, fsdem__mac_coord(m, p.x, 0), fsdem__mac_coord(m, p.y, 1), m->dim == 3 ? fsdem__mac_coord(m, p.z, 2) : 0);
 }
 
 /* ===== >>impl_dem : discrete element method ======================================================== */
@@ -8717,7 +8880,7 @@ struct fsdem_pic {
     int fstep[3][3];   /* face index stride of axis-a faces along b */
     fsdem_real dx, inv_dx;
     fsdem_vec3 lo, hi; /* grid box */
-    fsdem_real surface_tol; /* m; solid distances within this count as on the surface (>>pic_geometry) */
+    fsdem__mac mac;    /* the layout of the grid below (its n, fn, fstep, dx, lo, hi mirror it for the loops) */
     double time;
     fsdem_real dt_last;
     long long steps;
@@ -9079,10 +9242,6 @@ void fsdem_pic_destroy(fsdem_pic *s) {
 
 const char *fsdem_pic_last_error(const fsdem_pic *s) { return s ? s->status.message : "fsdem_pic is NULL"; }
 
-static int fsdem__pic_cell(const fsdem_pic *s, int i, int j, int k) { return (k * s->n[1] + j) * s->n[0] + i; }
-static int fsdem__pic_face(const fsdem_pic *s, int a, int i, int j, int k) {
-    return (k * s->fn[a][1] + j) * s->fn[a][0] + i;
-}
 
 /* Fill the viscous face-grid coefficients of axis a: 1 between two faces, 0 on the boundary. */
 static void fsdem__pic_fill_vface(fsdem_pic *s, int a) {
@@ -9118,17 +9277,7 @@ static void fsdem__pic_layout(fsdem_pic *s, const fsdem_pic_desc *desc) {
     s->hi.x = s->lo.x + s->dx * (fsdem_real)s->n[0];
     s->hi.y = s->lo.y + s->dx * (fsdem_real)s->n[1];
     if (s->dim == 3) s->hi.z = s->lo.z + s->dx * (fsdem_real)s->n[2];
-    {
-        /* a millionth of the cell or of the largest coordinate, whichever is larger: above the
-           rounding of face positions (float included), far below any geometric detail */
-        fsdem_real extent = s->dx;
-        for (a = 0; a < 3; ++a) {
-            fsdem_real m = (fsdem_real)fabs(fsdem__comp(s->lo, a)), M = (fsdem_real)fabs(fsdem__comp(s->hi, a));
-            if (m > extent) extent = m;
-            if (M > extent) extent = M;
-        }
-        s->surface_tol = (fsdem_real)fsdem__tolerance(1e-6) * extent;
-    }
+    fsdem__mac_init(&s->mac, s->dim, s->n, s->dx, s->lo);
     s->cstep[0] = 1;
     s->cstep[1] = s->n[0];
     s->cstep[2] = s->n[0] * s->n[1];
@@ -9331,13 +9480,6 @@ static fsdem_real fsdem__pic_solid_sdf(const fsdem_pic *s, fsdem_vec3 p) {
     return d;
 }
 
-static fsdem_vec3 fsdem__pic_axis_shift(fsdem_vec3 p, int b, fsdem_real h) {
-    if (b == 0) p.x += h;
-    else if (b == 1) p.y += h;
-    else p.z += h;
-    return p;
-}
-
 static fsdem_real fsdem__pic_obst_dist(const fsdem_pic *s, fsdem_vec3 p) { return fsdem__pic_obst_min(s, p, NULL); }
 
 /* Unit gradient at p of a distance `dist` by central differences over 1e-3 of a cell (0 where it is
@@ -9346,7 +9488,7 @@ static fsdem_vec3 fsdem__pic_gradient(const fsdem_pic *s, fsdem_real (*dist)(con
     fsdem_real h = s->dx * (fsdem_real)1e-3, g[3] = {0, 0, 0}, len;
     int b;
     for (b = 0; b < s->dim; ++b)
-        g[b] = dist(s, fsdem__pic_axis_shift(p, b, h)) - dist(s, fsdem__pic_axis_shift(p, b, -h));
+        g[b] = dist(s, fsdem__axis_shift(p, b, h)) - dist(s, fsdem__axis_shift(p, b, -h));
     len = (fsdem_real)sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
     return len > 0 ? fsdem_v3(g[0] / len, g[1] / len, g[2] / len) : fsdem_v3(0, 0, 0);
 }
@@ -9358,89 +9500,9 @@ fsdem_real fsdem_pic_solid_distance(const fsdem_pic *s, fsdem_vec3 p, fsdem_vec3
     return fsdem__pic_solid_sdf(s, p);
 }
 
-/* Fraction of a segment with end values a, b that lies where the distance is > 0 (linear). */
-static fsdem_real fsdem__pic_frac2(fsdem_real a, fsdem_real b) {
-    if (a > 0 && b > 0) return 1;
-    if (a <= 0 && b <= 0) return 0;
-    return a > 0 ? a / (a - b) : b / (b - a);
-}
-
-/* Same for a triangle with vertex values a, b, c (exact for a linear distance). */
-static fsdem_real fsdem__pic_frac3(fsdem_real a, fsdem_real b, fsdem_real c) {
-    int pos = (a > 0) + (b > 0) + (c > 0);
-    fsdem_real t;
-    if (pos == 3) return 1;
-    if (pos == 0) return 0;
-    if (pos == 1) { /* the lone positive vertex first */
-        if (b > 0) { t = a; a = b; b = t; }
-        else if (c > 0) { t = a; a = c; c = t; }
-        return a * a / ((a - b) * (a - c));
-    }
-    if (b <= 0) { t = a; a = b; b = t; }
-    else if (c <= 0) { t = a; a = c; c = t; }
-    return 1 - a * a / ((a - b) * (a - c));
-}
-
-#define FSDEM__PIC_SUB 4 /* sub-segments (sub-squares per side) of a face for its open fraction */
-
-/* Distance to the obstacle union for the face fractions, 0 within surface_tol of the surface. A
-   face lying on a solid's side (a box edge on a grid line) must not depend on the rounding of the
-   two coordinates: left to it, the face could come out open by 1e-15 of its area and leave a
-   chain of cells joined only by such faces, a near-singular pressure operator. Counted as on the
-   surface, a sample point there is solid (fsdem__pic_frac2 opens only d > 0), so a side on a face
-   and a side a hair off it give the same fractions. */
-typedef fsdem_real (*fsdem__pic_dist_fn)(const void *solid, fsdem_vec3 p);
-
-static fsdem_real fsdem__pic_face_sample(const fsdem_pic *s, fsdem__pic_dist_fn dist, const void *solid, fsdem_vec3 p) {
-    fsdem_real d = dist(solid, p);
-    return (fsdem_real)fabs(d) <= s->surface_tol ? 0 : d;
-}
-
-/* The obstacle union as a fsdem__pic_dist_fn (`solid` is the solver). */
+/* The obstacle union as a fsdem__geom_dist_fn (`solid` is the solver). */
 static fsdem_real fsdem__pic_obstacles_dist(const void *solid, fsdem_vec3 p) {
     return fsdem__pic_obst_min((const fsdem_pic *)solid, p, NULL);
-}
-
-/* Open fraction of the face of axis a with lower corner `c0` (m), spanning one cell along the
-   other axes, outside the solid whose signed distance is dist(solid, p) (the obstacle union, or a
-   coupler's moving body). */
-static fsdem_real fsdem__pic_face_fraction(const fsdem_pic *s, int a, fsdem_vec3 c0, fsdem__pic_dist_fn dist, const void *solid) {
-    const int S = FSDEM__PIC_SUB;
-    fsdem_real h = s->dx / S, v[FSDEM__PIC_SUB + 1][FSDEM__PIC_SUB + 1], sum = 0;
-    int b1 = (a + 1) % 3, b2 = (a + 2) % 3, i, j;
-    if (s->dim == 2) {
-        int b = a == 0 ? 1 : 0;
-        for (i = 0; i <= S; ++i) v[0][i] = fsdem__pic_face_sample(s, dist, solid, fsdem__pic_axis_shift(c0, b, h * (fsdem_real)i));
-        for (i = 0; i < S; ++i) sum += fsdem__pic_frac2(v[0][i], v[0][i + 1]);
-        return sum / S;
-    }
-    for (j = 0; j <= S; ++j)
-        for (i = 0; i <= S; ++i)
-            v[j][i] = fsdem__pic_face_sample(
-                s, dist, solid, fsdem__pic_axis_shift(fsdem__pic_axis_shift(c0, b1, h * (fsdem_real)i), b2, h * (fsdem_real)j));
-    for (j = 0; j < S; ++j)
-        for (i = 0; i < S; ++i) {
-            fsdem_vec3 m = fsdem__pic_axis_shift(fsdem__pic_axis_shift(c0, b1, h * ((fsdem_real)i + (fsdem_real)0.5)), b2,
-                                                 h * ((fsdem_real)j + (fsdem_real)0.5));
-            fsdem_real vc = fsdem__pic_face_sample(s, dist, solid, m);
-            sum += fsdem__pic_frac3(vc, v[j][i], v[j][i + 1]) + fsdem__pic_frac3(vc, v[j][i + 1], v[j + 1][i + 1]) +
-                   fsdem__pic_frac3(vc, v[j + 1][i + 1], v[j + 1][i]) + fsdem__pic_frac3(vc, v[j + 1][i], v[j][i]);
-        }
-    return sum / (4 * S * S);
-}
-
-/* Face centre (m) of face (i, j, k) of axis a. */
-static fsdem_vec3 fsdem__pic_face_pos(const fsdem_pic *s, int a, int i, int j, int k) {
-    fsdem_vec3 p;
-    p.x = s->lo.x + s->dx * ((fsdem_real)i + (a == 0 ? 0 : (fsdem_real)0.5));
-    p.y = s->lo.y + s->dx * ((fsdem_real)j + (a == 1 ? 0 : (fsdem_real)0.5));
-    p.z = s->dim == 3 ? s->lo.z + s->dx * ((fsdem_real)k + (a == 2 ? 0 : (fsdem_real)0.5)) : 0;
-    return p;
-}
-
-static fsdem_vec3 fsdem__pic_cell_pos(const fsdem_pic *s, int i, int j, int k) {
-    return fsdem_v3(s->lo.x + s->dx * ((fsdem_real)i + (fsdem_real)0.5), s->lo.y + s->dx * ((fsdem_real)j + (fsdem_real)0.5),
-                    s->dim == 3 ? s->lo.z + s->dx * ((fsdem_real)k + (fsdem_real)0.5) : 0);
 }
 
 /* Face fractions and solid velocities of the obstacle union into open[a], vel[a]. Returns the
@@ -9452,24 +9514,24 @@ static int fsdem__pic_static_faces(const fsdem_pic *s, fsdem_real *open[3], fsde
         for (k = 0; k < s->fn[a][2]; ++k)
             for (j = 0; j < s->fn[a][1]; ++j)
                 for (i = 0; i < s->fn[a][0]; ++i) {
-                    int f = fsdem__pic_face(s, a, i, j, k);
-                    fsdem_vec3 p = fsdem__pic_face_pos(s, a, i, j, k);
+                    int f = fsdem__mac_face(&s->mac, a, i, j, k);
+                    fsdem_vec3 p = fsdem__mac_face_pos(&s->mac, a, i, j, k);
                     fsdem_real d = fsdem__pic_obst_min(s, p, &which);
                     open[a][f] = 1;
                     vel[a][f] = 0;
                     if (which < 0) continue;
                     vel[a][f] = fsdem__comp(s->obst[which].d.velocity, a);
                     if (d > reach) continue;
-                    p = fsdem__pic_axis_shift(p, (a + 1) % s->dim, -s->dx / 2);
-                    if (s->dim == 3) p = fsdem__pic_axis_shift(p, (a + 2) % 3, -s->dx / 2);
-                    open[a][f] = fsdem__pic_face_fraction(s, a, p, fsdem__pic_obstacles_dist, s);
+                    p = fsdem__axis_shift(p, (a + 1) % s->dim, -s->dx / 2);
+                    if (s->dim == 3) p = fsdem__axis_shift(p, (a + 2) % 3, -s->dx / 2);
+                    open[a][f] = fsdem__geom_face_fraction(s->dim, a, p, s->dx, s->mac.surface_tol, fsdem__pic_obstacles_dist, s);
                 }
     for (k = 0; k < s->n[2]; ++k)
         for (j = 0; j < s->n[1]; ++j)
             for (i = 0; i < s->n[0]; ++i) {
                 int any = 0;
                 for (a = 0; a < s->dim && !any; ++a) {
-                    int f = fsdem__pic_face(s, a, i, j, k);
+                    int f = fsdem__mac_face(&s->mac, a, i, j, k);
                     if (open[a][f] > 0 || open[a][f + s->fstep[a][a]] > 0) any = 1;
                 }
                 open_cells += any;
@@ -9484,9 +9546,9 @@ static void fsdem__pic_static_flags(fsdem_pic *s) {
         for (j = 0; j < s->n[1]; ++j)
             for (i = 0; i < s->n[0]; ++i) {
                 int any_open = 0, any_cut = 0;
-                c = fsdem__pic_cell(s, i, j, k);
+                c = fsdem__mac_cell(&s->mac, i, j, k);
                 for (a = 0; a < s->dim; ++a) {
-                    int f = fsdem__pic_face(s, a, i, j, k), g = f + s->fstep[a][a];
+                    int f = fsdem__mac_face(&s->mac, a, i, j, k), g = f + s->fstep[a][a];
                     if (s->sopen[a][f] > 0 || s->sopen[a][g] > 0) any_open = 1;
                     if (s->sopen[a][f] < 1 || s->sopen[a][g] < 1) any_cut = 1;
                 }
@@ -9502,9 +9564,9 @@ static void fsdem__pic_static_flags(fsdem_pic *s) {
                         for (di = -1; di <= 1; ++di) {
                             int x = i + di, y = j + dj, z = k + dk;
                             if (x < 0 || y < 0 || z < 0 || x >= s->n[0] || y >= s->n[1] || z >= s->n[2]) continue;
-                            if (s->ctmp[fsdem__pic_cell(s, x, y, z)] > 0) near = 1;
+                            if (s->ctmp[fsdem__mac_cell(&s->mac, x, y, z)] > 0) near = 1;
                         }
-                s->cnear[fsdem__pic_cell(s, i, j, k)] = (unsigned char)near;
+                s->cnear[fsdem__mac_cell(&s->mac, i, j, k)] = (unsigned char)near;
             }
 }
 
@@ -9528,7 +9590,7 @@ static void fsdem__pic_compute_fref(fsdem_pic *s) {
     for (k = 0; k < s->n[2]; ++k)
         for (j = 0; j < s->n[1]; ++j)
             for (i = 0; i < s->n[0]; ++i) {
-                c = fsdem__pic_cell(s, i, j, k);
+                c = fsdem__mac_cell(&s->mac, i, j, k);
                 if (s->csolid[c]) {
                     s->fref[c] = 0;
                     continue;
@@ -9539,7 +9601,7 @@ static void fsdem__pic_compute_fref(fsdem_pic *s) {
                 } else {
                     /* sites at offsets (q + 1/2) h from the lower corner of the 2-cell-wide support
                        [centre - dx, centre + dx] (lattice: h = dx / sub; sampling: h = 2 dx / 8) */
-                    fsdem_vec3 cc = fsdem__pic_cell_pos(s, i, j, k);
+                    fsdem_vec3 cc = fsdem__mac_cell_pos(&s->mac, i, j, k);
                     fsdem_real h = s->sub ? s->dx / (fsdem_real)S : 2 * s->dx / (fsdem_real)S, lo_off;
                     int per = s->sub ? 2 * S + 1 : S; /* lattice: the sites of the 3 cells that the kernel reaches */
                     double sum = 0, wsum = 0;
@@ -9699,7 +9761,7 @@ fsdem_result fsdem_pic_add_obstacle(fsdem_pic *s, const fsdem_pic_obstacle *ob, 
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_add_obstacle: obstacle %d (sdf): NULL callback", s->obst_count);
         for (i = 0; i < s->ncell; ++i) {
             /* a distance that is not a number would be ignored silently by the union below */
-            const fsdem_vec3 c = fsdem__pic_cell_pos(s, i % s->n[0], i / s->n[0] % s->n[1], i / (s->n[0] * s->n[1]));
+            const fsdem_vec3 c = fsdem__mac_cell_pos(&s->mac, i % s->n[0], i / s->n[0] % s->n[1], i / (s->n[0] * s->n[1]));
             fsdem_vec3 nrm;
             const fsdem_real dist = ob->sdf(ob->sdf_user, c, &nrm);
             if (!fsdem__finite(dist))
@@ -9855,23 +9917,13 @@ static void fsdem__pic_remove_marked(fsdem_pic *s) {
     s->cells_fresh = 0;
 }
 
-static int fsdem__pic_coord(const fsdem_pic *s, fsdem_real x, int axis) {
-    fsdem_real t = (x - fsdem__comp(s->lo, axis)) * s->inv_dx;
-    if (!(t > 0)) return 0; /* also NaN */
-    return t < (fsdem_real)s->n[axis] ? (int)t : s->n[axis] - 1;
-}
-
-static int fsdem__pic_cell_of(const fsdem_pic *s, fsdem_vec3 p) {
-    return fsdem__pic_cell(s, fsdem__pic_coord(s, p.x, 0), fsdem__pic_coord(s, p.y, 1),
-                           s->dim == 3 ? fsdem__pic_coord(s, p.z, 2) : 0);
-}
 
 /* Is p a valid place for a particle: inside the grid box and outside the obstacles. */
 static int fsdem__pic_open_at(const fsdem_pic *s, fsdem_vec3 p) {
     int b;
     for (b = 0; b < s->dim; ++b)
         if (!(fsdem__comp(p, b) > fsdem__comp(s->lo, b) && fsdem__comp(p, b) < fsdem__comp(s->hi, b))) return 0;
-    if (s->cnear[fsdem__pic_cell_of(s, p)] && fsdem__pic_obst_min(s, p, NULL) <= 0) return 0;
+    if (s->cnear[fsdem__mac_cell_of(&s->mac, p)] && fsdem__pic_obst_min(s, p, NULL) <= 0) return 0;
     return 1;
 }
 
@@ -9910,8 +9962,8 @@ static fsdem_result fsdem__pic_fill(fsdem_pic *s, fsdem_vec3 lo, fsdem_vec3 hi, 
             c1[b] = 0;
             continue;
         }
-        c0[b] = fsdem__pic_coord(s, fsdem__comp(lo, b), b);
-        c1[b] = fsdem__pic_coord(s, fsdem__comp(hi, b), b);
+        c0[b] = fsdem__mac_coord(&s->mac, fsdem__comp(lo, b), b);
+        c1[b] = fsdem__mac_coord(&s->mac, fsdem__comp(hi, b), b);
         cells *= c1[b] - c0[b] + 1;
     }
     if (fsdem__pic_make_room(s, (long)s->np + cells * s->ppc) != FSDEM_OK)
@@ -9920,7 +9972,7 @@ static fsdem_result fsdem__pic_fill(fsdem_pic *s, fsdem_vec3 lo, fsdem_vec3 hi, 
     for (k = c0[2]; k <= c1[2]; ++k)
         for (j = c0[1]; j <= c1[1]; ++j)
             for (i = c0[0]; i <= c1[0]; ++i) {
-                if (s->csolid[fsdem__pic_cell(s, i, j, k)]) continue;
+                if (s->csolid[fsdem__mac_cell(&s->mac, i, j, k)]) continue;
                 for (q = 0; q < s->ppc; ++q) {
                     fsdem_vec3 p = fsdem__pic_seed_pos(s, i, j, k, q);
                     int inside = 1;
@@ -9954,8 +10006,8 @@ fsdem_result fsdem_pic_fill_box(fsdem_pic *s, fsdem_vec3 lo, fsdem_vec3 hi, fsde
     for (b = 0; b < s->dim; ++b) {
         if (!(fsdem__comp(hi, b) > fsdem__comp(lo, b)))
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_box: hi.%c must exceed lo.%c", "xyz"[b], "xyz"[b]);
-        if (fsdem__comp(lo, b) < fsdem__comp(s->lo, b)) lo = fsdem__pic_axis_shift(lo, b, fsdem__comp(s->lo, b) - fsdem__comp(lo, b));
-        if (fsdem__comp(hi, b) > fsdem__comp(s->hi, b)) hi = fsdem__pic_axis_shift(hi, b, fsdem__comp(s->hi, b) - fsdem__comp(hi, b));
+        if (fsdem__comp(lo, b) < fsdem__comp(s->lo, b)) lo = fsdem__axis_shift(lo, b, fsdem__comp(s->lo, b) - fsdem__comp(lo, b));
+        if (fsdem__comp(hi, b) > fsdem__comp(s->hi, b)) hi = fsdem__axis_shift(hi, b, fsdem__comp(s->hi, b) - fsdem__comp(hi, b));
         if (!(fsdem__comp(hi, b) > fsdem__comp(lo, b)))
             return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_fill_box: the box is outside the domain along %c",
                                "xyz"[b]);
@@ -10083,7 +10135,7 @@ static void fsdem__pic_p2g(fsdem_pic *s) {
                         fsdem_real w = w12 * kw.w[0][q0], v = va;
                         f = row + i;
                         if (ca) {
-                            fsdem_vec3 xf = fsdem__pic_face_pos(s, a, i, j, k);
+                            fsdem_vec3 xf = fsdem__mac_face_pos(&s->mac, a, i, j, k);
                             v += fsdem__dot(ca[p], fsdem__sub(xf, x));
                         }
                         m[f] += w;
@@ -10127,7 +10179,7 @@ static int fsdem__pic_g2p(fsdem_pic *s) {
                         if (ratio > 0) flip += w * du[f];
                         if (apic) {
                             if (quad) {
-                                fsdem_vec3 d = fsdem__sub(fsdem__pic_face_pos(s, a, i, j, k), x);
+                                fsdem_vec3 d = fsdem__sub(fsdem__mac_face_pos(&s->mac, a, i, j, k), x);
                                 c[0] += w * u[f] * d.x * dfac;
                                 c[1] += w * u[f] * d.y * dfac;
                                 c[2] += w * u[f] * d.z * dfac;
@@ -10171,7 +10223,7 @@ static void fsdem__pic_effective_faces(fsdem_pic *s) {
         for (k = 0; k < s->fn[a][2]; ++k)
             for (j = 0; j < s->fn[a][1]; ++j)
                 for (i = 0; i < s->fn[a][0]; ++i) {
-                    int f = fsdem__pic_face(s, a, i, j, k), coord = a == 0 ? i : a == 1 ? j : k;
+                    int f = fsdem__mac_face(&s->mac, a, i, j, k), coord = a == 0 ? i : a == 1 ? j : k;
                     fsdem_real so = s->sopen[a][f], co = s->copen[a][f];
                     if (co < 0) co = 0;
                     if (co > 1) co = 1;
@@ -10216,7 +10268,7 @@ static void fsdem__pic_fraction(fsdem_pic *s) {
                 for (q0 = 0; q0 < kw.count[0]; ++q0) {
                     int i = kw.lo[0] + q0;
                     if (i < 0 || i >= s->n[0]) continue;
-                    s->frac[fsdem__pic_cell(s, i, j, k)] += kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2];
+                    s->frac[fsdem__mac_cell(&s->mac, i, j, k)] += kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2];
                 }
             }
         }
@@ -10240,7 +10292,7 @@ static void fsdem__pic_fraction(fsdem_pic *s) {
                 for (i = 0; i < s->n[0]; ++i) {
                     fsdem_real sum = 0;
                     int cnt = 0;
-                    c = fsdem__pic_cell(s, i, j, k);
+                    c = fsdem__mac_cell(&s->mac, i, j, k);
                     if (!fsdem__pic_mostly_solid(s, c)) continue;
                     coord[0] = i;
                     coord[1] = j;
@@ -10273,9 +10325,9 @@ static int fsdem__pic_types(fsdem_pic *s) {
         for (j = 0; j < s->n[1]; ++j)
             for (i = 0; i < s->n[0]; ++i) {
                 int open = 0;
-                c = fsdem__pic_cell(s, i, j, k);
+                c = fsdem__mac_cell(&s->mac, i, j, k);
                 for (a = 0; a < s->dim && !open; ++a) {
-                    int f = fsdem__pic_face(s, a, i, j, k);
+                    int f = fsdem__mac_face(&s->mac, a, i, j, k);
                     if (s->E[a][f] > 0 || s->E[a][f + s->fstep[a][a]] > 0) open = 1;
                 }
                 if (!open) s->ctype[c] = FSDEM_STENCIL_CELL_SOLID;
@@ -10454,7 +10506,7 @@ static fsdem_result fsdem__pic_viscosity(fsdem_pic *s, fsdem_real dt) {
                 for (i = 0; i < fn[0]; ++i) {
                     int f = (kk * fn[1] + j) * fn[0] + i, coord = a == 0 ? i : a == 1 ? j : kk, fluid = 0;
                     if (s->E[a][f] > 0) {
-                        int cidx = fsdem__pic_cell(s, i < s->n[0] ? i : s->n[0] - 1, j < s->n[1] ? j : s->n[1] - 1,
+                        int cidx = fsdem__mac_cell(&s->mac, i < s->n[0] ? i : s->n[0] - 1, j < s->n[1] ? j : s->n[1] - 1,
                                                    kk < s->n[2] ? kk : s->n[2] - 1);
                         if (coord < s->n[a] && s->ctype[cidx] == FSDEM_STENCIL_CELL_FLUID) fluid = 1;
                         if (coord > 0 && s->ctype[cidx - (coord < s->n[a] ? s->cstep[a] : 0)] == FSDEM_STENCIL_CELL_FLUID) fluid = 1;
@@ -10539,7 +10591,7 @@ static void fsdem__pic_ghost_diag(fsdem_pic *s) {
         for (j = 0; j < s->n[1]; ++j)
             for (i = 0; i < s->n[0]; ++i) {
                 fsdem_real d = 0;
-                c = fsdem__pic_cell(s, i, j, k);
+                c = fsdem__mac_cell(&s->mac, i, j, k);
                 if (s->ctype[c] != FSDEM_STENCIL_CELL_FLUID) {
                     s->diag[c] = 0;
                     continue;
@@ -10549,7 +10601,7 @@ static void fsdem__pic_ghost_diag(fsdem_pic *s) {
                 coord[2] = k;
                 for (a = 0; a < s->dim; ++a)
                     for (sg = 0; sg < 2; ++sg) {
-                        int f = fsdem__pic_face(s, a, i, j, k) + sg * s->fstep[a][a], nc = coord[a] + (sg ? 1 : -1);
+                        int f = fsdem__mac_face(&s->mac, a, i, j, k) + sg * s->fstep[a][a], nc = coord[a] + (sg ? 1 : -1);
                         fsdem_real e = s->E[a][f];
                         if (e <= 0) continue;
                         if (nc < 0 || nc >= s->n[a]) {
@@ -10589,7 +10641,7 @@ static fsdem_real fsdem__pic_divergence(const fsdem_pic *s, fsdem_real *const u[
     fsdem_real sum = 0;
     int a;
     for (a = 0; a < s->dim; ++a) {
-        int f = fsdem__pic_face(s, a, i, j, k), g = f + s->fstep[a][a];
+        int f = fsdem__mac_face(&s->mac, a, i, j, k), g = f + s->fstep[a][a];
         sum += s->E[a][g] * u[a][g] + (1 - s->E[a][g]) * s->us[a][g];
         sum -= s->E[a][f] * u[a][f] + (1 - s->E[a][f]) * s->us[a][f];
     }
@@ -10618,13 +10670,13 @@ static void fsdem__pic_apply_grad(fsdem_pic *s, const fsdem_real *q, fsdem_real 
         for (k = 0; k < s->fn[a][2]; ++k)
             for (j = 0; j < s->fn[a][1]; ++j)
                 for (i = 0; i < s->fn[a][0]; ++i) {
-                    int f = fsdem__pic_face(s, a, i, j, k), coord = a == 0 ? i : a == 1 ? j : k, ok;
+                    int f = fsdem__mac_face(&s->mac, a, i, j, k), coord = a == 0 ? i : a == 1 ? j : k, ok;
                     int cu = -1, cl = -1;
                     fsdem_real g;
                     s->fvalid[a][f] = 0;
                     if (s->E[a][f] <= 0) continue;
-                    if (coord < s->n[a]) cu = fsdem__pic_cell(s, i, j, k);
-                    if (coord > 0) cl = fsdem__pic_cell(s, i - (a == 0), j - (a == 1), k - (a == 2));
+                    if (coord < s->n[a]) cu = fsdem__mac_cell(&s->mac, i, j, k);
+                    if (coord > 0) cl = fsdem__mac_cell(&s->mac, i - (a == 0), j - (a == 1), k - (a == 2));
                     g = fsdem__pic_face_grad(s, q, cl, cu, &ok);
                     if (!ok) continue;
                     out[a][f] -= scale * g;
@@ -10645,7 +10697,7 @@ static fsdem_result fsdem__pic_project(fsdem_pic *s, fsdem_real dt) {
     for (k = 0; k < s->n[2]; ++k)
         for (j = 0; j < s->n[1]; ++j)
             for (i = 0; i < s->n[0]; ++i) {
-                c = fsdem__pic_cell(s, i, j, k);
+                c = fsdem__mac_cell(&s->mac, i, j, k);
                 if (s->ctype[c] != FSDEM_STENCIL_CELL_FLUID) {
                     s->rhs[c] = 0;
                     s->pres[c] = 0;
@@ -10678,7 +10730,7 @@ static fsdem_result fsdem__pic_project(fsdem_pic *s, fsdem_real dt) {
     for (k = 0; k < s->n[2]; ++k)
         for (j = 0; j < s->n[1]; ++j)
             for (i = 0; i < s->n[0]; ++i) {
-                c = fsdem__pic_cell(s, i, j, k);
+                c = fsdem__mac_cell(&s->mac, i, j, k);
                 if (s->ctype[c] == FSDEM_STENCIL_CELL_FLUID) {
                     fsdem_real dv = (fsdem_real)fabs(fsdem__pic_divergence(s, s->u, i, j, k));
                     if (dv > dmax) dmax = dv;
@@ -10734,7 +10786,7 @@ static int fsdem__pic_constrain(fsdem_pic *s) {
             continue;
         }
         s->px[p] = fsdem_v3(xb[0], xb[1], xb[2]);
-        if (s->obst_count && s->cnear[fsdem__pic_cell_of(s, s->px[p])]) {
+        if (s->obst_count && s->cnear[fsdem__mac_cell_of(&s->mac, s->px[p])]) {
             for (it = 0; it < 3; ++it) {
                 fsdem_real d = fsdem__pic_obst_min(s, s->px[p], NULL);
                 fsdem_vec3 nrm;
@@ -10769,7 +10821,7 @@ static fsdem_result fsdem__pic_density_projection(fsdem_pic *s) {
             for (i = 0; i < s->n[0]; ++i) {
                 fsdem_real f, rr, ref;
                 int surface = 0, coord[3];
-                c = fsdem__pic_cell(s, i, j, k);
+                c = fsdem__mac_cell(&s->mac, i, j, k);
                 s->ctmp[c] = 0;
                 if (s->ctype[c] != FSDEM_STENCIL_CELL_FLUID) {
                     s->rhs[c] = 0;
@@ -10780,7 +10832,7 @@ static fsdem_result fsdem__pic_density_projection(fsdem_pic *s) {
                 coord[2] = k;
                 for (a = 0; a < s->dim; ++a)
                     for (sg = 0; sg < 2; ++sg) {
-                        int f = fsdem__pic_face(s, a, i, j, k) + sg * s->fstep[a][a], nc = coord[a] + (sg ? 1 : -1);
+                        int f = fsdem__mac_face(&s->mac, a, i, j, k) + sg * s->fstep[a][a], nc = coord[a] + (sg ? 1 : -1);
                         if (s->E[a][f] <= 0) continue;
                         if (nc < 0 || nc >= s->n[a] || s->ctype[c + (sg ? 1 : -1) * s->cstep[a]] == FSDEM_STENCIL_CELL_AIR)
                             surface = 1;
@@ -10830,7 +10882,7 @@ static void fsdem__pic_bin(fsdem_pic *s) {
     int p, c, sum = 0;
     memset(s->cstart, 0, sizeof(int) * (size_t)(s->ncell + 1));
     for (p = 0; p < s->np; ++p) {
-        c = fsdem__pic_cell_of(s, s->px[p]);
+        c = fsdem__mac_cell_of(&s->mac, s->px[p]);
         s->pcell[p] = c;
         s->cstart[c + 1]++;
     }
@@ -10909,7 +10961,7 @@ static int fsdem__pic_donor(fsdem_pic *s, int i, int j, int k, int *taken) {
             for (di = -1; di <= 1; ++di) {
                 int x = i + di, y = j + dj, z = k + dk, c, count;
                 if (x < 0 || y < 0 || z < 0 || x >= s->n[0] || y >= s->n[1] || z >= s->n[2]) continue;
-                c = fsdem__pic_cell(s, x, y, z);
+                c = fsdem__mac_cell(&s->mac, x, y, z);
                 count = s->cstart[c + 1] - s->cstart[c];
                 if (maxp > 0 && count > maxp) count = maxp; /* the rest is already removed */
                 count -= taken[c];
@@ -10952,7 +11004,7 @@ static int fsdem__pic_reseed(fsdem_pic *s) {
         for (j = 0; j < s->n[1]; ++j)
             for (i = 0; i < s->n[0]; ++i) {
                 int count, coord[3], interior = 1, inflow = -1;
-                c = fsdem__pic_cell(s, i, j, k);
+                c = fsdem__mac_cell(&s->mac, i, j, k);
                 count = s->cstart[c + 1] - s->cstart[c] - taken[c];
                 if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID || (maxp > 0 && count > maxp)) continue;
                 coord[0] = i;
@@ -11258,8 +11310,8 @@ static int fsdem__pic_fluid_cell(const fsdem_pic *s, int c) { return c >= 0 && s
 /* The cells below (lower index along a) and above face (i, j, k) of axis a; -1 off the grid. */
 static void fsdem__pic_face_cells(const fsdem_pic *s, int a, const int f3[3], int *below, int *above) {
     const int coord = f3[a];
-    *above = coord < s->n[a] ? fsdem__pic_cell(s, f3[0], f3[1], f3[2]) : -1;
-    *below = coord > 0 ? fsdem__pic_cell(s, f3[0] - (a == 0), f3[1] - (a == 1), f3[2] - (a == 2)) : -1;
+    *above = coord < s->n[a] ? fsdem__mac_cell(&s->mac, f3[0], f3[1], f3[2]) : -1;
+    *below = coord > 0 ? fsdem__mac_cell(&s->mac, f3[0] - (a == 0), f3[1] - (a == 1), f3[2] - (a == 2)) : -1;
 }
 
 fsdem_result fsdem_pic_sample(const fsdem_pic *s, int count, const fsdem_vec3 *points, fsdem_fluid_sample *out) {
@@ -11303,7 +11355,7 @@ fsdem_result fsdem_pic_sample(const fsdem_pic *s, int count, const fsdem_vec3 *p
         for (q2 = 0; q2 < kw.count[2]; ++q2)
             for (q1 = 0; q1 < kw.count[1]; ++q1)
                 for (q0 = 0; q0 < kw.count[0]; ++q0) {
-                    const int c = fsdem__pic_cell(s, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2]);
+                    const int c = fsdem__mac_cell(&s->mac, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2]);
                     fsdem_real f = s->desc.free_surface ? (fsdem_real)0.5 - s->phi[c] * s->inv_dx : 1;
                     if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID) f = 0;
                     frac += kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2] * (f < 0 ? 0 : f > 1 ? 1 : f);
@@ -11330,8 +11382,8 @@ static fsdem_real fsdem__pic_spread(fsdem_pic *s, int a, fsdem_vec3 point, fsdem
     for (f3[2] = lo[2]; f3[2] <= hi[2]; ++f3[2])
         for (f3[1] = lo[1]; f3[1] <= hi[1]; ++f3[1])
             for (f3[0] = lo[0]; f3[0] <= hi[0]; ++f3[0]) {
-                const int f = fsdem__pic_face(s, a, f3[0], f3[1], f3[2]);
-                fsdem_vec3 xf = fsdem__pic_face_pos(s, a, f3[0], f3[1], f3[2]);
+                const int f = fsdem__mac_face(&s->mac, a, f3[0], f3[1], f3[2]);
+                fsdem_vec3 xf = fsdem__mac_face_pos(&s->mac, a, f3[0], f3[1], f3[2]);
                 fsdem_real w = 1;
                 int below, above;
                 fsdem__pic_face_cells(s, a, f3, &below, &above);
@@ -11451,12 +11503,12 @@ static fsdem_real fsdem__pic_level(const fsdem_pic *s, fsdem_vec3 p) {
     for (k = top; k >= 0 && k < s->n[u]; k += step) {
         int c, above;
         c3[u] = k;
-        c = fsdem__pic_cell(s, c3[0], c3[1], c3[2]);
+        c = fsdem__mac_cell(&s->mac, c3[0], c3[1], c3[2]);
         if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID || !(s->phi[c] < 0)) continue;
         /* the centre of cell c is in water; the surface is where phi crosses 0 towards the cell above */
         if (k == top) return up > 0 ? fsdem__comp(s->hi, u) : fsdem__comp(s->lo, u);
         c3[u] = k - step;
-        above = fsdem__pic_cell(s, c3[0], c3[1], c3[2]);
+        above = fsdem__mac_cell(&s->mac, c3[0], c3[1], c3[2]);
         c3[u] = k;
         {
             const fsdem_real centre = fsdem__comp(s->lo, u) + ((fsdem_real)k + (fsdem_real)0.5) * s->dx;
@@ -11475,7 +11527,7 @@ static fsdem_real fsdem__pic_pressure_at(const fsdem_pic *s, fsdem_vec3 p, fsdem
     int b, q0, q1, q2, count = 0, c;
     if (radius > 0) {
         for (c = 0; c < s->ncell; ++c) {
-            const fsdem_vec3 x = fsdem__pic_cell_pos(s, c % s->n[0], c / s->n[0] % s->n[1], c / (s->n[0] * s->n[1]));
+            const fsdem_vec3 x = fsdem__mac_cell_pos(&s->mac, c % s->n[0], c / s->n[0] % s->n[1], c / (s->n[0] * s->n[1]));
             if (s->ctype[c] == FSDEM_STENCIL_CELL_SOLID || fsdem__norm(fsdem__sub(x, p)) > radius) continue;
             sum += s->pres[c];
             count++;
@@ -11492,7 +11544,7 @@ static fsdem_real fsdem__pic_pressure_at(const fsdem_pic *s, fsdem_vec3 p, fsdem
             for (q1 = 0; q1 < kw.count[1]; ++q1)
                 for (q0 = 0; q0 < kw.count[0]; ++q0)
                     sum += kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2] *
-                           s->pres[fsdem__pic_cell(s, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])];
+                           s->pres[fsdem__mac_cell(&s->mac, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])];
         return sum;
     }
 }
@@ -11544,7 +11596,7 @@ static fsdem_real fsdem__pic_open_volume(const fsdem_pic *s, int c) {
     int a, side;
     for (a = 0; a < s->dim; ++a)
         for (side = 0; side < 2; ++side) {
-            const int f = fsdem__pic_face(s, a, i, j, k) + side * s->fstep[a][a];
+            const int f = fsdem__mac_face(&s->mac, a, i, j, k) + side * s->fstep[a][a];
             const fsdem_real co = s->copen[a][f] < 0 ? 0 : s->copen[a][f] > 1 ? 1 : s->copen[a][f];
             sum += s->sopen[a][f] < co ? s->sopen[a][f] : co;
         }
@@ -11614,7 +11666,7 @@ static fsdem_vec3 fsdem__pic_cell_velocity(const fsdem_pic *s, int i, int j, int
     fsdem_real v[3] = {0, 0, 0};
     int a;
     for (a = 0; a < s->dim; ++a) {
-        int f = fsdem__pic_face(s, a, i, j, k);
+        int f = fsdem__mac_face(&s->mac, a, i, j, k);
         v[a] = (s->u[a][f] + s->u[a][f + s->fstep[a][a]]) / 2;
     }
     return fsdem_v3(v[0], v[1], v[2]);
@@ -11629,8 +11681,8 @@ fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *s, const char *path) {
     for (k = 0; k < s->n[2]; ++k)
         for (j = 0; j < s->n[1]; ++j)
             for (i = 0; i < s->n[0]; ++i) {
-                int c = fsdem__pic_cell(s, i, j, k);
-                fsdem_vec3 x = fsdem__pic_cell_pos(s, i, j, k), v = fsdem__pic_cell_velocity(s, i, j, k);
+                int c = fsdem__mac_cell(&s->mac, i, j, k);
+                fsdem_vec3 x = fsdem__mac_cell_pos(&s->mac, i, j, k), v = fsdem__pic_cell_velocity(s, i, j, k);
                 fprintf(fp, "%d,%d,%d,%.9g,%.9g,%.9g,%d,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", i, j, k, (double)x.x, (double)x.y,
                         (double)x.z, (int)s->ctype[c], (double)s->pres[c], (double)s->phi[c], (double)s->frac[c], (double)v.x,
                         (double)v.y, (double)v.z);
@@ -16643,9 +16695,12 @@ fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *c) {
    Contents: >>couple_pic_object (desc, creation, per-body storage), >>couple_pic_faces (bodies as
    moving cut-cell solids: face fractions, solid velocities, J, references), >>couple_pic_exchange
    (the implicit pressure term, fluid forces), >>couple_pic_gap (Eq. 20, particles out of bodies),
-   >>couple_pic_step (coupled time stepping). The coupler writes the PIC through its coupling
-   functions and cuts the faces with the PIC's own face-fraction routine (fsdem__pic_face_fraction),
-   so static obstacles and moving bodies are cut alike. */
+   >>couple_pic_step (coupled time stepping). The coupler speaks to the PIC through its public
+   calls only: it indexes the grid through its own MAC layout (fsdem__mac, built from
+   fsdem_pic_get_fields), writes the coupling arrays (fsdem_pic_get_coupling: the coupler owns open,
+   solid_velocity, start_velocity and reference, and resets them at every cut) and cuts the faces
+   with the cut-cell sampler of >>geom that the PIC cuts its obstacles with, so static obstacles and
+   moving bodies are cut alike. */
 
 /* ---- >>couple_pic_object : desc, creation, per-body storage ---- */
 
@@ -16665,6 +16720,8 @@ struct fsdem_pic_dem {
     fsdem_real rho, nu;            /* liquid density, kinematic viscosity */
     fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC works per metre), 1 in 3D */
     fsdem_vec3 gravity;            /* m/s^2 */
+    fsdem__mac grid;               /* the PIC's layout, from fsdem_pic_get_fields */
+    unsigned char side_closed[6];  /* the PIC's domain sides that are walls (not outflow) */
     /* per body (DEM particle), `bodies` of them */
     int bodies, body_cap;
     int *body_id;        /* stable DEM id of each body of the last step */
@@ -16804,7 +16861,7 @@ static fsdem_result fsdem__pic_dem_reserve_bodies(fsdem_pic_dem *c, int n) {
 }
 
 static void fsdem__pic_dem_release(fsdem_pic_dem *c) {
-    const int ncell = c->desc.pic->ncell;
+    const int ncell = c->grid.ncell;
     fsdem__pic_dem_free_bodies(c);
     fsdem__free(&c->allocator, c->face, sizeof(int) * (size_t)c->face_cap);
     fsdem__free(&c->allocator, c->face_axis, (size_t)c->face_cap);
@@ -16852,7 +16909,12 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
     c->gravity = pd.gravity;
     c->depth = pd.dim == 2 ? fsdem_dem_get_desc(desc->dem).disc_length : 1;
     if (!(desc->contact_length > 0)) c->desc.contact_length = 4 * pd.cell_size; /* seed 000 §2.2.2 */
-    ncell = desc->pic->ncell;
+    {
+        const fsdem_pic_fields g = fsdem_pic_get_fields(desc->pic);
+        fsdem__mac_init(&c->grid, g.dim, g.n, g.cell_size, g.origin);
+    }
+    for (i = 0; i < 6; ++i) c->side_closed[i] = (unsigned char)(pd.boundary[i] != FSDEM_PIC_BC_OUTFLOW);
+    ncell = c->grid.ncell;
     if (fsdem__dem_particles_fit(desc->dem, pd.domain_min, pd.domain_max, &c->status, "fsdem_pic_dem_create") != FSDEM_OK) {
         if (desc->log) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, c->status.message);
         fsdem__free(&al, c, sizeof *c);
@@ -16900,7 +16962,7 @@ fsdem_pic_dem_desc fsdem_pic_dem_get_desc(const fsdem_pic_dem *c) {
 
 /* ---- >>couple_pic_faces : bodies as moving cut-cell solids ---- */
 
-/* A disc or sphere as a fsdem__pic_dist_fn. */
+/* A disc or sphere as a fsdem__geom_dist_fn. */
 typedef struct fsdem__pic_dem_ball {
     fsdem_vec3 centre;
     fsdem_real radius;
@@ -16913,19 +16975,20 @@ static fsdem_real fsdem__pic_dem_ball_dist(const void *solid, fsdem_vec3 p) {
 
 /* Index range [*lo, *hi] along axis q of the grid points at lo_q + (i + off) dx that lie within
    [x0, x1], clamped to 0 .. count - 1 (empty when *lo > *hi). */
-static void fsdem__pic_dem_range(const fsdem_pic *s, int q, fsdem_real off, fsdem_real x0, fsdem_real x1, int count, int *lo, int *hi) {
-    const fsdem_real o = fsdem__comp(s->lo, q);
-    double a = ceil((double)((x0 - o) * s->inv_dx - off)), b = floor((double)((x1 - o) * s->inv_dx - off));
+static void fsdem__pic_dem_range(const fsdem__mac *grid, int q, fsdem_real off, fsdem_real x0, fsdem_real x1, int count, int *lo, int *hi) {
+    const fsdem_real o = fsdem__comp(grid->lo, q);
+    double a = ceil((double)((x0 - o) * grid->inv_dx - off)), b = floor((double)((x1 - o) * grid->inv_dx - off));
     *lo = a < 0 ? 0 : a > count ? count : (int)a;
     *hi = b >= count ? count - 1 : b < -1 ? -1 : (int)b;
 }
 
 /* The centre of face entry e relative to `centre` (m). */
 static fsdem_vec3 fsdem__pic_dem_arm(const fsdem_pic_dem *c, int e, fsdem_vec3 centre) {
-    const fsdem_pic *s = c->desc.pic;
+    const fsdem__mac *grid = &c->grid;
     const int a = c->face_axis[e], f = c->face[e];
-    const int i = f % s->fn[a][0], j = f / s->fn[a][0] % s->fn[a][1], k = f / (s->fn[a][0] * s->fn[a][1]);
-    return fsdem__sub(fsdem__pic_face_pos(s, a, i, j, k), centre);
+    int idx[3];
+    fsdem__mac_face_coords(grid, a, f, idx);
+    return fsdem__sub(fsdem__mac_face_pos(grid, a, idx[0], idx[1], idx[2]), centre);
 }
 
 /* Adds `v`, `w` to cell `cell`'s entry of the J of the body being cut (entries from `first`). */
@@ -16967,28 +17030,28 @@ static void fsdem__pic_dem_clear_faces(fsdem_pic_dem *c) {
         memset(cp.solid_velocity[a], 0, sizeof(fsdem_real) * (size_t)cp.face_count[a]);
         memset(cp.start_velocity[a], 0, sizeof(fsdem_real) * (size_t)cp.face_count[a]);
     }
-    for (e = 0; e < c->desc.pic->ncell; ++e) cp.reference[e] = 1;
+    for (e = 0; e < c->grid.ncell; ++e) cp.reference[e] = 1;
     c->face_count = 0;
 }
 
 /* Part of the fluid-fraction kernel of cell (i, j, k) (the tent over the 2^dim cells around its
-   centre) outside the ball, sampled on 4 points per axis (fsdem__pic_compute_fref samples the
-   static obstacles alike). */
-static fsdem_real fsdem__pic_dem_kernel_open(const fsdem_pic *s, const fsdem__pic_dem_ball *ball, int i, int j, int k) {
+   centre) outside the ball, sampled on 4 points per axis (the PIC samples its static obstacles'
+   reference alike). */
+static fsdem_real fsdem__pic_dem_kernel_open(const fsdem__mac *grid, const fsdem__pic_dem_ball *ball, int i, int j, int k) {
     const int S = 4;
-    const fsdem_vec3 cc = fsdem__pic_cell_pos(s, i, j, k);
-    const fsdem_real h = 2 * s->dx / (fsdem_real)S;
+    const fsdem_vec3 cc = fsdem__mac_cell_pos(grid, i, j, k);
+    const fsdem_real h = 2 * grid->dx / (fsdem_real)S;
     fsdem_real open = 0, all = 0;
     int q[3], m;
-    for (q[2] = 0; q[2] < (s->dim == 3 ? S : 1); ++q[2])
+    for (q[2] = 0; q[2] < (grid->dim == 3 ? S : 1); ++q[2])
         for (q[1] = 0; q[1] < S; ++q[1])
             for (q[0] = 0; q[0] < S; ++q[0]) {
                 fsdem_vec3 p = cc;
                 fsdem_real w = 1;
-                for (m = 0; m < s->dim; ++m) {
-                    const fsdem_real off = -s->dx + h * ((fsdem_real)q[m] + (fsdem_real)0.5);
-                    w *= 1 - (fsdem_real)fabs(off) * s->inv_dx;
-                    p = fsdem__pic_axis_shift(p, m, off);
+                for (m = 0; m < grid->dim; ++m) {
+                    const fsdem_real off = -grid->dx + h * ((fsdem_real)q[m] + (fsdem_real)0.5);
+                    w *= 1 - (fsdem_real)fabs(off) * grid->inv_dx;
+                    p = fsdem__axis_shift(p, m, off);
                 }
                 all += w;
                 if (fsdem__pic_dem_ball_dist(ball, p) > 0) open += w;
@@ -16999,34 +17062,34 @@ static fsdem_real fsdem__pic_dem_kernel_open(const fsdem_pic *s, const fsdem__pi
 /* Cuts body b (step 2 of >>couple_pic): its faces (their closed parts, summed into the PIC's open
    fractions as pending negative values) and its references. */
 static fsdem_result fsdem__pic_dem_cut(fsdem_pic_dem *c, int b, fsdem_vec3 centre, fsdem_real radius) {
-    fsdem_pic *s = c->desc.pic;
-    fsdem_pic_coupling cp = fsdem_pic_get_coupling(s);
+    const fsdem__mac *grid = &c->grid;
+    fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
     const fsdem__pic_dem_ball ball = {centre, radius};
-    const fsdem_real reach = s->dx * (s->dim == 3 ? (fsdem_real)0.7072 : (fsdem_real)0.5001), margin = radius + s->dx;
+    const fsdem_real reach = grid->dx * (grid->dim == 3 ? (fsdem_real)0.7072 : (fsdem_real)0.5001), margin = radius + grid->dx;
     int a, q, lo[3], hi[3], idx[3];
     c->face_start[b] = c->face_count;
-    for (a = 0; a < s->dim; ++a) {
+    for (a = 0; a < grid->dim; ++a) {
         for (q = 0; q < 3; ++q) {
-            if (q < s->dim)
-                fsdem__pic_dem_range(s, q, q == a ? 0 : (fsdem_real)0.5, fsdem__comp(centre, q) - margin, fsdem__comp(centre, q) + margin,
-                                     s->fn[a][q], &lo[q], &hi[q]);
+            if (q < grid->dim)
+                fsdem__pic_dem_range(grid, q, q == a ? 0 : (fsdem_real)0.5, fsdem__comp(centre, q) - margin, fsdem__comp(centre, q) + margin,
+                                     grid->fn[a][q], &lo[q], &hi[q]);
             else lo[q] = hi[q] = 0;
         }
         for (idx[2] = lo[2]; idx[2] <= hi[2]; ++idx[2])
             for (idx[1] = lo[1]; idx[1] <= hi[1]; ++idx[1])
                 for (idx[0] = lo[0]; idx[0] <= hi[0]; ++idx[0]) {
-                    const int f = fsdem__pic_face(s, a, idx[0], idx[1], idx[2]), coord = idx[a];
-                    const fsdem_vec3 pf = fsdem__pic_face_pos(s, a, idx[0], idx[1], idx[2]), arm = fsdem__sub(pf, centre);
+                    const int f = fsdem__mac_face(grid, a, idx[0], idx[1], idx[2]), coord = idx[a];
+                    const fsdem_vec3 pf = fsdem__mac_face_pos(grid, a, idx[0], idx[1], idx[2]), arm = fsdem__sub(pf, centre);
                     const fsdem_real d = fsdem__norm(arm) - radius;
                     fsdem_real closed, *open = &cp.open[a][f];
                     if (d > reach) continue;
                     /* the domain's closed sides keep E = 0 and their own velocity (>>pic_cells) */
-                    if ((coord == 0 || coord == s->n[a]) && fsdem__pic_side_closed(s, 2 * a + (coord != 0))) continue;
+                    if ((coord == 0 || coord == grid->n[a]) && c->side_closed[2 * a + (coord != 0)]) continue;
                     if (d < -reach) closed = 1;
                     else {
-                        fsdem_vec3 corner = fsdem__pic_axis_shift(pf, (a + 1) % s->dim, -s->dx / 2);
-                        if (s->dim == 3) corner = fsdem__pic_axis_shift(corner, (a + 2) % 3, -s->dx / 2);
-                        closed = 1 - fsdem__pic_face_fraction(s, a, corner, fsdem__pic_dem_ball_dist, &ball);
+                        fsdem_vec3 corner = fsdem__axis_shift(pf, (a + 1) % grid->dim, -grid->dx / 2);
+                        if (grid->dim == 3) corner = fsdem__axis_shift(corner, (a + 2) % 3, -grid->dx / 2);
+                        closed = 1 - fsdem__geom_face_fraction(grid->dim, a, corner, grid->dx, grid->surface_tol, fsdem__pic_dem_ball_dist, &ball);
                     }
                     if (!(closed > 0)) continue;
                     if (fsdem__pic_dem_face_add(c, a, f, closed) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
@@ -17035,14 +17098,14 @@ static fsdem_result fsdem__pic_dem_cut(fsdem_pic_dem *c, int b, fsdem_vec3 centr
     }
     /* references of the cells whose kernel the body reaches */
     for (q = 0; q < 3; ++q) {
-        if (q < s->dim) fsdem__pic_dem_range(s, q, (fsdem_real)0.5, fsdem__comp(centre, q) - margin, fsdem__comp(centre, q) + margin, s->n[q], &lo[q], &hi[q]);
+        if (q < grid->dim) fsdem__pic_dem_range(grid, q, (fsdem_real)0.5, fsdem__comp(centre, q) - margin, fsdem__comp(centre, q) + margin, grid->n[q], &lo[q], &hi[q]);
         else lo[q] = hi[q] = 0;
     }
     for (idx[2] = lo[2]; idx[2] <= hi[2]; ++idx[2])
         for (idx[1] = lo[1]; idx[1] <= hi[1]; ++idx[1])
             for (idx[0] = lo[0]; idx[0] <= hi[0]; ++idx[0]) {
-                const int cell = fsdem__pic_cell(s, idx[0], idx[1], idx[2]);
-                const fsdem_real open = fsdem__pic_dem_kernel_open(s, &ball, idx[0], idx[1], idx[2]);
+                const int cell = fsdem__mac_cell(grid, idx[0], idx[1], idx[2]);
+                const fsdem_real open = fsdem__pic_dem_kernel_open(grid, &ball, idx[0], idx[1], idx[2]);
                 if (open < 1) cp.reference[cell] *= open; /* bodies do not overlap: their parts multiply */
             }
     return FSDEM_OK;
@@ -17051,24 +17114,22 @@ static fsdem_result fsdem__pic_dem_cut(fsdem_pic_dem *c, int b, fsdem_vec3 centr
 /* J of body b (step 3 of >>couple_pic) from the final closed parts of its faces: each face is the
    upper face of the cell below it (s = +1) and the lower face of the cell above it (s = -1). */
 static fsdem_result fsdem__pic_dem_jacobian(fsdem_pic_dem *c, int b, fsdem_vec3 centre) {
-    const fsdem_pic *s = c->desc.pic;
+    const fsdem__mac *grid = &c->grid;
     int e, idx[3];
     c->jac_start[b] = c->jac_count;
     for (e = c->face_start[b]; e < c->face_start[b + 1]; ++e) {
         const int a = c->face_axis[e], f = c->face[e];
-        fsdem_vec3 ea = fsdem__pic_axis_shift(fsdem__zero3(), a, c->face_closed[e]), arm, w;
+        fsdem_vec3 ea = fsdem__axis_shift(fsdem__zero3(), a, c->face_closed[e]), arm, w;
         int coord;
-        idx[0] = f % s->fn[a][0];
-        idx[1] = f / s->fn[a][0] % s->fn[a][1];
-        idx[2] = f / (s->fn[a][0] * s->fn[a][1]);
+        fsdem__mac_face_coords(grid, a, f, idx);
         coord = idx[a];
-        arm = fsdem__sub(fsdem__pic_face_pos(s, a, idx[0], idx[1], idx[2]), centre);
+        arm = fsdem__sub(fsdem__mac_face_pos(grid, a, idx[0], idx[1], idx[2]), centre);
         w = fsdem__cross(arm, ea);
         if (coord > 0 &&
-            fsdem__pic_dem_jac_add(c, fsdem__pic_cell(s, idx[0] - (a == 0), idx[1] - (a == 1), idx[2] - (a == 2)), ea, w) != FSDEM_OK)
+            fsdem__pic_dem_jac_add(c, fsdem__mac_cell(grid, idx[0] - (a == 0), idx[1] - (a == 1), idx[2] - (a == 2)), ea, w) != FSDEM_OK)
             return FSDEM_ERR_OUT_OF_MEMORY;
-        if (coord < s->n[a] &&
-            fsdem__pic_dem_jac_add(c, fsdem__pic_cell(s, idx[0], idx[1], idx[2]), fsdem__scale(ea, -1), fsdem__scale(w, -1)) != FSDEM_OK)
+        if (coord < grid->n[a] &&
+            fsdem__pic_dem_jac_add(c, fsdem__mac_cell(grid, idx[0], idx[1], idx[2]), fsdem__scale(ea, -1), fsdem__scale(w, -1)) != FSDEM_OK)
             return FSDEM_ERR_OUT_OF_MEMORY;
     }
     c->jac_start[b + 1] = c->jac_count;
@@ -17085,12 +17146,12 @@ static fsdem_result fsdem__pic_dem_jacobian(fsdem_pic_dem *c, int b, fsdem_vec3 
    cut into the PIC's coupling arrays, its volume as the faces see it, Q*, the solid velocities and
    J, then the viscous relaxation times. */
 static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
-    fsdem_pic *s = c->desc.pic;
-    fsdem_pic_coupling cp = fsdem_pic_get_coupling(s);
+    const fsdem__mac *grid = &c->grid;
+    fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     const fsdem_real inertia = c->dim == 3 ? (fsdem_real)0.4 : (fsdem_real)0.5; /* the DEM's spheres and discs */
-    const fsdem_real visc = c->rho * c->nu * (c->dim == 3 ? s->dx : 1);    /* >>pic_viscosity, per pair */
-    const fsdem_real cell = s->dx * s->dx * (s->dim == 3 ? s->dx : 1), g2 = fsdem__dot(c->gravity, c->gravity);
+    const fsdem_real visc = c->rho * c->nu * (c->dim == 3 ? grid->dx : 1);    /* >>pic_viscosity, per pair */
+    const fsdem_real cell = grid->dx * grid->dx * (grid->dim == 3 ? grid->dx : 1), g2 = fsdem__dot(c->gravity, c->gravity);
     int b, e, q;
     fsdem_result res;
     if ((res = fsdem__pic_dem_reserve_bodies(c, P.count)) != FSDEM_OK)
@@ -17170,13 +17231,15 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
         for (e = c->face_start[b]; e < c->face_start[b + 1]; ++e) {
             const int a = c->face_axis[e], f = c->face[e];
             if (cp.open[a][f] > 0) continue;
-            for (q = 0; q < s->dim; ++q) {
-                int coord = q == 0 ? f % s->fn[a][0] : q == 1 ? f / s->fn[a][0] % s->fn[a][1] : f / (s->fn[a][0] * s->fn[a][1]);
-                if (coord > 0 && cp.open[a][f - s->fstep[a][q]] > 0) pairs[a]++;
-                if (coord + 1 < s->fn[a][q] && cp.open[a][f + s->fstep[a][q]] > 0) pairs[a]++;
+            int idx[3];
+            fsdem__mac_face_coords(grid, a, f, idx);
+            for (q = 0; q < grid->dim; ++q) {
+                const int coord = idx[q];
+                if (coord > 0 && cp.open[a][f - grid->fstep[a][q]] > 0) pairs[a]++;
+                if (coord + 1 < grid->fn[a][q] && cp.open[a][f + grid->fstep[a][q]] > 0) pairs[a]++;
             }
         }
-        for (q = 0; q < s->dim; ++q)
+        for (q = 0; q < grid->dim; ++q)
             if (pairs[q] > most) most = pairs[q];
         c->relax[b] = 0;
         if (visc > 0 && most > 0 && c->inv_m[b] > 0) {
@@ -17196,9 +17259,9 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
 /* The accelerations M^-1 G, G = dx^(dim-1) J^T p over the FLUID cells, that the pressure p gives
    free body b (m/s^2, 1/s^2). */
 static void fsdem__pic_dem_accelerations(const fsdem_pic_dem *c, int b, const fsdem_real *p, fsdem_vec3 *acc, fsdem_vec3 *alpha) {
-    const fsdem_pic *s = c->desc.pic;
-    const unsigned char *type = s->ctype;
-    const fsdem_real area = s->dim == 3 ? s->dx * s->dx : s->dx;
+    const fsdem__mac *grid = &c->grid;
+    const unsigned char *type = fsdem_pic_get_fields(c->desc.pic).cell;
+    const fsdem_real area = grid->dim == 3 ? grid->dx * grid->dx : grid->dx;
     fsdem_vec3 G = fsdem__zero3(), T = fsdem__zero3();
     int e;
     for (e = c->jac_start[b]; e < c->jac_start[b + 1]; ++e) {
@@ -17214,10 +17277,10 @@ static void fsdem__pic_dem_accelerations(const fsdem_pic_dem *c, int b, const fs
 /* y += rho dx^dim J M^-1 J^T p over the FLUID cells (step 3 of >>couple_pic), per metre in 2D. */
 static void fsdem__pic_dem_operator(void *user, const fsdem_real *p, fsdem_real *y) {
     const fsdem_pic_dem *c = (const fsdem_pic_dem *)user;
-    const fsdem_pic *s = c->desc.pic;
-    const unsigned char *type = s->ctype;
+    const fsdem__mac *grid = &c->grid;
+    const unsigned char *type = fsdem_pic_get_fields(c->desc.pic).cell;
     /* with acc = M^-1 G the term is rho dx J . acc */
-    const fsdem_real k = c->rho * s->dx;
+    const fsdem_real k = c->rho * grid->dx;
     int b, e;
     for (b = 0; b < c->bodies; ++b) {
         fsdem_vec3 acc, alpha;
@@ -17255,12 +17318,12 @@ static void fsdem__pic_dem_response(void *user, const fsdem_real *p, fsdem_real 
 /* Step 4 of >>couple_pic after the PIC step: the pressure force G and the viscous force of every
    body from the step's pressure and shear, given to the DEM as held external loads. */
 static fsdem_result fsdem__pic_dem_loads(fsdem_pic_dem *c) {
-    const fsdem_pic *s = c->desc.pic;
+    const fsdem__mac *grid = &c->grid;
     fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
-    const fsdem_pic_fields g = fsdem_pic_get_fields(s);
+    const fsdem_pic_fields g = fsdem_pic_get_fields(c->desc.pic);
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
-    const fsdem_real area = s->dim == 3 ? s->dx * s->dx : s->dx;
+    const fsdem_real area = grid->dim == 3 ? grid->dx * grid->dx : grid->dx;
     int b, e;
     c->force_sum = fsdem__zero3();
     for (b = 0; b < c->bodies; ++b) {
@@ -17273,7 +17336,7 @@ static fsdem_result fsdem__pic_dem_loads(fsdem_pic_dem *c) {
             const int a = c->face_axis[e], f = c->face[e];
             const fsdem_real closed = 1 - cp.open[a][f], share = closed > c->face_closed[e] ? c->face_closed[e] / closed : 1;
             const fsdem_real v = cp.shear[a][f] * share;
-            const fsdem_vec3 force = fsdem__pic_axis_shift(fsdem__zero3(), a, v);
+            const fsdem_vec3 force = fsdem__axis_shift(fsdem__zero3(), a, v);
             if (v == 0) continue;
             F = fsdem__add(F, force);
             Tv = fsdem__add(Tv, fsdem__cross(fsdem__pic_dem_arm(c, e, P.position[b]), force));
@@ -17321,34 +17384,34 @@ fsdem_result fsdem_pic_dem_get_force(const fsdem_pic_dem *c, int index, fsdem_pi
 /* Builds the cell map of `count` boxes [centre_i - half_i, centre_i + half_i]. */
 static fsdem_result fsdem__pic_dem_map_build(fsdem_pic_dem *c, fsdem__pic_dem_map *map, int count, const fsdem_vec3 *centre,
                                              const fsdem_real *half, fsdem_real half_all) {
-    const fsdem_pic *s = c->desc.pic;
+    const fsdem__mac *grid = &c->grid;
     int pass, i, q, lo[3], hi[3], idx[3], total = 0;
-    memset(map->start, 0, sizeof(int) * (size_t)(s->ncell + 1));
+    memset(map->start, 0, sizeof(int) * (size_t)(grid->ncell + 1));
     for (pass = 0; pass < 2; ++pass) {
         for (i = 0; i < count; ++i) {
             const fsdem_real h = half ? half[i] : half_all;
             for (q = 0; q < 3; ++q) {
-                if (q < s->dim) fsdem__pic_dem_range(s, q, (fsdem_real)0.5, fsdem__comp(centre[i], q) - h - s->dx / 2,
-                                                     fsdem__comp(centre[i], q) + h + s->dx / 2, s->n[q], &lo[q], &hi[q]);
+                if (q < grid->dim) fsdem__pic_dem_range(grid, q, (fsdem_real)0.5, fsdem__comp(centre[i], q) - h - grid->dx / 2,
+                                                     fsdem__comp(centre[i], q) + h + grid->dx / 2, grid->n[q], &lo[q], &hi[q]);
                 else lo[q] = hi[q] = 0;
             }
             for (idx[2] = lo[2]; idx[2] <= hi[2]; ++idx[2])
                 for (idx[1] = lo[1]; idx[1] <= hi[1]; ++idx[1])
                     for (idx[0] = lo[0]; idx[0] <= hi[0]; ++idx[0]) {
-                        const int cell = fsdem__pic_cell(s, idx[0], idx[1], idx[2]);
+                        const int cell = fsdem__mac_cell(grid, idx[0], idx[1], idx[2]);
                         if (pass == 0) map->start[cell + 1]++;
                         else map->item[map->start[cell]++] = i;
                     }
         }
         if (pass == 0) {
-            for (i = 0; i < s->ncell; ++i) map->start[i + 1] += map->start[i];
-            total = map->start[s->ncell];
+            for (i = 0; i < grid->ncell; ++i) map->start[i + 1] += map->start[i];
+            total = map->start[grid->ncell];
             if (fsdem__grow(&c->allocator, (void **)&map->item, &map->item_cap, 0, total > 0 ? total : 1, sizeof(int)) != FSDEM_OK)
                 return FSDEM_ERR_OUT_OF_MEMORY;
         }
     }
     /* the second pass advanced every start to the next cell's: shift back */
-    for (i = s->ncell; i > 0; --i) map->start[i] = map->start[i - 1];
+    for (i = grid->ncell; i > 0; --i) map->start[i] = map->start[i - 1];
     map->start[0] = 0;
     return FSDEM_OK;
 }
@@ -17356,7 +17419,7 @@ static fsdem_result fsdem__pic_dem_map_build(fsdem_pic_dem *c, fsdem__pic_dem_ma
 /* The bodies as one solid for fsdem_pic_exclude_particles (`user` is the coupler). */
 static fsdem_real fsdem__pic_dem_solid(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
     const fsdem_pic_dem *c = (const fsdem_pic_dem *)user;
-    const int cell = fsdem__pic_cell_of(c->desc.pic, p);
+    const int cell = fsdem__mac_cell_of(&c->grid, p);
     fsdem_dem_particles P;
     fsdem_real best = (fsdem_real)1e30;
     int e;
@@ -17383,7 +17446,7 @@ static fsdem_result fsdem__pic_dem_exclude(fsdem_pic_dem *c, int from, int remov
     if (from >= P.count) return FSDEM_OK;
     if (fsdem__pic_dem_map_build(c, &c->body_map, P.count - from, P.position + from, P.radius + from, 0) != FSDEM_OK)
         return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the bodies");
-    for (e = 0; e < c->body_map.start[c->desc.pic->ncell] && from > 0; ++e) c->body_map.item[e] += from;
+    for (e = 0; e < c->body_map.start[c->grid.ncell] && from > 0; ++e) c->body_map.item[e] += from;
     res = fsdem_pic_exclude_particles(c->desc.pic, fsdem__pic_dem_solid, c, remove, &moved);
     if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
     if (remove) c->removed += moved;
@@ -17397,7 +17460,7 @@ static fsdem_result fsdem__pic_dem_gap(fsdem_pic_dem *c) {
     const fsdem_real offset = fsdem_dem_get_desc(c->desc.dem).contact_offset;
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     const fsdem_pic_particles W = fsdem_pic_get_particles(c->desc.pic);
-    const fsdem_pic *s = c->desc.pic;
+    const fsdem__mac *grid = &c->grid;
     int n = fsdem_dem_contacts(c->desc.dem, NULL, 0), k, p, e;
     if (n < 0) return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
     if (n > c->contact_cap) {
@@ -17426,7 +17489,7 @@ static fsdem_result fsdem__pic_dem_gap(fsdem_pic_dem *c) {
     if (fsdem__pic_dem_map_build(c, &c->contact_map, n, c->contact_point, NULL, half) != FSDEM_OK)
         return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the contacts");
     for (p = 0; p < W.count; ++p) {
-        const int cell = fsdem__pic_cell_of(s, W.position[p]);
+        const int cell = fsdem__mac_cell_of(grid, W.position[p]);
         for (e = c->contact_map.start[cell]; e < c->contact_map.start[cell + 1]; ++e) {
             const int q = c->contact_map.item[e];
             const fsdem_vec3 rel = fsdem__sub(W.position[p], c->contact_point[q]), nrm = c->contact[q].normal;

@@ -11,7 +11,9 @@
 #   - a public enum value breaks FSDEM_<ENUM>_<VALUE> (fsdem_result's codes excepted, as >>doc says);
 #   - the objects of the verb table in >>doc ("ONE DIALECT FOR EVERY SOLVER") are not exactly those
 #     with a create and a step, or one of them lacks a verb of the table (couplers: and get_force);
-#   - a stable_dt takes a non-const object.
+#   - a stable_dt takes a non-const object;
+#   - a coupler (>>impl_couple_*) calls a private helper of the PIC, MPS or SWE or reads a field of a
+#     solver object: couplers speak to the solvers through their public calls.
 # Usage: sh tests/map_check.sh [fsdem.h]          check
 #        sh tests/map_check.sh --symbols [fsdem.h] print the symbol block for >>config
 set -u
@@ -123,8 +125,41 @@ for o in $stepping; do
     echo "$api" | grep -qE "^${o}_write_([a-z]+_)?csv\$" || { echo "map_check: ${o} writes no CSV (${o}_write_csv or _write_<what>_csv)"; exit 1; }
 done
 
+# couplers speak to the solvers through their public calls: in an >>impl_couple_ chapter (comments
+# aside) no private helper of the PIC, MPS or SWE (fsdem__pic_, fsdem__mps_, fsdem__swe_ other than
+# the coupler's own fsdem__<fluid>_dem_) and no field of a solver object (through a pointer declared
+# as fsdem_pic/mps/swe/dem *, or desc.<solver>->)
+awk '
+function fail(msg) { print "map_check: " msg; bad = 1 }
+/^\/\* ===== >>impl_/ { coupler = ($0 ~ />>impl_couple_/); delete ptr; incomment = (index($0, "*/") == 0); next }
+!coupler { next }
+{
+    line = $0
+    # comments: drop /* ... */ spans, carrying an open one to the next lines
+    if (incomment) { if (match(line, /\*\//)) { line = substr(line, RSTART + 2); incomment = 0 } else next }
+    while (match(line, /\/\*/)) {
+        rest = substr(line, RSTART + 2)
+        if (match(rest, /\*\//)) line = substr(line, 1, index(line, "/*") - 1) " " substr(rest, RSTART + 2)
+        else { line = substr(line, 1, index(line, "/*") - 1); incomment = 1 }
+    }
+    gsub(/"([^"\\]|\\.)*"/, "\"\"", line)   # string literals
+    s = line
+    while (match(s, /fsdem__(pic|mps|swe)_[a-z0-9_]*/)) {
+        name = substr(s, RSTART, RLENGTH); s = substr(s, RSTART + RLENGTH)
+        if (name !~ /^fsdem__(pic|mps|swe)_dem_/) fail("line " NR ": a coupler calls the solver-private " name)
+    }
+    s = line
+    while (match(s, /fsdem_(pic|mps|swe|dem) \*(const )?[a-z_][a-z0-9_]*/)) {
+        decl = substr(s, RSTART, RLENGTH); s = substr(s, RSTART + RLENGTH)
+        n = split(decl, w, /[ *]+/); ptr[w[n]] = 1
+    }
+    if (match(line, /desc(\.|->)(pic|mps|swe|dem)->/)) fail("line " NR ": a coupler reads a solver field: " substr(line, RSTART, RLENGTH + 12))
+    for (v in ptr) if (match(line, "(^|[^a-z0-9_.>])" v "->")) fail("line " NR ": a coupler reads a field of solver object " v ": " substr(line, RSTART, RLENGTH + 12))
+}
+END { if (bad) exit 1 }' "$file" || exit 1
+
 # queries take a const object: every stable_dt (the state is read, never written; only the message)
 nonconst=$(awk '/^FSDEM_API fsdem_result fsdem_[a-z_]+_stable_dt\(/ && !/_stable_dt\(const / { print }' "$file")
 if [ -n "$nonconst" ]; then echo "map_check: a stable_dt that takes a non-const object: $nonconst"; exit 1; fi
 
-echo "map check: $(grep -c '>>' "$file") map lines, banners unique, order and references resolve, contents listed, symbols complete, enum names and verb table hold"
+echo "map check: $(grep -c '>>' "$file") map lines, banners unique, order and references resolve, contents listed, symbols complete, enum names and verb table hold, couplers use public calls"
