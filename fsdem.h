@@ -1401,7 +1401,10 @@ FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
      exactly the opposite, so a coupler that hands it to the solid conserves momentum.
    A cell whose faces are all closed becomes SOLID. Particles are pushed out of static obstacles
    in every step; moving solids are the coupler's (fsdem_pic_exclude_particles). The arrays are read
-   by the next step, which recounts the fluid fractions after this call. */
+   by the next step, which recounts the fluid fractions after this call. Owners: open,
+   solid_velocity, start_velocity and reference describe the moving solids as a whole, so one
+   coupler (fsdem_pic_dem) owns them and rewrites them before every step; acceleration and
+   pressure_rhs are sums that any coupler adds to (fsdem_pic_add_force). */
 typedef struct fsdem_pic_coupling {
     int dim;
     int n[3];
