@@ -384,11 +384,13 @@ START_TEST(light_disc_rises_with_the_implicit_solid_velocity) {
     }
     /* both close the balance to the solver's level: the PCG stops at a relative residual of 1e-8,
        and 1e-6 of the top speed is two orders above what it leaves and four below the pressure's
-       impulse per step that Q* alone would miss by (g dt = 2e-2 m/s) */
-    ck_assert_msg(worst_new < 1e-6 * top && worst_pic < 1e-6 * top, "flux imbalance %g (DEM) and %g (PIC) m/s, top speed %g m/s",
-                  worst_new, worst_pic, top);
+       impulse per step that Q* alone would miss by (g dt = 2e-2 m/s); float: 1e3 eps, the
+       solve's own tolerance there (1.1e-5 of the top speed measured) */
+    const double closed = TOL(1e-6, 1e3) * top;
+    ck_assert_msg(worst_new < closed && worst_pic < closed, "flux imbalance %g (DEM) and %g (PIC) m/s, top speed %g m/s", worst_new,
+                  worst_pic, top);
     /* and so does the PIC's own statistic, the same sums over dx (it took Q*'s flux before) */
-    ck_assert_msg(worst_stat < 1e-6 * top / dx, "max_divergence %g 1/s", worst_stat);
+    ck_assert_msg(worst_stat < closed / dx, "max_divergence %g 1/s", worst_stat);
     free_tank(&t);
 }
 END_TEST
@@ -581,7 +583,8 @@ END_TEST
    read about g dt / 2 from them (5e-3 m/s here) before. After one step of 1 ms the fastest
    particle moves at the pressure solve's residue: the discrete hydrostatic state is exact, and the
    PCG stops at a relative residual tau, so speeds are of order tau g dt; 1e-5 g dt is three orders
-   above it (float: its rounding floor) and 500 times below the defect. */
+   above it and 500 times below the defect (float: 3e3 eps, three times its tau; up to 6e-7 m/s
+   measured). */
 START_TEST(still_water_stays_still_next_to_a_body_at_rest) {
     const double dx = 0.01, R = 0.04, dt = 1e-3;
     int dim, where;
@@ -604,7 +607,7 @@ START_TEST(still_water_stays_still_next_to_a_body_at_rest) {
             }
             TEST_REPORT("%dD body at rest, centre %s: fastest particle after one PIC step %.2e m/s (g dt = %.2e m/s)", dim,
                         where == 0 ? "on a cell centre" : where == 1 ? "on a face" : dim == 2 ? "on a node" : "on an edge", fastest, G * dt);
-            ck_assert_msg(fastest < 1e-5 * G * dt, "%dD, case %d: a particle moves at %g m/s", dim, where, fastest);
+            ck_assert_msg(fastest < TOL(1e-5, 3e3) * G * dt, "%dD, case %d: a particle moves at %g m/s", dim, where, fastest);
             free_tank(&t);
         }
 }

@@ -410,7 +410,7 @@ static void report(const options *o, const result *r, const char *tag) {
             tag, r->level0_in, r->level_min_in, r->t_level_min_in, 1e3 * (r->level0_in - r->level_min_in),
             1e3 * r->level_rise_after_min, r->t_level_max_after, r->level0_out, r->level_max_out,
             1e3 * (r->level_max_out - r->level0_out));
-    vc_info(CASE, "%s: water particles %d at t = 0, between %d and %d during the run; the grid's liquid volume (fsdem_pic_stats.fluid_volume, cut cells and cylinder cells included) drifts by up to %.3g %%",
+    vc_info(CASE, "%s: water particles %d at t = 0, between %d and %d during the run; the grid's liquid volume (fsdem_pic_stats.fluid_volume, cut cells by their open volume) drifts by up to %.3g %%",
             tag, r->particles0, r->particles_min, r->particles_max, 100 * r->fluid_drift);
     vc_info(CASE, "%s: level noise before the cylinders reach the water %.3f mm, threshold %.3f mm; largest overlap %.3g m",
             tag, 1e3 * r->noise, 1e3 * threshold, r->max_overlap);
