@@ -9267,30 +9267,25 @@ static void fsdem__pic_compute_fref(fsdem_pic *s);
 /* Grid geometry, strides and seeding constants of a new solver from its (checked) desc. */
 static void fsdem__pic_layout(fsdem_pic *s, const fsdem_pic_desc *desc) {
     double cells[3], total, bytes;
-    int a, b, root;
-    s->dim = desc->dim;
-    s->dx = desc->cell_size;
-    s->inv_dx = 1 / s->dx;
+    int a, root;
+    int n[3];
     fsdem__pic_grid_size(desc, cells, &total, &bytes);
-    for (a = 0; a < 3; ++a) s->n[a] = (int)cells[a];
-    s->ncell = s->n[0] * s->n[1] * s->n[2];
-    s->lo = desc->domain_min;
-    s->hi = s->lo;
-    if (s->dim == 2) s->lo.z = s->hi.z = 0;
-    s->hi.x = s->lo.x + s->dx * (fsdem_real)s->n[0];
-    s->hi.y = s->lo.y + s->dx * (fsdem_real)s->n[1];
-    if (s->dim == 3) s->hi.z = s->lo.z + s->dx * (fsdem_real)s->n[2];
-    fsdem__mac_init(&s->mac, s->dim, s->n, s->dx, s->lo);
+    for (a = 0; a < 3; ++a) n[a] = (int)cells[a];
+    fsdem__mac_init(&s->mac, desc->dim, n, desc->cell_size, desc->domain_min);
+    /* the loops' mirrors of the layout */
+    s->dim = s->mac.dim;
+    s->dx = s->mac.dx;
+    s->inv_dx = s->mac.inv_dx;
+    s->ncell = s->mac.ncell;
+    s->lo = s->mac.lo;
+    s->hi = s->mac.hi;
+    memcpy(s->n, s->mac.n, sizeof s->n);
+    memcpy(s->fn, s->mac.fn, sizeof s->fn);
+    memcpy(s->fstep, s->mac.fstep, sizeof s->fstep);
     s->cstep[0] = 1;
     s->cstep[1] = s->n[0];
     s->cstep[2] = s->n[0] * s->n[1];
-    for (a = 0; a < 3; ++a) {
-        for (b = 0; b < 3; ++b) s->fn[a][b] = s->n[b] + (a == b && a < s->dim);
-        s->nface[a] = a < s->dim ? s->fn[a][0] * s->fn[a][1] * s->fn[a][2] : 0;
-        s->fstep[a][0] = 1;
-        s->fstep[a][1] = s->fn[a][0];
-        s->fstep[a][2] = s->fn[a][0] * s->fn[a][1];
-    }
+    for (a = 0; a < 3; ++a) s->nface[a] = a < s->dim ? s->fn[a][0] * s->fn[a][1] * s->fn[a][2] : 0;
     s->fqueue_size = s->nface[0] > s->nface[1] ? s->nface[0] : s->nface[1];
     if (s->nface[2] > s->fqueue_size) s->fqueue_size = s->nface[2];
     s->ppc = desc->particles_per_cell;
@@ -16724,6 +16719,7 @@ struct fsdem_pic_dem {
     fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC works per metre), 1 in 3D */
     fsdem_vec3 gravity;            /* m/s^2 */
     fsdem__mac grid;               /* the PIC's layout, from fsdem_pic_get_fields */
+    fsdem_pic_coupling arrays;     /* the PIC's coupling arrays (valid while it lives) */
     unsigned char side_closed[6];  /* the PIC's domain sides that are walls (not outflow) */
     /* per body (DEM particle), `bodies` of them */
     int bodies, body_cap;
@@ -16917,6 +16913,7 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
         fsdem__mac_init(&c->grid, g.dim, g.n, g.cell_size, g.origin);
     }
     for (i = 0; i < 6; ++i) c->side_closed[i] = (unsigned char)(pd.boundary[i] != FSDEM_PIC_BC_OUTFLOW);
+    c->arrays = fsdem_pic_get_coupling(desc->pic);
     ncell = c->grid.ncell;
     if (fsdem__dem_particles_fit(desc->dem, pd.domain_min, pd.domain_max, &c->status, "fsdem_pic_dem_create") != FSDEM_OK) {
         if (desc->log) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, c->status.message);
@@ -17026,7 +17023,7 @@ static fsdem_result fsdem__pic_dem_face_add(fsdem_pic_dem *c, int a, int f, fsde
 /* Resets the PIC's moving-solid arrays (open, at rest, full), all of them: the coupler owns them,
    and a restored PIC may hold another run's cut. */
 static void fsdem__pic_dem_clear_faces(fsdem_pic_dem *c) {
-    fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
+    const fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic); /* also marks the PIC's cells for a recount */
     int a, e;
     for (a = 0; a < cp.dim; ++a) {
         for (e = 0; e < cp.face_count[a]; ++e) cp.open[a][e] = 1;
@@ -17066,7 +17063,7 @@ static fsdem_real fsdem__pic_dem_kernel_open(const fsdem__mac *grid, const fsdem
    fractions as pending negative values) and its references. */
 static fsdem_result fsdem__pic_dem_cut(fsdem_pic_dem *c, int b, fsdem_vec3 centre, fsdem_real radius) {
     const fsdem__mac *grid = &c->grid;
-    fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
+    const fsdem_pic_coupling cp = c->arrays;
     const fsdem__pic_dem_ball ball = {centre, radius};
     const fsdem_real reach = grid->dx * (grid->dim == 3 ? (fsdem_real)0.7072 : (fsdem_real)0.5001), margin = radius + grid->dx;
     int a, q, lo[3], hi[3], idx[3];
@@ -17150,7 +17147,7 @@ static fsdem_result fsdem__pic_dem_jacobian(fsdem_pic_dem *c, int b, fsdem_vec3 
    J, then the viscous relaxation times. */
 static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
     const fsdem__mac *grid = &c->grid;
-    fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
+    const fsdem_pic_coupling cp = c->arrays;
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     const fsdem_real inertia = c->dim == 3 ? (fsdem_real)0.4 : (fsdem_real)0.5; /* the DEM's spheres and discs */
     const fsdem_real visc = c->rho * c->nu * (c->dim == 3 ? grid->dx : 1);    /* >>pic_viscosity, per pair */
@@ -17261,9 +17258,9 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
 
 /* The accelerations M^-1 G, G = dx^(dim-1) J^T p over the FLUID cells, that the pressure p gives
    free body b (m/s^2, 1/s^2). */
-static void fsdem__pic_dem_accelerations(const fsdem_pic_dem *c, int b, const fsdem_real *p, fsdem_vec3 *acc, fsdem_vec3 *alpha) {
+static void fsdem__pic_dem_accelerations(const fsdem_pic_dem *c, int b, const unsigned char *type, const fsdem_real *p, fsdem_vec3 *acc,
+                                         fsdem_vec3 *alpha) {
     const fsdem__mac *grid = &c->grid;
-    const unsigned char *type = fsdem_pic_get_fields(c->desc.pic).cell;
     const fsdem_real area = grid->dim == 3 ? grid->dx * grid->dx : grid->dx;
     fsdem_vec3 G = fsdem__zero3(), T = fsdem__zero3();
     int e;
@@ -17288,7 +17285,7 @@ static void fsdem__pic_dem_operator(void *user, const fsdem_real *p, fsdem_real 
     for (b = 0; b < c->bodies; ++b) {
         fsdem_vec3 acc, alpha;
         if (c->inv_m[b] == 0) continue;
-        fsdem__pic_dem_accelerations(c, b, p, &acc, &alpha);
+        fsdem__pic_dem_accelerations(c, b, type, p, &acc, &alpha);
         for (e = c->jac_start[b]; e < c->jac_start[b + 1]; ++e) {
             const int cell = c->jac_cell[e];
             if (type[cell] != FSDEM_STENCIL_CELL_FLUID) continue;
@@ -17303,17 +17300,18 @@ static void fsdem__pic_dem_operator(void *user, const fsdem_real *p, fsdem_real 
    particles see the body as it ends the step (not its Q*, which holds the step's gravity). */
 static void fsdem__pic_dem_response(void *user, const fsdem_real *p, fsdem_real dt) {
     const fsdem_pic_dem *c = (const fsdem_pic_dem *)user;
-    const fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
+    const unsigned char *type = fsdem_pic_get_fields(c->desc.pic).cell;
+    const fsdem_pic_coupling *cp = &c->arrays; /* mid-step: fsdem_pic_get_coupling would mark the cells for a recount */
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     int b, e;
     for (b = 0; b < c->bodies; ++b) {
         fsdem_vec3 acc, alpha;
         if (c->inv_m[b] == 0) continue;
-        fsdem__pic_dem_accelerations(c, b, p, &acc, &alpha);
+        fsdem__pic_dem_accelerations(c, b, type, p, &acc, &alpha);
         for (e = c->face_start[b]; e < c->face_start[b + 1]; ++e) {
             const int a = c->face_axis[e], f = c->face[e];
             const fsdem_vec3 dv = fsdem__add(acc, fsdem__cross(alpha, fsdem__pic_dem_arm(c, e, P.position[b])));
-            cp.solid_velocity[a][f] += dt * c->face_closed[e] * fsdem__comp(dv, a) / (1 - cp.open[a][f]);
+            cp->solid_velocity[a][f] += dt * c->face_closed[e] * fsdem__comp(dv, a) / (1 - cp->open[a][f]);
         }
     }
 }
@@ -17322,7 +17320,7 @@ static void fsdem__pic_dem_response(void *user, const fsdem_real *p, fsdem_real 
    body from the step's pressure and shear, given to the DEM as held external loads. */
 static fsdem_result fsdem__pic_dem_loads(fsdem_pic_dem *c) {
     const fsdem__mac *grid = &c->grid;
-    fsdem_pic_coupling cp = fsdem_pic_get_coupling(c->desc.pic);
+    const fsdem_pic_coupling cp = c->arrays;
     const fsdem_pic_fields g = fsdem_pic_get_fields(c->desc.pic);
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
