@@ -1399,11 +1399,22 @@ FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
      that the liquid exerted on the closed face f (E = 0) during the last step's implicit viscous
      solve, rho nu dx^(dim-2) sum (u_nb - us_f) over the liquid faces next to it; the liquid got
      exactly the opposite, so a coupler that hands it to the solid conserves momentum.
+   - porosity[c]: the volume fraction of cell c that the liquid may fill among granules smaller
+     than a cell, alpha_f' = 1 - alpha_s of seed 004 Eq. 6 (default 1), in (0, 1]. The pressure
+     equation becomes the variable-coefficient one of seed 004 Eq. 12a: every face's coefficient
+     and liquid flux are multiplied by the mean porosity of its two cells (Appendix B's beta), so
+     div(alpha_f' u) = 0; the fluid fraction of a cell counts its particles against porosity x a
+     full cell's (Eq. 7b over Eq. 6), and the density projection moves the particles towards that
+     target (Eq. 12b-13), so water that granules enter is pushed out; reseeding keeps the minimum
+     count of the porous cell, and fluid_volume counts porosity x the cell's open volume;
+     fsdem_pic_add_force divides by it, so the water's momentum rho alpha_f' dx^dim u still gains
+     exactly force x dt.
    A cell whose faces are all closed becomes SOLID. Particles are pushed out of static obstacles
    in every step; moving solids are the coupler's (fsdem_pic_exclude_particles). The arrays are read
    by the next step, which recounts the fluid fractions after this call. Owners: open,
    solid_velocity, start_velocity and reference describe the moving solids as a whole, so one
-   coupler (fsdem_pic_dem) owns them and rewrites them before every step; acceleration and
+   coupler (fsdem_pic_dem) owns them and rewrites them before every step; porosity describes the
+   granules as a whole and its one owner is the granular coupler (fsdem_gic); acceleration and
    pressure_rhs are sums that any coupler adds to (fsdem_pic_add_force). */
 typedef struct fsdem_pic_coupling {
     int dim;
@@ -1416,6 +1427,7 @@ typedef struct fsdem_pic_coupling {
     fsdem_real *reference;
     const fsdem_real *shear[3];
     fsdem_real *start_velocity[3];
+    fsdem_real *porosity;
 } fsdem_pic_coupling;
 
 FSDEM_API fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *pic);
@@ -8906,6 +8918,7 @@ struct fsdem_pic {
     fsdem_real *shear[3];                     /* viscous force on closed faces (viscosity > 0) */
     fsdem_real *cvstart[3];                   /* coupler: moving solids' velocity at the start of the step */
     fsdem_real *E[3], *us[3];                 /* effective open fraction and solid velocity */
+    fsdem_real *fpor[3], *Ef[3];              /* face porosity (mean of its cells') and E fpor */
     unsigned char *fvalid[3], *fvalid2[3];
     int *fqueue; /* breadth-first front of the extrapolation, max(nface) entries */
     int fqueue_size;
@@ -8913,6 +8926,7 @@ struct fsdem_pic {
     /* cells */
     fsdem_real *frac, *fref, *phi, *pres, *rhs, *diag, *ctmp, *crhs;
     fsdem_real *cref; /* coupler's factor on fref (moving solids) */
+    fsdem_real *cpor; /* coupler's target fluid volume fraction (granules, seed 004 Eq. 6) */
     unsigned char *ctype, *cnear, *csolid;
     int *cstart; /* ncell + 1 */
 
@@ -9176,6 +9190,8 @@ static int fsdem__pic_arrays(fsdem_pic *s, fsdem__pic_array t[FSDEM__PIC_MAX_ARR
         FSDEM__PIC_REALS(cvstart[a], nf, 0);
         FSDEM__PIC_REALS(E[a], nf, 1);
         FSDEM__PIC_REALS(us[a], nf, 0);
+        FSDEM__PIC_REALS(fpor[a], nf, 1);
+        FSDEM__PIC_REALS(Ef[a], nf, 1);
         FSDEM__PIC_BYTES(fvalid[a], nf);
         FSDEM__PIC_BYTES(fvalid2[a], nf);
         if (s->desc.viscosity > 0) {
@@ -9197,6 +9213,7 @@ static int fsdem__pic_arrays(fsdem_pic *s, fsdem__pic_array t[FSDEM__PIC_MAX_ARR
     FSDEM__PIC_REALS(ctmp, nc, 0);
     FSDEM__PIC_REALS(crhs, nc, 0);
     FSDEM__PIC_REALS(cref, nc, 1);
+    FSDEM__PIC_REALS(cpor, nc, 1);
     FSDEM__PIC_BYTES(ctype, nc);
     FSDEM__PIC_BYTES(cnear, nc);
     FSDEM__PIC_BYTES(csolid, nc);
@@ -9398,6 +9415,7 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
     }
     s->coupling.pressure_rhs = s->crhs;
     s->coupling.reference = s->cref;
+    s->coupling.porosity = s->cpor;
     fsdem__pic_static_flags(s);
     fsdem__pic_compute_fref(s);
     *out = s;
@@ -10239,6 +10257,14 @@ static void fsdem__pic_effective_faces(fsdem_pic *s) {
                         s->E[a][f] = so < co ? so : co;
                         s->us[a][f] = co < so ? s->cvel[a][f] : s->svel[a][f];
                     }
+                    {
+                        /* seed 004 Appendix B: beta = (alpha_j' + alpha_f') / 2 between two cells */
+                        const int cu = coord < s->n[a] ? fsdem__mac_cell(&s->mac, i, j, k) : -1;
+                        const int cl = coord > 0 ? fsdem__mac_cell(&s->mac, i - (a == 0), j - (a == 1), k - (a == 2)) : -1;
+                        const fsdem_real beta = cl < 0 ? s->cpor[cu] : cu < 0 ? s->cpor[cl] : (s->cpor[cl] + s->cpor[cu]) / 2;
+                        s->fpor[a][f] = beta;
+                        s->Ef[a][f] = s->E[a][f] * beta;
+                    }
                 }
 }
 
@@ -10272,7 +10298,7 @@ static void fsdem__pic_fraction(fsdem_pic *s) {
         }
     }
     for (c = 0; c < s->ncell; ++c) {
-        const fsdem_real ref = s->fref[c] * s->cref[c];
+        const fsdem_real ref = s->fref[c] * s->cref[c] * s->cpor[c];
         fsdem_real f = ref > (fsdem_real)1e-3 ? s->frac[c] * inv_ppc / ref : 0;
         s->frac[c] = f;
         if (f >= 1) s->phi[c] = -s->dx;
@@ -10600,7 +10626,7 @@ static void fsdem__pic_ghost_diag(fsdem_pic *s) {
                 for (a = 0; a < s->dim; ++a)
                     for (sg = 0; sg < 2; ++sg) {
                         int f = fsdem__mac_face(&s->mac, a, i, j, k) + sg * s->fstep[a][a], nc = coord[a] + (sg ? 1 : -1);
-                        fsdem_real e = s->E[a][f];
+                        fsdem_real e = s->Ef[a][f];
                         if (e <= 0) continue;
                         if (nc < 0 || nc >= s->n[a]) {
                             d += e; /* outflow side: theta = 1/2 */
@@ -10634,14 +10660,15 @@ static fsdem_real fsdem__pic_face_grad(const fsdem_pic *s, const fsdem_real *q, 
     return 0;
 }
 
-/* Divergence of the face field u (with the solid fluxes) of cell (i, j, k), 1/s. */
+/* Divergence of the face field u (with the solid fluxes) of cell (i, j, k), 1/s: the liquid's flux
+   weighted by the faces' porosity (seed 004 Eq. 12a), the solids' by their share of the face. */
 static fsdem_real fsdem__pic_divergence(const fsdem_pic *s, fsdem_real *const u[3], int i, int j, int k) {
     fsdem_real sum = 0;
     int a;
     for (a = 0; a < s->dim; ++a) {
         int f = fsdem__mac_face(&s->mac, a, i, j, k), g = f + s->fstep[a][a];
-        sum += s->E[a][g] * u[a][g] + (1 - s->E[a][g]) * s->us[a][g];
-        sum -= s->E[a][f] * u[a][f] + (1 - s->E[a][f]) * s->us[a][f];
+        sum += s->Ef[a][g] * u[a][g] + (1 - s->E[a][g]) * s->us[a][g];
+        sum -= s->Ef[a][f] * u[a][f] + (1 - s->E[a][f]) * s->us[a][f];
     }
     return sum * s->inv_dx;
 }
@@ -10652,7 +10679,7 @@ static void fsdem__pic_stencil_view(const fsdem_pic *s, fsdem_stencil *st, int w
     st->dim = s->dim;
     for (a = 0; a < 3; ++a) st->n[a] = s->n[a];
     st->cell = s->ctype;
-    for (a = 0; a < s->dim; ++a) st->face[a] = s->E[a];
+    for (a = 0; a < s->dim; ++a) st->face[a] = s->Ef[a];
     st->diag = s->diag;
     if (with_extra) {
         st->extra = s->pressure_extra;
@@ -10843,9 +10870,10 @@ static fsdem_result fsdem__pic_density_projection(fsdem_pic *s) {
                 ref = s->fref[c] * s->cref[c];
                 if (ref < FSDEM__PIC_FREF_RELIABLE) rr = 0; /* count unreliable (mostly solid) */
                 if (rr != 0) any = 1;
-                /* the volume to move is the deficit of the open part of the cell; the fluxes
-                   through the faces are weighted by their open fractions E like the pressure's */
-                s->rhs[c] = -dx2 * rr * (ref < 1 ? ref : 1);
+                /* the volume to move is the deficit of the open part of the cell (times its
+                   porosity: Eq. 12b multiplied by alpha_f'); the fluxes through the faces are
+                   weighted like the pressure's */
+                s->rhs[c] = -dx2 * rr * (ref < 1 ? ref : 1) * s->cpor[c];
             }
     s->d_iters = 0;
     if (!any) return FSDEM_OK;
@@ -11024,7 +11052,7 @@ static int fsdem__pic_reseed(fsdem_pic *s) {
                     continue;
                 }
                 /* the minimum is that of the cell's open part (the solids' share of the kernel aside) */
-                if (minp > 0 && count < minp * s->fref[c] * s->cref[c] && interior && s->ctype[c] == FSDEM_STENCIL_CELL_FLUID &&
+                if (minp > 0 && count < minp * s->fref[c] * s->cref[c] * s->cpor[c] && interior && s->ctype[c] == FSDEM_STENCIL_CELL_FLUID &&
                     s->frac[c] < 1) {
                     fsdem_vec3 x;
                     for (q = count; q < minp; ++q) {
@@ -11392,7 +11420,7 @@ static fsdem_real fsdem__pic_spread(fsdem_pic *s, int a, fsdem_vec3 point, fsdem
                 }
                 if (!(w > 0)) continue;
                 sum += w;
-                if (add != 0) s->cacc[a][f] += add * w;
+                if (add != 0) s->cacc[a][f] += add * w / s->fpor[a][f];
             }
     return sum;
 }
@@ -11615,7 +11643,7 @@ fsdem_pic_stats fsdem_pic_get_stats(const fsdem_pic *s) {
             f = 0.5 - (double)s->phi[c] * (double)s->inv_dx;
             f = f < 0 ? 0 : f > 1 ? 1 : f;
         }
-        vol += f * (double)fsdem__pic_open_volume(s, c);
+        vol += f * (double)fsdem__pic_open_volume(s, c) * (double)s->cpor[c];
     }
     for (p = 0; p < s->np; ++p) ke += (double)fsdem__dot(s->pv[p], s->pv[p]);
     st.time = (fsdem_real)s->time;
@@ -17645,8 +17673,8 @@ fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
 
 /* ---- >>restart_format : header, checksum, cursor ---- */
 
-#define FSDEM__RESTART_VERSION 3u /* 2: DEM contact options and material-pair tables (issue 23); 3: the PIC's start
-                                      velocities of moving solids at any viscosity */
+#define FSDEM__RESTART_VERSION 4u /* 2: DEM contact options and material-pair tables (issue 23); 3: the PIC's start
+                                      velocities of moving solids at any viscosity; 4: the PIC's porosity */
 #define FSDEM__RESTART_HEADER 64
 #define FSDEM__RESTART_BOM 0x01020304u
 #define FSDEM__RESTART_FNV_BASIS 0xcbf29ce484222325ull
@@ -18325,12 +18353,15 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
         fsdem__restart_data(io, s->cacc[a], fb);
         fsdem__restart_data(io, s->E[a], fb);
         fsdem__restart_data(io, s->us[a], fb);
+        fsdem__restart_data(io, s->fpor[a], fb);
+        fsdem__restart_data(io, s->Ef[a], fb);
     }
     fsdem__restart_data(io, s->frac, cells);
     fsdem__restart_data(io, s->phi, cells);
     fsdem__restart_data(io, s->pres, cells);
     fsdem__restart_data(io, s->crhs, cells);
     fsdem__restart_data(io, s->cref, cells);
+    fsdem__restart_data(io, s->cpor, cells);
     fsdem__restart_data(io, s->fref, cells);
     fsdem__restart_flags(io, s->ctype, s->ncell, FSDEM_STENCIL_CELL_SOLID, "type of cell");
     fsdem__restart_flags(io, s->cnear, s->ncell, 1, "near-solid flag of cell");
