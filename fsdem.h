@@ -88,9 +88,10 @@
 
    ONE DIALECT FOR EVERY SOLVER
      Each solver (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_mps) and each coupler (fsdem_swe_dem,
-     fsdem_mps_dem, fsdem_pic_dem) speaks these verbs; X is the object's name (tests/map_check.sh
-     holds every one of them to the table). A solver adds verbs of its own (add_particle, set_bed,
-     ...); a coupler's per-particle record is fsdem_X_get_force(x, index, &record).
+     fsdem_mps_dem, fsdem_pic_dem, fsdem_gic) speaks these verbs; X is the object's name
+     (tests/map_check.sh holds every one of them to the table). A solver adds verbs of its own
+     (add_particle, set_bed, ...); a coupler's per-particle record is fsdem_X_get_force(x, index,
+     &record).
        fsdem_X_desc fsdem_X_desc_default(dim)      defaults (couplers and fsdem_pcg: no argument)
        fsdem_result fsdem_X_desc_check(desc, message, size)  validation without creating anything
        fsdem_result fsdem_X_create(desc, &x)        *x is NULL on failure; destroy with _destroy
@@ -126,8 +127,9 @@
      interpolation weights are "kernels" (>>kernel).
 
    COUPLING INTERFACE
-     A coupler is named fsdem_<fluid>_dem (fsdem_swe_dem, fsdem_mps_dem, fsdem_pic_dem) and
-     holds non-owning pointers to a fluid and a DEM. It reaches them only through these functions:
+     A coupler is named fsdem_<fluid>_dem (fsdem_swe_dem, fsdem_mps_dem, fsdem_pic_dem), or after
+     its method (fsdem_gic, Granule-In-Cell, PIC with granules), and holds non-owning pointers to a
+     fluid and a DEM. It reaches them only through these functions:
        DEM   fsdem_dem_get_particles (read), fsdem_dem_get_desc, fsdem_dem_get_coupling (writable
              external loads), fsdem_dem_substep_count, fsdem_dem_advance_with (substeps with a
              callback at every force evaluation, Verlet substeps fused)
@@ -139,7 +141,7 @@
              (fsdem_mps_get_particles: positions, velocities, pressure gradients) and takes forces
              and porosities through fsdem_mps_get_coupling. The PIC, whose solids are cut faces,
              takes moving solids through fsdem_pic_get_coupling (open fractions, solid velocities
-             at the start and end of the step, references; shear read back),
+             at the start and end of the step, references, the granules' porosity; shear read back),
              fsdem_pic_set_pressure_extra (an implicit term of the pressure operator, and the
              solids' answer to the solved pressure) and fsdem_pic_exclude_particles, and is read
              through fsdem_pic_get_fields (pressure, open fractions) and fsdem_pic_get_particles.
@@ -235,6 +237,26 @@
 #define fsdem_dem_write_walls_vtp fsdem_dem_write_walls_vtp_f
 #define fsdem_drag_coefficient fsdem_drag_coefficient_f
 #define fsdem_drag_law_name fsdem_drag_law_name_f
+#define fsdem_gic_advance fsdem_gic_advance_f
+#define fsdem_gic_create fsdem_gic_create_f
+#define fsdem_gic_desc_check fsdem_gic_desc_check_f
+#define fsdem_gic_desc_default fsdem_gic_desc_default_f
+#define fsdem_gic_destroy fsdem_gic_destroy_f
+#define fsdem_gic_get_desc fsdem_gic_get_desc_f
+#define fsdem_gic_get_fields fsdem_gic_get_fields_f
+#define fsdem_gic_get_force fsdem_gic_get_force_f
+#define fsdem_gic_get_stats fsdem_gic_get_stats_f
+#define fsdem_gic_last_error fsdem_gic_last_error_f
+#define fsdem_gic_restore fsdem_gic_restore_f
+#define fsdem_gic_restore_memory fsdem_gic_restore_memory_f
+#define fsdem_gic_save fsdem_gic_save_f
+#define fsdem_gic_save_memory fsdem_gic_save_memory_f
+#define fsdem_gic_stable_dt fsdem_gic_stable_dt_f
+#define fsdem_gic_step fsdem_gic_step_f
+#define fsdem_gic_step_dt fsdem_gic_step_dt_f
+#define fsdem_gic_time fsdem_gic_time_f
+#define fsdem_gic_update fsdem_gic_update_f
+#define fsdem_gic_write_csv fsdem_gic_write_csv_f
 #define fsdem_mps_add_box_obstacle fsdem_mps_add_box_obstacle_f
 #define fsdem_mps_add_box_walls fsdem_mps_add_box_walls_f
 #define fsdem_mps_add_gauge fsdem_mps_add_gauge_f
@@ -1383,8 +1405,10 @@ FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
      min(static obstacle fraction, open);
    - solid_velocity[a][f]: velocity component a (m/s) of the moving solid on that face (default 0),
      used where open < the static fraction;
-   - acceleration[a][f]: extra acceleration (m/s^2) added with gravity (default 0; kept until
-     changed; fsdem_pic_add_force adds to it, fsdem_pic_clear_forces zeroes it);
+   - acceleration[a][f]: extra acceleration (m/s^2) added with gravity, that of a face the liquid
+     fills: where granules share it, the step divides it by the face's porosity, so the liquid's
+     momentum there, rho alpha_f' dx^dim u, gains rho dx^dim a dt whatever the porosity (default 0;
+     kept until changed; fsdem_pic_add_force adds to it, fsdem_pic_clear_forces zeroes it);
    - pressure_rhs[c]: added to the right-hand side of the pressure equation
      sum_f E_f (p_c - p_nb) = -(rho dx^2/dt) div (Pa; default 0, kept until changed);
    - reference[c]: the part of cell c's fluid-fraction kernel that moving solids leave open (default
@@ -1406,9 +1430,9 @@ FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
      div(alpha_f' u) = 0; the fluid fraction of a cell counts its particles against porosity x a
      full cell's (Eq. 7b over Eq. 6), and the density projection moves the particles towards that
      target (Eq. 12b-13), so water that granules enter is pushed out; reseeding keeps the minimum
-     count of the porous cell, and fluid_volume counts porosity x the cell's open volume;
-     fsdem_pic_add_force divides by it, so the water's momentum rho alpha_f' dx^dim u still gains
-     exactly force x dt.
+     count of the porous cell, and fluid_volume counts porosity x the cell's open volume; the
+     accelerations are divided by the faces' porosity (below), so a force from fsdem_pic_add_force
+     still gives the water exactly force x dt.
    A cell whose faces are all closed becomes SOLID. Particles are pushed out of static obstacles
    in every step; moving solids are the coupler's (fsdem_pic_exclude_particles). The arrays are read
    by the next step, which recounts the fluid fractions after this call. Owners: open,
@@ -2451,14 +2475,22 @@ FSDEM_API fsdem_result fsdem_mps_obstacle_force(const fsdem_mps *mps, int id, fs
                        faster than Cd0 |u - v| grows; the force c V |u - v| still grows.
      BEETSTRA          Beetstra, van der Hoef and Kuipers (2007): F(phi, Re) = F_d / (3 pi mu d eps |u - v|),
                        phi = 1 - eps, F_d the drag of Eq. 25 (the total force is F_d / eps):
-                       c = 18 mu eps F / d^2, exactly Stokes at eps = 1, Re = 0. */
+                       c = 18 mu eps F / d^2, exactly Stokes at eps = 1, Re = 0.
+     GIC               seed 004 Eq. 5b, the quadratic drag of the Granule-In-Cell method:
+                       F = 12 pi r^2 rho C |u - v| (u - v) with the seed's coefficient C = 0.44
+                       (Schiller 1933, its §6): c = 18 C rho |u - v| / d. Porosity and viscosity do not
+                       enter; there is no creeping-flow term, so c = 0 at |u - v| = 0 and a grain in
+                       this law settles at |u - v| = sqrt((rho_s - rho_f) g d / (18 C rho_f)). The
+                       seed's ablation with C = 0.044 (§6.1) is this law scaled by 0.1 (fsdem_gic_desc
+                       drag_scale). */
 typedef enum fsdem_drag_law {
     FSDEM_DRAG_LAW_STOKES = 0,           /* isolated sphere, creeping flow: 3 pi mu d, porosity ignored */
     FSDEM_DRAG_LAW_SCHILLER_NAUMANN = 1, /* isolated sphere, Cd of Eq. 27, Re = rho d |u - v| / mu, porosity ignored */
     FSDEM_DRAG_LAW_ERGUN_WEN_YU = 2,     /* seed 002 Eq. 26 exactly: Ergun for eps <= 0.8, Wen-Yu above */
     FSDEM_DRAG_LAW_GIDASPOW = 3,         /* Ergun and Wen-Yu joined by the smooth blend of Huilin and Gidaspow (2003) */
     FSDEM_DRAG_LAW_DI_FELICE = 4,        /* Di Felice (1994) */
-    FSDEM_DRAG_LAW_BEETSTRA = 5          /* Beetstra, van der Hoef and Kuipers (2007) */
+    FSDEM_DRAG_LAW_BEETSTRA = 5,         /* Beetstra, van der Hoef and Kuipers (2007) */
+    FSDEM_DRAG_LAW_GIC = 6               /* seed 004 Eq. 5b: quadratic, coefficient 0.44 */
 } fsdem_drag_law;
 
 /* Coefficient of the drag on one particle: F = c V (u - v) as above. Writes c (kg m^-3 s^-1) to
@@ -2814,6 +2846,157 @@ typedef struct fsdem_pic_dem_stats {
 
 FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupler);
 
+/* ===== >>couple_gic : Granule-In-Cell volume-fraction coupling (seed 004) ========================== */
+
+/* Two-way coupling of PIC/FLIP water (fsdem_pic) with DEM granules smaller than a grid cell
+   (fsdem_dem), through the volume fractions of seed 004 (Tang et al. 2025): the water shares each
+   cell with the sand, keeps the volume the sand leaves it, and the two exchange momentum on the
+   grid. Every coupled step of dt (seed 004 Algorithm 1, sand first):
+     1. sand substeps (Algorithm 2): the DEM advances dt in K = fsdem_dem_substep_count substeps
+        (fsdem_dem_advance_with); at every force evaluation each granule i of volume V_i (per the
+        DEM's disc_length in 2D) gets from the water of the last fluid step, sampled at its centre
+        (fsdem_pic_sample: velocity u, pressure gradient grad p, liquid fraction l):
+          pressure-gradient force  F_p = -V_i grad p                               (Eq. 5a)
+          drag                     F_d = s c V_i (u - v_i)                         (Eq. 5b, or >>drag)
+        with c of desc.drag at the porosity eps of the granule's position (the cells' alpha_f'
+        interpolated) and s = desc.drag_scale; the granule is given l (F_p + F_d) as its external
+        load (a granule in air, l = 0, feels neither);
+     2. momentum exchange (Eq. 18): each evaluation's -l F_d goes to the water's faces around the
+        granule (fsdem_pic_add_force, tent kernel of half-width max(r_i, dx)) weighted by the time
+        the DEM integrator holds it (h/2, h, ..., h, h/2 for Verlet substeps of h, h for the
+        predictor-corrector) over dt, so the water gains exactly the impulse the granules' drag
+        lost. F_p is not exchanged: the water's own step applies -grad p to the liquid's volume
+        alpha_f (Eq. 8 with Eq. 3's -alpha_f grad p), and -V_i grad p is the same mixture pressure
+        on the granule's volume; handing its reaction to the water too would count the pressure on
+        the granules' volume twice (a fixed bed under still water would then hold
+        grad p = rho g alpha_f / (alpha_f - alpha_s), not rho g);
+     3. granule volume fraction at the cell centres from the new positions (Eq. 7a),
+        alpha_s = sum_i V_i N(x_i - x) / dx^dim with the tent kernel N, the weight that would fall
+        outside the grid folded into the boundary cell (so sum alpha_s dx^dim = sum V_i exactly),
+        capped at desc.max_solid_fraction (§5.1: 0.740 in 3D, 0.907 in 2D); alpha_f' = 1 - alpha_s
+        becomes the PIC's porosity (fsdem_pic_coupling.porosity);
+     4. one PIC step of dt: the variable-coefficient velocity projection div(alpha_f' u) = 0
+        (Eq. 11/12a) after the exchanged accelerations, and after advection the density projection
+        towards alpha_f' (Eq. 12b-13, the ratio clamped to [0.5, 1.5], moves within a cell), which
+        pushes water out of the space the sand took and lets it into the space the sand left.
+   The granule forces of a substep use the fluid of the last step (§5.2); before the PIC's first
+   step, which has solved no pressure yet, grad p is that of water at rest, rho_f g. The stable coupled step
+   (Eq. 33) is the PIC's, at most desc.cfl dx / max |v_i| and desc.max_dt_ratio times the DEM's dt
+   (1000 in the seed), and at most desc.drag_dt_fraction of the shortest drag relaxation time of a
+   granule, m_i / (s c V_i), or of the water round it, alpha_f rho / (alpha_s s c), since the
+   exchange is explicit for the water.
+   Ownership: the coupler owns the PIC's porosity and its accelerations (it zeroes them at the start
+   of every step, fsdem_pic_clear_forces, so another coupler's forces on the same PIC would be
+   lost), and the DEM's external forces.
+   Not built yet (issue 22): virtual mass (Eq. 14-17), the concentration-gradient and capillary
+   forces (Eq. 21-31), wetting (Eq. 19-20), the granules' flux in the velocity projection. The
+   viscous stress of Eq. 3 is the PIC's nu lap(u), not div(alpha_f T). */
+
+typedef struct fsdem_gic fsdem_gic;
+
+typedef struct fsdem_gic_desc {
+    fsdem_pic *pic;               /* water; not owned; must outlive the coupler */
+    fsdem_dem *dem;               /* granules; same dim and gravity as the PIC; not owned */
+    fsdem_drag_law drag;          /* default FSDEM_DRAG_LAW_GIC (seed 004 Eq. 5b) */
+    fsdem_real drag_scale;        /* -; factor on the law's coefficient, > 0; default 1 (0.1 with */
+                                  /*    the GIC law is the seed's mu = 0.044 of §6.1) */
+    fsdem_real viscosity;         /* Pa s; dynamic viscosity the drag laws use (all but the GIC */
+                                  /*    law need one); 0: rho nu of the PIC; default 0 */
+    fsdem_real max_solid_fraction; /* -; cap of alpha_s in (0, 1); 0: 0.740 in 3D, 0.907 in 2D */
+                                  /*    (densest packings, §5.1); default 0 */
+    fsdem_real cfl;               /* -; Eq. 33: dt <= cfl dx / max |v_granule|, > 0; default 1 */
+    fsdem_real max_dt_ratio;      /* -; Eq. 33: dt <= this x the DEM's dt, >= 1; default 1000 */
+    fsdem_real drag_dt_fraction;  /* -; dt <= this x the shortest drag relaxation time, in (0, 1]; */
+                                  /*    default 0.5 */
+    long long max_substeps;       /* DEM substeps one coupled step may take; a longer step is */
+                                  /*    refused before anything moves; default 100000 */
+    fsdem_log_fn log;             /* optional; default NULL */
+    void *log_user;
+} fsdem_gic_desc;
+
+FSDEM_API fsdem_gic_desc fsdem_gic_desc_default(void);
+/* Checks a desc: both solvers set, the same dim and gravity, the ranges above, a viscosity for a
+   law that needs one. FSDEM_OK or FSDEM_ERR_INVALID_ARG with the reason, naming the field, in
+   `message` (may be NULL). */
+FSDEM_API fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *desc, char *message, size_t message_size);
+/* Creates a coupler (its memory from the DEM's allocator). FSDEM_ERR_INVALID_ARG as the check (the
+   reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_gic_destroy leaves the solvers
+   alive. */
+FSDEM_API fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out);
+FSDEM_API void fsdem_gic_destroy(fsdem_gic *coupler);
+FSDEM_API const char *fsdem_gic_last_error(const fsdem_gic *coupler);
+/* The desc in force (viscosity and max_solid_fraction resolved). */
+FSDEM_API fsdem_gic_desc fsdem_gic_get_desc(const fsdem_gic *coupler);
+
+/* Step 3 of the section at the current granule positions: alpha_s and the PIC's porosity. A step
+   does it after its substeps; call it once the granules are placed, so that the first step's
+   density projection already knows where the sand is. FSDEM_ERR_OUT_OF_MEMORY, FSDEM_ERR_NAN (a
+   granule position is not finite; nothing changed). */
+FSDEM_API fsdem_result fsdem_gic_update(fsdem_gic *coupler);
+
+/* Volume fractions on the PIC's cells (layout of fsdem_pic_fields), from the last update; valid
+   while the coupler lives. */
+typedef struct fsdem_gic_fields {
+    int dim;
+    int n[3];                        /* cells per axis (n[2] = 1 in 2D) */
+    fsdem_real cell_size;            /* m */
+    fsdem_vec3 origin;               /* m, lower corner */
+    const fsdem_real *solid_fraction; /* -; alpha_s of Eq. 7a before the cap */
+    const fsdem_real *porosity;      /* -; alpha_f' = 1 - min(alpha_s, max_solid_fraction) */
+} fsdem_gic_fields;
+
+FSDEM_API fsdem_gic_fields fsdem_gic_get_fields(const fsdem_gic *coupler);
+
+/* Fluid state and forces at one granule, from the last force evaluation of the last step. */
+typedef struct fsdem_gic_force {
+    int id;                       /* stable id of the DEM particle (fsdem_dem_particles.id) */
+    fsdem_vec3 pressure;          /* N; l F_p (Eq. 5a) */
+    fsdem_vec3 drag;              /* N; l F_d (Eq. 5b or the chosen law) */
+    fsdem_vec3 fluid_velocity;    /* m/s; u at the granule */
+    fsdem_real porosity;          /* -; eps at the granule */
+    fsdem_real liquid;            /* -; l, the liquid fraction at the granule (0: dry) */
+} fsdem_gic_force;
+
+/* Forces on DEM particle `index` from the last step, found by the particle's id.
+   FSDEM_ERR_NOT_FOUND for a bad index, before the first step (or after a restore), or for a
+   particle added since. */
+FSDEM_API fsdem_result fsdem_gic_get_force(const fsdem_gic *coupler, int index, fsdem_gic_force *out);
+/* One coupled step of the stable dt. */
+FSDEM_API fsdem_result fsdem_gic_step(fsdem_gic *coupler);
+/* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite or above
+   max_substeps DEM substeps, FSDEM_ERR_CFL when dt exceeds the PIC's cfl_max (fsdem_pic_check_dt)
+   or the drag limit of the last step; nothing moved then. Errors of either solver during the step
+   are passed on with their message. */
+FSDEM_API fsdem_result fsdem_gic_step_dt(fsdem_gic *coupler, fsdem_real dt);
+/* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
+FSDEM_API fsdem_result fsdem_gic_advance(fsdem_gic *coupler, fsdem_real duration, long long *steps);
+/* Stable coupled step (s) of the section (Eq. 33 and the drag limit of the last step).
+   FSDEM_ERR_NAN when a velocity is not finite. */
+FSDEM_API fsdem_result fsdem_gic_stable_dt(const fsdem_gic *coupler, fsdem_real *dt);
+/* The PIC time (s). */
+FSDEM_API double fsdem_gic_time(const fsdem_gic *coupler);
+
+typedef struct fsdem_gic_stats {
+    long long steps;              /* coupled steps */
+    double time;                  /* s */
+    fsdem_real dt;                /* s, the last coupled step */
+    long long substeps;           /* DEM substeps of the last step */
+    long long substeps_total;
+    int wet;                      /* granules with l > 0 at the last evaluation */
+    fsdem_vec3 pressure_impulse;  /* N s; the granules' Eq. 5a impulse over the last step */
+    fsdem_vec3 drag_impulse;      /* N s; the granules' drag impulse over the last step */
+    fsdem_vec3 to_fluid;          /* N s; the impulse handed to the water's faces, last step, in the */
+                                  /*    DEM's units (the water gets it per metre of depth in 2D) */
+    fsdem_vec3 lost;              /* N s; exchange with no liquid face in reach (dropped) */
+    fsdem_real drag_dt;           /* s; shortest drag relaxation time of the last step (0: none) */
+    fsdem_real max_solid_fraction; /* -; largest alpha_s of the last update, before the cap */
+    fsdem_real solid_volume;      /* m^3 (m^2 in 2D); sum of alpha_s dx^dim, = the granules' volume */
+    double seconds_pic;           /* CPU seconds in PIC steps */
+    double seconds_dem;           /* CPU seconds in DEM substeps with the force evaluations */
+} fsdem_gic_stats;
+
+FSDEM_API fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *coupler);
+
 /* ===== >>restart : checkpoint and restart ========================================================= */
 
 /* Saves the complete state of a solver or coupler to a file or to memory, and restores it, so that
@@ -2847,7 +3030,11 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
      fsdem_mps_dem  the states of its fsdem_mps and fsdem_dem, restored into the solvers it was
                     created with, and its own counters and per-particle force records;
      fsdem_pic_dem  the states of its fsdem_pic and fsdem_dem, restored into the solvers it was
-                    created with, and its own counters and per-body load records.
+                    created with, and its own counters and per-body load records;
+     fsdem_gic      the states of its fsdem_pic (whose porosity holds the sand's fractions) and
+                    fsdem_dem, its fractions, counters and the drag limit of its last step (the
+                    per-granule force records are not kept: fsdem_gic_get_force finds none until
+                    the next step).
    What must match (else FSDEM_ERR_INVALID_ARG naming the field): the desc fields that steps read.
    DEM: dim, domain, gravity, law, integrator, dt_rule, dt_param, skin, contact_offset, linear_*,
    disc_length, rotation, the contact options (tangential_*, coulomb_limit), periodic. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,
@@ -2885,14 +3072,15 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
          12      4  byte-order mark 0x01020304 as the saving machine stores it
          16      4  precision: sizeof(fsdem_real), 4 (FSDEM_USE_FLOAT) or 8
          20      4  object kind: 1 fsdem_dem, 2 fsdem_pic, 3 fsdem_swe, 4 fsdem_swe_dem, 5 fsdem_mps,
-                    6 fsdem_mps_dem, 7 fsdem_pic_dem
+                    6 fsdem_mps_dem, 7 fsdem_pic_dem, 8 fsdem_gic
          24      4  dimension of the object (the SWE's for fsdem_swe_dem)
          28      4  reserved (0)
          32     16  four sizes (int) for tools: DEM particles, materials, walls, pair-list entries;
                     PIC cells along x, y, z and particles; SWE nx, ny, point sources, gauges;
                     SWE-DEM nx, ny, DEM particles, force records; MPS particles, FLUID
                     particles, obstacles, 0; MPS-DEM MPS particles, DEM particles, force records, 0;
-                    PIC-DEM PIC particles, DEM particles, body load records, 0
+                    PIC-DEM PIC particles, DEM particles, body load records, 0; GIC PIC
+                    particles, DEM particles, PIC cells, 0
          48      8  payload bytes (unsigned)
          56      8  checksum: 64-bit FNV-1a over bytes 0 to 55 and the payload
    The payload holds tagged sections of integers and reals as the saving machine stores them. */
@@ -2945,6 +3133,12 @@ FSDEM_API fsdem_result fsdem_pic_dem_restore(fsdem_pic_dem *coupler, const char 
 FSDEM_API fsdem_result fsdem_pic_dem_save_memory(const fsdem_pic_dem *coupler, void *buffer, size_t capacity,
                                                  size_t *size);
 FSDEM_API fsdem_result fsdem_pic_dem_restore_memory(fsdem_pic_dem *coupler, const void *buffer, size_t size);
+
+/* The same four for the Granule-In-Cell coupler: its solvers' states are saved and restored with it. */
+FSDEM_API fsdem_result fsdem_gic_save(const fsdem_gic *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_gic_restore(fsdem_gic *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_gic_save_memory(const fsdem_gic *coupler, void *buffer, size_t capacity, size_t *size);
+FSDEM_API fsdem_result fsdem_gic_restore_memory(fsdem_gic *coupler, const void *buffer, size_t size);
 
 /* ===== >>io : CSV time series, ParaView series, VTK XML snapshots ================================== */
 
@@ -3093,10 +3287,13 @@ FSDEM_API fsdem_result fsdem_mps_write_csv(const fsdem_mps *mps, const char *pat
               fluid_u,fluid_v,fluid_w,porosity,reynolds,wet
      PIC-DEM  id,pressure_x,pressure_y,pressure_z,viscous_x,viscous_y,viscous_z,torque_x,torque_y,
               torque_z,weight_correction_x,weight_correction_y,weight_correction_z,volume,faces
+     GIC      id,pressure_x,pressure_y,pressure_z,drag_x,drag_y,drag_z,fluid_u,fluid_v,fluid_w,
+              porosity,liquid
    Units as in the record types (N, N m, m^3, m^2, m, m/s). */
 FSDEM_API fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *coupler, const char *path);
 FSDEM_API fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *coupler, const char *path);
 FSDEM_API fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *coupler, const char *path);
+FSDEM_API fsdem_result fsdem_gic_write_csv(const fsdem_gic *coupler, const char *path);
 
 /* Shallow-water fields as ImageData (.vti): extent 0..nx x 0..ny x 0..0 points, origin (x_min,
    y_min, 0), spacing (dx, dy, 1); a 1D channel is one cell high, 0..nx x 0..1, origin (x_min, 0, 0),
@@ -11161,7 +11358,7 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
     }
     for (a = 0; a < s->dim; ++a) {
         fsdem_real g = fsdem__comp(s->desc.gravity, a) * dt;
-        for (f = 0; f < s->nface[a]; ++f) s->u[a][f] += g + dt * s->cacc[a][f];
+        for (f = 0; f < s->nface[a]; ++f) s->u[a][f] += g + dt * s->cacc[a][f] / s->fpor[a][f];
     }
 
     /* 3. pressure projection */
@@ -11420,7 +11617,7 @@ static fsdem_real fsdem__pic_spread(fsdem_pic *s, int a, fsdem_vec3 point, fsdem
                 }
                 if (!(w > 0)) continue;
                 sum += w;
-                if (add != 0) s->cacc[a][f] += add * w / s->fpor[a][f];
+                if (add != 0) s->cacc[a][f] += add * w;
             }
     return sum;
 }
@@ -16031,6 +16228,9 @@ static fsdem_real fsdem__drag_ergun(fsdem_real eps, fsdem_real d, fsdem_real sli
     return 150 * (1 - eps) * mu / (eps * d * d) + (fsdem_real)1.75 * rho * slip / d;
 }
 
+/* The coefficient mu of seed 004 Eq. 5b, as its §6 gives it. */
+#define FSDEM__GIC_DRAG_COEFFICIENT ((fsdem_real)0.44)
+
 /* c of `law` (kg m^-3 s^-1) for valid arguments (fsdem_drag_coefficient checks them). */
 static fsdem_real fsdem__drag_per_volume(fsdem_drag_law law, fsdem_real eps, fsdem_real d, fsdem_real slip,
                                          fsdem_real rho, fsdem_real mu) {
@@ -16069,6 +16269,7 @@ static fsdem_real fsdem__drag_per_volume(fsdem_drag_law law, fsdem_real eps, fsd
                              (fsdem_real)0.413 * inertial;
         return 18 * mu * eps * f / (d * d);
     }
+    case FSDEM_DRAG_LAW_GIC: return 18 * FSDEM__GIC_DRAG_COEFFICIENT * rho * slip / d; /* seed 004 Eq. 5b */
     }
     return 0;
 }
@@ -16081,6 +16282,7 @@ const char *fsdem_drag_law_name(fsdem_drag_law law) {
     case FSDEM_DRAG_LAW_GIDASPOW: return "gidaspow";
     case FSDEM_DRAG_LAW_DI_FELICE: return "di_felice";
     case FSDEM_DRAG_LAW_BEETSTRA: return "beetstra";
+    case FSDEM_DRAG_LAW_GIC: return "gic";
     }
     return "unknown";
 }
@@ -16090,7 +16292,7 @@ fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsd
                                     char *message, size_t message_size) {
     static const char fn[] = "fsdem_drag_coefficient";
     fsdem_real c;
-    if ((int)law < (int)FSDEM_DRAG_LAW_STOKES || (int)law > (int)FSDEM_DRAG_LAW_BEETSTRA)
+    if ((int)law < (int)FSDEM_DRAG_LAW_STOKES || (int)law > (int)FSDEM_DRAG_LAW_GIC)
         return fsdem__reject(message, message_size, "%s: law must be a fsdem_drag_law, got %d", fn, (int)law);
     if (!(porosity > 0 && porosity <= 1))
         return fsdem__reject(message, message_size, "%s: porosity must be in (0, 1], got %g", fn, (double)porosity);
@@ -17661,11 +17863,461 @@ fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
     return st;
 }
 
+/* ===== >>impl_couple_gic : Granule-In-Cell ===========================================================
+
+   Contents: >>couple_gic_object (desc, creation), >>couple_gic_exchange (seed 004 Eq. 5a-5b, 7a, 18:
+   volume fractions, granule forces, the exchange to the grid), >>couple_gic_step (coupled time
+   stepping). The coupler speaks to the PIC and the DEM through their public calls (>>doc). */
+
+/* ---- >>couple_gic_object : desc, creation ---- */
+
+/* What one step's force evaluations add up (its figures in fsdem_gic_stats). */
+typedef struct fsdem__gic_tally {
+    fsdem_vec3 pressure, drag, to_fluid, lost; /* N s, in the DEM's units */
+    fsdem_real drag_dt;                        /* s; shortest relaxation time (0: none) */
+    int wet;
+} fsdem__gic_tally;
+
+struct fsdem_gic {
+    fsdem_gic_desc desc;
+    fsdem__status status;
+    fsdem_allocator allocator;
+    int dim;
+    fsdem__mac grid;               /* the PIC's cells (fsdem_pic_get_fields) */
+    fsdem_real rho;                /* kg/m^3, the water's */
+    fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC's forces are per metre), 1 in 3D */
+    fsdem_real cell_volume;        /* m^dim */
+    fsdem_real *solid, *porosity;  /* per cell: alpha_s (Eq. 7a), alpha_f' */
+    /* per granule: sample points, the samples, the force records of the last evaluation */
+    fsdem_vec3 *point;
+    fsdem_fluid_sample *sample;
+    fsdem_gic_force *force;
+    int granule_cap, records;
+    /* the sand substeps under way: their length h, count K, the evaluations made, the step's dt */
+    fsdem_real h, dt_now;
+    long long substeps_now, calls;
+    int failed;                    /* an evaluation failed (its message is in status) */
+    fsdem__gic_tally tally, last;  /* of the step under way, of the last step */
+    fsdem_real max_solid, solid_volume;
+    long long steps, substeps, substeps_total;
+    fsdem_real dt_last;
+    double sec_pic, sec_dem;
+};
+
+fsdem_gic_desc fsdem_gic_desc_default(void) {
+    fsdem_gic_desc d;
+    memset(&d, 0, sizeof d);
+    d.drag = FSDEM_DRAG_LAW_GIC;
+    d.drag_scale = 1;
+    d.cfl = 1;
+    d.max_dt_ratio = 1000;
+    d.drag_dt_fraction = (fsdem_real)0.5;
+    d.max_substeps = 100000;
+    return d;
+}
+
+fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t size) {
+    fsdem_dem_desc dd;
+    fsdem_pic_desc pd;
+    if (!d) return fsdem__reject(msg, size, "fsdem_gic_desc is NULL");
+    if (!d->pic || !d->dem) return fsdem__reject(msg, size, "fsdem_gic_desc.pic and .dem must both be set");
+    dd = fsdem_dem_get_desc(d->dem);
+    pd = fsdem_pic_get_desc(d->pic);
+    if (dd.dim != pd.dim) return fsdem__reject(msg, size, "fsdem_gic_desc: the DEM is %dD and the PIC %dD", dd.dim, pd.dim);
+    if (fsdem__norm(fsdem__sub(dd.gravity, pd.gravity)) > 1e-12 * fsdem__norm(pd.gravity))
+        return fsdem__reject(msg, size, "fsdem_gic_desc: the DEM gravity (%g, %g, %g) differs from the PIC's (%g, %g, %g) m/s^2",
+                             (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)pd.gravity.x,
+                             (double)pd.gravity.y, (double)pd.gravity.z);
+    if (strcmp(fsdem_drag_law_name(d->drag), "unknown") == 0)
+        return fsdem__reject(msg, size, "fsdem_gic_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
+    if (!(d->drag_scale > 0) || !fsdem__finite(d->drag_scale))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_scale must be > 0 and finite (got %g)", (double)d->drag_scale);
+    if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.viscosity must be >= 0 Pa s and finite (got %g)", (double)d->viscosity);
+    if (d->drag != FSDEM_DRAG_LAW_GIC && d->viscosity == 0 && !(pd.viscosity > 0))
+        return fsdem__reject(msg, size,
+                             "fsdem_gic_desc.viscosity: the %s drag law needs a viscosity, and it is 0 here and in the (inviscid) PIC",
+                             fsdem_drag_law_name(d->drag));
+    if (!(d->max_solid_fraction == 0 || (d->max_solid_fraction > 0 && d->max_solid_fraction < 1)))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.max_solid_fraction must be 0 (densest packing) or in (0, 1) (got %g)",
+                             (double)d->max_solid_fraction);
+    if (!(d->cfl > 0) || !fsdem__finite(d->cfl))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.cfl must be > 0 and finite (got %g)", (double)d->cfl);
+    if (!(d->max_dt_ratio >= 1) || !fsdem__finite(d->max_dt_ratio))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.max_dt_ratio must be >= 1 and finite (got %g)", (double)d->max_dt_ratio);
+    if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_dt_fraction must be in (0, 1] (got %g)", (double)d->drag_dt_fraction);
+    if (d->max_substeps < 1) return fsdem__reject(msg, size, "fsdem_gic_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_allocator al;
+    fsdem_gic *c;
+    fsdem_pic_fields g;
+    fsdem_pic_desc pd;
+    fsdem_result res;
+    size_t cells;
+    int k;
+    if (out) *out = NULL;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem_gic_desc_check(desc, msg, sizeof msg);
+    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
+    c = (fsdem_gic *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL, res == FSDEM_OK ? &al : NULL,
+                                       sizeof *c, "fsdem_gic_create", &res);
+    if (!c) return res;
+    pd = fsdem_pic_get_desc(desc->pic);
+    g = fsdem_pic_get_fields(desc->pic);
+    c->desc = *desc;
+    c->allocator = al;
+    c->status.log = desc->log;
+    c->status.log_user = desc->log_user;
+    c->dim = g.dim;
+    c->rho = pd.density;
+    c->depth = g.dim == 2 ? fsdem_dem_get_desc(desc->dem).disc_length : 1;
+    if (c->desc.viscosity == 0) c->desc.viscosity = pd.density * pd.viscosity;
+    if (c->desc.max_solid_fraction == 0) c->desc.max_solid_fraction = (fsdem_real)(g.dim == 3 ? 0.740 : 0.907);
+    fsdem__mac_init(&c->grid, g.dim, g.n, g.cell_size, g.origin);
+    c->cell_volume = g.cell_size * g.cell_size * (g.dim == 3 ? g.cell_size : 1);
+    cells = (size_t)c->grid.ncell;
+    c->solid = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
+    c->porosity = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
+    if (!c->solid || !c->porosity) {
+        fsdem__log_oom(desc->log, desc->log_user, "fsdem_gic_create", 2 * sizeof(fsdem_real) * cells);
+        fsdem_gic_destroy(c);
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    }
+    for (k = 0; k < c->grid.ncell; ++k) {
+        c->solid[k] = 0;
+        c->porosity[k] = 1;
+    }
+    *out = c;
+    return FSDEM_OK;
+}
+
+void fsdem_gic_destroy(fsdem_gic *c) {
+    fsdem_allocator al;
+    size_t cells;
+    if (!c) return;
+    al = c->allocator;
+    cells = (size_t)c->grid.ncell;
+    fsdem__free(&al, c->solid, sizeof(fsdem_real) * cells);
+    fsdem__free(&al, c->porosity, sizeof(fsdem_real) * cells);
+    fsdem__free(&al, c->point, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
+    fsdem__free(&al, c->sample, sizeof(fsdem_fluid_sample) * (size_t)c->granule_cap);
+    fsdem__free(&al, c->force, sizeof(fsdem_gic_force) * (size_t)c->granule_cap);
+    fsdem__free(&al, c, sizeof *c);
+}
+
+const char *fsdem_gic_last_error(const fsdem_gic *c) { return c ? c->status.message : "fsdem_gic is NULL"; }
+
+fsdem_gic_desc fsdem_gic_get_desc(const fsdem_gic *c) {
+    fsdem_gic_desc d;
+    if (c) return c->desc;
+    memset(&d, 0, sizeof d);
+    return d;
+}
+
+fsdem_gic_fields fsdem_gic_get_fields(const fsdem_gic *c) {
+    fsdem_gic_fields f;
+    int a;
+    memset(&f, 0, sizeof f);
+    if (!c) return f;
+    f.dim = c->dim;
+    for (a = 0; a < 3; ++a) f.n[a] = c->grid.n[a];
+    f.cell_size = c->grid.dx;
+    f.origin = c->grid.lo;
+    f.solid_fraction = c->solid;
+    f.porosity = c->porosity;
+    return f;
+}
+
+/* Room for `count` granules in the per-granule arrays (outside the substeps). */
+static fsdem_result fsdem__gic_reserve(fsdem_gic *c, int count) {
+    void **const arrays[3] = {(void **)&c->point, (void **)&c->sample, (void **)&c->force};
+    const size_t sizes[3] = {sizeof(fsdem_vec3), sizeof(fsdem_fluid_sample), sizeof(fsdem_gic_force)};
+    if (fsdem__grow_set(&c->allocator, arrays, sizes, 3, &c->granule_cap, c->records, count) != FSDEM_OK)
+        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_gic: out of memory (%d granules)", count);
+    return FSDEM_OK;
+}
+
+/* ---- >>couple_gic_exchange : volume fractions, granule forces, the exchange ---- */
+
+/* Volume of granule i (m^3; the disc's area times the DEM's disc_length in 2D, as its mass). */
+static fsdem_real fsdem__gic_volume(const fsdem_gic *c, fsdem_real r) {
+    return c->dim == 3 ? (fsdem_real)(4 * FSDEM__PI / 3) * r * r * r : (fsdem_real)FSDEM__PI * r * r * c->depth;
+}
+
+/* Kernel of point p over the cell centres (grid units: centre i at i), indices clamped into the
+   grid, so weight beyond a side falls on the boundary cell. */
+static void fsdem__gic_kernel(const fsdem_gic *c, fsdem_vec3 p, fsdem__kernel *kw) {
+    fsdem_real s[3];
+    int b;
+    for (b = 0; b < 3; ++b)
+        s[b] = b < c->dim ? (fsdem__comp(p, b) - fsdem__comp(c->grid.lo, b)) * c->grid.inv_dx - (fsdem_real)0.5 : 0;
+    fsdem__kernel_weights(kw, c->dim, s, c->grid.n, 0);
+}
+
+/* Step 3 of >>couple_gic: alpha_s (Eq. 7a) and the porosity, into the PIC. */
+fsdem_result fsdem_gic_update(fsdem_gic *c) {
+    fsdem_dem_particles P;
+    fsdem_pic_coupling pc;
+    int i, k, q0, q1, q2;
+    double volume = 0;
+    fsdem_real most = 0;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    P = fsdem_dem_get_particles(c->desc.dem);
+    for (i = 0; i < P.count; ++i)
+        if (!fsdem__finite3(P.position[i]))
+            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_gic_update: granule %d (id %d) has a non-finite position", i, P.id[i]);
+    memset(c->solid, 0, sizeof(fsdem_real) * (size_t)c->grid.ncell);
+    for (i = 0; i < P.count; ++i) {
+        const fsdem_real share = fsdem__gic_volume(c, P.radius[i]) / (c->cell_volume * c->depth);
+        fsdem__kernel kw;
+        fsdem__gic_kernel(c, P.position[i], &kw);
+        for (q2 = 0; q2 < kw.count[2]; ++q2)
+            for (q1 = 0; q1 < kw.count[1]; ++q1)
+                for (q0 = 0; q0 < kw.count[0]; ++q0)
+                    c->solid[fsdem__mac_cell(&c->grid, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])] +=
+                        share * kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2];
+    }
+    pc = fsdem_pic_get_coupling(c->desc.pic);
+    for (k = 0; k < c->grid.ncell; ++k) {
+        const fsdem_real s = c->solid[k];
+        volume += (double)s;
+        if (s > most) most = s;
+        c->porosity[k] = 1 - (s < c->desc.max_solid_fraction ? s : c->desc.max_solid_fraction);
+        pc.porosity[k] = c->porosity[k];
+    }
+    c->max_solid = most;
+    c->solid_volume = (fsdem_real)(volume * (double)c->cell_volume);
+    return fsdem__ok(&c->status);
+}
+
+/* The porosity alpha_f' at point p (the cells' values interpolated). */
+static fsdem_real fsdem__gic_porosity_at(const fsdem_gic *c, fsdem_vec3 p) {
+    fsdem__kernel kw;
+    fsdem_real e = 0;
+    int q0, q1, q2;
+    fsdem__gic_kernel(c, p, &kw);
+    for (q2 = 0; q2 < kw.count[2]; ++q2)
+        for (q1 = 0; q1 < kw.count[1]; ++q1)
+            for (q0 = 0; q0 < kw.count[0]; ++q0)
+                e += c->porosity[fsdem__mac_cell(&c->grid, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])] * kw.w[0][q0] * kw.w[1][q1] *
+                     kw.w[2][q2];
+    return e;
+}
+
+/* The shortest drag relaxation time of granule i with coefficient cs = s c (kg m^-3 s^-1) at
+   porosity eps: its own, m / (cs V), and the water's round it, alpha_f rho / (alpha_s cs). */
+static fsdem_real fsdem__gic_relaxation(const fsdem_gic *c, fsdem_real mass, fsdem_real volume, fsdem_real cs, fsdem_real eps) {
+    const fsdem_real grain = mass / (cs * volume), water = eps < 1 ? eps * c->rho / ((1 - eps) * cs) : grain;
+    return grain < water ? grain : water;
+}
+
+/* Steps 1-2 of >>couple_gic at one force evaluation of the sand substeps (fsdem_dem_substep_fn):
+   the granules' loads from the water of the last fluid step and their reactions onto its faces,
+   weighted by the time the integrator holds these loads. */
+static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time) {
+    fsdem_gic *c = (fsdem_gic *)user;
+    const fsdem_dem_particles P = fsdem_dem_get_particles(dem);
+    const fsdem_dem_coupling load = fsdem_dem_get_coupling(dem);
+    const int verlet = fsdem_dem_get_desc(dem).integrator == FSDEM_DEM_INTEGRATOR_VERLET;
+    const fsdem_real held = verlet && (c->calls == 0 || c->calls == c->substeps_now) ? c->h / 2 : c->h;
+    fsdem_result res;
+    int i, wet_count = 0;
+    c->failed = 1; /* until the evaluation completes */
+    (void)time;
+    for (i = 0; i < P.count; ++i) c->point[i] = P.position[i];
+    res = fsdem_pic_sample(c->desc.pic, P.count, c->point, c->sample);
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+    if (fsdem_pic_get_stats(c->desc.pic).steps == 0) /* no pressure solved yet: the water's at rest */
+        for (i = 0; i < P.count; ++i) c->sample[i].pressure_gradient = fsdem__scale(fsdem_pic_get_desc(c->desc.pic).gravity, c->rho);
+    for (i = 0; i < P.count; ++i) {
+        char why[FSDEM__MESSAGE_SIZE];
+        const fsdem_fluid_sample *s = &c->sample[i];
+        fsdem_gic_force *rec = &c->force[i];
+        const fsdem_real volume = fsdem__gic_volume(c, P.radius[i]), wet = s->volume_fraction;
+        const fsdem_vec3 slip = fsdem__sub(s->velocity, P.velocity[i]);
+        fsdem_real cv = 0, eps = fsdem__gic_porosity_at(c, P.position[i]);
+        rec->id = P.id[i];
+        rec->fluid_velocity = s->velocity;
+        rec->porosity = eps;
+        rec->liquid = wet;
+        rec->pressure = rec->drag = fsdem__zero3();
+        if (P.fixed[i] || !(wet > 0)) {
+            load.force[i] = fsdem__zero3();
+            continue;
+        }
+        res = fsdem_drag_coefficient(c->desc.drag, eps, 2 * P.radius[i], fsdem__norm(slip), c->rho,
+                                     c->desc.viscosity > 0 ? c->desc.viscosity : 1, &cv, NULL, why, sizeof why);
+        if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: granule %d (id %d): %s", i, P.id[i], why);
+        cv *= c->desc.drag_scale;
+        rec->pressure = fsdem__scale(s->pressure_gradient, -volume * wet);
+        rec->drag = fsdem__scale(slip, cv * volume * wet);
+        load.force[i] = fsdem__add(rec->pressure, rec->drag);
+        c->tally.pressure = fsdem__madd(c->tally.pressure, rec->pressure, held);
+        c->tally.drag = fsdem__madd(c->tally.drag, rec->drag, held);
+        wet_count++;
+        if (cv > 0) {
+            const fsdem_real t = fsdem__gic_relaxation(c, P.mass[i], volume, cv, eps);
+            if (c->tally.drag_dt == 0 || t < c->tally.drag_dt) c->tally.drag_dt = t;
+        }
+        if (rec->drag.x != 0 || rec->drag.y != 0 || rec->drag.z != 0) {
+            const fsdem_vec3 impulse = fsdem__scale(rec->drag, -held);
+            int taken = 0;
+            res = fsdem_pic_add_force(c->desc.pic, P.position[i], P.radius[i], fsdem__scale(impulse, 1 / (c->dt_now * c->depth)), &taken);
+            if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+            if (taken) c->tally.to_fluid = fsdem__add(c->tally.to_fluid, impulse);
+            else c->tally.lost = fsdem__add(c->tally.lost, impulse);
+        }
+    }
+    c->tally.wet = wet_count;
+    c->records = P.count;
+    c->calls++;
+    c->failed = 0;
+    return FSDEM_OK;
+}
+
+/* ---- >>couple_gic_step : coupled time stepping ---- */
+
+/* The stable coupled step of the section (Eq. 33, the drag limit of the last step). */
+static fsdem_result fsdem__gic_stable(const fsdem_gic *c, fsdem_real *dt) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    fsdem_result res = fsdem_pic_stable_dt(c->desc.pic, dt);
+    fsdem_real vmax = 0, limit = c->desc.max_dt_ratio * fsdem_dem_get_desc(c->desc.dem).dt;
+    int i;
+    if (res != FSDEM_OK)
+        return fsdem__fail((fsdem__status *)&c->status, res, "fsdem_gic_stable_dt: %s", fsdem_pic_last_error(c->desc.pic));
+    for (i = 0; i < P.count; ++i) {
+        const fsdem_real v = fsdem__norm(P.velocity[i]);
+        if (!fsdem__finite(v))
+            return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NAN, "fsdem_gic: granule %d (id %d) has a non-finite velocity", i,
+                               P.id[i]);
+        if (v > vmax) vmax = v;
+    }
+    if (vmax > 0 && c->desc.cfl * c->grid.dx / vmax < limit) limit = c->desc.cfl * c->grid.dx / vmax;
+    if (c->last.drag_dt > 0 && c->desc.drag_dt_fraction * c->last.drag_dt < limit) limit = c->desc.drag_dt_fraction * c->last.drag_dt;
+    if (limit < *dt) *dt = limit;
+    return FSDEM_OK;
+}
+
+/* One coupled step of dt after the checks: sand substeps with the exchange, fractions, the PIC. */
+static fsdem_result fsdem__gic_run(fsdem_gic *c, fsdem_real dt) {
+    long long substeps = 0;
+    fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_gic");
+    clock_t t0, t1;
+    if (res != FSDEM_OK) return res;
+    if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
+        return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+    if (c->last.drag_dt > 0 && dt > c->desc.drag_dt_fraction * c->last.drag_dt * (1 + (fsdem_real)1e-6))
+        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
+                           "fsdem_gic: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s", (double)dt,
+                           (double)c->desc.drag_dt_fraction, (double)c->last.drag_dt);
+    if ((res = fsdem__gic_reserve(c, fsdem_dem_get_particles(c->desc.dem).count)) != FSDEM_OK) return res;
+    fsdem_dem_substep_count(c->desc.dem, dt, &c->substeps_now);
+    c->h = dt / (fsdem_real)c->substeps_now;
+    c->dt_now = dt;
+    c->calls = 0;
+    c->failed = 0;
+    memset(&c->tally, 0, sizeof c->tally);
+    fsdem_pic_clear_forces(c->desc.pic);
+    t0 = clock();
+    res = fsdem_dem_advance_with(c->desc.dem, dt, fsdem__gic_evaluate, c, &substeps);
+    t1 = clock();
+    c->sec_dem += (double)(t1 - t0) / CLOCKS_PER_SEC;
+    c->last = c->tally;
+    c->substeps = substeps;
+    c->substeps_total += substeps;
+    if (res != FSDEM_OK)
+        return c->failed ? res : fsdem__fail(&c->status, res, "fsdem_gic: sand substeps: %s", fsdem_dem_last_error(c->desc.dem));
+    if ((res = fsdem_gic_update(c)) != FSDEM_OK) return res;
+    res = fsdem_pic_step_dt(c->desc.pic, dt);
+    c->sec_pic += (double)(clock() - t1) / CLOCKS_PER_SEC;
+    c->steps++;
+    c->dt_last = dt;
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
+    return fsdem__ok(&c->status);
+}
+
+fsdem_result fsdem_gic_step(fsdem_gic *c) {
+    fsdem_real dt = 0;
+    fsdem_result res;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if ((res = fsdem__gic_stable(c, &dt)) != FSDEM_OK) return res;
+    return fsdem__gic_run(c, dt);
+}
+
+fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) {
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_gic_step_dt: dt = %g s must be > 0 and finite", (double)dt);
+    return fsdem__gic_run(c, dt);
+}
+
+/* fsdem__coupled_advance's verbs for this coupler. */
+static double fsdem__gic_now(const void *c) { return fsdem_pic_time(((const fsdem_gic *)c)->desc.pic); }
+
+static fsdem_result fsdem__gic_prepare(void *c, fsdem_real *dt) { return fsdem__gic_stable((const fsdem_gic *)c, dt); }
+
+static fsdem_result fsdem__gic_go(void *c, fsdem_real dt) { return fsdem__gic_run((fsdem_gic *)c, dt); }
+
+fsdem_result fsdem_gic_advance(fsdem_gic *c, fsdem_real duration, long long *steps) {
+    static const fsdem__coupled_verbs verbs = {fsdem__gic_now, fsdem__gic_prepare, fsdem__gic_go};
+    if (steps) *steps = 0;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__coupled_advance(c, &c->status, "fsdem_gic_advance", &verbs, duration, steps);
+}
+
+fsdem_result fsdem_gic_stable_dt(const fsdem_gic *c, fsdem_real *dt) {
+    if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__gic_stable(c, dt);
+}
+
+double fsdem_gic_time(const fsdem_gic *c) { return c ? fsdem_pic_time(c->desc.pic) : 0; }
+
+/* The record of DEM particle `index` from the last step, or -1. */
+static int fsdem__gic_record(const fsdem_gic *c, int index) {
+    return c->records ? fsdem__dem_record_of(c->desc.dem, index, &c->force[0].id, sizeof(fsdem_gic_force), c->records) : -1;
+}
+
+fsdem_result fsdem_gic_get_force(const fsdem_gic *c, int index, fsdem_gic_force *out) {
+    int k;
+    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
+    k = fsdem__gic_record(c, index);
+    if (k < 0) return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_gic_get_force: no record of particle %d", index);
+    *out = c->force[k];
+    return fsdem__ok((fsdem__status *)&c->status);
+}
+
+fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *c) {
+    fsdem_gic_stats st;
+    memset(&st, 0, sizeof st);
+    if (!c) return st;
+    st.steps = c->steps;
+    st.time = fsdem_pic_time(c->desc.pic);
+    st.dt = c->dt_last;
+    st.substeps = c->substeps;
+    st.substeps_total = c->substeps_total;
+    st.wet = c->last.wet;
+    st.pressure_impulse = c->last.pressure;
+    st.drag_impulse = c->last.drag;
+    st.to_fluid = c->last.to_fluid;
+    st.lost = c->last.lost;
+    st.drag_dt = c->last.drag_dt;
+    st.max_solid_fraction = c->max_solid;
+    st.solid_volume = c->solid_volume;
+    st.seconds_pic = c->sec_pic;
+    st.seconds_dem = c->sec_dem;
+    return st;
+}
+
 /* ===== >>impl_restart : checkpoint and restart =======================================================
 
    Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
    every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_swe_dem, >>restart_mps,
-   >>restart_mps_dem, >>restart_pic_dem (one visitor per object lists what it saves, in order, and serves saving and
+   >>restart_mps_dem, >>restart_pic_dem, >>restart_gic (one visitor per object lists what it saves, in order, and serves saving and
    restoring alike), >>restart_api
    (memory and files). A restore runs the visitor three times over the payload: CHECK validates
    everything and compares the desc, RESERVE allocates, COMMIT writes into the object. Only COMMIT
@@ -17685,7 +18337,7 @@ fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
 typedef char fsdem__restart_int_sizes[sizeof(unsigned int) == 4 && sizeof(unsigned long long) == 8 ? 1 : -1];
 
 enum { FSDEM__RESTART_DEM = 1, FSDEM__RESTART_PIC = 2, FSDEM__RESTART_SWE = 3, FSDEM__RESTART_SWE_DEM = 4, FSDEM__RESTART_MPS = 5,
-       FSDEM__RESTART_MPS_DEM = 6, FSDEM__RESTART_PIC_DEM = 7 };
+       FSDEM__RESTART_MPS_DEM = 6, FSDEM__RESTART_PIC_DEM = 7, FSDEM__RESTART_GIC = 8 };
 
 typedef enum fsdem__restart_mode {
     FSDEM__RESTART_WRITE = 0,   /* object to payload (to memory, to a file, or only measured) */
@@ -18876,6 +19528,45 @@ static void fsdem__restart_pic_dem(fsdem__restart *io, void *object) {
     fsdem__restart_tag(io, "PDM.");
 }
 
+/* ---- >>restart_gic : Granule-In-Cell coupler ---- */
+
+/* The two solvers, then the coupler's fractions, counters and last step's tally (its drag limit
+   bounds the next step). The force records are rebuilt by the next step's evaluations. */
+static void fsdem__restart_gic(fsdem__restart *io, void *object) {
+    fsdem_gic *c = (fsdem_gic *)object;
+    const size_t cells = sizeof(fsdem_real) * (size_t)c->grid.ncell;
+    fsdem__restart_tag(io, "GIC1");
+    io->section = "water (PIC)";
+    fsdem__restart_pic(io, c->desc.pic);
+    io->section = "granules (DEM)";
+    fsdem__restart_dem(io, c->desc.dem);
+    io->section = NULL;
+    fsdem__restart_same_int(io, (int)c->desc.drag, "drag");
+    fsdem__restart_same_real(io, c->desc.drag_scale, "drag_scale");
+    fsdem__restart_same_real(io, c->desc.viscosity, "viscosity");
+    fsdem__restart_same_real(io, c->desc.max_solid_fraction, "max_solid_fraction");
+    fsdem__restart_same_real(io, c->desc.cfl, "cfl");
+    fsdem__restart_same_real(io, c->desc.max_dt_ratio, "max_dt_ratio");
+    fsdem__restart_same_real(io, c->desc.drag_dt_fraction, "drag_dt_fraction");
+    fsdem__restart_same_ll(io, c->desc.max_substeps, "max_substeps");
+    fsdem__restart_data(io, c->solid, cells);
+    fsdem__restart_data(io, c->porosity, cells);
+    fsdem__restart_data(io, &c->max_solid, sizeof c->max_solid);
+    fsdem__restart_data(io, &c->solid_volume, sizeof c->solid_volume);
+    fsdem__restart_data(io, &c->last.pressure, sizeof c->last.pressure);
+    fsdem__restart_data(io, &c->last.drag, sizeof c->last.drag);
+    fsdem__restart_data(io, &c->last.to_fluid, sizeof c->last.to_fluid);
+    fsdem__restart_data(io, &c->last.lost, sizeof c->last.lost);
+    fsdem__restart_data(io, &c->last.drag_dt, sizeof c->last.drag_dt);
+    fsdem__restart_data(io, &c->last.wet, sizeof c->last.wet);
+    fsdem__restart_data(io, &c->steps, sizeof c->steps);
+    fsdem__restart_data(io, &c->substeps, sizeof c->substeps);
+    fsdem__restart_data(io, &c->substeps_total, sizeof c->substeps_total);
+    fsdem__restart_data(io, &c->dt_last, sizeof c->dt_last);
+    if (io->mode == FSDEM__RESTART_COMMIT) c->records = 0;
+    fsdem__restart_tag(io, "GIC.");
+}
+
 /* ---- >>restart_api : memory and files ---- */
 
 /* What the API needs to know of one object. */
@@ -18898,6 +19589,7 @@ static const char *fsdem__restart_kind_name(unsigned int kind) {
     case FSDEM__RESTART_MPS: return "fsdem_mps";
     case FSDEM__RESTART_MPS_DEM: return "fsdem_mps_dem";
     case FSDEM__RESTART_PIC_DEM: return "fsdem_pic_dem";
+    case FSDEM__RESTART_GIC: return "fsdem_gic";
     }
     return "unknown object";
 }
@@ -19007,6 +19699,24 @@ static fsdem__restart_object fsdem__restart_of_mps_dem(const fsdem_mps_dem *c) {
     o.allocator = &c->allocator;
     o.status = (fsdem__status *)&c->status;
     o.name = "fsdem_mps_dem";
+    return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_gic(const fsdem_gic *c) {
+    fsdem__restart_object o;
+    memset(&o, 0, sizeof o);
+    if (!c) return o;
+    o.kind = FSDEM__RESTART_GIC;
+    o.dim = c->dim;
+    o.sizes[0] = fsdem_pic_get_particles(c->desc.pic).count;
+    o.sizes[1] = fsdem_dem_get_particles(c->desc.dem).count;
+    o.sizes[2] = c->grid.ncell;
+    o.sizes[3] = 0;
+    o.object = (void *)c;
+    o.visit = fsdem__restart_gic;
+    o.allocator = &c->allocator;
+    o.status = (fsdem__status *)&c->status;
+    o.name = "fsdem_gic";
     return o;
 }
 
@@ -19378,6 +20088,27 @@ fsdem_result fsdem_pic_dem_save_memory(const fsdem_pic_dem *coupler, void *buffe
 
 fsdem_result fsdem_pic_dem_restore_memory(fsdem_pic_dem *coupler, const void *buffer, size_t size) {
     fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
+    return fsdem__restart_load_memory(&o, buffer, size);
+}
+
+/* fsdem_gic (>>restart): the Granule-In-Cell coupler with its two solvers. */
+fsdem_result fsdem_gic_save(const fsdem_gic *coupler, const char *path) {
+    fsdem__restart_object o = fsdem__restart_of_gic(coupler);
+    return fsdem__restart_save_file(&o, path);
+}
+
+fsdem_result fsdem_gic_restore(fsdem_gic *coupler, const char *path) {
+    fsdem__restart_object o = fsdem__restart_of_gic(coupler);
+    return fsdem__restart_load_file(&o, path);
+}
+
+fsdem_result fsdem_gic_save_memory(const fsdem_gic *coupler, void *buffer, size_t capacity, size_t *size) {
+    fsdem__restart_object o = fsdem__restart_of_gic(coupler);
+    return fsdem__restart_save_memory(&o, buffer, capacity, size);
+}
+
+fsdem_result fsdem_gic_restore_memory(fsdem_gic *coupler, const void *buffer, size_t size) {
+    fsdem__restart_object o = fsdem__restart_of_gic(coupler);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 
@@ -20463,6 +21194,26 @@ fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *c, const char *path) {
                                 "id,pressure_x,pressure_y,pressure_z,viscous_x,viscous_y,viscous_z,torque_x,torque_y,torque_z,"
                                 "weight_correction_x,weight_correction_y,weight_correction_z,volume,faces",
                                 fsdem_dem_get_particles(c->desc.dem).count, fsdem__io_pic_dem_row, c);
+}
+
+static int fsdem__io_gic_row(const void *object, int i, double *v) {
+    const fsdem_gic *c = (const fsdem_gic *)object;
+    const int k = fsdem__gic_record(c, i);
+    if (k < 0) return 0;
+    v[0] = c->force[k].id;
+    fsdem__io_put3(v + 1, c->force[k].pressure);
+    fsdem__io_put3(v + 4, c->force[k].drag);
+    fsdem__io_put3(v + 7, c->force[k].fluid_velocity);
+    v[10] = (double)c->force[k].porosity;
+    v[11] = (double)c->force[k].liquid;
+    return 1;
+}
+
+fsdem_result fsdem_gic_write_csv(const fsdem_gic *c, const char *path) {
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__io_write_rows(&c->status, "fsdem_gic_write_csv", path,
+                                "id,pressure_x,pressure_y,pressure_z,drag_x,drag_y,drag_z,fluid_u,fluid_v,fluid_w,porosity,liquid",
+                                fsdem_dem_get_particles(c->desc.dem).count, fsdem__io_gic_row, c);
 }
 
 static void fsdem__io_pic_velocity(const void *user, long long c, double out[3]) {

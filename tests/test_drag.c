@@ -67,6 +67,10 @@ START_TEST(test_drag_by_hand) {
         {FSDEM_DRAG_LAW_BEETSTRA, 0.75, 2e-4, 0.3, 1.2, 1.8e-5, 34465.57587356321},        /* Re 3, air */
         {FSDEM_DRAG_LAW_BEETSTRA, 0.6, 1e-3, 0.05, 1000, 1e-3, 192660.1646375388},         /* Re 30 */
         {FSDEM_DRAG_LAW_BEETSTRA, 0.9, 1e-3, 0.5, 1000, 1e-3, 403193.7123828798},          /* Re 450 */
+        /* seed 004 Eq. 5b: c = 18 (0.44) rho slip / d whatever eps and mu */
+        {FSDEM_DRAG_LAW_GIC, 0.5, 1e-3, 0.05, 1000, 1e-3, 396000.0},
+        {FSDEM_DRAG_LAW_GIC, 1, 7.8e-4, 0.01, 1000, 1e-2, 101538.4615384615},
+        {FSDEM_DRAG_LAW_GIC, 0.7, 1e-3, 0, 1000, 1e-3, 0.0},                              /* no creeping term */
     };
     /* rounding of the inputs to fsdem_real and of a few pow/exp calls, relative */
     const double tol = TOL(1e-12, 64);

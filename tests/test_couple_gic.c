@@ -1,0 +1,350 @@
+/* Granule-In-Cell (seed 004): the granule volume fraction of regular packings (Eq. 7a), still water
+   over a fixed bed (the variable-coefficient projections, Eq. 12a-12b), the momentum exchange of
+   Eq. 18 (the water gains exactly what the granules' drag loses), restart, bad input. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "fsdem_tests.h"
+
+#define RHO 1000.0
+#define G 9.81
+#define PI 3.14159265358979323846
+
+typedef struct gic_tank {
+    fsdem_pic *pic;
+    fsdem_dem *dem;
+    fsdem_gic *gic;
+} gic_tank;
+
+/* A closed box [0, L]^dim with cells of dx, water up to `depth` (none for depth 0), and an empty
+   DEM over the same box (Verlet, GIC contact law, dt 1e-4 s) of granule density rho_s. */
+static gic_tank make_gic(int dim, double L, double dx, double depth, double rho_s) {
+    gic_tank t;
+    fsdem_pic_desc pd = fsdem_pic_desc_default(dim);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(dim);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_gic_desc gd = fsdem_gic_desc_default();
+    const fsdem_real l = (fsdem_real)L;
+    pd.cell_size = (fsdem_real)dx;
+    pd.jitter = 0;
+    pd.domain_max = dim == 2 ? fsdem_v3(l, l, 0) : fsdem_v3(l, l, l);
+    pd.gravity = dim == 2 ? fsdem_v3(0, (fsdem_real)-G, 0) : fsdem_v3(0, 0, (fsdem_real)-G);
+    pd.dt_max = (fsdem_real)5e-3;
+    pd.pressure_tolerance = (fsdem_real)TOL(1e-8, 1e3);
+    ck_assert_int_eq(fsdem_pic_create(&pd, &t.pic), FSDEM_OK);
+    if (depth > 0) {
+        const fsdem_vec3 top = dim == 2 ? fsdem_v3(l, (fsdem_real)depth, 0) : fsdem_v3(l, l, (fsdem_real)depth);
+        ck_assert_int_eq(fsdem_pic_fill_box(t.pic, fsdem_v3(0, 0, 0), top, fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    }
+    dd.domain_min = fsdem_v3(0, 0, 0);
+    dd.domain_max = pd.domain_max;
+    dd.gravity = pd.gravity;
+    dd.law = FSDEM_DEM_LAW_GIC;
+    dd.rotation = 0;
+    dd.dt = (fsdem_real)1e-4;
+    ck_assert_int_eq(fsdem_dem_create(&dd, &t.dem), FSDEM_OK);
+    m.density = (fsdem_real)rho_s;
+    m.young_modulus = (fsdem_real)1e6;
+    ck_assert_int_eq(fsdem_dem_add_material(t.dem, &m, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_add_wall(t.dem, &(fsdem_dem_wall_desc){FSDEM_DEM_WALL_TYPE_BOX_INSIDE, dd.domain_min, dd.domain_max,
+                                                                       fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0, NULL, NULL},
+                                        NULL),
+                     FSDEM_OK);
+    gd.pic = t.pic;
+    gd.dem = t.dem;
+    ck_assert_int_eq(fsdem_gic_create(&gd, &t.gic), FSDEM_OK);
+    return t;
+}
+
+static void free_gic(gic_tank *t) {
+    fsdem_gic_destroy(t->gic);
+    fsdem_dem_destroy(t->dem);
+    fsdem_pic_destroy(t->pic);
+}
+
+static void add_granule(gic_tank *t, fsdem_vec3 x, double r, int fixed, fsdem_vec3 v) {
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    p.position = x;
+    p.radius = (fsdem_real)r;
+    p.fixed = fixed;
+    p.velocity = v;
+    ck_assert_int_eq(fsdem_dem_add_particle(t->dem, &p, NULL), FSDEM_OK);
+}
+
+/* Granules on a cubic (square) lattice of spacing s filling [lo, hi) along every axis but with the
+   last axis up to `top`; returns the count. */
+static int add_lattice(gic_tank *t, int dim, double s, double r, double lo, double hi, double top, int fixed) {
+    int i, j, k, n = 0;
+    const int m = (int)floor((hi - lo) / s + 1e-9), mt = (int)floor((top - lo) / s + 1e-9);
+    for (k = 0; k < (dim == 3 ? mt : 1); ++k)
+        for (j = 0; j < (dim == 3 ? m : mt); ++j)
+            for (i = 0; i < m; ++i) {
+                const fsdem_vec3 x = fsdem_v3((fsdem_real)(lo + (i + 0.5) * s), (fsdem_real)(lo + (j + 0.5) * s),
+                                              dim == 3 ? (fsdem_real)(lo + (k + 0.5) * s) : 0);
+                add_granule(t, x, r, fixed, fsdem_v3(0, 0, 0));
+                ++n;
+            }
+    return n;
+}
+
+/* Eq. 7a on a regular packing: every interior cell reads the packing's solid fraction within 2 %
+   (the issue's line) for lattice spacings of dx/2 and 2 dx/3 (a spacing that does not divide the
+   cell: the tent kernel's sum over the lattice then ripples), and the cells hold exactly the
+   granules' volume (the weight beyond a side is folded into the boundary cell). */
+START_TEST(test_gic_solid_fraction_of_a_packing) {
+    static const double spacing[2] = {0.5, 2.0 / 3.0};
+    int dim, q;
+    for (dim = 2; dim <= 3; ++dim)
+        for (q = 0; q < 2; ++q) {
+            const double L = 0.12, dx = 0.01, s = spacing[q] * dx, r = 0.4 * s;
+            const double phi = dim == 2 ? PI * r * r / (s * s) : 4.0 / 3.0 * PI * r * r * r / (s * s * s);
+            gic_tank t = make_gic(dim, L, dx, 0, 2500);
+            const int n = add_lattice(&t, dim, s, r, 0, L, L, 1);
+            fsdem_gic_fields f;
+            fsdem_gic_stats st;
+            double worst = 0, total = 0;
+            int c, i, j, k, checked = 0;
+            ck_assert_int_eq(fsdem_gic_update(t.gic), FSDEM_OK);
+            f = fsdem_gic_get_fields(t.gic);
+            st = fsdem_gic_get_stats(t.gic);
+            for (k = 0; k < f.n[2]; ++k)
+                for (j = 0; j < f.n[1]; ++j)
+                    for (i = 0; i < f.n[0]; ++i) {
+                        const int interior = i > 0 && i < f.n[0] - 1 && j > 0 && j < f.n[1] - 1 && (dim == 2 || (k > 0 && k < f.n[2] - 1));
+                        c = i + f.n[0] * (j + f.n[1] * k);
+                        total += f.solid_fraction[c];
+                        if (!interior) continue;
+                        ++checked;
+                        if (fabs(f.solid_fraction[c] / phi - 1) > worst) worst = fabs(f.solid_fraction[c] / phi - 1);
+                        ck_assert_msg(fabs(f.porosity[c] - (1 - f.solid_fraction[c])) <= 4 * TEST_EPS, "porosity of cell %d", c);
+                    }
+            ck_assert_int_gt(checked, 0);
+            ck_assert_msg(worst <= 0.02, "%dD, spacing %g dx: alpha_s off by %.3g %% of %g", dim, spacing[q], 100 * worst, phi);
+            {
+                const double cellv = pow(dx, dim), vol = n * (dim == 2 ? PI * r * r : 4.0 / 3.0 * PI * r * r * r);
+                /* rounding: one product per granule and cell, summed over ~1e4 terms */
+                ck_assert_msg(fabs(total * cellv / vol - 1) <= TOL(1e-12, 1e3), "%dD: cells hold %.15g of the granules' volume",
+                              dim, total * cellv / vol);
+                ck_assert_msg(fabs(st.solid_volume / vol - 1) <= TOL(1e-12, 1e3), "stats.solid_volume %.15g", (double)st.solid_volume);
+            }
+            TEST_REPORT("%dD, spacing %.3f dx, phi %.4f: worst interior cell %.4f %%", dim, spacing[q], phi, 100 * worst);
+            free_gic(&t);
+        }
+}
+END_TEST
+
+/* Still water over a fixed, uniform bed (solid fraction 0.5, granules a quarter cell apart): after
+   1 s the water is at rest (the issue's line: fastest particle below 1e-3 m/s), the level has risen
+   by the bed's solid volume (the density projection makes room for it, Eq. 12b) and the pressure
+   under the bed is hydrostatic for that level. */
+START_TEST(test_gic_still_water_over_a_fixed_bed) {
+    const double L = 0.2, dx = 0.01, depth = 0.1, bed = 0.04, s = dx / 4, phi = 0.5, r = s * sqrt(phi / PI);
+    gic_tank t = make_gic(2, L, dx, depth, 2500);
+    fsdem_pic_stats ps;
+    fsdem_real level = 0, p_floor = 0;
+    int id_level, id_floor;
+    add_lattice(&t, 2, s, r, 0, L, bed, 1);
+    ck_assert_int_eq(fsdem_gic_update(t.gic), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_add_gauge(t.pic, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3((fsdem_real)(L / 2), 0, 0), 0, &id_level), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_add_gauge(t.pic, FSDEM_PIC_GAUGE_KIND_PRESSURE, fsdem_v3((fsdem_real)(L / 2), (fsdem_real)(dx / 2), 0), 0,
+                                         &id_floor),
+                     FSDEM_OK);
+    ck_assert_int_eq(fsdem_gic_advance(t.gic, 1, NULL), FSDEM_OK);
+    ps = fsdem_pic_get_stats(t.pic);
+    ck_assert_int_eq(fsdem_pic_gauge(t.pic, id_level, &level), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_gauge(t.pic, id_floor, &p_floor), FSDEM_OK);
+    TEST_REPORT("after 1 s: fastest particle %.3g m/s, level %.5f m (water %.3f + bed's solid %.3f), floor pressure %.2f Pa "
+                "(rho g level - rho g dx/2 = %.2f)",
+                (double)ps.max_speed, (double)level, depth, phi * bed, (double)p_floor, RHO * G * ((double)level - dx / 2));
+    ck_assert_msg(ps.max_speed < 1e-3, "fastest particle %g m/s after 1 s", (double)ps.max_speed);
+    /* the level moves in steps of the level set's resolution: within a tenth of a cell */
+    ck_assert_msg(fabs(level - (depth + phi * bed)) < 0.1 * dx, "level %g m, expected %g m", (double)level, depth + phi * bed);
+    ck_assert_msg(fabs(p_floor / (RHO * G * (level - dx / 2)) - 1) < 0.02, "floor pressure %g Pa", (double)p_floor);
+    free_gic(&t);
+}
+END_TEST
+
+/* Eq. 18: free granules sinking through still water, no contacts. Over one step the water's faces
+   gain exactly the impulse the granules' drag lost (to rounding): the stats' sums, and the PIC's
+   accelerations summed as the grid's momentum (rho dx^dim per face) times dt; and each
+   granule's momentum changes by its weight, its pressure force and its drag, nothing else. */
+START_TEST(test_gic_momentum_exchange_exact) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        const double L = 0.1, dx = 0.01, r = 0.002, dt = 2e-3;
+        gic_tank t = make_gic(dim, L, dx, 0.08, 2500);
+        fsdem_dem_particles P;
+        fsdem_vec3 p0[8], sum_mv = fsdem_v3(0, 0, 0), weight = fsdem_v3(0, 0, 0);
+        fsdem_pic_coupling pc;
+        fsdem_gic_stats st;
+        double grid[3] = {0, 0, 0}, scale;
+        int i, a, f;
+        const fsdem_real depth = dim == 2 ? fsdem_dem_get_desc(t.dem).disc_length : 1;
+        for (i = 0; i < 8; ++i) {
+            const double x = 0.02 + 0.02 * (i % 4), y = 0.03 + 0.025 * (i / 4);
+            add_granule(&t, dim == 2 ? fsdem_v3((fsdem_real)x, (fsdem_real)y, 0) : fsdem_v3((fsdem_real)x, (fsdem_real)0.05, (fsdem_real)y), r,
+                        0, dim == 2 ? fsdem_v3((fsdem_real)0.05, (fsdem_real)-0.1, 0) : fsdem_v3((fsdem_real)0.05, (fsdem_real)0.02, (fsdem_real)-0.1));
+        }
+        ck_assert_int_eq(fsdem_gic_update(t.gic), FSDEM_OK);
+        ck_assert_int_eq(fsdem_gic_step_dt(t.gic, (fsdem_real)dt), FSDEM_OK); /* the water starts moving */
+        P = fsdem_dem_get_particles(t.dem);
+        for (i = 0; i < 8; ++i) p0[i] = fsdem_v3(P.mass[i] * P.velocity[i].x, P.mass[i] * P.velocity[i].y, P.mass[i] * P.velocity[i].z);
+        ck_assert_int_eq(fsdem_gic_step_dt(t.gic, (fsdem_real)dt), FSDEM_OK);
+        st = fsdem_gic_get_stats(t.gic);
+        P = fsdem_dem_get_particles(t.dem);
+        ck_assert_int_eq(st.wet, 8);
+        ck_assert_msg(fsdem_dem_get_stats(t.dem).contacts == 0, "no contacts expected");
+        for (i = 0; i < 8; ++i) {
+            sum_mv = fsdem_v3(sum_mv.x + P.mass[i] * P.velocity[i].x - p0[i].x, sum_mv.y + P.mass[i] * P.velocity[i].y - p0[i].y,
+                              sum_mv.z + P.mass[i] * P.velocity[i].z - p0[i].z);
+            weight = fsdem_v3(weight.x + P.mass[i] * (fsdem_real)dt * fsdem_dem_get_desc(t.dem).gravity.x,
+                              weight.y + P.mass[i] * (fsdem_real)dt * fsdem_dem_get_desc(t.dem).gravity.y,
+                              weight.z + P.mass[i] * (fsdem_real)dt * fsdem_dem_get_desc(t.dem).gravity.z);
+        }
+        pc = fsdem_pic_get_coupling(t.pic);
+
+        /* the water's faces gain rho dx^dim a dt each, whatever their porosity (fsdem_pic_coupling) */
+        for (a = 0; a < dim; ++a)
+            for (f = 0; f < pc.face_count[a]; ++f) grid[a] += pc.acceleration[a][f];
+        scale = RHO * pow(dx, dim) * dt * depth;
+        for (a = 0; a < dim; ++a) {
+            const double drag = a == 0 ? st.drag_impulse.x : a == 1 ? st.drag_impulse.y : st.drag_impulse.z;
+            const double fluid = a == 0 ? st.to_fluid.x : a == 1 ? st.to_fluid.y : st.to_fluid.z;
+            const double press = a == 0 ? st.pressure_impulse.x : a == 1 ? st.pressure_impulse.y : st.pressure_impulse.z;
+            const double mv = a == 0 ? sum_mv.x : a == 1 ? sum_mv.y : sum_mv.z, w = a == 0 ? weight.x : a == 1 ? weight.y : weight.z;
+            const double ref = fabs(drag) + fabs(press) + fabs(w);
+            ck_assert_msg(fabs(drag + fluid) <= TOL(1e-13, 64) * ref, "%dD axis %d: drag %g, to fluid %g", dim, a, drag, fluid);
+            ck_assert_msg(fabs(grid[a] * scale - fluid) <= TOL(1e-12, 256) * ref, "%dD axis %d: grid %.15g, to fluid %.15g", dim, a,
+                          grid[a] * scale, fluid);
+            ck_assert_msg(fabs(mv - (w + press + drag)) <= TOL(1e-10, 1e3) * ref, "%dD axis %d: m dv %.15g, impulses %.15g", dim, a, mv,
+                          w + press + drag);
+            TEST_REPORT("%dD axis %d: drag impulse %.6g N s, to the grid %.6g, granules' m dv %.6g = weight %.6g + pressure %.6g + drag",
+                        dim, a, drag, grid[a] * scale, mv, w, press);
+        }
+        ck_assert(st.lost.x == 0 && st.lost.y == 0 && st.lost.z == 0);
+        free_gic(&t);
+    }
+}
+END_TEST
+
+/* A saved coupler goes on bit for bit: the granules' and the water's states after three more steps
+   from the restored state equal those of the uninterrupted run. */
+START_TEST(test_gic_restart_bit_for_bit) {
+    const double L = 0.1, dx = 0.01;
+    gic_tank a = make_gic(2, L, dx, 0.06, 2500), b = make_gic(2, L, dx, 0.06, 2500);
+    size_t need = 0, size = 0;
+    void *buf;
+    int i, k;
+    for (i = 0; i < 12; ++i) {
+        const fsdem_vec3 x = fsdem_v3((fsdem_real)(0.02 + 0.005 * i), (fsdem_real)(0.07 + 0.002 * (i % 3)), 0);
+        add_granule(&a, x, 0.002, 0, fsdem_v3(0, 0, 0));
+        add_granule(&b, x, 0.002, 0, fsdem_v3(0, 0, 0));
+    }
+    ck_assert_int_eq(fsdem_gic_update(a.gic), FSDEM_OK);
+    for (k = 0; k < 3; ++k) ck_assert_int_eq(fsdem_gic_step(a.gic), FSDEM_OK);
+    fsdem_gic_save_memory(a.gic, NULL, 0, &need);
+    buf = malloc(need);
+    ck_assert_int_eq(fsdem_gic_save_memory(a.gic, buf, need, &size), FSDEM_OK);
+    ck_assert_int_eq(fsdem_gic_restore_memory(b.gic, buf, size), FSDEM_OK);
+    for (k = 0; k < 3; ++k) {
+        ck_assert_int_eq(fsdem_gic_step(a.gic), FSDEM_OK);
+        ck_assert_int_eq(fsdem_gic_step(b.gic), FSDEM_OK);
+    }
+    {
+        const fsdem_dem_particles pa = fsdem_dem_get_particles(a.dem), pb = fsdem_dem_get_particles(b.dem);
+        const fsdem_pic_particles qa = fsdem_pic_get_particles(a.pic), qb = fsdem_pic_get_particles(b.pic);
+        ck_assert_int_eq(pa.count, pb.count);
+        ck_assert_int_eq(qa.count, qb.count);
+        ck_assert(memcmp(pa.position, pb.position, sizeof(fsdem_vec3) * (size_t)pa.count) == 0);
+        ck_assert(memcmp(pa.velocity, pb.velocity, sizeof(fsdem_vec3) * (size_t)pa.count) == 0);
+        ck_assert(memcmp(qa.position, qb.position, sizeof(fsdem_vec3) * (size_t)qa.count) == 0);
+        ck_assert(memcmp(qa.velocity, qb.velocity, sizeof(fsdem_vec3) * (size_t)qa.count) == 0);
+        ck_assert(fsdem_gic_time(a.gic) == fsdem_gic_time(b.gic));
+        ck_assert(fsdem_gic_get_stats(a.gic).steps == fsdem_gic_get_stats(b.gic).steps);
+    }
+    free(buf);
+    free_gic(&a);
+    free_gic(&b);
+}
+END_TEST
+
+/* Bad input: each desc field named, NULL objects, refused steps that change nothing. */
+START_TEST(test_gic_bad_input) {
+    gic_tank t = make_gic(2, 0.1, 0.01, 0.05, 2500);
+    fsdem_gic_desc d = fsdem_gic_desc_default();
+    fsdem_gic *g = NULL;
+    char msg[256];
+    fsdem_real dt;
+    fsdem_gic_force rec;
+    size_t k;
+    static const struct {
+        const char *field;
+        int which;
+        double value;
+    } bad[] = {{"drag_scale", 0, 0}, {"drag_scale", 0, NAN}, {"viscosity", 1, -1}, {"max_solid_fraction", 2, 1},
+               {"cfl", 3, 0}, {"max_dt_ratio", 4, 0.5}, {"drag_dt_fraction", 5, 1.5}, {"max_substeps", 6, 0}};
+    ck_assert_int_eq(fsdem_gic_desc_check(NULL, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_msg(strstr(msg, ".pic and .dem") != NULL, "%s", msg);
+    d.pic = t.pic;
+    d.dem = t.dem;
+    ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_OK);
+    for (k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+        fsdem_gic_desc e = d;
+        switch (bad[k].which) {
+        case 0: e.drag_scale = (fsdem_real)bad[k].value; break;
+        case 1: e.viscosity = (fsdem_real)bad[k].value; break;
+        case 2: e.max_solid_fraction = (fsdem_real)bad[k].value; break;
+        case 3: e.cfl = (fsdem_real)bad[k].value; break;
+        case 4: e.max_dt_ratio = (fsdem_real)bad[k].value; break;
+        case 5: e.drag_dt_fraction = (fsdem_real)bad[k].value; break;
+        default: e.max_substeps = (long long)bad[k].value; break;
+        }
+        ck_assert_int_eq(fsdem_gic_create(&e, &g), FSDEM_ERR_INVALID_ARG);
+        ck_assert(g == NULL);
+        fsdem_gic_desc_check(&e, msg, sizeof msg);
+        ck_assert_msg(strstr(msg, bad[k].field) != NULL, "case %d: %s", (int)k, msg);
+    }
+    d.drag = FSDEM_DRAG_LAW_STOKES; /* needs a viscosity; the PIC here is inviscid */
+    ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_msg(strstr(msg, "viscosity") != NULL, "%s", msg);
+    d.viscosity = (fsdem_real)1e-3;
+    ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_OK);
+    /* NULL objects */
+    ck_assert_int_eq(fsdem_gic_step(NULL), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_gic_step_dt(NULL, 1e-3), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_gic_advance(NULL, 1, NULL), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_gic_stable_dt(NULL, &dt), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_gic_update(NULL), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_gic_get_force(NULL, 0, &rec), FSDEM_ERR_INVALID_ARG);
+    ck_assert(fsdem_gic_get_stats(NULL).steps == 0 && fsdem_gic_time(NULL) == 0);
+    ck_assert(strstr(fsdem_gic_last_error(NULL), "NULL") != NULL);
+    fsdem_gic_destroy(NULL);
+    /* refused steps: nothing moves, nothing is counted */
+    add_granule(&t, fsdem_v3((fsdem_real)0.05, (fsdem_real)0.03, 0), 0.002, 0, fsdem_v3(0, 0, 0));
+    ck_assert_int_eq(fsdem_gic_step_dt(t.gic, 0), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_gic_step_dt(t.gic, (fsdem_real)NAN), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_gic_step_dt(t.gic, 100), FSDEM_ERR_INVALID_ARG); /* 1e6 substeps > max_substeps */
+    ck_assert_msg(strstr(fsdem_gic_last_error(t.gic), "max_substeps") != NULL, "%s", fsdem_gic_last_error(t.gic));
+    ck_assert_int_eq(fsdem_gic_get_force(t.gic, 0, &rec), FSDEM_ERR_NOT_FOUND);
+    ck_assert(fsdem_gic_get_stats(t.gic).steps == 0 && fsdem_dem_time(t.dem) == 0 && fsdem_pic_time(t.pic) == 0);
+    ck_assert_int_eq(fsdem_gic_step(t.gic), FSDEM_OK);
+    ck_assert_int_eq(fsdem_gic_get_force(t.gic, 0, &rec), FSDEM_OK);
+    ck_assert(rec.liquid > 0 && rec.pressure.y > 0); /* under water: buoyancy up */
+    free_gic(&t);
+}
+END_TEST
+
+Suite *couple_gic_suite(void) {
+    Suite *s = suite_create("couple_gic");
+    TCase *tc = tcase_create("gic");
+    tcase_set_timeout(tc, 600);
+    tcase_add_test(tc, test_gic_solid_fraction_of_a_packing);
+    tcase_add_test(tc, test_gic_still_water_over_a_fixed_bed);
+    tcase_add_test(tc, test_gic_momentum_exchange_exact);
+    tcase_add_test(tc, test_gic_restart_bit_for_bit);
+    tcase_add_test(tc, test_gic_bad_input);
+    suite_add_tcase(s, tc);
+    return s;
+}
