@@ -35,6 +35,8 @@ static fsdem_result save_pic_dem(const void *o, void *b, size_t c, size_t *s) {
     return fsdem_pic_dem_save_memory((const fsdem_pic_dem *)o, b, c, s);
 }
 
+static fsdem_result save_gic(const void *o, void *b, size_t c, size_t *s) { return fsdem_gic_save_memory((const fsdem_gic *)o, b, c, s); }
+
 static int print_hash(const char *name, const void *object, save_fn save) {
     size_t size = 0;
     unsigned char *buf;
@@ -258,8 +260,49 @@ static int pic_dem_scene(void) {
     return bad;
 }
 
+/* A block of 60 granules falling into a 2D FLIP tank of 1/32 m cells, 25 adaptive steps: volume
+   fractions, the porous projections, granule forces and the exchange, sand substeps with contacts. */
+static int gic_scene(void) {
+    fsdem_pic_desc pd = fsdem_pic_desc_default(2);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_gic_desc gd = fsdem_gic_desc_default();
+    fsdem_pic *pic = NULL;
+    fsdem_dem *dem = NULL;
+    fsdem_gic *c = NULL;
+    int k, bad;
+    pd.cell_size = (fsdem_real)(1.0 / 32);
+    pd.dt_max = (fsdem_real)2e-3;
+    dd.domain_max = fsdem_v3(1, 1, 0);
+    dd.law = FSDEM_DEM_LAW_GIC;
+    dd.rotation = 0;
+    dd.dt = 2e-5;
+    m.young_modulus = 1e6;
+    bad = fsdem_pic_create(&pd, &pic) != FSDEM_OK || fsdem_dem_create(&dd, &dem) != FSDEM_OK;
+    if (!bad) {
+        gd.pic = pic;
+        gd.dem = dem;
+        bad = fsdem_pic_fill_box(pic, fsdem_v3(0, 0, 0), fsdem_v3(1, 0.4, 0), fsdem_v3(0, 0, 0), NULL) != FSDEM_OK ||
+              fsdem_dem_add_material(dem, &m, NULL) != FSDEM_OK;
+        for (k = 0; k < 60 && !bad; ++k) {
+            fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+            p.radius = (fsdem_real)0.006;
+            p.position = fsdem_v3((fsdem_real)(0.4 + 0.0125 * (k % 12)), (fsdem_real)(0.38 + 0.0125 * (k / 12)), 0);
+            p.velocity = fsdem_v3(0, (fsdem_real)-0.3, 0);
+            bad = fsdem_dem_add_particle(dem, &p, NULL) != FSDEM_OK;
+        }
+        bad = bad || fsdem_gic_create(&gd, &c) != FSDEM_OK || fsdem_gic_update(c) != FSDEM_OK;
+        for (k = 0; k < 25 && !bad; ++k) bad = fsdem_gic_step(c) != FSDEM_OK;
+        bad = bad || print_hash("gic", c, save_gic);
+    }
+    fsdem_gic_destroy(c);
+    fsdem_dem_destroy(dem);
+    fsdem_pic_destroy(pic);
+    return bad;
+}
+
 int main(void) {
-    const int bad = dem_scene() | pic_scene() | swe_scene() | mps_scene() | swe_dem_scene() | mps_dem_scene() | pic_dem_scene();
+    const int bad = dem_scene() | pic_scene() | swe_scene() | mps_scene() | swe_dem_scene() | mps_dem_scene() | pic_dem_scene() | gic_scene();
     if (bad) printf("determinism: a scene failed\n");
     return bad;
 }
