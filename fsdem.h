@@ -2859,13 +2859,23 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
           pressure-gradient force  F_p = -V_i grad p                               (Eq. 5a)
           drag                     F_d = s c V_i (u - v_i)                         (Eq. 5b, or >>drag)
         with c of desc.drag at the porosity eps of the granule's position (the cells' alpha_f'
-        interpolated) and s = desc.drag_scale; the granule is given l (F_p + F_d) as its external
-        load (a granule in air, l = 0, feels neither);
-     2. momentum exchange (Eq. 18): each evaluation's -l F_d goes to the water's faces around the
+        interpolated) and s = desc.drag_scale, and with desc.virtual_mass its added mass
+        m_a = C_a rho_f V_i l (C_a = 1/2 for a sphere, Eq. 5c; 1 for a disc, the potential-flow
+        value of a cylinder) in the inertia of Eq. 14, (m + m_a) dv/dt = m_a a_f + F_o, where
+        a_f = g - grad p / rho_f + F_s / (rho_f alpha_f) is the water's acceleration of the last
+        step at the granule (Eq. 17: the grid's FLIP increment, the exchange's acceleration taken
+        from the PIC's faces) and F_o = F_c + m g + l (F_p + F_d) every other force, the contacts
+        F_c of the evaluation included. The DEM keeps the mass m, so the granule is given the load
+        F_ext that makes its m dv/dt = F_c + m g + F_ext the motion of Eq. 14:
+          F_ext = (m l (F_p + F_d) + m m_a (a_f - g) - m_a F_c) / (m + m_a),
+        whose part beyond l (F_p + F_d) is the virtual-mass force F_v = m_a (a_f - dv/dt) (Eq. 5c).
+        A granule in air (l = 0) feels none of them. With the predictor-corrector integrator F_c is
+        that of the substep's start (its loads are held over the substep);
+     2. momentum exchange (Eq. 18): each evaluation's -(l F_d + F_v) goes to the water's faces around the
         granule (fsdem_pic_add_force, tent kernel of half-width max(r_i, dx)) weighted by the time
         the DEM integrator holds it (h/2, h, ..., h, h/2 for Verlet substeps of h, h for the
         predictor-corrector) over dt, so the water gains exactly the impulse the granules' drag
-        lost. F_p is not exchanged: the water's own step applies -grad p to the liquid's volume
+        and virtual mass lost. F_p is not exchanged: the water's own step applies -grad p to the liquid's volume
         alpha_f (Eq. 8 with Eq. 3's -alpha_f grad p), and -V_i grad p is the same mixture pressure
         on the granule's volume; handing its reaction to the water too would count the pressure on
         the granules' volume twice (a fixed bed under still water would then hold
@@ -2888,7 +2898,7 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
    Ownership: the coupler owns the PIC's porosity and its accelerations (it zeroes them at the start
    of every step, fsdem_pic_clear_forces, so another coupler's forces on the same PIC would be
    lost), and the DEM's external forces.
-   Not built yet (issue 22): virtual mass (Eq. 14-17), the concentration-gradient and capillary
+   Not built yet (issue 22): the concentration-gradient and capillary
    forces (Eq. 21-31), wetting (Eq. 19-20), the granules' flux in the velocity projection. The
    viscous stress of Eq. 3 is the PIC's nu lap(u), not div(alpha_f T). */
 
@@ -2900,6 +2910,7 @@ typedef struct fsdem_gic_desc {
     fsdem_drag_law drag;          /* default FSDEM_DRAG_LAW_GIC (seed 004 Eq. 5b) */
     fsdem_real drag_scale;        /* -; factor on the law's coefficient, > 0; default 1 (0.1 with */
                                   /*    the GIC law is the seed's mu = 0.044 of §6.1) */
+    int virtual_mass;             /* 1: the granules' added mass, Eq. 14-17 (see step 1); default 1 */
     fsdem_real viscosity;         /* Pa s; dynamic viscosity the drag laws use (all but the GIC */
                                   /*    law need one); 0: rho nu of the PIC; default 0 */
     fsdem_real max_solid_fraction; /* -; cap of alpha_s in (0, 1); 0: 0.740 in 3D, 0.907 in 2D */
@@ -2952,7 +2963,9 @@ typedef struct fsdem_gic_force {
     int id;                       /* stable id of the DEM particle (fsdem_dem_particles.id) */
     fsdem_vec3 pressure;          /* N; l F_p (Eq. 5a) */
     fsdem_vec3 drag;              /* N; l F_d (Eq. 5b or the chosen law) */
+    fsdem_vec3 virtual_mass;      /* N; F_v (Eq. 5c, 14), 0 without desc.virtual_mass */
     fsdem_vec3 fluid_velocity;    /* m/s; u at the granule */
+    fsdem_vec3 fluid_acceleration; /* m/s^2; a_f of Eq. 17 at the granule */
     fsdem_real porosity;          /* -; eps at the granule */
     fsdem_real liquid;            /* -; l, the liquid fraction at the granule (0: dry) */
 } fsdem_gic_force;
@@ -2985,6 +2998,7 @@ typedef struct fsdem_gic_stats {
     int wet;                      /* granules with l > 0 at the last evaluation */
     fsdem_vec3 pressure_impulse;  /* N s; the granules' Eq. 5a impulse over the last step */
     fsdem_vec3 drag_impulse;      /* N s; the granules' drag impulse over the last step */
+    fsdem_vec3 virtual_mass_impulse; /* N s; the granules' virtual-mass impulse, last step */
     fsdem_vec3 to_fluid;          /* N s; the impulse handed to the water's faces, last step, in the */
                                   /*    DEM's units (the water gets it per metre of depth in 2D) */
     fsdem_vec3 lost;              /* N s; exchange with no liquid face in reach (dropped) */
@@ -3287,8 +3301,8 @@ FSDEM_API fsdem_result fsdem_mps_write_csv(const fsdem_mps *mps, const char *pat
               fluid_u,fluid_v,fluid_w,porosity,reynolds,wet
      PIC-DEM  id,pressure_x,pressure_y,pressure_z,viscous_x,viscous_y,viscous_z,torque_x,torque_y,
               torque_z,weight_correction_x,weight_correction_y,weight_correction_z,volume,faces
-     GIC      id,pressure_x,pressure_y,pressure_z,drag_x,drag_y,drag_z,fluid_u,fluid_v,fluid_w,
-              porosity,liquid
+     GIC      id,pressure_x,pressure_y,pressure_z,drag_x,drag_y,drag_z,virtual_mass_x,virtual_mass_y,
+              virtual_mass_z,fluid_u,fluid_v,fluid_w,porosity,liquid
    Units as in the record types (N, N m, m^3, m^2, m, m/s). */
 FSDEM_API fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *coupler, const char *path);
 FSDEM_API fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *coupler, const char *path);
@@ -17873,7 +17887,7 @@ fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
 
 /* What one step's force evaluations add up (its figures in fsdem_gic_stats). */
 typedef struct fsdem__gic_tally {
-    fsdem_vec3 pressure, drag, to_fluid, lost; /* N s, in the DEM's units */
+    fsdem_vec3 pressure, drag, virtual_mass, to_fluid, lost; /* N s, in the DEM's units */
     fsdem_real drag_dt;                        /* s; shortest relaxation time (0: none) */
     int wet;
 } fsdem__gic_tally;
@@ -17892,6 +17906,7 @@ struct fsdem_gic {
     fsdem_vec3 *point;
     fsdem_fluid_sample *sample;
     fsdem_gic_force *force;
+    fsdem_vec3 *fluid_accel;       /* a_f of Eq. 17 at each granule, for the step under way */
     int granule_cap, records;
     /* the sand substeps under way: their length h, count K, the evaluations made, the step's dt */
     fsdem_real h, dt_now;
@@ -17909,6 +17924,7 @@ fsdem_gic_desc fsdem_gic_desc_default(void) {
     memset(&d, 0, sizeof d);
     d.drag = FSDEM_DRAG_LAW_GIC;
     d.drag_scale = 1;
+    d.virtual_mass = 1;
     d.cfl = 1;
     d.max_dt_ratio = 1000;
     d.drag_dt_fraction = (fsdem_real)0.5;
@@ -17930,6 +17946,8 @@ fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t siz
                              (double)pd.gravity.y, (double)pd.gravity.z);
     if (strcmp(fsdem_drag_law_name(d->drag), "unknown") == 0)
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
+    if (d->virtual_mass != 0 && d->virtual_mass != 1)
+        return fsdem__reject(msg, size, "fsdem_gic_desc.virtual_mass must be 0 or 1 (got %d)", d->virtual_mass);
     if (!(d->drag_scale > 0) || !fsdem__finite(d->drag_scale))
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag_scale must be > 0 and finite (got %g)", (double)d->drag_scale);
     if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
@@ -18007,6 +18025,7 @@ void fsdem_gic_destroy(fsdem_gic *c) {
     fsdem__free(&al, c->point, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
     fsdem__free(&al, c->sample, sizeof(fsdem_fluid_sample) * (size_t)c->granule_cap);
     fsdem__free(&al, c->force, sizeof(fsdem_gic_force) * (size_t)c->granule_cap);
+    fsdem__free(&al, c->fluid_accel, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
     fsdem__free(&al, c, sizeof *c);
 }
 
@@ -18035,9 +18054,9 @@ fsdem_gic_fields fsdem_gic_get_fields(const fsdem_gic *c) {
 
 /* Room for `count` granules in the per-granule arrays (outside the substeps). */
 static fsdem_result fsdem__gic_reserve(fsdem_gic *c, int count) {
-    void **const arrays[3] = {(void **)&c->point, (void **)&c->sample, (void **)&c->force};
-    const size_t sizes[3] = {sizeof(fsdem_vec3), sizeof(fsdem_fluid_sample), sizeof(fsdem_gic_force)};
-    if (fsdem__grow_set(&c->allocator, arrays, sizes, 3, &c->granule_cap, c->records, count) != FSDEM_OK)
+    void **const arrays[4] = {(void **)&c->point, (void **)&c->sample, (void **)&c->force, (void **)&c->fluid_accel};
+    const size_t sizes[4] = {sizeof(fsdem_vec3), sizeof(fsdem_fluid_sample), sizeof(fsdem_gic_force), sizeof(fsdem_vec3)};
+    if (fsdem__grow_set(&c->allocator, arrays, sizes, 4, &c->granule_cap, c->records, count) != FSDEM_OK)
         return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_gic: out of memory (%d granules)", count);
     return FSDEM_OK;
 }
@@ -18116,6 +18135,44 @@ static fsdem_real fsdem__gic_relaxation(const fsdem_gic *c, fsdem_real mass, fsd
     return grain < water ? grain : water;
 }
 
+/* The face field q of axis a (layout of fsdem_pic_coupling) at point p, trilinear between faces. */
+static fsdem_real fsdem__gic_face_value(const fsdem_gic *c, const fsdem_real *q, int a, fsdem_vec3 p) {
+    fsdem__kernel kw;
+    fsdem_real s[3], v = 0;
+    int b, q0, q1, q2;
+    for (b = 0; b < 3; ++b)
+        s[b] = b < c->dim ? (fsdem__comp(p, b) - fsdem__comp(c->grid.lo, b)) * c->grid.inv_dx - (b == a ? 0 : (fsdem_real)0.5) : 0;
+    fsdem__kernel_weights(&kw, c->dim, s, c->grid.fn[a], 0);
+    for (q2 = 0; q2 < kw.count[2]; ++q2)
+        for (q1 = 0; q1 < kw.count[1]; ++q1)
+            for (q0 = 0; q0 < kw.count[0]; ++q0)
+                v += q[fsdem__mac_face(&c->grid, a, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])] * kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2];
+    return v;
+}
+
+/* a_f of Eq. 17 at every granule from the water of the last step, before its accelerations are
+   cleared: g - grad p / rho_f + F_s / (rho_f alpha_f) (0 before the PIC's first step: water at rest). */
+static void fsdem__gic_fluid_accelerations(fsdem_gic *c) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    const fsdem_pic_coupling pc = fsdem_pic_get_coupling(c->desc.pic);
+    const fsdem_vec3 g = fsdem_pic_get_desc(c->desc.pic).gravity;
+    int i, a;
+    if (!c->desc.virtual_mass) return;
+    if (fsdem_pic_get_stats(c->desc.pic).steps == 0) {
+        for (i = 0; i < P.count; ++i) c->fluid_accel[i] = fsdem__zero3();
+        return;
+    }
+    for (i = 0; i < P.count; ++i) c->point[i] = P.position[i];
+    fsdem_pic_sample(c->desc.pic, P.count, c->point, c->sample);
+    for (i = 0; i < P.count; ++i) {
+        const fsdem_real eps = fsdem__gic_porosity_at(c, P.position[i]);
+        fsdem_vec3 af = fsdem__madd(g, c->sample[i].pressure_gradient, -1 / c->rho);
+        for (a = 0; a < c->dim; ++a)
+            fsdem__set_comp(&af, a, fsdem__comp(af, a) + fsdem__gic_face_value(c, pc.acceleration[a], a, P.position[i]) / eps);
+        c->fluid_accel[i] = af;
+    }
+}
+
 /* Steps 1-2 of >>couple_gic at one force evaluation of the sand substeps (fsdem_dem_substep_fn):
    the granules' loads from the water of the last fluid step and their reactions onto its faces,
    weighted by the time the integrator holds these loads. */
@@ -18123,7 +18180,9 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
     fsdem_gic *c = (fsdem_gic *)user;
     const fsdem_dem_particles P = fsdem_dem_get_particles(dem);
     const fsdem_dem_coupling load = fsdem_dem_get_coupling(dem);
-    const int verlet = fsdem_dem_get_desc(dem).integrator == FSDEM_DEM_INTEGRATOR_VERLET;
+    const fsdem_dem_desc dd = fsdem_dem_get_desc(dem);
+    const int verlet = dd.integrator == FSDEM_DEM_INTEGRATOR_VERLET;
+    const fsdem_vec3 gravity = dd.gravity;
     const fsdem_real held = verlet && (c->calls == 0 || c->calls == c->substeps_now) ? c->h / 2 : c->h;
     fsdem_result res;
     int i, wet_count = 0;
@@ -18145,7 +18204,8 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
         rec->fluid_velocity = s->velocity;
         rec->porosity = eps;
         rec->liquid = wet;
-        rec->pressure = rec->drag = fsdem__zero3();
+        rec->pressure = rec->drag = rec->virtual_mass = fsdem__zero3();
+        rec->fluid_acceleration = c->desc.virtual_mass ? c->fluid_accel[i] : fsdem__zero3();
         if (P.fixed[i] || !(wet > 0)) {
             load.force[i] = fsdem__zero3();
             continue;
@@ -18157,20 +18217,31 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
         rec->pressure = fsdem__scale(s->pressure_gradient, -volume * wet);
         rec->drag = fsdem__scale(slip, cv * volume * wet);
         load.force[i] = fsdem__add(rec->pressure, rec->drag);
+        if (c->desc.virtual_mass) { /* Eq. 14 through the DEM's mass m (>>couple_gic step 1) */
+            const fsdem_real m = P.mass[i], ma = (c->dim == 3 ? (fsdem_real)0.5 : 1) * c->rho * volume * wet, k = 1 / (m + ma);
+            const fsdem_vec3 ext = fsdem__madd(fsdem__madd(fsdem__scale(load.force[i], m * k), fsdem__sub(c->fluid_accel[i], gravity), m * ma * k),
+                                               P.force[i], -ma * k);
+            rec->virtual_mass = fsdem__sub(ext, load.force[i]);
+            load.force[i] = ext;
+        }
         c->tally.pressure = fsdem__madd(c->tally.pressure, rec->pressure, held);
         c->tally.drag = fsdem__madd(c->tally.drag, rec->drag, held);
+        c->tally.virtual_mass = fsdem__madd(c->tally.virtual_mass, rec->virtual_mass, held);
         wet_count++;
         if (cv > 0) {
             const fsdem_real t = fsdem__gic_relaxation(c, P.mass[i], volume, cv, eps);
             if (c->tally.drag_dt == 0 || t < c->tally.drag_dt) c->tally.drag_dt = t;
         }
-        if (rec->drag.x != 0 || rec->drag.y != 0 || rec->drag.z != 0) {
-            const fsdem_vec3 impulse = fsdem__scale(rec->drag, -held);
+        {
+            const fsdem_vec3 impulse = fsdem__scale(fsdem__add(rec->drag, rec->virtual_mass), -held);
             int taken = 0;
-            res = fsdem_pic_add_force(c->desc.pic, P.position[i], P.radius[i], fsdem__scale(impulse, 1 / (c->dt_now * c->depth)), &taken);
-            if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
-            if (taken) c->tally.to_fluid = fsdem__add(c->tally.to_fluid, impulse);
-            else c->tally.lost = fsdem__add(c->tally.lost, impulse);
+            if (impulse.x != 0 || impulse.y != 0 || impulse.z != 0) {
+                res = fsdem_pic_add_force(c->desc.pic, P.position[i], P.radius[i], fsdem__scale(impulse, 1 / (c->dt_now * c->depth)),
+                                          &taken);
+                if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+                if (taken) c->tally.to_fluid = fsdem__add(c->tally.to_fluid, impulse);
+                else c->tally.lost = fsdem__add(c->tally.lost, impulse);
+            }
         }
     }
     c->tally.wet = wet_count;
@@ -18222,6 +18293,7 @@ static fsdem_result fsdem__gic_run(fsdem_gic *c, fsdem_real dt) {
     c->calls = 0;
     c->failed = 0;
     memset(&c->tally, 0, sizeof c->tally);
+    fsdem__gic_fluid_accelerations(c);
     fsdem_pic_clear_forces(c->desc.pic);
     t0 = clock();
     res = fsdem_dem_advance_with(c->desc.dem, dt, fsdem__gic_evaluate, c, &substeps);
@@ -18303,6 +18375,7 @@ fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *c) {
     st.wet = c->last.wet;
     st.pressure_impulse = c->last.pressure;
     st.drag_impulse = c->last.drag;
+    st.virtual_mass_impulse = c->last.virtual_mass;
     st.to_fluid = c->last.to_fluid;
     st.lost = c->last.lost;
     st.drag_dt = c->last.drag_dt;
@@ -19543,6 +19616,7 @@ static void fsdem__restart_gic(fsdem__restart *io, void *object) {
     io->section = NULL;
     fsdem__restart_same_int(io, (int)c->desc.drag, "drag");
     fsdem__restart_same_real(io, c->desc.drag_scale, "drag_scale");
+    fsdem__restart_same_int(io, c->desc.virtual_mass, "virtual_mass");
     fsdem__restart_same_real(io, c->desc.viscosity, "viscosity");
     fsdem__restart_same_real(io, c->desc.max_solid_fraction, "max_solid_fraction");
     fsdem__restart_same_real(io, c->desc.cfl, "cfl");
@@ -19555,6 +19629,7 @@ static void fsdem__restart_gic(fsdem__restart *io, void *object) {
     fsdem__restart_data(io, &c->solid_volume, sizeof c->solid_volume);
     fsdem__restart_data(io, &c->last.pressure, sizeof c->last.pressure);
     fsdem__restart_data(io, &c->last.drag, sizeof c->last.drag);
+    fsdem__restart_data(io, &c->last.virtual_mass, sizeof c->last.virtual_mass);
     fsdem__restart_data(io, &c->last.to_fluid, sizeof c->last.to_fluid);
     fsdem__restart_data(io, &c->last.lost, sizeof c->last.lost);
     fsdem__restart_data(io, &c->last.drag_dt, sizeof c->last.drag_dt);
@@ -21203,16 +21278,18 @@ static int fsdem__io_gic_row(const void *object, int i, double *v) {
     v[0] = c->force[k].id;
     fsdem__io_put3(v + 1, c->force[k].pressure);
     fsdem__io_put3(v + 4, c->force[k].drag);
-    fsdem__io_put3(v + 7, c->force[k].fluid_velocity);
-    v[10] = (double)c->force[k].porosity;
-    v[11] = (double)c->force[k].liquid;
+    fsdem__io_put3(v + 7, c->force[k].virtual_mass);
+    fsdem__io_put3(v + 10, c->force[k].fluid_velocity);
+    v[13] = (double)c->force[k].porosity;
+    v[14] = (double)c->force[k].liquid;
     return 1;
 }
 
 fsdem_result fsdem_gic_write_csv(const fsdem_gic *c, const char *path) {
     if (!c) return FSDEM_ERR_INVALID_ARG;
     return fsdem__io_write_rows(&c->status, "fsdem_gic_write_csv", path,
-                                "id,pressure_x,pressure_y,pressure_z,drag_x,drag_y,drag_z,fluid_u,fluid_v,fluid_w,porosity,liquid",
+                                "id,pressure_x,pressure_y,pressure_z,drag_x,drag_y,drag_z,virtual_mass_x,virtual_mass_y,virtual_mass_z,"
+                                "fluid_u,fluid_v,fluid_w,porosity,liquid",
                                 fsdem_dem_get_particles(c->desc.dem).count, fsdem__io_gic_row, c);
 }
 

@@ -57,6 +57,9 @@ static gic_tank make_gic(int dim, double L, double dx, double depth, double rho_
     return t;
 }
 
+/* The component of v along the last axis (up). */
+static double test_up(fsdem_vec3 v, int dim) { return dim == 2 ? v.y : v.z; }
+
 static void free_gic(gic_tank *t) {
     fsdem_gic_destroy(t->gic);
     fsdem_dem_destroy(t->dem);
@@ -165,10 +168,11 @@ START_TEST(test_gic_still_water_over_a_fixed_bed) {
 }
 END_TEST
 
-/* Eq. 18: free granules sinking through still water, no contacts. Over one step the water's faces
-   gain exactly the impulse the granules' drag lost (to rounding): the stats' sums, and the PIC's
-   accelerations summed as the grid's momentum (rho dx^dim per face) times dt; and each
-   granule's momentum changes by its weight, its pressure force and its drag, nothing else. */
+/* Eq. 18: free granules sinking through still water, no contacts, with virtual mass. Over one step
+   the water's faces gain exactly the impulse the granules' drag and virtual mass lost (to
+   rounding): the stats' sums, and the PIC's accelerations summed as the grid's momentum
+   (rho dx^dim per face) times dt; and the granules' momentum changes by their weight, pressure
+   force, drag and virtual-mass force, nothing else. */
 START_TEST(test_gic_momentum_exchange_exact) {
     int dim;
     for (dim = 2; dim <= 3; ++dim) {
@@ -209,7 +213,10 @@ START_TEST(test_gic_momentum_exchange_exact) {
             for (f = 0; f < pc.face_count[a]; ++f) grid[a] += pc.acceleration[a][f];
         scale = RHO * pow(dx, dim) * dt * depth;
         for (a = 0; a < dim; ++a) {
-            const double drag = a == 0 ? st.drag_impulse.x : a == 1 ? st.drag_impulse.y : st.drag_impulse.z;
+            /* the exchange: drag and virtual mass (the pressure force is the mixture's, not exchanged) */
+            const double drag = a == 0 ? st.drag_impulse.x + st.virtual_mass_impulse.x
+                                : a == 1 ? st.drag_impulse.y + st.virtual_mass_impulse.y
+                                         : st.drag_impulse.z + st.virtual_mass_impulse.z;
             const double fluid = a == 0 ? st.to_fluid.x : a == 1 ? st.to_fluid.y : st.to_fluid.z;
             const double press = a == 0 ? st.pressure_impulse.x : a == 1 ? st.pressure_impulse.y : st.pressure_impulse.z;
             const double mv = a == 0 ? sum_mv.x : a == 1 ? sum_mv.y : sum_mv.z, w = a == 0 ? weight.x : a == 1 ? weight.y : weight.z;
@@ -219,11 +226,49 @@ START_TEST(test_gic_momentum_exchange_exact) {
                           grid[a] * scale, fluid);
             ck_assert_msg(fabs(mv - (w + press + drag)) <= TOL(1e-10, 1e3) * ref, "%dD axis %d: m dv %.15g, impulses %.15g", dim, a, mv,
                           w + press + drag);
-            TEST_REPORT("%dD axis %d: drag impulse %.6g N s, to the grid %.6g, granules' m dv %.6g = weight %.6g + pressure %.6g + drag",
+            TEST_REPORT("%dD axis %d: drag + virtual mass %.6g N s, to the grid %.6g, granules' m dv %.6g = weight %.6g + pressure %.6g + "
+                        "exchange",
                         dim, a, drag, grid[a] * scale, mv, w, press);
         }
         ck_assert(st.lost.x == 0 && st.lost.y == 0 && st.lost.z == 0);
         free_gic(&t);
+    }
+}
+END_TEST
+
+/* Eq. 14: a granule released at rest in still water starts with the acceleration
+   (rho_s - rho) g / (rho_s + C_a rho) with virtual mass (C_a = 1/2 for a sphere, 1 for a disc) and
+   (rho_s - rho) g / rho_s without; over 0.2 ms the quadratic drag (Eq. 5b) is below 0.3 % of the
+   weight, so the velocities after one step stand in the ratio (rho_s + C_a rho) / rho_s within 1 %. */
+START_TEST(test_gic_virtual_mass_inertia) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        double v[2];
+        const double ca = dim == 3 ? 0.5 : 1, rho_s = 2500, dt = 2e-4;
+        int vm;
+        for (vm = 0; vm <= 1; ++vm) {
+            gic_tank t = make_gic(dim, 0.1, 0.01, 0.08, rho_s);
+            fsdem_gic_desc gd = fsdem_gic_get_desc(t.gic);
+            fsdem_gic_force rec;
+            fsdem_gic_destroy(t.gic);
+            gd.virtual_mass = vm;
+            ck_assert_int_eq(fsdem_gic_create(&gd, &t.gic), FSDEM_OK);
+            add_granule(&t, dim == 2 ? fsdem_v3((fsdem_real)0.051, (fsdem_real)0.043, 0) : fsdem_v3((fsdem_real)0.051, (fsdem_real)0.047, (fsdem_real)0.043),
+                        0.001, 0, fsdem_v3(0, 0, 0));
+            ck_assert_int_eq(fsdem_gic_update(t.gic), FSDEM_OK);
+            ck_assert_int_eq(fsdem_gic_step_dt(t.gic, (fsdem_real)dt), FSDEM_OK);
+            v[vm] = -test_up(fsdem_dem_get_particles(t.dem).velocity[0], dim);
+            ck_assert_int_eq(fsdem_gic_get_force(t.gic, 0, &rec), FSDEM_OK);
+            ck_assert(vm ? test_up(rec.virtual_mass, dim) > 0 : rec.virtual_mass.x == 0 && rec.virtual_mass.y == 0 && rec.virtual_mass.z == 0);
+            free_gic(&t);
+        }
+        {
+            const double ratio = v[0] / v[1], expect = (rho_s + ca * RHO) / rho_s, a0 = (rho_s - RHO) * G / (rho_s + ca * RHO);
+            TEST_REPORT("%dD: after %g s, %.6g m/s without and %.6g m/s with virtual mass (a0 dt %.6g): ratio %.5f, expected %.5f", dim, dt, v[0],
+                        v[1], a0 * dt, ratio, expect);
+            ck_assert_msg(fabs(ratio / expect - 1) < 0.01, "%dD: ratio %g, expected %g", dim, ratio, expect);
+            ck_assert_msg(fabs(v[1] / (a0 * dt) - 1) < 0.01, "%dD: %g m/s after dt, a0 dt %g", dim, v[1], a0 * dt);
+        }
     }
 }
 END_TEST
@@ -283,7 +328,8 @@ START_TEST(test_gic_bad_input) {
         int which;
         double value;
     } bad[] = {{"drag_scale", 0, 0}, {"drag_scale", 0, NAN}, {"viscosity", 1, -1}, {"max_solid_fraction", 2, 1},
-               {"cfl", 3, 0}, {"max_dt_ratio", 4, 0.5}, {"drag_dt_fraction", 5, 1.5}, {"max_substeps", 6, 0}};
+               {"cfl", 3, 0}, {"max_dt_ratio", 4, 0.5}, {"drag_dt_fraction", 5, 1.5}, {"max_substeps", 6, 0},
+               {"virtual_mass", 7, 2}};
     ck_assert_int_eq(fsdem_gic_desc_check(NULL, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_msg(strstr(msg, ".pic and .dem") != NULL, "%s", msg);
@@ -299,6 +345,7 @@ START_TEST(test_gic_bad_input) {
         case 3: e.cfl = (fsdem_real)bad[k].value; break;
         case 4: e.max_dt_ratio = (fsdem_real)bad[k].value; break;
         case 5: e.drag_dt_fraction = (fsdem_real)bad[k].value; break;
+        case 7: e.virtual_mass = (int)bad[k].value; break;
         default: e.max_substeps = (long long)bad[k].value; break;
         }
         ck_assert_int_eq(fsdem_gic_create(&e, &g), FSDEM_ERR_INVALID_ARG);
@@ -343,6 +390,7 @@ Suite *couple_gic_suite(void) {
     tcase_add_test(tc, test_gic_solid_fraction_of_a_packing);
     tcase_add_test(tc, test_gic_still_water_over_a_fixed_bed);
     tcase_add_test(tc, test_gic_momentum_exchange_exact);
+    tcase_add_test(tc, test_gic_virtual_mass_inertia);
     tcase_add_test(tc, test_gic_restart_bit_for_bit);
     tcase_add_test(tc, test_gic_bad_input);
     suite_add_tcase(s, tc);
