@@ -2862,10 +2862,13 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
         interpolated) and s = desc.drag_scale, and with desc.virtual_mass its added mass
         m_a = C_a rho_f V_i l (C_a = 1/2 for a sphere, Eq. 5c; 1 for a disc, the potential-flow
         value of a cylinder) in the inertia of Eq. 14, (m + m_a) dv/dt = m_a a_f + F_o, where
-        a_f = g - grad p / rho_f + F_s / (rho_f alpha_f) is the water's acceleration of the last
-        step at the granule (Eq. 17: the grid's FLIP increment, the exchange's acceleration taken
-        from the PIC's faces) and F_o = F_c + m g + l (F_p + F_d) every other force, the contacts
-        F_c of the evaluation included. The DEM keeps the mass m, so the granule is given the load
+        a_f = g - grad p / rho_f is the water's acceleration of the last step at the granule and
+        F_o = F_c + m g + l (F_p + F_d) every other force, the contacts F_c of the evaluation
+        included. Eq. 17's a_f also holds the exchange, F_s / (rho_f alpha_f); it is left out: held
+        from the last step it feeds the virtual-mass reaction back on itself with the gain
+        C_a alpha_s / alpha_f (the water's acceleration from the granules' added mass over the
+        water's own mass in the cell), above 1 wherever alpha_s > 1/3 for spheres (1/2 for discs),
+        and a ball of sand entering water at 1 m/s then diverged within tens of steps. The DEM keeps the mass m, so the granule is given the load
         F_ext that makes its m dv/dt = F_c + m g + F_ext the motion of Eq. 14:
           F_ext = (m l (F_p + F_d) + m m_a (a_f - g) - m_a F_c) / (m + m_a),
         whose part beyond l (F_p + F_d) is the virtual-mass force F_v = m_a (a_f - dv/dt) (Eq. 5c).
@@ -2894,7 +2897,8 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
    (Eq. 33) is the PIC's, at most desc.cfl dx / max |v_i| and desc.max_dt_ratio times the DEM's dt
    (1000 in the seed), and at most desc.drag_dt_fraction of the shortest drag relaxation time of a
    granule, m_i / (s c V_i), or of the water round it, alpha_f rho / (alpha_s s c), since the
-   exchange is explicit for the water.
+   exchange is explicit for the water: c at the granule's slip against the water of the last step,
+   for the granules in the water and those that reach it within the step (against water at rest).
    Ownership: the coupler owns the PIC's porosity and its accelerations (it zeroes them at the start
    of every step, fsdem_pic_clear_forces, so another coupler's forces on the same PIC would be
    lost), and the DEM's external forces.
@@ -2910,7 +2914,9 @@ typedef struct fsdem_gic_desc {
     fsdem_drag_law drag;          /* default FSDEM_DRAG_LAW_GIC (seed 004 Eq. 5b) */
     fsdem_real drag_scale;        /* -; factor on the law's coefficient, > 0; default 1 (0.1 with */
                                   /*    the GIC law is the seed's mu = 0.044 of §6.1) */
-    int virtual_mass;             /* 1: the granules' added mass, Eq. 14-17 (see step 1); default 1 */
+    int virtual_mass;             /* 1: the granules' added mass, Eq. 14-17 (see step 1); default 0: */
+                                  /*    explicit, it diverged in dense sand entering water at 1 m/s */
+                                  /*    (validation/gic_volume); dilute granules take it well */
     fsdem_real viscosity;         /* Pa s; dynamic viscosity the drag laws use (all but the GIC */
                                   /*    law need one); 0: rho nu of the PIC; default 0 */
     fsdem_real max_solid_fraction; /* -; cap of alpha_s in (0, 1); 0: 0.740 in 3D, 0.907 in 2D */
@@ -2965,7 +2971,7 @@ typedef struct fsdem_gic_force {
     fsdem_vec3 drag;              /* N; l F_d (Eq. 5b or the chosen law) */
     fsdem_vec3 virtual_mass;      /* N; F_v (Eq. 5c, 14), 0 without desc.virtual_mass */
     fsdem_vec3 fluid_velocity;    /* m/s; u at the granule */
-    fsdem_vec3 fluid_acceleration; /* m/s^2; a_f of Eq. 17 at the granule */
+    fsdem_vec3 fluid_acceleration; /* m/s^2; a_f at the granule (>>couple_gic step 1) */
     fsdem_real porosity;          /* -; eps at the granule */
     fsdem_real liquid;            /* -; l, the liquid fraction at the granule (0: dry) */
 } fsdem_gic_force;
@@ -2978,12 +2984,12 @@ FSDEM_API fsdem_result fsdem_gic_get_force(const fsdem_gic *coupler, int index, 
 FSDEM_API fsdem_result fsdem_gic_step(fsdem_gic *coupler);
 /* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite or above
    max_substeps DEM substeps, FSDEM_ERR_CFL when dt exceeds the PIC's cfl_max (fsdem_pic_check_dt)
-   or the drag limit of the last step; nothing moved then. Errors of either solver during the step
+   or the drag limit; nothing moved then. Errors of either solver during the step
    are passed on with their message. */
 FSDEM_API fsdem_result fsdem_gic_step_dt(fsdem_gic *coupler, fsdem_real dt);
 /* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
 FSDEM_API fsdem_result fsdem_gic_advance(fsdem_gic *coupler, fsdem_real duration, long long *steps);
-/* Stable coupled step (s) of the section (Eq. 33 and the drag limit of the last step).
+/* Stable coupled step (s) of the section (Eq. 33 and the drag limit).
    FSDEM_ERR_NAN when a velocity is not finite. */
 FSDEM_API fsdem_result fsdem_gic_stable_dt(const fsdem_gic *coupler, fsdem_real *dt);
 /* The PIC time (s). */
@@ -3002,7 +3008,8 @@ typedef struct fsdem_gic_stats {
     fsdem_vec3 to_fluid;          /* N s; the impulse handed to the water's faces, last step, in the */
                                   /*    DEM's units (the water gets it per metre of depth in 2D) */
     fsdem_vec3 lost;              /* N s; exchange with no liquid face in reach (dropped) */
-    fsdem_real drag_dt;           /* s; shortest drag relaxation time of the last step (0: none) */
+    fsdem_real drag_dt;           /* s; shortest drag relaxation time at the last step's start, of a */
+                                  /*    granule or of a cell's water (0: none; >>couple_gic) */
     fsdem_real max_solid_fraction; /* -; largest alpha_s of the last update, before the cap */
     fsdem_real solid_volume;      /* m^3 (m^2 in 2D); sum of alpha_s dx^dim, = the granules' volume */
     double seconds_pic;           /* CPU seconds in PIC steps */
@@ -17902,6 +17909,7 @@ struct fsdem_gic {
     fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC's forces are per metre), 1 in 3D */
     fsdem_real cell_volume;        /* m^dim */
     fsdem_real *solid, *porosity;  /* per cell: alpha_s (Eq. 7a), alpha_f' */
+    fsdem_real *rate;              /* per cell: the water's drag rate (1/s), scratch of the step limit */
     /* per granule: sample points, the samples, the force records of the last evaluation */
     fsdem_vec3 *point;
     fsdem_fluid_sample *sample;
@@ -17924,7 +17932,6 @@ fsdem_gic_desc fsdem_gic_desc_default(void) {
     memset(&d, 0, sizeof d);
     d.drag = FSDEM_DRAG_LAW_GIC;
     d.drag_scale = 1;
-    d.virtual_mass = 1;
     d.cfl = 1;
     d.max_dt_ratio = 1000;
     d.drag_dt_fraction = (fsdem_real)0.5;
@@ -18001,8 +18008,9 @@ fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out) {
     cells = (size_t)c->grid.ncell;
     c->solid = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
     c->porosity = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
-    if (!c->solid || !c->porosity) {
-        fsdem__log_oom(desc->log, desc->log_user, "fsdem_gic_create", 2 * sizeof(fsdem_real) * cells);
+    c->rate = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
+    if (!c->solid || !c->porosity || !c->rate) {
+        fsdem__log_oom(desc->log, desc->log_user, "fsdem_gic_create", 3 * sizeof(fsdem_real) * cells);
         fsdem_gic_destroy(c);
         return FSDEM_ERR_OUT_OF_MEMORY;
     }
@@ -18022,6 +18030,7 @@ void fsdem_gic_destroy(fsdem_gic *c) {
     cells = (size_t)c->grid.ncell;
     fsdem__free(&al, c->solid, sizeof(fsdem_real) * cells);
     fsdem__free(&al, c->porosity, sizeof(fsdem_real) * cells);
+    fsdem__free(&al, c->rate, sizeof(fsdem_real) * cells);
     fsdem__free(&al, c->point, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
     fsdem__free(&al, c->sample, sizeof(fsdem_fluid_sample) * (size_t)c->granule_cap);
     fsdem__free(&al, c->force, sizeof(fsdem_gic_force) * (size_t)c->granule_cap);
@@ -18128,35 +18137,12 @@ static fsdem_real fsdem__gic_porosity_at(const fsdem_gic *c, fsdem_vec3 p) {
     return e;
 }
 
-/* The shortest drag relaxation time of granule i with coefficient cs = s c (kg m^-3 s^-1) at
-   porosity eps: its own, m / (cs V), and the water's round it, alpha_f rho / (alpha_s cs). */
-static fsdem_real fsdem__gic_relaxation(const fsdem_gic *c, fsdem_real mass, fsdem_real volume, fsdem_real cs, fsdem_real eps) {
-    const fsdem_real grain = mass / (cs * volume), water = eps < 1 ? eps * c->rho / ((1 - eps) * cs) : grain;
-    return grain < water ? grain : water;
-}
-
-/* The face field q of axis a (layout of fsdem_pic_coupling) at point p, trilinear between faces. */
-static fsdem_real fsdem__gic_face_value(const fsdem_gic *c, const fsdem_real *q, int a, fsdem_vec3 p) {
-    fsdem__kernel kw;
-    fsdem_real s[3], v = 0;
-    int b, q0, q1, q2;
-    for (b = 0; b < 3; ++b)
-        s[b] = b < c->dim ? (fsdem__comp(p, b) - fsdem__comp(c->grid.lo, b)) * c->grid.inv_dx - (b == a ? 0 : (fsdem_real)0.5) : 0;
-    fsdem__kernel_weights(&kw, c->dim, s, c->grid.fn[a], 0);
-    for (q2 = 0; q2 < kw.count[2]; ++q2)
-        for (q1 = 0; q1 < kw.count[1]; ++q1)
-            for (q0 = 0; q0 < kw.count[0]; ++q0)
-                v += q[fsdem__mac_face(&c->grid, a, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])] * kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2];
-    return v;
-}
-
-/* a_f of Eq. 17 at every granule from the water of the last step, before its accelerations are
-   cleared: g - grad p / rho_f + F_s / (rho_f alpha_f) (0 before the PIC's first step: water at rest). */
+/* a_f of Eq. 17 at every granule from the water of the last step, g - grad p / rho_f (0 before the
+   PIC's first step: water at rest); the exchange's part is left out (>>couple_gic step 1). */
 static void fsdem__gic_fluid_accelerations(fsdem_gic *c) {
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
-    const fsdem_pic_coupling pc = fsdem_pic_get_coupling(c->desc.pic);
     const fsdem_vec3 g = fsdem_pic_get_desc(c->desc.pic).gravity;
-    int i, a;
+    int i;
     if (!c->desc.virtual_mass) return;
     if (fsdem_pic_get_stats(c->desc.pic).steps == 0) {
         for (i = 0; i < P.count; ++i) c->fluid_accel[i] = fsdem__zero3();
@@ -18164,13 +18150,7 @@ static void fsdem__gic_fluid_accelerations(fsdem_gic *c) {
     }
     for (i = 0; i < P.count; ++i) c->point[i] = P.position[i];
     fsdem_pic_sample(c->desc.pic, P.count, c->point, c->sample);
-    for (i = 0; i < P.count; ++i) {
-        const fsdem_real eps = fsdem__gic_porosity_at(c, P.position[i]);
-        fsdem_vec3 af = fsdem__madd(g, c->sample[i].pressure_gradient, -1 / c->rho);
-        for (a = 0; a < c->dim; ++a)
-            fsdem__set_comp(&af, a, fsdem__comp(af, a) + fsdem__gic_face_value(c, pc.acceleration[a], a, P.position[i]) / eps);
-        c->fluid_accel[i] = af;
-    }
+    for (i = 0; i < P.count; ++i) c->fluid_accel[i] = fsdem__madd(g, c->sample[i].pressure_gradient, -1 / c->rho);
 }
 
 /* Steps 1-2 of >>couple_gic at one force evaluation of the sand substeps (fsdem_dem_substep_fn):
@@ -18228,10 +18208,6 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
         c->tally.drag = fsdem__madd(c->tally.drag, rec->drag, held);
         c->tally.virtual_mass = fsdem__madd(c->tally.virtual_mass, rec->virtual_mass, held);
         wet_count++;
-        if (cv > 0) {
-            const fsdem_real t = fsdem__gic_relaxation(c, P.mass[i], volume, cv, eps);
-            if (c->tally.drag_dt == 0 || t < c->tally.drag_dt) c->tally.drag_dt = t;
-        }
         {
             const fsdem_vec3 impulse = fsdem__scale(fsdem__add(rec->drag, rec->virtual_mass), -held);
             int taken = 0;
@@ -18253,7 +18229,51 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
 
 /* ---- >>couple_gic_step : coupled time stepping ---- */
 
-/* The stable coupled step of the section (Eq. 33, the drag limit of the last step). */
+/* The shortest drag relaxation time (s; 0: none) of the granules in the water now or within
+   `horizon` (s) of their paths (a granule about to enter the water counts, at its speed against
+   water at rest), from the water of the last step: a granule's own, m_i / (s c V_i), and the
+   water's in each cell, rho alpha_f' dx^dim / sum_i s c_i V_i N_i over the granules' kernel
+   weights there (the rate at which their drag relaxes it: the cell's share of the exchange over
+   its water's mass, with the capped porosity and overlapping granules as they are). */
+static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    fsdem_real shortest = 0;
+    int i, k, q0, q1, q2;
+    memset(c->rate, 0, sizeof(fsdem_real) * (size_t)c->grid.ncell);
+    for (i = 0; i < P.count; ++i) {
+        fsdem_fluid_sample here, ahead;
+        const fsdem_vec3 x = P.position[i], y = fsdem__madd(x, P.velocity[i], horizon);
+        const fsdem_real volume = fsdem__gic_volume(c, P.radius[i]);
+        fsdem_real cv = 0, t;
+        fsdem__kernel kw;
+        if (P.fixed[i] || fsdem_pic_sample(c->desc.pic, 1, &x, &here) != FSDEM_OK || fsdem_pic_sample(c->desc.pic, 1, &y, &ahead) != FSDEM_OK)
+            continue;
+        if (!(here.volume_fraction > 0) && !(ahead.volume_fraction > 0)) continue;
+        if (!(here.volume_fraction > 0)) here.velocity = fsdem__zero3();
+        if (fsdem_drag_coefficient(c->desc.drag, fsdem__gic_porosity_at(c, here.volume_fraction > 0 ? x : y), 2 * P.radius[i],
+                                   fsdem__norm(fsdem__sub(here.velocity, P.velocity[i])), c->rho, c->desc.viscosity > 0 ? c->desc.viscosity : 1,
+                                   &cv, NULL, NULL, 0) != FSDEM_OK ||
+            !(cv > 0))
+            continue;
+        cv *= c->desc.drag_scale;
+        t = P.mass[i] / (cv * volume);
+        if (shortest == 0 || t < shortest) shortest = t;
+        fsdem__gic_kernel(c, here.volume_fraction > 0 ? x : y, &kw);
+        for (q2 = 0; q2 < kw.count[2]; ++q2)
+            for (q1 = 0; q1 < kw.count[1]; ++q1)
+                for (q0 = 0; q0 < kw.count[0]; ++q0)
+                    c->rate[fsdem__mac_cell(&c->grid, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])] +=
+                        cv * volume / c->depth * kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2];
+    }
+    for (k = 0; k < c->grid.ncell; ++k)
+        if (c->rate[k] > 0) {
+            const fsdem_real t = c->rho * c->porosity[k] * c->cell_volume / c->rate[k];
+            if (shortest == 0 || t < shortest) shortest = t;
+        }
+    return shortest;
+}
+
+/* The stable coupled step of the section (Eq. 33, the drag limit). */
 static fsdem_result fsdem__gic_stable(const fsdem_gic *c, fsdem_real *dt) {
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     fsdem_result res = fsdem_pic_stable_dt(c->desc.pic, dt);
@@ -18269,8 +18289,11 @@ static fsdem_result fsdem__gic_stable(const fsdem_gic *c, fsdem_real *dt) {
         if (v > vmax) vmax = v;
     }
     if (vmax > 0 && c->desc.cfl * c->grid.dx / vmax < limit) limit = c->desc.cfl * c->grid.dx / vmax;
-    if (c->last.drag_dt > 0 && c->desc.drag_dt_fraction * c->last.drag_dt < limit) limit = c->desc.drag_dt_fraction * c->last.drag_dt;
     if (limit < *dt) *dt = limit;
+    {
+        const fsdem_real drag = fsdem__gic_drag_time(c, *dt);
+        if (drag > 0 && c->desc.drag_dt_fraction * drag < *dt) *dt = c->desc.drag_dt_fraction * drag;
+    }
     return FSDEM_OK;
 }
 
@@ -18282,10 +18305,6 @@ static fsdem_result fsdem__gic_run(fsdem_gic *c, fsdem_real dt) {
     if (res != FSDEM_OK) return res;
     if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
         return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
-    if (c->last.drag_dt > 0 && dt > c->desc.drag_dt_fraction * c->last.drag_dt * (1 + (fsdem_real)1e-6))
-        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
-                           "fsdem_gic: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s", (double)dt,
-                           (double)c->desc.drag_dt_fraction, (double)c->last.drag_dt);
     if ((res = fsdem__gic_reserve(c, fsdem_dem_get_particles(c->desc.dem).count)) != FSDEM_OK) return res;
     fsdem_dem_substep_count(c->desc.dem, dt, &c->substeps_now);
     c->h = dt / (fsdem_real)c->substeps_now;
@@ -18293,6 +18312,7 @@ static fsdem_result fsdem__gic_run(fsdem_gic *c, fsdem_real dt) {
     c->calls = 0;
     c->failed = 0;
     memset(&c->tally, 0, sizeof c->tally);
+    c->tally.drag_dt = fsdem__gic_drag_time(c, dt);
     fsdem__gic_fluid_accelerations(c);
     fsdem_pic_clear_forces(c->desc.pic);
     t0 = clock();
@@ -18322,9 +18342,15 @@ fsdem_result fsdem_gic_step(fsdem_gic *c) {
 }
 
 fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) {
+    fsdem_real drag;
     if (!c) return FSDEM_ERR_INVALID_ARG;
     if (!(dt > 0) || !fsdem__finite(dt))
         return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_gic_step_dt: dt = %g s must be > 0 and finite", (double)dt);
+    drag = fsdem__gic_drag_time(c, dt);
+    if (drag > 0 && dt > c->desc.drag_dt_fraction * drag * (1 + (fsdem_real)1e-6))
+        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
+                           "fsdem_gic_step_dt: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s",
+                           (double)dt, (double)c->desc.drag_dt_fraction, (double)drag);
     return fsdem__gic_run(c, dt);
 }
 

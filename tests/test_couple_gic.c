@@ -178,6 +178,7 @@ START_TEST(test_gic_momentum_exchange_exact) {
     for (dim = 2; dim <= 3; ++dim) {
         const double L = 0.1, dx = 0.01, r = 0.002, dt = 2e-3;
         gic_tank t = make_gic(dim, L, dx, 0.08, 2500);
+        fsdem_gic_desc gd = fsdem_gic_get_desc(t.gic);
         fsdem_dem_particles P;
         fsdem_vec3 p0[8], sum_mv = fsdem_v3(0, 0, 0), weight = fsdem_v3(0, 0, 0);
         fsdem_pic_coupling pc;
@@ -185,6 +186,9 @@ START_TEST(test_gic_momentum_exchange_exact) {
         double grid[3] = {0, 0, 0}, scale;
         int i, a, f;
         const fsdem_real depth = dim == 2 ? fsdem_dem_get_desc(t.dem).disc_length : 1;
+        fsdem_gic_destroy(t.gic); /* again with virtual mass, whose reaction is exchanged too */
+        gd.virtual_mass = 1;
+        ck_assert_int_eq(fsdem_gic_create(&gd, &t.gic), FSDEM_OK);
         for (i = 0; i < 8; ++i) {
             const double x = 0.02 + 0.02 * (i % 4), y = 0.03 + 0.025 * (i / 4);
             add_granule(&t, dim == 2 ? fsdem_v3((fsdem_real)x, (fsdem_real)y, 0) : fsdem_v3((fsdem_real)x, (fsdem_real)0.05, (fsdem_real)y), r,
