@@ -1424,7 +1424,8 @@ FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
      solve, rho nu dx^(dim-2) sum (u_nb - us_f) over the liquid faces next to it; the liquid got
      exactly the opposite, so a coupler that hands it to the solid conserves momentum.
    - porosity[c]: the volume fraction of cell c that the liquid may fill among granules smaller
-     than a cell, alpha_f' = 1 - alpha_s of seed 004 Eq. 6 (default 1), in (0, 1]. The pressure
+     than a cell, alpha_f' = 1 - alpha_s of seed 004 Eq. 6 (default 1), in (0, 1] (a step refuses
+     another value with FSDEM_ERR_INVALID_ARG naming the cell, before anything moves). The pressure
      equation becomes the variable-coefficient one of seed 004 Eq. 12a: every face's coefficient
      and liquid flux are multiplied by the mean porosity of its two cells (Appendix B's beta), so
      div(alpha_f' u) = 0; the fluid fraction of a cell counts its particles against porosity x a
@@ -11441,11 +11442,23 @@ static fsdem_result fsdem__pic_do_step(fsdem_pic *s, fsdem_real dt) {
     return worst;
 }
 
+/* FSDEM_OK when every coupler porosity is in (0, 1], else the refusal naming the first cell that
+   is not (a step would divide by it). */
+static fsdem_result fsdem__pic_check_porosity(const fsdem_pic *s, const char *who) {
+    int c;
+    for (c = 0; c < s->ncell; ++c)
+        if (!(s->cpor[c] > 0 && s->cpor[c] <= 1))
+            return fsdem__fail((fsdem__status *)&s->status, FSDEM_ERR_INVALID_ARG,
+                               "%s: fsdem_pic_coupling.porosity of cell %d is %g, not in (0, 1]", who, c, (double)s->cpor[c]);
+    return FSDEM_OK;
+}
+
 fsdem_result fsdem_pic_check_dt(const fsdem_pic *s, fsdem_real dt) {
     fsdem__status *st;
     int who;
     fsdem_real umax, cfl;
     if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (fsdem__pic_check_porosity(s, "fsdem_pic_step_dt") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     st = (fsdem__status *)&s->status; /* the message is the object's only mutable part here */
     if (!(dt > 0) || !fsdem__finite(dt))
         return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "fsdem_pic_step_dt: dt = %g s must be > 0 and finite", (double)dt);
@@ -11474,6 +11487,7 @@ fsdem_result fsdem_pic_step(fsdem_pic *s) {
     int who;
     fsdem_real umax;
     if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (fsdem__pic_check_porosity(s, "fsdem_pic_step") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     umax = fsdem__pic_umax(s, &who);
     if (!fsdem__finite(umax))
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pic: particle %d has a non-finite velocity", who);
@@ -11488,6 +11502,7 @@ fsdem_result fsdem_pic_advance(fsdem_pic *s, fsdem_real duration, long long *ste
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!(duration >= 0) || !fsdem__finite(duration))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_advance: duration = %g s must be >= 0", (double)duration);
+    if (fsdem__pic_check_porosity(s, "fsdem_pic_advance") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     end = s->time + (double)duration;
     while (s->time < end - 1e-12 * (end > 1 ? end : 1)) {
         int who;

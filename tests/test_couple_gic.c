@@ -380,6 +380,17 @@ START_TEST(test_gic_bad_input) {
     ck_assert_msg(strstr(fsdem_gic_last_error(t.gic), "max_substeps") != NULL, "%s", fsdem_gic_last_error(t.gic));
     ck_assert_int_eq(fsdem_gic_get_force(t.gic, 0, &rec), FSDEM_ERR_NOT_FOUND);
     ck_assert(fsdem_gic_get_stats(t.gic).steps == 0 && fsdem_dem_time(t.dem) == 0 && fsdem_pic_time(t.pic) == 0);
+    {
+        /* a porosity out of (0, 1] in the PIC: refused, named, nothing moved */
+        fsdem_pic_coupling pc = fsdem_pic_get_coupling(t.pic);
+        pc.porosity[7] = 0;
+        ck_assert_int_eq(fsdem_pic_step(t.pic), FSDEM_ERR_INVALID_ARG);
+        ck_assert_int_eq(fsdem_pic_step_dt(t.pic, (fsdem_real)1e-3), FSDEM_ERR_INVALID_ARG);
+        ck_assert_int_eq(fsdem_pic_advance(t.pic, (fsdem_real)1e-3, NULL), FSDEM_ERR_INVALID_ARG);
+        ck_assert_msg(strstr(fsdem_pic_last_error(t.pic), "porosity of cell 7") != NULL, "%s", fsdem_pic_last_error(t.pic));
+        ck_assert(fsdem_pic_time(t.pic) == 0);
+        pc.porosity[7] = 1;
+    }
     ck_assert_int_eq(fsdem_gic_step(t.gic), FSDEM_OK);
     ck_assert_int_eq(fsdem_gic_get_force(t.gic, 0, &rec), FSDEM_OK);
     ck_assert(rec.liquid > 0 && rec.pressure.y > 0); /* under water: buoyancy up */
