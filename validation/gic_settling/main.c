@@ -13,6 +13,7 @@
    (the water's vertical velocity sampled at the granule, m/s). */
 #include "fsdem.h"
 #include "common.h"
+#include "gic_case.h"
 
 #define CASE "gic_settling"
 #define PI 3.14159265358979323846
@@ -32,10 +33,7 @@ typedef struct outcome {
 static outcome run(double ratio, double ut, int vm) {
     const double dx = ratio * d, W = 16 * dx, H = 24 * dx, depth = 22 * dx;
     fsdem_pic_desc pd = fsdem_pic_desc_default(3);
-    fsdem_dem_desc dd = fsdem_dem_desc_default(3);
-    fsdem_dem_material m = fsdem_dem_material_default();
     fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
-    fsdem_gic_desc gd = fsdem_gic_desc_default();
     fsdem_pic *pic = NULL;
     fsdem_dem *dem = NULL;
     fsdem_gic *gic = NULL;
@@ -57,32 +55,12 @@ static outcome run(double ratio, double ut, int vm) {
         fsdem_pic_destroy(pic);
         return o;
     }
-    dd.domain_min = fsdem_v3(0, 0, 0);
-    dd.domain_max = pd.domain_max;
-    dd.law = FSDEM_DEM_LAW_GIC;
-    dd.rotation = 0;
-    m.density = (fsdem_real)rho_s;
-    m.young_modulus = (fsdem_real)1e6; /* seed 004 §6 */
-    p.radius = (fsdem_real)(d / 2);
-    /* off the grid's planes: a centre on a face or a node would sample the symmetric case only */
-    p.position = fsdem_v3((fsdem_real)(0.5 * W + 0.31 * dx), (fsdem_real)(0.5 * W + 0.17 * dx), (fsdem_real)(depth - 3.4 * dx));
-    if (fsdem_dem_create(&dd, &dem) != FSDEM_OK || fsdem_dem_add_material(dem, &m, NULL) != FSDEM_OK ||
-        fsdem_dem_add_particle(dem, &p, NULL) != FSDEM_OK) {
+    dem = gic_case_dem(3, fsdem_v3(0, 0, 0), pd.domain_max, rho_s, fsdem_dem_material_default().friction, 0);
+    if (!dem || fsdem_dem_add_particle(dem, &p, NULL) != FSDEM_OK) {
         snprintf(o.error, sizeof o.error, "DEM: %s", dem ? fsdem_dem_last_error(dem) : "create failed");
         goto done;
     }
-    {
-        fsdem_real dt_dem = 0;
-        fsdem_dem_stable_dt(dem, &dt_dem);
-        fsdem_dem_set_dt(dem, dt_dem);
-    }
-    gd.pic = pic;
-    gd.dem = dem;
-    gd.virtual_mass = vm;
-    if (fsdem_gic_create(&gd, &gic) != FSDEM_OK || fsdem_gic_update(gic) != FSDEM_OK) {
-        snprintf(o.error, sizeof o.error, "GIC: %s", gic ? fsdem_gic_last_error(gic) : "create failed");
-        goto done;
-    }
+    if (gic_case_couple(pic, dem, vm, &gic, o.error, sizeof o.error)) goto done;
     snprintf(name, sizeof name, "settling_R%g_vm%d.csv", ratio, vm);
     if (fsdem_csv_open(&csv, name, "t,z,w,w_fluid") != FSDEM_OK) {
         snprintf(o.error, sizeof o.error, "cannot write %s", name);

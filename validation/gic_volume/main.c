@@ -10,6 +10,7 @@
    (the granules' volume below the water level, m^2), level (the water level at x = 0.1 m, m). */
 #include "fsdem.h"
 #include "common.h"
+#include "gic_case.h"
 
 #define CASE "gic_volume"
 #define PI 3.14159265358979323846
@@ -27,9 +28,6 @@ typedef struct outcome {
 
 static outcome run(double dx, double r, int idp, double t_end) {
     fsdem_pic_desc pd = fsdem_pic_desc_default(2);
-    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
-    fsdem_dem_material m = fsdem_dem_material_default();
-    fsdem_gic_desc gd = fsdem_gic_desc_default();
     fsdem_pic *pic = NULL;
     fsdem_dem *dem = NULL;
     fsdem_gic *gic = NULL;
@@ -51,18 +49,11 @@ static outcome run(double dx, double r, int idp, double t_end) {
         fsdem_pic_destroy(pic);
         return o;
     }
-    dd.domain_min = fsdem_v3(0, 0, 0);
-    dd.domain_max = pd.domain_max;
-    dd.law = FSDEM_DEM_LAW_GIC;
-    dd.rotation = 0;
-    dd.disc_length = (fsdem_real)(2 * r); /* discs as heavy as spheres: k_n = E r (Eq. 1a) is per granule */
-    m.density = (fsdem_real)rho_s;
-    m.young_modulus = (fsdem_real)1e6; /* seed 004 §6 */
-    m.friction = (fsdem_real)0.5;
-    if (fsdem_dem_create(&dd, &dem) != FSDEM_OK || fsdem_dem_add_material(dem, &m, NULL) != FSDEM_OK ||
-        fsdem_dem_add_wall(dem, &(fsdem_dem_wall_desc){FSDEM_DEM_WALL_TYPE_BOX_INSIDE, dd.domain_min, dd.domain_max, fsdem_v3(0, 0, 0),
-                                                       fsdem_v3(0, 0, 0), 0, NULL, NULL},
-                           NULL) != FSDEM_OK) {
+    /* discs as heavy as spheres (disc_length 2r): k_n = E r (Eq. 1a) is per granule */
+    dem = gic_case_dem(2, fsdem_v3(0, 0, 0), pd.domain_max, rho_s, 0.5, 2 * r);
+    if (!dem || fsdem_dem_add_wall(dem, &(fsdem_dem_wall_desc){FSDEM_DEM_WALL_TYPE_BOX_INSIDE, fsdem_v3(0, 0, 0), pd.domain_max,
+                                                                fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0), 0, NULL, NULL},
+                                    NULL) != FSDEM_OK) {
         snprintf(o.error, sizeof o.error, "DEM: %s", dem ? fsdem_dem_last_error(dem) : "create failed");
         goto done;
     }
@@ -80,18 +71,7 @@ static outcome run(double dx, double r, int idp, double t_end) {
             }
             o.granules++;
         }
-    {
-        fsdem_real dt_dem = 0;
-        fsdem_dem_stable_dt(dem, &dt_dem);
-        fsdem_dem_set_dt(dem, dt_dem);
-    }
-    gd.pic = pic;
-    gd.dem = dem;
-    gd.virtual_mass = VIRTUAL_MASS;
-    if (fsdem_gic_create(&gd, &gic) != FSDEM_OK || fsdem_gic_update(gic) != FSDEM_OK) {
-        snprintf(o.error, sizeof o.error, "GIC: %s", gic ? fsdem_gic_last_error(gic) : "create failed");
-        goto done;
-    }
+    if (gic_case_couple(pic, dem, VIRTUAL_MASS, &gic, o.error, sizeof o.error)) goto done;
     o.v0 = fsdem_pic_get_stats(pic).fluid_volume;
     snprintf(name, sizeof name, "volume_idp%d.csv", idp);
     if (fsdem_csv_open(&csv, name, "t,fluid_volume,particle_volume,sand_volume_wet,level") != FSDEM_OK) {
