@@ -55,6 +55,9 @@ static outcome run(double ratio, double ut, int vm) {
         fsdem_pic_destroy(pic);
         return o;
     }
+    p.radius = (fsdem_real)(d / 2);
+    /* off the grid's planes: a centre on a face or a node would sample the symmetric case only */
+    p.position = fsdem_v3((fsdem_real)(0.5 * W + 0.31 * dx), (fsdem_real)(0.5 * W + 0.17 * dx), (fsdem_real)(depth - 3.4 * dx));
     dem = gic_case_dem(3, fsdem_v3(0, 0, 0), pd.domain_max, rho_s, fsdem_dem_material_default().friction, 0);
     if (!dem || fsdem_dem_add_particle(dem, &p, NULL) != FSDEM_OK) {
         snprintf(o.error, sizeof o.error, "DEM: %s", dem ? fsdem_dem_last_error(dem) : "create failed");
