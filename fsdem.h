@@ -2948,8 +2948,9 @@ FSDEM_API fsdem_gic_desc fsdem_gic_get_desc(const fsdem_gic *coupler);
 
 /* Step 3 of the section at the current granule positions: alpha_s and the PIC's porosity. A step
    does it after its substeps; call it once the granules are placed, so that the first step's
-   density projection already knows where the sand is. FSDEM_ERR_OUT_OF_MEMORY, FSDEM_ERR_NAN (a
-   granule position is not finite; nothing changed). */
+   density projection already knows where the sand is. FSDEM_ERR_NAN (a granule position is not
+   finite) and FSDEM_ERR_OUT_OF_DOMAIN (a granule outside the PIC's grid), naming the granule;
+   nothing changed then. */
 FSDEM_API fsdem_result fsdem_gic_update(fsdem_gic *coupler);
 
 /* Volume fractions on the PIC's cells (layout of fsdem_pic_fields), from the last update; valid
@@ -18111,9 +18112,17 @@ fsdem_result fsdem_gic_update(fsdem_gic *c) {
     fsdem_real most = 0;
     if (!c) return FSDEM_ERR_INVALID_ARG;
     P = fsdem_dem_get_particles(c->desc.dem);
-    for (i = 0; i < P.count; ++i)
+    for (i = 0; i < P.count; ++i) {
+        int a, outside = 0;
         if (!fsdem__finite3(P.position[i]))
             return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_gic_update: granule %d (id %d) has a non-finite position", i, P.id[i]);
+        for (a = 0; a < c->dim; ++a)
+            outside |= fsdem__comp(P.position[i], a) < fsdem__comp(c->grid.lo, a) || fsdem__comp(P.position[i], a) > fsdem__comp(c->grid.hi, a);
+        if (outside) /* its volume would be folded into the boundary cells */
+            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_DOMAIN,
+                               "fsdem_gic_update: granule %d (id %d) at (%g, %g, %g) m is outside the PIC's grid (keep the DEM's walls within it)",
+                               i, P.id[i], (double)P.position[i].x, (double)P.position[i].y, (double)P.position[i].z);
+    }
     memset(c->solid, 0, sizeof(fsdem_real) * (size_t)c->grid.ncell);
     for (i = 0; i < P.count; ++i) {
         const fsdem_real share = fsdem__gic_volume(c, P.radius[i]) / (c->cell_volume * c->depth);

@@ -379,6 +379,29 @@ START_TEST(test_gic_bad_input) {
     ck_assert_int_eq(fsdem_gic_step_dt(t.gic, 100), FSDEM_ERR_INVALID_ARG); /* 1e6 substeps > max_substeps */
     ck_assert_msg(strstr(fsdem_gic_last_error(t.gic), "max_substeps") != NULL, "%s", fsdem_gic_last_error(t.gic));
     ck_assert_int_eq(fsdem_gic_get_force(t.gic, 0, &rec), FSDEM_ERR_NOT_FOUND);
+    {
+        /* a granule outside the PIC's grid (the DEM's domain here is wider): refused, named */
+        fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+        gic_tank u = make_gic(2, 0.1, 0.01, 0.05, 2500);
+        fsdem_dem_desc dd = fsdem_dem_get_desc(u.dem);
+        fsdem_dem *wide = NULL;
+        fsdem_gic_desc gd = fsdem_gic_get_desc(u.gic);
+        fsdem_gic *g2 = NULL;
+        dd.domain_min = fsdem_v3(-1, -1, 0);
+        ck_assert_int_eq(fsdem_dem_create(&dd, &wide), FSDEM_OK);
+        const fsdem_dem_material mat = fsdem_dem_material_default();
+        ck_assert_int_eq(fsdem_dem_add_material(wide, &mat, NULL), FSDEM_OK);
+        p.radius = (fsdem_real)0.002;
+        p.position = fsdem_v3((fsdem_real)0.05, (fsdem_real)-0.01, 0);
+        ck_assert_int_eq(fsdem_dem_add_particle(wide, &p, NULL), FSDEM_OK);
+        gd.dem = wide;
+        ck_assert_int_eq(fsdem_gic_create(&gd, &g2), FSDEM_OK);
+        ck_assert_int_eq(fsdem_gic_update(g2), FSDEM_ERR_OUT_OF_DOMAIN);
+        ck_assert_msg(strstr(fsdem_gic_last_error(g2), "granule 0") != NULL, "%s", fsdem_gic_last_error(g2));
+        fsdem_gic_destroy(g2);
+        fsdem_dem_destroy(wide);
+        free_gic(&u);
+    }
     ck_assert(fsdem_gic_get_stats(t.gic).steps == 0 && fsdem_dem_time(t.dem) == 0 && fsdem_pic_time(t.pic) == 0);
     {
         /* a porosity out of (0, 1] in the PIC: refused, named, nothing moved */
