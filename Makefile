@@ -29,6 +29,8 @@ help:
 	@echo "make test-float the Check suite with fsdem_real = float (-DFSDEM_USE_FLOAT)"
 	@echo "make determinism  the same results from gcc and clang at -O0/-O2/-march=native/no SIMD"
 	@echo "make valgrind   the suite under Valgrind (no errors, no leaks)"
+	@echo "make test-omp   the suite built with OpenMP, on OMP_THREADS (2) threads"
+	@echo "make tsan       ThreadSanitizer on the threaded solvers at 2 and 4 threads (clang, libomp-dev)"
 	@echo "make sanitize   the suite with AddressSanitizer and UndefinedBehaviorSanitizer"
 	@echo "make demo       the headline example (cylinder-layer collapse) in under a minute"
 	@echo "make examples   all examples"
@@ -86,6 +88,11 @@ test: map-check compile-checks $(BUILD)/check_fsdem
 # tests/determinism.c prints a hash of each solver's saved state, pinned in tests/determinism.expected
 # (regenerate it, with the reason in the commit, when a change of the numerics is intended).
 DETERMINISM_FLAGS := "-O0" "-O2" "-O2 -march=native" "-O2 -DFSDEM_NO_SIMD"
+# ... and the same hashes from an OpenMP build (-fopenmp) at each of these thread counts (>>doc THREADS)
+DETERMINISM_THREADS := 1 2 3 4
+# ... and, with grains so small that every scene takes every threaded path (the dot products' blocks
+# change, so these hashes are compared with the same build without OpenMP, not with the pins)
+DETERMINISM_GRAIN := -DFSDEM__DEM_CHUNK=64 -DFSDEM__DOT_BLOCK=256 -DFSDEM__SWE_BAND_ROWS=2
 determinism: | $(BUILD)
 	@for c in gcc clang; do if command -v $$c >/dev/null; then for f in $(DETERMINISM_FLAGS); do \
 	  $$c $(STD) $(WARN) $$f -I. tests/determinism.c -o $(BUILD)/determinism $(LDLIBS) || exit 1; \
@@ -93,7 +100,22 @@ determinism: | $(BUILD)
 	  if ! diff -q tests/determinism.expected $(BUILD)/determinism.out >/dev/null; then \
 	    echo "determinism: $$c $$f gives other results:"; diff tests/determinism.expected $(BUILD)/determinism.out; exit 1; fi; \
 	done; fi; done
-	@echo "determinism: gcc and clang at $(DETERMINISM_FLAGS): every solver's state hash as pinned"
+	@for c in gcc clang; do if command -v $$c >/dev/null; then \
+	  $$c $(STD) $(WARN) -O2 -fopenmp -I. tests/determinism.c -o $(BUILD)/determinism_omp $(LDLIBS) || exit 1; \
+	  for t in $(DETERMINISM_THREADS); do OMP_NUM_THREADS=$$t $(BUILD)/determinism_omp > $(BUILD)/determinism.out || exit 1; \
+	    if ! diff -q tests/determinism.expected $(BUILD)/determinism.out >/dev/null; then \
+	      echo "determinism: $$c -fopenmp at $$t threads gives other results:"; diff tests/determinism.expected $(BUILD)/determinism.out; exit 1; fi; \
+	done; fi; done
+	@$(CC) $(STD) $(WARN) -O2 $(DETERMINISM_GRAIN) -I. tests/determinism.c -o $(BUILD)/determinism_grain $(LDLIBS) && \
+	  $(BUILD)/determinism_grain > $(BUILD)/determinism_grain.out && \
+	  $(CC) $(STD) $(WARN) -O2 -fopenmp $(DETERMINISM_GRAIN) -I. tests/determinism.c -o $(BUILD)/determinism_grain_omp $(LDLIBS) || exit 1; \
+	for t in $(DETERMINISM_THREADS); do OMP_NUM_THREADS=$$t $(BUILD)/determinism_grain_omp > $(BUILD)/determinism.out || exit 1; \
+	  diff -q $(BUILD)/determinism_grain.out $(BUILD)/determinism.out >/dev/null || { \
+	    echo "determinism: with every loop threaded ($(DETERMINISM_GRAIN)), $$t threads differ from one:"; \
+	    diff $(BUILD)/determinism_grain.out $(BUILD)/determinism.out; exit 1; }; done
+	@echo "determinism: gcc and clang at $(DETERMINISM_FLAGS), and with OpenMP at $(DETERMINISM_THREADS) threads:" \
+	  "every solver's state hash as pinned; with every threaded loop taken ($(DETERMINISM_GRAIN)), the same" \
+	  "hashes at every thread count as without OpenMP"
 
 # The same suite with fsdem_real = float; its tolerances follow the precision (tests/fsdem_tests.h).
 .PHONY: test-float
@@ -102,6 +124,38 @@ $(BUILD)/check_fsdem_float: $(TEST_SRC) tests/fsdem_tests.h fsdem.h | $(BUILD) c
 
 test-float: $(BUILD)/check_fsdem_float
 	$(BUILD)/check_fsdem_float
+
+# The Check suite built with OpenMP and run on OMP_THREADS threads (default 2): the threaded paths
+# meet the same analytical checks.
+OMP_THREADS ?= 2
+.PHONY: test-omp tsan
+$(BUILD)/check_fsdem_omp: $(TEST_SRC) tests/fsdem_tests.h fsdem.h | $(BUILD) check-deps
+	$(CC) $(STD) $(WARN) $(CFLAGS) -fopenmp $(CHECK_CFLAGS) -I. $(TEST_SRC) -o $@ $(CHECK_LIBS) $(LDLIBS)
+
+test-omp: $(BUILD)/check_fsdem_omp
+	OMP_NUM_THREADS=$(OMP_THREADS) $(BUILD)/check_fsdem_omp
+
+# ThreadSanitizer on the threaded code (clang, LLVM's OpenMP runtime with its Archer tool, so the
+# runtime's own synchronisation is understood): every determinism scene, and the suites of the
+# threaded solvers, at 2 and 4 threads. Needs libomp-dev (installed like Check when run as root).
+TSAN_SUITES := swe linalg dem dem_contact
+tsan: | $(BUILD) check-deps
+	@if ! ls /usr/lib/llvm-*/lib/libarcher.so >/dev/null 2>&1 && [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	  echo "installing LLVM's OpenMP runtime: apt-get install -y libomp-dev"; apt-get install -y libomp-dev >/dev/null 2>&1; fi
+	clang $(STD) $(WARN) -O1 -g -fopenmp -fsanitize=thread -I. tests/determinism.c -o $(BUILD)/determinism_tsan $(LDLIBS)
+	clang $(STD) $(WARN) -O1 -g -fopenmp -fsanitize=thread $(CHECK_CFLAGS) -I. $(TEST_SRC) -o $(BUILD)/check_fsdem_tsan \
+	  $(CHECK_LIBS) $(LDLIBS)
+	@archer=$$(ls /usr/lib/llvm-*/lib/libarcher.so 2>/dev/null | head -1); \
+	[ -n "$$archer" ] || { echo "tsan: libarcher.so not found; run: sudo apt-get install -y libomp-dev"; exit 1; }; \
+	for t in 2 4; do \
+	  TSAN_OPTIONS="halt_on_error=1 ignore_noninstrumented_modules=1" OMP_TOOL_LIBRARIES=$$archer OMP_NUM_THREADS=$$t \
+	    $(BUILD)/determinism_tsan > $(BUILD)/determinism.out || exit 1; \
+	  diff -q tests/determinism.expected $(BUILD)/determinism.out >/dev/null || { echo "tsan: other hashes at $$t threads"; exit 1; }; \
+	  for suite in $(TSAN_SUITES); do \
+	    TSAN_OPTIONS="halt_on_error=1 ignore_noninstrumented_modules=1" OMP_TOOL_LIBRARIES=$$archer OMP_NUM_THREADS=$$t \
+	      CK_FORK=no CK_RUN_SUITE=$$suite $(BUILD)/check_fsdem_tsan >/dev/null || exit 1; done; \
+	done
+	@echo "tsan: the determinism scenes and the suites $(TSAN_SUITES) at 2 and 4 threads: no data race"
 
 valgrind: $(BUILD)/check_fsdem
 	CK_FORK=no valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=all -q $(BUILD)/check_fsdem
@@ -202,10 +256,13 @@ validate-status:
 
 # Benchmarks are built for any x86-64 (SSE2) by default; BENCH_FLAGS=-march=native builds them for
 # this CPU (wider SIMD lanes in the DEM contact kernel). Rebuild with `make -B bench BENCH_FLAGS=...`.
+# They are built with OpenMP (BENCH_OMP; empty for a build without it): dem_column, swe2d, pcg_poisson
+# and pic_dambreak run on one thread and then on two, and print speedup_2t.
 BENCH_FLAGS ?=
+BENCH_OMP ?= -fopenmp
 $(BUILD)/bench/%: bench/%/main.c fsdem.h | $(BUILD)
 	@mkdir -p $(dir $@)
-	$(CC) $(STD) $(WARN) -O3 -DNDEBUG $(BENCH_FLAGS) -I. $< -o $@ $(LDLIBS)
+	$(CC) $(STD) $(WARN) -O3 -DNDEBUG $(BENCH_OMP) $(BENCH_FLAGS) -I. $< -o $@ $(LDLIBS)
 
 # the MPS-DEM and PIC-DEM dam breaks' cases are shared by their validation cases and their benches
 $(BUILD)/bench/mpsdem_dambreak: validation/mpsdem_dambreak/case.h

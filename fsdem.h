@@ -150,6 +150,18 @@
      No global mutable state. Distinct objects may be used from distinct threads at once; one
      object must not be used from two threads at once.
 
+   THREADS
+     Built with OpenMP (-fopenmp), a step runs its loops on OpenMP threads (fsdem_set_threads, or
+     OMP_NUM_THREADS). Results do not depend on the thread count, bit for bit, and equal those of a
+     build without OpenMP: no floating-point atomics; each value is written by one thread, and a sum
+     over many items is taken in an order fixed by the data alone (the PCG's dot products in blocks
+     of FSDEM__DOT_BLOCK entries, added block by block; the contact forces on a particle in the
+     order of the contact list). `make determinism` pins the same hashes at 1, 2, 3 and 4 threads.
+     Threaded so far: the shallow-water rows (bands of rows, each with its own work rows and a
+     copy of the rows beside it), the PCG (operators, smoothers, transfers, vector updates, dot
+     products) and the DEM's contact kernels and integration. The PIC, MPS and the couplers' own
+     loops run on one thread.
+
    ERRORS
      Fallible calls return fsdem_result: FSDEM_OK (0) or a negative code; fsdem_result_string()
      names it. The object keeps a message with the detail (which field, which particle), read with
@@ -388,6 +400,7 @@
 #define fsdem_pvd_close fsdem_pvd_close_f
 #define fsdem_pvd_open fsdem_pvd_open_f
 #define fsdem_result_string fsdem_result_string_f
+#define fsdem_set_threads fsdem_set_threads_f
 #define fsdem_stencil_apply fsdem_stencil_apply_f
 #define fsdem_stencil_check fsdem_stencil_check_f
 #define fsdem_swe_add_force fsdem_swe_add_force_f
@@ -456,6 +469,7 @@
 #define fsdem_swe_volume fsdem_swe_volume_f
 #define fsdem_swe_write_csv fsdem_swe_write_csv_f
 #define fsdem_swe_write_vti fsdem_swe_write_vti_f
+#define fsdem_threads fsdem_threads_f
 #endif
 /* FSDEM__SYMBOLS_END */
 
@@ -533,6 +547,14 @@ typedef struct fsdem_allocator {
     void (*free)(void *user, void *ptr, size_t size);
     void *user;
 } fsdem_allocator;
+
+/* Threads. Built with OpenMP (-fopenmp), the solvers run their loops on the calling thread's OpenMP
+   team, and every result is the same bit for bit at any thread count and as in a build without
+   OpenMP (>>doc THREADS). The count is OpenMP's own (OMP_NUM_THREADS, omp_set_num_threads):
+   fsdem_set_threads(n >= 1) sets it for the calling thread, fsdem_threads() reads it. Without OpenMP
+   no thread is created, fsdem_set_threads does nothing and fsdem_threads() is 1. */
+FSDEM_API void fsdem_set_threads(int count);
+FSDEM_API int fsdem_threads(void);
 
 /* Vector helpers (inline in every translation unit). */
 static inline fsdem_vec3 fsdem_v3(fsdem_real x, fsdem_real y, fsdem_real z) {
@@ -3396,6 +3418,26 @@ FSDEM_API fsdem_result fsdem_swe_write_vti(const fsdem_swe *swe, const char *pat
 #define FSDEM__RESTRICT restrict
 #endif
 
+/* OpenMP, when the build has it: FSDEM__OMP(directive) is `#pragma omp directive`, and nothing
+   without -fopenmp (where gcc would warn of an unknown pragma). fsdem__workers() is the team size a
+   parallel region asks for. */
+#ifdef _OPENMP
+#include <omp.h>
+#define FSDEM__PRAGMA(x) _Pragma(#x)
+#define FSDEM__OMP(x) FSDEM__PRAGMA(omp x)
+static int fsdem__workers(void) { return omp_get_max_threads(); }
+static int fsdem__worker(void) { return omp_get_thread_num(); }
+void fsdem_set_threads(int count) {
+    if (count >= 1) omp_set_num_threads(count);
+}
+#else
+#define FSDEM__OMP(x)
+static int fsdem__workers(void) { return 1; }
+static int fsdem__worker(void) { return 0; }
+void fsdem_set_threads(int count) { (void)count; }
+#endif
+int fsdem_threads(void) { return fsdem__workers(); }
+
 const char *fsdem_result_string(fsdem_result result) {
     switch (result) {
     case FSDEM_OK: return "FSDEM_OK";
@@ -4555,6 +4597,7 @@ struct fsdem_dem {
     fsdem__dem_list pp, pp_old, pw, pw_old;
     struct fsdem__dem_wall_hit *hits; /* scratch: one particle's wall contacts (fsdem__dem_wall_hits) */
     fsdem__arena arena;           /* per-step scratch of the force evaluation, reserved by rebuilds */
+    int workers;                  /* threads the arena was reserved for (fsdem__dem_force_scratch) */
     int *found, found_capacity;   /* scratch of the rebuild: pairs within reach (fsdem__dem_find_pairs) */
     int *inert, inert_count, inert_capacity; /* pairs of fixed particles within reach (i, j), listed aside */
     int hit_capacity;
@@ -5905,6 +5948,29 @@ fsdem_vec3 fsdem_dem_wall_impulse(const fsdem_dem *d, int id) {
     return d && id >= 0 && id < d->wall_count ? d->walls[id].impulse : fsdem__zero3();
 }
 
+/* Threaded evaluation (>>doc THREADS): the pair list is cut into chunks of this many entries for
+   the touching pass, and the touching pairs into batches as on one thread. */
+#ifndef FSDEM__DEM_CHUNK /* (tests/determinism.c sets it small, so every scene takes the threaded path) */
+#define FSDEM__DEM_CHUNK 8192
+#endif
+
+/* One touching pair's results, kept so the forces can be added in the order of the contact list. */
+typedef struct fsdem__dem_result {
+    fsdem_vec3 force, torque_i, torque_j, rolling;
+    int i, other, rolls;
+} fsdem__dem_result;
+
+/* Bytes of the force evaluation's scratch for `workers` threads: the touching list, one batch per
+   thread, and with threads the chunk counts and a result per pair. */
+static size_t fsdem__dem_force_scratch(const fsdem_dem *d, int workers) {
+    const size_t pairs = (size_t)d->pp.count, chunks = pairs / FSDEM__DEM_CHUNK + 1;
+    size_t bytes = fsdem__arena_bytes(sizeof(int) * pairs) + (size_t)workers * fsdem__arena_bytes(sizeof(fsdem__dem_batch));
+    if (workers > 1)
+        bytes += fsdem__arena_bytes(sizeof(int) * chunks) + fsdem__arena_bytes(sizeof(fsdem__dem_result) * pairs) +
+                 fsdem__arena_bytes(sizeof(fsdem_real) * (size_t)workers);
+    return bytes;
+}
+
 /* ---- >>dem_neighbours : neighbour lists with contact history ---- */
 
 /* Doubles the entry arrays of a list (all three or none). */
@@ -6138,9 +6204,8 @@ static fsdem_result fsdem__dem_rebuild(fsdem_dem *d) {
         if (d->pw.start[i + 1] - d->pw.start[i] > k) k = d->pw.start[i + 1] - d->pw.start[i];
     d->need_rebuild = fsdem__grow(&d->allocator, (void **)&d->hits, &d->hit_capacity, 0, k, sizeof(fsdem__dem_wall_hit)) !=
                           FSDEM_OK ||
-                      fsdem__arena_reserve(&d->allocator, &d->arena,
-                                           fsdem__arena_bytes(sizeof(int) * (size_t)d->pp.count) +
-                                               fsdem__arena_bytes(sizeof(fsdem__dem_batch))) != FSDEM_OK;
+                      fsdem__arena_reserve(&d->allocator, &d->arena, fsdem__dem_force_scratch(d, fsdem__workers())) != FSDEM_OK;
+    d->workers = d->need_rebuild ? 1 : fsdem__workers();
     return d->need_rebuild ? FSDEM_ERR_OUT_OF_MEMORY : FSDEM_OK;
 }
 
@@ -6342,18 +6407,18 @@ FSDEM__FORCE_INLINE void fsdem__dem_scatter(fsdem_dem *d, const fsdem__dem_batch
         }
 }
 
-/* The entries of the particle-pair list whose pair touches, into `touching`; returns their number.
-   With `commit`, the pairs that do not touch lose their spring. Branch-free, and instantiated with
-   and without `commit`. */
-FSDEM__FORCE_INLINE int fsdem__dem_touching(fsdem_dem *d, int *FSDEM__RESTRICT touching, const int commit, const int periodic) {
+/* The entries [k0, k1) of the particle-pair list whose pair touches, into `touching`; returns their
+   number. With `commit`, the pairs that do not touch lose their spring. Branch-free, and
+   instantiated with and without `commit`. */
+FSDEM__FORCE_INLINE int fsdem__dem_touching_range(fsdem_dem *d, int *FSDEM__RESTRICT touching, int k0, int k1, const int commit,
+                                                  const int periodic) {
     const fsdem_real off = d->desc.contact_offset;
     const fsdem_vec3 *FSDEM__RESTRICT x = d->x;
     const fsdem_real *FSDEM__RESTRICT r = d->r;
     const int *FSDEM__RESTRICT first = d->pp.first;
     int *FSDEM__RESTRICT keys = d->pp.key;
-    const int pairs = d->pp.count;
     int k, count = 0;
-    for (k = 0; k < pairs; ++k) {
+    for (k = k0; k < k1; ++k) {
         const int key = keys[k], i = first[k], j = FSDEM__DEM_PARTNER(key);
         const fsdem_vec3 e = periodic ? fsdem__min_image(&d->periods, fsdem__sub(x[i], x[j])) : fsdem__sub(x[i], x[j]);
         const fsdem_real ex = e.x, ey = e.y, ez = e.z, reach = r[i] + r[j] + off;
@@ -6363,6 +6428,117 @@ FSDEM__FORCE_INLINE int fsdem__dem_touching(fsdem_dem *d, int *FSDEM__RESTRICT t
         if (commit) keys[k] = key & ~((touch - 1) & FSDEM__DEM_HELD); /* arithmetic: a branch here would mispredict */
     }
     return count;
+}
+
+/* The touching entries of the whole pair list into `touching`, in list order: on `team` threads chunk
+   by chunk (each chunk's entries at its own start, then moved together), else in one pass. */
+static int fsdem__dem_touching(fsdem_dem *d, int *touching, int commit, int team, int *chunk_count) {
+    const int pairs = d->pp.count, chunks = pairs / FSDEM__DEM_CHUNK + 1, periodic = d->periods.any;
+    int q, count = 0;
+    if (team <= 1 || chunks <= 1) {
+        if (periodic) return commit ? fsdem__dem_touching_range(d, touching, 0, pairs, 1, 1) : fsdem__dem_touching_range(d, touching, 0, pairs, 0, 1);
+        return commit ? fsdem__dem_touching_range(d, touching, 0, pairs, 1, 0) : fsdem__dem_touching_range(d, touching, 0, pairs, 0, 0);
+    }
+    FSDEM__OMP(parallel for schedule(static) num_threads(team))
+    for (q = 0; q < chunks; ++q) {
+        const int k0 = q * FSDEM__DEM_CHUNK, k1 = pairs - k0 < FSDEM__DEM_CHUNK ? pairs : k0 + FSDEM__DEM_CHUNK;
+        int *out = touching + k0;
+        if (periodic) chunk_count[q] = commit ? fsdem__dem_touching_range(d, out, k0, k1, 1, 1) : fsdem__dem_touching_range(d, out, k0, k1, 0, 1);
+        else chunk_count[q] = commit ? fsdem__dem_touching_range(d, out, k0, k1, 1, 0) : fsdem__dem_touching_range(d, out, k0, k1, 0, 0);
+    }
+    for (q = 0; q < chunks; ++q) {
+        memmove(touching + count, touching + (size_t)q * FSDEM__DEM_CHUNK, sizeof(int) * (size_t)chunk_count[q]);
+        count += chunk_count[q];
+    }
+    return count;
+}
+
+/* A batch's results into `out` (one per lane), with the rolling-resistance torque where the pair has
+   it, its springs committed when `commit`; returns its largest overlap. */
+static fsdem_real fsdem__dem_keep_results(fsdem_dem *d, const fsdem__dem_batch *b, fsdem__dem_result *out, int commit,
+                                          fsdem_real h) {
+    fsdem_real max_overlap = 0;
+    int c;
+    for (c = 0; c < b->count; ++c) {
+        fsdem__dem_result *o = out + c;
+        const fsdem_real mu_r = d->rolling ? d->pairs[b->pair[c]].rolling : 0;
+        o->i = b->i[c];
+        o->other = b->other[c];
+        o->force = fsdem__dem_batch_vec(b->force, c);
+        o->torque_i = fsdem__dem_batch_vec(b->torque_i, c);
+        o->torque_j = fsdem__dem_batch_vec(b->torque_j, c);
+        o->rolls = mu_r > 0;
+        if (o->rolls)
+            o->rolling = fsdem__dem_rolling_torque(fsdem__sub(d->w[o->i], d->w[o->other]), mu_r, b->r_eff[c], b->fn[c],
+                                                   d->inv_i[o->i] + d->inv_i[o->other], h);
+        if (commit) {
+            d->pp.history[b->entry[c]] = fsdem__dem_batch_vec(b->spring, c);
+            d->pp.key[b->entry[c]] |= FSDEM__DEM_HELD;
+        }
+        if (b->delta[c] > max_overlap) max_overlap = b->delta[c];
+    }
+    return max_overlap;
+}
+
+/* Adds the results of `count` touching pairs to the particles in [lo, hi), in the order
+   fsdem__dem_scatter adds them on one thread: batch by batch, in each the forces and torques pair
+   by pair, then the rolling torques. Each thread adds to its own particles only. */
+static void fsdem__dem_add_results(fsdem_dem *d, const fsdem__dem_result *res, int count, int lo, int hi) {
+    fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t;
+    int b0, c;
+    for (b0 = 0; b0 < count; b0 += FSDEM__DEM_BATCH) {
+        const int b1 = count - b0 < FSDEM__DEM_BATCH ? count : b0 + FSDEM__DEM_BATCH;
+        for (c = b0; c < b1; ++c) {
+            const fsdem__dem_result *r = res + c;
+            if (r->i >= lo && r->i < hi) {
+                f[r->i] = fsdem__add(f[r->i], r->force);
+                t[r->i] = fsdem__add(t[r->i], r->torque_i);
+            }
+            if (r->other >= lo && r->other < hi) {
+                f[r->other] = fsdem__sub(f[r->other], r->force);
+                t[r->other] = fsdem__add(t[r->other], r->torque_j);
+            }
+        }
+        for (c = b0; c < b1; ++c) {
+            const fsdem__dem_result *r = res + c;
+            if (!r->rolls) continue;
+            if (r->i >= lo && r->i < hi) t[r->i] = fsdem__add(t[r->i], r->rolling);
+            if (r->other >= lo && r->other < hi) t[r->other] = fsdem__sub(t[r->other], r->rolling);
+        }
+    }
+}
+
+/* The touching pairs' forces on `team` threads: batches of the contact list evaluated in parallel
+   into per-pair results, then added to the particles by their owners in list order, so every
+   particle sums the same terms in the same order as on one thread. */
+FSDEM__FORCE_INLINE void fsdem__dem_pairs_threaded(fsdem_dem *d, const int *touching, int nt, fsdem__dem_batch *batches,
+                                               fsdem__dem_result *res, fsdem_real *overlaps, int team, fsdem_real h,
+                                               int keep, const fsdem_dem_law law, const fsdem__dem_rules *rules) {
+    const int uniform = d->material_count == 1, nb = (nt + FSDEM__DEM_BATCH - 1) / FSDEM__DEM_BATCH, n = d->n;
+    const fsdem__dem_pair *pairs = uniform ? d->pairs : NULL;
+    int w;
+    FSDEM__OMP(parallel num_threads(team))
+    {
+        const int me = fsdem__worker();
+        fsdem__dem_batch *b = batches + me;
+        fsdem_real largest = 0;
+        int q, c;
+        FSDEM__OMP(for schedule(static))
+        for (q = 0; q < nb; ++q) {
+            const int k0 = q * FSDEM__DEM_BATCH, k1 = nt - k0 < FSDEM__DEM_BATCH ? nt : k0 + FSDEM__DEM_BATCH;
+            fsdem_real m;
+            b->count = 0;
+            for (c = k0; c < k1; ++c) fsdem__dem_gather_pair(d, b, b->count++, touching[c], law, uniform);
+            fsdem__dem_batch_pad(b, 1, uniform);
+            fsdem__dem_batch_law(b, law, h, 1, d->desc.contact_offset, pairs, rules);
+            m = fsdem__dem_keep_results(d, b, res + k0, keep, h);
+            if (m > largest) largest = m;
+        }
+        overlaps[me] = largest;
+        fsdem__dem_add_results(d, res, nt, (int)((long long)n * me / team), (int)((long long)n * (me + 1) / team));
+    }
+    for (w = 0; w < team; ++w)
+        if (overlaps[w] > d->max_overlap) d->max_overlap = overlaps[w];
 }
 
 /* Runs the kernels on a filled batch (particle pairs or, with `walls`, wall contacts), applies it
@@ -6387,13 +6563,15 @@ FSDEM__FORCE_INLINE int fsdem__dem_drain(fsdem_dem *d, fsdem__dem_batch *b, int 
    contact law (fsdem__dem_compute_forces). */
 FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real h, int commit, const fsdem_dem_law law) {
     const int n = d->n, keep = commit && (law == FSDEM_DEM_LAW_HERTZ_MINDLIN || law == FSDEM__DEM_LAW_SEED002);
-    const int uniform = d->material_count == 1;
+    const int uniform = d->material_count == 1, workers = fsdem__workers();
+    const int team = d->pp.count > 2 * FSDEM__DEM_CHUNK ? (workers < d->workers ? workers : d->workers) : 1;
     const fsdem__dem_rules rules = fsdem__dem_rules_of(d);
-    fsdem__dem_batch *b;
-    int *touching, i, k, c, nt = 0, nw = 0;
+    fsdem__dem_batch *b, *batches;
+    int *touching, *chunk_count = NULL, i, k, c, nt = 0, nw = 0;
     fsdem__arena_reset(&d->arena);
     touching = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)d->pp.count);
-    b = (fsdem__dem_batch *)fsdem__arena_push(&d->arena, sizeof *b);
+    b = batches = (fsdem__dem_batch *)fsdem__arena_push(&d->arena, sizeof *b * (size_t)d->workers);
+    if (team > 1) chunk_count = (int *)fsdem__arena_push(&d->arena, sizeof(int) * (size_t)(d->pp.count / FSDEM__DEM_CHUNK + 1));
     if (!d->forces_cleared) {
         memset(d->f, 0, sizeof *d->f * (size_t)n);
         memset(d->t, 0, sizeof *d->t * (size_t)n);
@@ -6401,12 +6579,18 @@ FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real 
     d->forces_cleared = 0;
     for (k = 0; k < d->wall_count; ++k) d->walls[k].force = fsdem__zero3();
     d->max_overlap = 0;
-    if (d->periods.any) nt = commit ? fsdem__dem_touching(d, touching, 1, 1) : fsdem__dem_touching(d, touching, 0, 1);
-    else nt = commit ? fsdem__dem_touching(d, touching, 1, 0) : fsdem__dem_touching(d, touching, 0, 0);
+    nt = fsdem__dem_touching(d, touching, commit, team, chunk_count);
     b->count = 0;
-    for (k = 0; k < nt; ++k) {
-        fsdem__dem_gather_pair(d, b, b->count++, touching[k], law, uniform);
-        if (b->count == FSDEM__DEM_BATCH || k == nt - 1) fsdem__dem_drain(d, b, 0, law, h, keep, &rules);
+    if (team > 1) {
+        fsdem__dem_result *res = (fsdem__dem_result *)fsdem__arena_push(&d->arena, sizeof(fsdem__dem_result) * (size_t)d->pp.count);
+        fsdem_real *overlaps = (fsdem_real *)fsdem__arena_push(&d->arena, sizeof(fsdem_real) * (size_t)team);
+        fsdem__dem_pairs_threaded(d, touching, nt, batches, res, overlaps, team, h, keep, law, &rules);
+        b->count = 0; /* the walls' batches follow in the first */
+    } else {
+        for (k = 0; k < nt; ++k) {
+            fsdem__dem_gather_pair(d, b, b->count++, touching[k], law, uniform);
+            if (b->count == FSDEM__DEM_BATCH || k == nt - 1) fsdem__dem_drain(d, b, 0, law, h, keep, &rules);
+        }
     }
     for (k = 0; k < d->pw.count; k = d->pw.start[i + 1]) {
         /* row to row through the particles with wall entries */
@@ -6463,6 +6647,8 @@ FSDEM__FORCE_INLINE int fsdem__dem_verlet_pass(fsdem_dem *d, fsdem_real h, const
     const int planar = d->desc.dim == 2, n = d->n;
     fsdem_real disp2 = d->max_disp2;
     int i, k, outside = 0; /* or suspect: not finite */
+    FSDEM__OMP(parallel for schedule(static) reduction(max : disp2) reduction(| : outside) num_threads(fsdem__workers())
+               if (n > FSDEM__DEM_CHUNK))
     for (i = 0; i < n; ++i) {
         if (!fixed[i]) {
             const fsdem_real a = h * inv_m[i], b = h_spin * inv_i[i];
@@ -7043,7 +7229,11 @@ struct fsdem_pcg {
     int levels;
     fsdem__level level[FSDEM__MG_MAX_LEVELS];
     fsdem_real *ic;         /* stencil IC/MIC: 1/sqrt(pivot); CSR Jacobi: 1/diagonal */
-    fsdem_real *rowbuf;     /* multigrid: two rows of the finest level */
+    fsdem_real *rowbuf;     /* multigrid: two rows of the finest level per worker */
+    fsdem_real *restricted; /* multigrid, threaded: each fine row's residual restricted along x */
+    double *dot_part;       /* a dot product's block sums (FSDEM__DOT_BLOCK) */
+    int *progress;          /* multigrid, threaded: stages finished per slab of a level */
+    int workers;            /* threads the per-worker buffers were carved for (at setup) */
     int ns_components, ns_cells; /* null space: fluid regions without a Dirichlet anchor */
     int *ns_cell;           /* their cells, each region's first cell stored as -(c + 1) */
     unsigned char *mark;
@@ -7317,6 +7507,22 @@ fsdem_result fsdem_pcg_set_tolerance(fsdem_pcg *s, fsdem_real tolerance, int max
     s->desc.tolerance = tolerance;
     s->desc.max_iterations = max_iterations;
     return fsdem__ok(&s->status);
+}
+
+/* Dot products are summed in blocks of this many entries, the blocks' sums then added in order
+   (>>doc THREADS): a vector of one block is summed exactly as before threads came. */
+#ifndef FSDEM__DOT_BLOCK /* (see FSDEM__DEM_CHUNK) */
+#define FSDEM__DOT_BLOCK 16384
+#endif
+static size_t fsdem__dot_blocks(int n) { return ((size_t)n + FSDEM__DOT_BLOCK - 1) / FSDEM__DOT_BLOCK; }
+
+/* Reals of one worker's multigrid row buffer: two rows of the finest level with their ends. */
+static size_t fsdem__mg_rowbuf_length(const fsdem_pcg *s) { return 2 * ((size_t)s->level[0].n[0] + 8); }
+
+/* Reals of the threaded restriction's scratch: every row of the finest level restricted along x (the
+   finest level has the most rows and the widest coarse rows). */
+static size_t fsdem__mg_restricted_length(const fsdem__level *F, const fsdem__level *C) {
+    return (size_t)F->n[1] * (size_t)F->n[2] * (size_t)C->n[0];
 }
 
 /* Carves arrays out of one block: a first pass with base = NULL measures, a second assigns. */
@@ -7599,6 +7805,7 @@ static void fsdem__level_apply(const fsdem__level *L, int dim, const fsdem_real 
     int i, j, k, sy = L->sy, sz = L->sz;
     const fsdem_real *d = L->d, *w0 = L->w[0], *w1 = L->w[1], *w2 = L->w[2];
     if (dim == 2) {
+        FSDEM__OMP(parallel for private(i) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
         for (j = 0; j < L->n[1]; ++j) {
             int c0 = (j + 1) * sy + 1;
             for (i = 0; i < L->n[0]; ++i) {
@@ -7609,6 +7816,7 @@ static void fsdem__level_apply(const fsdem__level *L, int dim, const fsdem_real 
         }
         return;
     }
+    FSDEM__OMP(parallel for private(i, j) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
     for (k = 0; k < L->n[2]; ++k)
         for (j = 0; j < L->n[1]; ++j) {
             int c0 = (k + 1) * sz + (j + 1) * sy + 1;
@@ -7751,14 +7959,13 @@ static void fsdem__mg_prolong_row(const fsdem__level *F, const fsdem__level *C, 
     }
 }
 
-/* bc += P^T (b - A x) over row (j, k) of F, the residual formed on the fly. b is 0 off fluid cells
-   on every level, so the residual is too (d and the couplings vanish there). Coarse ghost and
-   non-fluid entries receive values that fsdem__mg_clean clears. */
-static void fsdem__mg_restrict_row(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *b,
-                                const fsdem_real *x, fsdem_real *bc, int j, int k, fsdem_real *buf) {
+/* P^T (b - A x) along x of row (j, k) of F into cr (C->n[0] values), the residual formed on the fly
+   in r (n0 + 4 reals). b is 0 off fluid cells on every level, so the residual is too (d and the
+   couplings vanish there). */
+static void fsdem__mg_restrict_x(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *b,
+                                 const fsdem_real *x, int j, int k, fsdem_real *r, fsdem_real *cr) {
     int i, I, J, K, oy, oz, crow, f0, n0 = F->n[0], nI = C->n[0], sy = F->sy, sz = F->sz;
     fsdem_real ay, by, az, bz;
-    fsdem_real *r = buf + 2, *cr = buf + F->n[0] + 6;
     const fsdem_real *d, *w0, *w1, *w2, *bb, *xx;
     const unsigned char *type;
     fsdem__mg_axis_weights(j, C->ratio[1], C->sy, &J, &oy, &ay, &by);
@@ -7800,18 +8007,61 @@ static void fsdem__mg_restrict_row(const fsdem__level *F, const fsdem__level *C,
     } else {
         for (I = 0; I < nI; ++I) cr[I] = r[I];
     }
-    /* y and z: add to up to four coarse rows */
-    {
-        fsdem_real *c00 = bc + crow, *c10 = c00 + oy, *c01 = c00 + oz, *c11 = c00 + oy + oz;
-        fsdem_real w00 = ay * az, w10 = by * az, w01 = ay * bz, w11 = by * bz;
-        for (I = 0; I < nI; ++I) c00[I] += w00 * cr[I];
-        if (w10 != 0)
-            for (I = 0; I < nI; ++I) c10[I] += w10 * cr[I];
-        if (w01 != 0)
-            for (I = 0; I < nI; ++I) c01[I] += w01 * cr[I];
-        if (w11 != 0)
-            for (I = 0; I < nI; ++I) c11[I] += w11 * cr[I];
+}
+
+/* The coarse rows that fine row (j, k) restricts to: (J, K), its y neighbour on the child's side,
+   its z neighbour and their diagonal (targets 0-3), with their weights. */
+typedef struct fsdem__mg_targets {
+    int row[4], slab[4];
+    fsdem_real w[4];
+} fsdem__mg_targets;
+
+static fsdem__mg_targets fsdem__mg_targets_of(const fsdem__level *C, int dim, int j, int k) {
+    fsdem__mg_targets t;
+    int J, K, oy, oz, dy, dz;
+    fsdem_real ay, by, az, bz;
+    fsdem__mg_axis_weights(j, C->ratio[1], 1, &J, &dy, &ay, &by);
+    fsdem__mg_axis_weights(k, C->ratio[2], 1, &K, &dz, &az, &bz);
+    if (dim == 2) {
+        az = 1;
+        bz = 0;
+        dz = 0;
     }
+    oy = dy * C->sy;
+    oz = dz * C->sz;
+    t.row[0] = fsdem__level_index(C, dim, 0, J, K);
+    t.row[1] = t.row[0] + oy;
+    t.row[2] = t.row[0] + oz;
+    t.row[3] = t.row[0] + oy + oz;
+    /* the slab (a plane in 3D, a row in 2D) each target lies in */
+    t.slab[0] = t.slab[1] = dim == 3 ? K : J;
+    t.slab[2] = t.slab[3] = dim == 3 ? K + dz : J;
+    if (dim == 2) t.slab[1] = t.slab[3] = J + dy;
+    t.w[0] = ay * az;
+    t.w[1] = by * az;
+    t.w[2] = ay * bz;
+    t.w[3] = by * bz;
+    return t;
+}
+
+/* bc += w cr on the targets of t in `mask` (bit q: target q); zero weights are skipped. */
+static void fsdem__mg_restrict_add(fsdem_real *bc, const fsdem__mg_targets *t, const fsdem_real *cr, int nI, int mask) {
+    int q, I;
+    for (q = 0; q < 4; ++q)
+        if ((mask >> q & 1) && (q == 0 || t->w[q] != 0)) {
+            fsdem_real *c = bc + t->row[q], w = t->w[q];
+            for (I = 0; I < nI; ++I) c[I] += w * cr[I];
+        }
+}
+
+/* bc += P^T (b - A x) over row (j, k) of F (x first, then y and z as axpys between whole rows).
+   Coarse ghost and non-fluid entries receive values that fsdem__mg_clean clears. */
+static void fsdem__mg_restrict_row(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *b,
+                                const fsdem_real *x, fsdem_real *bc, int j, int k, fsdem_real *buf) {
+    fsdem_real *cr = buf + F->n[0] + 6;
+    const fsdem__mg_targets t = fsdem__mg_targets_of(C, dim, j, k);
+    fsdem__mg_restrict_x(F, C, dim, b, x, j, k, buf + 2, cr);
+    fsdem__mg_restrict_add(bc, &t, cr, C->n[0], 15);
 }
 
 /* Zeroes b on the non-fluid cells (ghosts included) of a level after a restriction. */
@@ -7835,6 +8085,21 @@ typedef struct fsdem__mg_stage {
     int kind, colour;
 } fsdem__mg_stage;
 
+/* One stage over the rows of slabs [p0, p1) on the calling thread, with row buffer `buf` (the
+   restriction's second pass excepted: fsdem__mg_gather). */
+static void fsdem__mg_stage_rows(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b, fsdem_real *x,
+                                 fsdem_real *xc_or_bc, const fsdem__mg_stage *stage, int p0, int p1, fsdem_real *buf) {
+    int p, j;
+    for (p = p0; p < p1; ++p) {
+        const int jb = dim == 3 ? 0 : p, je = dim == 3 ? L->n[1] : p + 1, k = dim == 3 ? p : 0;
+        for (j = jb; j < je; ++j) switch (stage->kind) {
+            case FSDEM__STAGE_SMOOTH: fsdem__mg_smooth_row(L, dim, b, x, stage->colour, j, k, 0); break;
+            case FSDEM__STAGE_SMOOTH_FROM_ZERO: fsdem__mg_smooth_row(L, dim, b, x, stage->colour, j, k, 1); break;
+            default: fsdem__mg_prolong_row(L, C, dim, xc_or_bc, x, j, k, buf); break;
+            }
+    }
+}
+
 static void fsdem__mg_pipeline(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b,
                                fsdem_real *x, fsdem_real *xc_or_bc, const fsdem__mg_stage *stage, int stages,
                                fsdem_real *buf) {
@@ -7843,47 +8108,130 @@ static void fsdem__mg_pipeline(const fsdem__level *L, const fsdem__level *C, int
         for (s = 0; s < stages; ++s) {
             int p = t - s, jb = dim == 3 ? 0 : p, je = dim == 3 ? L->n[1] : p + 1, k = dim == 3 ? p : 0;
             if (p < 0 || p >= slabs) continue;
-            for (j = jb; j < je; ++j) switch (stage[s].kind) {
-                case FSDEM__STAGE_SMOOTH: fsdem__mg_smooth_row(L, dim, b, x, stage[s].colour, j, k, 0); break;
-                case FSDEM__STAGE_SMOOTH_FROM_ZERO: fsdem__mg_smooth_row(L, dim, b, x, stage[s].colour, j, k, 1); break;
-                case FSDEM__STAGE_RESTRICT: fsdem__mg_restrict_row(L, C, dim, b, x, xc_or_bc, j, k, buf); break;
-                default: fsdem__mg_prolong_row(L, C, dim, xc_or_bc, x, j, k, buf); break;
-                }
+            if (stage[s].kind != FSDEM__STAGE_RESTRICT) fsdem__mg_stage_rows(L, C, dim, b, x, xc_or_bc, stage + s, p, p + 1, buf);
+            else
+                for (j = jb; j < je; ++j) fsdem__mg_restrict_row(L, C, dim, b, x, xc_or_bc, j, k, buf);
         }
 }
 
+/* The restriction's second pass for coarse slab P: the fine rows' x-restricted residuals
+   (`restricted`, row j + k n1) added to the coarse rows of P, fine row after fine row as the
+   pipeline adds them, so every coarse entry sums the same terms in the same order. */
+static void fsdem__mg_gather(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *restricted,
+                             fsdem_real *bc, int P) {
+    const int axis = dim == 3 ? 2 : 1, slabs = F->n[axis], nI = C->n[0];
+    const int p0 = C->ratio[axis] == 2 ? 2 * P - 1 : P, p1 = C->ratio[axis] == 2 ? 2 * P + 2 : P;
+    int p, j, q;
+    for (p = p0 < 0 ? 0 : p0; p <= p1 && p < slabs; ++p) {
+        const int jb = dim == 3 ? 0 : p, je = dim == 3 ? F->n[1] : p + 1, k = dim == 3 ? p : 0;
+        for (j = jb; j < je; ++j) {
+            const fsdem__mg_targets t = fsdem__mg_targets_of(C, dim, j, k);
+            int mask = 0;
+            for (q = 0; q < 4; ++q) mask |= (t.slab[q] == P) << q;
+            fsdem__mg_restrict_add(bc, &t, restricted + ((size_t)k * F->n[1] + j) * (size_t)nI, nI, mask);
+        }
+    }
+}
+
+/* Progress of the threaded pipeline: the number of stages finished on a slab, published by the
+   thread that owns the slab and awaited by its neighbours' owners (integer atomics only). */
+#ifdef _OPENMP
+static int fsdem__mg_progress(const int *done, int p) { return __atomic_load_n(done + p, __ATOMIC_ACQUIRE); }
+static void fsdem__mg_publish(int *done, int p, int stages) { __atomic_store_n(done + p, stages, __ATOMIC_RELEASE); }
+#endif
+
+/* The pipeline of one thread over its slabs [p0, p1), downwards or upwards: stage s on slab p waits
+   until stage s - 1 is finished on both neighbours (p - 1, p + 1), which may belong to other threads.
+   Then every stage reads what it would read in one thread's pipeline (a colour's half-sweep reads
+   the other colour only; stage s + 1 of a neighbour waits for stage s here), so the result is the
+   same bit for bit. Neighbouring threads sweep towards each other's ends or away from them together,
+   so they meet in step. The restriction writes each fine row's x-restricted residual
+   (`restricted`); fsdem__mg_gather adds them to the coarse level after the pipeline. */
+static void fsdem__mg_thread_pipeline(const fsdem_pcg *s, const fsdem__level *L, const fsdem__level *C,
+                                      const fsdem_real *b, fsdem_real *x, fsdem_real *xc, const fsdem__mg_stage *stage,
+                                      int stages, int p0, int p1, int down, int *done, fsdem_real *buf) {
+#ifdef _OPENMP
+    const int dim = s->dim, slabs = dim == 3 ? L->n[2] : L->n[1], len = p1 - p0, nI = C ? C->n[0] : 0;
+    int t, q, j;
+    for (t = 0; t < len + stages - 1; ++t)
+        for (q = 0; q < stages; ++q) {
+            const int local = t - q, p = down ? p1 - 1 - local : p0 + local;
+            if (local < 0 || local >= len) continue;
+            while ((p > 0 && fsdem__mg_progress(done, p - 1) < q) || (p + 1 < slabs && fsdem__mg_progress(done, p + 1) < q)) {
+            }
+            if (stage[q].kind != FSDEM__STAGE_RESTRICT) fsdem__mg_stage_rows(L, C, dim, b, x, xc, stage + q, p, p + 1, buf);
+            else {
+                const int jb = dim == 3 ? 0 : p, je = dim == 3 ? L->n[1] : p + 1, k = dim == 3 ? p : 0;
+                for (j = jb; j < je; ++j)
+                    fsdem__mg_restrict_x(L, C, dim, b, x, j, k, buf + 2, s->restricted + ((size_t)k * L->n[1] + j) * (size_t)nI);
+            }
+            fsdem__mg_publish(done, p, q + 1);
+        }
+#else
+    (void)s, (void)L, (void)C, (void)b, (void)x, (void)xc, (void)stage, (void)stages, (void)p0, (void)p1, (void)down;
+    (void)done, (void)buf;
+#endif
+}
+
+/* Runs the stages on level L: on one thread, the pipeline; with threads (and a level large enough
+   to pay for them), one pipeline per thread over its share of the slabs (fsdem__mg_thread_pipeline),
+   then the restriction's gather over the coarse slabs. The same result bit for bit. */
+static void fsdem__mg_run(const fsdem_pcg *s, const fsdem__level *L, const fsdem__level *C, const fsdem_real *b,
+                          fsdem_real *x, fsdem_real *xc_or_bc, const fsdem__mg_stage *stage, int stages) {
+    const int dim = s->dim, slabs = dim == 3 ? L->n[2] : L->n[1], workers = fsdem__workers();
+    const int team = workers < s->workers ? (workers < slabs ? workers : slabs) : (s->workers < slabs ? s->workers : slabs);
+    const size_t rowbuf = fsdem__mg_rowbuf_length(s);
+    int p, P;
+    if (team <= 1 || L->count <= FSDEM__DOT_BLOCK || !s->restricted) {
+        fsdem__mg_pipeline(L, C, dim, b, x, xc_or_bc, stage, stages, s->rowbuf);
+        return;
+    }
+    for (p = 0; p < slabs; ++p) s->progress[p] = 0;
+    FSDEM__OMP(parallel num_threads(team))
+    {
+        const int w = fsdem__worker(), p0 = (int)((long long)slabs * w / team), p1 = (int)((long long)slabs * (w + 1) / team);
+        fsdem__mg_thread_pipeline(s, L, C, b, x, xc_or_bc, stage, stages, p0, p1, !(w & 1), s->progress,
+                                  s->rowbuf + (size_t)w * rowbuf);
+    }
+    if (C && stage[stages - 1].kind == FSDEM__STAGE_RESTRICT) {
+        const int cslabs = dim == 3 ? C->n[2] : C->n[1];
+        FSDEM__OMP(parallel for schedule(static) num_threads(team))
+        for (P = 0; P < cslabs; ++P) fsdem__mg_gather(L, C, dim, s->restricted, xc_or_bc, P);
+    }
+}
+
 /* Pre-smoothing from x = 0 (red first), then (when C is given) bc = P^T (b - A x). */
-static void fsdem__mg_down(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b, fsdem_real *x,
-                           fsdem_real *bc, int sweeps, fsdem_real *buf) {
+static void fsdem__mg_down(const fsdem_pcg *s, const fsdem__level *L, const fsdem__level *C, const fsdem_real *b,
+                           fsdem_real *x, fsdem_real *bc, int sweeps) {
     fsdem__mg_stage stage[2 * 64 + 2];
-    int n = 0, s;
-    for (s = 0; s < 2 * sweeps; ++s) {
-        stage[n].kind = s == 0 ? FSDEM__STAGE_SMOOTH_FROM_ZERO : FSDEM__STAGE_SMOOTH;
-        stage[n++].colour = s & 1;
+    int n = 0, h;
+    for (h = 0; h < 2 * sweeps; ++h) {
+        stage[n].kind = h == 0 ? FSDEM__STAGE_SMOOTH_FROM_ZERO : FSDEM__STAGE_SMOOTH;
+        stage[n++].colour = h & 1;
     }
     if (C) {
         stage[n].kind = FSDEM__STAGE_RESTRICT;
         stage[n++].colour = 0;
         memset(bc, 0, sizeof(fsdem_real) * (size_t)C->count);
     }
-    fsdem__mg_pipeline(L, C, dim, b, x, bc, stage, n, buf);
+    fsdem__mg_run(s, L, C, b, x, bc, stage, n);
     if (C) fsdem__mg_clean(C, bc);
 }
 
 /* (When C is given) x += P xc, then post-smoothing (black first: the adjoint of the pre-smoother). */
-static void fsdem__mg_up(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b, fsdem_real *x,
-                         fsdem_real *xc, int sweeps, fsdem_real *buf) {
+static void fsdem__mg_up(const fsdem_pcg *s, const fsdem__level *L, const fsdem__level *C, const fsdem_real *b,
+                         fsdem_real *x, fsdem_real *xc, int sweeps) {
     fsdem__mg_stage stage[2 * 64 + 2];
-    int n = 0, s;
+    int n = 0, h;
     if (C) {
         stage[n].kind = FSDEM__STAGE_PROLONG;
         stage[n++].colour = 0;
     }
-    for (s = 0; s < 2 * sweeps; ++s) {
+    for (h = 0; h < 2 * sweeps; ++h) {
         stage[n].kind = FSDEM__STAGE_SMOOTH;
-        stage[n++].colour = (s & 1) ^ 1;
+        stage[n++].colour = (h & 1) ^ 1;
     }
-    fsdem__mg_pipeline(L, C, dim, b, x, xc, stage, n, buf);
+    fsdem__mg_run(s, L, C, b, x, xc, stage, n);
 }
 
 /* z = M^-1 r: one V-cycle from a zero guess. */
@@ -7892,15 +8240,15 @@ static void fsdem__mg_vcycle(fsdem_pcg *s, const fsdem_real *r, fsdem_real *z) {
     fsdem__level *lv = s->level;
     lv[0].b = (fsdem_real *)r; /* read only at level 0 */
     lv[0].x = z;
-    for (l = 0; l < last; ++l) fsdem__mg_down(&lv[l], &lv[l + 1], dim, lv[l].b, lv[l].x, lv[l + 1].b, nu, s->rowbuf);
+    for (l = 0; l < last; ++l) fsdem__mg_down(s, &lv[l], &lv[l + 1], lv[l].b, lv[l].x, lv[l + 1].b, nu);
     if (lv[last].n[0] * lv[last].n[1] * lv[last].n[2] == 1) {
         int c = fsdem__level_index(&lv[last], dim, 0, 0, 0);
         lv[last].x[c] = lv[last].inv_d[c] * lv[last].b[c];
     } else {
-        fsdem__mg_down(&lv[last], NULL, dim, lv[last].b, lv[last].x, NULL, nu, s->rowbuf);
-        fsdem__mg_up(&lv[last], NULL, dim, lv[last].b, lv[last].x, NULL, nu, s->rowbuf);
+        fsdem__mg_down(s, &lv[last], NULL, lv[last].b, lv[last].x, NULL, nu);
+        fsdem__mg_up(s, &lv[last], NULL, lv[last].b, lv[last].x, NULL, nu);
     }
-    for (l = last - 1; l >= 0; --l) fsdem__mg_up(&lv[l], &lv[l + 1], dim, lv[l].b, lv[l].x, lv[l + 1].x, nu, s->rowbuf);
+    for (l = last - 1; l >= 0; --l) fsdem__mg_up(s, &lv[l], &lv[l + 1], lv[l].b, lv[l].x, lv[l + 1].x, nu);
     lv[0].b = lv[0].x = NULL;
 }
 
@@ -8525,7 +8873,15 @@ static void fsdem__stencil_carve(fsdem_pcg *s, fsdem__pcg_carver *cv, int levels
         s->uy = (fsdem_real *)fsdem__pcg_carve(cv, (size_t)cells, sizeof(fsdem_real));
     }
     s->ic = want_ic ? (fsdem_real *)fsdem__pcg_carve(cv, (size_t)N, sizeof(fsdem_real)) : NULL;
-    s->rowbuf = levels > 1 ? (fsdem_real *)fsdem__pcg_carve(cv, 2 * ((size_t)s->level[0].n[0] + 8), sizeof(fsdem_real)) : NULL;
+    s->rowbuf = levels > 1 ? (fsdem_real *)fsdem__pcg_carve(cv, (size_t)s->workers * fsdem__mg_rowbuf_length(s), sizeof(fsdem_real))
+                           : NULL;
+    s->restricted = levels > 1 && s->workers > 1
+                        ? (fsdem_real *)fsdem__pcg_carve(cv, fsdem__mg_restricted_length(&s->level[0], &s->level[1]), sizeof(fsdem_real))
+                        : NULL;
+    s->dot_part = (double *)fsdem__pcg_carve(cv, fsdem__dot_blocks(N), sizeof(double));
+    s->progress = levels > 1 && s->workers > 1
+                      ? (int *)fsdem__pcg_carve(cv, (size_t)(s->dim == 3 ? s->level[0].n[2] : s->level[0].n[1]), sizeof(int))
+                      : NULL;
     s->mark = (unsigned char *)fsdem__pcg_carve(cv, (size_t)N, 1);
     s->ns_cell = (int *)fsdem__pcg_carve(cv, (size_t)N, sizeof(int));
     for (l = 0; l < levels; ++l) {
@@ -8651,6 +9007,7 @@ fsdem_result fsdem_pcg_setup_stencil(fsdem_pcg *s, const fsdem_stencil *st) {
         fsdem_pcg probe = *s;
         memcpy(probe.level, plan, sizeof plan);
         probe.dim = st->dim;
+        probe.workers = fsdem__workers();
         cv.base = NULL;
         cv.used = 0;
         cv.overflow = 0;
@@ -8665,6 +9022,7 @@ fsdem_result fsdem_pcg_setup_stencil(fsdem_pcg *s, const fsdem_stencil *st) {
     s->kind = FSDEM__KIND_NONE;
     memcpy(s->level, plan, sizeof plan);
     s->dim = st->dim;
+    s->workers = fsdem__workers();
     cv.base = (char *)s->arena;
     cv.used = 0;
     fsdem__stencil_carve(s, &cv, levels, pc == FSDEM_PRECOND_IC0 || pc == FSDEM_PRECOND_MIC0, cells, st->extra != NULL);
@@ -8719,6 +9077,7 @@ static void fsdem__csr_carve(fsdem_pcg *s, fsdem__pcg_carver *cv, int n, int upp
     for (a = 0; a < 4; ++a) *vec[a] = (fsdem_real *)fsdem__pcg_carve(cv, (size_t)n, sizeof(fsdem_real));
     s->ux = s->uy = NULL;
     s->ic = pc != FSDEM_PRECOND_NONE ? (fsdem_real *)fsdem__pcg_carve(cv, (size_t)n, sizeof(fsdem_real)) : NULL;
+    s->dot_part = (double *)fsdem__pcg_carve(cv, fsdem__dot_blocks(n), sizeof(double));
     s->u_start = s->u_col = s->u_pos = NULL;
     s->u_val = NULL;
     if (pc == FSDEM_PRECOND_IC0 || pc == FSDEM_PRECOND_MIC0) {
@@ -8827,6 +9186,7 @@ static void fsdem__pcg_precondition(fsdem_pcg *s, const fsdem_real *r, fsdem_rea
     switch (s->precond) {
     case FSDEM_PRECOND_JACOBI: {
         const fsdem_real *inv = s->kind == FSDEM__KIND_CSR ? s->ic : s->level[0].inv_d;
+        FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (n > FSDEM__DOT_BLOCK))
         for (i = 0; i < n; ++i) z[i] = inv[i] * r[i];
         break;
     }
@@ -8914,18 +9274,59 @@ static void fsdem__pcg_store(const fsdem_pcg *s, const fsdem_real *src, fsdem_re
     }
 }
 
-static double fsdem__pcg_vdot(const fsdem_real *a, const fsdem_real *b, int n) {
+/* a.b over [lo, hi) with two interleaved accumulators (lo even). */
+static double fsdem__pcg_block_dot(const fsdem_real *a, const fsdem_real *b, int lo, int hi) {
     double s0 = 0, s1 = 0;
     int i;
-    for (i = 0; i + 1 < n; i += 2) {
+    for (i = lo; i + 1 < hi; i += 2) {
         s0 += (double)a[i] * b[i];
         s1 += (double)a[i + 1] * b[i + 1];
     }
-    if (i < n) s0 += (double)a[i] * b[i];
+    if (i < hi) s0 += (double)a[i] * b[i];
     return s0 + s1;
 }
 
+/* a.b over n entries: block by block (FSDEM__DOT_BLOCK), the block sums added in order, so the bits
+   do not depend on the threads (a vector of one block gives the block's sum itself). */
+static double fsdem__pcg_vdot(const fsdem_pcg *s, const fsdem_real *a, const fsdem_real *b, int n) {
+    const int blocks = (int)fsdem__dot_blocks(n);
+    double *part = s->dot_part, sum = 0;
+    int q;
+    if (blocks <= 1) return fsdem__pcg_block_dot(a, b, 0, n);
+    FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()))
+    for (q = 0; q < blocks; ++q) {
+        const int lo = q * FSDEM__DOT_BLOCK, hi = n - lo < FSDEM__DOT_BLOCK ? n : lo + FSDEM__DOT_BLOCK;
+        part[q] = fsdem__pcg_block_dot(a, b, lo, hi);
+    }
+    for (q = 0; q < blocks; ++q) sum += part[q];
+    return sum;
+}
+
 static int fsdem__pcg_finite_d(double v) { return v == v && v - v == 0; }
+
+/* x += alpha p, r -= alpha A p (A p in z); returns r.r, summed block by block as fsdem__pcg_vdot
+   (one accumulator inside a block). */
+static double fsdem__pcg_step_x_r(const fsdem_pcg *s, fsdem_real alpha) {
+    const int n = s->length, blocks = (int)fsdem__dot_blocks(n);
+    fsdem_real *FSDEM__RESTRICT xv = s->x, *FSDEM__RESTRICT rv = s->r;
+    const fsdem_real *FSDEM__RESTRICT pv = s->p, *FSDEM__RESTRICT qv = s->z;
+    double *part = s->dot_part, sum = 0;
+    int q;
+    FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (blocks > 1))
+    for (q = 0; q < blocks; ++q) {
+        const int lo = q * FSDEM__DOT_BLOCK, hi = n - lo < FSDEM__DOT_BLOCK ? n : lo + FSDEM__DOT_BLOCK;
+        double acc = 0;
+        int i;
+        for (i = lo; i < hi; ++i) {
+            xv[i] += alpha * pv[i];
+            rv[i] -= alpha * qv[i];
+            acc += (double)rv[i] * rv[i];
+        }
+        part[q] = acc;
+    }
+    for (q = 0; q < blocks; ++q) sum += part[q];
+    return sum;
+}
 
 /* True residual b - A x into `out` (uses z as scratch); returns its squared norm. */
 static double fsdem__pcg_true_residual(fsdem_pcg *s, const fsdem_real *b, fsdem_real *out) {
@@ -8934,7 +9335,7 @@ static double fsdem__pcg_true_residual(fsdem_pcg *s, const fsdem_real *b, fsdem_
     fsdem__pcg_project(s, out);
     fsdem__pcg_apply(s, s->x, s->z);
     for (i = 0; i < s->length; ++i) out[i] -= s->z[i];
-    return fsdem__pcg_vdot(out, out, s->length);
+    return fsdem__pcg_vdot(s, out, out, s->length);
 }
 
 /* r.z must be positive and finite for a symmetric positive definite preconditioner and operator. */
@@ -8976,10 +9377,10 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: initial guess x[%d] = %g is not finite", bad,
                            (double)x[bad]);
     }
-    bb = fsdem__pcg_vdot(s->r, s->r, n);
+    bb = fsdem__pcg_vdot(s, s->r, s->r, n);
     removed = fsdem__pcg_project(s, s->r);
     inf.incompatibility = bb > 0 ? (fsdem_real)sqrt(removed / bb) : 0;
-    bb = fsdem__pcg_vdot(s->r, s->r, n);
+    bb = fsdem__pcg_vdot(s, s->r, s->r, n);
     if (!fsdem__pcg_finite_d(bb)) {
         if (info) *info = inf;
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: ||b|| overflows");
@@ -8996,7 +9397,7 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
     fsdem__pcg_project(s, s->x);
     fsdem__pcg_apply(s, s->x, s->z);
     for (i = 0; i < n; ++i) s->r[i] -= s->z[i];
-    rr = fsdem__pcg_vdot(s->r, s->r, n);
+    rr = fsdem__pcg_vdot(s, s->r, s->r, n);
     for (;;) {
         double pq, alpha, rz_new, beta;
         if (!fsdem__pcg_finite_d(rr)) {
@@ -9023,14 +9424,14 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
         if (restart) {
             fsdem__pcg_precondition(s, s->r, s->z);
             fsdem__pcg_project(s, s->z);
-            rz = fsdem__pcg_vdot(s->r, s->z, n);
+            rz = fsdem__pcg_vdot(s, s->r, s->z, n);
             res = fsdem__pcg_check_rz(s, rz, it);
             if (res != FSDEM_OK) break;
             memcpy(s->p, s->z, sizeof(fsdem_real) * (size_t)n);
             restart = 0;
         }
         fsdem__pcg_apply(s, s->p, s->z); /* z is free until the next preconditioning */
-        pq = fsdem__pcg_vdot(s->p, s->z, n);
+        pq = fsdem__pcg_vdot(s, s->p, s->z, n);
         if (!fsdem__pcg_finite_d(pq)) {
             res = fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_pcg_solve: p.Ap is NaN/Inf at iteration %d", it);
             break;
@@ -9042,32 +9443,22 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
             break;
         }
         alpha = rz / pq;
-        {
-            double acc0 = 0;
-            fsdem_real al = (fsdem_real)alpha;
-            fsdem_real *xv = s->x, *rv = s->r;
-            const fsdem_real *pv = s->p, *qv = s->z;
-            for (i = 0; i < n; ++i) {
-                xv[i] += al * pv[i];
-                rv[i] -= al * qv[i];
-                acc0 += (double)rv[i] * rv[i];
-            }
-            rr = acc0;
-        }
+        rr = fsdem__pcg_step_x_r(s, (fsdem_real)alpha);
         ++it;
         r_is_true = 0;
         if (!fsdem__pcg_finite_d(rr) || rr <= tol2) continue;
         fsdem__pcg_precondition(s, s->r, s->z);
         fsdem__pcg_project(s, s->z);
-        rz_new = fsdem__pcg_vdot(s->r, s->z, n);
+        rz_new = fsdem__pcg_vdot(s, s->r, s->z, n);
         res = fsdem__pcg_check_rz(s, rz_new, it);
         if (res != FSDEM_OK) break;
         beta = rz_new / rz;
         rz = rz_new;
         {
-            fsdem_real be = (fsdem_real)beta;
+            const fsdem_real be = (fsdem_real)beta;
             fsdem_real *pv = s->p;
             const fsdem_real *zv = s->z;
+            FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (n > FSDEM__DOT_BLOCK))
             for (i = 0; i < n; ++i) pv[i] = zv[i] + be * pv[i];
         }
     }
@@ -12009,6 +12400,27 @@ typedef struct fsdem__swe_sface {
     fsdem_real mass, a, t, h, e, pad;
 } fsdem__swe_sface;
 
+/* What a step finds, per band of rows (maxima over the wet cells, counts, the first non-finite cell). */
+typedef struct fsdem__swe_tally {
+    fsdem_real wave, speed2, hmax, accel;
+    int wet, negative, bad;
+    long long fallbacks;
+} fsdem__swe_tally;
+
+/* The work rows of one band of rows (>>swe_step): the ring of primitive rows, the predicted face
+   states of the last two rows, the south-face fluxes, and (2D) a copy of the state rows beside the
+   band, taken before any band writes its own rows. */
+typedef struct fsdem__swe_work {
+    int slots;                /* primitive row slots: 3 in 2D, 1 in 1D */
+    int nx;
+    fsdem_real *prim;         /* slots x 4 x (nx + 2): eta, h, u, v with one ghost cell at each end */
+    fsdem__swe_rowcell *rows; /* 2D: 2 x nx, ring of the last two rows */
+    fsdem__swe_sface *south;  /* 2D: nx south-face data of the row in flight */
+    fsdem_real *halo;         /* 2D: 4 rows x (eta, qx, qy) x nx */
+    int halo_row[4];          /* the state row each halo row holds (-1: none) */
+    fsdem__swe_tally tally;   /* the band's results of the step in flight */
+} fsdem__swe_work;
+
 /* The row kernel is instantiated once per limiter and dimension (FSDEM__FORCE_INLINE) so that its
    inner loop has neither a limiter switch nor 2D branches in 1D. */
 
@@ -12054,10 +12466,9 @@ struct fsdem_swe {
     int sources_used;
 
     /* work rows */
-    int slots;            /* primitive row slots: 3 in 2D, 1 in 1D */
-    fsdem_real *prim;     /* slots x 4 x (nx + 2): eta, h, u, v with one ghost cell at each end */
-    fsdem__swe_rowcell *rows; /* 2D: 2 x nx, ring of the last two rows (>>swe_step) */
-    fsdem__swe_sface *south;  /* 2D: nx south-face data of the row in flight */
+    fsdem__swe_work *work; /* one per band of rows a thread sweeps (>>swe_step) */
+    int workers;           /* bands the work rows were allocated for (threads at creation) */
+    fsdem_real *bterm;     /* the step's boundary-face volumes, in the order one sweep meets them */
 
     fsdem__swe_bnd bnd[4];
     fsdem_real bvalue[4]; /* boundary values at the middle of the step in flight */
@@ -12330,6 +12741,14 @@ static void fsdem__swe_scan(fsdem_swe *s) {
     s->wet_cells = wet;
 }
 
+/* Reals of one band's work rows (fsdem__swe_work), and of the work headers' room per band. */
+#define FSDEM__SWE_WORK_HEAD ((sizeof(fsdem__swe_work) + sizeof(fsdem_real) - 1) / sizeof(fsdem_real))
+static size_t fsdem__swe_work_reals(const fsdem_swe *s) {
+    const size_t nx = (size_t)s->nx;
+    if (s->dim != 2) return 4 * (nx + 2);
+    return 3 * 4 * (nx + 2) + (2 * sizeof(fsdem__swe_rowcell) + sizeof(fsdem__swe_sface)) / sizeof(fsdem_real) * nx + 12 * nx;
+}
+
 fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
     char msg[FSDEM__MESSAGE_SIZE];
     fsdem_allocator al;
@@ -12359,12 +12778,10 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
     s->dy = desc->dim == 2 ? (desc->y_max - desc->y_min) / (fsdem_real)desc->ny : desc->width;
     s->area = s->dx * s->dy;
     s->rain = desc->rain_rate;
-    s->slots = desc->dim == 2 ? 3 : 1;
     n = (size_t)s->n;
     nx = (size_t)s->nx;
-    reals = 6 * n + (size_t)s->slots * 4 * (nx + 2);
-    if (s->dim == 2)
-        reals += (2 * sizeof(fsdem__swe_rowcell) + sizeof(fsdem__swe_sface)) / sizeof(fsdem_real) * nx;
+    s->workers = s->dim == 2 ? fsdem__workers() : 1;
+    reals = 6 * n + 2 * nx + 2 * (size_t)s->ny + (size_t)s->workers * (fsdem__swe_work_reals(s) + FSDEM__SWE_WORK_HEAD);
     s->block_bytes = reals * sizeof(fsdem_real);
     s->block = (fsdem_real *)fsdem__alloc(&al, s->block_bytes);
     if (!s->block) {
@@ -12373,16 +12790,30 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
         return FSDEM_ERR_OUT_OF_MEMORY;
     }
     memset(s->block, 0, s->block_bytes);
-    s->eta = s->block;
+    s->work = (fsdem__swe_work *)(void *)s->block; /* first: the block is aligned for its pointers */
+    s->eta = s->block + (size_t)s->workers * FSDEM__SWE_WORK_HEAD;
     s->qx = s->eta + n;
     s->qy = s->qx + n;
     s->bed = s->qy + n;
     s->sx = s->bed + n;
     s->sy = s->sx + n;
-    s->prim = s->sy + n;
-    if (s->dim == 2) {
-        s->rows = (fsdem__swe_rowcell *)(void *)(s->prim + (size_t)s->slots * 4 * (nx + 2));
-        s->south = (fsdem__swe_sface *)(void *)(s->rows + 2 * nx);
+    s->bterm = s->sy + n;
+    {
+        fsdem_real *next = s->bterm + 2 * nx + 2 * (size_t)s->ny;
+        int w;
+        for (w = 0; w < s->workers; ++w) {
+            fsdem__swe_work *wk = s->work + w;
+            wk->slots = s->dim == 2 ? 3 : 1;
+            wk->nx = s->nx;
+            wk->prim = next;
+            next += (size_t)wk->slots * 4 * (nx + 2);
+            if (s->dim == 2) {
+                wk->rows = (fsdem__swe_rowcell *)(void *)next;
+                wk->south = (fsdem__swe_sface *)(void *)(wk->rows + 2 * nx);
+                wk->halo = (fsdem_real *)(void *)(wk->south + nx);
+                next = wk->halo + 12 * nx;
+            }
+        }
     }
     for (k = 0; k < 4; ++k) {
         s->bnd[k].type = FSDEM_SWE_BC_WALL;
@@ -13157,37 +13588,64 @@ FSDEM__FORCE_INLINE fsdem_real fsdem__swe_limit(int limiter, fsdem_real a, fsdem
     }
 }
 
-/* Per-step constants and accumulators. */
+/* Per-step constants and one band's accumulators. */
 typedef struct fsdem__swe_ctx {
     fsdem_real dt, lx, ly, g, dry, tiny, rain_dt, idx, idy, manning, visc;
     int order, limiter, two_d, sources, friction;
-    /* results */
-    fsdem_real wave, speed2, hmax, bflux, accel;
-    int wet, negative, bad;
-    long long fallbacks;
+    fsdem__swe_work *w; /* the band's work rows */
+    fsdem_real *bterm;  /* where the boundary-face volumes go (NULL: a row beside the band, not kept) */
+    fsdem__swe_tally t; /* results */
 } fsdem__swe_ctx;
 
 /* Row j of the primitive ring (slot j mod slots), pointer to its `var` array (0 eta, 1 h, 2 u, 3 v). */
-static fsdem_real *fsdem__swe_prim(const fsdem_swe *s, int j, int var) {
-    int slot = ((j % s->slots) + s->slots) % s->slots;
-    return s->prim + ((size_t)slot * 4 + (size_t)var) * (size_t)(s->nx + 2);
+static fsdem_real *fsdem__swe_prim(const fsdem__swe_work *w, int j, int var) {
+    int slot = ((j % w->slots) + w->slots) % w->slots;
+    return w->prim + ((size_t)slot * 4 + (size_t)var) * (size_t)(w->nx + 2);
 }
 
-static fsdem__swe_rowcell *fsdem__swe_rowcells(const fsdem_swe *s, int j) {
-    return s->rows + (size_t)(j & 1) * (size_t)s->nx;
+static fsdem__swe_rowcell *fsdem__swe_rowcells(const fsdem__swe_work *w, int j) {
+    return w->rows + (size_t)(j & 1) * (size_t)w->nx;
+}
+
+/* Index of a boundary face in the step's list (bterm), in the order a single sweep meets them: the
+   west and east faces of row 0, the south side, then the west and east faces of each next row, and
+   the north side last. */
+static int fsdem__swe_bterm_west(const fsdem_swe *s, int j) { return j == 0 ? 0 : s->nx + 2 * j; }
+static int fsdem__swe_bterm_side(const fsdem_swe *s, int north, int i) { return north ? s->nx + 2 * s->ny + i : 2 + i; }
+
+/* The volume (m^3, positive inwards) through boundary face `index` in this step. */
+static void fsdem__swe_bterm_put(const fsdem__swe_ctx *c, int index, fsdem_real volume) {
+    if (c->bterm) c->bterm[index] = volume;
+}
+
+/* The state arrays (eta, qx, qy) of row `src`: the band's copy of a row beside it, or the live row. */
+static void fsdem__swe_state_row(const fsdem_swe *s, const fsdem__swe_work *w, int src, const fsdem_real **eta,
+                                 const fsdem_real **qx, const fsdem_real **qy) {
+    const size_t nx = (size_t)s->nx;
+    int q;
+    for (q = 0; q < 4; ++q)
+        if (s->dim == 2 && w->halo_row[q] == src) {
+            *eta = w->halo + 3 * q * nx;
+            *qx = *eta + nx;
+            *qy = *qx + nx;
+            return;
+        }
+    *eta = s->eta + (size_t)src * nx;
+    *qx = s->qx + (size_t)src * nx;
+    *qy = s->qy + (size_t)src * nx;
 }
 
 /* Loads row `src` of the state as primitive values into ring row `dst`, with one ghost cell at each
    end. A ghost row (dst != src) beyond a wall mirrors `src` (v flips); beyond other sides it copies
    h, u, v and extrapolates the bed linearly from row `ext` (ext < 0: flat), so a uniform flow down
    a slope keeps its gravity forcing in the boundary cells. Ghost cells at the row ends do the same. */
-static void fsdem__swe_load_row(const fsdem_swe *s, int src, int dst, int flip_v, int ext) {
-    fsdem_real *e = fsdem__swe_prim(s, dst, 0) + 1, *h = fsdem__swe_prim(s, dst, 1) + 1;
-    fsdem_real *u = fsdem__swe_prim(s, dst, 2) + 1, *v = fsdem__swe_prim(s, dst, 3) + 1;
-    const fsdem_real *eta = s->eta + (size_t)src * (size_t)s->nx, *bed = s->bed + (size_t)src * (size_t)s->nx;
-    const fsdem_real *qx = s->qx + (size_t)src * (size_t)s->nx, *qy = s->qy + (size_t)src * (size_t)s->nx;
+static void fsdem__swe_load_row(const fsdem_swe *s, fsdem__swe_work *w, int src, int dst, int flip_v, int ext) {
+    fsdem_real *e = fsdem__swe_prim(w, dst, 0) + 1, *h = fsdem__swe_prim(w, dst, 1) + 1;
+    fsdem_real *u = fsdem__swe_prim(w, dst, 2) + 1, *v = fsdem__swe_prim(w, dst, 3) + 1;
+    const fsdem_real *bed = s->bed + (size_t)src * (size_t)s->nx, *eta, *qx, *qy;
     fsdem_real dry = s->desc.dry_depth, vs = flip_v ? -1 : 1;
     int i, nx = s->nx;
+    fsdem__swe_state_row(s, w, src, &eta, &qx, &qy);
     for (i = 0; i < nx; ++i) {
         fsdem_real ee = eta[i], hh = ee - bed[i];
         e[i] = ee;
@@ -13249,7 +13707,7 @@ static inline void fsdem__swe_finish(fsdem_swe *s, fsdem__swe_ctx *c, int k, fsd
     h = e - s->bed[k];
     if (h < c->dry) {
         qx = qy = 0;
-        if (h < 0) c->negative = 1;
+        if (h < 0) c->t.negative = 1;
     } else {
         fsdem_real n = s->manning ? s->manning[k] : c->manning, u, v, cc, w;
         if (n > 0) {
@@ -13264,12 +13722,12 @@ static inline void fsdem__swe_finish(fsdem_swe *s, fsdem__swe_ctx *c, int k, fsd
         v = qy / h;
         cc = (fsdem_real)sqrt(c->g * h);
         w = ((u < 0 ? -u : u) + cc) * c->idx + ((v < 0 ? -v : v) + cc) * c->idy;
-        if (w > c->wave) c->wave = w;
-        if (u * u + v * v > c->speed2) c->speed2 = u * u + v * v;
-        if (h > c->hmax) c->hmax = h;
-        c->wet++;
+        if (w > c->t.wave) c->t.wave = w;
+        if (u * u + v * v > c->t.speed2) c->t.speed2 = u * u + v * v;
+        if (h > c->t.hmax) c->t.hmax = h;
+        c->t.wet++;
     }
-    if (!((e + qx + qy) - (e + qx + qy) == 0) && c->bad < 0) c->bad = k;
+    if (!((e + qx + qy) - (e + qx + qy) == 0) && c->t.bad < 0) c->t.bad = k;
     s->eta[k] = e;
     s->qx[k] = qx;
     s->qy[k] = qy;
@@ -13277,17 +13735,17 @@ static inline void fsdem__swe_finish(fsdem_swe *s, fsdem__swe_ctx *c, int k, fsd
 
 /* Explicit eddy-viscosity increment of cell i of row j (time-n velocities, face depth the smaller of
    the two cells, so nothing diffuses into dry cells): dt div(nu h grad u). */
-static void fsdem__swe_viscous(const fsdem_swe *s, const fsdem__swe_ctx *c, int j, int i, fsdem_real *dqx,
+static void fsdem__swe_viscous(const fsdem__swe_ctx *c, int j, int i, fsdem_real *dqx,
                                fsdem_real *dqy) {
-    const fsdem_real *h = fsdem__swe_prim(s, j, 1) + 1, *u = fsdem__swe_prim(s, j, 2) + 1, *v = fsdem__swe_prim(s, j, 3) + 1;
+    const fsdem_real *h = fsdem__swe_prim(c->w, j, 1) + 1, *u = fsdem__swe_prim(c->w, j, 2) + 1, *v = fsdem__swe_prim(c->w, j, 3) + 1;
     fsdem_real kx = c->visc * c->dt * c->idx * c->idx, hc = h[i], fx, fy;
     fsdem_real hw = h[i - 1] < hc ? h[i - 1] : hc, he = h[i + 1] < hc ? h[i + 1] : hc;
     fx = kx * (he * (u[i + 1] - u[i]) - hw * (u[i] - u[i - 1]));
     fy = kx * (he * (v[i + 1] - v[i]) - hw * (v[i] - v[i - 1]));
     if (c->two_d) {
-        const fsdem_real *hs = fsdem__swe_prim(s, j - 1, 1) + 1, *us = fsdem__swe_prim(s, j - 1, 2) + 1;
-        const fsdem_real *vs = fsdem__swe_prim(s, j - 1, 3) + 1, *hn = fsdem__swe_prim(s, j + 1, 1) + 1;
-        const fsdem_real *un = fsdem__swe_prim(s, j + 1, 2) + 1, *vn = fsdem__swe_prim(s, j + 1, 3) + 1;
+        const fsdem_real *hs = fsdem__swe_prim(c->w, j - 1, 1) + 1, *us = fsdem__swe_prim(c->w, j - 1, 2) + 1;
+        const fsdem_real *vs = fsdem__swe_prim(c->w, j - 1, 3) + 1, *hn = fsdem__swe_prim(c->w, j + 1, 1) + 1;
+        const fsdem_real *un = fsdem__swe_prim(c->w, j + 1, 2) + 1, *vn = fsdem__swe_prim(c->w, j + 1, 3) + 1;
         fsdem_real ky = c->visc * c->dt * c->idy * c->idy;
         fsdem_real hS = hs[i] < hc ? hs[i] : hc, hN = hn[i] < hc ? hn[i] : hc;
         fx += ky * (hN * (un[i] - u[i]) - hS * (u[i] - us[i]));
@@ -13348,7 +13806,7 @@ FSDEM__FORCE_INLINE void fsdem__swe_hancock(fsdem__swe_ctx *c, fsdem__swe_recon 
         }
     }
     if (!(hp >= half * (shx > shy ? shx : shy) && hp > 0)) {
-        c->fallbacks++;
+        c->t.fallbacks++;
         return;
     }
     if (hp >= c->dry) {
@@ -13415,7 +13873,7 @@ FSDEM__FORCE_INLINE void fsdem__swe_reconstruct(const fsdem_swe *s, fsdem__swe_c
             const fsdem_real ay = reuse ? r->sy[0] : fsdem__swe_limit(FSDEM_SWE_LIMITER_MINMOD, p->e[i] - so[0], no[0] - p->e[i]);
             acc += (ay < 0 ? -ay : ay) * c->idy * c->idy;
         }
-        if (acc > c->accel) c->accel = acc;
+        if (acc > c->t.accel) c->t.accel = acc;
     }
 }
 
@@ -13428,22 +13886,22 @@ FSDEM__FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, in
     fsdem_real Ee = 0, Eh = 0, Eu = 0, Ev = 0; /* east state of the previous cell */
     fsdem_real Wm = 0, Wa = 0, Wt = 0, Wh = 0, We = 0; /* west-face data of the previous cell */
     fsdem_real vx = 0, vy = 0; /* viscous increment of the previous cell */
-    fsdem__swe_rowcell *rc = two_d ? fsdem__swe_rowcells(s, j) : NULL;
+    fsdem__swe_rowcell *rc = two_d ? fsdem__swe_rowcells(c->w, j) : NULL;
     fsdem__swe_rows p;
     fsdem__swe_flux f;
     int i;
-    p.e = fsdem__swe_prim(s, j, 0) + 1;
-    p.h = fsdem__swe_prim(s, j, 1) + 1;
-    p.u = fsdem__swe_prim(s, j, 2) + 1;
-    p.v = fsdem__swe_prim(s, j, 3) + 1;
-    p.se = fsdem__swe_prim(s, j - 1, 0) + 1;
-    p.sh = fsdem__swe_prim(s, j - 1, 1) + 1;
-    p.su = fsdem__swe_prim(s, j - 1, 2) + 1;
-    p.sv = fsdem__swe_prim(s, j - 1, 3) + 1;
-    p.ne = fsdem__swe_prim(s, j + 1, 0) + 1;
-    p.nh = fsdem__swe_prim(s, j + 1, 1) + 1;
-    p.nu = fsdem__swe_prim(s, j + 1, 2) + 1;
-    p.nv = fsdem__swe_prim(s, j + 1, 3) + 1;
+    p.e = fsdem__swe_prim(c->w, j, 0) + 1;
+    p.h = fsdem__swe_prim(c->w, j, 1) + 1;
+    p.u = fsdem__swe_prim(c->w, j, 2) + 1;
+    p.v = fsdem__swe_prim(c->w, j, 3) + 1;
+    p.se = fsdem__swe_prim(c->w, j - 1, 0) + 1;
+    p.sh = fsdem__swe_prim(c->w, j - 1, 1) + 1;
+    p.su = fsdem__swe_prim(c->w, j - 1, 2) + 1;
+    p.sv = fsdem__swe_prim(c->w, j - 1, 3) + 1;
+    p.ne = fsdem__swe_prim(c->w, j + 1, 0) + 1;
+    p.nh = fsdem__swe_prim(c->w, j + 1, 1) + 1;
+    p.nu = fsdem__swe_prim(c->w, j + 1, 2) + 1;
+    p.nv = fsdem__swe_prim(c->w, j + 1, 3) + 1;
     p.b = s->blocked ? s->blocked + (size_t)j * (size_t)nx : NULL;
     p.sb = p.b && j > 0 ? p.b - nx : NULL;
     p.nb = p.b && j < s->ny - 1 ? p.b + nx : NULL;
@@ -13463,12 +13921,12 @@ FSDEM__FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, in
                 q->s[2] = r.v - half * r.sy[3];
                 q->s[3] = r.u - half * r.sy[2];
             }
-            if (c->visc > 0) fsdem__swe_viscous(s, c, j, i, &cvx, &cvy);
+            if (c->visc > 0) fsdem__swe_viscous(c, j, i, &cvx, &cvy);
             /* ---- face i - 1/2 ---- */
             if (i == 0) {
                 fsdem__swe_boundary_flux(s, FSDEM_SIDE_XMIN, 0, r.e - half * r.sx[0], r.h - half * r.sx[1], r.u - half * r.sx[2],
                                          r.v - half * r.sx[3], &f);
-                c->bflux += f.mass * s->dy * c->dt;
+                fsdem__swe_bterm_put(c, fsdem__swe_bterm_west(s, j), f.mass * s->dy * c->dt);
             } else if (p.b && (p.b[i - 1] || p.b[i])) {
                 /* a face of a blocked cell reflects; between two blocked cells nothing moves */
                 if (!p.b[i]) fsdem__swe_wall_flux(s, 0, r.e - half * r.sx[0], r.h - half * r.sx[1], r.u - half * r.sx[2],
@@ -13485,7 +13943,7 @@ FSDEM__FORCE_INLINE void fsdem__swe_row_impl(fsdem_swe *s, fsdem__swe_ctx *c, in
             Ev = r.v + half * r.sx[3];
         } else {
             fsdem__swe_boundary_flux(s, FSDEM_SIDE_XMAX, 1, Ee, Eh, Eu, Ev, &f);
-            c->bflux -= f.mass * s->dy * c->dt;
+            fsdem__swe_bterm_put(c, fsdem__swe_bterm_west(s, j) + 1, -(f.mass * s->dy * c->dt));
         }
         if (i > 0) {
             /* cell i - 1 has both x faces now */
@@ -13532,24 +13990,25 @@ static void fsdem__swe_row(fsdem_swe *s, fsdem__swe_ctx *c, int j) {
 /* ---- >>swe_step : y faces, repair, stable dt, stepping ---- */
 
 /* y faces between rows j-1 and j (j = 0: the YMIN boundary; j = ny: the YMAX boundary). Cells of row
-   j-1 get their north faces and are finished; the south-face data of row j are stored. */
-static void fsdem__swe_yfaces(fsdem_swe *s, fsdem__swe_ctx *c, int j) {
+   j-1 get their north faces and are finished (when `finish`: not a row beside the band); the
+   south-face data of row j are stored. */
+static void fsdem__swe_yfaces(fsdem_swe *s, fsdem__swe_ctx *c, int j, int finish) {
     const int nx = s->nx, ny = s->ny;
     const fsdem_real g = c->g, ly = c->ly, half = (fsdem_real)0.5;
-    fsdem__swe_sface *S = s->south;
-    const fsdem__swe_rowcell *lo = j > 0 ? fsdem__swe_rowcells(s, j - 1) : NULL;
-    const fsdem__swe_rowcell *hi = j < ny ? fsdem__swe_rowcells(s, j) : NULL;
+    fsdem__swe_sface *S = c->w->south;
+    const fsdem__swe_rowcell *lo = j > 0 ? fsdem__swe_rowcells(c->w, j - 1) : NULL;
+    const fsdem__swe_rowcell *hi = j < ny ? fsdem__swe_rowcells(c->w, j) : NULL;
     fsdem__swe_flux f;
     int i, row = (j - 1) * nx;
     for (i = 0; i < nx; ++i) {
         if (j == 0) {
             const fsdem_real *R = hi[i].s;
             fsdem__swe_boundary_flux(s, FSDEM_SIDE_YMIN, 0, R[0], R[1], R[2], R[3], &f);
-            c->bflux += f.mass * s->dx * c->dt;
+            fsdem__swe_bterm_put(c, fsdem__swe_bterm_side(s, 0, i), f.mass * s->dx * c->dt);
         } else if (j == ny) {
             const fsdem_real *L = lo[i].n;
             fsdem__swe_boundary_flux(s, FSDEM_SIDE_YMAX, 1, L[0], L[1], L[2], L[3], &f);
-            c->bflux -= f.mass * s->dx * c->dt;
+            fsdem__swe_bterm_put(c, fsdem__swe_bterm_side(s, 1, i), -(f.mass * s->dx * c->dt));
         } else if (s->blocked && (s->blocked[row + i] || s->blocked[row + nx + i])) {
             const fsdem_real *L = lo[i].n, *R = hi[i].s;
             if (!s->blocked[row + nx + i]) fsdem__swe_wall_flux(s, 0, R[0], R[1], R[2], R[3], &f);
@@ -13559,7 +14018,7 @@ static void fsdem__swe_yfaces(fsdem_swe *s, fsdem__swe_ctx *c, int j) {
             const fsdem_real *L = lo[i].n, *R = hi[i].s;
             fsdem__swe_riemann(g, c->tiny, L[0], L[1], L[2], L[3], R[0], R[1], R[2], R[3], &f);
         }
-        if (j > 0) {
+        if (j > 0 && finish) {
             const fsdem__swe_sface *q = S + i;
             fsdem_real de = lo[i].acc[0] - ly * (f.mass - q->mass);
             fsdem_real dqy = lo[i].acc[2] - ly * (f.aL - q->a + half * g * (f.hL + q->h) * (f.eL - q->e));
@@ -13675,10 +14134,107 @@ static void fsdem__swe_gauge_values(const void *solver, fsdem_real *out) {
     }
 }
 
+/* Loads state row r into the band's ring: a ghost row below row 0 (r = -1) and above the last
+   (r = ny) as the sides want (>>impl_swe item 1). */
+static void fsdem__swe_load_ring(const fsdem_swe *s, fsdem__swe_work *w, int r) {
+    const int ny = s->ny, wall_lo = s->bnd[FSDEM_SIDE_YMIN].type == FSDEM_SWE_BC_WALL;
+    const int wall_hi = s->bnd[FSDEM_SIDE_YMAX].type == FSDEM_SWE_BC_WALL;
+    if (r < 0) fsdem__swe_load_row(s, w, 0, -1, wall_lo, !wall_lo && ny > 1 ? 1 : -1);
+    else if (r >= ny) fsdem__swe_load_row(s, w, ny - 1, ny, wall_hi, !wall_hi && ny > 1 ? ny - 2 : -1);
+    else fsdem__swe_load_row(s, w, r, r, 0, -1);
+}
+
+/* Copies the state rows beside band [j0, j1) (j0 - 2, j0 - 1, j1, j1 + 1, where they exist) into its
+   halo, so the band reads them as they were before any band wrote. */
+static void fsdem__swe_band_halo(const fsdem_swe *s, fsdem__swe_work *w, int j0, int j1) {
+    const int rows[4] = {j0 - 2, j0 - 1, j1, j1 + 1};
+    const size_t nx = (size_t)s->nx;
+    int q;
+    for (q = 0; q < 4; ++q) {
+        const int r = rows[q];
+        fsdem_real *h = w->halo + 3 * q * nx;
+        w->halo_row[q] = -1;
+        if (r < 0 || r >= s->ny) continue;
+        memcpy(h, s->eta + (size_t)r * nx, sizeof(fsdem_real) * nx);
+        memcpy(h + nx, s->qx + (size_t)r * nx, sizeof(fsdem_real) * nx);
+        memcpy(h + 2 * nx, s->qy + (size_t)r * nx, sizeof(fsdem_real) * nx);
+        w->halo_row[q] = r;
+    }
+}
+
+/* Sweeps rows [j0, j1) of a 2D grid, bottom to top, into c's work rows and tally. The faces with the
+   rows beside the band need those rows reconstructed: they are, from the halo, with a copy of the
+   context whose tally and boundary volumes are dropped (their own band counts them), and they are
+   not finished. Every cell's update is then what one sweep of the whole grid computes. */
+static void fsdem__swe_band(fsdem_swe *s, fsdem__swe_ctx *c, int j0, int j1) {
+    fsdem__swe_ctx beside = *c;
+    int j;
+    beside.bterm = NULL;
+    if (j0 > 0) fsdem__swe_load_ring(s, c->w, j0 - 2);
+    fsdem__swe_load_ring(s, c->w, j0 - 1);
+    fsdem__swe_load_ring(s, c->w, j0);
+    if (j0 > 0) fsdem__swe_row(s, &beside, j0 - 1);
+    for (j = j0; j < j1; ++j) {
+        fsdem__swe_load_ring(s, c->w, j + 1);
+        fsdem__swe_row(s, c, j);
+        fsdem__swe_yfaces(s, c, j, j > j0); /* (row j0 - 1 is the band's below's) */
+    }
+    if (j1 < s->ny) {
+        fsdem__swe_load_ring(s, c->w, j1 + 1);
+        fsdem__swe_row(s, &beside, j1);
+    }
+    fsdem__swe_yfaces(s, c, j1, 1);
+}
+
+/* Rows of a band at least (fewer rows would spend more on the rows beside it than on its own). */
+#ifndef FSDEM__SWE_BAND_ROWS /* (see FSDEM__DEM_CHUNK) */
+#define FSDEM__SWE_BAND_ROWS 8
+#endif
+
+/* The 2D sweep: one band of rows per thread (as many as the work rows allow), each band copying the
+   rows beside it before any band writes; the tallies are then combined in band order (maxima and
+   counts: the same for any split; the first non-finite cell: the lowest band's). */
+static void fsdem__swe_sweep(fsdem_swe *s, fsdem__swe_ctx *c) {
+    int bands = fsdem__workers(), b;
+    if (bands > s->workers) bands = s->workers;
+    if (bands > s->ny / FSDEM__SWE_BAND_ROWS) bands = s->ny / FSDEM__SWE_BAND_ROWS;
+    if (bands < 1) bands = 1;
+    FSDEM__OMP(parallel num_threads(bands))
+    {
+        int team = 1, w = 0;
+        fsdem__swe_ctx mine = *c;
+#ifdef _OPENMP
+        team = omp_get_num_threads();
+        w = fsdem__worker();
+#endif
+        {
+            const int j0 = (int)((long long)s->ny * w / team), j1 = (int)((long long)s->ny * (w + 1) / team);
+            mine.w = s->work + w;
+            if (team > 1) fsdem__swe_band_halo(s, mine.w, j0, j1);
+            else mine.w->halo_row[0] = mine.w->halo_row[1] = mine.w->halo_row[2] = mine.w->halo_row[3] = -1;
+            FSDEM__OMP(barrier)
+            fsdem__swe_band(s, &mine, j0, j1);
+            mine.w->tally = mine.t;
+        }
+        if (w == 0) bands = team;
+    }
+    for (b = 0; b < bands; ++b) {
+        const fsdem__swe_tally *t = &s->work[b].tally;
+        if (t->wave > c->t.wave) c->t.wave = t->wave;
+        if (t->speed2 > c->t.speed2) c->t.speed2 = t->speed2;
+        if (t->hmax > c->t.hmax) c->t.hmax = t->hmax;
+        if (t->accel > c->t.accel) c->t.accel = t->accel;
+        c->t.wet += t->wet;
+        c->t.negative |= t->negative;
+        c->t.fallbacks += t->fallbacks;
+        if (c->t.bad < 0) c->t.bad = t->bad;
+    }
+}
+
 /* One step of exactly dt (already validated). */
 static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
     fsdem__swe_ctx c;
-    int j, k, side;
+    int k, side;
     fsdem_real tm = s->time + (fsdem_real)0.5 * dt;
     const double t0 = s->time;
     fsdem__series_begin(&s->gauges);
@@ -13699,26 +14255,22 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
     c.two_d = s->dim == 2;
     c.sources = s->sources_used;
     c.friction = s->manning != NULL || s->desc.manning > 0;
-    c.bad = -1;
+    c.t.bad = -1;
     for (side = 0; side < 4; ++side)
         s->bvalue[side] = fsdem__swe_series_at(s->bnd[side].t, s->bnd[side].v, s->bnd[side].n, s->bnd[side].value, tm);
+    c.bterm = s->bterm;
     if (!c.two_d) {
-        fsdem__swe_load_row(s, 0, 0, 0, -1);
+        c.w = s->work;
+        fsdem__swe_load_row(s, c.w, 0, 0, 0, -1);
         fsdem__swe_row(s, &c, 0);
     } else {
-        int wall_lo = s->bnd[FSDEM_SIDE_YMIN].type == FSDEM_SWE_BC_WALL;
-        int wall_hi = s->bnd[FSDEM_SIDE_YMAX].type == FSDEM_SWE_BC_WALL;
-        fsdem__swe_load_row(s, 0, -1, wall_lo, !wall_lo && s->ny > 1 ? 1 : -1);
-        fsdem__swe_load_row(s, 0, 0, 0, -1);
-        for (j = 0; j < s->ny; ++j) {
-            if (j + 1 < s->ny) fsdem__swe_load_row(s, j + 1, j + 1, 0, -1);
-            else fsdem__swe_load_row(s, j, j + 1, wall_hi, !wall_hi && s->ny > 1 ? j - 1 : -1);
-            fsdem__swe_row(s, &c, j);
-            fsdem__swe_yfaces(s, &c, j);
-        }
-        fsdem__swe_yfaces(s, &c, s->ny);
+        fsdem__swe_sweep(s, &c);
     }
-    s->vol_boundary += c.bflux;
+    {
+        fsdem_real bflux = 0;
+        for (k = 0; k < (c.two_d ? 2 * (s->nx + s->ny) : 2); ++k) bflux += s->bterm[k];
+        s->vol_boundary += bflux;
+    }
     s->vol_source += c.rain_dt * s->area * (fsdem_real)(s->n - s->blocked_count);
     for (k = 0; k < s->src_count; ++k) {
         fsdem__swe_src *p = &s->src[k];
@@ -13734,22 +14286,22 @@ static fsdem_result fsdem__swe_do_step(fsdem_swe *s, fsdem_real dt) {
         else {
             fsdem_real w = (fsdem_real)sqrt(c.g * h) * (c.idx + c.idy) +
                            ((fsdem_real)fabs(s->qx[p->cell]) * c.idx + (fsdem_real)fabs(s->qy[p->cell]) * c.idy) / h;
-            if (w > c.wave) c.wave = w;
+            if (w > c.t.wave) c.t.wave = w;
         }
     }
-    if (c.negative) fsdem__swe_repair(s);
-    s->fallbacks += c.fallbacks;
-    s->max_wave = c.wave;
-    s->max_accel = c.g * c.accel;
-    s->max_speed = (fsdem_real)sqrt(c.speed2);
-    s->max_depth = c.hmax;
-    s->wet_cells = c.wet;
+    if (c.t.negative) fsdem__swe_repair(s);
+    s->fallbacks += c.t.fallbacks;
+    s->max_wave = c.t.wave;
+    s->max_accel = c.g * c.t.accel;
+    s->max_speed = (fsdem_real)sqrt(c.t.speed2);
+    s->max_depth = c.t.hmax;
+    s->wet_cells = c.t.wet;
     s->time += dt;
     s->dt_last = dt;
     s->steps++;
-    if (c.bad >= 0)
+    if (c.t.bad >= 0)
         return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_swe_step: non-finite state in cell %d (i=%d, j=%d) at t=%g s",
-                           c.bad, c.bad % s->nx, c.bad / s->nx, (double)s->time);
+                           c.t.bad, c.t.bad % s->nx, c.t.bad / s->nx, (double)s->time);
     if (fsdem__series_step(&s->gauges, t0, s->time) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_IO, "fsdem_swe: could not write the gauge file");
     return fsdem__ok(&s->status);

@@ -78,6 +78,43 @@ static int dem_scene(void) {
     return bad;
 }
 
+/* 8,000 spheres of two materials settling in a box, enough pairs for the threaded contact kernels
+   (their batches evaluated in parallel, the forces added by each particle's owner) and the threaded
+   Verlet passes. */
+static int dem_bulk_scene(void) {
+    fsdem_dem_desc d = fsdem_dem_desc_default(3);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_dem_wall_desc w;
+    fsdem_dem *dem;
+    int mat[2], i, bad;
+    d.domain_min = fsdem_v3(-0.01, -0.01, -0.01);
+    d.domain_max = fsdem_v3(0.05, 0.05, 0.08);
+    d.dt = 5e-6;
+    if (fsdem_dem_create(&d, &dem) != FSDEM_OK) return 1;
+    m.friction = (fsdem_real)0.4;
+    m.rolling_friction = (fsdem_real)0.02;
+    fsdem_dem_add_material(dem, &m, &mat[0]);
+    m.young_modulus *= 2;
+    m.friction = (fsdem_real)0.2;
+    fsdem_dem_add_material(dem, &m, &mat[1]);
+    w = fsdem_dem_wall_box(fsdem_v3(0, 0, 0), fsdem_v3(0.042, 0.042, 0.07), 1, mat[0]);
+    fsdem_dem_add_wall(dem, &w, NULL);
+    for (i = 0; i < 8000; ++i) {
+        fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+        const unsigned u = (unsigned)i * 2654435761u;
+        p.radius = (fsdem_real)(i % 3 ? 0.001 : 0.0009);
+        p.position = fsdem_v3((fsdem_real)(0.00105 + 0.0021 * (i % 20) + 1e-5 * (u % 7)),
+                              (fsdem_real)(0.00105 + 0.0021 * (i / 20 % 20) + 1e-5 * (u / 7 % 7)),
+                              (fsdem_real)(0.00105 + 0.0021 * (i / 400)));
+        p.velocity = fsdem_v3((fsdem_real)(0.01 * ((u >> 8) % 11) - 0.05), 0, (fsdem_real)-0.3);
+        p.material = mat[i % 2];
+        fsdem_dem_add_particle(dem, &p, NULL);
+    }
+    bad = fsdem_dem_advance(dem, 0.003, NULL) != FSDEM_OK || print_hash("dem_bulk", dem, save_dem);
+    fsdem_dem_destroy(dem);
+    return bad;
+}
+
 /* A 2D FLIP dam break with an obstacle: transfers, reseeding (random draws), projections. */
 static int pic_scene(void) {
     fsdem_pic_desc d = fsdem_pic_desc_default(2);
@@ -301,8 +338,59 @@ static int gic_scene(void) {
     return bad;
 }
 
+/* The PCG with multigrid and with Jacobi on grids large enough for the threaded kernels (blocked dot
+   products, staged V-cycle): a 2D and a 3D Poisson problem with varying face coefficients, solid
+   cells and air cells (Dirichlet), the solution's bits hashed. */
+static int pcg_scene(void) {
+    static const int dims[2] = {2, 3}, sizes[2][3] = {{300, 200, 1}, {44, 40, 36}};
+    static const fsdem_precond preconds[2] = {FSDEM_PRECOND_MG, FSDEM_PRECOND_JACOBI};
+    unsigned long long h = 1469598103934665603ULL;
+    int g, q, bad = 0;
+    for (g = 0; g < 2 && !bad; ++g) {
+        const int *n = sizes[g], cells = n[0] * n[1] * n[2];
+        const int faces = (n[0] + 1) * (n[1] + 1) * (n[2] + 1);
+        unsigned char *cell = (unsigned char *)malloc((size_t)cells);
+        fsdem_real *face = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)faces * 3), *b, *x;
+        fsdem_stencil st;
+        int c, a;
+        b = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)cells);
+        x = (fsdem_real *)malloc(sizeof(fsdem_real) * (size_t)cells);
+        if (!cell || !face || !b || !x) return 1;
+        for (c = 0; c < cells; ++c) {
+            const int i = c % n[0], j = c / n[0] % n[1];
+            cell[c] = (unsigned)c * 7919u % 23u == 0 ? FSDEM_STENCIL_CELL_SOLID : j > n[1] - 3 && i % 5 ? FSDEM_STENCIL_CELL_AIR
+                                                                                              : FSDEM_STENCIL_CELL_FLUID;
+            b[c] = (fsdem_real)((unsigned)c * 104729u % 1000u / 1000.0 - 0.5);
+        }
+        for (c = 0; c < 3 * faces; ++c) face[c] = (fsdem_real)(0.5 + (unsigned)c * 31u % 17u / 16.0);
+        memset(&st, 0, sizeof st);
+        st.dim = dims[g];
+        for (a = 0; a < 3; ++a) st.n[a] = n[a];
+        st.cell = cell;
+        for (a = 0; a < dims[g]; ++a) st.face[a] = face + (size_t)a * faces;
+        for (q = 0; q < 2 && !bad; ++q) {
+            fsdem_pcg_desc d = fsdem_pcg_desc_default();
+            fsdem_pcg *s;
+            d.preconditioner = preconds[q];
+            d.tolerance = (fsdem_real)1e-6;
+            d.max_iterations = 10000;
+            memset(x, 0, sizeof(fsdem_real) * (size_t)cells);
+            bad = fsdem_pcg_create(&d, &s) != FSDEM_OK || fsdem_pcg_setup_stencil(s, &st) != FSDEM_OK ||
+                  fsdem_pcg_solve(s, b, x, NULL) != FSDEM_OK;
+            fsdem_pcg_destroy(s);
+            h = h * 31 + hash_bytes((const unsigned char *)x, sizeof(fsdem_real) * (size_t)cells);
+        }
+        free(cell);
+        free(face);
+        free(b);
+        free(x);
+    }
+    if (!bad) printf("pcg %016llx\n", h);
+    return bad;
+}
+
 int main(void) {
-    const int bad = dem_scene() | pic_scene() | swe_scene() | mps_scene() | swe_dem_scene() | mps_dem_scene() | pic_dem_scene() | gic_scene();
+    const int bad = dem_scene() | dem_bulk_scene() | pic_scene() | swe_scene() | mps_scene() | swe_dem_scene() | mps_dem_scene() | pic_dem_scene() | gic_scene() | pcg_scene();
     if (bad) printf("determinism: a scene failed\n");
     return bad;
 }
