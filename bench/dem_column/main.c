@@ -7,7 +7,8 @@
    plane walls x = 0, x = 0.168, y = 0, y = 0.042 and the floor z = 0, open top (the domain, which
    fsdem needs closed, reaches z = 0.2 m without a wall). Hertz-Mindlin, E = 1e8 Pa, nu = 0.3,
    e = 0.9, mu = 0.3 for particles and walls, g = 9.81 m/s^2 along -z, dt = 5e-6 s, 30,000 steps
-   (0.15 s), skin 0.4 mm, velocity Verlet (fsdem_dem_advance, 1000 steps a call), single thread.
+   (0.15 s), skin 0.4 mm, velocity Verlet (fsdem_dem_advance, 1000 steps a call), on one thread and
+   then on two (speedup_2t; the second run needs a build with OpenMP, as `make bench` builds it).
 
    Usage: dem_column [steps [trace_interval]]
      steps           number of steps (default 30000) for quick runs
@@ -75,9 +76,9 @@ static int fail(fsdem_dem *dem, const char *what, fsdem_result res) {
     return 1;
 }
 
-int main(int argc, char **argv) {
-    long steps = argc > 1 ? strtol(argv[1], NULL, 10) : STEPS;
-    long trace = argc > 2 ? strtol(argv[2], NULL, 10) : 0;
+/* The column on `threads` threads (fsdem_set_threads; one without OpenMP); its BENCH lines, and the
+   throughput into *rate. */
+static int run_column(long steps, long trace, int threads, double *rate) {
     fsdem_dem_desc desc = fsdem_dem_desc_default(3);
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_dem *dem = NULL;
@@ -90,6 +91,7 @@ int main(int argc, char **argv) {
     long s;
     int material, i, j, k;
 
+    fsdem_set_threads(threads);
     if (steps < 0) steps = 0;
     desc.domain_min = fsdem_v3(0, 0, 0);
     desc.domain_max = fsdem_v3(BOX_X, BOX_Y, BOX_TOP);
@@ -164,6 +166,8 @@ int main(int argc, char **argv) {
     energy = fsdem_dem_get_energy(dem);
     stats = fsdem_dem_get_stats(dem);
     getrusage(RUSAGE_SELF, &usage);
+    *rate = loop_time > 0 ? (double)fsdem_dem_get_particles(dem).count * (double)steps / loop_time : 0.0;
+    printf("BENCH dem_column threads=%d ranks=1\n", fsdem_threads());
     printf("BENCH dem_column particles=%d 1\n", fsdem_dem_get_particles(dem).count);
     printf("BENCH dem_column steps=%ld 1\n", steps);
     printf("BENCH dem_column particle_steps_per_s=%.4g 1/s\n",
@@ -178,5 +182,21 @@ int main(int argc, char **argv) {
     printf("BENCH dem_column memory_bytes=%zu B\n", stats.memory_bytes);
     printf("BENCH dem_column peak_rss=%ld KiB\n", (long)usage.ru_maxrss);
     fsdem_dem_destroy(dem);
+    return 0;
+}
+
+/* The column on one thread, then on two (a build with OpenMP): the same results bit for bit
+   (>>doc THREADS), and the speed-up. */
+int main(int argc, char **argv) {
+    const long steps = argc > 1 ? strtol(argv[1], NULL, 10) : STEPS, trace = argc > 2 ? strtol(argv[2], NULL, 10) : 0;
+    double one = 0, two = 0;
+    if (run_column(steps, trace, 1, &one)) return 1;
+    fsdem_set_threads(2);
+    if (fsdem_threads() < 2) {
+        printf("BENCH dem_column speedup_2t=n/a (built without OpenMP)\n");
+        return 0;
+    }
+    if (run_column(steps, 0, 2, &two)) return 1;
+    printf("BENCH dem_column speedup_2t=%.2f (particle steps per second, 2 threads over 1)\n", one > 0 ? two / one : 0.0);
     return 0;
 }

@@ -11,6 +11,10 @@
      BENCH pcg_poisson_<2d|3d>_<precond> time_s=<setup+solve> iters=<n> setup_s=... solve_s=...
            resetup_s=<setup again on the same object, memory reused> memory_mb=... relres=...
 
+   on one thread, and for multigrid the same on two (a build with OpenMP, as `make bench` builds):
+
+     BENCH pcg_poisson_<2d|3d>_mg_2t threads=2 ranks=1 time_s=... speedup_2t=<ratio>
+
    then the iteration counts of every preconditioner over a sweep of grid sizes:
 
      BENCH pcg_poisson_sweep_<2d|3d> n=<n> iters_none=... iters_jacobi=... iters_ic0=...
@@ -95,12 +99,28 @@ static run_result run_once(int dim, int n, fsdem_precond pc, const fsdem_real *b
     return r;
 }
 
+/* The fastest of `repeats` cold runs on `threads` threads. */
+static run_result run_best(int dim, int n, fsdem_precond pc, const fsdem_real *b, fsdem_real *x, fsdem_real *y, int repeats,
+                           int threads) {
+    run_result best;
+    int k;
+    fsdem_set_threads(threads);
+    memset(&best, 0, sizeof best);
+    for (k = 0; k < repeats; ++k) {
+        run_result r = run_once(dim, n, pc, b, x, y);
+        if (k == 0 || r.setup_s + r.solve_s < best.setup_s + best.solve_s) best = r;
+    }
+    fsdem_set_threads(1);
+    return best;
+}
+
 int main(int argc, char **argv) {
     static const fsdem_precond pcs[5] = {FSDEM_PRECOND_NONE, FSDEM_PRECOND_JACOBI, FSDEM_PRECOND_IC0,
                                          FSDEM_PRECOND_MIC0, FSDEM_PRECOND_MG};
     int repeats = argc > 1 ? atoi(argv[1]) : 3, quick = argc > 2 && strcmp(argv[2], "quick") == 0;
     int dim, status = 0;
     if (repeats < 1) repeats = 1;
+    fsdem_set_threads(1);
     for (dim = 2; dim <= 3; ++dim) {
         int n_big = dim == 2 ? (quick ? 256 : 512) : (quick ? 64 : 128);
         int n_small = dim == 2 ? 64 : 32, cells = dim == 3 ? n_big * n_big * n_big : n_big * n_big, p, n, i;
@@ -113,14 +133,9 @@ int main(int argc, char **argv) {
         for (p = 0; p < 5; ++p) {
             run_result best;
             double h = 1.0 / (n_big + 1);
-            int k;
             if (pcs[p] == FSDEM_PRECOND_NONE) continue;
             for (i = 0; i < cells; ++i) b[i] = (fsdem_real)(h * h);
-            memset(&best, 0, sizeof best);
-            for (k = 0; k < repeats; ++k) {
-                run_result r = run_once(dim, n_big, pcs[p], b, x, y);
-                if (k == 0 || r.setup_s + r.solve_s < best.setup_s + best.solve_s) best = r;
-            }
+            best = run_best(dim, n_big, pcs[p], b, x, y, repeats, 1);
             printf("BENCH pcg_poisson_%dd_%s time_s=%.4f iters=%d setup_s=%.4f solve_s=%.4f resetup_s=%.4f "
                    "memory_mb=%.1f relres=%.2e n=%d%s\n",
                    dim, precond_name(pcs[p]), best.setup_s + best.solve_s, best.iters, best.setup_s, best.solve_s,
@@ -128,6 +143,20 @@ int main(int argc, char **argv) {
                    best.status == FSDEM_OK ? "" : " FAILED");
             fflush(stdout);
             if (best.status != FSDEM_OK) status = 1;
+            if (pcs[p] == FSDEM_PRECOND_MG) { /* the same solve on two threads (a build with OpenMP) */
+                run_result two;
+                fsdem_set_threads(2);
+                if (fsdem_threads() < 2) {
+                    printf("BENCH pcg_poisson_%dd_mg speedup_2t=n/a (built without OpenMP)\n", dim);
+                    continue;
+                }
+                two = run_best(dim, n_big, pcs[p], b, x, y, repeats, 2);
+                printf("BENCH pcg_poisson_%dd_mg_2t threads=2 ranks=1 time_s=%.4f iters=%d setup_s=%.4f solve_s=%.4f "
+                       "speedup_2t=%.2f (setup + solve; solve alone %.2f)\n",
+                       dim, two.setup_s + two.solve_s, two.iters, two.setup_s, two.solve_s,
+                       (best.setup_s + best.solve_s) / (two.setup_s + two.solve_s), best.solve_s / two.solve_s);
+                fflush(stdout);
+            }
         }
         /* iteration counts over grid sizes */
         for (n = n_small, i = 0; n <= n_big; n *= 2, ++i) {

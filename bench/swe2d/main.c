@@ -7,7 +7,7 @@
    solution's own 1e-3 h_L contour); the same run with the library's default minmod limiter is
    reported beside it. Then a 1D run on 10^6 cells, and a STREAM-like copy for the machine's memory
    bandwidth. Prints BENCH lines only (the front lines say whether the 2 % bound is met); no exit status.
-   One thread. */
+   One thread, then the MC run again on two (speedup_2t; a build with OpenMP, as `make bench` builds). */
 #define _POSIX_C_SOURCE 199309L
 #define FSDEM_IMPLEMENTATION
 #include "fsdem.h"
@@ -67,7 +67,7 @@ static double front(const fsdem_real *h, int nx, int ny, double x_min, double dx
 }
 
 /* Runs the case `repeats` times (the machine may be shared) and reports the fastest run. */
-static void run_2d(const char *name, fsdem_swe_limiter limiter, double bandwidth, int repeats) {
+static double run_2d(const char *name, fsdem_swe_limiter limiter, double bandwidth, int repeats) {
     fsdem_swe_desc d = fsdem_swe_desc_default(2);
     fsdem_swe *s = NULL;
     fsdem_real *h;
@@ -90,7 +90,7 @@ static void run_2d(const char *name, fsdem_swe_limiter limiter, double bandwidth
         if (s) fsdem_swe_destroy(s);
         if (fsdem_swe_create(&d, &s) != FSDEM_OK || fsdem_swe_set_cells(s, dam, NULL) != FSDEM_OK) {
             printf("BENCH %s error=create\n", name);
-            return;
+            return 0;
         }
         v0 = fsdem_swe_volume(s);
         w0 = wall();
@@ -111,7 +111,9 @@ static void run_2d(const char *name, fsdem_swe_limiter limiter, double bandwidth
     xf = front(h, 1024, 128, -0.5, dx, 1e-3 * hl);
     x5 = travel - 3 * sqrt(g * 0.05 * hl) * t_end;
     xf5 = front(h, 1024, 128, -0.5, dx, 0.05 * hl);
-    printf("BENCH %s cell_updates_per_s=%.4g cells*steps/s (fastest of %d runs, one thread)\n", name, rate, repeats);
+    printf("BENCH %s threads=%d ranks=1\n", name, fsdem_threads());
+    printf("BENCH %s cell_updates_per_s=%.4g cells*steps/s (fastest of %d runs, %d thread%s)\n", name, rate, repeats,
+           fsdem_threads(), fsdem_threads() > 1 ? "s" : "");
     printf("BENCH %s cell_updates_per_cpu_s=%.4g cells*steps/s\n", name, (double)steps * 1024 * 128 / t_cpu);
     printf("BENCH %s steps=%lld\n", name, steps);
     printf("BENCH %s wall_time=%.3f s\n", name, t_wall);
@@ -134,6 +136,7 @@ static void run_2d(const char *name, fsdem_swe_limiter limiter, double bandwidth
     }
     free(h);
     fsdem_swe_destroy(s);
+    return rate;
 }
 
 static void run_1d(double bandwidth) {
@@ -172,8 +175,18 @@ static void run_1d(double bandwidth) {
 int main(void) {
     double bw = stream_copy_bandwidth();
     printf("BENCH stream copy_bandwidth=%.3g GB/s\n", bw / 1e9);
-    run_2d("swe2d", FSDEM_SWE_LIMITER_MC, bw, 3);            /* the benchmark: MC limiter */
+    double one, two;
+    fsdem_set_threads(1);
+    one = run_2d("swe2d", FSDEM_SWE_LIMITER_MC, bw, 3);      /* the benchmark: MC limiter */
     run_2d("swe2d_minmod", FSDEM_SWE_LIMITER_MINMOD, bw, 1); /* beside it: the library's default limiter */
     run_1d(bw);
+    fsdem_set_threads(2); /* the same run on two threads (bands of rows; the same result bit for bit) */
+    if (fsdem_threads() < 2) {
+        printf("BENCH swe2d speedup_2t=n/a (built without OpenMP)\n");
+        return 0;
+    }
+    two = run_2d("swe2d_2t", FSDEM_SWE_LIMITER_MC, bw, 3);
+    printf("BENCH swe2d speedup_2t=%.2f (cell updates per second, 2 threads over 1; per core: %.3g)\n",
+           one > 0 ? two / one : 0.0, two / 2);
     return 0;
 }
