@@ -12384,7 +12384,8 @@ fsdem_result fsdem_pic_write_grid_csv(const fsdem_pic *s, const char *path) {
    geometrically decaying leaks ahead of fronts and waves before they become subnormal numbers.
    Sweeps: rows are processed bottom to top with ring buffers of three rows of primitive values and two
    rows of predicted face states, so each state array is read once and written once per step; the
-   row kernel is specialised per limiter. Single-threaded (no OpenMP in this section). */
+   row kernel is specialised per limiter. With threads, each thread sweeps its own band of rows
+   (fsdem__swe_sweep), bit for bit the single sweep. */
 
 /* Work data of one cell of a row in flight (2D): the predicted states at its north and south faces
    and its increments from the x faces. Kept together so the y-face sweep streams one array. */
