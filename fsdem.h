@@ -3420,13 +3420,15 @@ FSDEM_API fsdem_result fsdem_swe_write_vti(const fsdem_swe *swe, const char *pat
 
 /* OpenMP, when the build has it: FSDEM__OMP(directive) is `#pragma omp directive`, and nothing
    without -fopenmp (where gcc would warn of an unknown pragma). fsdem__workers() is the team size a
-   parallel region asks for. */
+   parallel region asks for, fsdem__worker() the calling thread's number in its team and fsdem__team()
+   the team's size. */
 #ifdef _OPENMP
 #include <omp.h>
 #define FSDEM__PRAGMA(x) _Pragma(#x)
 #define FSDEM__OMP(x) FSDEM__PRAGMA(omp x)
 static int fsdem__workers(void) { return omp_get_max_threads(); }
 static int fsdem__worker(void) { return omp_get_thread_num(); }
+static int fsdem__team(void) { return omp_get_num_threads(); }
 void fsdem_set_threads(int count) {
     if (count >= 1) omp_set_num_threads(count);
 }
@@ -3434,9 +3436,17 @@ void fsdem_set_threads(int count) {
 #define FSDEM__OMP(x)
 static int fsdem__workers(void) { return 1; }
 static int fsdem__worker(void) { return 0; }
+static int fsdem__team(void) { return 1; }
 void fsdem_set_threads(int count) { (void)count; }
 #endif
 int fsdem_threads(void) { return fsdem__workers(); }
+
+/* The calling thread's share [*begin, *end) of n items split evenly over its team, in team order. */
+static void fsdem__share(int n, int *begin, int *end) {
+    const int me = fsdem__worker(), size = fsdem__team();
+    *begin = (int)((long long)n * me / size);
+    *end = (int)((long long)n * (me + 1) / size);
+}
 
 const char *fsdem_result_string(fsdem_result result) {
     switch (result) {
@@ -6517,12 +6527,13 @@ FSDEM__FORCE_INLINE void fsdem__dem_pairs_threaded(fsdem_dem *d, const int *touc
     const int uniform = d->material_count == 1, nb = (nt + FSDEM__DEM_BATCH - 1) / FSDEM__DEM_BATCH, n = d->n;
     const fsdem__dem_pair *pairs = uniform ? d->pairs : NULL;
     int w;
+    for (w = 0; w < team; ++w) overlaps[w] = 0; /* (a team may come with fewer threads than asked) */
     FSDEM__OMP(parallel num_threads(team))
     {
         const int me = fsdem__worker();
         fsdem__dem_batch *b = batches + me;
         fsdem_real largest = 0;
-        int q, c;
+        int q, c, lo, hi;
         FSDEM__OMP(for schedule(static))
         for (q = 0; q < nb; ++q) {
             const int k0 = q * FSDEM__DEM_BATCH, k1 = nt - k0 < FSDEM__DEM_BATCH ? nt : k0 + FSDEM__DEM_BATCH;
@@ -6535,7 +6546,8 @@ FSDEM__FORCE_INLINE void fsdem__dem_pairs_threaded(fsdem_dem *d, const int *touc
             if (m > largest) largest = m;
         }
         overlaps[me] = largest;
-        fsdem__dem_add_results(d, res, nt, (int)((long long)n * me / team), (int)((long long)n * (me + 1) / team));
+        fsdem__share(n, &lo, &hi);
+        fsdem__dem_add_results(d, res, nt, lo, hi);
     }
     for (w = 0; w < team; ++w)
         if (overlaps[w] > d->max_overlap) d->max_overlap = overlaps[w];
@@ -6634,9 +6646,10 @@ static fsdem_vec3 fsdem__dem_spin_rate(const fsdem_dem *d, const fsdem_vec3 *t, 
    cleared for the force evaluation that follows. Returns nonzero when the pass may have produced a
    state that is not finite or outside the domain; fsdem__dem_check_particles then finds and names the
    particle. (Positions are checked after the drift, velocities after a pass without one.) Written
-   once and instantiated per flag, so each pass reads every array it needs once. */
-FSDEM__FORCE_INLINE int fsdem__dem_verlet_pass(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift,
-                                           const int external) {
+   once and instantiated per flag, so each pass reads every array it needs once; this part does
+   particles [i0, i1), raising *max_disp2 and or-ing *suspect. */
+FSDEM__FORCE_INLINE void fsdem__dem_verlet_range(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift,
+                                                const int external, int i0, int i1, fsdem_real *max_disp2, int *suspect) {
     const fsdem_vec3 g = d->desc.gravity, lo = d->desc.domain_min, hi = d->desc.domain_max;
     fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t;
     const fsdem_vec3 *FSDEM__RESTRICT fe = d->fext, *FSDEM__RESTRICT te = d->text, *FSDEM__RESTRICT x_ref = d->x_ref;
@@ -6644,12 +6657,10 @@ FSDEM__FORCE_INLINE int fsdem__dem_verlet_pass(fsdem_dem *d, fsdem_real h, const
     const unsigned char *FSDEM__RESTRICT fixed = d->fixed;
     fsdem_vec3 *FSDEM__RESTRICT x = d->x, *FSDEM__RESTRICT v = d->v, *FSDEM__RESTRICT w = d->w;
     const fsdem_real h_spin = d->desc.rotation ? h : 0;
-    const int planar = d->desc.dim == 2, n = d->n;
-    fsdem_real disp2 = d->max_disp2;
-    int i, k, outside = 0; /* or suspect: not finite */
-    FSDEM__OMP(parallel for schedule(static) reduction(max : disp2) reduction(| : outside) num_threads(fsdem__workers())
-               if (n > FSDEM__DEM_CHUNK))
-    for (i = 0; i < n; ++i) {
+    const int planar = d->desc.dim == 2;
+    fsdem_real disp2 = *max_disp2;
+    int i, outside = 0; /* or suspect: not finite */
+    for (i = i0; i < i1; ++i) {
         if (!fixed[i]) {
             const fsdem_real a = h * inv_m[i], b = h_spin * inv_i[i];
             v[i].x += h * g.x + a * (external ? f[i].x + fe[i].x : f[i].x);
@@ -6680,6 +6691,26 @@ FSDEM__FORCE_INLINE int fsdem__dem_verlet_pass(fsdem_dem *d, fsdem_real h, const
                finds nothing); a tree, so no long chain of dependent additions */
             const fsdem_real sum = (v[i].x + v[i].y) + (v[i].z + w[i].x) + (w[i].y + w[i].z);
             outside |= !(sum - sum == 0);
+        }
+    }
+    *max_disp2 = disp2;
+    *suspect |= outside;
+}
+
+/* The pass over all particles: on one thread, or (many particles) each thread over its share, the
+   largest displacement and the suspicion combined (a maximum and an or: the same at any split). */
+FSDEM__FORCE_INLINE int fsdem__dem_verlet_pass(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift,
+                                           const int external) {
+    const int n = d->n, team = n > FSDEM__DEM_CHUNK ? fsdem__workers() : 1;
+    fsdem_real disp2 = d->max_disp2;
+    int k, outside = 0;
+    if (team <= 1) fsdem__dem_verlet_range(d, h, drift, h_drift, external, 0, n, &disp2, &outside);
+    else {
+        FSDEM__OMP(parallel num_threads(team) reduction(max : disp2) reduction(| : outside))
+        {
+            int i0, i1;
+            fsdem__share(n, &i0, &i1);
+            fsdem__dem_verlet_range(d, h, drift, h_drift, external, i0, i1, &disp2, &outside);
         }
     }
     d->max_disp2 = disp2;
@@ -7800,13 +7831,13 @@ static void fsdem__level_mark_near_solid(fsdem__level *F, const fsdem__level *C,
 
 /* ---- >>linalg_kernels : stencil kernels on padded levels ---- */
 
-/* y = A x on a level (interior cells; y untouched on ghosts). */
-static void fsdem__level_apply(const fsdem__level *L, int dim, const fsdem_real *x, fsdem_real *y) {
+/* y = A x on slabs [p0, p1) of a level (rows in 2D, planes in 3D; interior cells). */
+FSDEM__FORCE_INLINE void fsdem__level_apply_slabs(const fsdem__level *L, int dim, const fsdem_real *x, fsdem_real *y, int p0,
+                                                  int p1) {
     int i, j, k, sy = L->sy, sz = L->sz;
     const fsdem_real *d = L->d, *w0 = L->w[0], *w1 = L->w[1], *w2 = L->w[2];
     if (dim == 2) {
-        FSDEM__OMP(parallel for private(i) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
-        for (j = 0; j < L->n[1]; ++j) {
+        for (j = p0; j < p1; ++j) {
             int c0 = (j + 1) * sy + 1;
             for (i = 0; i < L->n[0]; ++i) {
                 int c = c0 + i;
@@ -7816,8 +7847,7 @@ static void fsdem__level_apply(const fsdem__level *L, int dim, const fsdem_real 
         }
         return;
     }
-    FSDEM__OMP(parallel for private(i, j) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
-    for (k = 0; k < L->n[2]; ++k)
+    for (k = p0; k < p1; ++k)
         for (j = 0; j < L->n[1]; ++j) {
             int c0 = (k + 1) * sz + (j + 1) * sy + 1;
             for (i = 0; i < L->n[0]; ++i) {
@@ -7826,6 +7856,21 @@ static void fsdem__level_apply(const fsdem__level *L, int dim, const fsdem_real 
                        w1[c + sy] * x[c + sy] - w2[c] * x[c - sz] - w2[c + sz] * x[c + sz];
             }
         }
+}
+
+/* y = A x on a level (interior cells; y untouched on ghosts), each thread over its share of slabs. */
+static void fsdem__level_apply(const fsdem__level *L, int dim, const fsdem_real *x, fsdem_real *y) {
+    const int slabs = dim == 3 ? L->n[2] : L->n[1], team = L->count > FSDEM__DOT_BLOCK ? fsdem__workers() : 1;
+    if (team <= 1) {
+        fsdem__level_apply_slabs(L, dim, x, y, 0, slabs);
+        return;
+    }
+    FSDEM__OMP(parallel num_threads(team))
+    {
+        int p0, p1;
+        fsdem__share(slabs, &p0, &p1);
+        fsdem__level_apply_slabs(L, dim, x, y, p0, p1);
+    }
 }
 
 /* Gauss-Seidel on the cells of one colour ((i + j + k) % 2 == colour) of row (j, k). With
@@ -8189,7 +8234,9 @@ static void fsdem__mg_run(const fsdem_pcg *s, const fsdem__level *L, const fsdem
     for (p = 0; p < slabs; ++p) s->progress[p] = 0;
     FSDEM__OMP(parallel num_threads(team))
     {
-        const int w = fsdem__worker(), p0 = (int)((long long)slabs * w / team), p1 = (int)((long long)slabs * (w + 1) / team);
+        const int w = fsdem__worker();
+        int p0, p1;
+        fsdem__share(slabs, &p0, &p1);
         fsdem__mg_thread_pipeline(s, L, C, b, x, xc_or_bc, stage, stages, p0, p1, !(w & 1), s->progress,
                                   s->rowbuf + (size_t)w * rowbuf);
     }
@@ -14202,14 +14249,11 @@ static void fsdem__swe_sweep(fsdem_swe *s, fsdem__swe_ctx *c) {
     if (bands < 1) bands = 1;
     FSDEM__OMP(parallel num_threads(bands))
     {
-        int team = 1, w = 0;
+        const int team = fsdem__team(), w = fsdem__worker();
         fsdem__swe_ctx mine = *c;
-#ifdef _OPENMP
-        team = omp_get_num_threads();
-        w = fsdem__worker();
-#endif
         {
-            const int j0 = (int)((long long)s->ny * w / team), j1 = (int)((long long)s->ny * (w + 1) / team);
+            int j0, j1;
+            fsdem__share(s->ny, &j0, &j1);
             mine.w = s->work + w;
             if (team > 1) fsdem__swe_band_halo(s, mine.w, j0, j1);
             else mine.w->halo_row[0] = mine.w->halo_row[1] = mine.w->halo_row[2] = mine.w->halo_row[3] = -1;
