@@ -7658,8 +7658,8 @@ static void fsdem__level_ghosts(fsdem__level *L, int dim) {
 
 /* Diagonal of a level from its physical face coefficients and the extra diagonal `extra`. */
 static void fsdem__level_diagonal(fsdem__level *L, int dim, const fsdem_real *extra) {
-    int c, a;
-    L->fluid = 0;
+    int c, a, fluid = 0;
+    FSDEM__OMP(parallel for private(a) reduction(+ : fluid) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
     for (c = 0; c < L->count; ++c) {
         fsdem_real d = 0;
         if (FSDEM__TYPE(L->type[c]) != FSDEM_STENCIL_CELL_FLUID) {
@@ -7673,8 +7673,9 @@ static void fsdem__level_diagonal(fsdem__level *L, int dim, const fsdem_real *ex
         d += extra[c];
         L->d[c] = d;
         L->inv_d[c] = d > 0 ? 1 / d : 0;
-        L->fluid++;
+        fluid++;
     }
+    L->fluid = fluid;
 }
 
 /* Reduces the physical face coefficients of a level to matrix off-diagonals. */
@@ -7697,6 +7698,7 @@ static void fsdem__level_from_stencil(fsdem__level *L, const fsdem_stencil *st, 
     for (a = 0; a < 3; ++a)
         if (a < dim) memset(L->w[a], 0, sizeof(fsdem_real) * (size_t)L->count);
     memset(extra, 0, sizeof(fsdem_real) * (size_t)L->count);
+    FSDEM__OMP(parallel for collapse(2) private(i) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
     for (k = 0; k < L->n[2]; ++k)
         for (j = 0; j < L->n[1]; ++j)
             for (i = 0; i < L->n[0]; ++i)
@@ -7709,6 +7711,7 @@ static void fsdem__level_from_stencil(fsdem__level *L, const fsdem_stencil *st, 
         ext[1] = L->n[1];
         ext[2] = L->n[2];
         ext[a] += 1;
+        FSDEM__OMP(parallel for collapse(2) private(i) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
         for (k = 0; k < ext[2]; ++k)
             for (j = 0; j < ext[1]; ++j)
                 for (i = 0; i < ext[0]; ++i) {
@@ -7740,6 +7743,7 @@ static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim
     memset(C->type, FSDEM_STENCIL_CELL_SOLID, (size_t)C->count);
     memset(cextra, 0, sizeof(fsdem_real) * (size_t)C->count);
     for (a = 0; a < dim; ++a) memset(C->w[a], 0, sizeof(fsdem_real) * (size_t)C->count);
+    FSDEM__OMP(parallel for collapse(2) private(I, di, dj, dk) schedule(static) num_threads(fsdem__workers()) if (C->count > FSDEM__DOT_BLOCK))
     for (K = 0; K < C->n[2]; ++K)
         for (J = 0; J < C->n[1]; ++J)
             for (I = 0; I < C->n[0]; ++I) {
@@ -7770,6 +7774,7 @@ static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim
         ext[1] = C->n[1];
         ext[2] = C->n[2];
         ext[a] += 1;
+        FSDEM__OMP(parallel for collapse(2) private(I) schedule(static) num_threads(fsdem__workers()) if (C->count > FSDEM__DOT_BLOCK))
         for (K = 0; K < ext[2]; ++K)
             for (J = 0; J < ext[1]; ++J)
                 for (I = 0; I < ext[0]; ++I) {
@@ -7810,6 +7815,7 @@ static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim
 /* Marks fine fluid cells whose interpolation kernel (from level C) contains a solid cell. */
 static void fsdem__level_mark_near_solid(fsdem__level *F, const fsdem__level *C, int dim) {
     int i, j, k;
+    FSDEM__OMP(parallel for collapse(2) private(i) schedule(static) num_threads(fsdem__workers()) if (F->count > FSDEM__DOT_BLOCK))
     for (k = 0; k < F->n[2]; ++k)
         for (j = 0; j < F->n[1]; ++j)
             for (i = 0; i < F->n[0]; ++i) {
