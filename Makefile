@@ -92,7 +92,7 @@ DETERMINISM_FLAGS := "-O0" "-O2" "-O2 -march=native" "-O2 -DFSDEM_NO_SIMD"
 DETERMINISM_THREADS := 1 2 3 4
 # ... and, with grains so small that every scene takes every threaded path (the dot products' blocks
 # change, so these hashes are compared with the same build without OpenMP, not with the pins)
-DETERMINISM_GRAIN := -DFSDEM__DEM_CHUNK=64 -DFSDEM__DOT_BLOCK=256 -DFSDEM__SWE_BAND_ROWS=2
+DETERMINISM_GRAIN := -DFSDEM__DEM_CHUNK=64 -DFSDEM__DOT_BLOCK=256 -DFSDEM__SWE_BAND_ROWS=2 -DFSDEM__TEAM_ITEMS=16
 determinism: | $(BUILD)
 	@for c in gcc clang; do if command -v $$c >/dev/null; then for f in $(DETERMINISM_FLAGS); do \
 	  $$c $(STD) $(WARN) $$f -I. tests/determinism.c -o $(BUILD)/determinism $(LDLIBS) || exit 1; \

@@ -3441,6 +3441,11 @@ void fsdem_set_threads(int count) { (void)count; }
 #endif
 int fsdem_threads(void) { return fsdem__workers(); }
 
+/* Loops over fewer items than this stay on one thread (starting a team costs microseconds). */
+#ifndef FSDEM__TEAM_ITEMS /* (see FSDEM__DEM_CHUNK) */
+#define FSDEM__TEAM_ITEMS 4096
+#endif
+
 /* The calling thread's share [*begin, *end) of n items split evenly over its team, in team order. */
 static void fsdem__share(int n, int *begin, int *end) {
     const int me = fsdem__worker(), size = fsdem__team();
@@ -5960,7 +5965,7 @@ fsdem_vec3 fsdem_dem_wall_impulse(const fsdem_dem *d, int id) {
 
 /* Threaded evaluation (>>doc THREADS): the pair list is cut into chunks of this many entries for
    the touching pass, and the touching pairs into batches as on one thread. */
-#ifndef FSDEM__DEM_CHUNK /* (tests/determinism.c sets it small, so every scene takes the threaded path) */
+#ifndef FSDEM__DEM_CHUNK /* (make determinism sets these grains small, so every scene takes every threaded path) */
 #define FSDEM__DEM_CHUNK 8192
 #endif
 
@@ -10833,14 +10838,11 @@ static void fsdem__pic_p2g(fsdem_pic *s) {
 
 /* Grid to particles. `du` holds u_new - u_old (FLIP) in uold. Returns the first particle with a
    non-finite velocity, or -1. */
-static int fsdem__pic_g2p(fsdem_pic *s) {
-    int a, p, q0, q1, q2, bad = -1, b;
-    int quad = s->desc.kernel == FSDEM_PIC_KERNEL_QUADRATIC;
-    fsdem_real ratio = s->desc.transfer == FSDEM_PIC_TRANSFER_FLIP ? s->desc.flip_ratio : 0;
-    int apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC;
-    fsdem_real dfac = 4 * s->inv_dx * s->inv_dx;
+/* The grid-to-particle transfer of particle p; returns nonzero when its new velocity is not finite. */
+FSDEM__FORCE_INLINE int fsdem__pic_g2p_one(fsdem_pic *s, int p, const int quad, fsdem_real ratio, const int apic, fsdem_real dfac) {
+    int a, q0, q1, q2, b, bad = 0;
     fsdem__kernel kw;
-    for (p = 0; p < s->np; ++p) {
+    {
         fsdem_vec3 x = s->px[p];
         fsdem_real vnew[3] = {0, 0, 0};
         for (a = 0; a < s->dim; ++a) {
@@ -10880,10 +10882,22 @@ static int fsdem__pic_g2p(fsdem_pic *s) {
             }
         }
         s->pv[p] = fsdem_v3(vnew[0], vnew[1], vnew[2]);
-        for (b = 0; b < s->dim; ++b)
-            if (!fsdem__finite(vnew[b]) && bad < 0) bad = p;
+        for (b = 0; b < s->dim; ++b) bad |= !fsdem__finite(vnew[b]);
     }
     return bad;
+}
+
+/* Grid to particles, every particle on its own (threaded); returns the first particle whose velocity
+   is not finite, or -1. */
+static int fsdem__pic_g2p(fsdem_pic *s) {
+    const int quad = s->desc.kernel == FSDEM_PIC_KERNEL_QUADRATIC, apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC;
+    const fsdem_real ratio = s->desc.transfer == FSDEM_PIC_TRANSFER_FLIP ? s->desc.flip_ratio : 0;
+    const fsdem_real dfac = 4 * s->inv_dx * s->inv_dx;
+    int p, first = s->np;
+    FSDEM__OMP(parallel for schedule(static) reduction(min : first) num_threads(fsdem__workers()) if (s->np > FSDEM__TEAM_ITEMS))
+    for (p = 0; p < s->np; ++p)
+        if (fsdem__pic_g2p_one(s, p, quad, ratio, apic, dfac) && p < first) first = p;
+    return first < s->np ? first : -1;
 }
 
 /* ---- >>pic_cells : effective faces, fluid fraction, level set, cell types ---- */
@@ -11431,8 +11445,10 @@ static fsdem_result fsdem__pic_project(fsdem_pic *s, fsdem_real dt) {
 
 /* ---- >>pic_advection : particle motion, solids, outflow ---- */
 
+/* Moves every particle through the grid velocity (threaded: each particle on its own). */
 static void fsdem__pic_advect(fsdem_pic *s, fsdem_real dt) {
     int p;
+    FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (s->np > FSDEM__TEAM_ITEMS))
     for (p = 0; p < s->np; ++p) {
         fsdem_vec3 x = s->px[p], k1, k2, k3;
         k1 = fsdem__pic_interp_vel(s, s->u, x);
