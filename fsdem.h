@@ -10836,9 +10836,8 @@ static void fsdem__pic_p2g(fsdem_pic *s) {
     }
 }
 
-/* Grid to particles. `du` holds u_new - u_old (FLIP) in uold. Returns the first particle with a
-   non-finite velocity, or -1. */
-/* The grid-to-particle transfer of particle p; returns nonzero when its new velocity is not finite. */
+/* The grid-to-particle transfer of particle p (`du` holds u_new - u_old (FLIP) in uold); returns
+   nonzero when its new velocity is not finite. */
 FSDEM__FORCE_INLINE int fsdem__pic_g2p_one(fsdem_pic *s, int p, const int quad, fsdem_real ratio, const int apic, fsdem_real dfac) {
     int a, q0, q1, q2, b, bad = 0;
     fsdem__kernel kw;
