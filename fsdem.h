@@ -158,9 +158,13 @@
      of FSDEM__DOT_BLOCK entries, added block by block; the contact forces on a particle in the
      order of the contact list). `make determinism` pins the same hashes at 1, 2, 3 and 4 threads.
      Threaded so far: the shallow-water rows (bands of rows, each with its own work rows and a
-     copy of the rows beside it), the PCG (operators, smoothers, transfers, vector updates, dot
-     products) and the DEM's contact kernels and integration. The PIC, MPS and the couplers' own
-     loops run on one thread.
+     copy of the rows beside it), the PCG on stencils (the levels' construction, the operator,
+     Jacobi, the multigrid V-cycle as one pipeline per thread, vector updates, dot products), the
+     DEM's touching pass, contact kernels and integration, and the PIC's grid-to-particle transfer
+     and advection (its solves through the PCG). IC(0)/MIC(0), AMG, the DEM's wall contacts and
+     neighbour lists, the PIC's particle-to-grid transfer and grid loops, MPS and the couplers' own
+     loops run on one thread. Work buffers are sized for the thread count at creation (SWE), setup
+     (PCG) or the last neighbour-list build (DEM); a larger team later uses that many threads.
 
    ERRORS
      Fallible calls return fsdem_result: FSDEM_OK (0) or a negative code; fsdem_result_string()
