@@ -249,6 +249,8 @@ int main(int argc, char **argv) {
     double t_end = argc > 1 ? atof(argv[1]) : 0.6;
     int steps3 = argc > 2 ? atoi(argv[2]) : 5;
     double cl = argc > 3 ? atof(argv[3]) : 0.05, ch = argc > 4 ? atof(argv[4]) : 0.1;
+    fsdem_set_threads(1); /* one thread, as the figures in README.md (the threaded benches print speedup_2t) */
+    printf("BENCH mps_dambreak threads=%d ranks=1\n", fsdem_threads());
     if (t_end > 0) bench_2d(t_end);
     if (steps3 > 0) bench_3d(steps3, cl, ch);
     return 0;

@@ -53,6 +53,8 @@ int main(int argc, char **argv) {
     struct rusage usage;
     double t0, wall, mps, dem;
     int k, done = 0;
+    fsdem_set_threads(1); /* one thread, as the figures in README.md (the threaded benches print speedup_2t) */
+    printf("BENCH mpsdem_dambreak threads=%d ranks=1\n", fsdem_threads());
     if (sd_create(&c, r0, FSDEM_MPS_MODEL_B, 1) != 0) {
         printf("BENCH mpsdem_dambreak error=create message=\"%s\"\n", c.error);
         return 1;

@@ -55,6 +55,8 @@ int main(int argc, char **argv) {
     fsdem_result res = FSDEM_OK;
     double t0, wall, arrival = -1, cpu, transfers;
     long long iterations = 0;
+    fsdem_set_threads(1); /* one thread, as the figures in README.md (the threaded benches print speedup_2t) */
+    printf("BENCH picdem_dambreak threads=%d ranks=1\n", fsdem_threads());
     if (wd_create(&c, dx, layers, beta) != 0) {
         printf("BENCH picdem_dambreak error=create message=\"%s\"\n", c.error);
         return 1;
