@@ -6387,13 +6387,30 @@ static void fsdem__dem_gather_wall(const fsdem_dem *d, fsdem__dem_batch *b, int 
 
 static fsdem_vec3 fsdem__dem_batch_vec(const fsdem_real (*a)[FSDEM__DEM_BATCH], int c) { return fsdem_v3(a[0][c], a[1][c], a[2][c]); }
 
+/* Lane c's new spring into its list entry, which holds one from now on. */
+static void fsdem__dem_commit_spring(fsdem__dem_list *l, const fsdem__dem_batch *b, int c) {
+    l->history[b->entry[c]] = fsdem__dem_batch_vec(b->spring, c);
+    l->key[b->entry[c]] |= FSDEM__DEM_HELD;
+}
+
+/* The rolling-resistance torque on lane c's particle (minus it on a partner particle) into *tr;
+   returns 0 where its material pair has none. */
+static int fsdem__dem_lane_rolling(const fsdem_dem *d, const fsdem__dem_batch *b, int c, int walls, fsdem_real h,
+                                   fsdem_vec3 *tr) {
+    const int i = b->i[c], o = b->other[c];
+    const fsdem_real mu_r = d->pairs[b->pair[c]].rolling;
+    if (!(mu_r > 0)) return 0;
+    *tr = fsdem__dem_rolling_torque(walls ? d->w[i] : fsdem__sub(d->w[i], d->w[o]), mu_r, b->r_eff[c], b->fn[c],
+                                    d->inv_i[i] + (walls ? 0 : d->inv_i[o]), h);
+    return 1;
+}
+
 /* Adds a batch's forces and torques to the particles (and its walls, `walls`), commits the springs
    when `commit` and the law has history, and applies rolling resistance. */
 FSDEM__FORCE_INLINE void fsdem__dem_scatter(fsdem_dem *d, const fsdem__dem_batch *FSDEM__RESTRICT b, const int walls, int commit,
                                         fsdem_real h) {
     fsdem__dem_list *l = walls ? &d->pw : &d->pp;
-    fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t, *FSDEM__RESTRICT history = l->history;
-    int *FSDEM__RESTRICT keys = l->key;
+    fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t;
     fsdem_real max_overlap = d->max_overlap;
     int c;
     for (c = 0; c < b->count; ++c) {
@@ -6406,21 +6423,15 @@ FSDEM__FORCE_INLINE void fsdem__dem_scatter(fsdem_dem *d, const fsdem__dem_batch
             f[o] = fsdem__sub(f[o], force);
             t[o] = fsdem__add(t[o], fsdem__dem_batch_vec(b->torque_j, c));
         }
-        if (commit) {
-            history[b->entry[c]] = fsdem__dem_batch_vec(b->spring, c);
-            keys[b->entry[c]] |= FSDEM__DEM_HELD;
-        }
+        if (commit) fsdem__dem_commit_spring(l, b, c);
         if (b->delta[c] > max_overlap) max_overlap = b->delta[c];
     }
     d->max_overlap = max_overlap;
     if (d->rolling)
         for (c = 0; c < b->count; ++c) {
             const int i = b->i[c], o = b->other[c];
-            const fsdem_real mu_r = d->pairs[b->pair[c]].rolling;
-            fsdem_vec3 w_rel, tr;
-            if (!(mu_r > 0)) continue;
-            w_rel = walls ? d->w[i] : fsdem__sub(d->w[i], d->w[o]);
-            tr = fsdem__dem_rolling_torque(w_rel, mu_r, b->r_eff[c], b->fn[c], d->inv_i[i] + (walls ? 0 : d->inv_i[o]), h);
+            fsdem_vec3 tr;
+            if (!fsdem__dem_lane_rolling(d, b, c, walls, h, &tr)) continue;
             t[i] = fsdem__add(t[i], tr);
             if (!walls) t[o] = fsdem__sub(t[o], tr);
         }
@@ -6480,20 +6491,13 @@ static fsdem_real fsdem__dem_keep_results(fsdem_dem *d, const fsdem__dem_batch *
     int c;
     for (c = 0; c < b->count; ++c) {
         fsdem__dem_result *o = out + c;
-        const fsdem_real mu_r = d->rolling ? d->pairs[b->pair[c]].rolling : 0;
         o->i = b->i[c];
         o->other = b->other[c];
         o->force = fsdem__dem_batch_vec(b->force, c);
         o->torque_i = fsdem__dem_batch_vec(b->torque_i, c);
         o->torque_j = fsdem__dem_batch_vec(b->torque_j, c);
-        o->rolls = mu_r > 0;
-        if (o->rolls)
-            o->rolling = fsdem__dem_rolling_torque(fsdem__sub(d->w[o->i], d->w[o->other]), mu_r, b->r_eff[c], b->fn[c],
-                                                   d->inv_i[o->i] + d->inv_i[o->other], h);
-        if (commit) {
-            d->pp.history[b->entry[c]] = fsdem__dem_batch_vec(b->spring, c);
-            d->pp.key[b->entry[c]] |= FSDEM__DEM_HELD;
-        }
+        o->rolls = d->rolling && fsdem__dem_lane_rolling(d, b, c, 0, h, &o->rolling);
+        if (commit) fsdem__dem_commit_spring(&d->pp, b, c);
         if (b->delta[c] > max_overlap) max_overlap = b->delta[c];
     }
     return max_overlap;
