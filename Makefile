@@ -25,6 +25,7 @@ BENCHES    := $(patsubst bench/%/main.c,%,$(wildcard bench/*/main.c))
 all: $(BUILD)/check_fsdem examples
 
 help:
+	@echo "make fsdem.h    write the single header fsdem.h from src/ (src/README.md)"
 	@echo "make test       Check suite (installs Check with apt-get when missing and run as root)"
 	@echo "make test-float the Check suite with fsdem_real = float (-DFSDEM_USE_FLOAT)"
 	@echo "make determinism  the same results from gcc and clang at -O0/-O2/-march=native/no SIMD"
@@ -77,7 +78,16 @@ compile-checks: | $(BUILD)
 	@echo "compile checks: gcc and clang (C99: double, float, AVX-512 lanes, no SIMD), $(CXX) and clang++: warning-free;" \
 	  "float and double objects refuse to link together"
 
-# The map of fsdem.h (its >>tag banners) is exact, and the float build's symbol list complete.
+# fsdem.h is generated from src/ (src/README.md) and committed. `make fsdem.h` writes it; no other
+# target does, so `make test` checks the committed header against src/ instead of rewriting it.
+ifneq ($(filter fsdem.h,$(MAKECMDGOALS)),)
+.PHONY: fsdem.h
+fsdem.h:
+	sh src/pack.sh fsdem.h
+endif
+
+# The map of fsdem.h (its >>tag banners) is exact, the header is what src/ packs into, and the float
+# build's symbol list complete.
 map-check:
 	@sh tests/map_check.sh fsdem.h
 

@@ -12,8 +12,13 @@
 #   - the objects of the verb table in >>doc ("ONE DIALECT FOR EVERY SOLVER") are not exactly those
 #     with a create and a step, or one of them lacks a verb of the table (couplers: and get_force);
 #   - a stable_dt takes a non-const object;
-#   - a coupler (>>impl_couple_*) calls a private helper of the PIC, MPS or SWE or reads a field of a
-#     solver object: couplers speak to the solvers through their public calls.
+#   - the coupling chapter or a coupler (>>impl_couple, >>impl_couple_*) calls a private helper of
+#     the DEM, PIC, MPS or SWE or reads a field of a solver object: couplers speak to the solvers
+#     through their public calls;
+# and, where the header is generated from src/ (src/pack.sh beside it), when
+#   - the header differs from what `make fsdem.h` writes from src/;
+#   - a file of src/ is not packed (not listed in src/pack.sh), runs over MAX_FILE_LINES lines, or
+#     does not open with its >>tag banner.
 # Usage: sh tests/map_check.sh [fsdem.h]          check
 #        sh tests/map_check.sh --symbols [fsdem.h] print the symbol block for >>config
 set -u
@@ -21,6 +26,25 @@ mode=check
 if [ "${1:-}" = "--symbols" ]; then mode=symbols; shift; fi
 file=${1:-fsdem.h}
 [ -r "$file" ] || { echo "map_check: cannot read $file"; exit 1; }
+MAX_FILE_LINES=1500
+
+# the source in rooms: the header is src/ packed, every file of src/ is packed, short, and opens with
+# its banner (the documentation block has its banner on its fourth line)
+src=$(dirname "$file")/src
+if [ "$mode" = check ] && [ -r "$src/pack.sh" ]; then
+    if ! sh "$src/pack.sh" | cmp -s - "$file"; then
+        echo "map_check: $file differs from what src/ packs into (edit src/, then run: make fsdem.h)"
+        sh "$src/pack.sh" | diff "$file" - | head -20 | sed 's/^/  /'
+        exit 1
+    fi
+    for f in $(cd "$src" && find . -name '*.[ch]' | sed 's|^\./||' | LC_ALL=C sort); do
+        grep -qE "(^|[ \"])$f( |\"|$)" "$src/pack.sh" || { echo "map_check: src/$f is not packed (list it in src/pack.sh)"; exit 1; }
+        lines=$(wc -l < "$src/$f")
+        [ "$lines" -le $MAX_FILE_LINES ] || { echo "map_check: src/$f has $lines lines, more than $MAX_FILE_LINES: split it by concept"; exit 1; }
+        head -4 "$src/$f" | grep -qE '^(/\*|  ) *(=====|----) >>[a-z_]+ :' ||
+            { echo "map_check: src/$f does not open with its >>tag banner"; exit 1; }
+    done
+fi
 
 # public functions: the name before "(" on each FSDEM_API declaration
 api=$(awk '/^FSDEM_API / { line = $0; while (line !~ /\(/) { getline nxt; line = line " " nxt }
@@ -125,13 +149,14 @@ for o in $stepping; do
     echo "$api" | grep -qE "^${o}_write_([a-z]+_)?csv\$" || { echo "map_check: ${o} writes no CSV (${o}_write_csv or _write_<what>_csv)"; exit 1; }
 done
 
-# couplers speak to the solvers through their public calls: in an >>impl_couple_ chapter (comments
-# aside) no private helper of the PIC, MPS or SWE (fsdem__pic_, fsdem__mps_, fsdem__swe_ other than
-# the coupler's own fsdem__<fluid>_dem_) and no field of a solver object (through a pointer declared
-# as fsdem_pic/mps/swe/dem *, or desc.<solver>->)
+# couplers speak to the solvers through their public calls: in the >>impl_couple chapter and the
+# >>impl_couple_ chapters (comments aside) no private helper of the DEM, PIC, MPS or SWE
+# (fsdem__dem_, fsdem__pic_, fsdem__mps_, fsdem__swe_ other than a coupler's own fsdem__<fluid>_dem_)
+# and no field of a solver object (through a pointer declared as fsdem_pic/mps/swe/dem *, or
+# desc.<solver>->)
 awk '
 function fail(msg) { print "map_check: " msg; bad = 1 }
-/^\/\* ===== >>impl_/ { coupler = ($0 ~ />>impl_couple_/); delete ptr; incomment = (index($0, "*/") == 0); next }
+/^\/\* ===== >>impl_/ { coupler = ($0 ~ />>impl_couple[_ ]/); delete ptr; incomment = (index($0, "*/") == 0); next }
 !coupler { next }
 {
     line = $0

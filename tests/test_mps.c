@@ -1,6 +1,5 @@
 /* MPS solver (seed 002 §2.1, §2.4): lattice constants, operators, pressure matrix, still water,
-   bad input. Built against the merged header (wip/merge.sh) by tests/wip_mps_check.sh until the
-   module is merged into fsdem.h. */
+   bad input. */
 #include "fsdem_tests.h"
 #include <string.h>
 

@@ -1,0 +1,535 @@
+/* ===== >>impl_couple_gic : Granule-In-Cell ===========================================================
+
+   Contents: >>couple_gic_object (desc, creation), >>couple_gic_exchange (seed 004 Eq. 5a-5b, 7a, 18:
+   volume fractions, granule forces, the exchange to the grid), >>couple_gic_step (coupled time
+   stepping). The coupler speaks to the PIC and the DEM through their public calls (>>doc). */
+
+/* ---- >>couple_gic_object : desc, creation ---- */
+
+/* What one step's force evaluations add up (its figures in fsdem_gic_stats). */
+typedef struct fsdem__gic_tally {
+    fsdem_vec3 pressure, drag, virtual_mass, to_fluid, lost; /* N s, in the DEM's units */
+    fsdem_real drag_dt;                        /* s; shortest relaxation time (0: none) */
+    int wet;
+} fsdem__gic_tally;
+
+struct fsdem_gic {
+    fsdem_gic_desc desc;
+    fsdem__status status;
+    fsdem_allocator allocator;
+    int dim;
+    fsdem__mac grid;               /* the PIC's cells (fsdem_pic_get_fields) */
+    fsdem_real rho;                /* kg/m^3, the water's */
+    fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC's forces are per metre), 1 in 3D */
+    fsdem_real cell_volume;        /* m^dim */
+    fsdem_real *solid, *porosity;  /* per cell: alpha_s (Eq. 7a), alpha_f' */
+    fsdem_real *rate;              /* per cell: the water's drag rate (1/s), scratch of the step limit */
+    /* per granule: sample points, the samples, the force records of the last evaluation */
+    fsdem_vec3 *point;
+    fsdem_fluid_sample *sample;
+    fsdem_gic_force *force;
+    fsdem_vec3 *fluid_accel;       /* a_f of Eq. 17 at each granule, for the step under way */
+    int granule_cap, records;
+    /* the sand substeps under way: their length h, count K, the evaluations made, the step's dt */
+    fsdem_real h, dt_now;
+    long long substeps_now, calls;
+    int failed;                    /* an evaluation failed (its message is in status) */
+    fsdem__gic_tally tally, last;  /* of the step under way, of the last step */
+    fsdem_real max_solid, solid_volume;
+    long long steps, substeps, substeps_total;
+    fsdem_real dt_last;
+    double sec_pic, sec_dem;
+};
+
+fsdem_gic_desc fsdem_gic_desc_default(void) {
+    fsdem_gic_desc d;
+    memset(&d, 0, sizeof d);
+    d.drag = FSDEM_DRAG_LAW_GIC;
+    d.drag_scale = 1;
+    d.cfl = 1;
+    d.max_dt_ratio = 1000;
+    d.drag_dt_fraction = (fsdem_real)0.5;
+    d.max_substeps = 100000;
+    return d;
+}
+
+fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t size) {
+    fsdem_dem_desc dd;
+    fsdem_pic_desc pd;
+    if (!d) return fsdem__reject(msg, size, "fsdem_gic_desc is NULL");
+    if (!d->pic || !d->dem) return fsdem__reject(msg, size, "fsdem_gic_desc.pic and .dem must both be set");
+    dd = fsdem_dem_get_desc(d->dem);
+    pd = fsdem_pic_get_desc(d->pic);
+    if (dd.dim != pd.dim) return fsdem__reject(msg, size, "fsdem_gic_desc: the DEM is %dD and the PIC %dD", dd.dim, pd.dim);
+    if (fsdem__norm(fsdem__sub(dd.gravity, pd.gravity)) > 1e-12 * fsdem__norm(pd.gravity))
+        return fsdem__reject(msg, size, "fsdem_gic_desc: the DEM gravity (%g, %g, %g) differs from the PIC's (%g, %g, %g) m/s^2",
+                             (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)pd.gravity.x,
+                             (double)pd.gravity.y, (double)pd.gravity.z);
+    if (strcmp(fsdem_drag_law_name(d->drag), "unknown") == 0)
+        return fsdem__reject(msg, size, "fsdem_gic_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
+    if (d->virtual_mass != 0 && d->virtual_mass != 1)
+        return fsdem__reject(msg, size, "fsdem_gic_desc.virtual_mass must be 0 or 1 (got %d)", d->virtual_mass);
+    if (!(d->drag_scale > 0) || !fsdem__finite(d->drag_scale))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_scale must be > 0 and finite (got %g)", (double)d->drag_scale);
+    if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.viscosity must be >= 0 Pa s and finite (got %g)", (double)d->viscosity);
+    if (d->drag != FSDEM_DRAG_LAW_GIC && d->viscosity == 0 && !(pd.viscosity > 0))
+        return fsdem__reject(msg, size,
+                             "fsdem_gic_desc.viscosity: the %s drag law needs a viscosity, and it is 0 here and in the (inviscid) PIC",
+                             fsdem_drag_law_name(d->drag));
+    if (!(d->max_solid_fraction == 0 || (d->max_solid_fraction > 0 && d->max_solid_fraction < 1)))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.max_solid_fraction must be 0 (densest packing) or in (0, 1) (got %g)",
+                             (double)d->max_solid_fraction);
+    if (!(d->cfl > 0) || !fsdem__finite(d->cfl))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.cfl must be > 0 and finite (got %g)", (double)d->cfl);
+    if (!(d->max_dt_ratio >= 1) || !fsdem__finite(d->max_dt_ratio))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.max_dt_ratio must be >= 1 and finite (got %g)", (double)d->max_dt_ratio);
+    if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_dt_fraction must be in (0, 1] (got %g)", (double)d->drag_dt_fraction);
+    if (d->max_substeps < 1) return fsdem__reject(msg, size, "fsdem_gic_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_allocator al;
+    fsdem_gic *c;
+    fsdem_pic_fields g;
+    fsdem_pic_desc pd;
+    fsdem_result res;
+    size_t cells;
+    int k;
+    if (out) *out = NULL;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem_gic_desc_check(desc, msg, sizeof msg);
+    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
+    c = (fsdem_gic *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL, res == FSDEM_OK ? &al : NULL,
+                                       sizeof *c, "fsdem_gic_create", &res);
+    if (!c) return res;
+    pd = fsdem_pic_get_desc(desc->pic);
+    g = fsdem_pic_get_fields(desc->pic);
+    c->desc = *desc;
+    c->allocator = al;
+    c->status.log = desc->log;
+    c->status.log_user = desc->log_user;
+    c->dim = g.dim;
+    c->rho = pd.density;
+    c->depth = g.dim == 2 ? fsdem_dem_get_desc(desc->dem).disc_length : 1;
+    if (c->desc.viscosity == 0) c->desc.viscosity = pd.density * pd.viscosity;
+    if (c->desc.max_solid_fraction == 0) c->desc.max_solid_fraction = (fsdem_real)(g.dim == 3 ? 0.740 : 0.907);
+    fsdem__mac_init(&c->grid, g.dim, g.n, g.cell_size, g.origin);
+    c->cell_volume = g.cell_size * g.cell_size * (g.dim == 3 ? g.cell_size : 1);
+    cells = (size_t)c->grid.ncell;
+    c->solid = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
+    c->porosity = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
+    c->rate = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
+    if (!c->solid || !c->porosity || !c->rate) {
+        fsdem__log_oom(desc->log, desc->log_user, "fsdem_gic_create", 3 * sizeof(fsdem_real) * cells);
+        fsdem_gic_destroy(c);
+        return FSDEM_ERR_OUT_OF_MEMORY;
+    }
+    for (k = 0; k < c->grid.ncell; ++k) {
+        c->solid[k] = 0;
+        c->porosity[k] = 1;
+    }
+    *out = c;
+    return FSDEM_OK;
+}
+
+void fsdem_gic_destroy(fsdem_gic *c) {
+    fsdem_allocator al;
+    size_t cells;
+    if (!c) return;
+    al = c->allocator;
+    cells = (size_t)c->grid.ncell;
+    fsdem__free(&al, c->solid, sizeof(fsdem_real) * cells);
+    fsdem__free(&al, c->porosity, sizeof(fsdem_real) * cells);
+    fsdem__free(&al, c->rate, sizeof(fsdem_real) * cells);
+    fsdem__free(&al, c->point, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
+    fsdem__free(&al, c->sample, sizeof(fsdem_fluid_sample) * (size_t)c->granule_cap);
+    fsdem__free(&al, c->force, sizeof(fsdem_gic_force) * (size_t)c->granule_cap);
+    fsdem__free(&al, c->fluid_accel, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
+    fsdem__free(&al, c, sizeof *c);
+}
+
+const char *fsdem_gic_last_error(const fsdem_gic *c) { return c ? c->status.message : "fsdem_gic is NULL"; }
+
+fsdem_gic_desc fsdem_gic_get_desc(const fsdem_gic *c) {
+    fsdem_gic_desc d;
+    if (c) return c->desc;
+    memset(&d, 0, sizeof d);
+    return d;
+}
+
+fsdem_gic_fields fsdem_gic_get_fields(const fsdem_gic *c) {
+    fsdem_gic_fields f;
+    int a;
+    memset(&f, 0, sizeof f);
+    if (!c) return f;
+    f.dim = c->dim;
+    for (a = 0; a < 3; ++a) f.n[a] = c->grid.n[a];
+    f.cell_size = c->grid.dx;
+    f.origin = c->grid.lo;
+    f.solid_fraction = c->solid;
+    f.porosity = c->porosity;
+    return f;
+}
+
+/* Room for `count` granules in the per-granule arrays (outside the substeps). */
+static fsdem_result fsdem__gic_reserve(fsdem_gic *c, int count) {
+    void **const arrays[4] = {(void **)&c->point, (void **)&c->sample, (void **)&c->force, (void **)&c->fluid_accel};
+    const size_t sizes[4] = {sizeof(fsdem_vec3), sizeof(fsdem_fluid_sample), sizeof(fsdem_gic_force), sizeof(fsdem_vec3)};
+    if (fsdem__grow_set(&c->allocator, arrays, sizes, 4, &c->granule_cap, c->records, count) != FSDEM_OK)
+        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_gic: out of memory (%d granules)", count);
+    return FSDEM_OK;
+}
+
+/* ---- >>couple_gic_exchange : volume fractions, granule forces, the exchange ---- */
+
+/* Volume of granule i (m^3; the disc's area times the DEM's disc_length in 2D, as its mass). */
+static fsdem_real fsdem__gic_volume(const fsdem_gic *c, fsdem_real r) {
+    return c->dim == 3 ? (fsdem_real)(4 * FSDEM__PI / 3) * r * r * r : (fsdem_real)FSDEM__PI * r * r * c->depth;
+}
+
+/* Kernel of point p over the cell centres (grid units: centre i at i), indices clamped into the
+   grid, so weight beyond a side falls on the boundary cell. */
+static void fsdem__gic_kernel(const fsdem_gic *c, fsdem_vec3 p, fsdem__kernel *kw) {
+    fsdem_real s[3];
+    int b;
+    for (b = 0; b < 3; ++b)
+        s[b] = b < c->dim ? (fsdem__comp(p, b) - fsdem__comp(c->grid.lo, b)) * c->grid.inv_dx - (fsdem_real)0.5 : 0;
+    fsdem__kernel_weights(kw, c->dim, s, c->grid.n, 0);
+}
+
+/* Step 3 of >>couple_gic: alpha_s (Eq. 7a) and the porosity, into the PIC. */
+fsdem_result fsdem_gic_update(fsdem_gic *c) {
+    fsdem_dem_particles P;
+    fsdem_pic_coupling pc;
+    int i, k, q0, q1, q2;
+    double volume = 0;
+    fsdem_real most = 0;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    P = fsdem_dem_get_particles(c->desc.dem);
+    for (i = 0; i < P.count; ++i) {
+        int a, outside = 0;
+        if (!fsdem__finite3(P.position[i]))
+            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_gic_update: granule %d (id %d) has a non-finite position", i, P.id[i]);
+        for (a = 0; a < c->dim; ++a)
+            outside |= fsdem__comp(P.position[i], a) < fsdem__comp(c->grid.lo, a) || fsdem__comp(P.position[i], a) > fsdem__comp(c->grid.hi, a);
+        if (outside) /* its volume would be folded into the boundary cells */
+            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_DOMAIN,
+                               "fsdem_gic_update: granule %d (id %d) at (%g, %g, %g) m is outside the PIC's grid (keep the DEM's walls within it)",
+                               i, P.id[i], (double)P.position[i].x, (double)P.position[i].y, (double)P.position[i].z);
+    }
+    memset(c->solid, 0, sizeof(fsdem_real) * (size_t)c->grid.ncell);
+    for (i = 0; i < P.count; ++i) {
+        const fsdem_real share = fsdem__gic_volume(c, P.radius[i]) / (c->cell_volume * c->depth);
+        fsdem__kernel kw;
+        fsdem__gic_kernel(c, P.position[i], &kw);
+        for (q2 = 0; q2 < kw.count[2]; ++q2)
+            for (q1 = 0; q1 < kw.count[1]; ++q1)
+                for (q0 = 0; q0 < kw.count[0]; ++q0)
+                    c->solid[fsdem__mac_cell(&c->grid, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])] +=
+                        share * kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2];
+    }
+    pc = fsdem_pic_get_coupling(c->desc.pic);
+    for (k = 0; k < c->grid.ncell; ++k) {
+        const fsdem_real s = c->solid[k];
+        volume += (double)s;
+        if (s > most) most = s;
+        c->porosity[k] = 1 - (s < c->desc.max_solid_fraction ? s : c->desc.max_solid_fraction);
+        pc.porosity[k] = c->porosity[k];
+    }
+    c->max_solid = most;
+    c->solid_volume = (fsdem_real)(volume * (double)c->cell_volume);
+    return fsdem__ok(&c->status);
+}
+
+/* The porosity alpha_f' at point p (the cells' values interpolated). */
+static fsdem_real fsdem__gic_porosity_at(const fsdem_gic *c, fsdem_vec3 p) {
+    fsdem__kernel kw;
+    fsdem_real e = 0;
+    int q0, q1, q2;
+    fsdem__gic_kernel(c, p, &kw);
+    for (q2 = 0; q2 < kw.count[2]; ++q2)
+        for (q1 = 0; q1 < kw.count[1]; ++q1)
+            for (q0 = 0; q0 < kw.count[0]; ++q0)
+                e += c->porosity[fsdem__mac_cell(&c->grid, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])] * kw.w[0][q0] * kw.w[1][q1] *
+                     kw.w[2][q2];
+    return e;
+}
+
+/* a_f of Eq. 17 at every granule from the water of the last step, g - grad p / rho_f (0 before the
+   PIC's first step: water at rest); the exchange's part is left out (>>couple_gic step 1). */
+static void fsdem__gic_fluid_accelerations(fsdem_gic *c) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    const fsdem_vec3 g = fsdem_pic_get_desc(c->desc.pic).gravity;
+    int i;
+    if (!c->desc.virtual_mass) return;
+    if (fsdem_pic_get_stats(c->desc.pic).steps == 0) {
+        for (i = 0; i < P.count; ++i) c->fluid_accel[i] = fsdem__zero3();
+        return;
+    }
+    for (i = 0; i < P.count; ++i) c->point[i] = P.position[i];
+    fsdem_pic_sample(c->desc.pic, P.count, c->point, c->sample);
+    for (i = 0; i < P.count; ++i) c->fluid_accel[i] = fsdem__madd(g, c->sample[i].pressure_gradient, -1 / c->rho);
+}
+
+/* Steps 1-2 of >>couple_gic at one force evaluation of the sand substeps (fsdem_dem_substep_fn):
+   the granules' loads from the water of the last fluid step and their reactions onto its faces,
+   weighted by the time the integrator holds these loads. */
+static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time) {
+    fsdem_gic *c = (fsdem_gic *)user;
+    const fsdem_dem_particles P = fsdem_dem_get_particles(dem);
+    const fsdem_dem_coupling load = fsdem_dem_get_coupling(dem);
+    const fsdem_dem_desc dd = fsdem_dem_get_desc(dem);
+    const int verlet = dd.integrator == FSDEM_DEM_INTEGRATOR_VERLET;
+    const fsdem_vec3 gravity = dd.gravity;
+    const fsdem_real held = verlet && (c->calls == 0 || c->calls == c->substeps_now) ? c->h / 2 : c->h;
+    fsdem_result res;
+    int i, wet_count = 0;
+    c->failed = 1; /* until the evaluation completes */
+    (void)time;
+    for (i = 0; i < P.count; ++i) c->point[i] = P.position[i];
+    res = fsdem_pic_sample(c->desc.pic, P.count, c->point, c->sample);
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+    if (fsdem_pic_get_stats(c->desc.pic).steps == 0) /* no pressure solved yet: the water's at rest */
+        for (i = 0; i < P.count; ++i) c->sample[i].pressure_gradient = fsdem__scale(fsdem_pic_get_desc(c->desc.pic).gravity, c->rho);
+    for (i = 0; i < P.count; ++i) {
+        char why[FSDEM__MESSAGE_SIZE];
+        const fsdem_fluid_sample *s = &c->sample[i];
+        fsdem_gic_force *rec = &c->force[i];
+        const fsdem_real volume = fsdem__gic_volume(c, P.radius[i]), wet = s->volume_fraction;
+        const fsdem_vec3 slip = fsdem__sub(s->velocity, P.velocity[i]);
+        fsdem_real cv = 0, eps = fsdem__gic_porosity_at(c, P.position[i]);
+        rec->id = P.id[i];
+        rec->fluid_velocity = s->velocity;
+        rec->porosity = eps;
+        rec->liquid = wet;
+        rec->pressure = rec->drag = rec->virtual_mass = fsdem__zero3();
+        rec->fluid_acceleration = c->desc.virtual_mass ? c->fluid_accel[i] : fsdem__zero3();
+        if (P.fixed[i] || !(wet > 0)) {
+            load.force[i] = fsdem__zero3();
+            continue;
+        }
+        res = fsdem_drag_coefficient(c->desc.drag, eps, 2 * P.radius[i], fsdem__norm(slip), c->rho,
+                                     c->desc.viscosity > 0 ? c->desc.viscosity : 1, &cv, NULL, why, sizeof why);
+        if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: granule %d (id %d): %s", i, P.id[i], why);
+        cv *= c->desc.drag_scale;
+        rec->pressure = fsdem__scale(s->pressure_gradient, -volume * wet);
+        rec->drag = fsdem__scale(slip, cv * volume * wet);
+        load.force[i] = fsdem__add(rec->pressure, rec->drag);
+        if (c->desc.virtual_mass) { /* Eq. 14 through the DEM's mass m (>>couple_gic step 1) */
+            const fsdem_real m = P.mass[i], ma = (c->dim == 3 ? (fsdem_real)0.5 : 1) * c->rho * volume * wet, k = 1 / (m + ma);
+            const fsdem_vec3 ext = fsdem__madd(fsdem__madd(fsdem__scale(load.force[i], m * k), fsdem__sub(c->fluid_accel[i], gravity), m * ma * k),
+                                               P.force[i], -ma * k);
+            rec->virtual_mass = fsdem__sub(ext, load.force[i]);
+            load.force[i] = ext;
+        }
+        c->tally.pressure = fsdem__madd(c->tally.pressure, rec->pressure, held);
+        c->tally.drag = fsdem__madd(c->tally.drag, rec->drag, held);
+        c->tally.virtual_mass = fsdem__madd(c->tally.virtual_mass, rec->virtual_mass, held);
+        wet_count++;
+        {
+            const fsdem_vec3 impulse = fsdem__scale(fsdem__add(rec->drag, rec->virtual_mass), -held);
+            int taken = 0;
+            if (impulse.x != 0 || impulse.y != 0 || impulse.z != 0) {
+                res = fsdem_pic_add_force(c->desc.pic, P.position[i], P.radius[i], fsdem__scale(impulse, 1 / (c->dt_now * c->depth)),
+                                          &taken);
+                if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+                if (taken) c->tally.to_fluid = fsdem__add(c->tally.to_fluid, impulse);
+                else c->tally.lost = fsdem__add(c->tally.lost, impulse);
+            }
+        }
+    }
+    c->tally.wet = wet_count;
+    c->records = P.count;
+    c->calls++;
+    c->failed = 0;
+    return FSDEM_OK;
+}
+
+/* ---- >>couple_gic_step : coupled time stepping ---- */
+
+/* The shortest drag relaxation time (s; 0: none) of the granules in the water now or within
+   `horizon` (s) of their paths (a granule about to enter the water counts, at its speed against
+   water at rest), from the water of the last step: a granule's own, m_i / (s c V_i), and the
+   water's in each cell, rho alpha_f' dx^dim / sum_i s c_i V_i N_i over the granules' kernel
+   weights there (the rate at which their drag relaxes it: the cell's share of the exchange over
+   its water's mass, with the capped porosity and overlapping granules as they are). */
+static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    fsdem_real shortest = 0;
+    int i, k, q0, q1, q2;
+    memset(c->rate, 0, sizeof(fsdem_real) * (size_t)c->grid.ncell);
+    for (i = 0; i < P.count; ++i) {
+        fsdem_fluid_sample here, ahead;
+        const fsdem_vec3 x = P.position[i], y = fsdem__madd(x, P.velocity[i], horizon);
+        const fsdem_real volume = fsdem__gic_volume(c, P.radius[i]);
+        fsdem_real cv = 0, t;
+        fsdem__kernel kw;
+        if (P.fixed[i] || fsdem_pic_sample(c->desc.pic, 1, &x, &here) != FSDEM_OK || fsdem_pic_sample(c->desc.pic, 1, &y, &ahead) != FSDEM_OK)
+            continue;
+        if (!(here.volume_fraction > 0) && !(ahead.volume_fraction > 0)) continue;
+        if (!(here.volume_fraction > 0)) here.velocity = fsdem__zero3();
+        if (fsdem_drag_coefficient(c->desc.drag, fsdem__gic_porosity_at(c, here.volume_fraction > 0 ? x : y), 2 * P.radius[i],
+                                   fsdem__norm(fsdem__sub(here.velocity, P.velocity[i])), c->rho, c->desc.viscosity > 0 ? c->desc.viscosity : 1,
+                                   &cv, NULL, NULL, 0) != FSDEM_OK ||
+            !(cv > 0))
+            continue;
+        cv *= c->desc.drag_scale;
+        t = P.mass[i] / (cv * volume);
+        if (shortest == 0 || t < shortest) shortest = t;
+        fsdem__gic_kernel(c, here.volume_fraction > 0 ? x : y, &kw);
+        for (q2 = 0; q2 < kw.count[2]; ++q2)
+            for (q1 = 0; q1 < kw.count[1]; ++q1)
+                for (q0 = 0; q0 < kw.count[0]; ++q0)
+                    c->rate[fsdem__mac_cell(&c->grid, kw.idx[0][q0], kw.idx[1][q1], kw.idx[2][q2])] +=
+                        cv * volume / c->depth * kw.w[0][q0] * kw.w[1][q1] * kw.w[2][q2];
+    }
+    for (k = 0; k < c->grid.ncell; ++k)
+        if (c->rate[k] > 0) {
+            const fsdem_real t = c->rho * c->porosity[k] * c->cell_volume / c->rate[k];
+            if (shortest == 0 || t < shortest) shortest = t;
+        }
+    return shortest;
+}
+
+/* The stable coupled step of the section (Eq. 33, the drag limit). */
+static fsdem_result fsdem__gic_stable(const fsdem_gic *c, fsdem_real *dt) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    fsdem_result res = fsdem_pic_stable_dt(c->desc.pic, dt);
+    fsdem_real vmax = 0, limit = c->desc.max_dt_ratio * fsdem_dem_get_desc(c->desc.dem).dt;
+    int i;
+    if (res != FSDEM_OK)
+        return fsdem__fail((fsdem__status *)&c->status, res, "fsdem_gic_stable_dt: %s", fsdem_pic_last_error(c->desc.pic));
+    for (i = 0; i < P.count; ++i) {
+        const fsdem_real v = fsdem__norm(P.velocity[i]);
+        if (!fsdem__finite(v))
+            return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NAN, "fsdem_gic: granule %d (id %d) has a non-finite velocity", i,
+                               P.id[i]);
+        if (v > vmax) vmax = v;
+    }
+    if (vmax > 0 && c->desc.cfl * c->grid.dx / vmax < limit) limit = c->desc.cfl * c->grid.dx / vmax;
+    if (limit < *dt) *dt = limit;
+    {
+        const fsdem_real drag = fsdem__gic_drag_time(c, *dt);
+        if (drag > 0 && c->desc.drag_dt_fraction * drag < *dt) *dt = c->desc.drag_dt_fraction * drag;
+    }
+    return FSDEM_OK;
+}
+
+/* One coupled step of dt after the checks: sand substeps with the exchange, fractions, the PIC. */
+static fsdem_result fsdem__gic_run(fsdem_gic *c, fsdem_real dt) {
+    long long substeps = 0;
+    fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_gic");
+    clock_t t0, t1;
+    if (res != FSDEM_OK) return res;
+    if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
+        return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+    if ((res = fsdem__gic_reserve(c, fsdem_dem_get_particles(c->desc.dem).count)) != FSDEM_OK) return res;
+    fsdem_dem_substep_count(c->desc.dem, dt, &c->substeps_now);
+    c->h = dt / (fsdem_real)c->substeps_now;
+    c->dt_now = dt;
+    c->calls = 0;
+    c->failed = 0;
+    memset(&c->tally, 0, sizeof c->tally);
+    c->tally.drag_dt = fsdem__gic_drag_time(c, dt);
+    fsdem__gic_fluid_accelerations(c);
+    fsdem_pic_clear_forces(c->desc.pic);
+    t0 = clock();
+    res = fsdem_dem_advance_with(c->desc.dem, dt, fsdem__gic_evaluate, c, &substeps);
+    t1 = clock();
+    c->sec_dem += (double)(t1 - t0) / CLOCKS_PER_SEC;
+    c->last = c->tally;
+    c->substeps = substeps;
+    c->substeps_total += substeps;
+    if (res != FSDEM_OK)
+        return c->failed ? res : fsdem__fail(&c->status, res, "fsdem_gic: sand substeps: %s", fsdem_dem_last_error(c->desc.dem));
+    if ((res = fsdem_gic_update(c)) != FSDEM_OK) return res;
+    res = fsdem_pic_step_dt(c->desc.pic, dt);
+    c->sec_pic += (double)(clock() - t1) / CLOCKS_PER_SEC;
+    c->steps++;
+    c->dt_last = dt;
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
+    return fsdem__ok(&c->status);
+}
+
+fsdem_result fsdem_gic_step(fsdem_gic *c) {
+    fsdem_real dt = 0;
+    fsdem_result res;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if ((res = fsdem__gic_stable(c, &dt)) != FSDEM_OK) return res;
+    return fsdem__gic_run(c, dt);
+}
+
+fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) {
+    fsdem_real drag;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_gic_step_dt: dt = %g s must be > 0 and finite", (double)dt);
+    drag = fsdem__gic_drag_time(c, dt);
+    if (drag > 0 && dt > c->desc.drag_dt_fraction * drag * (1 + (fsdem_real)1e-6))
+        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
+                           "fsdem_gic_step_dt: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s",
+                           (double)dt, (double)c->desc.drag_dt_fraction, (double)drag);
+    return fsdem__gic_run(c, dt);
+}
+
+/* fsdem__coupled_advance's verbs for this coupler. */
+static double fsdem__gic_now(const void *c) { return fsdem_pic_time(((const fsdem_gic *)c)->desc.pic); }
+
+static fsdem_result fsdem__gic_prepare(void *c, fsdem_real *dt) { return fsdem__gic_stable((const fsdem_gic *)c, dt); }
+
+static fsdem_result fsdem__gic_go(void *c, fsdem_real dt) { return fsdem__gic_run((fsdem_gic *)c, dt); }
+
+fsdem_result fsdem_gic_advance(fsdem_gic *c, fsdem_real duration, long long *steps) {
+    static const fsdem__coupled_verbs verbs = {fsdem__gic_now, fsdem__gic_prepare, fsdem__gic_go};
+    if (steps) *steps = 0;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__coupled_advance(c, &c->status, "fsdem_gic_advance", &verbs, duration, steps);
+}
+
+fsdem_result fsdem_gic_stable_dt(const fsdem_gic *c, fsdem_real *dt) {
+    if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__gic_stable(c, dt);
+}
+
+double fsdem_gic_time(const fsdem_gic *c) { return c ? fsdem_pic_time(c->desc.pic) : 0; }
+
+/* The record of DEM particle `index` from the last step, or -1. */
+static int fsdem__gic_record(const fsdem_gic *c, int index) {
+    return c->records ? fsdem__dem_record_of(c->desc.dem, index, &c->force[0].id, sizeof(fsdem_gic_force), c->records) : -1;
+}
+
+fsdem_result fsdem_gic_get_force(const fsdem_gic *c, int index, fsdem_gic_force *out) {
+    int k;
+    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
+    k = fsdem__gic_record(c, index);
+    if (k < 0) return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_gic_get_force: no record of particle %d", index);
+    *out = c->force[k];
+    return fsdem__ok((fsdem__status *)&c->status);
+}
+
+fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *c) {
+    fsdem_gic_stats st;
+    memset(&st, 0, sizeof st);
+    if (!c) return st;
+    st.steps = c->steps;
+    st.time = fsdem_pic_time(c->desc.pic);
+    st.dt = c->dt_last;
+    st.substeps = c->substeps;
+    st.substeps_total = c->substeps_total;
+    st.wet = c->last.wet;
+    st.pressure_impulse = c->last.pressure;
+    st.drag_impulse = c->last.drag;
+    st.virtual_mass_impulse = c->last.virtual_mass;
+    st.to_fluid = c->last.to_fluid;
+    st.lost = c->last.lost;
+    st.drag_dt = c->last.drag_dt;
+    st.max_solid_fraction = c->max_solid;
+    st.solid_volume = c->solid_volume;
+    st.seconds_pic = c->sec_pic;
+    st.seconds_dem = c->sec_dem;
+    return st;
+}

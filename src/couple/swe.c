@@ -1,0 +1,351 @@
+/* ===== >>impl_couple_swe : SWE-DEM floating debris =================================================
+
+   Contents: >>couple_swe_object (desc, creation), >>couple_swe_geometry (submerged parts of a
+   sphere), >>couple_swe_forces (seed 003 Eq. 5-8), >>couple_swe_step (coupled time stepping). The
+   coupler reaches the solvers through their coupling functions only (>>doc). */
+
+/* ---- >>couple_swe_object : desc, creation ---- */
+
+struct fsdem_swe_dem {
+    fsdem_swe_dem_desc desc;
+    fsdem__status status;
+    fsdem_allocator allocator;
+    fsdem_real rho, g, dry;        /* the SWE's density, |g| and dry depth */
+    fsdem_swe_dem_force *force;    /* one per DEM particle of the last update */
+    int force_capacity, records;   /* records: the particles of the last update */
+    long long steps, substeps, substeps_total;
+    fsdem_real dt_last;
+    int in_water;
+    fsdem_vec3 impulse;            /* N s, given to the water */
+    fsdem_vec3 *reaction;          /* N, horizontal force on each sphere whose reaction the water took */
+};
+
+fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void) {
+    fsdem_swe_dem_desc d;
+    memset(&d, 0, sizeof d);
+    d.beta = (fsdem_real)1.1;
+    d.two_way = 1;
+    d.heave_damping = 0;
+    d.max_substeps = 100000;
+    return d;
+}
+
+fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *d, char *msg, size_t size) {
+    fsdem_dem_desc dd;
+    fsdem_vec3 g;
+    fsdem_real gs;
+    if (!d) return fsdem__reject(msg, size, "fsdem_swe_dem_desc is NULL");
+    if (!d->swe || !d->dem) return fsdem__reject(msg, size, "fsdem_swe_dem_desc.swe and .dem must both be set");
+    dd = fsdem_dem_get_desc(d->dem);
+    if (dd.dim != 3)
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.dem must be 3D (spheres, z vertical); it has dim %d", dd.dim);
+    g = dd.gravity;
+    gs = -fsdem_swe_get_desc(d->swe).gravity.z;
+    if (g.x != 0 || g.y != 0 || !(fabs(g.z + gs) <= 1e-12 * gs))
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc: the DEM gravity (%g, %g, %g) must be (0, 0, -g) with the SWE's g = %g m/s^2",
+                             (double)g.x, (double)g.y, (double)g.z, (double)gs);
+    if (!(d->beta > 0) || !fsdem__finite(d->beta))
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.beta must be > 0 (got %g)", (double)d->beta);
+    if (!(d->heave_damping >= 0) || !fsdem__finite(d->heave_damping))
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.heave_damping must be >= 0 (got %g)",
+                             (double)d->heave_damping);
+    if (d->max_substeps < 1)
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
+    return FSDEM_OK;
+}
+
+fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_allocator al;
+    fsdem_swe_dem *c;
+    fsdem_result res;
+    if (out) *out = NULL;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem_swe_dem_desc_check(desc, msg, sizeof msg);
+    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
+    c = (fsdem_swe_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
+                                           res == FSDEM_OK ? &al : NULL, sizeof *c, "fsdem_swe_dem_create", &res);
+    if (!c) return res;
+    {
+        const fsdem_swe_desc sd = fsdem_swe_get_desc(desc->swe);
+        c->rho = sd.density;
+        c->g = -sd.gravity.z;
+        c->dry = sd.dry_depth;
+    }
+    c->desc = *desc;
+    c->allocator = al;
+    c->status.log = desc->log;
+    c->status.log_user = desc->log_user;
+    *out = c;
+    return FSDEM_OK;
+}
+
+void fsdem_swe_dem_destroy(fsdem_swe_dem *c) {
+    fsdem_allocator al;
+    if (!c) return;
+    al = c->allocator;
+    fsdem__free(&al, c->force, sizeof(fsdem_swe_dem_force) * (size_t)c->force_capacity);
+    fsdem__free(&al, c->reaction, sizeof(fsdem_vec3) * (size_t)c->force_capacity);
+    fsdem__free(&al, c, sizeof *c);
+}
+
+const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *c) { return c ? c->status.message : "fsdem_swe_dem is NULL"; }
+
+fsdem_swe_dem_desc fsdem_swe_dem_get_desc(const fsdem_swe_dem *c) {
+    fsdem_swe_dem_desc d;
+    if (c) return c->desc;
+    memset(&d, 0, sizeof d);
+    return d;
+}
+
+/* ---- >>couple_swe_geometry : submerged parts of a sphere ---- */
+
+/* Submerged part of a vertical circle of radius r centred at height zc under a surface at eta: its
+   area and its first moment M = int (eta - z) w(z) dz, so the hydrostatic force on it is rho g M.
+   With z = zc - r cos(phi) and w = 2 r sin(phi) both integrals are closed forms in the angle theta of
+   the waterline: area r^2 (theta - sin cos), M = 2 r^2 [(eta - zc)(theta - sin cos)/2 + r sin^3 / 3]. */
+static void fsdem__swe_dem_submerged_disc(fsdem_real r, fsdem_real zc, fsdem_real eta, fsdem_real *area, fsdem_real *moment) {
+    fsdem_real top = eta < zc + r ? eta : zc + r, c, s, th;
+    if (top <= zc - r) {
+        *area = *moment = 0;
+        return;
+    }
+    c = (zc - top) / r;
+    c = c < -1 ? -1 : c > 1 ? 1 : c;
+    th = (fsdem_real)acos(c);
+    s = (fsdem_real)sin(th);
+    *area = r * r * (th - s * c);
+    *moment = 2 * r * r * ((eta - zc) * (th - s * c) / 2 + r * s * s * s / 3);
+}
+
+/* Volume of the part of a sphere (radius r, centre height zc) below the surface eta: a cap. */
+static fsdem_real fsdem__swe_dem_submerged_sphere(fsdem_real r, fsdem_real zc, fsdem_real eta) {
+    fsdem_real s = eta - (zc - r);
+    if (s <= 0) return 0;
+    if (s > 2 * r) s = 2 * r;
+    return (fsdem_real)FSDEM__PI * s * s * (3 * r - s) / 3;
+}
+
+/* Water at p shifted by `shift` along a horizontal axis (0: x, 1: y); off the grid it is `fallback`. */
+static fsdem_swe_cell fsdem__swe_dem_water_at(const fsdem_swe *swe, fsdem_vec3 p, int axis, fsdem_real shift,
+                                              fsdem_swe_cell fallback) {
+    fsdem_swe_cell cell;
+    fsdem_real x = p.x + (axis == 0 ? shift : 0), y = p.y + (axis == 1 ? shift : 0);
+    return fsdem_swe_sample_state(swe, x, y, &cell) == FSDEM_OK ? cell : fallback;
+}
+
+/* Buoyancy (Eq. 5) and heave damping of sphere i at its current height and vertical speed, against
+   the water surface held in out->surface; updates `out` and returns the vertical force (N). */
+static fsdem_real fsdem__swe_dem_vertical(const fsdem_swe_dem *c, const fsdem_dem_particles *pv, int i,
+                                          fsdem_swe_dem_force *out) {
+    const fsdem_real rho = c->rho, g = c->g, r = pv->radius[i], z = pv->position[i].z;
+    out->submerged_volume = fsdem__swe_dem_submerged_sphere(r, z, out->surface);
+    out->buoyancy = fsdem_v3(0, 0, rho * g * out->submerged_volume);
+    out->heave = fsdem__zero3();
+    if (c->desc.heave_damping > 0) {
+        /* critical damping of the hydrostatic spring rho g A_waterplane of the bobbing */
+        fsdem_real a2 = r * r - (out->surface - z) * (out->surface - z);
+        if (a2 > 0)
+            out->heave.z = -2 * c->desc.heave_damping * (fsdem_real)sqrt(rho * g * (fsdem_real)FSDEM__PI * a2 * pv->mass[i]) *
+                           pv->velocity[i].z;
+    }
+    return out->buoyancy.z + out->heave.z;
+}
+
+/* ---- >>couple_swe_forces : seed 003 Eq. 5-8 ---- */
+
+fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
+    fsdem_swe *swe;
+    fsdem_dem_particles pv;
+    fsdem_dem_coupling loads;
+    fsdem_real beta;
+    int i, a, axes, n;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    swe = c->desc.swe;
+    beta = c->desc.beta;
+    axes = fsdem_swe_get_desc(swe).dim;
+    pv = fsdem_dem_get_particles(c->desc.dem);
+    n = pv.count;
+    if (n > c->force_capacity) {
+        fsdem_swe_dem_force *force = (fsdem_swe_dem_force *)fsdem__alloc(&c->allocator, sizeof *force * (size_t)n);
+        fsdem_vec3 *reaction = (fsdem_vec3 *)fsdem__alloc(&c->allocator, sizeof *reaction * (size_t)n);
+        if (!force || !reaction) {
+            fsdem__free(&c->allocator, force, sizeof *force * (size_t)n);
+            fsdem__free(&c->allocator, reaction, sizeof *reaction * (size_t)n);
+            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_dem: out of memory for the forces of %d particles", n);
+        }
+        fsdem__free(&c->allocator, c->force, sizeof *force * (size_t)c->force_capacity);
+        fsdem__free(&c->allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
+        c->force = force;
+        c->reaction = reaction;
+        c->force_capacity = n;
+    }
+    loads = fsdem_dem_get_coupling(c->desc.dem);
+    if (c->desc.two_way) fsdem_swe_clear_forces(swe);
+    c->in_water = 0;
+    for (i = 0; i < n; ++i) {
+        fsdem_swe_dem_force *out = &c->force[i];
+        const fsdem_vec3 p = pv.position[i], w = pv.velocity[i];
+        const fsdem_real r = pv.radius[i];
+        fsdem_swe_cell centre, back[2], front[2], flow;
+        fsdem_vec3 horizontal;
+        memset(out, 0, sizeof *out);
+        out->id = pv.id[i];
+        loads.force[i] = c->reaction[i] = fsdem__zero3();
+        if (pv.fixed[i] || fsdem_swe_sample_state(swe, p.x, p.y, &centre) != FSDEM_OK) continue;
+        /* the water at the centre, and at the back (-r) and front (+r) along each horizontal axis; the
+           flow velocity is the centre's, or that of the deepest side while a front reaches the sphere */
+        flow = centre;
+        for (a = 0; a < axes; ++a) {
+            back[a] = fsdem__swe_dem_water_at(swe, p, a, -r, centre);
+            front[a] = fsdem__swe_dem_water_at(swe, p, a, r, centre);
+            if (flow.depth < c->dry && back[a].depth > flow.depth) flow = back[a];
+            if (flow.depth < c->dry && front[a].depth > flow.depth) flow = front[a];
+        }
+        if (flow.depth < c->dry) continue;
+        out->in_water = 1;
+        c->in_water++;
+        out->surface = centre.eta;
+        for (a = 0; a < axes; ++a) {
+            /* Eq. 6-7 along axis a */
+            fsdem_real area_b, area_f, m_b, m_f, rel, hydro, dyn;
+            fsdem__swe_dem_submerged_disc(r, p.z, back[a].eta, &area_b, &m_b);
+            fsdem__swe_dem_submerged_disc(r, p.z, front[a].eta, &area_f, &m_f);
+            rel = beta * (a == 0 ? flow.u : flow.v) - (a == 0 ? w.x : w.y);
+            hydro = c->rho * c->g * (m_b - m_f);
+            dyn = c->rho * rel * (rel < 0 ? -rel : rel) * (rel > 0 ? area_b : area_f);
+            if (a == 0) {
+                out->hydrostatic.x = hydro;
+                out->dynamic.x = dyn;
+                out->frontal_area = area_f;
+            } else {
+                out->hydrostatic.y = hydro;
+                out->dynamic.y = dyn;
+            }
+        }
+        horizontal = fsdem__add(out->hydrostatic, out->dynamic);
+        if (c->desc.two_way) {
+            /* Eq. 8: the reaction -F_h as a momentum source under the sphere; a force whose reaction
+               no wet cell can take is dropped, so momentum is exchanged, never created */
+            int taken = 0;
+            fsdem_swe_add_force(swe, p, r, fsdem__scale(horizontal, -1), &taken);
+            if (!taken) out->hydrostatic = out->dynamic = horizontal = fsdem__zero3();
+            c->reaction[i] = horizontal;
+        }
+        horizontal.z = fsdem__swe_dem_vertical(c, &pv, i, out);
+        loads.force[i] = horizontal;
+    }
+    c->records = n;
+    return fsdem__ok(&c->status);
+}
+
+/* The record of DEM particle `index` (-1: none). */
+static int fsdem__swe_dem_record(const fsdem_swe_dem *c, int index) {
+    return c->records ? fsdem__dem_record_of(c->desc.dem, index, &c->force[0].id, sizeof *c->force, c->records) : -1;
+}
+
+fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *c, int index, fsdem_swe_dem_force *out) {
+    int k;
+    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
+    if ((k = fsdem__swe_dem_record(c, index)) < 0)
+        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND,
+                           "fsdem_swe_dem_get_force: no particle %d in the last update", index);
+    *out = c->force[k];
+    return FSDEM_OK;
+}
+
+/* ---- >>couple_swe_step : coupled time stepping ---- */
+
+/* fsdem_dem_substep_fn: buoyancy and heave damping of the spheres in water refreshed for the heights
+   of every DEM force evaluation, against the water surface held over the fluid step. */
+static fsdem_result fsdem__swe_dem_refresh(void *user, fsdem_dem *dem, double time) {
+    fsdem_swe_dem *c = (fsdem_swe_dem *)user;
+    const fsdem_dem_particles pv = fsdem_dem_get_particles(dem);
+    const fsdem_dem_coupling loads = fsdem_dem_get_coupling(dem);
+    int i;
+    (void)time;
+    for (i = 0; i < pv.count; ++i)
+        if (c->force[i].in_water) loads.force[i].z = fsdem__swe_dem_vertical(c, &pv, i, &c->force[i]);
+    return FSDEM_OK;
+}
+
+/* One coupled step of dt: the DEM substep count is checked before anything moves; `adaptive` steps
+   the water with fsdem_swe_step (whose dt is the stable dt computed by the caller), otherwise with
+   fsdem_swe_step_dt. */
+static fsdem_result fsdem__swe_dem_step(fsdem_swe_dem *c, fsdem_real dt, int adaptive) {
+    fsdem_result res;
+    long long k, substeps = 0;
+    int count;
+    res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_swe_dem");
+    if (res != FSDEM_OK) return res;
+    res = fsdem_swe_dem_update_forces(c);
+    if (res != FSDEM_OK) return res;
+    res = adaptive ? fsdem_swe_step(c->desc.swe) : fsdem_swe_step_dt(c->desc.swe, dt);
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: shallow-water step: %s", fsdem_swe_last_error(c->desc.swe));
+    count = fsdem_dem_get_particles(c->desc.dem).count;
+    for (k = 0; k < c->force_capacity && k < count; ++k)
+        c->impulse = fsdem__madd(c->impulse, c->reaction[k], -dt);
+    res = fsdem_dem_advance_with(c->desc.dem, dt, fsdem__swe_dem_refresh, c, &substeps);
+    c->steps++;
+    c->dt_last = dt;
+    c->substeps = substeps;
+    c->substeps_total += substeps;
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
+    return fsdem__ok(&c->status);
+}
+
+fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c) {
+    fsdem_real dt = 0;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    fsdem_swe_stable_dt(c->desc.swe, &dt);
+    return fsdem__swe_dem_step(c, dt, 1);
+}
+
+fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *c, fsdem_real dt) {
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_dem_step_dt: dt must be > 0 (got %g s)", (double)dt);
+    return fsdem__swe_dem_step(c, dt, 0);
+}
+
+fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *c, fsdem_real duration, long long *steps) {
+    double end;
+    long long n = 0;
+    fsdem_result res = FSDEM_OK;
+    if (steps) *steps = 0;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_dem_advance: duration must be >= 0 (got %g s)",
+                           (double)duration);
+    end = fsdem_swe_time(c->desc.swe) + (double)duration;
+    while (res == FSDEM_OK && fsdem_swe_time(c->desc.swe) < end) {
+        fsdem_real dt = 0;
+        const double left = end - fsdem_swe_time(c->desc.swe);
+        fsdem_swe_stable_dt(c->desc.swe, &dt);
+        res = (double)dt >= left ? fsdem__swe_dem_step(c, (fsdem_real)left, 0) : fsdem__swe_dem_step(c, dt, 1);
+        ++n;
+    }
+    if (steps) *steps = n;
+    return res;
+}
+
+fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *c, fsdem_real *dt) {
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    return fsdem_swe_stable_dt(c->desc.swe, dt);
+}
+
+double fsdem_swe_dem_time(const fsdem_swe_dem *c) { return c ? fsdem_swe_time(c->desc.swe) : 0; }
+
+fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
+    fsdem_swe_dem_stats st;
+    memset(&st, 0, sizeof st);
+    if (!c) return st;
+    st.steps = c->steps;
+    st.time = fsdem_swe_time(c->desc.swe);
+    st.dt = c->dt_last;
+    st.substeps = c->substeps;
+    st.substeps_total = c->substeps_total;
+    st.in_water = c->in_water;
+    st.impulse_to_water = c->impulse;
+    return st;
+}

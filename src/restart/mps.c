@@ -1,0 +1,168 @@
+/* ---- >>restart_mps : MPS ---- */
+
+/* Checks (in CHECK) the `count` open planes about to be read, inflows or outflows: an axis of the
+   solver's, a direction of +-1, a finite plane (corrupted data otherwise). */
+static void fsdem__restart_mps_planes(fsdem__restart *io, int dim, int count, int inflows) {
+    const size_t size = inflows ? sizeof(fsdem_mps_inflow_desc) : sizeof(fsdem_mps_outflow_desc);
+    const unsigned char *p = io->mode == FSDEM__RESTART_CHECK ? fsdem__restart_peek(io, size * (size_t)count) : NULL;
+    int k;
+    for (k = 0; p && k < count; ++k) {
+        fsdem_mps_inflow_desc in;
+        fsdem_mps_outflow_desc out;
+        int axis, direction;
+        fsdem_real position;
+        if (inflows) {
+            memcpy(&in, p + size * (size_t)k, size);
+            axis = in.axis, direction = in.direction, position = in.position;
+        } else {
+            memcpy(&out, p + size * (size_t)k, size);
+            axis = out.axis, direction = out.direction, position = out.position;
+        }
+        if (axis < 0 || axis >= dim || (direction != 1 && direction != -1) || !fsdem__finite(position)) {
+            fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s %d: axis %d, direction %d, plane %g (corrupted data)",
+                                inflows ? "inflow" : "outflow", k, axis, direction, (double)position);
+            return;
+        }
+    }
+}
+
+/* The particles go into fresh arrays of the saved capacity (all FSDEM__MPS_ARRAYS of them and the
+   four row-offset arrays, as fsdem__mps_reserve makes them); of their contents the state that the
+   next step reads (positions, velocities, pressures: the pressure solve starts from them, kinds,
+   porosities, a coupler's forces, obstacle membership) and the views of the last step (number
+   density, surface flags, pressure gradients) are saved. The neighbour rows and the matrix are
+   rebuilt by every step; their memory stays. */
+static void fsdem__restart_mps(fsdem__restart *io, void *object) {
+    fsdem_mps *s = (fsdem_mps *)object;
+    const fsdem_mps_desc *d = &s->desc;
+    const fsdem_allocator *al = &s->allocator;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    int no = s->obst_n, nin = s->inflow_n, nout = s->outflow_n, n = s->n, cap = s->cap, i, a;
+    fsdem__mps_obst *obst;
+    fsdem_mps_inflow_desc *inflows;
+    fsdem_mps_outflow_desc *outflows;
+    fsdem__restart_tag(io, "MPS5");
+    fsdem__restart_same_int(io, d->dim, "dim");
+    fsdem__restart_same_real(io, d->r0, "r0");
+    fsdem__restart_same_real(io, d->re, "re");
+    fsdem__restart_same_real(io, d->re_laplacian, "re_laplacian");
+    fsdem__restart_same_real(io, d->density, "density");
+    fsdem__restart_same_real(io, d->viscosity, "viscosity");
+    fsdem__restart_same_vec3(io, d->gravity, "gravity");
+    fsdem__restart_same_real(io, d->gamma, "gamma");
+    fsdem__restart_same_int(io, (int)d->model, "model");
+    fsdem__restart_same_real(io, d->beta, "beta");
+    fsdem__restart_same_real(io, d->alpha, "alpha");
+    fsdem__restart_same_real(io, d->cfl, "cfl");
+    fsdem__restart_same_real(io, d->dt_max, "dt_max");
+    fsdem__restart_same_vec3(io, d->domain_min, "domain_min");
+    fsdem__restart_same_vec3(io, d->domain_max, "domain_max");
+    fsdem__restart_same_int(io, d->periodic[0], "periodic[0]");
+    fsdem__restart_same_int(io, d->periodic[1], "periodic[1]");
+    fsdem__restart_same_int(io, d->periodic[2], "periodic[2]");
+    fsdem__restart_same_int(io, (int)d->gradient, "gradient");
+    fsdem__restart_same_int(io, (int)d->wall_viscosity, "wall_viscosity");
+    fsdem__restart_same_int(io, d->clamp_negative_pressure, "clamp_negative_pressure");
+    fsdem__restart_same_real(io, d->collision_distance, "collision_distance");
+    fsdem__restart_same_real(io, d->restitution, "restitution");
+    fsdem__restart_same_real(io, d->shifting, "shifting");
+    fsdem__restart_same_int(io, (int)d->pressure_precond, "pressure_precond");
+    fsdem__restart_same_real(io, d->pressure_tolerance, "pressure_tolerance");
+    fsdem__restart_same_int(io, d->pressure_max_iterations, "pressure_max_iterations");
+
+    fsdem__restart_data(io, &s->time, sizeof s->time);
+    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
+    fsdem__restart_data(io, &s->steps, sizeof s->steps);
+    fsdem__restart_data(io, &s->iters_total, sizeof s->iters_total);
+    fsdem__restart_data(io, &s->iters, sizeof s->iters);
+    fsdem__restart_data(io, &s->residual, sizeof s->residual);
+    fsdem__restart_data(io, &s->surface_count, sizeof s->surface_count);
+    fsdem__restart_data(io, &s->pair_count, sizeof s->pair_count);
+
+    /* obstacles, into a fresh array */
+    fsdem__restart_count(io, &no, 1 << 24, sizeof(fsdem__mps_obst), "obstacle count");
+    obst = (fsdem__mps_obst *)fsdem__restart_block(io, al, sizeof *obst * (size_t)no);
+    if (commit) {
+        fsdem__free(al, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
+        s->bytes += sizeof *obst * (size_t)no - sizeof *s->obst * (size_t)s->obst_cap;
+        s->obst = obst;
+        s->obst_n = s->obst_cap = no;
+    }
+    fsdem__restart_data(io, s->obst, sizeof *s->obst * (size_t)no);
+
+    /* open boundaries, into fresh arrays */
+    fsdem__restart_count(io, &nin, 1 << 24, sizeof(fsdem_mps_inflow_desc), "inflow count");
+    inflows = (fsdem_mps_inflow_desc *)fsdem__restart_block(io, al, sizeof *inflows * (size_t)nin);
+    fsdem__restart_count(io, &nout, 1 << 24, sizeof(fsdem_mps_outflow_desc), "outflow count");
+    outflows = (fsdem_mps_outflow_desc *)fsdem__restart_block(io, al, sizeof *outflows * (size_t)nout);
+    if (commit) {
+        fsdem__free(al, s->inflows, sizeof *s->inflows * (size_t)s->inflow_cap);
+        fsdem__free(al, s->outflows, sizeof *s->outflows * (size_t)s->outflow_cap);
+        s->bytes += sizeof *inflows * (size_t)nin - sizeof *s->inflows * (size_t)s->inflow_cap;
+        s->bytes += sizeof *outflows * (size_t)nout - sizeof *s->outflows * (size_t)s->outflow_cap;
+        s->inflows = inflows;
+        s->inflow_n = s->inflow_cap = nin;
+        s->outflows = outflows;
+        s->outflow_n = s->outflow_cap = nout;
+    }
+    fsdem__restart_mps_planes(io, s->dim, nin, 1);
+    fsdem__restart_data(io, s->inflows, sizeof *s->inflows * (size_t)nin);
+    fsdem__restart_mps_planes(io, s->dim, nout, 0);
+    fsdem__restart_data(io, s->outflows, sizeof *s->outflows * (size_t)nout);
+    fsdem__restart_data(io, &s->inflow_total, sizeof s->inflow_total);
+    fsdem__restart_data(io, &s->outflow_total, sizeof s->outflow_total);
+
+    /* particles, into fresh arrays of the saved capacity */
+    fsdem__restart_count(io, &cap, 1 << 29, 0, "particle capacity");
+    fsdem__restart_count(io, &n, cap, 2 * sizeof(fsdem_vec3), "particle count");
+    if (io->res == FSDEM_OK && (io->mode == FSDEM__RESTART_RESERVE || commit)) {
+        void **ptr[FSDEM__MPS_ARRAYS];
+        size_t elem[FSDEM__MPS_ARRAYS];
+        void *fresh[FSDEM__MPS_ARRAYS + 4];
+        const int k = fsdem__mps_arrays(s, ptr, elem);
+        for (a = 0; a < k; ++a) fresh[a] = fsdem__restart_block(io, al, elem[a] * (size_t)cap);
+        for (a = 0; a < 4; ++a) fresh[k + a] = fsdem__restart_block(io, al, sizeof(int) * (size_t)(cap + 1));
+        if (commit) {
+            for (a = 0; a < k; ++a) {
+                fsdem__free(al, *ptr[a], elem[a] * (size_t)s->cap);
+                *ptr[a] = fresh[a];
+                s->bytes += elem[a] * (size_t)cap - elem[a] * (size_t)s->cap;
+            }
+            for (a = 0; a < 4; ++a) {
+                int **rows = fsdem__mps_rows(s, a);
+                fsdem__free(al, *rows, sizeof(int) * (size_t)(s->cap + 1));
+                *rows = (int *)fresh[k + a];
+                memset(*rows, 0, sizeof(int) * (size_t)(cap + 1));
+            }
+            s->bytes += 4 * sizeof(int) * (size_t)cap - 4 * sizeof(int) * (size_t)s->cap;
+            s->cap = cap;
+            s->n = n;
+            s->rows = 0; /* the pressure matrix of the last step is not kept */
+        }
+    }
+    fsdem__restart_data(io, s->x, sizeof *s->x * (size_t)n);
+    fsdem__restart_data(io, s->v, sizeof *s->v * (size_t)n);
+    fsdem__restart_data(io, s->p, sizeof *s->p * (size_t)n);
+    fsdem__restart_data(io, s->eps, sizeof *s->eps * (size_t)n);
+    fsdem__restart_data(io, s->nd, sizeof *s->nd * (size_t)n);
+    fsdem__restart_data(io, &s->external, sizeof s->external);
+    fsdem__restart_data(io, s->fext, sizeof *s->fext * (size_t)n);
+    fsdem__restart_data(io, s->gradp, sizeof *s->gradp * (size_t)n);
+    fsdem__restart_flags(io, s->kind, n, FSDEM_MPS_KIND_DUMMY, "kind of particle");
+    fsdem__restart_flags(io, s->surf, n, 1, "surface flag of particle");
+    fsdem__restart_ints(io, s->body, n, -1, no - 1, "obstacle of particle");
+    fsdem__restart_ints(io, s->inlet, n, -1, nin - 1, "inflow of particle");
+    fsdem__restart_gauges(io, &s->gauges, al, "fsdem_mps_gauges_close");
+    if (commit) {
+        s->counts[0] = s->counts[1] = s->counts[2] = 0;
+        s->buffered = 0;
+        for (i = 0; i < n; ++i) {
+            s->counts[s->kind[i]]++;
+            s->buffered += s->inlet[i] >= 0;
+            s->us[i] = s->shift[i] = fsdem__zero3();
+            s->unknown[i] = -1;
+        }
+        s->solid_pairs_of = -1; /* the solids may be others: their pairs are found again */
+    }
+    fsdem__restart_tag(io, "MPS.");
+}

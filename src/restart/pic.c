@@ -1,0 +1,221 @@
+/* ---- >>restart_pic : PIC/FLIP ---- */
+
+/* Everything of a PIC solver, in order. State: time, last dt, steps (they pick the sorting steps),
+   the random-number state, particles with their capacity (a full capacity refuses inflow seeds) and
+   APIC matrices, obstacles (polygons with their vertices) with the static face fractions, solid
+   velocities and cell flags derived from them (recomputing them samples SDF callbacks), the
+   coupler's arrays, cells_fresh with the fractions and level set it vouches for, the pressure (the
+   initial guess of the next solve), the face velocities, effective faces and cell types (views,
+   sampling and fsdem_pic_add_force read them between steps), counters and the last step's figures.
+   Configuration: the grid and the desc fields that steps read, compared. Not saved, rewritten
+   before use: uold, wsum, ftmp, the valid-face marks, the extrapolation queue, rhs, diag, ctmp,
+   cstart and the particle scratch (ptmp, pcell, pidx; pflag is zeroed), the viscous face grids, the
+   linear solvers (set up at every use), CPU times, the allocator, log and message. SDF obstacles
+   keep the object's callbacks; a pressure-extra operator stays as set. */
+/* The gauges of a PIC solver (positions, kinds, radii); their file is not part of the state. */
+/* Point gauges (fsdem__gauges) into fresh arrays; refused while their file is open (`close` names
+   the function that closes it). */
+static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fsdem_allocator *al, const char *close) {
+    int ng = g->count;
+    fsdem_vec3 *at;
+    int *kind;
+    fsdem_real *radius;
+    if (io->mode == FSDEM__RESTART_CHECK && g->series.file)
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the object has a gauge file open: close it (%s) before restoring and open it again afterwards", close);
+    fsdem__restart_count(io, &ng, 1 << 24, sizeof(fsdem_vec3) + sizeof(int) + sizeof(fsdem_real), "gauge count");
+    at = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)ng);
+    kind = (int *)fsdem__restart_block(io, al, sizeof(int) * (size_t)ng);
+    radius = (fsdem_real *)fsdem__restart_block(io, al, sizeof(fsdem_real) * (size_t)ng);
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        fsdem__gauges_free(g, al);
+        g->at = at;
+        g->kind = kind;
+        g->radius = radius;
+        g->count = g->capacity = ng;
+    }
+    fsdem__restart_data(io, g->at, sizeof(fsdem_vec3) * (size_t)ng);
+    fsdem__restart_ints(io, g->kind, ng, FSDEM__GAUGE_LEVEL, FSDEM__GAUGE_PRESSURE, "gauge kind");
+    fsdem__restart_data(io, g->radius, sizeof(fsdem_real) * (size_t)ng);
+}
+
+static void fsdem__restart_pic(fsdem__restart *io, void *object) {
+    fsdem_pic *s = (fsdem_pic *)object;
+    const fsdem_pic_desc *pd = &s->desc;
+    const fsdem_allocator *al = &s->allocator;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT, apic = pd->transfer == FSDEM_PIC_TRANSFER_APIC;
+    static const char *bc_names[6] = {"boundary[0]", "boundary[1]", "boundary[2]",
+                                      "boundary[3]", "boundary[4]", "boundary[5]"};
+    static const char *bv_names[6] = {"boundary_velocity[0]", "boundary_velocity[1]", "boundary_velocity[2]",
+                                      "boundary_velocity[3]", "boundary_velocity[4]", "boundary_velocity[5]"};
+    int grid[3], no = s->obst_count, np = s->np, pcap = s->pcap, a, k;
+    fsdem__pic_obst *obst;
+    size_t cells = sizeof(fsdem_real) * (size_t)s->ncell;
+    fsdem__restart_tag(io, "PIC2");
+    for (a = 0; a < 3; ++a) grid[a] = s->n[a];
+    fsdem__restart_value(io, grid, sizeof grid);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK &&
+        (grid[0] != s->n[0] || grid[1] != s->n[1] || grid[2] != s->n[2]))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the grid has %d x %d x %d cells in the save and %d x %d x %d in the object (create the "
+                            "object from the desc it was saved with)",
+                            grid[0], grid[1], grid[2], s->n[0], s->n[1], s->n[2]);
+    fsdem__restart_same_int(io, pd->dim, "dim");
+    fsdem__restart_same_vec3(io, pd->domain_min, "domain_min");
+    fsdem__restart_same_real(io, pd->cell_size, "cell_size");
+    fsdem__restart_same_real(io, pd->density, "density");
+    fsdem__restart_same_real(io, pd->viscosity, "viscosity");
+    fsdem__restart_same_vec3(io, pd->gravity, "gravity");
+    for (k = 0; k < 6; ++k) {
+        fsdem__restart_same_int(io, (int)pd->boundary[k], bc_names[k]);
+        fsdem__restart_same_vec3(io, pd->boundary_velocity[k], bv_names[k]);
+    }
+    fsdem__restart_same_int(io, pd->free_surface, "free_surface");
+    fsdem__restart_same_int(io, (int)pd->transfer, "transfer");
+    fsdem__restart_same_real(io, pd->flip_ratio, "flip_ratio");
+    fsdem__restart_same_int(io, (int)pd->kernel, "kernel");
+    fsdem__restart_same_int(io, pd->particles_per_cell, "particles_per_cell");
+    fsdem__restart_same_real(io, pd->jitter, "jitter");
+    fsdem__restart_same_int(io, pd->min_particles_per_cell, "min_particles_per_cell");
+    fsdem__restart_same_int(io, pd->max_particles_per_cell, "max_particles_per_cell");
+    fsdem__restart_same_int(io, pd->advection_order, "advection_order");
+    fsdem__restart_same_real(io, pd->cfl, "cfl");
+    fsdem__restart_same_real(io, pd->cfl_max, "cfl_max");
+    fsdem__restart_same_real(io, pd->dt_max, "dt_max");
+    fsdem__restart_same_int(io, pd->density_projection, "density_projection");
+    fsdem__restart_same_real(io, pd->ghost_theta_min, "ghost_theta_min");
+    fsdem__restart_same_int(io, pd->extrapolation_layers, "extrapolation_layers");
+    fsdem__restart_same_int(io, (int)pd->pressure_precond, "pressure_precond");
+    fsdem__restart_same_real(io, pd->pressure_tolerance, "pressure_tolerance");
+    fsdem__restart_same_int(io, pd->pressure_max_iterations, "pressure_max_iterations");
+    fsdem__restart_same_int(io, (int)pd->viscosity_precond, "viscosity_precond");
+    fsdem__restart_same_real(io, pd->viscosity_tolerance, "viscosity_tolerance");
+
+    fsdem__restart_data(io, &s->time, sizeof s->time);
+    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
+    fsdem__restart_data(io, &s->steps, sizeof s->steps);
+    fsdem__restart_data(io, &s->rng, sizeof s->rng);
+    fsdem__restart_data(io, &s->cells_fresh, sizeof s->cells_fresh);
+    fsdem__restart_data(io, &s->fluid_cells, sizeof s->fluid_cells);
+    fsdem__restart_data(io, &s->p_iters, sizeof s->p_iters);
+    fsdem__restart_data(io, &s->v_iters, sizeof s->v_iters);
+    fsdem__restart_data(io, &s->d_iters, sizeof s->d_iters);
+    fsdem__restart_data(io, &s->p_res, sizeof s->p_res);
+    fsdem__restart_data(io, &s->max_div, sizeof s->max_div);
+    fsdem__restart_data(io, &s->div_before, sizeof s->div_before);
+    fsdem__restart_data(io, &s->reseeded, sizeof s->reseeded);
+    fsdem__restart_data(io, &s->removed, sizeof s->removed);
+    fsdem__restart_data(io, &s->refused, sizeof s->refused);
+    fsdem__restart_data(io, &s->moved, sizeof s->moved);
+
+    /* obstacles, into a fresh array (polygons own their vertices) */
+    fsdem__restart_count(io, &no, 1 << 20, 2 * sizeof(int) + 5 * sizeof(fsdem_vec3) + sizeof(fsdem_real), "obstacle count");
+    obst = (fsdem__pic_obst *)fsdem__restart_block(io, al, sizeof(fsdem__pic_obst) * (size_t)no);
+    for (k = 0; k < no && io->res == FSDEM_OK; ++k) {
+        fsdem__pic_obst o;
+        fsdem_vec3 *verts;
+        int type, nv;
+        if (io->mode == FSDEM__RESTART_WRITE) o = s->obst[k];
+        else memset(&o, 0, sizeof o);
+        type = (int)o.d.type;
+        nv = o.d.type == FSDEM_PIC_OBSTACLE_TYPE_POLYGON ? o.d.vertex_count : 0;
+        fsdem__restart_int_in(io, &type, 0, FSDEM_PIC_OBSTACLE_TYPE_SDF, "obstacle type");
+        fsdem__restart_value(io, &o.d.a, sizeof o.d.a);
+        fsdem__restart_value(io, &o.d.b, sizeof o.d.b);
+        fsdem__restart_value(io, &o.d.radius, sizeof o.d.radius);
+        fsdem__restart_value(io, &o.d.velocity, sizeof o.d.velocity);
+        fsdem__restart_value(io, &o.box_lo, sizeof o.box_lo);
+        fsdem__restart_value(io, &o.box_hi, sizeof o.box_hi);
+        fsdem__restart_count(io, &nv, 1 << 24, sizeof(fsdem_vec3), "polygon vertex count");
+        if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && (type == FSDEM_PIC_OBSTACLE_TYPE_POLYGON) != (nv >= 3))
+            fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "obstacle %d has %d vertices (corrupted data)", k, nv);
+        verts = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)nv);
+        fsdem__restart_data(io, io->mode == FSDEM__RESTART_WRITE ? o.verts : verts, sizeof(fsdem_vec3) * (size_t)nv);
+        if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_PIC_OBSTACLE_TYPE_SDF) {
+            if (k >= s->obst_count || s->obst[k].d.type != FSDEM_PIC_OBSTACLE_TYPE_SDF)
+                fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                                    "obstacle %d is an SDF obstacle in the save: add the same SDF obstacles "
+                                    "(fsdem_pic_obstacle_sdf), in the same order, to the object before restoring",
+                                    k);
+            else {
+                o.d.sdf = s->obst[k].d.sdf;
+                o.d.sdf_user = s->obst[k].d.sdf_user;
+            }
+        }
+        if (commit) {
+            o.d.type = (fsdem_pic_obstacle_type)type;
+            o.d.vertex_count = nv;
+            o.d.vertices = o.verts = verts;
+            obst[k] = o;
+        }
+    }
+    if (commit) {
+        for (k = 0; k < s->obst_count; ++k)
+            if (s->obst[k].verts) fsdem__pic_release(s, s->obst[k].verts, sizeof(fsdem_vec3) * (size_t)s->obst[k].d.vertex_count);
+        fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
+        s->obst = obst;
+        s->obst_count = s->obst_capacity = no;
+        s->bytes += sizeof(fsdem__pic_obst) * (size_t)no;
+        for (k = 0; k < no; ++k) s->bytes += sizeof(fsdem_vec3) * (size_t)obst[k].d.vertex_count;
+    }
+
+    /* particles, into fresh arrays of the saved capacity */
+    fsdem__restart_count(io, &pcap, 1 << 29, 0, "particle capacity");
+    fsdem__restart_count(io, &np, pcap, 2 * sizeof(fsdem_vec3), "particle count");
+    if (io->res == FSDEM_OK) {
+        const size_t vb = sizeof(fsdem_vec3) * (size_t)pcap, ib = sizeof(int) * (size_t)pcap;
+        fsdem_vec3 *px = (fsdem_vec3 *)fsdem__restart_block(io, al, vb), *pv = (fsdem_vec3 *)fsdem__restart_block(io, al, vb);
+        fsdem_vec3 *pt = (fsdem_vec3 *)fsdem__restart_block(io, al, vb), *pc[3] = {NULL, NULL, NULL};
+        int *pcell, *pidx;
+        unsigned char *pflag;
+        for (a = 0; a < 3 && apic; ++a) pc[a] = (fsdem_vec3 *)fsdem__restart_block(io, al, vb);
+        pcell = (int *)fsdem__restart_block(io, al, ib);
+        pidx = (int *)fsdem__restart_block(io, al, ib);
+        pflag = (unsigned char *)fsdem__restart_block(io, al, (size_t)pcap);
+        if (commit) {
+            fsdem__pic_free_particles(s);
+            s->px = px;
+            s->pv = pv;
+            s->ptmp = pt;
+            for (a = 0; a < 3; ++a) s->pc[a] = pc[a];
+            s->pcell = pcell;
+            s->pidx = pidx;
+            s->pflag = pflag;
+            if (pflag) memset(pflag, 0, (size_t)pcap);
+            s->pcap = pcap;
+            s->np = np;
+            s->bytes += (apic ? 6 : 3) * vb + 2 * ib + (size_t)pcap;
+        }
+    }
+    fsdem__restart_data(io, s->px, sizeof(fsdem_vec3) * (size_t)np);
+    fsdem__restart_data(io, s->pv, sizeof(fsdem_vec3) * (size_t)np);
+    for (a = 0; a < 3 && apic; ++a) fsdem__restart_data(io, s->pc[a], sizeof(fsdem_vec3) * (size_t)np);
+
+    /* grid fields, in place (the grid matches) */
+    for (a = 0; a < s->dim; ++a) {
+        const size_t fb = sizeof(fsdem_real) * (size_t)s->nface[a];
+        fsdem__restart_data(io, s->u[a], fb);
+        fsdem__restart_data(io, s->sopen[a], fb);
+        fsdem__restart_data(io, s->svel[a], fb);
+        fsdem__restart_data(io, s->copen[a], fb);
+        fsdem__restart_data(io, s->cvel[a], fb);
+        fsdem__restart_data(io, s->cvstart[a], fb);
+        fsdem__restart_data(io, s->cacc[a], fb);
+        fsdem__restart_data(io, s->E[a], fb);
+        fsdem__restart_data(io, s->us[a], fb);
+        fsdem__restart_data(io, s->fpor[a], fb);
+        fsdem__restart_data(io, s->Ef[a], fb);
+    }
+    fsdem__restart_data(io, s->frac, cells);
+    fsdem__restart_data(io, s->phi, cells);
+    fsdem__restart_data(io, s->pres, cells);
+    fsdem__restart_data(io, s->crhs, cells);
+    fsdem__restart_data(io, s->cref, cells);
+    fsdem__restart_data(io, s->cpor, cells);
+    fsdem__restart_data(io, s->fref, cells);
+    fsdem__restart_flags(io, s->ctype, s->ncell, FSDEM_STENCIL_CELL_SOLID, "type of cell");
+    fsdem__restart_flags(io, s->cnear, s->ncell, 1, "near-solid flag of cell");
+    fsdem__restart_flags(io, s->csolid, s->ncell, 1, "solid flag of cell");
+    fsdem__restart_gauges(io, &s->gauges, &s->allocator, "fsdem_pic_gauges_close");
+    fsdem__restart_tag(io, "PIC.");
+}
