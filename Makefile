@@ -33,13 +33,16 @@ help:
 	@echo "make test-omp   the suite built with OpenMP, on OMP_THREADS (2) threads"
 	@echo "make tsan       ThreadSanitizer on the threaded solvers at 2 and 4 threads (clang, libomp-dev)"
 	@echo "make sanitize   the suite with AddressSanitizer and UndefinedBehaviorSanitizer"
-	@echo "make demo       the headline example (cylinder-layer collapse) in under a minute"
+	@echo "make demo       the headline: water breaking through a pile of cylinders, PNG frames and ParaView"
+	@echo "                 series in build/demo/ (about a minute)"
 	@echo "make examples   all examples"
 	@echo "make validate   the default tier of validation (within 20 min with -j2): every case at a resolution"
-	@echo "                 that fits; build/validation/REPORT.md and validation/REPORT-default.md"
+	@echo "                 that fits; everything in build/validation/ (REPORT.md)"
+	@echo "make validate-publish [TIER=full]  the last run's records into validation/report-<tier>/ and"
+	@echo "                 validation/REPORT-<tier>.md, to commit"
 	@echo "                 (installs gnuplot-nox with apt-get when missing and run as root)"
 	@echo "make validate-full  the full tier (the seeds' resolutions, fine runs: hours): build/validation-full/"
-	@echo "                 REPORT.md and validation/REPORT-full.md; CASES=\"a b\" runs some cases (either tier)"
+	@echo "                 REPORT.md; CASES=\"a b\" runs some cases (either tier)"
 	@echo "make validate-status  which cases of the committed reports are stale (their code changed since)"
 	@echo "make validate-report  render validation/REPORT-default.md and REPORT-full.md again from their records"
 	@echo "make bench      throughput benchmarks (BENCH lines); BENCH_FLAGS=-march=native for this CPU"
@@ -181,8 +184,13 @@ $(BUILD)/examples/%: examples/%.c fsdem.h | $(BUILD)
 
 examples: $(EXAMPLES)
 
-demo: $(BUILD)/examples/01_cylinder_collapse
-	cd $(BUILD)/examples && ./01_cylinder_collapse
+# The headline: water breaking through a pile of cylinders (seed 000's wet collapse), PNG frames
+# and ParaView series in build/demo/ (about 50 s of CPU on one core).
+$(BUILD)/examples/12_demo_wet_collapse: examples/png_writer.h
+
+demo: $(BUILD)/examples/12_demo_wet_collapse
+	@mkdir -p $(BUILD)/demo
+	$(BUILD)/examples/12_demo_wet_collapse $(BUILD)/demo
 
 # gnuplot draws the validation plots. Install it when we can, otherwise say exactly how; the cases
 # still run without it and the report says that the plots were not drawn.
@@ -216,9 +224,10 @@ $(BUILD)/validation/%/run: $(BUILD)/validation/%/main.o $(BUILD)/validation/fsde
 
 # `make validate` runs the default tier, `make validate-full` the full one; CASES="a b" names some
 # cases. One make target per case, longest first (by the last recorded run), so `make -j2 validate`
-# runs two at a time. Each case's output goes to build/validation[-full]/<case>/ and its record to
-# validation/report-<tier>/<case>/; then both reports are written. The status is non-zero when a
-# case failed (a CHECK FAIL or a crash), after the reports are written.
+# runs two at a time. Everything goes to build/validation[-full]/: each case's output and record
+# in <case>/, the report REPORT.md. The status is non-zero when a case failed (a CHECK FAIL or a
+# crash), after the report is written. `make validate-publish` (TIER=default or full) then copies
+# the records into validation/report-<tier>/ and renders validation/REPORT-<tier>.md, to commit.
 CASES ?= $(VALIDATION)
 VALIDATE_ORDER_default = $(shell sh validation/tiers.sh order default $(CASES))
 VALIDATE_ORDER_full = $(shell sh validation/tiers.sh order full $(CASES))
@@ -227,7 +236,7 @@ VALIDATE_RUNS_full = $(addprefix validate-run-full/,$(VALIDATE_ORDER_full))
 VALIDATE_OUT_default := $(BUILD)/validation
 VALIDATE_OUT_full := $(BUILD)/validation-full
 
-.PHONY: validate validate-full validate-runs-default validate-runs-full validate-report validate-status
+.PHONY: validate validate-full validate-runs-default validate-runs-full validate-report validate-status validate-publish
 validate-runs-default: $(VALIDATE_RUNS_default)
 validate-runs-full: $(VALIDATE_RUNS_full)
 validate-run-default/%: $(BUILD)/validation/%/run FORCE
@@ -243,19 +252,28 @@ validate validate-full: | $(BUILD) gnuplot-deps
 	for c in $$cases; do [ -f validation/$$c/main.c ] || { echo "no validation case '$$c'"; exit 2; }; done; \
 	$(MAKE) --no-print-directory validate-runs-$$tier CASES="$$cases"; made=$$?; \
 	wall=$$(( $$(date +%s) - start )); \
+	rm -f $$out/run.txt; \
 	if [ "$$(echo $$cases | tr ' ' '\n' | LC_ALL=C sort | paste -s -d' ')" = "$(sort $(VALIDATION))" ] && [ $$made = 0 ]; then \
 	  echo "$$(date -u +%Y-%m-%d) on $$(git rev-parse --short HEAD 2>/dev/null || echo unknown), all $(words $(VALIDATION)) cases," \
 	    "make $(or $(filter -j%,$(MAKEFLAGS)),-j1) on $$(nproc) cores: $$wall s of wall time, compilation included" \
-	    > validation/report-$$tier/run.txt; fi; \
+	    > $$out/run.txt; fi; \
 	sh validation/tiers.sh render $$tier $$out $$out/REPORT.md; \
-	$(MAKE) --no-print-directory validate-report; \
 	echo "validate ($$tier tier): $$(sh validation/tiers.sh verdict $$out $$cases); total wall time" \
 	  "$$(( $$(date +%s) - start )) s ($$wall s to the end of the runs, compilation included)"; \
-	echo "report: $$out/REPORT.md, validation/REPORT-$$tier.md"; \
+	echo "report: $$out/REPORT.md (make validate-publish$(if $(filter validate-full,$@), TIER=full) commits it to validation/)"; \
 	[ $$made = 0 ] && sh validation/tiers.sh verdict $$out $$cases >/dev/null
 
+# The records of the last run of a tier (build/validation[-full]/) into the committed report:
+# validation/report-<tier>/ and validation/REPORT-<tier>.md (TIER=default or full).
+TIER ?= default
+validate-publish:
+	@sh validation/tiers.sh publish $(TIER) $(VALIDATE_OUT_$(TIER))
+	@mkdir -p validation/report-$(TIER)
+	@sh validation/tiers.sh render $(TIER) validation/report-$(TIER) validation/REPORT-$(TIER).md report-$(TIER)/
+	@echo "validation/REPORT-$(TIER).md rendered from validation/report-$(TIER)/"
+
 # The committed reports, rendered again from their records (validation/report-<tier>/<case>/): after
-# a run, or to mark blocks stale after fsdem.h changed.
+# a merge, or to mark blocks stale after fsdem.h changed.
 validate-report:
 	@for t in default full; do mkdir -p validation/report-$$t; \
 	  sh validation/tiers.sh render $$t validation/report-$$t validation/REPORT-$$t.md report-$$t/; done

@@ -18,20 +18,29 @@
      >>grid     cell grid (uniform spatial binning) shared by DEM, MPS and the couplings
      >>dem      discrete element method: particles, materials, contact laws, walls, integration
      >>linalg   CSR and MAC-grid stencil operators, preconditioned conjugate gradients (Jacobi,
-                IC(0), MIC(0), geometric multigrid) shared by the pressure solves
+                IC(0), MIC(0), geometric multigrid on stencils, smoothed-aggregation algebraic
+                multigrid on CSR matrices) shared by the pressure solves
      >>pic      PIC/FLIP/APIC free-surface solver on a MAC grid: cut-cell obstacles, ghost-fluid
-                pressure, implicit viscosity, density projection (seeds 000 and 004)
+                pressure, implicit viscosity, porosity and density projection (seeds 000 and 004)
      >>swe      shallow-water equations in 1D and 2D: HLL, MUSCL-Hancock, wet/dry, well-balanced
                 (seed 003)
-     >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
      >>mps      MPS free-surface particle solver: fluid, wall and dummy particles, mixed-source
-                pressure equation on the shared PCG, probes and gauges (seed 002)
+                pressure equation on the shared PCG, periodic axes, inflow and outflow, probes and
+                gauges (seed 002)
      >>drag     drag laws of unresolved couplings: Stokes, Schiller-Naumann, Ergun/Wen-Yu (seed 002
-                Eq. 26), Gidaspow blend, Di Felice, Beetstra-van der Hoef-Kuipers
+                Eq. 26), Gidaspow blend, Di Felice, Beetstra-van der Hoef-Kuipers, the GIC law
+                (seed 004)
+     >>couple   what every coupler shares: the staged step (one fluid step, the DEM's substeps),
+                the stable rule, the advance, per-particle records and their CSV, claims on the
+                solvers' coupling arrays, couplers of one fluid stepped together
+     >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
      >>couple_mps  unresolved MPS-DEM, Models A and B: porosity and momentum exchange by local
                 averaging, sequential staggered substepping (seed 002)
      >>couple_pic  resolved cut-cell PIC-DEM: moving discs and spheres in the pressure equation
                 (implicit solid velocity), the gap and contact dissipation, subcycling (seed 000)
+     >>couple_gic  Granule-In-Cell: granules smaller than a cell through volume fractions, the
+                porous projections, drag, pressure-gradient force and virtual mass, sand substeps
+                first (seed 004)
      >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
                 to memory, bit-exact continuation (versioned binary format with a checksum)
      >>io       CSV time series; ParaView .pvd series, valid after every entry; VTK XML snapshots
@@ -58,6 +67,9 @@
                              as the target flags allow: 2 doubles with SSE2 (any x86-64), 4 with
                              -mavx2, 8 with -mavx512f or -march=native on such a CPU. Read only by
                              the implementation's translation unit.
+     FSDEM_NO_OPENMP         no threads even in a build with -fopenmp (the library's loops run on
+                             the calling thread, as without OpenMP). Read only by the
+                             implementation's translation unit.
      FSDEM_VERSION_MAJOR/MINOR/PATCH, FSDEM_VERSION_STRING: the version of this file (read-only).
 
    CONCEPTS
@@ -91,8 +103,10 @@
      Each solver (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_mps) and each coupler (fsdem_swe_dem,
      fsdem_mps_dem, fsdem_pic_dem, fsdem_gic) speaks these verbs; X is the object's name
      (tests/map_check.sh holds every one of them to the table). A solver adds verbs of its own
-     (add_particle, set_bed, ...); a coupler's per-particle record is fsdem_X_get_force(x, index,
-     &record).
+     (add_particle, set_bed, ...); a coupler adds fsdem_X_update(x) (what it writes into the
+     solvers, from the current state, without stepping), fsdem_X_get_force(x, index, &record) (its
+     per-particle record), fsdem_X_write_csv(x, path) (the records) and fsdem_X_coupler(x) (the
+     coupler as any coupler, to step with others of its fluid: fsdem_coupled_step, >>couple).
        fsdem_X_desc fsdem_X_desc_default(dim)      defaults (couplers and fsdem_pcg: no argument)
        fsdem_result fsdem_X_desc_check(desc, message, size)  validation without creating anything
        fsdem_result fsdem_X_create(desc, &x)        *x is NULL on failure; destroy with _destroy
@@ -108,7 +122,8 @@
        fsdem_result fsdem_X_stable_dt(x, &dt)       the stable step of the current state (s)
        double       fsdem_X_time(x)                 simulated time (s), a double everywhere
        fsdem_X_stats fsdem_X_get_stats(x)           counters and figures; starts with
-                                                    long long steps, double time, fsdem_real dt
+                                                    long long steps, double time, fsdem_real dt (a
+                                                    coupler's with fsdem_coupling_stats, which does)
        fsdem_X_particles / fsdem_X_fields fsdem_X_get_particles / _get_fields(x)  views (SoA)
        fsdem_result fsdem_X_write_<what>(x, path)   snapshots: CSV, and VTK XML (.vtp, .vti) with a
                                                     last argument fsdem_vtk_format (>>io); FSDEM_ERR_IO
@@ -146,18 +161,28 @@
              fsdem_pic_set_pressure_extra (an implicit term of the pressure operator, and the
              solids' answer to the solved pressure) and fsdem_pic_exclude_particles, and is read
              through fsdem_pic_get_fields (pressure, open fractions) and fsdem_pic_get_particles.
+       both  fsdem_<solver>_claims and fsdem_claim: a coupler claims the arrays it writes (the
+             DEM's external loads, the fluid's arrays of its kind) for as long as it lives, so two
+             couplers never write one array; couplers of one fluid that write different arrays
+             step together (fsdem_coupled_step, >>couple). tests/map_check.sh refuses a coupler
+             chapter that calls a solver's private helper or reads a solver's struct.
 
    THREAD SAFETY
      No global mutable state. Distinct objects may be used from distinct threads at once; one
      object must not be used from two threads at once.
 
    THREADS
-     Built with OpenMP (-fopenmp), a step runs its loops on OpenMP threads (fsdem_set_threads, or
-     OMP_NUM_THREADS). Results do not depend on the thread count, bit for bit, and equal those of a
-     build without OpenMP: no floating-point atomics; each value is written by one thread, and a sum
-     over many items is taken in an order fixed by the data alone (the PCG's dot products in blocks
-     of FSDEM__DOT_BLOCK entries, added block by block; the contact forces on a particle in the
-     order of the contact list). `make determinism` pins the same hashes at 1, 2, 3 and 4 threads.
+     Built with OpenMP (-fopenmp; FSDEM_NO_OPENMP keeps such a build on one thread), a step runs its
+     loops on OpenMP threads (fsdem_set_threads, or OMP_NUM_THREADS). Results do not depend on the
+     thread count, bit for bit, and equal those of a build without OpenMP: no floating-point
+     atomics; each value is written by one thread, and a sum over many items is taken in an order
+     fixed by the data alone (the PCG's dot products in blocks of FSDEM__DOT_BLOCK entries, added
+     block by block; the contact forces on a particle in the order of the contact list). `make
+     determinism` pins the same hashes at 1, 2, 3 and 4 threads. One rule sizes every team
+     (fsdem__team_for in >>core: the thread count, but no more threads than the loop's items over
+     its grain, nor than its work buffers were sized for); every function that opens a parallel
+     region or runs inside one says so in a `threaded:` line above it; the one wait between threads
+     (the multigrid pipeline's) uses OpenMP atomics and pauses the CPU while it spins.
      Threaded so far: the shallow-water rows (bands of rows, each with its own work rows and a
      copy of the rows beside it), the PCG on stencils (the levels' construction, the operator,
      Jacobi, the multigrid V-cycle as one pipeline per thread, vector updates, dot products), the
@@ -203,6 +228,12 @@
 #define fsdem_cellgrid_neighbourhood fsdem_cellgrid_neighbourhood_f
 #define fsdem_cellgrid_setup fsdem_cellgrid_setup_f
 #define fsdem_cellgrid_setup_periodic fsdem_cellgrid_setup_periodic_f
+#define fsdem_claim fsdem_claim_f
+#define fsdem_claimant fsdem_claimant_f
+#define fsdem_coupled_advance fsdem_coupled_advance_f
+#define fsdem_coupled_stable_dt fsdem_coupled_stable_dt_f
+#define fsdem_coupled_step fsdem_coupled_step_f
+#define fsdem_coupled_step_dt fsdem_coupled_step_dt_f
 #define fsdem_csr_apply fsdem_csr_apply_f
 #define fsdem_csr_check fsdem_csr_check_f
 #define fsdem_csv_close fsdem_csv_close_f
@@ -213,6 +244,7 @@
 #define fsdem_dem_add_wall fsdem_dem_add_wall_f
 #define fsdem_dem_advance fsdem_dem_advance_f
 #define fsdem_dem_advance_with fsdem_dem_advance_with_f
+#define fsdem_dem_claims fsdem_dem_claims_f
 #define fsdem_dem_contacts fsdem_dem_contacts_f
 #define fsdem_dem_create fsdem_dem_create_f
 #define fsdem_dem_desc_check fsdem_dem_desc_check_f
@@ -257,6 +289,7 @@
 #define fsdem_drag_coefficient fsdem_drag_coefficient_f
 #define fsdem_drag_law_name fsdem_drag_law_name_f
 #define fsdem_gic_advance fsdem_gic_advance_f
+#define fsdem_gic_coupler fsdem_gic_coupler_f
 #define fsdem_gic_create fsdem_gic_create_f
 #define fsdem_gic_desc_check fsdem_gic_desc_check_f
 #define fsdem_gic_desc_default fsdem_gic_desc_default_f
@@ -283,8 +316,10 @@
 #define fsdem_mps_add_outflow fsdem_mps_add_outflow_f
 #define fsdem_mps_add_particles fsdem_mps_add_particles_f
 #define fsdem_mps_advance fsdem_mps_advance_f
+#define fsdem_mps_claims fsdem_mps_claims_f
 #define fsdem_mps_create fsdem_mps_create_f
 #define fsdem_mps_dem_advance fsdem_mps_dem_advance_f
+#define fsdem_mps_dem_coupler fsdem_mps_dem_coupler_f
 #define fsdem_mps_dem_create fsdem_mps_dem_create_f
 #define fsdem_mps_dem_desc_check fsdem_mps_dem_desc_check_f
 #define fsdem_mps_dem_desc_default fsdem_mps_dem_desc_default_f
@@ -316,9 +351,11 @@
 #define fsdem_mps_get_particles fsdem_mps_get_particles_f
 #define fsdem_mps_get_stats fsdem_mps_get_stats_f
 #define fsdem_mps_gradient fsdem_mps_gradient_f
+#define fsdem_mps_inflow_desc_default fsdem_mps_inflow_desc_default_f
 #define fsdem_mps_laplacian fsdem_mps_laplacian_f
 #define fsdem_mps_last_error fsdem_mps_last_error_f
 #define fsdem_mps_obstacle_force fsdem_mps_obstacle_force_f
+#define fsdem_mps_outflow_desc_default fsdem_mps_outflow_desc_default_f
 #define fsdem_mps_pressure_matrix fsdem_mps_pressure_matrix_f
 #define fsdem_mps_probe_height fsdem_mps_probe_height_f
 #define fsdem_mps_probe_pressure fsdem_mps_probe_pressure_f
@@ -347,9 +384,11 @@
 #define fsdem_pic_add_particles fsdem_pic_add_particles_f
 #define fsdem_pic_advance fsdem_pic_advance_f
 #define fsdem_pic_check_dt fsdem_pic_check_dt_f
+#define fsdem_pic_claims fsdem_pic_claims_f
 #define fsdem_pic_clear_forces fsdem_pic_clear_forces_f
 #define fsdem_pic_create fsdem_pic_create_f
 #define fsdem_pic_dem_advance fsdem_pic_dem_advance_f
+#define fsdem_pic_dem_coupler fsdem_pic_dem_coupler_f
 #define fsdem_pic_dem_create fsdem_pic_dem_create_f
 #define fsdem_pic_dem_desc_check fsdem_pic_dem_desc_check_f
 #define fsdem_pic_dem_desc_default fsdem_pic_dem_desc_default_f
@@ -366,6 +405,7 @@
 #define fsdem_pic_dem_step fsdem_pic_dem_step_f
 #define fsdem_pic_dem_step_dt fsdem_pic_dem_step_dt_f
 #define fsdem_pic_dem_time fsdem_pic_dem_time_f
+#define fsdem_pic_dem_update fsdem_pic_dem_update_f
 #define fsdem_pic_dem_write_csv fsdem_pic_dem_write_csv_f
 #define fsdem_pic_desc_check fsdem_pic_desc_check_f
 #define fsdem_pic_desc_default fsdem_pic_desc_default_f
@@ -406,6 +446,7 @@
 #define fsdem_pvd_add fsdem_pvd_add_f
 #define fsdem_pvd_close fsdem_pvd_close_f
 #define fsdem_pvd_open fsdem_pvd_open_f
+#define fsdem_release fsdem_release_f
 #define fsdem_result_string fsdem_result_string_f
 #define fsdem_set_threads fsdem_set_threads_f
 #define fsdem_stencil_apply fsdem_stencil_apply_f
@@ -418,10 +459,12 @@
 #define fsdem_swe_block_box fsdem_swe_block_box_f
 #define fsdem_swe_block_polygon fsdem_swe_block_polygon_f
 #define fsdem_swe_cell_at fsdem_swe_cell_at_f
+#define fsdem_swe_claims fsdem_swe_claims_f
 #define fsdem_swe_clear_forces fsdem_swe_clear_forces_f
 #define fsdem_swe_copy_field fsdem_swe_copy_field_f
 #define fsdem_swe_create fsdem_swe_create_f
 #define fsdem_swe_dem_advance fsdem_swe_dem_advance_f
+#define fsdem_swe_dem_coupler fsdem_swe_dem_coupler_f
 #define fsdem_swe_dem_create fsdem_swe_dem_create_f
 #define fsdem_swe_dem_desc_check fsdem_swe_dem_desc_check_f
 #define fsdem_swe_dem_desc_default fsdem_swe_dem_desc_default_f
@@ -438,7 +481,7 @@
 #define fsdem_swe_dem_step fsdem_swe_dem_step_f
 #define fsdem_swe_dem_step_dt fsdem_swe_dem_step_dt_f
 #define fsdem_swe_dem_time fsdem_swe_dem_time_f
-#define fsdem_swe_dem_update_forces fsdem_swe_dem_update_forces_f
+#define fsdem_swe_dem_update fsdem_swe_dem_update_f
 #define fsdem_swe_dem_write_csv fsdem_swe_dem_write_csv_f
 #define fsdem_swe_desc_check fsdem_swe_desc_check_f
 #define fsdem_swe_desc_default fsdem_swe_desc_default_f
@@ -562,6 +605,24 @@ typedef struct fsdem_allocator {
    no thread is created, fsdem_set_threads does nothing and fsdem_threads() is 1. */
 FSDEM_API void fsdem_set_threads(int count);
 FSDEM_API int fsdem_threads(void);
+
+/* Who writes a solver's coupling arrays. A coupler claims the arrays it writes when it is created
+   and releases them when it is destroyed, so that two writers never share one array: a second claim
+   is refused, naming the first claimant, and writers of different arrays share the solver (>>couple).
+   A solver's arrays are the bits of its enum fsdem_<solver>_arrays; fsdem_<solver>_claims gives its
+   registry, which lives as long as the solver. */
+typedef struct fsdem_claims fsdem_claims;
+/* Claims the arrays of the bits `arrays` for `owner` (any non-NULL pointer; `name` names it in
+   messages and is copied, up to 47 characters). FSDEM_OK, also for arrays the owner holds already;
+   FSDEM_ERR_INVALID_ARG, with nothing claimed, for a NULL argument, a bit the solver does not have,
+   or an array another owner holds: the reason, naming the array and its claimant, goes to `message`
+   (may be NULL). */
+FSDEM_API fsdem_result fsdem_claim(fsdem_claims *claims, unsigned arrays, const void *owner, const char *name, char *message,
+                                   size_t message_size);
+/* Releases the arrays of `arrays` that `owner` holds (the others stay as they are). */
+FSDEM_API void fsdem_release(fsdem_claims *claims, unsigned arrays, const void *owner);
+/* The name of the claimant of the first held array of `arrays`, or NULL when none is held. */
+FSDEM_API const char *fsdem_claimant(const fsdem_claims *claims, unsigned arrays);
 
 /* Vector helpers (inline in every translation unit). */
 static inline fsdem_vec3 fsdem_v3(fsdem_real x, fsdem_real y, fsdem_real z) {
@@ -878,6 +939,14 @@ typedef struct fsdem_dem_coupling {
 } fsdem_dem_coupling;
 
 FSDEM_API fsdem_dem_coupling fsdem_dem_get_coupling(fsdem_dem *dem);
+
+/* The DEM's arrays a coupler claims (fsdem_claim; >>couple: one coupler per DEM). */
+typedef enum fsdem_dem_arrays {
+    FSDEM_DEM_ARRAYS_LOADS = 1    /* the external loads of fsdem_dem_get_coupling */
+} fsdem_dem_arrays;
+
+/* The DEM's claim registry (>>core_claims); NULL for a NULL DEM. */
+FSDEM_API fsdem_claims *fsdem_dem_claims(fsdem_dem *dem);
 
 /* ---- walls ---- */
 
@@ -1465,11 +1534,12 @@ FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
      still gives the water exactly force x dt.
    A cell whose faces are all closed becomes SOLID. Particles are pushed out of static obstacles
    in every step; moving solids are the coupler's (fsdem_pic_exclude_particles). The arrays are read
-   by the next step, which recounts the fluid fractions after this call. Owners: open,
-   solid_velocity, start_velocity and reference describe the moving solids as a whole, so one
-   coupler (fsdem_pic_dem) owns them and rewrites them before every step; porosity describes the
-   granules as a whole and its one owner is the granular coupler (fsdem_gic); acceleration and
-   pressure_rhs are sums that any coupler adds to (fsdem_pic_add_force). */
+   by the next step, which recounts the fluid fractions after this call. Owners, claimed
+   (fsdem_pic_arrays below): open, solid_velocity, start_velocity and reference describe the moving
+   solids as a whole, so one coupler (fsdem_pic_dem) owns them and rewrites them before every step;
+   porosity describes the granules as a whole and acceleration their exchange with the water, so
+   their one owner is the granular coupler (fsdem_gic), which clears the accelerations before every
+   step; pressure_rhs is a sum that any writer adds to. */
 typedef struct fsdem_pic_coupling {
     int dim;
     int n[3];
@@ -1485,6 +1555,19 @@ typedef struct fsdem_pic_coupling {
 } fsdem_pic_coupling;
 
 FSDEM_API fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *pic);
+
+/* The PIC's coupling arrays, as writers claim them (fsdem_claim): the moving solids (fsdem_pic_dem),
+   the granules' porosity and the accelerations (fsdem_gic), each of one writer; pressure_rhs is a
+   sum any writer adds to. */
+typedef enum fsdem_pic_arrays {
+    FSDEM_PIC_ARRAYS_SOLIDS = 1,      /* open, solid_velocity, start_velocity, reference, and the */
+                                      /*    pressure's extra term (fsdem_pic_set_pressure_extra) */
+    FSDEM_PIC_ARRAYS_POROSITY = 2,    /* porosity */
+    FSDEM_PIC_ARRAYS_ACCELERATION = 4 /* acceleration (fsdem_pic_add_force, fsdem_pic_clear_forces) */
+} fsdem_pic_arrays;
+
+/* The PIC's claim registry (>>core_claims); NULL for a NULL PIC. */
+FSDEM_API fsdem_claims *fsdem_pic_claims(fsdem_pic *pic);
 /* The moving solids' answer to a solved pressure p (Pa, cell layout) over a step of dt (s): it
    sets solid_velocity to their velocity at the end of the step, Q* plus the response that the
    extra term K p stands for. */
@@ -1751,6 +1834,15 @@ typedef struct fsdem_swe_coupling {
 
 FSDEM_API fsdem_swe_coupling fsdem_swe_get_coupling(fsdem_swe *swe);
 
+/* The shallow water's coupling arrays, as writers claim them (fsdem_claim; a two-way fsdem_swe_dem
+   claims them). */
+typedef enum fsdem_swe_arrays {
+    FSDEM_SWE_ARRAYS_SOURCE = 1   /* source_x, source_y (fsdem_swe_add_force, fsdem_swe_clear_forces) */
+} fsdem_swe_arrays;
+
+/* The shallow water's claim registry (>>core_claims); NULL for a NULL solver. */
+FSDEM_API fsdem_claims *fsdem_swe_claims(fsdem_swe *swe);
+
 typedef enum fsdem_swe_field {
     FSDEM_SWE_FIELD_DEPTH = 0, /* m */
     FSDEM_SWE_FIELD_ETA = 1,   /* m */
@@ -1902,105 +1994,6 @@ FSDEM_API fsdem_result fsdem_swe_gauges_close(fsdem_swe *swe);
    swe, material): (z - z_b)/sqrt(1 + |grad z_b|^2) with the bed normal; exact on planar beds. `user` is
    the fsdem_swe. Points outside the SWE grid take the nearest cell's bed. */
 FSDEM_API fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal);
-
-/* ===== >>couple_swe : SWE-DEM floating debris (seed 003) ========================================== */
-
-/* Two-way coupling of a shallow-water solver (1D along x, or 2D in x-y) with DEM debris after seed 003
-   Eq. 3-8. The debris are the spheres of a 3D fsdem_dem whose z axis is vertical (gravity along -z);
-   the water surface and velocity at a sphere come from the fsdem_swe. On each sphere:
-     buoyancy      F_b = rho g V_sub, upwards, V_sub the submerged spherical cap (Eq. 5);
-     horizontal    F_h = p_B S_B - p_F S_F per horizontal axis (Eq. 6-7): the hydrostatic part
-                   rho g z integrated over the submerged circular segments of the sphere's back and
-                   front (with the surface elevations sampled at x - r and x + r), plus the dynamic
-                   pressure rho (beta u - w)^2 on the side facing the relative flow.
-   The vertical position follows from buoyancy against gravity in the DEM (floating), and a sphere in
-   water too shallow to float it rests on the bed with friction when the DEM has a bed wall (a plane,
-   or fsdem_swe_bed_sdf for the solver's own bathymetry). On the water, the reaction -F_h is a momentum
-   source spread over the wet cells under the sphere's footprint as force per unit plan area divided by
-   rho (Eq. 8 as printed, S_px = p/rho, is loose about units; this form makes the exchange exact: the
-   water gains exactly -F_h dt per step while the debris gains F_h dt).
-   Each coupled step: forces from the current state, one SWE step dt, then K DEM substeps of dt/K
-   (seed 000 Eq. 25, fsdem_dem_advance_with) with the horizontal forces held fixed and the buoyancy
-   (and heave damping) recomputed at every DEM force evaluation from the sphere's height against the
-   held water surface: buoyancy is a stiff spring, and holding it over a whole fluid step would let
-   bobbing grow without bound. A horizontal force is only applied while wet cells under (or next to)
-   the sphere can take its reaction. The coupler owns the SWE's momentum sources and the DEM's
-   external forces, and reaches both solvers through their coupling functions only (>>doc). */
-
-typedef struct fsdem_swe_dem fsdem_swe_dem;
-
-typedef struct fsdem_swe_dem_desc {
-    fsdem_swe *swe;               /* water; not owned; must outlive the coupler */
-    fsdem_dem *dem;               /* debris: dim 3, gravity along -z; not owned */
-    fsdem_real beta;              /* -; surface-velocity correction of seed 003 Eq. 6; default 1.1 */
-    int two_way;                  /* 1: the water feels the reaction (Eq. 8); 0: one-way; default 1 */
-    fsdem_real heave_damping;     /* -; fraction of critical damping of the bobbing about the floating
-                                     draft (wave radiation is not in the SWE); default 0 */
-    long long max_substeps;       /* DEM substeps one coupled step may take; a longer step is refused
-                                     before anything moves; default 100000 */
-    fsdem_log_fn log;             /* optional; default NULL */
-    void *log_user;
-} fsdem_swe_dem_desc;
-
-FSDEM_API fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void);
-/* Creates a coupler. FSDEM_ERR_INVALID_ARG (missing solver, DEM not 3D, gravity not along -z or
-   different from the SWE's, beta <= 0, negative damping; the reason goes to desc->log and to
-   `message` of fsdem_swe_dem_desc_check), FSDEM_ERR_OUT_OF_MEMORY. Destroy with fsdem_swe_dem_destroy
-   (which leaves the solvers alive). */
-FSDEM_API fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *desc, char *message, size_t message_size);
-FSDEM_API fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out);
-FSDEM_API void fsdem_swe_dem_destroy(fsdem_swe_dem *coupler);
-FSDEM_API const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *coupler);
-
-/* Fluid forces on one sphere, as the last fsdem_swe_dem_update_forces computed them. */
-typedef struct fsdem_swe_dem_force {
-    int id;                       /* stable id of the DEM particle (fsdem_dem_particles.id) */
-    fsdem_vec3 buoyancy;          /* N, (0, 0, rho g V_sub) */
-    fsdem_vec3 hydrostatic;       /* N, horizontal */
-    fsdem_vec3 dynamic;           /* N, horizontal */
-    fsdem_vec3 heave;             /* N, vertical damping (0 unless heave_damping > 0) */
-    fsdem_real submerged_volume;  /* m^3 */
-    fsdem_real frontal_area;      /* m^2, submerged area facing +x (S_F of seed 003 along x) */
-    fsdem_real surface;           /* m, water surface at the centre, held over the DEM substeps */
-    int in_water;                 /* 1 when water reaches the sphere */
-} fsdem_swe_dem_force;
-
-/* Computes the fluid forces on every free sphere from the current states, writes them to the DEM's
-   external forces and, with two_way, the reactions to the SWE's momentum sources. */
-FSDEM_API fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *coupler);
-/* Forces on particle `index` from the last update (zero for fixed particles and dry spheres), found
-   by the particle's id, so removals since do not mix the records up. FSDEM_ERR_NOT_FOUND for a bad
-   index or a particle added since the update. */
-FSDEM_API fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *coupler, int index, fsdem_swe_dem_force *out);
-/* One coupled step: update the forces, one adaptive SWE step of at most dt_cap (<= 0: no cap), then
-   the DEM over the same dt in substeps. The step goes to *dt and the substep count to *substeps (both
-   may be NULL). Errors of either solver are passed on with their message. */
-/* One coupled step of the SWE's stable dt: update the forces, the SWE step, then the DEM over the
-   same dt in substeps. The substep count is checked first, so a step the DEM cannot take (more than
-   max_substeps) is refused with FSDEM_ERR_INVALID_ARG before anything moves. Errors of either
-   solver are passed on with their message. */
-FSDEM_API fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *coupler);
-/* One coupled step of dt (s); FSDEM_ERR_CFL (nothing moved) when it is unstable for the SWE. */
-FSDEM_API fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *coupler, fsdem_real dt);
-/* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
-FSDEM_API fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *coupler, fsdem_real duration, long long *steps);
-/* The SWE's stable dt (s). */
-FSDEM_API fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *coupler, fsdem_real *dt);
-/* The SWE's time (s). */
-FSDEM_API double fsdem_swe_dem_time(const fsdem_swe_dem *coupler);
-FSDEM_API fsdem_swe_dem_desc fsdem_swe_dem_get_desc(const fsdem_swe_dem *coupler);
-
-typedef struct fsdem_swe_dem_stats {
-    long long steps;              /* coupled steps */
-    double time;                  /* s */
-    fsdem_real dt;                /* s, the last coupled step */
-    long long substeps;           /* DEM substeps of the last coupled step */
-    long long substeps_total;     /* DEM substeps of all coupled steps */
-    int in_water;                 /* spheres in water at the last force update */
-    fsdem_vec3 impulse_to_water;  /* N s, momentum given to the water by the reactions, total */
-} fsdem_swe_dem_stats;
-
-FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupler);
 
 /* ===== >>mps : MPS free-surface solver (seed 002) ================================================== */
 
@@ -2285,6 +2278,9 @@ typedef struct fsdem_mps_inflow_desc {
                          /*    fsdem_mps_fill_box's (components along `axis` ignored) */
     fsdem_real speed;    /* m/s, > 0 and finite */
 } fsdem_mps_inflow_desc;
+/* Defaults: axis 0, direction +1; the plane's position, its extent (lo, hi) and the speed have none
+   and are 0: set them (fsdem_mps_add_inflow refuses a speed of 0, naming it). */
+FSDEM_API fsdem_mps_inflow_desc fsdem_mps_inflow_desc_default(void);
 /* Adds an inflow and fills its buffer (*added particles; may be NULL); the whole buffer, down to
    ceil(re/r0) r0 upstream of the plane, must lie inside the domain. FSDEM_ERR_INVALID_ARG (a field
    named), FSDEM_ERR_OUT_OF_DOMAIN, FSDEM_ERR_OUT_OF_MEMORY; nothing is added on error. */
@@ -2297,6 +2293,9 @@ typedef struct fsdem_mps_outflow_desc {
     fsdem_vec3 lo, hi;   /* m; the outlet's extent over the other axes (components along `axis` */
                          /*    ignored): liquid past the plane outside it is not touched */
 } fsdem_mps_outflow_desc;
+/* Defaults: axis 0, direction +1; the plane's position and its extent (lo, hi) have none and are 0:
+   set them. */
+FSDEM_API fsdem_mps_outflow_desc fsdem_mps_outflow_desc_default(void);
 /* Adds an outflow. FSDEM_ERR_INVALID_ARG (a field named, or a zone outside the domain),
    FSDEM_ERR_OUT_OF_MEMORY. */
 FSDEM_API fsdem_result fsdem_mps_add_outflow(fsdem_mps *mps, const fsdem_mps_outflow_desc *outflow);
@@ -2342,6 +2341,15 @@ typedef struct fsdem_mps_coupling {
 } fsdem_mps_coupling;
 
 FSDEM_API fsdem_mps_coupling fsdem_mps_get_coupling(fsdem_mps *mps);
+
+/* The MPS's coupling arrays, as writers claim them (fsdem_claim; fsdem_mps_dem claims both). */
+typedef enum fsdem_mps_arrays {
+    FSDEM_MPS_ARRAYS_FORCE = 1,   /* force */
+    FSDEM_MPS_ARRAYS_POROSITY = 2 /* porosity */
+} fsdem_mps_arrays;
+
+/* The MPS's claim registry (>>core_claims); NULL for a NULL MPS. */
+FSDEM_API fsdem_claims *fsdem_mps_claims(fsdem_mps *mps);
 
 /* ---- particle-interaction operators (seed 002 Eq. 7-10) ---- */
 
@@ -2537,6 +2545,163 @@ FSDEM_API fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real por
 /* Name of a law ("ergun_wen_yu", ...), "unknown" for other values. Never NULL. */
 FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
 
+/* ===== >>couple : what every coupler shares, and couplers stepped together ======================== */
+
+/* A coupler (fsdem_swe_dem, fsdem_mps_dem, fsdem_pic_dem, fsdem_gic) joins one fluid and one DEM.
+   Its step is a list of named stages around one step of the fluid: the fluid first for SWE-DEM,
+   MPS-DEM and PIC-DEM (forces from the current state, the fluid step, then the DEM's substeps), the
+   granules first for GIC (seed 004 Algorithm 1: sand substeps, volume fractions, then the fluid).
+   Every coupler steps alike:
+     - step: its stable dt, the fluid's stable dt cut by the coupler's own limits (drag or viscous
+       relaxation, bodies' speed); step_dt(dt): that dt, refused with FSDEM_ERR_CFL above the
+       coupler's hard limits; either refuses before anything moves when the DEM would need more
+       than desc.max_substeps substeps;
+     - advance(duration): steps of the stable dt until exactly `duration` later, the last two
+       shortened to end there (never a sliver: a last step shorter than half a stable one is
+       avoided by halving the two);
+     - time: the fluid's; get_stats starts with the fsdem_coupling_stats below;
+     - update: what the coupler writes into the solvers, from the current state, without stepping;
+     - get_force(index): the record of DEM particle `index` from the last update, found by the
+       particle's stable id (so particles removed since do not mix the records up; FSDEM_ERR_NOT_FOUND
+       for a bad index, before the first update or for a particle added since), and
+       write_csv(path): the records as CSV, one row per DEM particle that has one, in index order,
+       the record's fields as columns (a vector as name_x, name_y, name_z), the first the particle's
+       stable id; before the first update the file holds the header alone (FSDEM_ERR_IO);
+   A coupler claims the solvers' arrays it writes when it is created and releases them when it is
+   destroyed (fsdem_claim): the DEM's external loads, and the fluid's arrays of its kind (SWE-DEM the
+   SWE's momentum sources; MPS-DEM the MPS's forces and porosities; PIC-DEM the PIC's moving solids;
+   GIC the PIC's porosity and accelerations). A second coupler that would write a claimed array is
+   refused at creation, naming the first. Couplers that write different arrays of one fluid, each
+   with its own DEM, share that fluid and step together with fsdem_coupled_step: one PIC then
+   carries a granular bed (fsdem_gic) and resolved bodies (fsdem_pic_dem) at once. */
+
+/* Figures every coupler keeps (the head of its fsdem_X_stats). */
+typedef struct fsdem_coupling_stats {
+    long long steps;              /* coupled steps */
+    double time;                  /* s; the fluid's time */
+    fsdem_real dt;                /* s; the last coupled step */
+    long long substeps;           /* DEM substeps of the last step */
+    long long substeps_total;     /* DEM substeps of all steps */
+    double seconds_fluid;         /* CPU seconds in the fluid's steps */
+    double seconds_dem;           /* CPU seconds in the DEM's substeps (the force evaluations */
+                                  /*    they call back included) */
+    double seconds_coupling;      /* CPU seconds in the coupler's own work (forces, fractions, cuts) */
+} fsdem_coupling_stats;
+
+/* Any coupler, as fsdem_swe_dem_coupler, fsdem_mps_dem_coupler, fsdem_pic_dem_coupler and
+   fsdem_gic_coupler give it (the same object: destroy it as what it is). */
+typedef struct fsdem_coupler fsdem_coupler;
+
+/* Couplers of one fluid stepped together: every coupler's stages before the fluid step, in the
+   order of the list, one step of the fluid, then every coupler's stages after it. The step is the
+   smallest stable dt of them all (fsdem_coupled_stable_dt), or dt; each coupler refuses it as its
+   own step would, before anything moves. FSDEM_ERR_INVALID_ARG for an empty list, a NULL entry,
+   a coupler listed twice or couplers of different fluids. A failure's message goes to every
+   coupler of the list (fsdem_X_last_error). A list of one is that coupler's own step. */
+FSDEM_API fsdem_result fsdem_coupled_step(fsdem_coupler *const *couplers, int count);
+FSDEM_API fsdem_result fsdem_coupled_step_dt(fsdem_coupler *const *couplers, int count, fsdem_real dt);
+FSDEM_API fsdem_result fsdem_coupled_advance(fsdem_coupler *const *couplers, int count, fsdem_real duration, long long *steps);
+FSDEM_API fsdem_result fsdem_coupled_stable_dt(fsdem_coupler *const *couplers, int count, fsdem_real *dt);
+
+/* ===== >>couple_swe : SWE-DEM floating debris (seed 003) ========================================== */
+
+/* Two-way coupling of a shallow-water solver (1D along x, or 2D in x-y) with DEM debris after seed 003
+   Eq. 3-8. The debris are the spheres of a 3D fsdem_dem whose z axis is vertical (gravity along -z);
+   the water surface and velocity at a sphere come from the fsdem_swe. On each sphere:
+     buoyancy      F_b = rho g V_sub, upwards, V_sub the submerged spherical cap (Eq. 5);
+     horizontal    F_h = p_B S_B - p_F S_F per horizontal axis (Eq. 6-7): the hydrostatic part
+                   rho g z integrated over the submerged circular segments of the sphere's back and
+                   front (with the surface elevations sampled at x - r and x + r), plus the dynamic
+                   pressure rho (beta u - w)^2 on the side facing the relative flow.
+   The vertical position follows from buoyancy against gravity in the DEM (floating), and a sphere in
+   water too shallow to float it rests on the bed with friction when the DEM has a bed wall (a plane,
+   or fsdem_swe_bed_sdf for the solver's own bathymetry). On the water, the reaction -F_h is a momentum
+   source spread over the wet cells under the sphere's footprint as force per unit plan area divided by
+   rho (Eq. 8 as printed, S_px = p/rho, is loose about units; this form makes the exchange exact: the
+   water gains exactly -F_h dt per step while the debris gains F_h dt).
+   Each coupled step: forces from the current state, one SWE step dt, then K DEM substeps of dt/K
+   (seed 000 Eq. 25, fsdem_dem_advance_with) with the horizontal forces held fixed and the buoyancy
+   (and heave damping) recomputed at every DEM force evaluation from the sphere's height against the
+   held water surface: buoyancy is a stiff spring, and holding it over a whole fluid step would let
+   bobbing grow without bound. A horizontal force is only applied while wet cells under (or next to)
+   the sphere can take its reaction. The coupler owns the SWE's momentum sources and the DEM's
+   external forces (it claims them, >>couple), and reaches both solvers through their coupling
+   functions only (>>doc). */
+
+typedef struct fsdem_swe_dem fsdem_swe_dem;
+
+typedef struct fsdem_swe_dem_desc {
+    fsdem_swe *swe;               /* water; not owned; must outlive the coupler */
+    fsdem_dem *dem;               /* debris: dim 3, gravity along -z; not owned */
+    fsdem_real beta;              /* -; surface-velocity correction of seed 003 Eq. 6; default 1.1 */
+    int two_way;                  /* 1: the water feels the reaction (Eq. 8); 0: one-way; default 1 */
+    fsdem_real heave_damping;     /* -; fraction of critical damping of the bobbing about the floating
+                                     draft (wave radiation is not in the SWE); default 0 */
+    long long max_substeps;       /* DEM substeps one coupled step may take; a longer step is refused
+                                     before anything moves; default 100000 */
+    fsdem_log_fn log;             /* optional; default NULL */
+    void *log_user;
+} fsdem_swe_dem_desc;
+
+FSDEM_API fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void);
+/* Creates a coupler. FSDEM_ERR_INVALID_ARG (missing solver, DEM not 3D, gravity not along -z or
+   different from the SWE's, beta <= 0, negative damping; the reason goes to desc->log and to
+   `message` of fsdem_swe_dem_desc_check), FSDEM_ERR_OUT_OF_MEMORY. Destroy with fsdem_swe_dem_destroy
+   (which leaves the solvers alive). */
+FSDEM_API fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *desc, char *message, size_t message_size);
+FSDEM_API fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out);
+FSDEM_API void fsdem_swe_dem_destroy(fsdem_swe_dem *coupler);
+FSDEM_API const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *coupler);
+
+/* Fluid forces on one sphere, as the last update computed them (fsdem_swe_dem_update). */
+typedef struct fsdem_swe_dem_force {
+    int id;                       /* stable id of the DEM particle (fsdem_dem_particles.id) */
+    fsdem_vec3 buoyancy;          /* N, (0, 0, rho g V_sub) */
+    fsdem_vec3 hydrostatic;       /* N, horizontal */
+    fsdem_vec3 dynamic;           /* N, horizontal */
+    fsdem_vec3 heave;             /* N, vertical damping (0 unless heave_damping > 0) */
+    fsdem_real submerged_volume;  /* m^3 */
+    fsdem_real frontal_area;      /* m^2, submerged area facing +x (S_F of seed 003 along x) */
+    fsdem_real surface;           /* m, water surface at the centre, held over the DEM substeps */
+    int wet;                      /* 1 when water reaches the sphere */
+} fsdem_swe_dem_force;
+
+/* Computes the fluid forces on every free sphere from the current states, writes them to the DEM's
+   external forces and, with two_way, the reactions to the SWE's momentum sources. A step does it
+   first; call it to see the forces without stepping. FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_swe_dem_update(fsdem_swe_dem *coupler);
+/* Forces on particle `index` from the last update (zero for fixed particles and dry spheres), found
+   by the particle's id, so removals since do not mix the records up. FSDEM_ERR_NOT_FOUND for a bad
+   index or a particle added since the update. */
+FSDEM_API fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *coupler, int index, fsdem_swe_dem_force *out);
+/* The records as CSV (>>couple): id, buoyancy_x .. _z, hydrostatic_x .. _z, dynamic_x .. _z,
+   heave_x .. _z, submerged_volume, frontal_area, surface, wet. */
+FSDEM_API fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *coupler, const char *path);
+/* One coupled step of the SWE's stable dt: update the forces, the SWE step, then the DEM over the
+   same dt in substeps. The substep count is checked first, so a step the DEM cannot take (more than
+   max_substeps) is refused with FSDEM_ERR_INVALID_ARG before anything moves. Errors of either
+   solver are passed on with their message. */
+FSDEM_API fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *coupler);
+/* One coupled step of dt (s); FSDEM_ERR_CFL (nothing moved) when it is unstable for the SWE. */
+FSDEM_API fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *coupler, fsdem_real dt);
+/* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
+FSDEM_API fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *coupler, fsdem_real duration, long long *steps);
+/* The SWE's stable dt (s). */
+FSDEM_API fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *coupler, fsdem_real *dt);
+/* The SWE's time (s). */
+FSDEM_API double fsdem_swe_dem_time(const fsdem_swe_dem *coupler);
+FSDEM_API fsdem_swe_dem_desc fsdem_swe_dem_get_desc(const fsdem_swe_dem *coupler);
+
+typedef struct fsdem_swe_dem_stats {
+    fsdem_coupling_stats coupling; /* steps, time, dt, substeps, CPU seconds (>>couple) */
+    int wet;                      /* spheres in water at the last update */
+    fsdem_vec3 impulse_to_water;  /* N s, momentum given to the water by the reactions, total */
+} fsdem_swe_dem_stats;
+
+FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupler);
+/* The coupler as any coupler, to step with others on the same SWE (fsdem_coupled_step). */
+FSDEM_API fsdem_coupler *fsdem_swe_dem_coupler(fsdem_swe_dem *coupler);
+
 /* ===== >>couple_mps : unresolved MPS-DEM, Models A and B (seed 002) ================================ */
 
 /* Two-way coupling of MPS water (fsdem_mps) with DEM sediment (fsdem_dem) by local averaging, after
@@ -2685,6 +2850,9 @@ FSDEM_API fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *coupler);
    since do not mix the records up. FSDEM_ERR_NOT_FOUND for a bad index, before the first update, or
    for a particle added since. */
 FSDEM_API fsdem_result fsdem_mps_dem_get_force(const fsdem_mps_dem *coupler, int index, fsdem_mps_dem_force *out);
+/* The records as CSV (>>couple): id, drag_x .. _z, pressure_x .. _z, total_x .. _z,
+   fluid_velocity_x .. _z, porosity, reynolds, wet. */
+FSDEM_API fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *coupler, const char *path);
 /* One coupled step of the stable dt (fsdem_mps_dem_stable_dt after the update). The DEM substep
    count is checked before anything moves (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of
    either solver are passed on with their message. */
@@ -2700,11 +2868,8 @@ FSDEM_API fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *coupler, fsd
 FSDEM_API double fsdem_mps_dem_time(const fsdem_mps_dem *coupler);
 
 typedef struct fsdem_mps_dem_stats {
-    long long steps;              /* coupled steps */
-    double time;                  /* s */
-    fsdem_real dt;                /* s, the last coupled step */
-    long long substeps;           /* DEM substeps of the last coupled step */
-    long long substeps_total;
+    fsdem_coupling_stats coupling; /* steps, time, dt, substeps, CPU seconds (>>couple; the */
+                                  /*    update's time counts as the coupling's) */
     int wet;                      /* DEM particles in water at the last update */
     fsdem_vec3 drag;              /* N; sum of F^d, last update */
     fsdem_vec3 pressure;          /* N; sum of the pressure parts (-V grad P or -V rho g) */
@@ -2716,11 +2881,11 @@ typedef struct fsdem_mps_dem_stats {
     fsdem_real drag_dt;           /* s; the shortest drag relaxation time of the last update, of */
                                   /*    a grain or of the water (0: none) */
     long long pairs;              /* DEM-MPS pairs within the radius, last update */
-    double seconds_mps;           /* CPU seconds in MPS steps */
-    double seconds_dem;           /* CPU seconds in DEM substeps and the coupling (updates) */
 } fsdem_mps_dem_stats;
 
 FSDEM_API fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *coupler);
+/* The coupler as any coupler (fsdem_coupled_step). */
+FSDEM_API fsdem_coupler *fsdem_mps_dem_coupler(fsdem_mps_dem *coupler);
 
 /* ===== >>couple_pic : resolved cut-cell PIC-DEM (seed 000) ========================================= */
 
@@ -2815,7 +2980,7 @@ FSDEM_API fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *desc, 
    the check (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_pic_dem_destroy
    removes the term and the moving solids from the PIC and leaves both solvers alive. The coupler
    owns the PIC's open, solid_velocity and reference arrays (fsdem_pic_get_coupling): every step
-   resets and rewrites them. */
+   resets and rewrites them (it claims them, >>couple). */
 FSDEM_API fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem **out);
 FSDEM_API void fsdem_pic_dem_destroy(fsdem_pic_dem *coupler);
 FSDEM_API const char *fsdem_pic_dem_last_error(const fsdem_pic_dem *coupler);
@@ -2839,6 +3004,13 @@ typedef struct fsdem_pic_dem_force {
    not mix the records up. FSDEM_ERR_NOT_FOUND for a bad index, before the first step, or for a
    particle added since. */
 FSDEM_API fsdem_result fsdem_pic_dem_get_force(const fsdem_pic_dem *coupler, int index, fsdem_pic_dem_force *out);
+/* The records as CSV (>>couple): id, pressure_force_x .. _z, viscous_force_x .. _z, torque_x .. _z,
+   weight_correction_x .. _z, volume, faces. */
+FSDEM_API fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *coupler, const char *path);
+/* Steps 2-3 and 7 of the section at the current state, without stepping: the water particles inside
+   bodies added since are removed, and every body is cut into the PIC's coupling arrays at its
+   velocity (no prediction), as at creation. FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_pic_dem_update(fsdem_pic_dem *coupler);
 /* One coupled step of the stable dt. The DEM substep count is checked before anything moves
    (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of either solver are passed on with their
    message. */
@@ -2857,23 +3029,19 @@ FSDEM_API fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *coupler, fsd
 FSDEM_API double fsdem_pic_dem_time(const fsdem_pic_dem *coupler);
 
 typedef struct fsdem_pic_dem_stats {
-    long long steps;             /* coupled steps */
-    double time;                 /* s */
-    fsdem_real dt;               /* s, the last coupled step */
-    long long substeps;          /* DEM substeps of the last step */
-    long long substeps_total;
+    fsdem_coupling_stats coupling; /* steps, time, dt, substeps, CPU seconds (>>couple) */
     fsdem_vec3 fluid_force;      /* N; sum of the fluid forces on the bodies, last step */
     fsdem_real viscous_dt;       /* s; the viscous limit of the last step (0: none) */
     int contacts;                /* contacts (gap areas) after the last step */
     long long dissipated;        /* particle velocities scaled by Eq. 20, total */
     long long pushed;            /* particles moved out of bodies, total */
     long long removed;           /* particles removed inside new bodies, total */
-    double seconds_pic;          /* CPU seconds in PIC steps */
-    double seconds_dem;          /* CPU seconds in DEM substeps */
-    double seconds_coupling;     /* CPU seconds in the coupling (faces, forces, gap, exclusion) */
 } fsdem_pic_dem_stats;
 
 FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupler);
+/* The coupler as any coupler, to step with others on the same PIC (fsdem_coupled_step: a GIC sand
+   bed and resolved bodies at once). */
+FSDEM_API fsdem_coupler *fsdem_pic_dem_coupler(fsdem_pic_dem *coupler);
 
 /* ===== >>couple_gic : Granule-In-Cell volume-fraction coupling (seed 004) ========================== */
 
@@ -2928,9 +3096,9 @@ FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupl
    granule, m_i / (s c V_i), or of the water round it, alpha_f rho / (alpha_s s c), since the
    exchange is explicit for the water: c at the granule's slip against the water of the last step,
    for the granules in the water and those that reach it within the step (against water at rest).
-   Ownership: the coupler owns the PIC's porosity and its accelerations (it zeroes them at the start
-   of every step, fsdem_pic_clear_forces, so another coupler's forces on the same PIC would be
-   lost), and the DEM's external forces.
+   Ownership: the coupler claims the PIC's porosity and its accelerations (it zeroes them at the start
+   of every step, fsdem_pic_clear_forces) and the DEM's external forces (>>couple); a resolved
+   PIC-DEM on the same PIC, with its own DEM, steps with it (fsdem_coupled_step).
    Not built yet (issue 22): the concentration-gradient and capillary
    forces (Eq. 21-31), wetting (Eq. 19-20), the granules' flux in the velocity projection. The
    viscous stress of Eq. 3 is the PIC's nu lap(u), not div(alpha_f T). */
@@ -2946,8 +3114,8 @@ typedef struct fsdem_gic_desc {
     int virtual_mass;             /* 1: the granules' added mass, Eq. 14-17 (see step 1); default 0: */
                                   /*    explicit, it diverged in dense sand entering water at 1 m/s */
                                   /*    (validation/gic_volume); dilute granules take it well */
-    fsdem_real viscosity;         /* Pa s; dynamic viscosity the drag laws use (all but the GIC */
-                                  /*    law need one); 0: rho nu of the PIC; default 0 */
+    fsdem_real viscosity;         /* m^2/s; kinematic viscosity the drag laws use, as the PIC's */
+                                  /*    (all but the GIC law need one); 0: the PIC's; default 0 */
     fsdem_real max_solid_fraction; /* -; cap of alpha_s in (0, 1); 0: 0.740 in 3D, 0.907 in 2D */
                                   /*    (densest packings, §5.1); default 0 */
     fsdem_real cfl;               /* -; Eq. 33: dt <= cfl dx / max |v_granule|, > 0; default 1 */
@@ -3010,6 +3178,9 @@ typedef struct fsdem_gic_force {
    FSDEM_ERR_NOT_FOUND for a bad index, before the first step (or after a restore), or for a
    particle added since. */
 FSDEM_API fsdem_result fsdem_gic_get_force(const fsdem_gic *coupler, int index, fsdem_gic_force *out);
+/* The records as CSV (>>couple): id, pressure_x .. _z, drag_x .. _z, virtual_mass_x .. _z,
+   fluid_velocity_x .. _z, fluid_acceleration_x .. _z, porosity, liquid. */
+FSDEM_API fsdem_result fsdem_gic_write_csv(const fsdem_gic *coupler, const char *path);
 /* One coupled step of the stable dt. */
 FSDEM_API fsdem_result fsdem_gic_step(fsdem_gic *coupler);
 /* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite or above
@@ -3026,11 +3197,8 @@ FSDEM_API fsdem_result fsdem_gic_stable_dt(const fsdem_gic *coupler, fsdem_real 
 FSDEM_API double fsdem_gic_time(const fsdem_gic *coupler);
 
 typedef struct fsdem_gic_stats {
-    long long steps;              /* coupled steps */
-    double time;                  /* s */
-    fsdem_real dt;                /* s, the last coupled step */
-    long long substeps;           /* DEM substeps of the last step */
-    long long substeps_total;
+    fsdem_coupling_stats coupling; /* steps, time, dt, substeps, CPU seconds (>>couple; the force */
+                                  /*    evaluations count as the DEM's, in its substeps) */
     int wet;                      /* granules with l > 0 at the last evaluation */
     fsdem_vec3 pressure_impulse;  /* N s; the granules' Eq. 5a impulse over the last step */
     fsdem_vec3 drag_impulse;      /* N s; the granules' drag impulse over the last step */
@@ -3042,11 +3210,12 @@ typedef struct fsdem_gic_stats {
                                   /*    granule or of a cell's water (0: none; >>couple_gic) */
     fsdem_real max_solid_fraction; /* -; largest alpha_s of the last update, before the cap */
     fsdem_real solid_volume;      /* m^3 (m^2 in 2D); sum of alpha_s dx^dim, = the granules' volume */
-    double seconds_pic;           /* CPU seconds in PIC steps */
-    double seconds_dem;           /* CPU seconds in DEM substeps with the force evaluations */
 } fsdem_gic_stats;
 
 FSDEM_API fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *coupler);
+/* The coupler as any coupler, to step with others on the same PIC (fsdem_coupled_step: a sand bed
+   and resolved bodies at once). */
+FSDEM_API fsdem_coupler *fsdem_gic_coupler(fsdem_gic *coupler);
 
 /* ===== >>restart : checkpoint and restart ========================================================= */
 
@@ -3328,24 +3497,6 @@ FSDEM_API fsdem_result fsdem_mps_write_vtp(const fsdem_mps *mps, const char *pat
    kind,surface,x,y,z,vx,vy,vz,pressure,number_density,porosity (kind a fsdem_mps_kind). */
 FSDEM_API fsdem_result fsdem_mps_write_csv(const fsdem_mps *mps, const char *path);
 
-/* A coupler's per-particle records (fsdem_X_get_force) as CSV, one row per DEM particle that has
-   one, in index order; the first column is the particle's stable id (fsdem_dem_particles.id). A
-   particle added since the last update or step has no record yet and one removed since has no row;
-   before the first update or step the file holds the header alone.
-     SWE-DEM  id,buoyancy_z,hydrostatic_x,hydrostatic_y,dynamic_x,dynamic_y,heave_z,submerged_volume,
-              frontal_area,surface,in_water
-     MPS-DEM  id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,
-              fluid_u,fluid_v,fluid_w,porosity,reynolds,wet
-     PIC-DEM  id,pressure_x,pressure_y,pressure_z,viscous_x,viscous_y,viscous_z,torque_x,torque_y,
-              torque_z,weight_correction_x,weight_correction_y,weight_correction_z,volume,faces
-     GIC      id,pressure_x,pressure_y,pressure_z,drag_x,drag_y,drag_z,virtual_mass_x,virtual_mass_y,
-              virtual_mass_z,fluid_u,fluid_v,fluid_w,porosity,liquid
-   Units as in the record types (N, N m, m^3, m^2, m, m/s). */
-FSDEM_API fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *coupler, const char *path);
-FSDEM_API fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *coupler, const char *path);
-FSDEM_API fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *coupler, const char *path);
-FSDEM_API fsdem_result fsdem_gic_write_csv(const fsdem_gic *coupler, const char *path);
-
 /* Shallow-water fields as ImageData (.vti): extent 0..nx x 0..ny x 0..0 points, origin (x_min,
    y_min, 0), spacing (dx, dy, 1); a 1D channel is one cell high, 0..nx x 0..1, origin (x_min, 0, 0),
    spacing (dx, width, 1). Cell data h (m, eta - bed), eta (m), bed (m), velocity (m/s, (u, v, 0) as
@@ -3397,9 +3548,9 @@ FSDEM_API fsdem_result fsdem_swe_write_vti(const fsdem_swe *swe, const char *pat
 /* ===== >>impl_core : results, allocator, messages, vector algebra ================================== */
 
 /* Contents: results and messages, the allocator and growth, the per-step scratch arena, the status
-   every object keeps, finite-value checks, the CSV series of probes, 3-vector algebra,
-   >>core_gauges (the point gauges of the particle solvers) and >>core_lane (short vectors for the
-   batched kernels). */
+   every object keeps, finite-value checks, the CSV series of probes and CSV snapshots of rows,
+   3-vector algebra, >>core_gauges (the point gauges of the particle solvers), >>core_lane (short
+   vectors for the batched kernels) and >>core_claims (who writes a solver's coupling arrays). */
 
 #define FSDEM__PI 3.14159265358979323846
 #define FSDEM__MESSAGE_SIZE 512
@@ -3425,11 +3576,12 @@ FSDEM_API fsdem_result fsdem_swe_write_vti(const fsdem_swe *swe, const char *pat
 #define FSDEM__RESTRICT restrict
 #endif
 
-/* OpenMP, when the build has it: FSDEM__OMP(directive) is `#pragma omp directive`, and nothing
-   without -fopenmp (where gcc would warn of an unknown pragma). fsdem__workers() is the team size a
-   parallel region asks for, fsdem__worker() the calling thread's number in its team and fsdem__team()
-   the team's size. */
-#ifdef _OPENMP
+/* OpenMP, when the build has it and FSDEM_NO_OPENMP is not defined (>>doc THREADS):
+   FSDEM__OMP(directive) is `#pragma omp directive`, and nothing otherwise (where gcc would warn of an
+   unknown pragma). fsdem__workers() is the calling thread's OpenMP thread count, fsdem__worker() the
+   calling thread's number in its team and fsdem__team() the team's size. */
+#if defined(_OPENMP) && !defined(FSDEM_NO_OPENMP)
+#define FSDEM__THREADS 1
 #include <omp.h>
 #define FSDEM__PRAGMA(x) _Pragma(#x)
 #define FSDEM__OMP(x) FSDEM__PRAGMA(omp x)
@@ -3453,7 +3605,31 @@ int fsdem_threads(void) { return fsdem__workers(); }
 #define FSDEM__TEAM_ITEMS 4096
 #endif
 
-/* The calling thread's share [*begin, *end) of n items split evenly over its team, in team order. */
+/* The team of a threaded loop, the one rule every parallel region takes its size from: the calling
+   thread's OpenMP thread count, but no more threads than items / grain (a share of fewer than
+   `grain` items does not pay for a thread) nor than `cap` (the threads the loop's work buffers were
+   sized for; FSDEM__NO_CAP for a loop without), and at least one. Results never depend on it (>>doc
+   THREADS). */
+#define FSDEM__NO_CAP 0x7fffffff
+static int fsdem__team_for(long long items, long long grain, int cap) {
+    long long team = fsdem__workers();
+    if (grain > 0 && items / grain < team) team = items / grain;
+    if (cap < team) team = cap;
+    return team < 1 ? 1 : (int)team;
+}
+
+/* A pause in a spin-wait: the CPU's hint that the thread only waits (x86 PAUSE, ARM YIELD), which
+   frees the core's shared resources for the thread it waits for. */
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define FSDEM__SPIN_PAUSE() __builtin_ia32_pause()
+#elif defined(__GNUC__) && (defined(__aarch64__) || defined(__arm__))
+#define FSDEM__SPIN_PAUSE() __asm__ __volatile__("yield")
+#else
+#define FSDEM__SPIN_PAUSE() ((void)0)
+#endif
+
+/* threaded: inside a team. The calling thread's share [*begin, *end) of n items split evenly over
+   its team, in team order. */
 static void fsdem__share(int n, int *begin, int *end) {
     const int me = fsdem__worker(), size = fsdem__team();
     *begin = (int)((long long)n * me / size);
@@ -3741,6 +3917,33 @@ static fsdem_result fsdem__series_close(fsdem__series *ser, const fsdem_allocato
 
 
 
+/* CSV snapshots of rows of numbers (the MPS particles, the couplers' records). Fills the values of
+   row `index`; returns 0 when the row is left out. */
+typedef int (*fsdem__row_fn)(const void *object, int index, double *values);
+
+/* Writes `header` and the rows 0 .. rows-1 that `row` gives (as many values as the header has
+   names), with 17 significant digits so that they read back exactly. */
+static fsdem_result fsdem__write_rows(const fsdem__status *status, const char *who, const char *path, const char *header,
+                                      int rows, fsdem__row_fn row, const void *object) {
+    double values[32];
+    int columns = 1, index, k, bad;
+    const char *h;
+    FILE *fp;
+    if (!path) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_INVALID_ARG, "%s: path is NULL", who);
+    for (h = header; *h; ++h) columns += *h == ',';
+    FSDEM_ASSERT(columns <= (int)(sizeof values / sizeof values[0]));
+    if (!(fp = fopen(path, "w"))) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_IO, "%s: cannot open '%s' for writing", who, path);
+    fprintf(fp, "%s\n", header);
+    for (index = 0; index < rows; ++index) {
+        if (!row(object, index, values)) continue;
+        for (k = 0; k < columns; ++k) fprintf(fp, k ? ",%.17g" : "%.17g", values[k]);
+        fputc('\n', fp);
+    }
+    bad = ferror(fp);
+    if (fclose(fp) != 0 || bad) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_IO, "%s: cannot write '%s'", who, path);
+    return fsdem__ok((fsdem__status *)status);
+}
+
 /* A relative tolerance of at least `floor` and of 100 roundings of fsdem_real, so a test written for
    double still holds in float. */
 static double fsdem__tolerance(double floor) {
@@ -3971,6 +4174,61 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__lane_set(fsdem_real s) {
     int l;
     for (l = 0; l < FSDEM__LANES; ++l) v[l] = s;
     return fsdem__lane_load(v);
+}
+
+/* ---- >>core_claims : who writes a solver's coupling arrays ---- */
+
+#define FSDEM__CLAIMABLE 4 /* arrays of one solver that can be claimed (bits 0 .. 3) */
+
+/* A solver's registry: the name of each array (by bit) and who holds it. */
+struct fsdem_claims {
+    const char *solver;                        /* "PIC", as messages name it */
+    const char *const *array;                  /* the arrays' names, by bit */
+    int count;                                 /* arrays (bits 0 .. count - 1) */
+    const void *owner[FSDEM__CLAIMABLE];       /* NULL: free */
+    char name[FSDEM__CLAIMABLE][48];
+};
+
+/* The registry of a new solver with `count` arrays, all free. */
+static void fsdem__claims_init(fsdem_claims *c, const char *solver, const char *const *array, int count) {
+    FSDEM_ASSERT(count <= FSDEM__CLAIMABLE);
+    memset(c, 0, sizeof *c);
+    c->solver = solver;
+    c->array = array;
+    c->count = count;
+}
+
+fsdem_result fsdem_claim(fsdem_claims *c, unsigned arrays, const void *owner, const char *name, char *msg, size_t size) {
+    int k;
+    if (!c || !owner || !name) return fsdem__reject(msg, size, "fsdem_claim: the registry, owner and name must be set");
+    if (arrays >> c->count)
+        return fsdem__reject(msg, size, "fsdem_claim: the %s has %d claimable arrays, bits 0x%x (got 0x%x)", c->solver, c->count,
+                             (1u << c->count) - 1, arrays);
+    for (k = 0; k < c->count; ++k)
+        if ((arrays >> k & 1) && c->owner[k] && c->owner[k] != owner)
+            return fsdem__reject(msg, size, "the %s's %s is claimed by %s (one writer per array: destroy it first)", c->solver,
+                                 c->array[k], c->name[k]);
+    for (k = 0; k < c->count; ++k)
+        if (arrays >> k & 1) {
+            c->owner[k] = owner;
+            snprintf(c->name[k], sizeof c->name[k], "%s", name);
+        }
+    return FSDEM_OK;
+}
+
+void fsdem_release(fsdem_claims *c, unsigned arrays, const void *owner) {
+    int k;
+    if (!c) return;
+    for (k = 0; k < c->count; ++k)
+        if ((arrays >> k & 1) && c->owner[k] == owner) c->owner[k] = NULL;
+}
+
+const char *fsdem_claimant(const fsdem_claims *c, unsigned arrays) {
+    int k;
+    if (!c) return NULL;
+    for (k = 0; k < c->count; ++k)
+        if ((arrays >> k & 1) && c->owner[k]) return c->name[k];
+    return NULL;
 }
 
 /* ===== >>impl_geom : signed distances and closest points =============================================
@@ -4397,6 +4655,14 @@ typedef struct fsdem__periods {
     fsdem_real length[3], inv[3]; /* m, 1/m; 0 along the other axes */
 } fsdem__periods;
 
+/* The smallest extent (m) of the box [lo, hi] along the first `dim` axes. */
+static fsdem_real fsdem__smallest_extent(fsdem_vec3 lo, fsdem_vec3 hi, int dim) {
+    fsdem_real e = hi.x - lo.x;
+    if (hi.y - lo.y < e) e = hi.y - lo.y;
+    if (dim == 3 && hi.z - lo.z < e) e = hi.z - lo.z;
+    return e;
+}
+
 /* The periods of the axes a < dim with periodic[a] set, those of the box [lo, hi]. */
 static fsdem__periods fsdem__periods_of(const int periodic[3], int dim, fsdem_vec3 lo, fsdem_vec3 hi) {
     fsdem__periods p;
@@ -4593,6 +4859,7 @@ typedef struct fsdem__dem_wall_hit {
 struct fsdem_dem {
     fsdem_dem_desc desc; /* dt_rule and dt_param resolved */
     fsdem__status status;
+    fsdem_claims claims;             /* who writes its coupling arrays (>>core_claims) */
     fsdem_allocator allocator;
     fsdem_real dt;
     double time;
@@ -4634,6 +4901,9 @@ struct fsdem_dem {
     int contacts, wall_contacts;
     fsdem_real max_overlap;
 };
+
+/* The arrays of fsdem_dem_arrays, by bit (>>core_claims). */
+static const char *const fsdem__dem_claimable[1] = {"external loads"};
 
 /* ---- >>dem_desc : defaults and validation ---- */
 
@@ -5449,6 +5719,7 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     d->allocator = desc->allocator;
     d->status.log = desc->log;
     d->status.log_user = desc->log_user;
+    fsdem__claims_init(&d->claims, "DEM", fsdem__dem_claimable, 1);
     d->dt = desc->dt;
     d->grid.allocator = desc->allocator;
     d->need_rebuild = 1;
@@ -5740,6 +6011,8 @@ fsdem_dem_particles fsdem_dem_get_particles(const fsdem_dem *d) {
     p.fixed = d->fixed;
     return p;
 }
+
+fsdem_claims *fsdem_dem_claims(fsdem_dem *d) { return d ? &d->claims : NULL; }
 
 fsdem_dem_coupling fsdem_dem_get_coupling(fsdem_dem *d) {
     fsdem_dem_coupling e;
@@ -6443,6 +6716,7 @@ FSDEM__FORCE_INLINE void fsdem__dem_scatter(fsdem_dem *d, const fsdem__dem_batch
 /* The entries [k0, k1) of the particle-pair list whose pair touches, into `touching`; returns their
    number. With `commit`, the pairs that do not touch lose their spring. Branch-free, and
    instantiated with and without `commit`. */
+/* threaded: inside a team: one chunk of the pair list. */
 FSDEM__FORCE_INLINE int fsdem__dem_touching_range(fsdem_dem *d, int *FSDEM__RESTRICT touching, int k0, int k1, const int commit,
                                                   const int periodic) {
     const fsdem_real off = d->desc.contact_offset;
@@ -6465,6 +6739,7 @@ FSDEM__FORCE_INLINE int fsdem__dem_touching_range(fsdem_dem *d, int *FSDEM__REST
 
 /* The touching entries of the whole pair list into `touching`, in list order: on `team` threads chunk
    by chunk (each chunk's entries at its own start, then moved together), else in one pass. */
+/* threaded: opens a team over the chunks of the pair list. */
 static int fsdem__dem_touching(fsdem_dem *d, int *touching, int commit, int team, int *chunk_count) {
     const int pairs = d->pp.count, chunks = pairs / FSDEM__DEM_CHUNK + 1, periodic = d->periods.any;
     int q, count = 0;
@@ -6488,6 +6763,7 @@ static int fsdem__dem_touching(fsdem_dem *d, int *touching, int commit, int team
 
 /* A batch's results into `out` (one per lane), with the rolling-resistance torque where the pair has
    it, its springs committed when `commit`; returns its largest overlap. */
+/* threaded: inside a team: one batch. */
 static fsdem_real fsdem__dem_keep_results(fsdem_dem *d, const fsdem__dem_batch *b, fsdem__dem_result *out, int commit,
                                           fsdem_real h) {
     fsdem_real max_overlap = 0;
@@ -6509,6 +6785,7 @@ static fsdem_real fsdem__dem_keep_results(fsdem_dem *d, const fsdem__dem_batch *
 /* Adds the results of `count` touching pairs to the particles in [lo, hi), in the order
    fsdem__dem_scatter adds them on one thread: batch by batch, in each the forces and torques pair
    by pair, then the rolling torques. Each thread adds to its own particles only. */
+/* threaded: inside a team: the calling thread's particles. */
 static void fsdem__dem_add_results(fsdem_dem *d, const fsdem__dem_result *res, int count, int lo, int hi) {
     fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t;
     int b0, c;
@@ -6537,6 +6814,7 @@ static void fsdem__dem_add_results(fsdem_dem *d, const fsdem__dem_result *res, i
 /* The touching pairs' forces on `team` threads: batches of the contact list evaluated in parallel
    into per-pair results, then added to the particles by their owners in list order, so every
    particle sums the same terms in the same order as on one thread. */
+/* threaded: opens a team over the batches, then over the particles. */
 FSDEM__FORCE_INLINE void fsdem__dem_pairs_threaded(fsdem_dem *d, const int *touching, int nt, fsdem__dem_batch *batches,
                                                fsdem__dem_result *res, fsdem_real *overlaps, int team, fsdem_real h,
                                                int keep, const fsdem_dem_law law, const fsdem__dem_rules *rules) {
@@ -6591,8 +6869,7 @@ FSDEM__FORCE_INLINE int fsdem__dem_drain(fsdem_dem *d, fsdem__dem_batch *b, int 
    contact law (fsdem__dem_compute_forces). */
 FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real h, int commit, const fsdem_dem_law law) {
     const int n = d->n, keep = commit && (law == FSDEM_DEM_LAW_HERTZ_MINDLIN || law == FSDEM__DEM_LAW_SEED002);
-    const int uniform = d->material_count == 1, workers = fsdem__workers();
-    const int team = d->pp.count > 2 * FSDEM__DEM_CHUNK ? (workers < d->workers ? workers : d->workers) : 1;
+    const int uniform = d->material_count == 1, team = fsdem__team_for(d->pp.count, 2 * FSDEM__DEM_CHUNK, d->workers);
     const fsdem__dem_rules rules = fsdem__dem_rules_of(d);
     fsdem__dem_batch *b, *batches;
     int *touching, *chunk_count = NULL, i, k, c, nt = 0, nw = 0;
@@ -6664,6 +6941,7 @@ static fsdem_vec3 fsdem__dem_spin_rate(const fsdem_dem *d, const fsdem_vec3 *t, 
    particle. (Positions are checked after the drift, velocities after a pass without one.) Written
    once and instantiated per flag, so each pass reads every array it needs once; this part does
    particles [i0, i1), raising *max_disp2 and or-ing *suspect. */
+/* threaded: inside a team: the calling thread's particles. */
 FSDEM__FORCE_INLINE void fsdem__dem_verlet_range(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift,
                                                 const int external, int i0, int i1, fsdem_real *max_disp2, int *suspect) {
     const fsdem_vec3 g = d->desc.gravity, lo = d->desc.domain_min, hi = d->desc.domain_max;
@@ -6715,9 +6993,10 @@ FSDEM__FORCE_INLINE void fsdem__dem_verlet_range(fsdem_dem *d, fsdem_real h, con
 
 /* The pass over all particles: on one thread, or (many particles) each thread over its share, the
    largest displacement and the suspicion combined (a maximum and an or: the same at any split). */
+/* threaded: opens a team over the particles. */
 FSDEM__FORCE_INLINE int fsdem__dem_verlet_pass(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift,
                                            const int external) {
-    const int n = d->n, team = n > FSDEM__DEM_CHUNK ? fsdem__workers() : 1;
+    const int n = d->n, team = fsdem__team_for(n, FSDEM__DEM_CHUNK, FSDEM__NO_CAP);
     fsdem_real disp2 = d->max_disp2;
     int k, outside = 0;
     if (team <= 1) fsdem__dem_verlet_range(d, h, drift, h_drift, external, 0, n, &disp2, &outside);
@@ -6933,88 +7212,6 @@ static fsdem_result fsdem__dem_advance_verlet(fsdem_dem *d, fsdem_real h, long l
         }
     }
     return FSDEM_OK;
-}
-
-/* The smallest extent (m) of the box [lo, hi] along the first `dim` axes. */
-static fsdem_real fsdem__smallest_extent(fsdem_vec3 lo, fsdem_vec3 hi, int dim) {
-    fsdem_real e = hi.x - lo.x;
-    if (hi.y - lo.y < e) e = hi.y - lo.y;
-    if (dim == 3 && hi.z - lo.z < e) e = hi.z - lo.z;
-    return e;
-}
-
-/* A coupler's record of DEM particle `index`. Records k = 0 .. count - 1 were made for particles
-   whose stable ids, the int at ids + k stride bytes, ascend: the DEM keeps its ids in index order
-   (new particles go to the end, removals keep the order), so a particle removed or added since the
-   records were made is told by its id, found by bisection. Returns the record, or -1 for none. */
-static int fsdem__dem_record_of(const fsdem_dem *d, int index, const int *ids, size_t stride, int count) {
-    int lo = 0, hi = count - 1, id;
-    if (index < 0 || index >= d->n) return -1;
-    id = d->id[index];
-    while (lo <= hi) {
-        const int mid = lo + (hi - lo) / 2, at = *(const int *)(const void *)((const char *)ids + (size_t)mid * stride);
-        if (at == id) return mid;
-        if (at < id) lo = mid + 1;
-        else hi = mid - 1;
-    }
-    return -1;
-}
-
-/* A coupler's check that every DEM particle fits in the fluid's domain [lo, hi] (a sphere wider
-   than the domain's smallest extent leaves no fluid around it); the particle goes to `status`. */
-static fsdem_result fsdem__dem_particles_fit(const fsdem_dem *d, fsdem_vec3 lo, fsdem_vec3 hi, fsdem__status *status, const char *who) {
-    const fsdem_real extent = fsdem__smallest_extent(lo, hi, d->desc.dim);
-    int i;
-    for (i = 0; i < d->n; ++i)
-        if (!(2 * d->r[i] < extent))
-            return fsdem__fail(status, FSDEM_ERR_INVALID_ARG,
-                               "%s: DEM particle %d (id %d) of radius %g m does not fit in the fluid's domain (smallest extent %g m)",
-                               who, i, d->id[i], (double)d->r[i], (double)extent);
-    return FSDEM_OK;
-}
-
-/* A coupler's check before a fluid step of dt moves anything: the DEM can follow it in at most
-   `max` substeps; the failure goes to the coupler's `status` under its name `who`. */
-static fsdem_result fsdem__dem_substeps_within(const fsdem_dem *d, fsdem_real dt, long long max, fsdem__status *status,
-                                               const char *who) {
-    long long substeps = 0;
-    const fsdem_result res = fsdem_dem_substep_count(d, dt, &substeps);
-    if (res != FSDEM_OK) return fsdem__fail(status, res, "%s: %s", who, fsdem_dem_last_error(d));
-    if (substeps > max)
-        return fsdem__fail(status, FSDEM_ERR_INVALID_ARG,
-                           "%s: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)", who,
-                           (double)dt, substeps, max, (double)d->dt);
-    return FSDEM_OK;
-}
-
-/* The advance of a coupler whose step is prepared (forces, stable dt) and then run: steps until
-   exactly `duration` later, the last ones shortened to end exactly as the solvers' advances do
-   (fsdem_mps_dem_advance, fsdem_pic_dem_advance). */
-typedef struct fsdem__coupled_verbs {
-    double (*now)(const void *coupler);                        /* the fluid's time (s) */
-    fsdem_result (*prepare)(void *coupler, fsdem_real *dt);    /* the stable dt of the coming step */
-    fsdem_result (*run)(void *coupler, fsdem_real dt);         /* one coupled step of dt */
-} fsdem__coupled_verbs;
-
-static fsdem_result fsdem__coupled_advance(void *c, fsdem__status *status, const char *who, const fsdem__coupled_verbs *v,
-                                           fsdem_real duration, long long *steps) {
-    double end;
-    long long n = 0;
-    fsdem_result res = FSDEM_OK;
-    if (!(duration >= 0) || !fsdem__finite(duration))
-        return fsdem__fail(status, FSDEM_ERR_INVALID_ARG, "%s: duration = %g s must be >= 0", who, (double)duration);
-    end = v->now(c) + (double)duration;
-    while (res == FSDEM_OK && v->now(c) < end - 1e-12 * (end > 1 ? end : 1)) {
-        const double left = end - v->now(c);
-        fsdem_real dt = 0;
-        if ((res = v->prepare(c, &dt)) != FSDEM_OK) break;
-        if ((double)dt >= left) dt = (fsdem_real)left;
-        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
-        res = v->run(c, dt);
-        ++n;
-    }
-    if (steps) *steps = n;
-    return res;
 }
 
 /* fsdem_dem_advance_with, its errors under the public name `who` */
@@ -7673,9 +7870,11 @@ static void fsdem__level_ghosts(fsdem__level *L, int dim) {
 }
 
 /* Diagonal of a level from its physical face coefficients and the extra diagonal `extra`. */
+/* threaded: opens a team over the cells. */
 static void fsdem__level_diagonal(fsdem__level *L, int dim, const fsdem_real *extra) {
     int c, a, fluid = 0;
-    FSDEM__OMP(parallel for private(a) reduction(+ : fluid) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
+    FSDEM__OMP(parallel for private(a) reduction(+ : fluid) schedule(static)
+               num_threads(fsdem__team_for(L->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
     for (c = 0; c < L->count; ++c) {
         fsdem_real d = 0;
         if (FSDEM__TYPE(L->type[c]) != FSDEM_STENCIL_CELL_FLUID) {
@@ -7708,13 +7907,15 @@ static void fsdem__level_offdiagonal(fsdem__level *L, int dim) {
 }
 
 /* Level 0 from the caller's stencil: types, physical coefficients, extra diagonal (to `extra`). */
+/* threaded: opens teams over the rows. */
 static void fsdem__level_from_stencil(fsdem__level *L, const fsdem_stencil *st, fsdem_real *extra) {
     int dim = st->dim, i, j, k, a;
     memset(L->type, FSDEM_STENCIL_CELL_SOLID, (size_t)L->count);
     for (a = 0; a < 3; ++a)
         if (a < dim) memset(L->w[a], 0, sizeof(fsdem_real) * (size_t)L->count);
     memset(extra, 0, sizeof(fsdem_real) * (size_t)L->count);
-    FSDEM__OMP(parallel for collapse(2) private(i) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
+    FSDEM__OMP(parallel for collapse(2) private(i) schedule(static)
+               num_threads(fsdem__team_for(L->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
     for (k = 0; k < L->n[2]; ++k)
         for (j = 0; j < L->n[1]; ++j)
             for (i = 0; i < L->n[0]; ++i)
@@ -7727,7 +7928,8 @@ static void fsdem__level_from_stencil(fsdem__level *L, const fsdem_stencil *st, 
         ext[1] = L->n[1];
         ext[2] = L->n[2];
         ext[a] += 1;
-        FSDEM__OMP(parallel for collapse(2) private(i) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
+        FSDEM__OMP(parallel for collapse(2) private(i) schedule(static)
+                   num_threads(fsdem__team_for(L->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
         for (k = 0; k < ext[2]; ++k)
             for (j = 0; j < ext[1]; ++j)
                 for (i = 0; i < ext[0]; ++i) {
@@ -7752,6 +7954,7 @@ static void fsdem__level_from_stencil(fsdem__level *L, const fsdem_stencil *st, 
 
 /* Coarse level C from fine level F (physical coefficients, extra diagonal `fextra`); writes the
    coarse extra diagonal to `cextra`. */
+/* threaded: opens teams over the coarse rows. */
 static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim, const fsdem_real *fextra,
                                  fsdem_real *cextra) {
     int I, J, K, a, di, dj, dk;
@@ -7759,7 +7962,8 @@ static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim
     memset(C->type, FSDEM_STENCIL_CELL_SOLID, (size_t)C->count);
     memset(cextra, 0, sizeof(fsdem_real) * (size_t)C->count);
     for (a = 0; a < dim; ++a) memset(C->w[a], 0, sizeof(fsdem_real) * (size_t)C->count);
-    FSDEM__OMP(parallel for collapse(2) private(I, di, dj, dk) schedule(static) num_threads(fsdem__workers()) if (C->count > FSDEM__DOT_BLOCK))
+    FSDEM__OMP(parallel for collapse(2) private(I, di, dj, dk) schedule(static)
+               num_threads(fsdem__team_for(C->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
     for (K = 0; K < C->n[2]; ++K)
         for (J = 0; J < C->n[1]; ++J)
             for (I = 0; I < C->n[0]; ++I) {
@@ -7790,7 +7994,8 @@ static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim
         ext[1] = C->n[1];
         ext[2] = C->n[2];
         ext[a] += 1;
-        FSDEM__OMP(parallel for collapse(2) private(I) schedule(static) num_threads(fsdem__workers()) if (C->count > FSDEM__DOT_BLOCK))
+        FSDEM__OMP(parallel for collapse(2) private(I) schedule(static)
+                   num_threads(fsdem__team_for(C->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
         for (K = 0; K < ext[2]; ++K)
             for (J = 0; J < ext[1]; ++J)
                 for (I = 0; I < ext[0]; ++I) {
@@ -7829,9 +8034,11 @@ static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim
 }
 
 /* Marks fine fluid cells whose interpolation kernel (from level C) contains a solid cell. */
+/* threaded: opens a team over the rows. */
 static void fsdem__level_mark_near_solid(fsdem__level *F, const fsdem__level *C, int dim) {
     int i, j, k;
-    FSDEM__OMP(parallel for collapse(2) private(i) schedule(static) num_threads(fsdem__workers()) if (F->count > FSDEM__DOT_BLOCK))
+    FSDEM__OMP(parallel for collapse(2) private(i) schedule(static)
+               num_threads(fsdem__team_for(F->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
     for (k = 0; k < F->n[2]; ++k)
         for (j = 0; j < F->n[1]; ++j)
             for (i = 0; i < F->n[0]; ++i) {
@@ -7854,6 +8061,7 @@ static void fsdem__level_mark_near_solid(fsdem__level *F, const fsdem__level *C,
 /* ---- >>linalg_kernels : stencil kernels on padded levels ---- */
 
 /* y = A x on slabs [p0, p1) of a level (rows in 2D, planes in 3D; interior cells). */
+/* threaded: inside a team: the calling thread's slabs. */
 FSDEM__FORCE_INLINE void fsdem__level_apply_slabs(const fsdem__level *L, int dim, const fsdem_real *x, fsdem_real *y, int p0,
                                                   int p1) {
     int i, j, k, sy = L->sy, sz = L->sz;
@@ -7881,8 +8089,9 @@ FSDEM__FORCE_INLINE void fsdem__level_apply_slabs(const fsdem__level *L, int dim
 }
 
 /* y = A x on a level (interior cells; y untouched on ghosts), each thread over its share of slabs. */
+/* threaded: opens a team over the slabs. */
 static void fsdem__level_apply(const fsdem__level *L, int dim, const fsdem_real *x, fsdem_real *y) {
-    const int slabs = dim == 3 ? L->n[2] : L->n[1], team = L->count > FSDEM__DOT_BLOCK ? fsdem__workers() : 1;
+    const int slabs = dim == 3 ? L->n[2] : L->n[1], team = fsdem__team_for(L->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP);
     if (team <= 1) {
         fsdem__level_apply_slabs(L, dim, x, y, 0, slabs);
         return;
@@ -8029,6 +8238,7 @@ static void fsdem__mg_prolong_row(const fsdem__level *F, const fsdem__level *C, 
 /* P^T (b - A x) along x of row (j, k) of F into cr (C->n[0] values), the residual formed on the fly
    in r (n0 + 4 reals). b is 0 off fluid cells on every level, so the residual is too (d and the
    couplings vanish there). */
+/* threaded: inside a team: one row of the calling thread's slab. */
 static void fsdem__mg_restrict_x(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *b,
                                  const fsdem_real *x, int j, int k, fsdem_real *r, fsdem_real *cr) {
     int i, I, J, K, oy, oz, crow, f0, n0 = F->n[0], nI = C->n[0], sy = F->sy, sz = F->sz;
@@ -8154,6 +8364,7 @@ typedef struct fsdem__mg_stage {
 
 /* One stage over the rows of slabs [p0, p1) on the calling thread, with row buffer `buf` (the
    restriction's second pass excepted: fsdem__mg_gather). */
+/* threaded: inside a team: rows of the calling thread's slab. */
 static void fsdem__mg_stage_rows(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b, fsdem_real *x,
                                  fsdem_real *xc_or_bc, const fsdem__mg_stage *stage, int p0, int p1, fsdem_real *buf) {
     int p, j;
@@ -8184,6 +8395,7 @@ static void fsdem__mg_pipeline(const fsdem__level *L, const fsdem__level *C, int
 /* The restriction's second pass for coarse slab P: the fine rows' x-restricted residuals
    (`restricted`, row j + k n1) added to the coarse rows of P, fine row after fine row as the
    pipeline adds them, so every coarse entry sums the same terms in the same order. */
+/* threaded: inside a team: one coarse slab. */
 static void fsdem__mg_gather(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *restricted,
                              fsdem_real *bc, int P) {
     const int axis = dim == 3 ? 2 : 1, slabs = F->n[axis], nI = C->n[0];
@@ -8200,11 +8412,20 @@ static void fsdem__mg_gather(const fsdem__level *F, const fsdem__level *C, int d
     }
 }
 
+/* threaded: inside a team: the pipelines' progress, read and written with OpenMP atomics. */
 /* Progress of the threaded pipeline: the number of stages finished on a slab, published by the
    thread that owns the slab and awaited by its neighbours' owners (integer atomics only). */
-#ifdef _OPENMP
-static int fsdem__mg_progress(const int *done, int p) { return __atomic_load_n(done + p, __ATOMIC_ACQUIRE); }
-static void fsdem__mg_publish(int *done, int p, int stages) { __atomic_store_n(done + p, stages, __ATOMIC_RELEASE); }
+#ifdef FSDEM__THREADS
+static int fsdem__mg_progress(const int *done, int p) {
+    int stages;
+    FSDEM__OMP(atomic read acquire)
+    stages = done[p];
+    return stages;
+}
+static void fsdem__mg_publish(int *done, int p, int stages) {
+    FSDEM__OMP(atomic write release)
+    done[p] = stages + 0; /* (+ 0: gcc 12 takes a bare parameter under an atomic write for unused) */
+}
 #endif
 
 /* The pipeline of one thread over its slabs [p0, p1), downwards or upwards: stage s on slab p waits
@@ -8214,18 +8435,19 @@ static void fsdem__mg_publish(int *done, int p, int stages) { __atomic_store_n(d
    same bit for bit. Neighbouring threads sweep towards each other's ends or away from them together,
    so they meet in step. The restriction writes each fine row's x-restricted residual
    (`restricted`); fsdem__mg_gather adds them to the coarse level after the pipeline. */
+/* threaded: inside a team: the calling thread's pipeline, waiting on its neighbours' progress. */
 static void fsdem__mg_thread_pipeline(const fsdem_pcg *s, const fsdem__level *L, const fsdem__level *C,
                                       const fsdem_real *b, fsdem_real *x, fsdem_real *xc, const fsdem__mg_stage *stage,
                                       int stages, int p0, int p1, int down, int *done, fsdem_real *buf) {
-#ifdef _OPENMP
+#ifdef FSDEM__THREADS
     const int dim = s->dim, slabs = dim == 3 ? L->n[2] : L->n[1], len = p1 - p0, nI = C ? C->n[0] : 0;
     int t, q, j;
     for (t = 0; t < len + stages - 1; ++t)
         for (q = 0; q < stages; ++q) {
             const int local = t - q, p = down ? p1 - 1 - local : p0 + local;
             if (local < 0 || local >= len) continue;
-            while ((p > 0 && fsdem__mg_progress(done, p - 1) < q) || (p + 1 < slabs && fsdem__mg_progress(done, p + 1) < q)) {
-            }
+            while ((p > 0 && fsdem__mg_progress(done, p - 1) < q) || (p + 1 < slabs && fsdem__mg_progress(done, p + 1) < q))
+                FSDEM__SPIN_PAUSE();
             if (stage[q].kind != FSDEM__STAGE_RESTRICT) fsdem__mg_stage_rows(L, C, dim, b, x, xc, stage + q, p, p + 1, buf);
             else {
                 const int jb = dim == 3 ? 0 : p, je = dim == 3 ? L->n[1] : p + 1, k = dim == 3 ? p : 0;
@@ -8243,13 +8465,14 @@ static void fsdem__mg_thread_pipeline(const fsdem_pcg *s, const fsdem__level *L,
 /* Runs the stages on level L: on one thread, the pipeline; with threads (and a level large enough
    to pay for them), one pipeline per thread over its share of the slabs (fsdem__mg_thread_pipeline),
    then the restriction's gather over the coarse slabs. The same result bit for bit. */
+/* threaded: opens a team of pipelines over the slabs, then one over the coarse slabs. */
 static void fsdem__mg_run(const fsdem_pcg *s, const fsdem__level *L, const fsdem__level *C, const fsdem_real *b,
                           fsdem_real *x, fsdem_real *xc_or_bc, const fsdem__mg_stage *stage, int stages) {
-    const int dim = s->dim, slabs = dim == 3 ? L->n[2] : L->n[1], workers = fsdem__workers();
-    const int team = workers < s->workers ? (workers < slabs ? workers : slabs) : (s->workers < slabs ? s->workers : slabs);
+    const int dim = s->dim, slabs = dim == 3 ? L->n[2] : L->n[1];
+    const int team = fsdem__team_for(L->count, FSDEM__DOT_BLOCK, s->workers < slabs ? s->workers : slabs);
     const size_t rowbuf = fsdem__mg_rowbuf_length(s);
     int p, P;
-    if (team <= 1 || L->count <= FSDEM__DOT_BLOCK || !s->restricted) {
+    if (team <= 1 || !s->restricted) {
         fsdem__mg_pipeline(L, C, dim, b, x, xc_or_bc, stage, stages, s->rowbuf);
         return;
     }
@@ -9250,12 +9473,14 @@ static void fsdem__pcg_apply(fsdem_pcg *s, const fsdem_real *x, fsdem_real *y) {
 }
 
 /* z = M^-1 r. */
+/* threaded: opens a team for the Jacobi product; IC(0) and MIC(0) run on one thread. */
 static void fsdem__pcg_precondition(fsdem_pcg *s, const fsdem_real *r, fsdem_real *z) {
     int i, n = s->length;
     switch (s->precond) {
     case FSDEM_PRECOND_JACOBI: {
         const fsdem_real *inv = s->kind == FSDEM__KIND_CSR ? s->ic : s->level[0].inv_d;
-        FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (n > FSDEM__DOT_BLOCK))
+        FSDEM__OMP(parallel for schedule(static)
+                   num_threads(fsdem__team_for(n, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
         for (i = 0; i < n; ++i) z[i] = inv[i] * r[i];
         break;
     }
@@ -9344,6 +9569,7 @@ static void fsdem__pcg_store(const fsdem_pcg *s, const fsdem_real *src, fsdem_re
 }
 
 /* a.b over [lo, hi) with two interleaved accumulators (lo even). */
+/* threaded: inside a team: one block. */
 static double fsdem__pcg_block_dot(const fsdem_real *a, const fsdem_real *b, int lo, int hi) {
     double s0 = 0, s1 = 0;
     int i;
@@ -9357,12 +9583,14 @@ static double fsdem__pcg_block_dot(const fsdem_real *a, const fsdem_real *b, int
 
 /* a.b over n entries: block by block (FSDEM__DOT_BLOCK), the block sums added in order, so the bits
    do not depend on the threads (a vector of one block gives the block's sum itself). */
+/* threaded: opens a team over the blocks. */
 static double fsdem__pcg_vdot(const fsdem_pcg *s, const fsdem_real *a, const fsdem_real *b, int n) {
     const int blocks = (int)fsdem__dot_blocks(n);
     double *part = s->dot_part, sum = 0;
     int q;
     if (blocks <= 1) return fsdem__pcg_block_dot(a, b, 0, n);
-    FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()))
+    FSDEM__OMP(parallel for schedule(static)
+               num_threads(fsdem__team_for(blocks, 1, FSDEM__NO_CAP)))
     for (q = 0; q < blocks; ++q) {
         const int lo = q * FSDEM__DOT_BLOCK, hi = n - lo < FSDEM__DOT_BLOCK ? n : lo + FSDEM__DOT_BLOCK;
         part[q] = fsdem__pcg_block_dot(a, b, lo, hi);
@@ -9375,13 +9603,15 @@ static int fsdem__pcg_finite_d(double v) { return v == v && v - v == 0; }
 
 /* x += alpha p, r -= alpha A p (A p in z); returns r.r, summed block by block as fsdem__pcg_vdot
    (one accumulator inside a block). */
+/* threaded: opens a team over the blocks. */
 static double fsdem__pcg_step_x_r(const fsdem_pcg *s, fsdem_real alpha) {
     const int n = s->length, blocks = (int)fsdem__dot_blocks(n);
     fsdem_real *FSDEM__RESTRICT xv = s->x, *FSDEM__RESTRICT rv = s->r;
     const fsdem_real *FSDEM__RESTRICT pv = s->p, *FSDEM__RESTRICT qv = s->z;
     double *part = s->dot_part, sum = 0;
     int q;
-    FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (blocks > 1))
+    FSDEM__OMP(parallel for schedule(static)
+               num_threads(fsdem__team_for(blocks, 1, FSDEM__NO_CAP)))
     for (q = 0; q < blocks; ++q) {
         const int lo = q * FSDEM__DOT_BLOCK, hi = n - lo < FSDEM__DOT_BLOCK ? n : lo + FSDEM__DOT_BLOCK;
         double acc = 0;
@@ -9418,6 +9648,8 @@ static fsdem_result fsdem__pcg_check_rz(fsdem_pcg *s, double rz, int it) {
     return FSDEM_OK;
 }
 
+/* threaded: opens a team for the search direction; the operator, the preconditioner and the dot
+   products open their own. */
 fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, fsdem_pcg_info *info) {
     fsdem_pcg_info inf;
     double bb, rr, rz = 0, tol2, removed;
@@ -9527,7 +9759,8 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
             const fsdem_real be = (fsdem_real)beta;
             fsdem_real *pv = s->p;
             const fsdem_real *zv = s->z;
-            FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (n > FSDEM__DOT_BLOCK))
+            FSDEM__OMP(parallel for schedule(static)
+                       num_threads(fsdem__team_for(n, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
             for (i = 0; i < n; ++i) pv[i] = zv[i] + be * pv[i];
         }
     }
@@ -9567,6 +9800,7 @@ typedef struct fsdem__pic_obst {
 struct fsdem_pic {
     fsdem_pic_desc desc;
     fsdem__status status;
+    fsdem_claims claims;             /* who writes its coupling arrays (>>core_claims) */
     fsdem_allocator allocator;
     int dim, n[3], ncell;
     int fn[3][3];      /* face grid sizes: fn[a][b] = n[b] + (a == b) */
@@ -9633,6 +9867,9 @@ struct fsdem_pic {
     double sec_total, sec_pressure, sec_density;
     size_t bytes;
 };
+
+/* The arrays of fsdem_pic_arrays, by bit (>>core_claims). */
+static const char *const fsdem__pic_claimable[3] = {"moving solids", "porosity", "acceleration"};
 
 /* ---- >>pic_desc : defaults, validation, creation ---- */
 
@@ -10062,6 +10299,7 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
     s->bytes = sizeof *s;
     s->status.log = desc->log;
     s->status.log_user = desc->log_user;
+    fsdem__claims_init(&s->claims, "PIC", fsdem__pic_claimable, 3);
     fsdem__pic_layout(s, desc);
     for (a = 0; a < s->dim && desc->log; ++a)
         if (fsdem__comp(s->hi, a) != fsdem__comp(desc->domain_max, a)) {
@@ -10899,12 +11137,14 @@ FSDEM__FORCE_INLINE int fsdem__pic_g2p_one(fsdem_pic *s, int p, const int quad, 
 
 /* Grid to particles, every particle on its own (threaded); returns the first particle whose velocity
    is not finite, or -1. */
+/* threaded: opens a team over the particles. */
 static int fsdem__pic_g2p(fsdem_pic *s) {
     const int quad = s->desc.kernel == FSDEM_PIC_KERNEL_QUADRATIC, apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC;
     const fsdem_real ratio = s->desc.transfer == FSDEM_PIC_TRANSFER_FLIP ? s->desc.flip_ratio : 0;
     const fsdem_real dfac = 4 * s->inv_dx * s->inv_dx;
     int p, first = s->np;
-    FSDEM__OMP(parallel for schedule(static) reduction(min : first) num_threads(fsdem__workers()) if (s->np > FSDEM__TEAM_ITEMS))
+    FSDEM__OMP(parallel for schedule(static) reduction(min : first)
+               num_threads(fsdem__team_for(s->np, FSDEM__TEAM_ITEMS, FSDEM__NO_CAP)))
     for (p = 0; p < s->np; ++p)
         if (fsdem__pic_g2p_one(s, p, quad, ratio, apic, dfac) && p < first) first = p;
     return first < s->np ? first : -1;
@@ -11456,9 +11696,11 @@ static fsdem_result fsdem__pic_project(fsdem_pic *s, fsdem_real dt) {
 /* ---- >>pic_advection : particle motion, solids, outflow ---- */
 
 /* Moves every particle through the grid velocity (threaded: each particle on its own). */
+/* threaded: opens a team over the particles. */
 static void fsdem__pic_advect(fsdem_pic *s, fsdem_real dt) {
     int p;
-    FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (s->np > FSDEM__TEAM_ITEMS))
+    FSDEM__OMP(parallel for schedule(static)
+               num_threads(fsdem__team_for(s->np, FSDEM__TEAM_ITEMS, FSDEM__NO_CAP)))
     for (p = 0; p < s->np; ++p) {
         fsdem_vec3 x = s->px[p], k1, k2, k3;
         k1 = fsdem__pic_interp_vel(s, s->u, x);
@@ -12017,6 +12259,8 @@ fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *s) {
     return g;
 }
 
+fsdem_claims *fsdem_pic_claims(fsdem_pic *s) { return s ? &s->claims : NULL; }
+
 fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *s) {
     fsdem_pic_coupling c;
     if (s) {
@@ -12523,6 +12767,7 @@ typedef struct fsdem__swe_src {
 struct fsdem_swe {
     fsdem_swe_desc desc; /* bed, depth and the boundary series pointers are not kept */
     fsdem__status status;
+    fsdem_claims claims;             /* who writes its coupling arrays (>>core_claims) */
     fsdem_allocator allocator;
     int dim, nx, ny, n;
     fsdem_real dx, dy, area, g, tiny;
@@ -12560,6 +12805,9 @@ struct fsdem_swe {
     int gauge_count, gauge_capacity;
     fsdem__series gauges; /* the gauge file, h, eta, u, v per gauge */
 };
+
+/* The arrays of fsdem_swe_arrays, by bit (>>core_claims). */
+static const char *const fsdem__swe_claimable[1] = {"momentum sources"};
 
 /* ---- >>swe_desc : defaults and validation ---- */
 
@@ -12848,6 +13096,7 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
     s->allocator = al;
     s->status.log = desc->log;
     s->status.log_user = desc->log_user;
+    fsdem__claims_init(&s->claims, "shallow-water solver", fsdem__swe_claimable, 1);
     s->dim = desc->dim;
     s->nx = desc->nx;
     s->ny = desc->ny;
@@ -13066,6 +13315,8 @@ fsdem_swe_fields fsdem_swe_get_fields(const fsdem_swe *s) {
     f.blocked = s->blocked;
     return f;
 }
+
+fsdem_claims *fsdem_swe_claims(fsdem_swe *s) { return s ? &s->claims : NULL; }
 
 fsdem_swe_coupling fsdem_swe_get_coupling(fsdem_swe *s) {
     fsdem_swe_coupling c;
@@ -14226,6 +14477,7 @@ static void fsdem__swe_load_ring(const fsdem_swe *s, fsdem__swe_work *w, int r) 
 
 /* Copies the state rows beside band [j0, j1) (j0 - 2, j0 - 1, j1, j1 + 1, where they exist) into its
    halo, so the band reads them as they were before any band wrote. */
+/* threaded: inside a team: the calling thread's band. */
 static void fsdem__swe_band_halo(const fsdem_swe *s, fsdem__swe_work *w, int j0, int j1) {
     const int rows[4] = {j0 - 2, j0 - 1, j1, j1 + 1};
     const size_t nx = (size_t)s->nx;
@@ -14246,6 +14498,7 @@ static void fsdem__swe_band_halo(const fsdem_swe *s, fsdem__swe_work *w, int j0,
    rows beside the band need those rows reconstructed: they are, from the halo, with a copy of the
    context whose tally and boundary volumes are dropped (their own band counts them), and they are
    not finished. Every cell's update is then what one sweep of the whole grid computes. */
+/* threaded: inside a team: the calling thread's band of rows. */
 static void fsdem__swe_band(fsdem_swe *s, fsdem__swe_ctx *c, int j0, int j1) {
     fsdem__swe_ctx beside = *c;
     int j;
@@ -14274,11 +14527,9 @@ static void fsdem__swe_band(fsdem_swe *s, fsdem__swe_ctx *c, int j0, int j1) {
 /* The 2D sweep: one band of rows per thread (as many as the work rows allow), each band copying the
    rows beside it before any band writes; the tallies are then combined in band order (maxima and
    counts: the same for any split; the first non-finite cell: the lowest band's). */
+/* threaded: opens a team of bands of rows. */
 static void fsdem__swe_sweep(fsdem_swe *s, fsdem__swe_ctx *c) {
-    int bands = fsdem__workers(), b;
-    if (bands > s->workers) bands = s->workers;
-    if (bands > s->ny / FSDEM__SWE_BAND_ROWS) bands = s->ny / FSDEM__SWE_BAND_ROWS;
-    if (bands < 1) bands = 1;
+    int bands = fsdem__team_for(s->ny, FSDEM__SWE_BAND_ROWS, s->workers), b;
     FSDEM__OMP(parallel num_threads(bands))
     {
         const int team = fsdem__team(), w = fsdem__worker();
@@ -14595,358 +14846,6 @@ fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
     return (p.z - c0.bed) / len;
 }
 
-/* ===== >>impl_couple_swe : SWE-DEM floating debris =================================================
-
-   Contents: >>couple_swe_object (desc, creation), >>couple_swe_geometry (submerged parts of a
-   sphere), >>couple_swe_forces (seed 003 Eq. 5-8), >>couple_swe_step (coupled time stepping). The
-   coupler reaches the solvers through their coupling functions only (>>doc). */
-
-/* ---- >>couple_swe_object : desc, creation ---- */
-
-struct fsdem_swe_dem {
-    fsdem_swe_dem_desc desc;
-    fsdem__status status;
-    fsdem_allocator allocator;
-    fsdem_real rho, g, dry;        /* the SWE's density, |g| and dry depth */
-    fsdem_swe_dem_force *force;    /* one per DEM particle of the last update */
-    int force_capacity, records;   /* records: the particles of the last update */
-    long long steps, substeps, substeps_total;
-    fsdem_real dt_last;
-    int in_water;
-    fsdem_vec3 impulse;            /* N s, given to the water */
-    fsdem_vec3 *reaction;          /* N, horizontal force on each sphere whose reaction the water took */
-};
-
-fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void) {
-    fsdem_swe_dem_desc d;
-    memset(&d, 0, sizeof d);
-    d.beta = (fsdem_real)1.1;
-    d.two_way = 1;
-    d.heave_damping = 0;
-    d.max_substeps = 100000;
-    return d;
-}
-
-fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *d, char *msg, size_t size) {
-    fsdem_dem_desc dd;
-    fsdem_vec3 g;
-    fsdem_real gs;
-    if (!d) return fsdem__reject(msg, size, "fsdem_swe_dem_desc is NULL");
-    if (!d->swe || !d->dem) return fsdem__reject(msg, size, "fsdem_swe_dem_desc.swe and .dem must both be set");
-    dd = fsdem_dem_get_desc(d->dem);
-    if (dd.dim != 3)
-        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.dem must be 3D (spheres, z vertical); it has dim %d", dd.dim);
-    g = dd.gravity;
-    gs = -fsdem_swe_get_desc(d->swe).gravity.z;
-    if (g.x != 0 || g.y != 0 || !(fabs(g.z + gs) <= 1e-12 * gs))
-        return fsdem__reject(msg, size, "fsdem_swe_dem_desc: the DEM gravity (%g, %g, %g) must be (0, 0, -g) with the SWE's g = %g m/s^2",
-                             (double)g.x, (double)g.y, (double)g.z, (double)gs);
-    if (!(d->beta > 0) || !fsdem__finite(d->beta))
-        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.beta must be > 0 (got %g)", (double)d->beta);
-    if (!(d->heave_damping >= 0) || !fsdem__finite(d->heave_damping))
-        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.heave_damping must be >= 0 (got %g)",
-                             (double)d->heave_damping);
-    if (d->max_substeps < 1)
-        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
-    return FSDEM_OK;
-}
-
-fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out) {
-    char msg[FSDEM__MESSAGE_SIZE];
-    fsdem_allocator al;
-    fsdem_swe_dem *c;
-    fsdem_result res;
-    if (out) *out = NULL;
-    if (!out) return FSDEM_ERR_INVALID_ARG;
-    res = fsdem_swe_dem_desc_check(desc, msg, sizeof msg);
-    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
-    c = (fsdem_swe_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                           res == FSDEM_OK ? &al : NULL, sizeof *c, "fsdem_swe_dem_create", &res);
-    if (!c) return res;
-    {
-        const fsdem_swe_desc sd = fsdem_swe_get_desc(desc->swe);
-        c->rho = sd.density;
-        c->g = -sd.gravity.z;
-        c->dry = sd.dry_depth;
-    }
-    c->desc = *desc;
-    c->allocator = al;
-    c->status.log = desc->log;
-    c->status.log_user = desc->log_user;
-    *out = c;
-    return FSDEM_OK;
-}
-
-void fsdem_swe_dem_destroy(fsdem_swe_dem *c) {
-    fsdem_allocator al;
-    if (!c) return;
-    al = c->allocator;
-    fsdem__free(&al, c->force, sizeof(fsdem_swe_dem_force) * (size_t)c->force_capacity);
-    fsdem__free(&al, c->reaction, sizeof(fsdem_vec3) * (size_t)c->force_capacity);
-    fsdem__free(&al, c, sizeof *c);
-}
-
-const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *c) { return c ? c->status.message : "fsdem_swe_dem is NULL"; }
-
-fsdem_swe_dem_desc fsdem_swe_dem_get_desc(const fsdem_swe_dem *c) {
-    fsdem_swe_dem_desc d;
-    if (c) return c->desc;
-    memset(&d, 0, sizeof d);
-    return d;
-}
-
-/* ---- >>couple_swe_geometry : submerged parts of a sphere ---- */
-
-/* Submerged part of a vertical circle of radius r centred at height zc under a surface at eta: its
-   area and its first moment M = int (eta - z) w(z) dz, so the hydrostatic force on it is rho g M.
-   With z = zc - r cos(phi) and w = 2 r sin(phi) both integrals are closed forms in the angle theta of
-   the waterline: area r^2 (theta - sin cos), M = 2 r^2 [(eta - zc)(theta - sin cos)/2 + r sin^3 / 3]. */
-static void fsdem__swe_dem_submerged_disc(fsdem_real r, fsdem_real zc, fsdem_real eta, fsdem_real *area, fsdem_real *moment) {
-    fsdem_real top = eta < zc + r ? eta : zc + r, c, s, th;
-    if (top <= zc - r) {
-        *area = *moment = 0;
-        return;
-    }
-    c = (zc - top) / r;
-    c = c < -1 ? -1 : c > 1 ? 1 : c;
-    th = (fsdem_real)acos(c);
-    s = (fsdem_real)sin(th);
-    *area = r * r * (th - s * c);
-    *moment = 2 * r * r * ((eta - zc) * (th - s * c) / 2 + r * s * s * s / 3);
-}
-
-/* Volume of the part of a sphere (radius r, centre height zc) below the surface eta: a cap. */
-static fsdem_real fsdem__swe_dem_submerged_sphere(fsdem_real r, fsdem_real zc, fsdem_real eta) {
-    fsdem_real s = eta - (zc - r);
-    if (s <= 0) return 0;
-    if (s > 2 * r) s = 2 * r;
-    return (fsdem_real)FSDEM__PI * s * s * (3 * r - s) / 3;
-}
-
-/* Water at p shifted by `shift` along a horizontal axis (0: x, 1: y); off the grid it is `fallback`. */
-static fsdem_swe_cell fsdem__swe_dem_water_at(const fsdem_swe *swe, fsdem_vec3 p, int axis, fsdem_real shift,
-                                              fsdem_swe_cell fallback) {
-    fsdem_swe_cell cell;
-    fsdem_real x = p.x + (axis == 0 ? shift : 0), y = p.y + (axis == 1 ? shift : 0);
-    return fsdem_swe_sample_state(swe, x, y, &cell) == FSDEM_OK ? cell : fallback;
-}
-
-/* Buoyancy (Eq. 5) and heave damping of sphere i at its current height and vertical speed, against
-   the water surface held in out->surface; updates `out` and returns the vertical force (N). */
-static fsdem_real fsdem__swe_dem_vertical(const fsdem_swe_dem *c, const fsdem_dem_particles *pv, int i,
-                                          fsdem_swe_dem_force *out) {
-    const fsdem_real rho = c->rho, g = c->g, r = pv->radius[i], z = pv->position[i].z;
-    out->submerged_volume = fsdem__swe_dem_submerged_sphere(r, z, out->surface);
-    out->buoyancy = fsdem_v3(0, 0, rho * g * out->submerged_volume);
-    out->heave = fsdem__zero3();
-    if (c->desc.heave_damping > 0) {
-        /* critical damping of the hydrostatic spring rho g A_waterplane of the bobbing */
-        fsdem_real a2 = r * r - (out->surface - z) * (out->surface - z);
-        if (a2 > 0)
-            out->heave.z = -2 * c->desc.heave_damping * (fsdem_real)sqrt(rho * g * (fsdem_real)FSDEM__PI * a2 * pv->mass[i]) *
-                           pv->velocity[i].z;
-    }
-    return out->buoyancy.z + out->heave.z;
-}
-
-/* ---- >>couple_swe_forces : seed 003 Eq. 5-8 ---- */
-
-fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
-    fsdem_swe *swe;
-    fsdem_dem_particles pv;
-    fsdem_dem_coupling loads;
-    fsdem_real beta;
-    int i, a, axes, n;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    swe = c->desc.swe;
-    beta = c->desc.beta;
-    axes = fsdem_swe_get_desc(swe).dim;
-    pv = fsdem_dem_get_particles(c->desc.dem);
-    n = pv.count;
-    if (n > c->force_capacity) {
-        fsdem_swe_dem_force *force = (fsdem_swe_dem_force *)fsdem__alloc(&c->allocator, sizeof *force * (size_t)n);
-        fsdem_vec3 *reaction = (fsdem_vec3 *)fsdem__alloc(&c->allocator, sizeof *reaction * (size_t)n);
-        if (!force || !reaction) {
-            fsdem__free(&c->allocator, force, sizeof *force * (size_t)n);
-            fsdem__free(&c->allocator, reaction, sizeof *reaction * (size_t)n);
-            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_dem: out of memory for the forces of %d particles", n);
-        }
-        fsdem__free(&c->allocator, c->force, sizeof *force * (size_t)c->force_capacity);
-        fsdem__free(&c->allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
-        c->force = force;
-        c->reaction = reaction;
-        c->force_capacity = n;
-    }
-    loads = fsdem_dem_get_coupling(c->desc.dem);
-    if (c->desc.two_way) fsdem_swe_clear_forces(swe);
-    c->in_water = 0;
-    for (i = 0; i < n; ++i) {
-        fsdem_swe_dem_force *out = &c->force[i];
-        const fsdem_vec3 p = pv.position[i], w = pv.velocity[i];
-        const fsdem_real r = pv.radius[i];
-        fsdem_swe_cell centre, back[2], front[2], flow;
-        fsdem_vec3 horizontal;
-        memset(out, 0, sizeof *out);
-        out->id = pv.id[i];
-        loads.force[i] = c->reaction[i] = fsdem__zero3();
-        if (pv.fixed[i] || fsdem_swe_sample_state(swe, p.x, p.y, &centre) != FSDEM_OK) continue;
-        /* the water at the centre, and at the back (-r) and front (+r) along each horizontal axis; the
-           flow velocity is the centre's, or that of the deepest side while a front reaches the sphere */
-        flow = centre;
-        for (a = 0; a < axes; ++a) {
-            back[a] = fsdem__swe_dem_water_at(swe, p, a, -r, centre);
-            front[a] = fsdem__swe_dem_water_at(swe, p, a, r, centre);
-            if (flow.depth < c->dry && back[a].depth > flow.depth) flow = back[a];
-            if (flow.depth < c->dry && front[a].depth > flow.depth) flow = front[a];
-        }
-        if (flow.depth < c->dry) continue;
-        out->in_water = 1;
-        c->in_water++;
-        out->surface = centre.eta;
-        for (a = 0; a < axes; ++a) {
-            /* Eq. 6-7 along axis a */
-            fsdem_real area_b, area_f, m_b, m_f, rel, hydro, dyn;
-            fsdem__swe_dem_submerged_disc(r, p.z, back[a].eta, &area_b, &m_b);
-            fsdem__swe_dem_submerged_disc(r, p.z, front[a].eta, &area_f, &m_f);
-            rel = beta * (a == 0 ? flow.u : flow.v) - (a == 0 ? w.x : w.y);
-            hydro = c->rho * c->g * (m_b - m_f);
-            dyn = c->rho * rel * (rel < 0 ? -rel : rel) * (rel > 0 ? area_b : area_f);
-            if (a == 0) {
-                out->hydrostatic.x = hydro;
-                out->dynamic.x = dyn;
-                out->frontal_area = area_f;
-            } else {
-                out->hydrostatic.y = hydro;
-                out->dynamic.y = dyn;
-            }
-        }
-        horizontal = fsdem__add(out->hydrostatic, out->dynamic);
-        if (c->desc.two_way) {
-            /* Eq. 8: the reaction -F_h as a momentum source under the sphere; a force whose reaction
-               no wet cell can take is dropped, so momentum is exchanged, never created */
-            int taken = 0;
-            fsdem_swe_add_force(swe, p, r, fsdem__scale(horizontal, -1), &taken);
-            if (!taken) out->hydrostatic = out->dynamic = horizontal = fsdem__zero3();
-            c->reaction[i] = horizontal;
-        }
-        horizontal.z = fsdem__swe_dem_vertical(c, &pv, i, out);
-        loads.force[i] = horizontal;
-    }
-    c->records = n;
-    return fsdem__ok(&c->status);
-}
-
-/* The record of DEM particle `index` (-1: none). */
-static int fsdem__swe_dem_record(const fsdem_swe_dem *c, int index) {
-    return c->records ? fsdem__dem_record_of(c->desc.dem, index, &c->force[0].id, sizeof *c->force, c->records) : -1;
-}
-
-fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *c, int index, fsdem_swe_dem_force *out) {
-    int k;
-    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
-    if ((k = fsdem__swe_dem_record(c, index)) < 0)
-        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND,
-                           "fsdem_swe_dem_get_force: no particle %d in the last update", index);
-    *out = c->force[k];
-    return FSDEM_OK;
-}
-
-/* ---- >>couple_swe_step : coupled time stepping ---- */
-
-/* fsdem_dem_substep_fn: buoyancy and heave damping of the spheres in water refreshed for the heights
-   of every DEM force evaluation, against the water surface held over the fluid step. */
-static fsdem_result fsdem__swe_dem_refresh(void *user, fsdem_dem *dem, double time) {
-    fsdem_swe_dem *c = (fsdem_swe_dem *)user;
-    const fsdem_dem_particles pv = fsdem_dem_get_particles(dem);
-    const fsdem_dem_coupling loads = fsdem_dem_get_coupling(dem);
-    int i;
-    (void)time;
-    for (i = 0; i < pv.count; ++i)
-        if (c->force[i].in_water) loads.force[i].z = fsdem__swe_dem_vertical(c, &pv, i, &c->force[i]);
-    return FSDEM_OK;
-}
-
-/* One coupled step of dt: the DEM substep count is checked before anything moves; `adaptive` steps
-   the water with fsdem_swe_step (whose dt is the stable dt computed by the caller), otherwise with
-   fsdem_swe_step_dt. */
-static fsdem_result fsdem__swe_dem_step(fsdem_swe_dem *c, fsdem_real dt, int adaptive) {
-    fsdem_result res;
-    long long k, substeps = 0;
-    int count;
-    res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_swe_dem");
-    if (res != FSDEM_OK) return res;
-    res = fsdem_swe_dem_update_forces(c);
-    if (res != FSDEM_OK) return res;
-    res = adaptive ? fsdem_swe_step(c->desc.swe) : fsdem_swe_step_dt(c->desc.swe, dt);
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: shallow-water step: %s", fsdem_swe_last_error(c->desc.swe));
-    count = fsdem_dem_get_particles(c->desc.dem).count;
-    for (k = 0; k < c->force_capacity && k < count; ++k)
-        c->impulse = fsdem__madd(c->impulse, c->reaction[k], -dt);
-    res = fsdem_dem_advance_with(c->desc.dem, dt, fsdem__swe_dem_refresh, c, &substeps);
-    c->steps++;
-    c->dt_last = dt;
-    c->substeps = substeps;
-    c->substeps_total += substeps;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
-    return fsdem__ok(&c->status);
-}
-
-fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c) {
-    fsdem_real dt = 0;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    fsdem_swe_stable_dt(c->desc.swe, &dt);
-    return fsdem__swe_dem_step(c, dt, 1);
-}
-
-fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *c, fsdem_real dt) {
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_dem_step_dt: dt must be > 0 (got %g s)", (double)dt);
-    return fsdem__swe_dem_step(c, dt, 0);
-}
-
-fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *c, fsdem_real duration, long long *steps) {
-    double end;
-    long long n = 0;
-    fsdem_result res = FSDEM_OK;
-    if (steps) *steps = 0;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(duration >= 0) || !fsdem__finite(duration))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_dem_advance: duration must be >= 0 (got %g s)",
-                           (double)duration);
-    end = fsdem_swe_time(c->desc.swe) + (double)duration;
-    while (res == FSDEM_OK && fsdem_swe_time(c->desc.swe) < end) {
-        fsdem_real dt = 0;
-        const double left = end - fsdem_swe_time(c->desc.swe);
-        fsdem_swe_stable_dt(c->desc.swe, &dt);
-        res = (double)dt >= left ? fsdem__swe_dem_step(c, (fsdem_real)left, 0) : fsdem__swe_dem_step(c, dt, 1);
-        ++n;
-    }
-    if (steps) *steps = n;
-    return res;
-}
-
-fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *c, fsdem_real *dt) {
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem_swe_stable_dt(c->desc.swe, dt);
-}
-
-double fsdem_swe_dem_time(const fsdem_swe_dem *c) { return c ? fsdem_swe_time(c->desc.swe) : 0; }
-
-fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
-    fsdem_swe_dem_stats st;
-    memset(&st, 0, sizeof st);
-    if (!c) return st;
-    st.steps = c->steps;
-    st.time = fsdem_swe_time(c->desc.swe);
-    st.dt = c->dt_last;
-    st.substeps = c->substeps;
-    st.substeps_total = c->substeps_total;
-    st.in_water = c->in_water;
-    st.impulse_to_water = c->impulse;
-    return st;
-}
-
 /* ===== >>impl_mps : MPS solver ===================================================================== */
 
 /* Contents: the object below; >>mps_desc (defaults, validation, lattice constants, creation),
@@ -14965,6 +14864,7 @@ typedef struct fsdem__mps_obst {
 struct fsdem_mps {
     fsdem_mps_desc desc;
     fsdem__status status;
+    fsdem_claims claims;             /* who writes its coupling arrays (>>core_claims) */
     fsdem_allocator allocator;
     size_t bytes;                 /* held, besides the pcg */
     int dim;
@@ -15027,6 +14927,9 @@ struct fsdem_mps {
     double sec_total, sec_pressure, sec_search, sec_assembly, sec_solve;
     long long candidates;         /* pairs the last cell scan examined */
 };
+
+/* The arrays of fsdem_mps_arrays, by bit (>>core_claims). */
+static const char *const fsdem__mps_claimable[2] = {"forces", "porosity"};
 
 /* ---- >>mps_desc : defaults, validation, lattice constants, creation ---- */
 
@@ -15189,6 +15092,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     s->bytes = sizeof *s;
     s->status.log = desc->log;
     s->status.log_user = desc->log_user;
+    fsdem__claims_init(&s->claims, "MPS", fsdem__mps_claimable, 2);
     s->dim = desc->dim;
     s->r0 = desc->r0;
     s->re = desc->re > 0 ? desc->re : (fsdem_real)4.1 * desc->r0;
@@ -15646,6 +15550,20 @@ static fsdem_result fsdem__mps_check_open(fsdem_mps *s, const char *what, int ax
     if (to) *to = t;
     snprintf(field, sizeof field, "%s.lo/hi", what);
     return fsdem__mps_check_box(s, field, f, t);
+}
+
+fsdem_mps_inflow_desc fsdem_mps_inflow_desc_default(void) {
+    fsdem_mps_inflow_desc d;
+    memset(&d, 0, sizeof d);
+    d.direction = 1;
+    return d;
+}
+
+fsdem_mps_outflow_desc fsdem_mps_outflow_desc_default(void) {
+    fsdem_mps_outflow_desc d;
+    memset(&d, 0, sizeof d);
+    d.direction = 1;
+    return d;
 }
 
 fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in, int *added) {
@@ -16660,6 +16578,8 @@ fsdem_mps_particles fsdem_mps_get_particles(fsdem_mps *s) {
     return v;
 }
 
+fsdem_claims *fsdem_mps_claims(fsdem_mps *s) { return s ? &s->claims : NULL; }
+
 fsdem_mps_coupling fsdem_mps_get_coupling(fsdem_mps *s) {
     fsdem_mps_coupling c;
     memset(&c, 0, sizeof c);
@@ -16984,11 +16904,823 @@ fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsd
     return FSDEM_OK;
 }
 
+/* ===== >>impl_couple : the coupler head, the fluids, the staged step, records =====================
+
+   Contents: the head every coupler starts with, its class and its creation (below);
+   >>couple_fluids (the three fluids through their public calls), >>couple_step (the DEM's checks,
+   the staged step of couplers sharing a fluid, the stable rule, the advance), >>couple_records (the
+   per-particle records by their fields: lookup, CSV). A coupler, this chapter included, reaches the
+   solvers through their public calls only (>>doc; tests/map_check.sh holds every coupler chapter to
+   it). */
+
+/* Where a stage's CPU time goes (fsdem_coupling_stats). */
+enum { FSDEM__CLOCK_FLUID = 0, FSDEM__CLOCK_DEM = 1, FSDEM__CLOCK_COUPLING = 2 };
+
+/* One stage of a coupled step of dt; it names what failed in the coupler's message. The fluid's step
+   is the stage whose run is NULL: the driver takes it once for all couplers of the fluid. */
+typedef struct fsdem__stage {
+    const char *name;
+    int clock;
+    fsdem_result (*run)(fsdem_coupler *c, fsdem_real dt);
+} fsdem__stage;
+
+/* A fluid as the couplers see it: its public calls (>>couple_fluids). */
+typedef struct fsdem__fluid {
+    const char *name;                                   /* "PIC", as messages name it */
+    const char *field;                                  /* "pic", its field in a coupler's desc */
+    double (*time)(const void *fluid);
+    fsdem_result (*stable_dt)(const void *fluid, fsdem_real *dt);
+    fsdem_result (*step_dt)(void *fluid, fsdem_real dt);
+    const char *(*last_error)(const void *fluid);
+    fsdem_claims *(*claims)(void *fluid);
+} fsdem__fluid;
+
+/* A field of a coupler's per-particle record: CSV columns (_x, _y, _z for a vector) and, when
+   `saved`, part of the coupler's restart file (>>restart_couplers), in the order of the table. The
+   restart's tables of a coupler's own fields use the same type (and long long counts). */
+enum { FSDEM__FIELD_INT = 0, FSDEM__FIELD_REAL = 1, FSDEM__FIELD_VEC3 = 2, FSDEM__FIELD_LL = 3 };
+typedef struct fsdem__field {
+    const char *name;
+    int kind;
+    size_t offset;
+    int saved;
+} fsdem__field;
+
+/* What makes a coupler of one kind. */
+typedef struct fsdem__coupler_class {
+    const char *name;                   /* "fsdem_gic": its messages start so */
+    const fsdem__fluid *fluid;
+    size_t record_size;                 /* bytes of its per-particle record, whose first field is the int id */
+    const fsdem__field *fields;
+    int field_count;
+    /* its step (>>couple_step): prepare (may be NULL) does what must come before the step's length
+       is known, and undo (may be NULL) puts it back when the step is refused; limit (may be NULL)
+       cuts the fluid's stable dt by the coupler's own limits; check refuses a dt before anything
+       moves (chosen: the caller's dt, not a stable one); then the stages in order */
+    fsdem_result (*prepare)(fsdem_coupler *c);
+    void (*undo)(fsdem_coupler *c);
+    fsdem_result (*limit)(const fsdem_coupler *c, fsdem_real *dt);
+    fsdem_result (*check)(fsdem_coupler *c, fsdem_real dt, int chosen);
+    const fsdem__stage *stages;
+    int stage_count;
+} fsdem__coupler_class;
+
+/* The head of every coupler, its first member. */
+struct fsdem_coupler {
+    const fsdem__coupler_class *cls;
+    fsdem__status status;
+    fsdem_allocator allocator;          /* the DEM's */
+    void *fluid;                        /* not owned */
+    fsdem_dem *dem;                     /* not owned */
+    unsigned fluid_arrays;              /* the fluid's arrays it claimed */
+    long long max_substeps;             /* DEM substeps one coupled step may take */
+    long long steps, substeps, substeps_total;
+    fsdem_real dt_last;
+    double seconds[3];                  /* CPU seconds, by clock */
+    const void *record;                 /* the records of the last update (cls->record_size bytes */
+    int records;                        /*    each, ids ascending), `records` of them (0: none) */
+};
+
+/* The desc checks every coupler shares: a fluid of dimension fluid_dim and gravity fluid_g and a DEM
+   alike, the substep bound, and the arrays the coupler would claim free (`desc` names the desc,
+   "fsdem_gic_desc"). */
+static fsdem_result fsdem__coupler_check(const fsdem__coupler_class *cls, const char *desc, void *fluid, unsigned arrays, fsdem_dem *dem,
+                                         int fluid_dim, fsdem_vec3 fluid_g, long long max_substeps, char *msg, size_t size) {
+    const fsdem_dem_desc dd = fsdem_dem_get_desc(dem);
+    const char *holder;
+    if (fluid_dim && dd.dim != fluid_dim)
+        return fsdem__reject(msg, size, "%s: the DEM is %dD and the %s %dD", desc, dd.dim, cls->fluid->name, fluid_dim);
+    if (fsdem__norm(fsdem__sub(dd.gravity, fluid_g)) > 1e-12 * fsdem__norm(fluid_g))
+        return fsdem__reject(msg, size, "%s: the DEM gravity (%g, %g, %g) differs from the %s's (%g, %g, %g) m/s^2", desc, (double)dd.gravity.x,
+                             (double)dd.gravity.y, (double)dd.gravity.z, cls->fluid->name, (double)fluid_g.x, (double)fluid_g.y,
+                             (double)fluid_g.z);
+    if (max_substeps < 1) return fsdem__reject(msg, size, "%s.max_substeps must be >= 1 (got %lld)", desc, max_substeps);
+    if ((holder = fsdem_claimant(fsdem_dem_claims(dem), FSDEM_DEM_ARRAYS_LOADS)))
+        return fsdem__reject(msg, size, "%s.dem: its external loads are claimed by %s (one coupler per DEM: destroy it first)", desc, holder);
+    if ((holder = fsdem_claimant(cls->fluid->claims(fluid), arrays)))
+        return fsdem__reject(msg, size, "%s.%s: the %s's arrays this coupler writes are claimed by %s (destroy it first)", desc,
+                             cls->fluid->field, cls->fluid->name, holder);
+    return FSDEM_OK;
+}
+
+/* A new coupler of `size` bytes whose desc check gave `checked` (and `why`): zeroed, its memory from
+   the DEM's allocator, its head set, the DEM's loads and the fluid's `arrays` claimed. NULL, with
+   *res and the reason logged, on failure. */
+static void *fsdem__coupler_new(const fsdem__coupler_class *cls, fsdem_result checked, const char *why, void *fluid, fsdem_dem *dem,
+                                unsigned arrays, long long max_substeps, fsdem_log_fn log, void *log_user, size_t size,
+                                fsdem_result *res) {
+    char who[64];
+    fsdem_allocator al;
+    fsdem_coupler *c;
+    memset(&al, 0, sizeof al);
+    snprintf(who, sizeof who, "%s_create", cls->name);
+    if (checked == FSDEM_OK) al = fsdem_dem_get_desc(dem).allocator;
+    c = (fsdem_coupler *)fsdem__object_new(checked, why, log, log_user, checked == FSDEM_OK ? &al : NULL, size, who, res);
+    if (!c) return NULL;
+    c->cls = cls;
+    c->allocator = al;
+    c->status.log = log;
+    c->status.log_user = log_user;
+    c->fluid = fluid;
+    c->dem = dem;
+    c->fluid_arrays = arrays;
+    c->max_substeps = max_substeps;
+    /* the desc check found them free */
+    fsdem_claim(fsdem_dem_claims(dem), FSDEM_DEM_ARRAYS_LOADS, c, cls->name, NULL, 0);
+    fsdem_claim(cls->fluid->claims(fluid), arrays, c, cls->name, NULL, 0);
+    return c;
+}
+
+/* Releases the coupler's claims and frees its `size` bytes (its own arrays freed before). */
+static void fsdem__coupler_free(fsdem_coupler *c, size_t size) {
+    const fsdem_allocator al = c->allocator;
+    fsdem_release(fsdem_dem_claims(c->dem), FSDEM_DEM_ARRAYS_LOADS, c);
+    fsdem_release(c->cls->fluid->claims(c->fluid), c->fluid_arrays, c);
+    fsdem__free(&al, c, size);
+}
+
+static double fsdem__coupler_time(const fsdem_coupler *c) { return c->cls->fluid->time(c->fluid); }
+
+static fsdem_coupling_stats fsdem__coupler_stats(const fsdem_coupler *c) {
+    fsdem_coupling_stats st;
+    st.steps = c->steps;
+    st.time = fsdem__coupler_time(c);
+    st.dt = c->dt_last;
+    st.substeps = c->substeps;
+    st.substeps_total = c->substeps_total;
+    st.seconds_fluid = c->seconds[FSDEM__CLOCK_FLUID];
+    st.seconds_dem = c->seconds[FSDEM__CLOCK_DEM];
+    st.seconds_coupling = c->seconds[FSDEM__CLOCK_COUPLING];
+    return st;
+}
+
+/* ---- >>couple_fluids : the fluids through their public calls ---- */
+
+static double fsdem__fluid_pic_time(const void *f) { return fsdem_pic_time((const fsdem_pic *)f); }
+static fsdem_result fsdem__fluid_pic_stable(const void *f, fsdem_real *dt) { return fsdem_pic_stable_dt((const fsdem_pic *)f, dt); }
+static fsdem_result fsdem__fluid_pic_step(void *f, fsdem_real dt) { return fsdem_pic_step_dt((fsdem_pic *)f, dt); }
+static const char *fsdem__fluid_pic_error(const void *f) { return fsdem_pic_last_error((const fsdem_pic *)f); }
+static fsdem_claims *fsdem__fluid_pic_claims(void *f) { return fsdem_pic_claims((fsdem_pic *)f); }
+static const fsdem__fluid fsdem__fluid_pic = {"PIC", "pic", fsdem__fluid_pic_time, fsdem__fluid_pic_stable, fsdem__fluid_pic_step,
+                                              fsdem__fluid_pic_error, fsdem__fluid_pic_claims};
+
+static double fsdem__fluid_mps_time(const void *f) { return fsdem_mps_time((const fsdem_mps *)f); }
+static fsdem_result fsdem__fluid_mps_stable(const void *f, fsdem_real *dt) { return fsdem_mps_stable_dt((const fsdem_mps *)f, dt); }
+static fsdem_result fsdem__fluid_mps_step(void *f, fsdem_real dt) { return fsdem_mps_step_dt((fsdem_mps *)f, dt); }
+static const char *fsdem__fluid_mps_error(const void *f) { return fsdem_mps_last_error((const fsdem_mps *)f); }
+static fsdem_claims *fsdem__fluid_mps_claims(void *f) { return fsdem_mps_claims((fsdem_mps *)f); }
+static const fsdem__fluid fsdem__fluid_mps = {"MPS", "mps", fsdem__fluid_mps_time, fsdem__fluid_mps_stable, fsdem__fluid_mps_step,
+                                              fsdem__fluid_mps_error, fsdem__fluid_mps_claims};
+
+static double fsdem__fluid_swe_time(const void *f) { return fsdem_swe_time((const fsdem_swe *)f); }
+static fsdem_result fsdem__fluid_swe_stable(const void *f, fsdem_real *dt) { return fsdem_swe_stable_dt((const fsdem_swe *)f, dt); }
+static fsdem_result fsdem__fluid_swe_step(void *f, fsdem_real dt) { return fsdem_swe_step_dt((fsdem_swe *)f, dt); }
+static const char *fsdem__fluid_swe_error(const void *f) { return fsdem_swe_last_error((const fsdem_swe *)f); }
+static fsdem_claims *fsdem__fluid_swe_claims(void *f) { return fsdem_swe_claims((fsdem_swe *)f); }
+static const fsdem__fluid fsdem__fluid_swe = {"shallow-water", "swe", fsdem__fluid_swe_time, fsdem__fluid_swe_stable, fsdem__fluid_swe_step,
+                                              fsdem__fluid_swe_error, fsdem__fluid_swe_claims};
+
+/* ---- >>couple_step : the DEM's checks, the staged step, the stable rule, the advance ---- */
+
+/* Every DEM particle fits in the fluid's domain [lo, hi] (a sphere wider than the domain's smallest
+   extent leaves no fluid around it); the particle goes to the message under the name `who`. */
+static fsdem_result fsdem__coupler_particles_fit(fsdem_coupler *c, fsdem_vec3 lo, fsdem_vec3 hi, const char *who) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->dem);
+    const fsdem_real extent = fsdem__smallest_extent(lo, hi, P.dim);
+    int i;
+    for (i = 0; i < P.count; ++i)
+        if (!(2 * P.radius[i] < extent))
+            return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG,
+                               "%s: DEM particle %d (id %d) of radius %g m does not fit in the fluid's domain (smallest extent %g m)", who,
+                               i, P.id[i], (double)P.radius[i], (double)extent);
+    return FSDEM_OK;
+}
+
+/* Before a step of dt moves anything: the DEM can follow it in at most max_substeps substeps. */
+static fsdem_result fsdem__coupler_substeps_within(fsdem_coupler *c, fsdem_real dt) {
+    long long substeps = 0;
+    const fsdem_result res = fsdem_dem_substep_count(c->dem, dt, &substeps);
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "%s: %s", c->cls->name, fsdem_dem_last_error(c->dem));
+    if (substeps > c->max_substeps)
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG,
+                           "%s: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)", c->cls->name,
+                           (double)dt, substeps, c->max_substeps, (double)fsdem_dem_get_stats(c->dem).dt);
+    return FSDEM_OK;
+}
+
+/* The coupler's DEM over dt in substeps, `fn` (may be NULL) called at every force evaluation
+   (fsdem_dem_advance_with); the counts go to the head. A failure is named "<what>: <the DEM's
+   message>", unless `fn` failed (*fn_failed set) and named it already. */
+static fsdem_result fsdem__coupler_substeps(fsdem_coupler *c, fsdem_real dt, fsdem_dem_substep_fn fn, void *user, const char *what,
+                                            const int *fn_failed) {
+    long long substeps = 0;
+    const fsdem_result res = fsdem_dem_advance_with(c->dem, dt, fn, user, &substeps);
+    c->substeps = substeps;
+    c->substeps_total += substeps;
+    if (res != FSDEM_OK && !(fn_failed && *fn_failed))
+        return fsdem__fail(&c->status, res, "%s: %s: %s", c->cls->name, what, fsdem_dem_last_error(c->dem));
+    return res;
+}
+
+/* The message of couplers[from] (or a new one, from < 0) given to every coupler of the list. */
+static fsdem_result fsdem__coupled_fail(fsdem_coupler *const *list, int n, int from, fsdem_result res, const char *fmt, ...) {
+    int k;
+    if (from < 0) {
+        va_list ap;
+        va_start(ap, fmt);
+        fsdem__vfail(&list[0]->status, res, fmt, ap);
+        va_end(ap);
+        from = 0;
+    }
+    for (k = 0; k < n; ++k)
+        if (k != from) memcpy(list[k]->status.message, list[from]->status.message, sizeof list[k]->status.message);
+    return res;
+}
+
+/* Puts back what the couplers' prepare did (a refused step); passes `res` on. */
+static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem_result res) {
+    int k;
+    for (k = 0; k < n; ++k)
+        if (list[k]->cls->undo) list[k]->cls->undo(list[k]);
+    return res;
+}
+
+/* A list of couplers that can step together: not empty, no NULL, none twice, one fluid. */
+static fsdem_result fsdem__coupled_list(fsdem_coupler *const *list, int n, const char *who) {
+    int k, j;
+    if (!list || n < 1) return FSDEM_ERR_INVALID_ARG;
+    for (k = 0; k < n; ++k)
+        if (!list[k]) return FSDEM_ERR_INVALID_ARG;
+    for (k = 1; k < n; ++k) {
+        if (list[k]->fluid != list[0]->fluid)
+            return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: couplers %d (%s) and 0 (%s) have different fluids", who, k,
+                                       list[k]->cls->name, list[0]->cls->name);
+        for (j = 0; j < k; ++j)
+            if (list[j] == list[k]) return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: coupler %d is listed twice", who, k);
+    }
+    return FSDEM_OK;
+}
+
+/* The stable dt of couplers of one fluid: the fluid's, cut by every coupler's own limits. */
+static fsdem_result fsdem__coupled_stable(fsdem_coupler *const *list, int n, fsdem_real *dt) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
+    fsdem_result res = f->stable_dt(list[0]->fluid, dt);
+    int k;
+    if (res != FSDEM_OK)
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s stable step: %s", list[0]->cls->name, f->name, f->last_error(list[0]->fluid));
+    for (k = 0; k < n; ++k)
+        if (list[k]->cls->limit && (res = list[k]->cls->limit(list[k], dt)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
+    return FSDEM_OK;
+}
+
+/* The couplers' prepare, in order, timed as coupling (a failure undoes those before), then with
+   `dt` the stable dt. */
+static fsdem_result fsdem__coupled_prepare(fsdem_coupler *const *list, int n, fsdem_real *dt) {
+    fsdem_result res = FSDEM_OK;
+    int k;
+    for (k = 0; k < n && res == FSDEM_OK; ++k)
+        if (list[k]->cls->prepare) {
+            const clock_t t0 = clock();
+            if ((res = list[k]->cls->prepare(list[k])) != FSDEM_OK) fsdem__coupled_fail(list, n, k, fsdem__coupled_undo(list, k, res), NULL);
+            list[k]->seconds[FSDEM__CLOCK_COUPLING] += (double)(clock() - t0) / CLOCKS_PER_SEC;
+        }
+    if (res == FSDEM_OK && dt && (res = fsdem__coupled_stable(list, n, dt)) != FSDEM_OK) fsdem__coupled_undo(list, n, res);
+    return res;
+}
+
+/* The stages of coupler c before its fluid step (after = 0), or after it (after = 1), each timed on
+   its clock; the first failure ends them. */
+static fsdem_result fsdem__coupled_stages(fsdem_coupler *c, fsdem_real dt, int after) {
+    const fsdem__coupler_class *cls = c->cls;
+    fsdem_result res = FSDEM_OK;
+    int s = 0;
+    if (after)
+        while (s < cls->stage_count && cls->stages[s++].run) continue;
+    for (; s < cls->stage_count && res == FSDEM_OK && cls->stages[s].run; ++s) {
+        const clock_t t0 = clock();
+        res = cls->stages[s].run(c, dt);
+        c->seconds[cls->stages[s].clock] += (double)(clock() - t0) / CLOCKS_PER_SEC;
+    }
+    return res;
+}
+
+/* A coupled step of dt after the prepare: every coupler's check (a refusal undoes the prepare), the
+   stages before the fluid's step, the fluid's step (FSDEM_ERR_CFL: refused before it moved, the
+   prepare undone), the stages after it. `chosen`: dt is the caller's, not a stable one. */
+static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_real dt, int chosen) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
+    void *fluid = list[0]->fluid;
+    fsdem_result res;
+    clock_t t0;
+    double seconds;
+    int k;
+    for (k = 0; k < n; ++k)
+        if ((res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
+            return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
+    for (k = 0; k < n; ++k)
+        if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
+    t0 = clock();
+    res = f->step_dt(fluid, dt);
+    seconds = (double)(clock() - t0) / CLOCKS_PER_SEC;
+    for (k = 0; k < n; ++k) list[k]->seconds[FSDEM__CLOCK_FLUID] += seconds;
+    if (res != FSDEM_OK) {
+        if (res == FSDEM_ERR_CFL) fsdem__coupled_undo(list, n, res);
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s step: %s", list[0]->cls->name, f->name, f->last_error(fluid));
+    }
+    for (k = 0; k < n; ++k) {
+        list[k]->steps++;
+        list[k]->dt_last = dt;
+    }
+    for (k = 0; k < n; ++k)
+        if ((res = fsdem__coupled_stages(list[k], dt, 1)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
+    for (k = 0; k < n; ++k) fsdem__ok(&list[k]->status);
+    return FSDEM_OK;
+}
+
+/* The verbs of couplers stepping together, and of each coupler alone (a list of one); `who` names
+   the public function in messages. */
+static fsdem_result fsdem__coupled_step(fsdem_coupler *const *list, int n) {
+    fsdem_real dt = 0;
+    fsdem_result res = fsdem__coupled_prepare(list, n, &dt);
+    return res != FSDEM_OK ? res : fsdem__coupled_go(list, n, dt, 0);
+}
+
+static fsdem_result fsdem__coupled_step_dt(fsdem_coupler *const *list, int n, fsdem_real dt, const char *who) {
+    fsdem_result res;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: dt = %g s must be > 0 and finite", who, (double)dt);
+    if ((res = fsdem__coupled_prepare(list, n, NULL)) != FSDEM_OK) return res;
+    return fsdem__coupled_go(list, n, dt, 1);
+}
+
+/* Steps until exactly `duration` later: when less than one and a half stable steps are left, the
+   last two share them equally, so no step is a sliver; the end is reached to a relative 1e-12. */
+static fsdem_result fsdem__coupled_advance(fsdem_coupler *const *list, int n, fsdem_real duration, long long *steps, const char *who) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
+    const void *fluid = list[0]->fluid;
+    long long count = 0;
+    fsdem_result res = FSDEM_OK;
+    double end;
+    if (steps) *steps = 0;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: duration = %g s must be >= 0", who, (double)duration);
+    end = f->time(fluid) + (double)duration;
+    while (res == FSDEM_OK && f->time(fluid) < end - 1e-12 * (end > 1 ? end : 1)) {
+        const double left = end - f->time(fluid);
+        fsdem_real dt = 0;
+        if ((res = fsdem__coupled_prepare(list, n, &dt)) != FSDEM_OK) break;
+        if ((double)dt >= left) dt = (fsdem_real)left;
+        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
+        res = fsdem__coupled_go(list, n, dt, 0);
+        ++count;
+    }
+    if (steps) *steps = count;
+    return res;
+}
+
+fsdem_result fsdem_coupled_step(fsdem_coupler *const *couplers, int count) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_step");
+    return res != FSDEM_OK ? res : fsdem__coupled_step(couplers, count);
+}
+
+fsdem_result fsdem_coupled_step_dt(fsdem_coupler *const *couplers, int count, fsdem_real dt) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_step_dt");
+    return res != FSDEM_OK ? res : fsdem__coupled_step_dt(couplers, count, dt, "fsdem_coupled_step_dt");
+}
+
+fsdem_result fsdem_coupled_advance(fsdem_coupler *const *couplers, int count, fsdem_real duration, long long *steps) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_advance");
+    if (steps) *steps = 0;
+    return res != FSDEM_OK ? res : fsdem__coupled_advance(couplers, count, duration, steps, "fsdem_coupled_advance");
+}
+
+fsdem_result fsdem_coupled_stable_dt(fsdem_coupler *const *couplers, int count, fsdem_real *dt) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_stable_dt");
+    if (res != FSDEM_OK) return res;
+    if (!dt) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__coupled_stable(couplers, count, dt);
+}
+
+/* The verbs of one coupler (NULL refused), its step a list of one. */
+static fsdem_result fsdem__coupler_step(fsdem_coupler *c) { return c ? fsdem__coupled_step(&c, 1) : FSDEM_ERR_INVALID_ARG; }
+
+static fsdem_result fsdem__coupler_step_dt(fsdem_coupler *c, fsdem_real dt, const char *who) {
+    return c ? fsdem__coupled_step_dt(&c, 1, dt, who) : FSDEM_ERR_INVALID_ARG;
+}
+
+static fsdem_result fsdem__coupler_advance(fsdem_coupler *c, fsdem_real duration, long long *steps, const char *who) {
+    if (steps) *steps = 0;
+    return c ? fsdem__coupled_advance(&c, 1, duration, steps, who) : FSDEM_ERR_INVALID_ARG;
+}
+
+static fsdem_result fsdem__coupler_stable_dt(const fsdem_coupler *c, fsdem_real *dt) {
+    fsdem_coupler *list = (fsdem_coupler *)c; /* only the message changes (a failure's) */
+    return c && dt ? fsdem__coupled_stable(&list, 1, dt) : FSDEM_ERR_INVALID_ARG;
+}
+
+/* ---- >>couple_records : per-particle records by their fields ---- */
+
+/* The record of DEM particle `index` from the last update, or NULL. The records were made for
+   particles whose stable ids ascend (the DEM keeps its ids in index order: new particles go to the
+   end, removals keep the order), so a particle added or removed since is told by its id, found by
+   bisection. */
+static const void *fsdem__coupler_record(const fsdem_coupler *c, int index) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->dem);
+    const size_t size = c->cls->record_size;
+    int lo = 0, hi = c->records - 1;
+    if (index < 0 || index >= P.count || !c->record) return NULL;
+    while (lo <= hi) {
+        const int mid = lo + (hi - lo) / 2;
+        const char *r = (const char *)c->record + (size_t)mid * size;
+        const int at = *(const int *)(const void *)r;
+        if (at == P.id[index]) return r;
+        if (at < P.id[index]) lo = mid + 1;
+        else hi = mid - 1;
+    }
+    return NULL;
+}
+
+/* fsdem_X_get_force: a copy of the record of particle `index`. FSDEM_ERR_NOT_FOUND names the
+   particle (the only message a query writes). */
+static fsdem_result fsdem__coupler_get_record(const fsdem_coupler *c, int index, void *out, const char *who) {
+    const void *r;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    if (!(r = fsdem__coupler_record(c, index)))
+        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "%s: no particle %d in the last update", who, index);
+    memcpy(out, r, c->cls->record_size);
+    return FSDEM_OK;
+}
+
+/* Bytes of a field of kind `kind`. */
+static size_t fsdem__field_size(int kind) {
+    return kind == FSDEM__FIELD_INT    ? sizeof(int)
+           : kind == FSDEM__FIELD_REAL ? sizeof(fsdem_real)
+           : kind == FSDEM__FIELD_VEC3 ? sizeof(fsdem_vec3)
+                                       : sizeof(long long);
+}
+
+/* The values of the record of particle `index` as a CSV row (fsdem__row_fn); 0 without a record. */
+static int fsdem__coupler_row(const void *object, int index, double *v) {
+    const fsdem_coupler *c = (const fsdem_coupler *)object;
+    const char *r = (const char *)fsdem__coupler_record(c, index);
+    int k, n = 0;
+    if (!r) return 0;
+    for (k = 0; k < c->cls->field_count; ++k) {
+        const fsdem__field *f = &c->cls->fields[k];
+        const void *at = r + f->offset;
+        if (f->kind == FSDEM__FIELD_INT) v[n++] = *(const int *)at;
+        else if (f->kind == FSDEM__FIELD_REAL) v[n++] = (double)*(const fsdem_real *)at;
+        else {
+            const fsdem_vec3 *u = (const fsdem_vec3 *)at;
+            v[n++] = (double)u->x;
+            v[n++] = (double)u->y;
+            v[n++] = (double)u->z;
+        }
+    }
+    return 1;
+}
+
+/* fsdem_X_write_csv: a header of the record's fields (a vector as name_x, name_y, name_z), then a
+   row for every DEM particle with a record, in index order. */
+static fsdem_result fsdem__coupler_write_csv(const fsdem_coupler *c, const char *path, const char *who) {
+    char header[1024];
+    size_t used = 0;
+    int k;
+    for (k = 0; k < c->cls->field_count; ++k) {
+        const fsdem__field *f = &c->cls->fields[k];
+        const char *sep = k ? "," : "";
+        used += (size_t)(f->kind == FSDEM__FIELD_VEC3
+                             ? snprintf(header + used, sizeof header - used, "%s%s_x,%s_y,%s_z", sep, f->name, f->name, f->name)
+                             : snprintf(header + used, sizeof header - used, "%s%s", sep, f->name));
+        FSDEM_ASSERT(used < sizeof header);
+    }
+    return fsdem__write_rows(&c->status, who, path, header, fsdem_dem_get_particles(c->dem).count, fsdem__coupler_row, c);
+}
+
+/* ===== >>impl_couple_swe : SWE-DEM floating debris =================================================
+
+   Contents: >>couple_swe_object (desc, creation), >>couple_swe_geometry (submerged parts of a
+   sphere), >>couple_swe_forces (seed 003 Eq. 5-8), >>couple_swe_step (its stages and verbs on the
+   staged step of >>couple). The coupler reaches the solvers through their coupling functions only
+   (>>doc). */
+
+/* ---- >>couple_swe_object : desc, creation ---- */
+
+struct fsdem_swe_dem {
+    fsdem_coupler head;            /* >>couple; its records are `force` */
+    fsdem_swe_dem_desc desc;
+    fsdem_real rho, g, dry;        /* the SWE's density, |g| and dry depth */
+    fsdem_swe_dem_force *force;    /* one per DEM particle of the last update */
+    fsdem_vec3 *reaction;          /* N, horizontal force on each sphere whose reaction the water took */
+    int force_capacity;            /* of force and reaction */
+    int wet;                       /* spheres in water at the last update */
+    fsdem_vec3 impulse;            /* N s, given to the water */
+};
+
+static const fsdem__coupler_class *fsdem__swe_dem_class(void);
+
+fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void) {
+    fsdem_swe_dem_desc d;
+    memset(&d, 0, sizeof d);
+    d.beta = (fsdem_real)1.1;
+    d.two_way = 1;
+    d.heave_damping = 0;
+    d.max_substeps = 100000;
+    return d;
+}
+
+fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *d, char *msg, size_t size) {
+    fsdem_dem_desc dd;
+    fsdem_swe_desc sd;
+    fsdem_vec3 g;
+    fsdem_real gs;
+    if (!d) return fsdem__reject(msg, size, "fsdem_swe_dem_desc is NULL");
+    if (!d->swe || !d->dem) return fsdem__reject(msg, size, "fsdem_swe_dem_desc.swe and .dem must both be set");
+    dd = fsdem_dem_get_desc(d->dem);
+    sd = fsdem_swe_get_desc(d->swe);
+    if (dd.dim != 3)
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.dem must be 3D (spheres, z vertical); it has dim %d", dd.dim);
+    g = dd.gravity;
+    gs = -sd.gravity.z;
+    if (g.x != 0 || g.y != 0 || !(fabs(g.z + gs) <= 1e-12 * gs))
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc: the DEM gravity (%g, %g, %g) must be (0, 0, -g) with the SWE's g = %g m/s^2",
+                             (double)g.x, (double)g.y, (double)g.z, (double)gs);
+    if (!(d->beta > 0) || !fsdem__finite(d->beta))
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.beta must be > 0 (got %g)", (double)d->beta);
+    if (!(d->heave_damping >= 0) || !fsdem__finite(d->heave_damping))
+        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.heave_damping must be >= 0 (got %g)",
+                             (double)d->heave_damping);
+    return fsdem__coupler_check(fsdem__swe_dem_class(), "fsdem_swe_dem_desc", d->swe, d->two_way ? (unsigned)FSDEM_SWE_ARRAYS_SOURCE : 0u, d->dem, 0,
+                                sd.gravity, d->max_substeps, msg, size);
+}
+
+fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out) {
+    char msg[FSDEM__MESSAGE_SIZE];
+    fsdem_swe_dem *c;
+    fsdem_result res;
+    if (out) *out = NULL;
+    if (!out) return FSDEM_ERR_INVALID_ARG;
+    res = fsdem_swe_dem_desc_check(desc, msg, sizeof msg);
+    c = (fsdem_swe_dem *)fsdem__coupler_new(fsdem__swe_dem_class(), res, msg, desc ? desc->swe : NULL, desc ? desc->dem : NULL,
+                                            desc && desc->two_way ? (unsigned)FSDEM_SWE_ARRAYS_SOURCE : 0u, desc ? desc->max_substeps : 0,
+                                            desc ? desc->log : NULL, desc ? desc->log_user : NULL, sizeof *c, &res);
+    if (!c) return res;
+    {
+        const fsdem_swe_desc sd = fsdem_swe_get_desc(desc->swe);
+        c->rho = sd.density;
+        c->g = -sd.gravity.z;
+        c->dry = sd.dry_depth;
+    }
+    c->desc = *desc;
+    *out = c;
+    return FSDEM_OK;
+}
+
+void fsdem_swe_dem_destroy(fsdem_swe_dem *c) {
+    if (!c) return;
+    fsdem__free(&c->head.allocator, c->force, sizeof(fsdem_swe_dem_force) * (size_t)c->force_capacity);
+    fsdem__free(&c->head.allocator, c->reaction, sizeof(fsdem_vec3) * (size_t)c->force_capacity);
+    fsdem__coupler_free(&c->head, sizeof *c);
+}
+
+const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *c) { return c ? c->head.status.message : "fsdem_swe_dem is NULL"; }
+
+fsdem_swe_dem_desc fsdem_swe_dem_get_desc(const fsdem_swe_dem *c) {
+    fsdem_swe_dem_desc d;
+    if (c) return c->desc;
+    memset(&d, 0, sizeof d);
+    return d;
+}
+
+fsdem_coupler *fsdem_swe_dem_coupler(fsdem_swe_dem *c) { return c ? &c->head : NULL; }
+
+/* ---- >>couple_swe_geometry : submerged parts of a sphere ---- */
+
+/* Submerged part of a vertical circle of radius r centred at height zc under a surface at eta: its
+   area and its first moment M = int (eta - z) w(z) dz, so the hydrostatic force on it is rho g M.
+   With z = zc - r cos(phi) and w = 2 r sin(phi) both integrals are closed forms in the angle theta of
+   the waterline: area r^2 (theta - sin cos), M = 2 r^2 [(eta - zc)(theta - sin cos)/2 + r sin^3 / 3]. */
+static void fsdem__swe_dem_submerged_disc(fsdem_real r, fsdem_real zc, fsdem_real eta, fsdem_real *area, fsdem_real *moment) {
+    fsdem_real top = eta < zc + r ? eta : zc + r, c, s, th;
+    if (top <= zc - r) {
+        *area = *moment = 0;
+        return;
+    }
+    c = (zc - top) / r;
+    c = c < -1 ? -1 : c > 1 ? 1 : c;
+    th = (fsdem_real)acos(c);
+    s = (fsdem_real)sin(th);
+    *area = r * r * (th - s * c);
+    *moment = 2 * r * r * ((eta - zc) * (th - s * c) / 2 + r * s * s * s / 3);
+}
+
+/* Volume of the part of a sphere (radius r, centre height zc) below the surface eta: a cap. */
+static fsdem_real fsdem__swe_dem_submerged_sphere(fsdem_real r, fsdem_real zc, fsdem_real eta) {
+    fsdem_real s = eta - (zc - r);
+    if (s <= 0) return 0;
+    if (s > 2 * r) s = 2 * r;
+    return (fsdem_real)FSDEM__PI * s * s * (3 * r - s) / 3;
+}
+
+/* Water at p shifted by `shift` along a horizontal axis (0: x, 1: y); off the grid it is `fallback`. */
+static fsdem_swe_cell fsdem__swe_dem_water_at(const fsdem_swe *swe, fsdem_vec3 p, int axis, fsdem_real shift,
+                                              fsdem_swe_cell fallback) {
+    fsdem_swe_cell cell;
+    fsdem_real x = p.x + (axis == 0 ? shift : 0), y = p.y + (axis == 1 ? shift : 0);
+    return fsdem_swe_sample_state(swe, x, y, &cell) == FSDEM_OK ? cell : fallback;
+}
+
+/* Buoyancy (Eq. 5) and heave damping of sphere i at its current height and vertical speed, against
+   the water surface held in out->surface; updates `out` and returns the vertical force (N). */
+static fsdem_real fsdem__swe_dem_vertical(const fsdem_swe_dem *c, const fsdem_dem_particles *pv, int i,
+                                          fsdem_swe_dem_force *out) {
+    const fsdem_real rho = c->rho, g = c->g, r = pv->radius[i], z = pv->position[i].z;
+    out->submerged_volume = fsdem__swe_dem_submerged_sphere(r, z, out->surface);
+    out->buoyancy = fsdem_v3(0, 0, rho * g * out->submerged_volume);
+    out->heave = fsdem__zero3();
+    if (c->desc.heave_damping > 0) {
+        /* critical damping of the hydrostatic spring rho g A_waterplane of the bobbing */
+        fsdem_real a2 = r * r - (out->surface - z) * (out->surface - z);
+        if (a2 > 0)
+            out->heave.z = -2 * c->desc.heave_damping * (fsdem_real)sqrt(rho * g * (fsdem_real)FSDEM__PI * a2 * pv->mass[i]) *
+                           pv->velocity[i].z;
+    }
+    return out->buoyancy.z + out->heave.z;
+}
+
+/* ---- >>couple_swe_forces : seed 003 Eq. 5-8 ---- */
+
+fsdem_result fsdem_swe_dem_update(fsdem_swe_dem *c) {
+    fsdem_swe *swe;
+    fsdem_dem_particles pv;
+    fsdem_dem_coupling loads;
+    fsdem_real beta;
+    int i, a, axes, n;
+    if (!c) return FSDEM_ERR_INVALID_ARG;
+    swe = c->desc.swe;
+    beta = c->desc.beta;
+    axes = fsdem_swe_get_desc(swe).dim;
+    pv = fsdem_dem_get_particles(c->desc.dem);
+    n = pv.count;
+    if (n > c->force_capacity) {
+        fsdem_swe_dem_force *force = (fsdem_swe_dem_force *)fsdem__alloc(&c->head.allocator, sizeof *force * (size_t)n);
+        fsdem_vec3 *reaction = (fsdem_vec3 *)fsdem__alloc(&c->head.allocator, sizeof *reaction * (size_t)n);
+        if (!force || !reaction) {
+            fsdem__free(&c->head.allocator, force, sizeof *force * (size_t)n);
+            fsdem__free(&c->head.allocator, reaction, sizeof *reaction * (size_t)n);
+            return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_dem: out of memory for the forces of %d particles", n);
+        }
+        fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_capacity);
+        fsdem__free(&c->head.allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
+        c->force = force;
+        c->reaction = reaction;
+        c->force_capacity = n;
+    }
+    loads = fsdem_dem_get_coupling(c->desc.dem);
+    if (c->desc.two_way) fsdem_swe_clear_forces(swe);
+    c->wet = 0;
+    for (i = 0; i < n; ++i) {
+        fsdem_swe_dem_force *out = &c->force[i];
+        const fsdem_vec3 p = pv.position[i], w = pv.velocity[i];
+        const fsdem_real r = pv.radius[i];
+        fsdem_swe_cell centre, back[2], front[2], flow;
+        fsdem_vec3 horizontal;
+        memset(out, 0, sizeof *out);
+        out->id = pv.id[i];
+        loads.force[i] = c->reaction[i] = fsdem__zero3();
+        if (pv.fixed[i] || fsdem_swe_sample_state(swe, p.x, p.y, &centre) != FSDEM_OK) continue;
+        /* the water at the centre, and at the back (-r) and front (+r) along each horizontal axis; the
+           flow velocity is the centre's, or that of the deepest side while a front reaches the sphere */
+        flow = centre;
+        for (a = 0; a < axes; ++a) {
+            back[a] = fsdem__swe_dem_water_at(swe, p, a, -r, centre);
+            front[a] = fsdem__swe_dem_water_at(swe, p, a, r, centre);
+            if (flow.depth < c->dry && back[a].depth > flow.depth) flow = back[a];
+            if (flow.depth < c->dry && front[a].depth > flow.depth) flow = front[a];
+        }
+        if (flow.depth < c->dry) continue;
+        out->wet = 1;
+        c->wet++;
+        out->surface = centre.eta;
+        for (a = 0; a < axes; ++a) {
+            /* Eq. 6-7 along axis a */
+            fsdem_real area_b, area_f, m_b, m_f, rel, hydro, dyn;
+            fsdem__swe_dem_submerged_disc(r, p.z, back[a].eta, &area_b, &m_b);
+            fsdem__swe_dem_submerged_disc(r, p.z, front[a].eta, &area_f, &m_f);
+            rel = beta * (a == 0 ? flow.u : flow.v) - (a == 0 ? w.x : w.y);
+            hydro = c->rho * c->g * (m_b - m_f);
+            dyn = c->rho * rel * (rel < 0 ? -rel : rel) * (rel > 0 ? area_b : area_f);
+            if (a == 0) {
+                out->hydrostatic.x = hydro;
+                out->dynamic.x = dyn;
+                out->frontal_area = area_f;
+            } else {
+                out->hydrostatic.y = hydro;
+                out->dynamic.y = dyn;
+            }
+        }
+        horizontal = fsdem__add(out->hydrostatic, out->dynamic);
+        if (c->desc.two_way) {
+            /* Eq. 8: the reaction -F_h as a momentum source under the sphere; a force whose reaction
+               no wet cell can take is dropped, so momentum is exchanged, never created */
+            int taken = 0;
+            fsdem_swe_add_force(swe, p, r, fsdem__scale(horizontal, -1), &taken);
+            if (!taken) out->hydrostatic = out->dynamic = horizontal = fsdem__zero3();
+            c->reaction[i] = horizontal;
+        }
+        horizontal.z = fsdem__swe_dem_vertical(c, &pv, i, out);
+        loads.force[i] = horizontal;
+    }
+    c->head.record = c->force;
+    c->head.records = n;
+    return fsdem__ok(&c->head.status);
+}
+
+fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *c, int index, fsdem_swe_dem_force *out) {
+    return c ? fsdem__coupler_get_record(&c->head, index, out, "fsdem_swe_dem_get_force") : FSDEM_ERR_INVALID_ARG;
+}
+
+fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *c, const char *path) {
+    return c ? fsdem__coupler_write_csv(&c->head, path, "fsdem_swe_dem_write_csv") : FSDEM_ERR_INVALID_ARG;
+}
+
+fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
+    fsdem_swe_dem_stats st;
+    memset(&st, 0, sizeof st);
+    if (!c) return st;
+    st.coupling = fsdem__coupler_stats(&c->head);
+    st.wet = c->wet;
+    st.impulse_to_water = c->impulse;
+    return st;
+}
+
+/* ---- >>couple_swe_step : its stages and verbs ---- */
+
+/* fsdem_dem_substep_fn: buoyancy and heave damping of the spheres in water refreshed for the heights
+   of every DEM force evaluation, against the water surface held over the fluid step. */
+static fsdem_result fsdem__swe_dem_refresh(void *user, fsdem_dem *dem, double time) {
+    fsdem_swe_dem *c = (fsdem_swe_dem *)user;
+    const fsdem_dem_particles pv = fsdem_dem_get_particles(dem);
+    const fsdem_dem_coupling loads = fsdem_dem_get_coupling(dem);
+    int i;
+    (void)time;
+    for (i = 0; i < pv.count; ++i)
+        if (c->force[i].wet) loads.force[i].z = fsdem__swe_dem_vertical(c, &pv, i, &c->force[i]);
+    return FSDEM_OK;
+}
+
+static fsdem_result fsdem__swe_dem_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
+    (void)chosen;
+    return fsdem__coupler_substeps_within(head, dt);
+}
+
+static fsdem_result fsdem__swe_dem_forces(fsdem_coupler *head, fsdem_real dt) {
+    (void)dt;
+    return fsdem_swe_dem_update((fsdem_swe_dem *)(void *)head);
+}
+
+/* The reactions' impulse on the water over the step, then the DEM's substeps. */
+static fsdem_result fsdem__swe_dem_substeps(fsdem_coupler *head, fsdem_real dt) {
+    fsdem_swe_dem *c = (fsdem_swe_dem *)(void *)head;
+    const int count = fsdem_dem_get_particles(c->desc.dem).count;
+    int k;
+    for (k = 0; k < c->force_capacity && k < count; ++k) c->impulse = fsdem__madd(c->impulse, c->reaction[k], -dt);
+    return fsdem__coupler_substeps(head, dt, fsdem__swe_dem_refresh, c, "DEM substeps", NULL);
+}
+
+static const fsdem__stage fsdem__swe_dem_stages[3] = {{"forces", FSDEM__CLOCK_COUPLING, fsdem__swe_dem_forces},
+                                                      {"shallow-water step", FSDEM__CLOCK_FLUID, NULL},
+                                                      {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__swe_dem_substeps}};
+
+#define FSDEM__SWE_DEM_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_swe_dem_force, name), 1}
+static const fsdem__field fsdem__swe_dem_fields[9] = {
+    FSDEM__SWE_DEM_FIELD(id, INT),          FSDEM__SWE_DEM_FIELD(buoyancy, VEC3),         FSDEM__SWE_DEM_FIELD(hydrostatic, VEC3),
+    FSDEM__SWE_DEM_FIELD(dynamic, VEC3),    FSDEM__SWE_DEM_FIELD(heave, VEC3),            FSDEM__SWE_DEM_FIELD(submerged_volume, REAL),
+    FSDEM__SWE_DEM_FIELD(frontal_area, REAL), FSDEM__SWE_DEM_FIELD(surface, REAL),        FSDEM__SWE_DEM_FIELD(wet, INT)};
+#undef FSDEM__SWE_DEM_FIELD
+
+static const fsdem__coupler_class *fsdem__swe_dem_class(void) {
+    static const fsdem__coupler_class cls = {"fsdem_swe_dem", &fsdem__fluid_swe, sizeof(fsdem_swe_dem_force),
+        fsdem__swe_dem_fields, 9, NULL, NULL, NULL, fsdem__swe_dem_check, fsdem__swe_dem_stages, 3};
+    return &cls;
+}
+
+fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *c, fsdem_real dt) {
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_swe_dem_step_dt");
+}
+fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *c, fsdem_real duration, long long *steps) {
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_swe_dem_advance");
+}
+fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+double fsdem_swe_dem_time(const fsdem_swe_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
+
 /* ===== >>impl_couple_mps : unresolved MPS-DEM ========================================================
 
    Contents: >>couple_mps_object (desc, creation), >>couple_mps_exchange (seed 002 Eq. 25-36: pairs,
-   porosity, averages, forces, reactions), >>couple_mps_step (coupled time stepping). The coupler
-   reaches the solvers through their coupling functions only (>>doc). */
+   porosity, averages, forces, reactions), >>couple_mps_step (its stages and verbs on the staged
+   step of >>couple). The coupler reaches the solvers through their coupling functions only
+   (>>doc). */
 
 /* ---- >>couple_mps_object : desc, creation ---- */
 
@@ -17007,9 +17739,8 @@ typedef struct fsdem__mps_dem_tally {
 } fsdem__mps_dem_tally;
 
 struct fsdem_mps_dem {
+    fsdem_coupler head;            /* >>couple; its records are `force` */
     fsdem_mps_dem_desc desc;
-    fsdem__status status;
-    fsdem_allocator allocator;
     int dim;
     fsdem_mps_model model;         /* the MPS desc's */
     fsdem_real rho, mu;            /* fluid density, dynamic viscosity */
@@ -17029,8 +17760,8 @@ struct fsdem_mps_dem {
                                    /*    the water's drag relaxation time */
     fsdem_real *share;             /* per MPS particle: s_i of step 4 (0 for WALL and DUMMY) */
     int solid_cap;                 /* of solid, rate and share */
-    fsdem_mps_dem_force *force;    /* per DEM particle */
-    int force_cap, forces;         /* forces: DEM particles of the last update (0: none yet) */
+    fsdem_mps_dem_force *force;    /* per DEM particle of the last update (head.records of them) */
+    int force_cap;
     fsdem__mps_dem_tally tally;
     /* what the update of a step overwrote, put back when the step is refused (fsdem__mps_dem_keep) */
     fsdem_real *kept_porosity;     /* per MPS particle */
@@ -17039,11 +17770,9 @@ struct fsdem_mps_dem {
     fsdem_mps_dem_force *kept_force;
     int kept_mps_cap, kept_dem_cap, kept_forces;
     fsdem__mps_dem_tally kept_tally;
-    /* statistics */
-    long long steps, substeps, substeps_total;
-    fsdem_real dt_last;
-    double sec_mps, sec_dem;
 };
+
+static const fsdem__coupler_class *fsdem__mps_dem_class(void);
 
 fsdem_mps_dem_desc fsdem_mps_dem_desc_default(void) {
     fsdem_mps_dem_desc d;
@@ -17082,10 +17811,6 @@ fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, si
     }
     if (st.inflow_planes || st.outflow_planes) /* the coupler's per-particle records do not follow removals */
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: an MPS with inflows or outflows cannot be coupled yet");
-    if (fsdem__norm(fsdem__sub(dd.gravity, md.gravity)) > 1e-12 * fsdem__norm(md.gravity))
-        return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the DEM gravity (%g, %g, %g) differs from the MPS's (%g, %g, %g) m/s^2",
-                             (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)md.gravity.x,
-                             (double)md.gravity.y, (double)md.gravity.z);
     if (strcmp(fsdem_drag_law_name(d->drag), "unknown") == 0)
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
     if (!(d->averaging_radius == 0 ||
@@ -17099,14 +17824,12 @@ fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, si
     if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc.drag_dt_fraction must be in (0, 1] (got %g)",
                              (double)d->drag_dt_fraction);
-    if (d->max_substeps < 1)
-        return fsdem__reject(msg, size, "fsdem_mps_dem_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
-    return FSDEM_OK;
+    return fsdem__coupler_check(fsdem__mps_dem_class(), "fsdem_mps_dem_desc", d->mps, FSDEM_MPS_ARRAYS_FORCE | FSDEM_MPS_ARRAYS_POROSITY,
+                                d->dem, md.dim, md.gravity, d->max_substeps, msg, size);
 }
 
 fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem **out) {
     char msg[FSDEM__MESSAGE_SIZE];
-    fsdem_allocator al;
     fsdem_mps_dem *c;
     fsdem_mps_desc md;
     fsdem_result res;
@@ -17114,15 +17837,12 @@ fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem 
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_mps_dem_desc_check(desc, msg, sizeof msg);
-    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
-    c = (fsdem_mps_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                           res == FSDEM_OK ? &al : NULL, sizeof *c, "fsdem_mps_dem_create", &res);
+    c = (fsdem_mps_dem *)fsdem__coupler_new(fsdem__mps_dem_class(), res, msg, desc ? desc->mps : NULL, desc ? desc->dem : NULL,
+                                            FSDEM_MPS_ARRAYS_FORCE | FSDEM_MPS_ARRAYS_POROSITY, desc ? desc->max_substeps : 0,
+                                            desc ? desc->log : NULL, desc ? desc->log_user : NULL, sizeof *c, &res);
     if (!c) return res;
     md = fsdem_mps_get_desc(desc->mps);
     c->desc = *desc;
-    c->allocator = al;
-    c->status.log = desc->log;
-    c->status.log_user = desc->log_user;
     c->dim = md.dim;
     c->model = md.model;
     c->rho = md.density;
@@ -17134,7 +17854,7 @@ fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem 
     c->ns = (fsdem_real)(10 * FSDEM__PI / 21) * re * re * (c->dim == 3 ? re : 1);
     c->cell_volume = md.r0 * md.r0 * (c->dim == 3 ? md.r0 : 1);
     c->periods = fsdem__periods_of(md.periodic, md.dim, md.domain_min, md.domain_max);
-    if (fsdem_cellgrid_setup_periodic(&c->grid, &c->allocator, c->dim, md.domain_min, md.domain_max, re / 2, 0, md.periodic) !=
+    if (fsdem_cellgrid_setup_periodic(&c->grid, &c->head.allocator, c->dim, md.domain_min, md.domain_max, re / 2, 0, md.periodic) !=
         FSDEM_OK) {
         fsdem__log_oom(desc->log, desc->log_user, "fsdem_mps_dem_create", sizeof c->grid);
         fsdem_mps_dem_destroy(c);
@@ -17145,24 +17865,24 @@ fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem 
 }
 
 void fsdem_mps_dem_destroy(fsdem_mps_dem *c) {
-    fsdem_allocator al;
+    const fsdem_allocator *al;
     if (!c) return;
-    al = c->allocator;
+    al = &c->head.allocator;
     fsdem_cellgrid_free(&c->grid);
-    fsdem__free(&al, c->start, sizeof(int) * (size_t)c->start_cap);
-    fsdem__free(&al, c->pair, sizeof *c->pair * (size_t)c->pair_cap);
-    fsdem__free(&al, c->solid, sizeof(fsdem_real) * (size_t)c->solid_cap);
-    fsdem__free(&al, c->rate, sizeof(fsdem_real) * (size_t)c->solid_cap);
-    fsdem__free(&al, c->share, sizeof(fsdem_real) * (size_t)c->solid_cap);
-    fsdem__free(&al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
-    fsdem__free(&al, c->kept_porosity, sizeof(fsdem_real) * (size_t)c->kept_mps_cap);
-    fsdem__free(&al, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)c->kept_mps_cap);
-    fsdem__free(&al, c->kept_load, sizeof(fsdem_vec3) * (size_t)c->kept_dem_cap);
-    fsdem__free(&al, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_dem_cap);
-    fsdem__free(&al, c, sizeof *c);
+    fsdem__free(al, c->start, sizeof(int) * (size_t)c->start_cap);
+    fsdem__free(al, c->pair, sizeof *c->pair * (size_t)c->pair_cap);
+    fsdem__free(al, c->solid, sizeof(fsdem_real) * (size_t)c->solid_cap);
+    fsdem__free(al, c->rate, sizeof(fsdem_real) * (size_t)c->solid_cap);
+    fsdem__free(al, c->share, sizeof(fsdem_real) * (size_t)c->solid_cap);
+    fsdem__free(al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
+    fsdem__free(al, c->kept_porosity, sizeof(fsdem_real) * (size_t)c->kept_mps_cap);
+    fsdem__free(al, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)c->kept_mps_cap);
+    fsdem__free(al, c->kept_load, sizeof(fsdem_vec3) * (size_t)c->kept_dem_cap);
+    fsdem__free(al, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_dem_cap);
+    fsdem__coupler_free(&c->head, sizeof *c);
 }
 
-const char *fsdem_mps_dem_last_error(const fsdem_mps_dem *c) { return c ? c->status.message : "fsdem_mps_dem is NULL"; }
+const char *fsdem_mps_dem_last_error(const fsdem_mps_dem *c) { return c ? c->head.status.message : "fsdem_mps_dem is NULL"; }
 
 fsdem_mps_dem_desc fsdem_mps_dem_get_desc(const fsdem_mps_dem *c) {
     fsdem_mps_dem_desc d;
@@ -17257,7 +17977,7 @@ static fsdem_real fsdem__mps_dem_open_weight(const fsdem_mps_dem *c, const fsdem
 
 /* Makes room for the per-particle arrays (nd DEM, nm MPS particles). */
 static fsdem_result fsdem__mps_dem_room(fsdem_mps_dem *c, int nd, int nm) {
-    const fsdem_allocator *al = &c->allocator;
+    const fsdem_allocator *al = &c->head.allocator;
     int cap = c->force_cap;
     void **const fluid[3] = {(void **)&c->solid, (void **)&c->rate, (void **)&c->share};
     const size_t size[3] = {sizeof(fsdem_real), sizeof(fsdem_real), sizeof(fsdem_real)};
@@ -17284,7 +18004,7 @@ static fsdem_result fsdem__mps_dem_pairs(fsdem_mps_dem *c, const fsdem_dem_parti
                 const fsdem_real r2 = fsdem__dot(d, d);
                 if (mv->kind[i] == FSDEM_MPS_KIND_DUMMY || !(r2 < re2)) continue;
                 if (n == c->pair_cap &&
-                    fsdem__grow(&c->allocator, (void **)&c->pair, &c->pair_cap, n, n + 1, sizeof *c->pair) != FSDEM_OK)
+                    fsdem__grow(&c->head.allocator, (void **)&c->pair, &c->pair_cap, n, n + 1, sizeof *c->pair) != FSDEM_OK)
                     return FSDEM_ERR_OUT_OF_MEMORY;
                 c->pair[n].particle = i;
                 c->pair[n++].weight = fsdem__mps_dem_weight((fsdem_real)sqrt(r2), re);
@@ -17346,19 +18066,18 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
     fsdem_mps_particles mv;
     fsdem_mps_coupling mc;
     fsdem_dem_coupling dc;
-    clock_t t0 = clock();
     int i, k, e;
     if (!c) return FSDEM_ERR_INVALID_ARG;
     {
         const fsdem_mps_desc md = fsdem_mps_get_desc(c->desc.mps);
-        if (fsdem__dem_particles_fit(c->desc.dem, md.domain_min, md.domain_max, &c->status, "fsdem_mps_dem_update") != FSDEM_OK)
+        if (fsdem__coupler_particles_fit(&c->head, md.domain_min, md.domain_max, "fsdem_mps_dem_update") != FSDEM_OK)
             return FSDEM_ERR_INVALID_ARG;
     }
     dv = fsdem_dem_get_particles(c->desc.dem);
     mv = fsdem_mps_get_particles(c->desc.mps);
     memset(&c->tally, 0, sizeof c->tally);
     if (fsdem__mps_dem_room(c, dv.count, mv.count) != FSDEM_OK || fsdem__mps_dem_pairs(c, &dv, &mv) != FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem_update: out of memory (%d DEM and %d MPS particles)",
+        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem_update: out of memory (%d DEM and %d MPS particles)",
                            dv.count, mv.count);
     mc = fsdem_mps_get_coupling(c->desc.mps);
     dc = fsdem_dem_get_coupling(c->desc.dem);
@@ -17397,7 +18116,7 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
             c->tally.wet++;
         }
         if (!fsdem__finite3(c->force[k].total))
-            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_mps_dem_update: the fluid force on DEM particle %d is not finite", k);
+            return fsdem__fail(&c->head.status, FSDEM_ERR_NAN, "fsdem_mps_dem_update: the fluid force on DEM particle %d is not finite", k);
         dc.force[k] = c->force[k].total;
         c->tally.drag_sum = fsdem__add(c->tally.drag_sum, c->force[k].drag);
         c->tally.pressure_sum = fsdem__add(c->tally.pressure_sum, c->force[k].pressure);
@@ -17408,24 +18127,17 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
         c->tally.fluid_sum = fsdem__add(c->tally.fluid_sum, mc.force[i]);
     }
     c->tally.fluid_sum = fsdem__scale(c->tally.fluid_sum, c->depth);
-    c->forces = dv.count;
-    c->sec_dem += (double)(clock() - t0) / CLOCKS_PER_SEC;
-    return fsdem__ok(&c->status);
-}
-
-/* The record of DEM particle `index` (-1: none). */
-static int fsdem__mps_dem_record(const fsdem_mps_dem *c, int index) {
-    return c->forces ? fsdem__dem_record_of(c->desc.dem, index, &c->force[0].id, sizeof *c->force, c->forces) : -1;
+    c->head.record = c->force;
+    c->head.records = dv.count;
+    return fsdem__ok(&c->head.status);
 }
 
 fsdem_result fsdem_mps_dem_get_force(const fsdem_mps_dem *c, int index, fsdem_mps_dem_force *out) {
-    int k;
-    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
-    if ((k = fsdem__mps_dem_record(c, index)) < 0)
-        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_mps_dem_get_force: no particle %d in the last update",
-                           index);
-    *out = c->force[k];
-    return FSDEM_OK;
+    return c ? fsdem__coupler_get_record(&c->head, index, out, "fsdem_mps_dem_get_force") : FSDEM_ERR_INVALID_ARG;
+}
+
+fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *c, const char *path) {
+    return c ? fsdem__coupler_write_csv(&c->head, path, "fsdem_mps_dem_write_csv") : FSDEM_ERR_INVALID_ARG;
 }
 
 /* ---- >>couple_mps_step : coupled time stepping ---- */
@@ -17440,23 +18152,25 @@ static fsdem_result fsdem__mps_dem_keep(fsdem_mps_dem *c) {
     void **const grain[2] = {(void **)&c->kept_load, (void **)&c->kept_force};
     const size_t fluid_size[2] = {sizeof(fsdem_real), sizeof(fsdem_vec3)};
     const size_t grain_size[2] = {sizeof(fsdem_vec3), sizeof(fsdem_mps_dem_force)};
-    if (fsdem__grow_set(&c->allocator, fluid, fluid_size, 2, &c->kept_mps_cap, 0, mc.count) != FSDEM_OK ||
-        fsdem__grow_set(&c->allocator, grain, grain_size, 2, &c->kept_dem_cap, 0, dc.count > c->forces ? dc.count : c->forces) != FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem: out of memory (%d DEM and %d MPS particles)", dc.count,
+    const int records = c->head.records;
+    if (fsdem__grow_set(&c->head.allocator, fluid, fluid_size, 2, &c->kept_mps_cap, 0, mc.count) != FSDEM_OK ||
+        fsdem__grow_set(&c->head.allocator, grain, grain_size, 2, &c->kept_dem_cap, 0, dc.count > records ? dc.count : records) != FSDEM_OK)
+        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem: out of memory (%d DEM and %d MPS particles)", dc.count,
                            mc.count);
     if (mc.count) {
         memcpy(c->kept_porosity, mc.porosity, sizeof(fsdem_real) * (size_t)mc.count);
         memcpy(c->kept_reaction, mc.force, sizeof(fsdem_vec3) * (size_t)mc.count);
     }
     if (dc.count) memcpy(c->kept_load, dc.force, sizeof(fsdem_vec3) * (size_t)dc.count);
-    if (c->forces) memcpy(c->kept_force, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->forces);
-    c->kept_forces = c->forces;
+    if (records) memcpy(c->kept_force, c->force, sizeof(fsdem_mps_dem_force) * (size_t)records);
+    c->kept_forces = records;
     c->kept_tally = c->tally;
     return FSDEM_OK;
 }
 
-/* Puts back what fsdem__mps_dem_keep kept; passes `res` on. */
-static fsdem_result fsdem__mps_dem_undo(fsdem_mps_dem *c, fsdem_result res) {
+/* Puts back what fsdem__mps_dem_keep kept (the class's undo). */
+static void fsdem__mps_dem_undo(fsdem_coupler *head) {
+    fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
     const fsdem_mps_coupling mc = fsdem_mps_get_coupling(c->desc.mps);
     const fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
     if (mc.count) {
@@ -17465,122 +18179,86 @@ static fsdem_result fsdem__mps_dem_undo(fsdem_mps_dem *c, fsdem_result res) {
     }
     if (dc.count) memcpy(dc.force, c->kept_load, sizeof(fsdem_vec3) * (size_t)dc.count);
     if (c->kept_forces) memcpy(c->force, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_forces);
-    c->forces = c->kept_forces;
+    c->head.records = c->kept_forces;
     c->tally = c->kept_tally;
-    return res;
 }
 
-/* The update of a step, kept to be undone if the step is refused. */
-static fsdem_result fsdem__mps_dem_update_kept(fsdem_mps_dem *c) {
+/* The update of a step, kept to be undone if the step is refused (the class's prepare). */
+static fsdem_result fsdem__mps_dem_prepare(fsdem_coupler *head) {
+    fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
     fsdem_result res = fsdem__mps_dem_keep(c);
-    if (res == FSDEM_OK && (res = fsdem_mps_dem_update(c)) != FSDEM_OK) fsdem__mps_dem_undo(c, res);
+    if (res == FSDEM_OK && (res = fsdem_mps_dem_update(c)) != FSDEM_OK) fsdem__mps_dem_undo(head);
     return res;
 }
 
-/* The stable coupled step of the last update: the MPS's (Eq. 37) and the drag limit. */
-static fsdem_result fsdem__mps_dem_stable(const fsdem_mps_dem *c, fsdem_real *dt) {
-    const fsdem_result res = fsdem_mps_stable_dt(c->desc.mps, dt);
-    if (res != FSDEM_OK) return res;
+/* The drag limit of the last update on the stable step (>>couple_mps; the class's limit). */
+static fsdem_result fsdem__mps_dem_limit(const fsdem_coupler *head, fsdem_real *dt) {
+    const fsdem_mps_dem *c = (const fsdem_mps_dem *)(const void *)head;
     if (c->tally.drag_dt > 0 && c->desc.drag_dt_fraction * c->tally.drag_dt < *dt) *dt = c->desc.drag_dt_fraction * c->tally.drag_dt;
     return FSDEM_OK;
 }
 
-/* Step 5 of >>couple_mps after a kept update: the MPS step of dt, then the DEM substeps. A step
-   refused before anything moves (too many substeps, the drag limit, the MPS's CFL limits) undoes
-   the update. */
-static fsdem_result fsdem__mps_dem_run(fsdem_mps_dem *c, fsdem_real dt) {
-    long long substeps = 0;
-    fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_mps_dem");
-    clock_t t0, t1;
-    if (res != FSDEM_OK) return fsdem__mps_dem_undo(c, res);
+/* A step of dt refused before anything moves: too many substeps, or past the drag limit. */
+static fsdem_result fsdem__mps_dem_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
+    fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
+    const fsdem_result res = fsdem__coupler_substeps_within(head, dt);
+    (void)chosen;
+    if (res != FSDEM_OK) return res;
     if (c->tally.drag_dt > 0 && dt > c->desc.drag_dt_fraction * c->tally.drag_dt * (1 + (fsdem_real)1e-6))
-        return fsdem__mps_dem_undo(c, fsdem__fail(&c->status, FSDEM_ERR_CFL,
-                                                  "fsdem_mps_dem: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation "
-                                                  "time %g s",
-                                                  (double)dt, (double)c->desc.drag_dt_fraction, (double)c->tally.drag_dt));
-    t0 = clock();
-    res = fsdem_mps_step_dt(c->desc.mps, dt);
-    t1 = clock();
-    c->sec_mps += (double)(t1 - t0) / CLOCKS_PER_SEC;
-    if (res == FSDEM_ERR_CFL) fsdem__mps_dem_undo(c, res); /* refused before it moved */
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_mps_dem: MPS step: %s", fsdem_mps_last_error(c->desc.mps));
-    res = fsdem_dem_advance(c->desc.dem, dt, &substeps);
-    c->sec_dem += (double)(clock() - t1) / CLOCKS_PER_SEC;
-    c->steps++;
-    c->dt_last = dt;
-    c->substeps = substeps;
-    c->substeps_total += substeps;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_mps_dem: DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
-    return fsdem__ok(&c->status);
+        return fsdem__fail(&head->status, FSDEM_ERR_CFL,
+                           "fsdem_mps_dem: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s", (double)dt,
+                           (double)c->desc.drag_dt_fraction, (double)c->tally.drag_dt);
+    return FSDEM_OK;
 }
 
-fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *c) {
-    fsdem_real dt = 0;
-    fsdem_result res;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if ((res = fsdem__mps_dem_update_kept(c)) != FSDEM_OK) return res;
-    if ((res = fsdem__mps_dem_stable(c, &dt)) != FSDEM_OK)
-        return fsdem__mps_dem_undo(c, fsdem__fail(&c->status, res, "fsdem_mps_dem_step: %s", fsdem_mps_last_error(c->desc.mps)));
-    return fsdem__mps_dem_run(c, dt);
+/* Step 5 of >>couple_mps after the MPS step: the DEM over dt with the forces held. */
+static fsdem_result fsdem__mps_dem_substeps(fsdem_coupler *head, fsdem_real dt) {
+    return fsdem__coupler_substeps(head, dt, NULL, NULL, "DEM substeps", NULL);
 }
 
+static const fsdem__stage fsdem__mps_dem_stages[2] = {{"MPS step", FSDEM__CLOCK_FLUID, NULL},
+                                                      {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__mps_dem_substeps}};
+
+#define FSDEM__MPS_DEM_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_mps_dem_force, name), 1}
+static const fsdem__field fsdem__mps_dem_fields[8] = {
+    FSDEM__MPS_DEM_FIELD(id, INT),          FSDEM__MPS_DEM_FIELD(drag, VEC3),     FSDEM__MPS_DEM_FIELD(pressure, VEC3),
+    FSDEM__MPS_DEM_FIELD(total, VEC3),      FSDEM__MPS_DEM_FIELD(fluid_velocity, VEC3), FSDEM__MPS_DEM_FIELD(porosity, REAL),
+    FSDEM__MPS_DEM_FIELD(reynolds, REAL),   FSDEM__MPS_DEM_FIELD(wet, INT)};
+#undef FSDEM__MPS_DEM_FIELD
+
+static const fsdem__coupler_class *fsdem__mps_dem_class(void) {
+    static const fsdem__coupler_class cls = {"fsdem_mps_dem", &fsdem__fluid_mps, sizeof(fsdem_mps_dem_force),
+        fsdem__mps_dem_fields, 8, fsdem__mps_dem_prepare, fsdem__mps_dem_undo, fsdem__mps_dem_limit, fsdem__mps_dem_check,
+        fsdem__mps_dem_stages, 2};
+    return &cls;
+}
+
+fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
 fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *c, fsdem_real dt) {
-    fsdem_result res;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_dem_step_dt: dt = %g s must be > 0 and finite", (double)dt);
-    if ((res = fsdem__mps_dem_update_kept(c)) != FSDEM_OK) return res;
-    return fsdem__mps_dem_run(c, dt);
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_mps_dem_step_dt");
 }
-
-/* fsdem__coupled_advance's verbs for this coupler: the update and its stable step, the step. */
-static double fsdem__mps_dem_now(const void *c) { return fsdem_mps_time(((const fsdem_mps_dem *)c)->desc.mps); }
-
-static fsdem_result fsdem__mps_dem_prepare(void *object, fsdem_real *dt) {
-    fsdem_mps_dem *c = (fsdem_mps_dem *)object;
-    fsdem_result res = fsdem__mps_dem_update_kept(c);
-    if (res == FSDEM_OK && (res = fsdem__mps_dem_stable(c, dt)) != FSDEM_OK)
-        fsdem__mps_dem_undo(c, fsdem__fail(&c->status, res, "fsdem_mps_dem_advance: %s", fsdem_mps_last_error(c->desc.mps)));
-    return res;
-}
-
-static fsdem_result fsdem__mps_dem_go(void *c, fsdem_real dt) { return fsdem__mps_dem_run((fsdem_mps_dem *)c, dt); }
-
 fsdem_result fsdem_mps_dem_advance(fsdem_mps_dem *c, fsdem_real duration, long long *steps) {
-    static const fsdem__coupled_verbs verbs = {fsdem__mps_dem_now, fsdem__mps_dem_prepare, fsdem__mps_dem_go};
-    if (steps) *steps = 0;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__coupled_advance(c, &c->status, "fsdem_mps_dem_advance", &verbs, duration, steps);
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_mps_dem_advance");
 }
-
-fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) {
-    if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__mps_dem_stable(c, dt);
-}
-
-double fsdem_mps_dem_time(const fsdem_mps_dem *c) { return c ? fsdem_mps_time(c->desc.mps) : 0; }
+fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+double fsdem_mps_dem_time(const fsdem_mps_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
+fsdem_coupler *fsdem_mps_dem_coupler(fsdem_mps_dem *c) { return c ? &c->head : NULL; }
 
 fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *c) {
     fsdem_mps_dem_stats st;
     int k;
     memset(&st, 0, sizeof st);
     if (!c) return st;
-    st.steps = c->steps;
-    st.time = fsdem_mps_time(c->desc.mps);
-    st.dt = c->dt_last;
-    st.substeps = c->substeps;
-    st.substeps_total = c->substeps_total;
+    st.coupling = fsdem__coupler_stats(&c->head);
     st.wet = c->tally.wet;
     st.drag = c->tally.drag_sum;
     st.pressure = c->tally.pressure_sum;
     st.to_fluid = c->tally.fluid_sum;
     st.drag_dt = c->tally.drag_dt;
     st.pairs = c->tally.pairs;
-    for (k = 0; k < c->forces; ++k)
+    for (k = 0; k < c->head.records; ++k)
         st.exchanged = fsdem__add(st.exchanged, c->model == FSDEM_MPS_MODEL_A ? c->force[k].drag : c->force[k].total);
     st.exchange_residual = fsdem__norm(fsdem__add(st.to_fluid, st.exchanged));
-    st.seconds_mps = c->sec_mps;
-    st.seconds_dem = c->sec_dem;
     return st;
 }
 
@@ -17589,8 +18267,8 @@ fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *c) {
    Contents: >>couple_pic_object (desc, creation, per-body storage), >>couple_pic_faces (bodies as
    moving cut-cell solids: face fractions, solid velocities, J, references), >>couple_pic_exchange
    (the implicit pressure term, fluid forces), >>couple_pic_gap (Eq. 20, particles out of bodies),
-   >>couple_pic_step (coupled time stepping). The coupler speaks to the PIC through its public
-   calls only: it indexes the grid through its own MAC layout (fsdem__mac, built from
+   >>couple_pic_step (its stages and verbs on the staged step of >>couple). The coupler speaks to
+   the PIC through its public calls only: it indexes the grid through its own MAC layout (fsdem__mac, built from
    fsdem_pic_get_fields), writes the coupling arrays (fsdem_pic_get_coupling: the coupler owns open,
    solid_velocity, start_velocity and reference, and resets them at every cut) and cuts the faces
    with the cut-cell sampler of >>geom that the PIC cuts its obstacles with, so static obstacles and
@@ -17607,9 +18285,8 @@ typedef struct fsdem__pic_dem_map {
 } fsdem__pic_dem_map;
 
 struct fsdem_pic_dem {
+    fsdem_coupler head;            /* >>couple; its records are `load` once a step has loaded them */
     fsdem_pic_dem_desc desc;
-    fsdem__status status;
-    fsdem_allocator allocator;
     int dim;
     fsdem_real rho, nu;            /* liquid density, kinematic viscosity */
     fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC works per metre), 1 in 3D */
@@ -17619,13 +18296,11 @@ struct fsdem_pic_dem {
     unsigned char side_closed[6];  /* the PIC's domain sides that are walls (not outflow) */
     /* per body (DEM particle), `bodies` of them */
     int bodies, body_cap;
-    int *body_id;        /* stable DEM id of each body of the last step */
+    fsdem_pic_dem_force *load;     /* the record of each body: its id and volume from the last cut, */
+                                   /*    its loads from the last step */
     fsdem_vec3 *vstar, *wstar;     /* predicted velocities Q* (step 1) */
     fsdem_real *inv_m, *inv_i;     /* 1/kg and 1/(kg m^2) per metre of depth (0: fixed) */
-    fsdem_vec3 *fp, *fv, *tq;      /* last step's loads on the whole body (N, N m) */
-    fsdem_vec3 *wc;                /* N; the well-balanced weight's correction of the last step */
-    fsdem_real *volume;            /* m^3 (m^2 in 2D) as the faces normal to gravity see it */
-    fsdem_real *weight;            /* that volume over the exact one (desc.discrete_weight), else 1 */
+    fsdem_real *weight;            /* the volume seen over the exact one (desc.discrete_weight), else 1 */
     fsdem_real *relax;             /* s; viscous relaxation time (0: none) */
     /* faces each body covers or cuts: entries face_start[b] .. face_start[b + 1] */
     int *face_start;
@@ -17644,13 +18319,13 @@ struct fsdem_pic_dem {
     fsdem_vec3 *contact_point;
     int contact_count, contact_cap;
     int operator_set;              /* the pressure term is installed */
-    /* statistics */
-    long long steps, substeps, substeps_total, dissipated, pushed, removed;
-    fsdem_real dt_last, viscous_dt;
+    long long dissipated, pushed, removed;
+    fsdem_real viscous_dt;
     fsdem_vec3 force_sum;
-    double sec_pic, sec_dem, sec_coupling;
-    int loaded;                    /* the loads of a step are in fp, fv, tq */
+    int loaded;                    /* the loads of a step are in `load` */
 };
+
+static const fsdem__coupler_class *fsdem__pic_dem_class(void);
 
 fsdem_pic_dem_desc fsdem_pic_dem_desc_default(void) {
     fsdem_pic_dem_desc d;
@@ -17664,17 +18339,10 @@ fsdem_pic_dem_desc fsdem_pic_dem_desc_default(void) {
 }
 
 fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *d, char *msg, size_t size) {
-    fsdem_dem_desc dd;
     fsdem_pic_desc pd;
     if (!d) return fsdem__reject(msg, size, "fsdem_pic_dem_desc is NULL");
     if (!d->pic || !d->dem) return fsdem__reject(msg, size, "fsdem_pic_dem_desc.pic and .dem must both be set");
-    dd = fsdem_dem_get_desc(d->dem);
     pd = fsdem_pic_get_desc(d->pic);
-    if (dd.dim != pd.dim) return fsdem__reject(msg, size, "fsdem_pic_dem_desc: the DEM is %dD and the PIC %dD", dd.dim, pd.dim);
-    if (fsdem__norm(fsdem__sub(dd.gravity, pd.gravity)) > 1e-12 * fsdem__norm(pd.gravity))
-        return fsdem__reject(msg, size, "fsdem_pic_dem_desc: the DEM gravity (%g, %g, %g) differs from the PIC's (%g, %g, %g) m/s^2",
-                             (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)pd.gravity.x,
-                             (double)pd.gravity.y, (double)pd.gravity.z);
     if (!(d->dissipation >= 0 && d->dissipation <= 1))
         return fsdem__reject(msg, size, "fsdem_pic_dem_desc.dissipation must be in [0, 1] (got %g)", (double)d->dissipation);
     if (!(d->contact_length >= 0 && d->contact_length <= fsdem__smallest_extent(pd.domain_min, pd.domain_max, pd.dim)))
@@ -17686,91 +18354,80 @@ fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *d, char *msg, si
                              (double)d->viscous_dt_fraction);
     if (d->discrete_weight != 0 && d->discrete_weight != 1)
         return fsdem__reject(msg, size, "fsdem_pic_dem_desc.discrete_weight must be 0 or 1 (got %d)", d->discrete_weight);
-    if (d->max_substeps < 1)
-        return fsdem__reject(msg, size, "fsdem_pic_dem_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
-    return FSDEM_OK;
+    return fsdem__coupler_check(fsdem__pic_dem_class(), "fsdem_pic_dem_desc", d->pic, FSDEM_PIC_ARRAYS_SOLIDS, d->dem, pd.dim, pd.gravity,
+                                d->max_substeps, msg, size);
 }
 
 static void fsdem__pic_dem_free_bodies(fsdem_pic_dem *c) {
+    const fsdem_allocator *al = &c->head.allocator;
     const size_t n = (size_t)c->body_cap, V = sizeof(fsdem_vec3) * n, R = sizeof(fsdem_real) * n;
-    fsdem__free(&c->allocator, c->vstar, V);
-    fsdem__free(&c->allocator, c->wstar, V);
-    fsdem__free(&c->allocator, c->fp, V);
-    fsdem__free(&c->allocator, c->fv, V);
-    fsdem__free(&c->allocator, c->tq, V);
-    fsdem__free(&c->allocator, c->wc, V);
-    fsdem__free(&c->allocator, c->inv_m, R);
-    fsdem__free(&c->allocator, c->inv_i, R);
-    fsdem__free(&c->allocator, c->volume, R);
-    fsdem__free(&c->allocator, c->weight, R);
-    fsdem__free(&c->allocator, c->relax, R);
-    fsdem__free(&c->allocator, c->face_start, sizeof(int) * (n + 1));
-    fsdem__free(&c->allocator, c->jac_start, sizeof(int) * (n + 1));
-    fsdem__free(&c->allocator, c->body_id, sizeof(int) * n);
-    c->vstar = c->wstar = c->fp = c->fv = c->tq = c->wc = NULL;
-    c->inv_m = c->inv_i = c->volume = c->weight = c->relax = NULL;
-    c->face_start = c->jac_start = c->body_id = NULL;
+    fsdem__free(al, c->load, sizeof(fsdem_pic_dem_force) * n);
+    fsdem__free(al, c->vstar, V);
+    fsdem__free(al, c->wstar, V);
+    fsdem__free(al, c->inv_m, R);
+    fsdem__free(al, c->inv_i, R);
+    fsdem__free(al, c->weight, R);
+    fsdem__free(al, c->relax, R);
+    fsdem__free(al, c->face_start, sizeof(int) * (n + 1));
+    fsdem__free(al, c->jac_start, sizeof(int) * (n + 1));
+    c->load = NULL;
+    c->vstar = c->wstar = NULL;
+    c->inv_m = c->inv_i = c->weight = c->relax = NULL;
+    c->face_start = c->jac_start = NULL;
     c->body_cap = 0;
+    c->head.record = NULL;
+    c->head.records = 0;
 }
 
 /* Per-body arrays for `n` bodies (zeroed). Allocates only when the DEM has more particles than any
    step before. */
 static fsdem_result fsdem__pic_dem_reserve_bodies(fsdem_pic_dem *c, int n) {
+    const fsdem_allocator *al = &c->head.allocator;
     const size_t m = (size_t)(n > 0 ? n : 1), V = sizeof(fsdem_vec3) * m, R = sizeof(fsdem_real) * m;
     if (n <= c->body_cap && c->vstar) return FSDEM_OK;
     fsdem__pic_dem_free_bodies(c);
-    c->vstar = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->wstar = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->fp = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->fv = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->tq = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->wc = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->inv_m = (fsdem_real *)fsdem__alloc(&c->allocator, R);
-    c->inv_i = (fsdem_real *)fsdem__alloc(&c->allocator, R);
-    c->volume = (fsdem_real *)fsdem__alloc(&c->allocator, R);
-    c->weight = (fsdem_real *)fsdem__alloc(&c->allocator, R);
-    c->relax = (fsdem_real *)fsdem__alloc(&c->allocator, R);
-    c->face_start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (m + 1));
-    c->jac_start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (m + 1));
-    c->body_id = (int *)fsdem__alloc(&c->allocator, sizeof(int) * m);
+    c->load = (fsdem_pic_dem_force *)fsdem__alloc(al, sizeof(fsdem_pic_dem_force) * m);
+    c->vstar = (fsdem_vec3 *)fsdem__alloc(al, V);
+    c->wstar = (fsdem_vec3 *)fsdem__alloc(al, V);
+    c->inv_m = (fsdem_real *)fsdem__alloc(al, R);
+    c->inv_i = (fsdem_real *)fsdem__alloc(al, R);
+    c->weight = (fsdem_real *)fsdem__alloc(al, R);
+    c->relax = (fsdem_real *)fsdem__alloc(al, R);
+    c->face_start = (int *)fsdem__alloc(al, sizeof(int) * (m + 1));
+    c->jac_start = (int *)fsdem__alloc(al, sizeof(int) * (m + 1));
     c->body_cap = (int)m;
-    if (!c->vstar || !c->wstar || !c->fp || !c->fv || !c->tq || !c->wc || !c->inv_m || !c->inv_i || !c->volume || !c->weight || !c->relax ||
-        !c->face_start || !c->jac_start || !c->body_id) {
+    if (!c->load || !c->vstar || !c->wstar || !c->inv_m || !c->inv_i || !c->weight || !c->relax || !c->face_start || !c->jac_start) {
         fsdem__pic_dem_free_bodies(c);
         return FSDEM_ERR_OUT_OF_MEMORY;
     }
+    memset(c->load, 0, sizeof(fsdem_pic_dem_force) * m);
     memset(c->vstar, 0, V);
     memset(c->wstar, 0, V);
-    memset(c->fp, 0, V);
-    memset(c->fv, 0, V);
-    memset(c->tq, 0, V);
-    memset(c->wc, 0, V);
-    memset(c->volume, 0, R);
     memset(c->weight, 0, R);
     memset(c->relax, 0, R);
     memset(c->face_start, 0, sizeof(int) * (m + 1));
     memset(c->jac_start, 0, sizeof(int) * (m + 1));
-    memset(c->body_id, 0, sizeof(int) * m);
     c->loaded = 0;
     return FSDEM_OK;
 }
 
 static void fsdem__pic_dem_release(fsdem_pic_dem *c) {
+    const fsdem_allocator *al = &c->head.allocator;
     const int ncell = c->grid.ncell;
     fsdem__pic_dem_free_bodies(c);
-    fsdem__free(&c->allocator, c->face, sizeof(int) * (size_t)c->face_cap);
-    fsdem__free(&c->allocator, c->face_axis, (size_t)c->face_cap);
-    fsdem__free(&c->allocator, c->face_closed, sizeof(fsdem_real) * (size_t)c->face_cap);
-    fsdem__free(&c->allocator, c->jac_cell, sizeof(int) * (size_t)c->jac_cap);
-    fsdem__free(&c->allocator, c->jac_v, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
-    fsdem__free(&c->allocator, c->jac_w, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
-    fsdem__free(&c->allocator, c->slot, sizeof(int) * (size_t)ncell);
-    fsdem__free(&c->allocator, c->body_map.start, sizeof(int) * (size_t)(ncell + 1));
-    fsdem__free(&c->allocator, c->body_map.item, sizeof(int) * (size_t)c->body_map.item_cap);
-    fsdem__free(&c->allocator, c->contact_map.start, sizeof(int) * (size_t)(ncell + 1));
-    fsdem__free(&c->allocator, c->contact_map.item, sizeof(int) * (size_t)c->contact_map.item_cap);
-    fsdem__free(&c->allocator, c->contact, sizeof(fsdem_dem_contact) * (size_t)c->contact_cap);
-    fsdem__free(&c->allocator, c->contact_point, sizeof(fsdem_vec3) * (size_t)c->contact_cap);
+    fsdem__free(al, c->face, sizeof(int) * (size_t)c->face_cap);
+    fsdem__free(al, c->face_axis, (size_t)c->face_cap);
+    fsdem__free(al, c->face_closed, sizeof(fsdem_real) * (size_t)c->face_cap);
+    fsdem__free(al, c->jac_cell, sizeof(int) * (size_t)c->jac_cap);
+    fsdem__free(al, c->jac_v, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
+    fsdem__free(al, c->jac_w, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
+    fsdem__free(al, c->slot, sizeof(int) * (size_t)ncell);
+    fsdem__free(al, c->body_map.start, sizeof(int) * (size_t)(ncell + 1));
+    fsdem__free(al, c->body_map.item, sizeof(int) * (size_t)c->body_map.item_cap);
+    fsdem__free(al, c->contact_map.start, sizeof(int) * (size_t)(ncell + 1));
+    fsdem__free(al, c->contact_map.item, sizeof(int) * (size_t)c->contact_map.item_cap);
+    fsdem__free(al, c->contact, sizeof(fsdem_dem_contact) * (size_t)c->contact_cap);
+    fsdem__free(al, c->contact_point, sizeof(fsdem_vec3) * (size_t)c->contact_cap);
 }
 
 static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt);
@@ -17781,7 +18438,6 @@ static void fsdem__pic_dem_response(void *user, const fsdem_real *p, fsdem_real 
 
 fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem **out) {
     char msg[FSDEM__MESSAGE_SIZE];
-    fsdem_allocator al;
     fsdem_pic_dem *c;
     fsdem_pic_desc pd;
     fsdem_result res;
@@ -17789,15 +18445,12 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_pic_dem_desc_check(desc, msg, sizeof msg);
-    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
-    c = (fsdem_pic_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                           res == FSDEM_OK ? &al : NULL, sizeof *c, "fsdem_pic_dem_create", &res);
+    c = (fsdem_pic_dem *)fsdem__coupler_new(fsdem__pic_dem_class(), res, msg, desc ? desc->pic : NULL, desc ? desc->dem : NULL,
+                                            FSDEM_PIC_ARRAYS_SOLIDS, desc ? desc->max_substeps : 0, desc ? desc->log : NULL,
+                                            desc ? desc->log_user : NULL, sizeof *c, &res);
     if (!c) return res;
     pd = fsdem_pic_get_desc(desc->pic);
     c->desc = *desc;
-    c->allocator = al;
-    c->status.log = desc->log;
-    c->status.log_user = desc->log_user;
     c->dim = pd.dim;
     c->rho = pd.density;
     c->nu = pd.viscosity;
@@ -17811,14 +18464,13 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
     for (i = 0; i < 6; ++i) c->side_closed[i] = (unsigned char)(pd.boundary[i] != FSDEM_PIC_BC_OUTFLOW);
     c->arrays = fsdem_pic_get_coupling(desc->pic);
     ncell = c->grid.ncell;
-    if (fsdem__dem_particles_fit(desc->dem, pd.domain_min, pd.domain_max, &c->status, "fsdem_pic_dem_create") != FSDEM_OK) {
-        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, c->status.message);
-        fsdem__free(&al, c, sizeof *c);
+    if (fsdem__coupler_particles_fit(&c->head, pd.domain_min, pd.domain_max, "fsdem_pic_dem_create") != FSDEM_OK) {
+        fsdem__coupler_free(&c->head, sizeof *c);
         return FSDEM_ERR_INVALID_ARG;
     }
-    c->slot = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)ncell);
-    c->body_map.start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)(ncell + 1));
-    c->contact_map.start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)(ncell + 1));
+    c->slot = (int *)fsdem__alloc(&c->head.allocator, sizeof(int) * (size_t)ncell);
+    c->body_map.start = (int *)fsdem__alloc(&c->head.allocator, sizeof(int) * (size_t)(ncell + 1));
+    c->contact_map.start = (int *)fsdem__alloc(&c->head.allocator, sizeof(int) * (size_t)(ncell + 1));
     res = c->slot && c->body_map.start && c->contact_map.start ? FSDEM_OK : FSDEM_ERR_OUT_OF_MEMORY;
     if (res == FSDEM_OK) {
         for (i = 0; i < ncell; ++i) c->slot[i] = -1;
@@ -17828,7 +18480,7 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
     if (res == FSDEM_OK) res = fsdem__pic_dem_faces(c, 0);
     if (res == FSDEM_OK) res = fsdem_pic_set_pressure_extra(desc->pic, fsdem__pic_dem_operator, fsdem__pic_dem_response, c);
     if (res != FSDEM_OK) {
-        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, c->status.message[0] ? c->status.message : "fsdem_pic_dem_create: out of memory");
+        if (desc->log && !c->head.status.message[0]) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, "fsdem_pic_dem_create: out of memory");
         fsdem_pic_dem_destroy(c);
         return res;
     }
@@ -17838,16 +18490,16 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
 }
 
 void fsdem_pic_dem_destroy(fsdem_pic_dem *c) {
-    fsdem_allocator al;
     if (!c) return;
-    al = c->allocator;
     if (c->operator_set) fsdem_pic_set_pressure_extra(c->desc.pic, NULL, NULL, NULL);
     fsdem__pic_dem_clear_faces(c);
     fsdem__pic_dem_release(c);
-    fsdem__free(&al, c, sizeof *c);
+    fsdem__coupler_free(&c->head, sizeof *c);
 }
 
-const char *fsdem_pic_dem_last_error(const fsdem_pic_dem *c) { return c ? c->status.message : "fsdem_pic_dem is NULL"; }
+fsdem_coupler *fsdem_pic_dem_coupler(fsdem_pic_dem *c) { return c ? &c->head : NULL; }
+
+const char *fsdem_pic_dem_last_error(const fsdem_pic_dem *c) { return c ? c->head.status.message : "fsdem_pic_dem is NULL"; }
 
 fsdem_pic_dem_desc fsdem_pic_dem_get_desc(const fsdem_pic_dem *c) {
     fsdem_pic_dem_desc d;
@@ -17893,7 +18545,7 @@ static fsdem_result fsdem__pic_dem_jac_add(fsdem_pic_dem *c, int cell, fsdem_vec
     if (e < 0) {
         void **const arrays[3] = {(void **)&c->jac_cell, (void **)&c->jac_v, (void **)&c->jac_w};
         const size_t elem[3] = {sizeof(int), sizeof(fsdem_vec3), sizeof(fsdem_vec3)};
-        if (fsdem__grow_set(&c->allocator, arrays, elem, 3, &c->jac_cap, c->jac_count, c->jac_count + 1) != FSDEM_OK)
+        if (fsdem__grow_set(&c->head.allocator, arrays, elem, 3, &c->jac_cap, c->jac_count, c->jac_count + 1) != FSDEM_OK)
             return FSDEM_ERR_OUT_OF_MEMORY;
         e = c->slot[cell] = c->jac_count++;
         c->jac_cell[e] = cell;
@@ -17907,7 +18559,7 @@ static fsdem_result fsdem__pic_dem_jac_add(fsdem_pic_dem *c, int cell, fsdem_vec
 static fsdem_result fsdem__pic_dem_face_add(fsdem_pic_dem *c, int a, int f, fsdem_real closed) {
     void **const arrays[3] = {(void **)&c->face, (void **)&c->face_axis, (void **)&c->face_closed};
     const size_t elem[3] = {sizeof(int), 1, sizeof(fsdem_real)};
-    if (fsdem__grow_set(&c->allocator, arrays, elem, 3, &c->face_cap, c->face_count, c->face_count + 1) != FSDEM_OK)
+    if (fsdem__grow_set(&c->head.allocator, arrays, elem, 3, &c->face_cap, c->face_count, c->face_count + 1) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
     c->face[c->face_count] = f;
     c->face_axis[c->face_count] = (unsigned char)a;
@@ -18051,16 +18703,16 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
     int b, e, q;
     fsdem_result res;
     if ((res = fsdem__pic_dem_reserve_bodies(c, P.count)) != FSDEM_OK)
-        return fsdem__fail(&c->status, res, "fsdem_pic_dem: out of memory for the records of %d bodies", P.count);
+        return fsdem__fail(&c->head.status, res, "fsdem_pic_dem: out of memory for the records of %d bodies", P.count);
     fsdem__pic_dem_clear_faces(c);
     c->bodies = P.count;
-    if (P.count) memcpy(c->body_id, P.id, sizeof(int) * (size_t)P.count);
+    for (b = 0; b < P.count; ++b) c->load[b].id = P.id[b];
     for (b = 0; b < P.count; ++b)
         if ((res = fsdem__pic_dem_cut(c, b, P.position[b], P.radius[b])) != FSDEM_OK) {
             c->face_start[b + 1] = c->face_count;
             c->bodies = b + 1;
             for (q = 0; q <= c->bodies; ++q) c->jac_start[q] = 0;
-            return fsdem__fail(&c->status, res, "fsdem_pic_dem: out of memory cutting body %d", b);
+            return fsdem__fail(&c->head.status, res, "fsdem_pic_dem: out of memory cutting body %d", b);
         }
     c->face_start[P.count] = c->face_count;
     /* the faces' closed parts are pending (open = -(their sum)): each body's part is scaled to the
@@ -18077,7 +18729,7 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
         for (e = c->face_start[b]; e < c->face_start[b + 1]; ++e) axis[c->face_axis[e]] += c->face_closed[e] * cell;
         /* the volume that a pressure gradient along gravity acts on: sum_a (g_a^2 / g^2) V_a */
         for (q = 0; q < c->dim; ++q) seen += g2 > 0 ? fsdem__comp(c->gravity, q) * fsdem__comp(c->gravity, q) / g2 * axis[q] : axis[q] / (fsdem_real)c->dim;
-        c->volume[b] = seen;
+        c->load[b].volume = seen;
         c->weight[b] = c->desc.discrete_weight && seen > 0 ? seen / exact : 1;
         if (P.fixed[b]) {
             c->inv_m[b] = c->inv_i[b] = 0;
@@ -18117,7 +18769,7 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
         if ((res = fsdem__pic_dem_jacobian(c, b, P.position[b])) != FSDEM_OK) {
             for (q = 0; q <= c->bodies; ++q) c->jac_start[q] = 0;
             c->jac_count = 0;
-            return fsdem__fail(&c->status, res, "fsdem_pic_dem: out of memory for the J of body %d", b);
+            return fsdem__fail(&c->head.status, res, "fsdem_pic_dem: out of memory for the J of body %d", b);
         }
     /* the viscous relaxation time: the fastest component of the viscous solve's pull, visc per
        (closed face, open neighbour) pair (>>pic_viscosity) */
@@ -18238,42 +18890,47 @@ static fsdem_result fsdem__pic_dem_loads(fsdem_pic_dem *c) {
             F = fsdem__add(F, force);
             Tv = fsdem__add(Tv, fsdem__cross(fsdem__pic_dem_arm(c, e, P.position[b]), force));
         }
-        c->fp[b] = fsdem__scale(G, area * c->depth);
-        c->fv[b] = fsdem__scale(F, c->depth);
-        c->tq[b] = fsdem__scale(fsdem__add(fsdem__scale(T, area), Tv), c->depth);
-        if (!fsdem__finite3(c->fp[b]) || !fsdem__finite3(c->fv[b]) || !fsdem__finite3(c->tq[b]))
-            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_pic_dem: the fluid force on body %d is not finite", b);
-        c->force_sum = fsdem__add(c->force_sum, fsdem__add(c->fp[b], c->fv[b]));
+        fsdem_pic_dem_force *r = &c->load[b];
+        r->pressure_force = fsdem__scale(G, area * c->depth);
+        r->viscous_force = fsdem__scale(F, c->depth);
+        r->torque = fsdem__scale(fsdem__add(fsdem__scale(T, area), Tv), c->depth);
+        r->faces = c->face_start[b + 1] - c->face_start[b];
+        if (!fsdem__finite3(r->pressure_force) || !fsdem__finite3(r->viscous_force) || !fsdem__finite3(r->torque))
+            return fsdem__fail(&c->head.status, FSDEM_ERR_NAN, "fsdem_pic_dem: the fluid force on body %d is not finite", b);
+        c->force_sum = fsdem__add(c->force_sum, fsdem__add(r->pressure_force, r->viscous_force));
         if (dc.count > b) {
             /* the well-balanced weight's correction (item 8 of >>couple_pic; 0 for fixed bodies) */
-            c->wc[b] = P.fixed[b] ? fsdem__zero3() : fsdem__scale(c->gravity, P.mass[b] * (c->weight[b] - 1));
-            dc.force[b] = fsdem__add(fsdem__add(c->fp[b], c->fv[b]), c->wc[b]);
-            dc.torque[b] = c->tq[b];
+            r->weight_correction = P.fixed[b] ? fsdem__zero3() : fsdem__scale(c->gravity, P.mass[b] * (c->weight[b] - 1));
+            dc.force[b] = fsdem__add(fsdem__add(r->pressure_force, r->viscous_force), r->weight_correction);
+            dc.torque[b] = r->torque;
         }
     }
     c->loaded = 1;
+    c->head.record = c->load;
+    c->head.records = c->bodies;
     return FSDEM_OK;
 }
 
-/* The load record of DEM particle `index` (-1: none). */
-static int fsdem__pic_dem_record(const fsdem_pic_dem *c, int index) {
-    return c->loaded && c->bodies ? fsdem__dem_record_of(c->desc.dem, index, c->body_id, sizeof(int), c->bodies) : -1;
+fsdem_result fsdem_pic_dem_get_force(const fsdem_pic_dem *c, int index, fsdem_pic_dem_force *out) {
+    return c ? fsdem__coupler_get_record(&c->head, index, out, "fsdem_pic_dem_get_force") : FSDEM_ERR_INVALID_ARG;
 }
 
-fsdem_result fsdem_pic_dem_get_force(const fsdem_pic_dem *c, int index, fsdem_pic_dem_force *out) {
-    int k;
-    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
-    if ((k = fsdem__pic_dem_record(c, index)) < 0)
-        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_pic_dem_get_force: no body %d in the last step (%d)",
-                           index, c->loaded ? c->bodies : 0);
-    out->id = c->body_id[k];
-    out->pressure_force = c->fp[k];
-    out->viscous_force = c->fv[k];
-    out->torque = c->tq[k];
-    out->weight_correction = c->wc[k];
-    out->volume = c->volume[k];
-    out->faces = c->face_start[k + 1] - c->face_start[k];
-    return fsdem__ok((fsdem__status *)&c->status);
+fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *c, const char *path) {
+    return c ? fsdem__coupler_write_csv(&c->head, path, "fsdem_pic_dem_write_csv") : FSDEM_ERR_INVALID_ARG;
+}
+
+fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
+    fsdem_pic_dem_stats st;
+    memset(&st, 0, sizeof st);
+    if (!c) return st;
+    st.coupling = fsdem__coupler_stats(&c->head);
+    st.fluid_force = c->force_sum;
+    st.viscous_dt = c->viscous_dt;
+    st.contacts = c->contact_count;
+    st.dissipated = c->dissipated;
+    st.pushed = c->pushed;
+    st.removed = c->removed;
+    return st;
 }
 
 /* ---- >>couple_pic_gap : Eq. 20, particles out of bodies ---- */
@@ -18303,7 +18960,7 @@ static fsdem_result fsdem__pic_dem_map_build(fsdem_pic_dem *c, fsdem__pic_dem_ma
         if (pass == 0) {
             for (i = 0; i < grid->ncell; ++i) map->start[i + 1] += map->start[i];
             total = map->start[grid->ncell];
-            if (fsdem__grow(&c->allocator, (void **)&map->item, &map->item_cap, 0, total > 0 ? total : 1, sizeof(int)) != FSDEM_OK)
+            if (fsdem__grow(&c->head.allocator, (void **)&map->item, &map->item_cap, 0, total > 0 ? total : 1, sizeof(int)) != FSDEM_OK)
                 return FSDEM_ERR_OUT_OF_MEMORY;
         }
     }
@@ -18342,10 +18999,10 @@ static fsdem_result fsdem__pic_dem_exclude(fsdem_pic_dem *c, int from, int remov
     fsdem_result res;
     if (from >= P.count) return FSDEM_OK;
     if (fsdem__pic_dem_map_build(c, &c->body_map, P.count - from, P.position + from, P.radius + from, 0) != FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the bodies");
+        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the bodies");
     for (e = 0; e < c->body_map.start[c->grid.ncell] && from > 0; ++e) c->body_map.item[e] += from;
     res = fsdem_pic_exclude_particles(c->desc.pic, fsdem__pic_dem_solid, c, remove, &moved);
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
+    if (res != FSDEM_OK) return fsdem__fail(&c->head.status, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
     if (remove) c->removed += moved;
     else c->pushed += moved;
     return FSDEM_OK;
@@ -18359,20 +19016,20 @@ static fsdem_result fsdem__pic_dem_gap(fsdem_pic_dem *c) {
     const fsdem_pic_particles W = fsdem_pic_get_particles(c->desc.pic);
     const fsdem__mac *grid = &c->grid;
     int n = fsdem_dem_contacts(c->desc.dem, NULL, 0), k, p, e;
-    if (n < 0) return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
+    if (n < 0) return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
     if (n > c->contact_cap) {
         const size_t old = (size_t)c->contact_cap;
-        fsdem__free(&c->allocator, c->contact, sizeof(fsdem_dem_contact) * old);
-        fsdem__free(&c->allocator, c->contact_point, sizeof(fsdem_vec3) * old);
+        fsdem__free(&c->head.allocator, c->contact, sizeof(fsdem_dem_contact) * old);
+        fsdem__free(&c->head.allocator, c->contact_point, sizeof(fsdem_vec3) * old);
         c->contact_cap = 0;
-        c->contact = (fsdem_dem_contact *)fsdem__alloc(&c->allocator, sizeof(fsdem_dem_contact) * (size_t)n);
-        c->contact_point = (fsdem_vec3 *)fsdem__alloc(&c->allocator, sizeof(fsdem_vec3) * (size_t)n);
+        c->contact = (fsdem_dem_contact *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_dem_contact) * (size_t)n);
+        c->contact_point = (fsdem_vec3 *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_vec3) * (size_t)n);
         if (!c->contact || !c->contact_point) {
-            fsdem__free(&c->allocator, c->contact, sizeof(fsdem_dem_contact) * (size_t)n);
-            fsdem__free(&c->allocator, c->contact_point, sizeof(fsdem_vec3) * (size_t)n);
+            fsdem__free(&c->head.allocator, c->contact, sizeof(fsdem_dem_contact) * (size_t)n);
+            fsdem__free(&c->head.allocator, c->contact_point, sizeof(fsdem_vec3) * (size_t)n);
             c->contact = NULL;
             c->contact_point = NULL;
-            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
+            return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
         }
         c->contact_cap = n;
     }
@@ -18384,7 +19041,7 @@ static fsdem_result fsdem__pic_dem_gap(fsdem_pic_dem *c) {
         c->contact_point[k] = fsdem__madd(P.position[ct->i], ct->normal, -(P.radius[ct->i] + (offset - ct->overlap) / 2));
     }
     if (fsdem__pic_dem_map_build(c, &c->contact_map, n, c->contact_point, NULL, half) != FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the contacts");
+        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the contacts");
     for (p = 0; p < W.count; ++p) {
         const int cell = fsdem__mac_cell_of(grid, W.position[p]);
         for (e = c->contact_map.start[cell]; e < c->contact_map.start[cell + 1]; ++e) {
@@ -18399,141 +19056,135 @@ static fsdem_result fsdem__pic_dem_gap(fsdem_pic_dem *c) {
     return FSDEM_OK;
 }
 
-/* ---- >>couple_pic_step : coupled time stepping ---- */
+/* ---- >>couple_pic_step : its stages and verbs ---- */
 
-/* The stable coupled step (>>couple_pic, fsdem_pic_dem_stable_dt). */
-static fsdem_result fsdem__pic_dem_stable(const fsdem_pic_dem *c, fsdem_real *dt) {
-    fsdem__status *st = (fsdem__status *)&c->status; /* the message is the object's only mutable part here */
-    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
-    const fsdem_pic_desc pd = fsdem_pic_get_desc(c->desc.pic);
-    const fsdem_real dx = pd.cell_size;
+/* The fastest surface speed of a body, |V| + |w| r (m/s), and the body; -1 when one is not finite. */
+static fsdem_real fsdem__pic_dem_fastest(const fsdem_dem_particles *P, int *which) {
     fsdem_real vmax = 0;
     int b;
-    fsdem_result res = fsdem_pic_stable_dt(c->desc.pic, dt);
-    if (res != FSDEM_OK) return fsdem__fail(st, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
-    for (b = 0; b < P.count; ++b) {
-        const fsdem_real v = fsdem__norm(P.velocity[b]) + fsdem__norm(P.angular_velocity[b]) * P.radius[b];
-        if (!fsdem__finite(v)) return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_pic_dem: body %d has a non-finite velocity", b);
+    *which = -1;
+    for (b = 0; b < P->count; ++b) {
+        const fsdem_real v = fsdem__norm(P->velocity[b]) + fsdem__norm(P->angular_velocity[b]) * P->radius[b];
+        *which = b;
+        if (!fsdem__finite(v)) return -1;
         if (v > vmax) vmax = v;
     }
-    {
-        const fsdem_real body = pd.cfl * dx / (vmax + (fsdem_real)sqrt(fsdem__norm(pd.gravity) * dx));
-        if (body < *dt) *dt = body;
-    }
+    return vmax;
+}
+
+/* The stable step's limits of the bodies (>>couple_pic, fsdem_pic_dem_stable_dt): their speed
+   over the PIC's cfl, and the viscous limit of the last cut (the class's limit). */
+static fsdem_result fsdem__pic_dem_limit(const fsdem_coupler *head, fsdem_real *dt) {
+    const fsdem_pic_dem *c = (const fsdem_pic_dem *)(const void *)head;
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    const fsdem_pic_desc pd = fsdem_pic_get_desc(c->desc.pic);
+    int b;
+    const fsdem_real vmax = fsdem__pic_dem_fastest(&P, &b);
+    fsdem_real body;
+    if (vmax < 0) return fsdem__fail((fsdem__status *)&head->status, FSDEM_ERR_NAN, "fsdem_pic_dem: body %d has a non-finite velocity", b);
+    body = pd.cfl * pd.cell_size / (vmax + (fsdem_real)sqrt(fsdem__norm(pd.gravity) * pd.cell_size));
+    if (body < *dt) *dt = body;
     if (c->viscous_dt > 0 && c->desc.viscous_dt_fraction * c->viscous_dt < *dt) *dt = c->desc.viscous_dt_fraction * c->viscous_dt;
     return FSDEM_OK;
 }
 
-/* One coupled step of dt (steps 1-7 of >>couple_pic). */
-static fsdem_result fsdem__pic_dem_run(fsdem_pic_dem *c, fsdem_real dt) {
-    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+/* A step of dt refused before the cut changes the PIC's coupling arrays: too many substeps, a body
+   that no longer fits, a body moving more than cfl_max cells, the viscous limit of the last cut (the
+   one fsdem_pic_dem_stable_dt gave; the new cut may be a little stricter: the step it limits is the
+   next), the PIC's own refusal. */
+static fsdem_result fsdem__pic_dem_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
+    fsdem_pic_dem *c = (fsdem_pic_dem *)(void *)head;
     const fsdem_pic_desc pd = fsdem_pic_get_desc(c->desc.pic);
-    long long substeps = 0;
-    int b, before = c->bodies;
-    clock_t t0 = clock(), t1, t2;
-    fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_pic_dem");
-    if (res != FSDEM_OK) return res;
-    if ((res = fsdem__dem_particles_fit(c->desc.dem, pd.domain_min, pd.domain_max, &c->status, "fsdem_pic_dem")) != FSDEM_OK) return res;
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    fsdem_result res;
+    int b;
+    (void)chosen;
+    if ((res = fsdem__coupler_substeps_within(head, dt)) != FSDEM_OK) return res;
+    if ((res = fsdem__coupler_particles_fit(head, pd.domain_min, pd.domain_max, "fsdem_pic_dem")) != FSDEM_OK) return res;
     for (b = 0; b < P.count; ++b) {
         const fsdem_real v = fsdem__norm(P.velocity[b]) + fsdem__norm(P.angular_velocity[b]) * P.radius[b];
         if (v * dt > pd.cfl_max * pd.cell_size)
-            return fsdem__fail(&c->status, FSDEM_ERR_CFL, "fsdem_pic_dem: body %d at %g m/s moves %g cells in dt = %g s (cfl_max %g)", b,
+            return fsdem__fail(&head->status, FSDEM_ERR_CFL, "fsdem_pic_dem: body %d at %g m/s moves %g cells in dt = %g s (cfl_max %g)", b,
                                (double)v, (double)(v * dt / pd.cell_size), (double)dt, (double)pd.cfl_max);
     }
-    /* the limit of the last cut, the one fsdem_pic_dem_stable_dt gave (the new cut may be a little
-       stricter: the step it limits is the next) */
     if (c->viscous_dt > 0 && dt > c->desc.viscous_dt_fraction * c->viscous_dt * (1 + (fsdem_real)1e-6))
-        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
+        return fsdem__fail(&head->status, FSDEM_ERR_CFL,
                            "fsdem_pic_dem: dt = %g s exceeds viscous_dt_fraction %g of the shortest viscous relaxation time %g s",
                            (double)dt, (double)c->desc.viscous_dt_fraction, (double)c->viscous_dt);
-    /* the PIC's own refusal too, before the cut below changes its coupling arrays */
     if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
-        return fsdem__fail(&c->status, res, "fsdem_pic_dem: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
-    if (P.count > before && (res = fsdem__pic_dem_exclude(c, before, 1)) != FSDEM_OK) return res;
-    if ((res = fsdem__pic_dem_faces(c, dt)) != FSDEM_OK) return res;
-    t1 = clock();
-    c->sec_coupling += (double)(t1 - t0) / CLOCKS_PER_SEC;
-    res = fsdem_pic_step_dt(c->desc.pic, dt);
-    t2 = clock();
-    c->sec_pic += (double)(t2 - t1) / CLOCKS_PER_SEC;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
-    if ((res = fsdem__pic_dem_loads(c)) != FSDEM_OK) return res;
-    t1 = clock();
-    c->sec_coupling += (double)(t1 - t2) / CLOCKS_PER_SEC;
-    res = fsdem_dem_advance(c->desc.dem, dt, &substeps);
-    t2 = clock();
-    c->sec_dem += (double)(t2 - t1) / CLOCKS_PER_SEC;
-    c->steps++;
-    c->dt_last = dt;
-    c->substeps = substeps;
-    c->substeps_total += substeps;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
-    if ((res = fsdem__pic_dem_gap(c)) == FSDEM_OK) res = fsdem__pic_dem_exclude(c, 0, 0);
-    c->sec_coupling += (double)(clock() - t2) / CLOCKS_PER_SEC;
-    if (res != FSDEM_OK) return res;
-    return fsdem__ok(&c->status);
+        return fsdem__fail(&head->status, res, "fsdem_pic_dem: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
+    return FSDEM_OK;
 }
 
-fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *c) {
-    fsdem_real dt = 0;
+/* Step 7 of >>couple_pic for bodies added since the last cut: the water particles inside them go. */
+static fsdem_result fsdem__pic_dem_new_bodies(fsdem_coupler *head, fsdem_real dt) {
+    fsdem_pic_dem *c = (fsdem_pic_dem *)(void *)head;
+    (void)dt;
+    return fsdem_dem_get_particles(c->desc.dem).count > c->bodies ? fsdem__pic_dem_exclude(c, c->bodies, 1) : FSDEM_OK;
+}
+
+static fsdem_result fsdem__pic_dem_cut_stage(fsdem_coupler *head, fsdem_real dt) {
+    return fsdem__pic_dem_faces((fsdem_pic_dem *)(void *)head, dt);
+}
+
+static fsdem_result fsdem__pic_dem_loads_stage(fsdem_coupler *head, fsdem_real dt) {
+    (void)dt;
+    return fsdem__pic_dem_loads((fsdem_pic_dem *)(void *)head);
+}
+
+static fsdem_result fsdem__pic_dem_substeps(fsdem_coupler *head, fsdem_real dt) {
+    return fsdem__coupler_substeps(head, dt, NULL, NULL, "DEM substeps", NULL);
+}
+
+/* Steps 6-7 of >>couple_pic at the bodies' new positions. */
+static fsdem_result fsdem__pic_dem_gap_stage(fsdem_coupler *head, fsdem_real dt) {
+    fsdem_pic_dem *c = (fsdem_pic_dem *)(void *)head;
+    fsdem_result res = fsdem__pic_dem_gap(c);
+    (void)dt;
+    return res == FSDEM_OK ? fsdem__pic_dem_exclude(c, 0, 0) : res;
+}
+
+static const fsdem__stage fsdem__pic_dem_stages[6] = {
+    {"new bodies", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_new_bodies}, {"cut", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_cut_stage},
+    {"PIC step", FSDEM__CLOCK_FLUID, NULL},                          {"loads", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_loads_stage},
+    {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__pic_dem_substeps},     {"gap", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_gap_stage}};
+
+#define FSDEM__PIC_DEM_FIELD(name, kind, saved) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_pic_dem_force, name), saved}
+static const fsdem__field fsdem__pic_dem_fields[7] = {
+    FSDEM__PIC_DEM_FIELD(id, INT, 1),      FSDEM__PIC_DEM_FIELD(pressure_force, VEC3, 1), FSDEM__PIC_DEM_FIELD(viscous_force, VEC3, 1),
+    FSDEM__PIC_DEM_FIELD(torque, VEC3, 1), FSDEM__PIC_DEM_FIELD(weight_correction, VEC3, 1), FSDEM__PIC_DEM_FIELD(volume, REAL, 1),
+    FSDEM__PIC_DEM_FIELD(faces, INT, 0)};
+#undef FSDEM__PIC_DEM_FIELD
+
+static const fsdem__coupler_class *fsdem__pic_dem_class(void) {
+    static const fsdem__coupler_class cls = {"fsdem_pic_dem", &fsdem__fluid_pic, sizeof(fsdem_pic_dem_force),
+        fsdem__pic_dem_fields, 7, NULL, NULL, fsdem__pic_dem_limit, fsdem__pic_dem_check, fsdem__pic_dem_stages, 6};
+    return &cls;
+}
+
+fsdem_result fsdem_pic_dem_update(fsdem_pic_dem *c) {
     fsdem_result res;
     if (!c) return FSDEM_ERR_INVALID_ARG;
-    if ((res = fsdem__pic_dem_stable(c, &dt)) != FSDEM_OK) return res;
-    return fsdem__pic_dem_run(c, dt);
+    if ((res = fsdem__pic_dem_new_bodies(&c->head, 0)) == FSDEM_OK && (res = fsdem__pic_dem_faces(c, 0)) == FSDEM_OK) fsdem__ok(&c->head.status);
+    return res;
 }
 
+fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
 fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *c, fsdem_real dt) {
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_dem_step_dt: dt = %g s must be > 0 and finite", (double)dt);
-    return fsdem__pic_dem_run(c, dt);
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_pic_dem_step_dt");
 }
-
-/* fsdem__coupled_advance's verbs for this coupler. */
-static double fsdem__pic_dem_now(const void *c) { return fsdem_pic_time(((const fsdem_pic_dem *)c)->desc.pic); }
-static fsdem_result fsdem__pic_dem_prepare(void *c, fsdem_real *dt) { return fsdem__pic_dem_stable((fsdem_pic_dem *)c, dt); }
-static fsdem_result fsdem__pic_dem_go(void *c, fsdem_real dt) { return fsdem__pic_dem_run((fsdem_pic_dem *)c, dt); }
-
 fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *c, fsdem_real duration, long long *steps) {
-    static const fsdem__coupled_verbs verbs = {fsdem__pic_dem_now, fsdem__pic_dem_prepare, fsdem__pic_dem_go};
-    if (steps) *steps = 0;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__coupled_advance(c, &c->status, "fsdem_pic_dem_advance", &verbs, duration, steps);
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_pic_dem_advance");
 }
-
-fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *c, fsdem_real *dt) {
-    if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__pic_dem_stable(c, dt);
-}
-
-double fsdem_pic_dem_time(const fsdem_pic_dem *c) { return c ? fsdem_pic_time(c->desc.pic) : 0; }
-
-fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
-    fsdem_pic_dem_stats st;
-    memset(&st, 0, sizeof st);
-    if (!c) return st;
-    st.steps = c->steps;
-    st.time = fsdem_pic_time(c->desc.pic);
-    st.dt = c->dt_last;
-    st.substeps = c->substeps;
-    st.substeps_total = c->substeps_total;
-    st.fluid_force = c->force_sum;
-    st.viscous_dt = c->viscous_dt;
-    st.contacts = c->contact_count;
-    st.dissipated = c->dissipated;
-    st.pushed = c->pushed;
-    st.removed = c->removed;
-    st.seconds_pic = c->sec_pic;
-    st.seconds_dem = c->sec_dem;
-    st.seconds_coupling = c->sec_coupling;
-    return st;
-}
+fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+double fsdem_pic_dem_time(const fsdem_pic_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
 
 /* ===== >>impl_couple_gic : Granule-In-Cell ===========================================================
 
    Contents: >>couple_gic_object (desc, creation), >>couple_gic_exchange (seed 004 Eq. 5a-5b, 7a, 18:
-   volume fractions, granule forces, the exchange to the grid), >>couple_gic_step (coupled time
-   stepping). The coupler speaks to the PIC and the DEM through their public calls (>>doc). */
+   volume fractions, granule forces, the exchange to the grid), >>couple_gic_step (its stages and
+   verbs on the staged step of >>couple, sand first). The coupler speaks to the PIC and the DEM
+   through their public calls (>>doc). */
 
 /* ---- >>couple_gic_object : desc, creation ---- */
 
@@ -18545,12 +19196,12 @@ typedef struct fsdem__gic_tally {
 } fsdem__gic_tally;
 
 struct fsdem_gic {
+    fsdem_coupler head;            /* >>couple; its records are `force`, of the last evaluation */
     fsdem_gic_desc desc;
-    fsdem__status status;
-    fsdem_allocator allocator;
     int dim;
     fsdem__mac grid;               /* the PIC's cells (fsdem_pic_get_fields) */
     fsdem_real rho;                /* kg/m^3, the water's */
+    fsdem_real mu;                 /* Pa s, the dynamic viscosity the drag laws use */
     fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC's forces are per metre), 1 in 3D */
     fsdem_real cell_volume;        /* m^dim */
     fsdem_real *solid, *porosity;  /* per cell: alpha_s (Eq. 7a), alpha_f' */
@@ -18560,17 +19211,16 @@ struct fsdem_gic {
     fsdem_fluid_sample *sample;
     fsdem_gic_force *force;
     fsdem_vec3 *fluid_accel;       /* a_f of Eq. 17 at each granule, for the step under way */
-    int granule_cap, records;
+    int granule_cap;
     /* the sand substeps under way: their length h, count K, the evaluations made, the step's dt */
     fsdem_real h, dt_now;
     long long substeps_now, calls;
     int failed;                    /* an evaluation failed (its message is in status) */
     fsdem__gic_tally tally, last;  /* of the step under way, of the last step */
     fsdem_real max_solid, solid_volume;
-    long long steps, substeps, substeps_total;
-    fsdem_real dt_last;
-    double sec_pic, sec_dem;
 };
+
+static const fsdem__coupler_class *fsdem__gic_class(void);
 
 fsdem_gic_desc fsdem_gic_desc_default(void) {
     fsdem_gic_desc d;
@@ -18585,17 +19235,10 @@ fsdem_gic_desc fsdem_gic_desc_default(void) {
 }
 
 fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t size) {
-    fsdem_dem_desc dd;
     fsdem_pic_desc pd;
     if (!d) return fsdem__reject(msg, size, "fsdem_gic_desc is NULL");
     if (!d->pic || !d->dem) return fsdem__reject(msg, size, "fsdem_gic_desc.pic and .dem must both be set");
-    dd = fsdem_dem_get_desc(d->dem);
     pd = fsdem_pic_get_desc(d->pic);
-    if (dd.dim != pd.dim) return fsdem__reject(msg, size, "fsdem_gic_desc: the DEM is %dD and the PIC %dD", dd.dim, pd.dim);
-    if (fsdem__norm(fsdem__sub(dd.gravity, pd.gravity)) > 1e-12 * fsdem__norm(pd.gravity))
-        return fsdem__reject(msg, size, "fsdem_gic_desc: the DEM gravity (%g, %g, %g) differs from the PIC's (%g, %g, %g) m/s^2",
-                             (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)pd.gravity.x,
-                             (double)pd.gravity.y, (double)pd.gravity.z);
     if (strcmp(fsdem_drag_law_name(d->drag), "unknown") == 0)
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
     if (d->virtual_mass != 0 && d->virtual_mass != 1)
@@ -18603,7 +19246,7 @@ fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t siz
     if (!(d->drag_scale > 0) || !fsdem__finite(d->drag_scale))
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag_scale must be > 0 and finite (got %g)", (double)d->drag_scale);
     if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
-        return fsdem__reject(msg, size, "fsdem_gic_desc.viscosity must be >= 0 Pa s and finite (got %g)", (double)d->viscosity);
+        return fsdem__reject(msg, size, "fsdem_gic_desc.viscosity must be >= 0 m^2/s and finite (got %g)", (double)d->viscosity);
     if (d->drag != FSDEM_DRAG_LAW_GIC && d->viscosity == 0 && !(pd.viscosity > 0))
         return fsdem__reject(msg, size,
                              "fsdem_gic_desc.viscosity: the %s drag law needs a viscosity, and it is 0 here and in the (inviscid) PIC",
@@ -18617,13 +19260,12 @@ fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t siz
         return fsdem__reject(msg, size, "fsdem_gic_desc.max_dt_ratio must be >= 1 and finite (got %g)", (double)d->max_dt_ratio);
     if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag_dt_fraction must be in (0, 1] (got %g)", (double)d->drag_dt_fraction);
-    if (d->max_substeps < 1) return fsdem__reject(msg, size, "fsdem_gic_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
-    return FSDEM_OK;
+    return fsdem__coupler_check(fsdem__gic_class(), "fsdem_gic_desc", d->pic, FSDEM_PIC_ARRAYS_POROSITY | FSDEM_PIC_ARRAYS_ACCELERATION, d->dem,
+                                pd.dim, pd.gravity, d->max_substeps, msg, size);
 }
 
 fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out) {
     char msg[FSDEM__MESSAGE_SIZE];
-    fsdem_allocator al;
     fsdem_gic *c;
     fsdem_pic_fields g;
     fsdem_pic_desc pd;
@@ -18633,27 +19275,25 @@ fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out) {
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_gic_desc_check(desc, msg, sizeof msg);
-    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
-    c = (fsdem_gic *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL, res == FSDEM_OK ? &al : NULL,
-                                       sizeof *c, "fsdem_gic_create", &res);
+    c = (fsdem_gic *)fsdem__coupler_new(fsdem__gic_class(), res, msg, desc ? desc->pic : NULL, desc ? desc->dem : NULL,
+                                        FSDEM_PIC_ARRAYS_POROSITY | FSDEM_PIC_ARRAYS_ACCELERATION, desc ? desc->max_substeps : 0,
+                                        desc ? desc->log : NULL, desc ? desc->log_user : NULL, sizeof *c, &res);
     if (!c) return res;
     pd = fsdem_pic_get_desc(desc->pic);
     g = fsdem_pic_get_fields(desc->pic);
     c->desc = *desc;
-    c->allocator = al;
-    c->status.log = desc->log;
-    c->status.log_user = desc->log_user;
     c->dim = g.dim;
     c->rho = pd.density;
     c->depth = g.dim == 2 ? fsdem_dem_get_desc(desc->dem).disc_length : 1;
-    if (c->desc.viscosity == 0) c->desc.viscosity = pd.density * pd.viscosity;
+    if (c->desc.viscosity == 0) c->desc.viscosity = pd.viscosity;
+    c->mu = pd.density * c->desc.viscosity;
     if (c->desc.max_solid_fraction == 0) c->desc.max_solid_fraction = (fsdem_real)(g.dim == 3 ? 0.740 : 0.907);
     fsdem__mac_init(&c->grid, g.dim, g.n, g.cell_size, g.origin);
     c->cell_volume = g.cell_size * g.cell_size * (g.dim == 3 ? g.cell_size : 1);
     cells = (size_t)c->grid.ncell;
-    c->solid = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
-    c->porosity = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
-    c->rate = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
+    c->solid = (fsdem_real *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_real) * cells);
+    c->porosity = (fsdem_real *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_real) * cells);
+    c->rate = (fsdem_real *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_real) * cells);
     if (!c->solid || !c->porosity || !c->rate) {
         fsdem__log_oom(desc->log, desc->log_user, "fsdem_gic_create", 3 * sizeof(fsdem_real) * cells);
         fsdem_gic_destroy(c);
@@ -18668,22 +19308,24 @@ fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out) {
 }
 
 void fsdem_gic_destroy(fsdem_gic *c) {
-    fsdem_allocator al;
+    const fsdem_allocator *al;
     size_t cells;
     if (!c) return;
-    al = c->allocator;
+    al = &c->head.allocator;
     cells = (size_t)c->grid.ncell;
-    fsdem__free(&al, c->solid, sizeof(fsdem_real) * cells);
-    fsdem__free(&al, c->porosity, sizeof(fsdem_real) * cells);
-    fsdem__free(&al, c->rate, sizeof(fsdem_real) * cells);
-    fsdem__free(&al, c->point, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
-    fsdem__free(&al, c->sample, sizeof(fsdem_fluid_sample) * (size_t)c->granule_cap);
-    fsdem__free(&al, c->force, sizeof(fsdem_gic_force) * (size_t)c->granule_cap);
-    fsdem__free(&al, c->fluid_accel, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
-    fsdem__free(&al, c, sizeof *c);
+    fsdem__free(al, c->solid, sizeof(fsdem_real) * cells);
+    fsdem__free(al, c->porosity, sizeof(fsdem_real) * cells);
+    fsdem__free(al, c->rate, sizeof(fsdem_real) * cells);
+    fsdem__free(al, c->point, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
+    fsdem__free(al, c->sample, sizeof(fsdem_fluid_sample) * (size_t)c->granule_cap);
+    fsdem__free(al, c->force, sizeof(fsdem_gic_force) * (size_t)c->granule_cap);
+    fsdem__free(al, c->fluid_accel, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
+    fsdem__coupler_free(&c->head, sizeof *c);
 }
 
-const char *fsdem_gic_last_error(const fsdem_gic *c) { return c ? c->status.message : "fsdem_gic is NULL"; }
+const char *fsdem_gic_last_error(const fsdem_gic *c) { return c ? c->head.status.message : "fsdem_gic is NULL"; }
+
+fsdem_coupler *fsdem_gic_coupler(fsdem_gic *c) { return c ? &c->head : NULL; }
 
 fsdem_gic_desc fsdem_gic_get_desc(const fsdem_gic *c) {
     fsdem_gic_desc d;
@@ -18710,8 +19352,8 @@ fsdem_gic_fields fsdem_gic_get_fields(const fsdem_gic *c) {
 static fsdem_result fsdem__gic_reserve(fsdem_gic *c, int count) {
     void **const arrays[4] = {(void **)&c->point, (void **)&c->sample, (void **)&c->force, (void **)&c->fluid_accel};
     const size_t sizes[4] = {sizeof(fsdem_vec3), sizeof(fsdem_fluid_sample), sizeof(fsdem_gic_force), sizeof(fsdem_vec3)};
-    if (fsdem__grow_set(&c->allocator, arrays, sizes, 4, &c->granule_cap, c->records, count) != FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_gic: out of memory (%d granules)", count);
+    if (fsdem__grow_set(&c->head.allocator, arrays, sizes, 4, &c->granule_cap, c->head.records, count) != FSDEM_OK)
+        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_gic: out of memory (%d granules)", count);
     return FSDEM_OK;
 }
 
@@ -18744,11 +19386,11 @@ fsdem_result fsdem_gic_update(fsdem_gic *c) {
     for (i = 0; i < P.count; ++i) {
         int a, outside = 0;
         if (!fsdem__finite3(P.position[i]))
-            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_gic_update: granule %d (id %d) has a non-finite position", i, P.id[i]);
+            return fsdem__fail(&c->head.status, FSDEM_ERR_NAN, "fsdem_gic_update: granule %d (id %d) has a non-finite position", i, P.id[i]);
         for (a = 0; a < c->dim; ++a)
             outside |= fsdem__comp(P.position[i], a) < fsdem__comp(c->grid.lo, a) || fsdem__comp(P.position[i], a) > fsdem__comp(c->grid.hi, a);
         if (outside) /* its volume would be folded into the boundary cells */
-            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_DOMAIN,
+            return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_DOMAIN,
                                "fsdem_gic_update: granule %d (id %d) at (%g, %g, %g) m is outside the PIC's grid (keep the DEM's walls within it)",
                                i, P.id[i], (double)P.position[i].x, (double)P.position[i].y, (double)P.position[i].z);
     }
@@ -18773,7 +19415,7 @@ fsdem_result fsdem_gic_update(fsdem_gic *c) {
     }
     c->max_solid = most;
     c->solid_volume = (fsdem_real)(volume * (double)c->cell_volume);
-    return fsdem__ok(&c->status);
+    return fsdem__ok(&c->head.status);
 }
 
 /* The porosity alpha_f' at point p (the cells' values interpolated). */
@@ -18823,7 +19465,7 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
     (void)time;
     for (i = 0; i < P.count; ++i) c->point[i] = P.position[i];
     res = fsdem_pic_sample(c->desc.pic, P.count, c->point, c->sample);
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+    if (res != FSDEM_OK) return fsdem__fail(&c->head.status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
     if (fsdem_pic_get_stats(c->desc.pic).steps == 0) /* no pressure solved yet: the water's at rest */
         for (i = 0; i < P.count; ++i) c->sample[i].pressure_gradient = fsdem__scale(fsdem_pic_get_desc(c->desc.pic).gravity, c->rho);
     for (i = 0; i < P.count; ++i) {
@@ -18844,8 +19486,8 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
             continue;
         }
         res = fsdem_drag_coefficient(c->desc.drag, eps, 2 * P.radius[i], fsdem__norm(slip), c->rho,
-                                     c->desc.viscosity > 0 ? c->desc.viscosity : 1, &cv, NULL, why, sizeof why);
-        if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: granule %d (id %d): %s", i, P.id[i], why);
+                                     c->mu > 0 ? c->mu : 1, &cv, NULL, why, sizeof why);
+        if (res != FSDEM_OK) return fsdem__fail(&c->head.status, res, "fsdem_gic: granule %d (id %d): %s", i, P.id[i], why);
         cv *= c->desc.drag_scale;
         rec->pressure = fsdem__scale(s->pressure_gradient, -volume * wet);
         rec->drag = fsdem__scale(slip, cv * volume * wet);
@@ -18867,20 +19509,21 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
             if (impulse.x != 0 || impulse.y != 0 || impulse.z != 0) {
                 res = fsdem_pic_add_force(c->desc.pic, P.position[i], P.radius[i], fsdem__scale(impulse, 1 / (c->dt_now * c->depth)),
                                           &taken);
-                if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+                if (res != FSDEM_OK) return fsdem__fail(&c->head.status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
                 if (taken) c->tally.to_fluid = fsdem__add(c->tally.to_fluid, impulse);
                 else c->tally.lost = fsdem__add(c->tally.lost, impulse);
             }
         }
     }
     c->tally.wet = wet_count;
-    c->records = P.count;
+    c->head.record = c->force;
+    c->head.records = P.count;
     c->calls++;
     c->failed = 0;
     return FSDEM_OK;
 }
 
-/* ---- >>couple_gic_step : coupled time stepping ---- */
+/* ---- >>couple_gic_step : its stages and verbs (sand first) ---- */
 
 /* The shortest drag relaxation time (s; 0: none) of the granules in the water now or within
    `horizon` (s) of their paths (a granule about to enter the water counts, at its speed against
@@ -18904,7 +19547,7 @@ static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
         if (!(here.volume_fraction > 0) && !(ahead.volume_fraction > 0)) continue;
         if (!(here.volume_fraction > 0)) here.velocity = fsdem__zero3();
         if (fsdem_drag_coefficient(c->desc.drag, fsdem__gic_porosity_at(c, here.volume_fraction > 0 ? x : y), 2 * P.radius[i],
-                                   fsdem__norm(fsdem__sub(here.velocity, P.velocity[i])), c->rho, c->desc.viscosity > 0 ? c->desc.viscosity : 1,
+                                   fsdem__norm(fsdem__sub(here.velocity, P.velocity[i])), c->rho, c->mu > 0 ? c->mu : 1,
                                    &cv, NULL, NULL, 0) != FSDEM_OK ||
             !(cv > 0))
             continue;
@@ -18926,18 +19569,16 @@ static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
     return shortest;
 }
 
-/* The stable coupled step of the section (Eq. 33, the drag limit). */
-static fsdem_result fsdem__gic_stable(const fsdem_gic *c, fsdem_real *dt) {
+/* The coupler's limits on the stable step (Eq. 33, the drag limit; the class's limit). */
+static fsdem_result fsdem__gic_limit(const fsdem_coupler *head, fsdem_real *dt) {
+    const fsdem_gic *c = (const fsdem_gic *)(const void *)head;
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
-    fsdem_result res = fsdem_pic_stable_dt(c->desc.pic, dt);
     fsdem_real vmax = 0, limit = c->desc.max_dt_ratio * fsdem_dem_get_desc(c->desc.dem).dt;
     int i;
-    if (res != FSDEM_OK)
-        return fsdem__fail((fsdem__status *)&c->status, res, "fsdem_gic_stable_dt: %s", fsdem_pic_last_error(c->desc.pic));
     for (i = 0; i < P.count; ++i) {
         const fsdem_real v = fsdem__norm(P.velocity[i]);
         if (!fsdem__finite(v))
-            return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NAN, "fsdem_gic: granule %d (id %d) has a non-finite velocity", i,
+            return fsdem__fail((fsdem__status *)&head->status, FSDEM_ERR_NAN, "fsdem_gic: granule %d (id %d) has a non-finite velocity", i,
                                P.id[i]);
         if (v > vmax) vmax = v;
     }
@@ -18950,14 +19591,29 @@ static fsdem_result fsdem__gic_stable(const fsdem_gic *c, fsdem_real *dt) {
     return FSDEM_OK;
 }
 
-/* One coupled step of dt after the checks: sand substeps with the exchange, fractions, the PIC. */
-static fsdem_result fsdem__gic_run(fsdem_gic *c, fsdem_real dt) {
-    long long substeps = 0;
-    fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_gic");
-    clock_t t0, t1;
+/* A step of dt refused before anything moves: too many substeps, the PIC's own refusal, and for a
+   dt of the caller's the drag limit (a stable dt keeps it by construction). */
+static fsdem_result fsdem__gic_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
+    fsdem_gic *c = (fsdem_gic *)(void *)head;
+    fsdem_result res = fsdem__coupler_substeps_within(head, dt);
     if (res != FSDEM_OK) return res;
     if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
-        return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+        return fsdem__fail(&head->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+    if (chosen) {
+        const fsdem_real drag = fsdem__gic_drag_time(c, dt);
+        if (drag > 0 && dt > c->desc.drag_dt_fraction * drag * (1 + (fsdem_real)1e-6))
+            return fsdem__fail(&head->status, FSDEM_ERR_CFL,
+                               "fsdem_gic_step_dt: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s",
+                               (double)dt, (double)c->desc.drag_dt_fraction, (double)drag);
+    }
+    return FSDEM_OK;
+}
+
+/* Steps 1-2 of >>couple_gic: the sand's substeps over dt, each force evaluation handing its
+   exchange to the water's accelerations, cleared first. */
+static fsdem_result fsdem__gic_sand(fsdem_coupler *head, fsdem_real dt) {
+    fsdem_gic *c = (fsdem_gic *)(void *)head;
+    fsdem_result res;
     if ((res = fsdem__gic_reserve(c, fsdem_dem_get_particles(c->desc.dem).count)) != FSDEM_OK) return res;
     fsdem_dem_substep_count(c->desc.dem, dt, &c->substeps_now);
     c->h = dt / (fsdem_real)c->substeps_now;
@@ -18968,89 +19624,55 @@ static fsdem_result fsdem__gic_run(fsdem_gic *c, fsdem_real dt) {
     c->tally.drag_dt = fsdem__gic_drag_time(c, dt);
     fsdem__gic_fluid_accelerations(c);
     fsdem_pic_clear_forces(c->desc.pic);
-    t0 = clock();
-    res = fsdem_dem_advance_with(c->desc.dem, dt, fsdem__gic_evaluate, c, &substeps);
-    t1 = clock();
-    c->sec_dem += (double)(t1 - t0) / CLOCKS_PER_SEC;
+    res = fsdem__coupler_substeps(head, dt, fsdem__gic_evaluate, c, "sand substeps", &c->failed);
     c->last = c->tally;
-    c->substeps = substeps;
-    c->substeps_total += substeps;
-    if (res != FSDEM_OK)
-        return c->failed ? res : fsdem__fail(&c->status, res, "fsdem_gic: sand substeps: %s", fsdem_dem_last_error(c->desc.dem));
-    if ((res = fsdem_gic_update(c)) != FSDEM_OK) return res;
-    res = fsdem_pic_step_dt(c->desc.pic, dt);
-    c->sec_pic += (double)(clock() - t1) / CLOCKS_PER_SEC;
-    c->steps++;
-    c->dt_last = dt;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
-    return fsdem__ok(&c->status);
+    return res;
 }
 
-fsdem_result fsdem_gic_step(fsdem_gic *c) {
-    fsdem_real dt = 0;
-    fsdem_result res;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if ((res = fsdem__gic_stable(c, &dt)) != FSDEM_OK) return res;
-    return fsdem__gic_run(c, dt);
+/* Step 3 of >>couple_gic at the sand's new positions. */
+static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
+    (void)dt;
+    return fsdem_gic_update((fsdem_gic *)(void *)head);
 }
 
-fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) {
-    fsdem_real drag;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_gic_step_dt: dt = %g s must be > 0 and finite", (double)dt);
-    drag = fsdem__gic_drag_time(c, dt);
-    if (drag > 0 && dt > c->desc.drag_dt_fraction * drag * (1 + (fsdem_real)1e-6))
-        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
-                           "fsdem_gic_step_dt: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s",
-                           (double)dt, (double)c->desc.drag_dt_fraction, (double)drag);
-    return fsdem__gic_run(c, dt);
+static const fsdem__stage fsdem__gic_stages[3] = {{"sand substeps", FSDEM__CLOCK_DEM, fsdem__gic_sand},
+                                                  {"fractions", FSDEM__CLOCK_COUPLING, fsdem__gic_fractions},
+                                                  {"PIC step", FSDEM__CLOCK_FLUID, NULL}};
+
+#define FSDEM__GIC_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_gic_force, name), 0}
+static const fsdem__field fsdem__gic_fields[8] = {
+    FSDEM__GIC_FIELD(id, INT),           FSDEM__GIC_FIELD(pressure, VEC3),       FSDEM__GIC_FIELD(drag, VEC3),
+    FSDEM__GIC_FIELD(virtual_mass, VEC3), FSDEM__GIC_FIELD(fluid_velocity, VEC3), FSDEM__GIC_FIELD(fluid_acceleration, VEC3),
+    FSDEM__GIC_FIELD(porosity, REAL),    FSDEM__GIC_FIELD(liquid, REAL)};
+#undef FSDEM__GIC_FIELD
+
+static const fsdem__coupler_class *fsdem__gic_class(void) {
+    static const fsdem__coupler_class cls = {"fsdem_gic", &fsdem__fluid_pic, sizeof(fsdem_gic_force), fsdem__gic_fields, 8, NULL,
+        NULL, fsdem__gic_limit, fsdem__gic_check, fsdem__gic_stages, 3};
+    return &cls;
 }
 
-/* fsdem__coupled_advance's verbs for this coupler. */
-static double fsdem__gic_now(const void *c) { return fsdem_pic_time(((const fsdem_gic *)c)->desc.pic); }
-
-static fsdem_result fsdem__gic_prepare(void *c, fsdem_real *dt) { return fsdem__gic_stable((const fsdem_gic *)c, dt); }
-
-static fsdem_result fsdem__gic_go(void *c, fsdem_real dt) { return fsdem__gic_run((fsdem_gic *)c, dt); }
-
+fsdem_result fsdem_gic_step(fsdem_gic *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) { return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_gic_step_dt"); }
 fsdem_result fsdem_gic_advance(fsdem_gic *c, fsdem_real duration, long long *steps) {
-    static const fsdem__coupled_verbs verbs = {fsdem__gic_now, fsdem__gic_prepare, fsdem__gic_go};
-    if (steps) *steps = 0;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__coupled_advance(c, &c->status, "fsdem_gic_advance", &verbs, duration, steps);
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_gic_advance");
 }
-
-fsdem_result fsdem_gic_stable_dt(const fsdem_gic *c, fsdem_real *dt) {
-    if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__gic_stable(c, dt);
-}
-
-double fsdem_gic_time(const fsdem_gic *c) { return c ? fsdem_pic_time(c->desc.pic) : 0; }
-
-/* The record of DEM particle `index` from the last step, or -1. */
-static int fsdem__gic_record(const fsdem_gic *c, int index) {
-    return c->records ? fsdem__dem_record_of(c->desc.dem, index, &c->force[0].id, sizeof(fsdem_gic_force), c->records) : -1;
-}
+fsdem_result fsdem_gic_stable_dt(const fsdem_gic *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+double fsdem_gic_time(const fsdem_gic *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
 
 fsdem_result fsdem_gic_get_force(const fsdem_gic *c, int index, fsdem_gic_force *out) {
-    int k;
-    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
-    k = fsdem__gic_record(c, index);
-    if (k < 0) return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_gic_get_force: no record of particle %d", index);
-    *out = c->force[k];
-    return fsdem__ok((fsdem__status *)&c->status);
+    return c ? fsdem__coupler_get_record(&c->head, index, out, "fsdem_gic_get_force") : FSDEM_ERR_INVALID_ARG;
+}
+
+fsdem_result fsdem_gic_write_csv(const fsdem_gic *c, const char *path) {
+    return c ? fsdem__coupler_write_csv(&c->head, path, "fsdem_gic_write_csv") : FSDEM_ERR_INVALID_ARG;
 }
 
 fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *c) {
     fsdem_gic_stats st;
     memset(&st, 0, sizeof st);
     if (!c) return st;
-    st.steps = c->steps;
-    st.time = fsdem_pic_time(c->desc.pic);
-    st.dt = c->dt_last;
-    st.substeps = c->substeps;
-    st.substeps_total = c->substeps_total;
+    st.coupling = fsdem__coupler_stats(&c->head);
     st.wet = c->last.wet;
     st.pressure_impulse = c->last.pressure;
     st.drag_impulse = c->last.drag;
@@ -19060,18 +19682,15 @@ fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *c) {
     st.drag_dt = c->last.drag_dt;
     st.max_solid_fraction = c->max_solid;
     st.solid_volume = c->solid_volume;
-    st.seconds_pic = c->sec_pic;
-    st.seconds_dem = c->sec_dem;
     return st;
 }
 
 /* ===== >>impl_restart : checkpoint and restart =======================================================
 
    Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
-   every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_swe_dem, >>restart_mps,
-   >>restart_mps_dem, >>restart_pic_dem, >>restart_gic (one visitor per object lists what it saves, in order, and serves saving and
-   restoring alike), >>restart_api
-   (memory and files). A restore runs the visitor three times over the payload: CHECK validates
+   every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_mps, >>restart_couplers
+   (one visitor per object lists what it saves, in order, and serves saving and restoring alike; the
+   couplers' by their field tables), >>restart_api (memory and files). A restore runs the visitor three times over the payload: CHECK validates
    everything and compares the desc, RESERVE allocates, COMMIT writes into the object. Only COMMIT
    changes the object, and it cannot fail. */
 
@@ -19940,72 +20559,6 @@ static void fsdem__restart_swe(fsdem__restart *io, void *object) {
     fsdem__restart_tag(io, "SWE.");
 }
 
-/* ---- >>restart_swe_dem : SWE-DEM coupler ---- */
-
-/* A coupler's file holds the coupled run: the SWE, then the DEM (restored into the solvers the
-   coupler was created with), then the coupler's own state: counters, the last step, the impulse
-   given to the water and the per-particle force records and reactions (fsdem_swe_dem_get_force and
-   the next step's impulse read them). Configuration: beta, two_way, heave_damping, max_substeps and
-   the water's density, gravity and dry depth taken at creation, compared. Not saved: the solver
-   pointers, the allocator, log and message. */
-static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
-    fsdem_swe_dem *c = (fsdem_swe_dem *)object;
-    const int commit = io->mode == FSDEM__RESTART_COMMIT;
-    int count = c->force_capacity, k;
-    fsdem_swe_dem_force *force;
-    fsdem_vec3 *reaction;
-    fsdem__restart_tag(io, "SWD1");
-    io->section = "shallow water";
-    fsdem__restart_swe(io, c->desc.swe);
-    io->section = "debris (DEM)";
-    fsdem__restart_dem(io, c->desc.dem);
-    io->section = NULL;
-    fsdem__restart_same_real(io, c->desc.beta, "beta");
-    fsdem__restart_same_int(io, c->desc.two_way, "two_way");
-    fsdem__restart_same_real(io, c->desc.heave_damping, "heave_damping");
-    fsdem__restart_same_ll(io, c->desc.max_substeps, "max_substeps");
-    fsdem__restart_same_real(io, c->rho, "swe.density");
-    fsdem__restart_same_real(io, c->g, "swe.gravity");
-    fsdem__restart_same_real(io, c->dry, "swe.dry_depth");
-    fsdem__restart_data(io, &c->steps, sizeof c->steps);
-    fsdem__restart_data(io, &c->substeps, sizeof c->substeps);
-    fsdem__restart_data(io, &c->substeps_total, sizeof c->substeps_total);
-    fsdem__restart_data(io, &c->dt_last, sizeof c->dt_last);
-    fsdem__restart_data(io, &c->in_water, sizeof c->in_water);
-    fsdem__restart_data(io, &c->impulse, sizeof c->impulse);
-    fsdem__restart_count(io, &count, 1 << 29, sizeof(int) + 5 * sizeof(fsdem_vec3) + 3 * sizeof(fsdem_real), "force record count");
-    {
-        int records = c->records;
-        fsdem__restart_data(io, &records, sizeof records);
-        if (io->res == FSDEM_OK && (records < 0 || records > count)) fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "bad record count");
-        if (commit) c->records = records;
-    }
-    force = (fsdem_swe_dem_force *)fsdem__restart_block(io, &c->allocator, sizeof *force * (size_t)count);
-    reaction = (fsdem_vec3 *)fsdem__restart_block(io, &c->allocator, sizeof *reaction * (size_t)count);
-    if (commit) {
-        fsdem__free(&c->allocator, c->force, sizeof *force * (size_t)c->force_capacity);
-        fsdem__free(&c->allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
-        c->force = force;
-        c->reaction = reaction;
-        c->force_capacity = count;
-        if (force) memset(force, 0, sizeof *force * (size_t)count);
-    }
-    for (k = 0; k < count && io->res == FSDEM_OK; ++k) {
-        fsdem_swe_dem_force scratch, *f = io->mode == FSDEM__RESTART_WRITE || commit ? &c->force[k] : &scratch;
-        fsdem__restart_data(io, &f->id, sizeof f->id);
-        fsdem__restart_data(io, &f->buoyancy, sizeof f->buoyancy);
-        fsdem__restart_data(io, &f->hydrostatic, sizeof f->hydrostatic);
-        fsdem__restart_data(io, &f->dynamic, sizeof f->dynamic);
-        fsdem__restart_data(io, &f->heave, sizeof f->heave);
-        fsdem__restart_data(io, &f->submerged_volume, sizeof f->submerged_volume);
-        fsdem__restart_data(io, &f->frontal_area, sizeof f->frontal_area);
-        fsdem__restart_data(io, &f->surface, sizeof f->surface);
-        fsdem__restart_data(io, &f->in_water, sizeof f->in_water);
-    }
-    fsdem__restart_data(io, c->reaction, sizeof(fsdem_vec3) * (size_t)count);
-    fsdem__restart_tag(io, "SWD.");
-}
-
 /* ---- >>restart_mps : MPS ---- */
 
 /* Checks (in CHECK) the `count` open planes about to be read, inflows or outflows: an axis of the
@@ -20175,151 +20728,210 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_tag(io, "MPS.");
 }
 
-/* ---- >>restart_mps_dem : MPS-DEM coupler ---- */
+/* ---- >>restart_couplers : the four couplers, by their field tables ---- */
 
-/* The two solvers, then the coupler's counters and the force records of its last update (a step
-   recomputes them first, so they only serve fsdem_mps_dem_get_force until then). The pair lists
-   and the grid are rebuilt by every update. */
-static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
-    fsdem_mps_dem *c = (fsdem_mps_dem *)object;
-    const int commit = io->mode == FSDEM__RESTART_COMMIT;
-    int count = c->forces, k;
-    fsdem_mps_dem_force *force;
-    fsdem__restart_tag(io, "MPD1");
-    io->section = "water (MPS)";
-    fsdem__restart_mps(io, c->desc.mps);
-    io->section = "sediment (DEM)";
-    fsdem__restart_dem(io, c->desc.dem);
+/* A coupler's file holds the coupled run: its tag, the fluid, then the DEM in full (restored into the
+   solvers the coupler was created with), then the coupler's own part, listed in tables: its desc
+   (with the values resolved at creation) compared field by field, its counters and figures, and the
+   records of its last update that the next step or fsdem_X_get_force reads. Not saved: the solver
+   pointers, the claims, the allocator, log and message, the CPU times, and what every step rebuilds
+   (pair lists, grids, cuts). */
+
+#define FSDEM__RESTART_FIELD(type, name, kind, field) {name, FSDEM__FIELD_##kind, offsetof(type, field), 1}
+
+/* The desc fields of `object` in `same` compared with the save's (the name prints as desc.<name>). */
+static void fsdem__restart_same_fields(fsdem__restart *io, const void *object, const fsdem__field *same, int n) {
+    int k;
+    for (k = 0; k < n; ++k) {
+        const void *at = (const char *)object + same[k].offset;
+        switch (same[k].kind) {
+        case FSDEM__FIELD_INT: fsdem__restart_same_int(io, *(const int *)at, same[k].name); break;
+        case FSDEM__FIELD_LL: fsdem__restart_same_ll(io, *(const long long *)at, same[k].name); break;
+        case FSDEM__FIELD_REAL: fsdem__restart_same_real(io, *(const fsdem_real *)at, same[k].name); break;
+        default: fsdem__restart_same_vec3(io, *(const fsdem_vec3 *)at, same[k].name); break;
+        }
+    }
+}
+
+/* The fields of `object` (a struct, or a record) in `fields` that are saved, as data. */
+static void fsdem__restart_fields(fsdem__restart *io, void *object, const fsdem__field *fields, int n) {
+    int k;
+    for (k = 0; k < n; ++k)
+        if (fields[k].saved) fsdem__restart_data(io, object ? (char *)object + fields[k].offset : NULL, fsdem__field_size(fields[k].kind));
+}
+
+/* `count` records of the coupler's kind at `records` (NULL while checking and reserving: nothing is
+   stored then), their saved fields. */
+static void fsdem__restart_records(fsdem__restart *io, const fsdem_coupler *c, void *records, int count) {
+    int k;
+    for (k = 0; k < count && io->res == FSDEM_OK; ++k)
+        fsdem__restart_fields(io, records ? (char *)records + (size_t)k * c->cls->record_size : NULL, c->cls->fields, c->cls->field_count);
+}
+
+/* Bytes of the saved fields of one record: the least a count of records needs of the payload. */
+static size_t fsdem__restart_record_bytes(const fsdem_coupler *c) {
+    size_t bytes = 0;
+    int k;
+    for (k = 0; k < c->cls->field_count; ++k)
+        if (c->cls->fields[k].saved) bytes += fsdem__field_size(c->cls->fields[k].kind);
+    return bytes;
+}
+
+/* The start of every coupler's file: the tag, the fluid (`fluid` visits it, in the section named
+   `fluid_section`), the DEM, and the desc fields in `same`. */
+static void fsdem__restart_coupler(fsdem__restart *io, fsdem_coupler *c, const char *tag, fsdem__restart_visit_fn fluid,
+                                   const char *fluid_section, const char *dem_section, const fsdem__field *same, int n) {
+    fsdem__restart_tag(io, tag);
+    io->section = fluid_section;
+    fluid(io, c->fluid);
+    io->section = dem_section;
+    fsdem__restart_dem(io, c->dem);
     io->section = NULL;
-    fsdem__restart_same_int(io, (int)c->desc.drag, "drag");
-    fsdem__restart_same_real(io, c->desc.averaging_radius, "averaging_radius");
-    fsdem__restart_same_real(io, c->desc.min_porosity, "min_porosity");
-    fsdem__restart_same_real(io, c->desc.drag_dt_fraction, "drag_dt_fraction");
-    fsdem__restart_same_ll(io, c->desc.max_substeps, "max_substeps");
-    fsdem__restart_data(io, &c->steps, sizeof c->steps);
-    fsdem__restart_data(io, &c->substeps, sizeof c->substeps);
-    fsdem__restart_data(io, &c->substeps_total, sizeof c->substeps_total);
-    fsdem__restart_data(io, &c->tally.pairs, sizeof c->tally.pairs);
-    fsdem__restart_data(io, &c->dt_last, sizeof c->dt_last);
-    fsdem__restart_data(io, &c->tally.drag_dt, sizeof c->tally.drag_dt);
-    fsdem__restart_data(io, &c->tally.wet, sizeof c->tally.wet);
-    fsdem__restart_data(io, &c->tally.drag_sum, sizeof c->tally.drag_sum);
-    fsdem__restart_data(io, &c->tally.pressure_sum, sizeof c->tally.pressure_sum);
-    fsdem__restart_data(io, &c->tally.fluid_sum, sizeof c->tally.fluid_sum);
-    fsdem__restart_count(io, &count, 1 << 29, sizeof(int) + 4 * sizeof(fsdem_vec3) + 2 * sizeof(fsdem_real), "force record count");
-    force = (fsdem_mps_dem_force *)fsdem__restart_block(io, &c->allocator, sizeof *force * (size_t)count);
+    fsdem__restart_same_fields(io, c, same, n);
+}
+
+/* Where records read in a restore go: the object's in WRITE and COMMIT, nowhere otherwise. */
+static void *fsdem__restart_here(const fsdem__restart *io, void *records) {
+    return io->mode == FSDEM__RESTART_WRITE || io->mode == FSDEM__RESTART_COMMIT ? records : NULL;
+}
+
+/* SWE-DEM: the counters, the last step, the impulse given to the water, and the force records and
+   reactions of every particle slot (the next step's impulse reads the reactions). */
+static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
+    static const fsdem__field same[7] = {
+        FSDEM__RESTART_FIELD(fsdem_swe_dem, "beta", REAL, desc.beta),           FSDEM__RESTART_FIELD(fsdem_swe_dem, "two_way", INT, desc.two_way),
+        FSDEM__RESTART_FIELD(fsdem_swe_dem, "heave_damping", REAL, desc.heave_damping), FSDEM__RESTART_FIELD(fsdem_swe_dem, "max_substeps", LL, desc.max_substeps),
+        FSDEM__RESTART_FIELD(fsdem_swe_dem, "swe.density", REAL, rho),          FSDEM__RESTART_FIELD(fsdem_swe_dem, "swe.gravity", REAL, g),
+        FSDEM__RESTART_FIELD(fsdem_swe_dem, "swe.dry_depth", REAL, dry)};
+    static const fsdem__field state[6] = {
+        FSDEM__RESTART_FIELD(fsdem_swe_dem, "", LL, head.steps),  FSDEM__RESTART_FIELD(fsdem_swe_dem, "", LL, head.substeps),
+        FSDEM__RESTART_FIELD(fsdem_swe_dem, "", LL, head.substeps_total), FSDEM__RESTART_FIELD(fsdem_swe_dem, "", REAL, head.dt_last),
+        FSDEM__RESTART_FIELD(fsdem_swe_dem, "", INT, wet),         FSDEM__RESTART_FIELD(fsdem_swe_dem, "", VEC3, impulse)};
+    fsdem_swe_dem *c = (fsdem_swe_dem *)object;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    int count = c->force_capacity, records = c->head.records;
+    fsdem_swe_dem_force *force;
+    fsdem_vec3 *reaction;
+    fsdem__restart_coupler(io, &c->head, "SWD1", fsdem__restart_swe, "shallow water", "debris (DEM)", same, 7);
+    fsdem__restart_fields(io, c, state, 6);
+    fsdem__restart_count(io, &count, 1 << 29, fsdem__restart_record_bytes(&c->head) + sizeof(fsdem_vec3), "force record count");
+    fsdem__restart_data(io, &records, sizeof records);
+    if (io->res == FSDEM_OK && (records < 0 || records > count)) fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "bad record count");
+    force = (fsdem_swe_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
+    reaction = (fsdem_vec3 *)fsdem__restart_block(io, &c->head.allocator, sizeof *reaction * (size_t)count);
     if (commit) {
-        fsdem__free(&c->allocator, c->force, sizeof *force * (size_t)c->force_cap);
+        fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_capacity);
+        fsdem__free(&c->head.allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
         c->force = force;
-        c->forces = c->force_cap = count;
+        c->reaction = reaction;
+        c->force_capacity = count;
         if (force) memset(force, 0, sizeof *force * (size_t)count);
+        c->head.record = force;
+        c->head.records = records;
     }
-    for (k = 0; k < count && io->res == FSDEM_OK; ++k) {
-        fsdem_mps_dem_force scratch, *f = io->mode == FSDEM__RESTART_WRITE || commit ? &c->force[k] : &scratch;
-        fsdem__restart_data(io, &f->id, sizeof f->id);
-        fsdem__restart_data(io, &f->drag, sizeof f->drag);
-        fsdem__restart_data(io, &f->pressure, sizeof f->pressure);
-        fsdem__restart_data(io, &f->total, sizeof f->total);
-        fsdem__restart_data(io, &f->fluid_velocity, sizeof f->fluid_velocity);
-        fsdem__restart_data(io, &f->porosity, sizeof f->porosity);
-        fsdem__restart_data(io, &f->reynolds, sizeof f->reynolds);
-        fsdem__restart_data(io, &f->wet, sizeof f->wet);
+    fsdem__restart_records(io, &c->head, fsdem__restart_here(io, c->force), count);
+    fsdem__restart_data(io, c->reaction, sizeof(fsdem_vec3) * (size_t)count);
+    fsdem__restart_tag(io, "SWD.");
+}
+
+/* MPS-DEM: the counters, the tally and the force records of its last update (a step recomputes them
+   first, so they serve fsdem_mps_dem_get_force until then); the pair lists and the grid are rebuilt
+   by every update. */
+static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
+    static const fsdem__field same[5] = {
+        FSDEM__RESTART_FIELD(fsdem_mps_dem, "drag", INT, desc.drag), FSDEM__RESTART_FIELD(fsdem_mps_dem, "averaging_radius", REAL, desc.averaging_radius),
+        FSDEM__RESTART_FIELD(fsdem_mps_dem, "min_porosity", REAL, desc.min_porosity),
+        FSDEM__RESTART_FIELD(fsdem_mps_dem, "drag_dt_fraction", REAL, desc.drag_dt_fraction),
+        FSDEM__RESTART_FIELD(fsdem_mps_dem, "max_substeps", LL, desc.max_substeps)};
+    static const fsdem__field state[10] = {
+        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, head.steps),         FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, head.substeps),
+        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, head.substeps_total), FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, tally.pairs),
+        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", REAL, head.dt_last),      FSDEM__RESTART_FIELD(fsdem_mps_dem, "", REAL, tally.drag_dt),
+        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", INT, tally.wet),          FSDEM__RESTART_FIELD(fsdem_mps_dem, "", VEC3, tally.drag_sum),
+        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", VEC3, tally.pressure_sum), FSDEM__RESTART_FIELD(fsdem_mps_dem, "", VEC3, tally.fluid_sum)};
+    fsdem_mps_dem *c = (fsdem_mps_dem *)object;
+    int count = c->head.records;
+    fsdem_mps_dem_force *force;
+    fsdem__restart_coupler(io, &c->head, "MPD1", fsdem__restart_mps, "water (MPS)", "sediment (DEM)", same, 5);
+    fsdem__restart_fields(io, c, state, 10);
+    fsdem__restart_count(io, &count, 1 << 29, fsdem__restart_record_bytes(&c->head), "force record count");
+    force = (fsdem_mps_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_cap);
+        c->force = force;
+        c->force_cap = count;
+        if (force) memset(force, 0, sizeof *force * (size_t)count);
+        c->head.record = force;
+        c->head.records = count;
     }
+    fsdem__restart_records(io, &c->head, fsdem__restart_here(io, c->force), count);
     fsdem__restart_tag(io, "MPD.");
 }
 
-/* ---- >>restart_pic_dem : PIC-DEM coupler ---- */
-
-/* The two solvers, then the coupler's counters, its viscous limit and the loads of its last step.
-   Its cut (faces, J, references) is redone at the start of every step over the PIC's reset coupling
-   arrays, so it is not saved; the viscous limit of the saved step is: the run goes on bit for bit. */
+/* PIC-DEM: the counters, the viscous limit and the loads of its last step. Its cut (faces, J,
+   references) is redone at the start of every step over the PIC's reset coupling arrays, so it is
+   not saved; the viscous limit of the saved step is: the run goes on bit for bit. */
 static void fsdem__restart_pic_dem(fsdem__restart *io, void *object) {
+    static const fsdem__field same[5] = {
+        FSDEM__RESTART_FIELD(fsdem_pic_dem, "dissipation", REAL, desc.dissipation),
+        FSDEM__RESTART_FIELD(fsdem_pic_dem, "contact_length", REAL, desc.contact_length),
+        FSDEM__RESTART_FIELD(fsdem_pic_dem, "viscous_dt_fraction", REAL, desc.viscous_dt_fraction),
+        FSDEM__RESTART_FIELD(fsdem_pic_dem, "discrete_weight", INT, desc.discrete_weight),
+        FSDEM__RESTART_FIELD(fsdem_pic_dem, "max_substeps", LL, desc.max_substeps)};
+    static const fsdem__field state[9] = {
+        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, head.steps),   FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, head.substeps),
+        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, head.substeps_total), FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, dissipated),
+        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, pushed),       FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, removed),
+        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", REAL, head.dt_last), FSDEM__RESTART_FIELD(fsdem_pic_dem, "", REAL, viscous_dt),
+        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", VEC3, force_sum)};
     fsdem_pic_dem *c = (fsdem_pic_dem *)object;
-    const int commit = io->mode == FSDEM__RESTART_COMMIT;
     int count = c->loaded ? c->bodies : 0, b;
-    fsdem__restart_tag(io, "PDM1");
-    io->section = "water (PIC)";
-    fsdem__restart_pic(io, c->desc.pic);
-    io->section = "bodies (DEM)";
-    fsdem__restart_dem(io, c->desc.dem);
-    io->section = NULL;
-    fsdem__restart_same_real(io, c->desc.dissipation, "dissipation");
-    fsdem__restart_same_real(io, c->desc.contact_length, "contact_length");
-    fsdem__restart_same_real(io, c->desc.viscous_dt_fraction, "viscous_dt_fraction");
-    fsdem__restart_same_int(io, c->desc.discrete_weight, "discrete_weight");
-    fsdem__restart_same_ll(io, c->desc.max_substeps, "max_substeps");
-    fsdem__restart_data(io, &c->steps, sizeof c->steps);
-    fsdem__restart_data(io, &c->substeps, sizeof c->substeps);
-    fsdem__restart_data(io, &c->substeps_total, sizeof c->substeps_total);
-    fsdem__restart_data(io, &c->dissipated, sizeof c->dissipated);
-    fsdem__restart_data(io, &c->pushed, sizeof c->pushed);
-    fsdem__restart_data(io, &c->removed, sizeof c->removed);
-    fsdem__restart_data(io, &c->dt_last, sizeof c->dt_last);
-    fsdem__restart_data(io, &c->viscous_dt, sizeof c->viscous_dt);
-    fsdem__restart_data(io, &c->force_sum, sizeof c->force_sum);
-    fsdem__restart_count(io, &count, 1 << 29, sizeof(int) + 4 * sizeof(fsdem_vec3) + sizeof(fsdem_real), "body load count");
-    if (io->mode == FSDEM__RESTART_RESERVE && fsdem__pic_dem_reserve_bodies(c, count) != FSDEM_OK) io->res = FSDEM_ERR_OUT_OF_MEMORY;
-    if (commit) { /* the next step cuts afresh, as every step does */
+    fsdem__restart_coupler(io, &c->head, "PDM1", fsdem__restart_pic, "water (PIC)", "bodies (DEM)", same, 5);
+    fsdem__restart_fields(io, c, state, 9);
+    fsdem__restart_count(io, &count, 1 << 29, fsdem__restart_record_bytes(&c->head), "body load count");
+    if (io->mode == FSDEM__RESTART_RESERVE) fsdem__restart_need(io, fsdem__pic_dem_reserve_bodies(c, count), "the bodies' records");
+    if (io->mode == FSDEM__RESTART_COMMIT) { /* the next step cuts afresh, as every step does */
         c->face_count = c->jac_count = 0;
         c->bodies = count;
         c->loaded = count > 0;
         for (b = 0; b <= count; ++b) c->face_start[b] = c->jac_start[b] = 0;
+        for (b = 0; b < count; ++b) c->load[b].faces = 0;
+        c->head.record = c->load;
+        c->head.records = count;
     }
-    for (b = 0; b < count && io->res == FSDEM_OK; ++b) {
-        fsdem_vec3 scratch[4];
-        fsdem_real vol;
-        const int here = io->mode == FSDEM__RESTART_WRITE || commit;
-        int id;
-        fsdem__restart_data(io, here ? &c->body_id[b] : &id, sizeof(int));
-        fsdem__restart_data(io, here ? &c->fp[b] : &scratch[0], sizeof(fsdem_vec3));
-        fsdem__restart_data(io, here ? &c->fv[b] : &scratch[1], sizeof(fsdem_vec3));
-        fsdem__restart_data(io, here ? &c->tq[b] : &scratch[2], sizeof(fsdem_vec3));
-        fsdem__restart_data(io, here ? &c->wc[b] : &scratch[3], sizeof(fsdem_vec3));
-        fsdem__restart_data(io, here ? &c->volume[b] : &vol, sizeof(fsdem_real));
-    }
+    fsdem__restart_records(io, &c->head, fsdem__restart_here(io, c->load), count);
     fsdem__restart_tag(io, "PDM.");
 }
 
-/* ---- >>restart_gic : Granule-In-Cell coupler ---- */
-
-/* The two solvers, then the coupler's fractions, counters and last step's tally (its drag limit
-   bounds the next step). The force records are rebuilt by the next step's evaluations. */
+/* GIC: the volume fractions, the last step's tally (its drag limit bounds the next step) and the
+   counters. The force records are rebuilt by the next step's evaluations. */
 static void fsdem__restart_gic(fsdem__restart *io, void *object) {
+    static const fsdem__field same[9] = {
+        FSDEM__RESTART_FIELD(fsdem_gic, "drag", INT, desc.drag),          FSDEM__RESTART_FIELD(fsdem_gic, "drag_scale", REAL, desc.drag_scale),
+        FSDEM__RESTART_FIELD(fsdem_gic, "virtual_mass", INT, desc.virtual_mass), FSDEM__RESTART_FIELD(fsdem_gic, "viscosity", REAL, mu),
+        FSDEM__RESTART_FIELD(fsdem_gic, "max_solid_fraction", REAL, desc.max_solid_fraction), FSDEM__RESTART_FIELD(fsdem_gic, "cfl", REAL, desc.cfl),
+        FSDEM__RESTART_FIELD(fsdem_gic, "max_dt_ratio", REAL, desc.max_dt_ratio),
+        FSDEM__RESTART_FIELD(fsdem_gic, "drag_dt_fraction", REAL, desc.drag_dt_fraction),
+        FSDEM__RESTART_FIELD(fsdem_gic, "max_substeps", LL, desc.max_substeps)};
+    static const fsdem__field state[13] = {
+        FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, max_solid),       FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, solid_volume),
+        FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.pressure),   FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.drag),
+        FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.virtual_mass), FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.to_fluid),
+        FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.lost),       FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, last.drag_dt),
+        FSDEM__RESTART_FIELD(fsdem_gic, "", INT, last.wet),         FSDEM__RESTART_FIELD(fsdem_gic, "", LL, head.steps),
+        FSDEM__RESTART_FIELD(fsdem_gic, "", LL, head.substeps),     FSDEM__RESTART_FIELD(fsdem_gic, "", LL, head.substeps_total),
+        FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, head.dt_last)};
     fsdem_gic *c = (fsdem_gic *)object;
     const size_t cells = sizeof(fsdem_real) * (size_t)c->grid.ncell;
-    fsdem__restart_tag(io, "GIC1");
-    io->section = "water (PIC)";
-    fsdem__restart_pic(io, c->desc.pic);
-    io->section = "granules (DEM)";
-    fsdem__restart_dem(io, c->desc.dem);
-    io->section = NULL;
-    fsdem__restart_same_int(io, (int)c->desc.drag, "drag");
-    fsdem__restart_same_real(io, c->desc.drag_scale, "drag_scale");
-    fsdem__restart_same_int(io, c->desc.virtual_mass, "virtual_mass");
-    fsdem__restart_same_real(io, c->desc.viscosity, "viscosity");
-    fsdem__restart_same_real(io, c->desc.max_solid_fraction, "max_solid_fraction");
-    fsdem__restart_same_real(io, c->desc.cfl, "cfl");
-    fsdem__restart_same_real(io, c->desc.max_dt_ratio, "max_dt_ratio");
-    fsdem__restart_same_real(io, c->desc.drag_dt_fraction, "drag_dt_fraction");
-    fsdem__restart_same_ll(io, c->desc.max_substeps, "max_substeps");
+    fsdem__restart_coupler(io, &c->head, "GIC1", fsdem__restart_pic, "water (PIC)", "granules (DEM)", same, 9);
     fsdem__restart_data(io, c->solid, cells);
     fsdem__restart_data(io, c->porosity, cells);
-    fsdem__restart_data(io, &c->max_solid, sizeof c->max_solid);
-    fsdem__restart_data(io, &c->solid_volume, sizeof c->solid_volume);
-    fsdem__restart_data(io, &c->last.pressure, sizeof c->last.pressure);
-    fsdem__restart_data(io, &c->last.drag, sizeof c->last.drag);
-    fsdem__restart_data(io, &c->last.virtual_mass, sizeof c->last.virtual_mass);
-    fsdem__restart_data(io, &c->last.to_fluid, sizeof c->last.to_fluid);
-    fsdem__restart_data(io, &c->last.lost, sizeof c->last.lost);
-    fsdem__restart_data(io, &c->last.drag_dt, sizeof c->last.drag_dt);
-    fsdem__restart_data(io, &c->last.wet, sizeof c->last.wet);
-    fsdem__restart_data(io, &c->steps, sizeof c->steps);
-    fsdem__restart_data(io, &c->substeps, sizeof c->substeps);
-    fsdem__restart_data(io, &c->substeps_total, sizeof c->substeps_total);
-    fsdem__restart_data(io, &c->dt_last, sizeof c->dt_last);
-    if (io->mode == FSDEM__RESTART_COMMIT) c->records = 0;
+    fsdem__restart_fields(io, c, state, 13);
+    if (io->mode == FSDEM__RESTART_COMMIT) c->head.records = 0;
     fsdem__restart_tag(io, "GIC.");
 }
+
+#undef FSDEM__RESTART_FIELD
 
 /* ---- >>restart_api : memory and files ---- */
 
@@ -20414,8 +21026,8 @@ static fsdem__restart_object fsdem__restart_of_swe_dem(const fsdem_swe_dem *c) {
     o.sizes[3] = c->force_capacity;
     o.object = (void *)c;
     o.visit = fsdem__restart_swe_dem;
-    o.allocator = &c->allocator;
-    o.status = (fsdem__status *)&c->status;
+    o.allocator = &c->head.allocator;
+    o.status = (fsdem__status *)&c->head.status;
     o.name = "fsdem_swe_dem";
     return o;
 }
@@ -20446,12 +21058,12 @@ static fsdem__restart_object fsdem__restart_of_mps_dem(const fsdem_mps_dem *c) {
     o.dim = c->dim;
     o.sizes[0] = c->desc.mps->n;
     o.sizes[1] = c->desc.dem->n;
-    o.sizes[2] = c->forces;
+    o.sizes[2] = c->head.records;
     o.sizes[3] = 0;
     o.object = (void *)c;
     o.visit = fsdem__restart_mps_dem;
-    o.allocator = &c->allocator;
-    o.status = (fsdem__status *)&c->status;
+    o.allocator = &c->head.allocator;
+    o.status = (fsdem__status *)&c->head.status;
     o.name = "fsdem_mps_dem";
     return o;
 }
@@ -20468,8 +21080,8 @@ static fsdem__restart_object fsdem__restart_of_gic(const fsdem_gic *c) {
     o.sizes[3] = 0;
     o.object = (void *)c;
     o.visit = fsdem__restart_gic;
-    o.allocator = &c->allocator;
-    o.status = (fsdem__status *)&c->status;
+    o.allocator = &c->head.allocator;
+    o.status = (fsdem__status *)&c->head.status;
     o.name = "fsdem_gic";
     return o;
 }
@@ -20486,8 +21098,8 @@ static fsdem__restart_object fsdem__restart_of_pic_dem(const fsdem_pic_dem *c) {
     o.sizes[3] = 0;
     o.object = (void *)c;
     o.visit = fsdem__restart_pic_dem;
-    o.allocator = &c->allocator;
-    o.status = (fsdem__status *)&c->status;
+    o.allocator = &c->head.allocator;
+    o.status = (fsdem__status *)&c->head.status;
     o.name = "fsdem_pic_dem";
     return o;
 }
@@ -21824,34 +22436,6 @@ fsdem_result fsdem_mps_write_vtp(const fsdem_mps *s, const char *path, fsdem_vtk
     return fsdem__vtk_particles_end(&w, s->x, s->n);
 }
 
-/* ---- CSV snapshots of rows of numbers ---- */
-
-/* Fills the values of row `index`; returns 0 when the row is left out. */
-typedef int (*fsdem__io_row_fn)(const void *object, int index, double *values);
-
-/* Writes `header` and the rows 0 .. rows-1 that `row` gives (as many values as the header has
-   names), with 17 significant digits so that they read back exactly. */
-static fsdem_result fsdem__io_write_rows(const fsdem__status *status, const char *who, const char *path, const char *header,
-                                         int rows, fsdem__io_row_fn row, const void *object) {
-    double values[32];
-    int columns = 1, index, k, bad;
-    const char *h;
-    FILE *fp;
-    if (!path) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_INVALID_ARG, "%s: path is NULL", who);
-    for (h = header; *h; ++h) columns += *h == ',';
-    FSDEM_ASSERT(columns <= (int)(sizeof values / sizeof values[0]));
-    if (!(fp = fopen(path, "w"))) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_IO, "%s: cannot open '%s' for writing", who, path);
-    fprintf(fp, "%s\n", header);
-    for (index = 0; index < rows; ++index) {
-        if (!row(object, index, values)) continue;
-        for (k = 0; k < columns; ++k) fprintf(fp, k ? ",%.17g" : "%.17g", values[k]);
-        fputc('\n', fp);
-    }
-    bad = ferror(fp);
-    if (fclose(fp) != 0 || bad) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_IO, "%s: cannot write '%s'", who, path);
-    return fsdem__ok((fsdem__status *)status);
-}
-
 static void fsdem__io_put3(double *v, fsdem_vec3 a) {
     v[0] = (double)a.x;
     v[1] = (double)a.y;
@@ -21872,104 +22456,8 @@ static int fsdem__io_mps_row(const void *object, int i, double *v) {
 
 fsdem_result fsdem_mps_write_csv(const fsdem_mps *s, const char *path) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__io_write_rows(&s->status, "fsdem_mps_write_csv", path,
+    return fsdem__write_rows(&s->status, "fsdem_mps_write_csv", path,
                                 "kind,surface,x,y,z,vx,vy,vz,pressure,number_density,porosity", s->n, fsdem__io_mps_row, s);
-}
-
-static int fsdem__io_swe_dem_row(const void *object, int i, double *v) {
-    const fsdem_swe_dem *c = (const fsdem_swe_dem *)object;
-    const int k = fsdem__swe_dem_record(c, i);
-    fsdem_swe_dem_force f;
-    if (k < 0) return 0;
-    f = c->force[k];
-    v[0] = f.id;
-    v[1] = (double)f.buoyancy.z;
-    v[2] = (double)f.hydrostatic.x;
-    v[3] = (double)f.hydrostatic.y;
-    v[4] = (double)f.dynamic.x;
-    v[5] = (double)f.dynamic.y;
-    v[6] = (double)f.heave.z;
-    v[7] = (double)f.submerged_volume;
-    v[8] = (double)f.frontal_area;
-    v[9] = (double)f.surface;
-    v[10] = f.in_water;
-    return 1;
-}
-
-fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *c, const char *path) {
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__io_write_rows(&c->status, "fsdem_swe_dem_write_csv", path,
-                                "id,buoyancy_z,hydrostatic_x,hydrostatic_y,dynamic_x,dynamic_y,heave_z,submerged_volume,"
-                                "frontal_area,surface,in_water",
-                                fsdem_dem_get_particles(c->desc.dem).count, fsdem__io_swe_dem_row, c);
-}
-
-static int fsdem__io_mps_dem_row(const void *object, int i, double *v) {
-    const fsdem_mps_dem *c = (const fsdem_mps_dem *)object;
-    const int k = fsdem__mps_dem_record(c, i);
-    const fsdem_mps_dem_force *f = &c->force[k < 0 ? 0 : k];
-    if (k < 0) return 0;
-    v[0] = f->id;
-    fsdem__io_put3(v + 1, f->drag);
-    fsdem__io_put3(v + 4, f->pressure);
-    fsdem__io_put3(v + 7, f->total);
-    fsdem__io_put3(v + 10, f->fluid_velocity);
-    v[13] = (double)f->porosity;
-    v[14] = (double)f->reynolds;
-    v[15] = f->wet;
-    return 1;
-}
-
-fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *c, const char *path) {
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__io_write_rows(&c->status, "fsdem_mps_dem_write_csv", path,
-                                "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,fluid_u,"
-                                "fluid_v,fluid_w,porosity,reynolds,wet",
-                                fsdem_dem_get_particles(c->desc.dem).count, fsdem__io_mps_dem_row, c);
-}
-
-static int fsdem__io_pic_dem_row(const void *object, int i, double *v) {
-    const fsdem_pic_dem *c = (const fsdem_pic_dem *)object;
-    fsdem_pic_dem_force f;
-    if (fsdem__pic_dem_record(c, i) < 0 || fsdem_pic_dem_get_force(c, i, &f) != FSDEM_OK) return 0;
-    v[0] = f.id;
-    fsdem__io_put3(v + 1, f.pressure_force);
-    fsdem__io_put3(v + 4, f.viscous_force);
-    fsdem__io_put3(v + 7, f.torque);
-    fsdem__io_put3(v + 10, f.weight_correction);
-    v[13] = (double)f.volume;
-    v[14] = f.faces;
-    return 1;
-}
-
-fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *c, const char *path) {
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__io_write_rows(&c->status, "fsdem_pic_dem_write_csv", path,
-                                "id,pressure_x,pressure_y,pressure_z,viscous_x,viscous_y,viscous_z,torque_x,torque_y,torque_z,"
-                                "weight_correction_x,weight_correction_y,weight_correction_z,volume,faces",
-                                fsdem_dem_get_particles(c->desc.dem).count, fsdem__io_pic_dem_row, c);
-}
-
-static int fsdem__io_gic_row(const void *object, int i, double *v) {
-    const fsdem_gic *c = (const fsdem_gic *)object;
-    const int k = fsdem__gic_record(c, i);
-    if (k < 0) return 0;
-    v[0] = c->force[k].id;
-    fsdem__io_put3(v + 1, c->force[k].pressure);
-    fsdem__io_put3(v + 4, c->force[k].drag);
-    fsdem__io_put3(v + 7, c->force[k].virtual_mass);
-    fsdem__io_put3(v + 10, c->force[k].fluid_velocity);
-    v[13] = (double)c->force[k].porosity;
-    v[14] = (double)c->force[k].liquid;
-    return 1;
-}
-
-fsdem_result fsdem_gic_write_csv(const fsdem_gic *c, const char *path) {
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__io_write_rows(&c->status, "fsdem_gic_write_csv", path,
-                                "id,pressure_x,pressure_y,pressure_z,drag_x,drag_y,drag_z,virtual_mass_x,virtual_mass_y,virtual_mass_z,"
-                                "fluid_u,fluid_v,fluid_w,porosity,liquid",
-                                fsdem_dem_get_particles(c->desc.dem).count, fsdem__io_gic_row, c);
 }
 
 static void fsdem__io_pic_velocity(const void *user, long long c, double out[3]) {

@@ -154,8 +154,8 @@ int main(void) {
             fsdem_swe_dem_stats st = fsdem_swe_dem_get_stats(cpl);
             fsdem_real dt_next = 0;
             fsdem_swe_dem_stable_dt(cpl, &dt_next); /* the SWE's stable dt, that of the next coupled step */
-            printf("%6.2f %7lld %9lld %10.3g %14.3f %9d\n", st.time, st.steps, st.substeps_total, (double)dt_next,
-                   mean_radius(dem), st.in_water);
+            printf("%6.2f %7lld %9lld %10.3g %14.3f %9d\n", st.coupling.time, st.coupling.steps, st.coupling.substeps_total, (double)dt_next,
+                   mean_radius(dem), st.wet);
             fflush(stdout);
         }
     }

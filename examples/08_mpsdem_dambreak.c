@@ -181,8 +181,8 @@ int main(void) {
         snprintf(name, sizeof name, "sediment_%04d.vtp", frame);
         if (fsdem_dem_write_vtp(dem, name, FSDEM_VTK_FORMAT_APPENDED) == FSDEM_OK) fsdem_pvd_add(&sediment_series, row[0], name);
         if (frame % 5 == 0)
-            printf("%6.2f %6lld %10.4f %10.4f %8.3f %8.1f %8.1f\n", (double)row[0], st.steps, (double)row[1], (double)row[2],
-                   (double)fsdem_mps_get_stats(mps).max_speed, st.seconds_mps, st.seconds_dem);
+            printf("%6.2f %6lld %10.4f %10.4f %8.3f %8.1f %8.1f\n", (double)row[0], st.coupling.steps, (double)row[1], (double)row[2],
+                   (double)fsdem_mps_get_stats(mps).max_speed, st.coupling.seconds_fluid, (st.coupling.seconds_dem + st.coupling.seconds_coupling));
         fflush(stdout);
         if (frame * frame_every >= t_end - 1e-9) break;
         frame++;
@@ -195,8 +195,8 @@ int main(void) {
     }
     {
         fsdem_mps_dem_stats st = fsdem_mps_dem_get_stats(cpl);
-        printf("%d frames, %lld coupled steps, %lld DEM substeps; CPU %.1f s MPS, %.1f s DEM and coupling\n", frame + 1, st.steps,
-               st.substeps_total, st.seconds_mps, st.seconds_dem);
+        printf("%d frames, %lld coupled steps, %lld DEM substeps; CPU %.1f s MPS, %.1f s DEM and coupling\n", frame + 1, st.coupling.steps,
+               st.coupling.substeps_total, st.coupling.seconds_fluid, (st.coupling.seconds_dem + st.coupling.seconds_coupling));
     }
     printf("wrote water.pvd and sediment.pvd (ParaView) with water_*.vtp, sediment_*.vtp, and fronts.csv\n");
     fsdem_csv_close(&csv);

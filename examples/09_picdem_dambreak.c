@@ -130,8 +130,8 @@ int main(void) {
         snprintf(name, sizeof name, "cylinders_%04d.vtp", frame);
         if (fsdem_dem_write_vtp(dem, name, FSDEM_VTK_FORMAT_APPENDED) == FSDEM_OK) fsdem_pvd_add(&cylinder_series, t, name);
         if (frame % 5 == 0)
-            printf("%6.2f %6lld %9.4f %9.4f %9d %8.1f %8.1f %8.1f\n", t, st.steps, x_ave, x_max, st.contacts, st.seconds_pic,
-                   st.seconds_dem, st.seconds_coupling);
+            printf("%6.2f %6lld %9.4f %9.4f %9d %8.1f %8.1f %8.1f\n", t, st.coupling.steps, x_ave, x_max, st.contacts, st.coupling.seconds_fluid,
+                   st.coupling.seconds_dem, st.coupling.seconds_coupling);
         fflush(stdout);
         if (frame * frame_every >= t_end - 1e-9) break;
         frame++;
@@ -145,7 +145,7 @@ int main(void) {
     {
         const fsdem_pic_dem_stats st = fsdem_pic_dem_get_stats(cpl);
         printf("%d frames, %lld coupled steps, %lld DEM substeps; %lld particle velocities damped in contact areas\n", frame + 1,
-               st.steps, st.substeps_total, st.dissipated);
+               st.coupling.steps, st.coupling.substeps_total, st.dissipated);
     }
     printf("wrote water.pvd and cylinders.pvd (ParaView) with water_*.vtp, cylinders_*.vtp, and walls.vtp\n");
     fsdem_pvd_close(&water_series);

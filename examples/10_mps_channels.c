@@ -96,14 +96,12 @@ static int open_channel(void) {
         fsdem_mps_fill_box(mps, fsdem_v3(0, 0, 0), fsdem_v3((fsdem_real)L, (fsdem_real)H, 0), fsdem_v3((fsdem_real)U, 0, 0), NULL) !=
             FSDEM_OK)
         return fail(mps);
-    in.axis = 0;
-    in.direction = 1;
+    in = fsdem_mps_inflow_desc_default(); /* along +x */
     in.position = 0;
     in.lo = fsdem_v3(0, 0, 0);
     in.hi = fsdem_v3(0, (fsdem_real)H, 0);
     in.speed = (fsdem_real)U;
-    out.axis = 0;
-    out.direction = 1;
+    out = fsdem_mps_outflow_desc_default();
     out.position = (fsdem_real)L;
     out.lo = fsdem_v3(0, 0, 0);
     out.hi = fsdem_v3(0, (fsdem_real)H, 0);

@@ -106,8 +106,8 @@ int main(void) {
         snprintf(name, sizeof name, "sand_%04d.vtp", frame);
         if (fsdem_dem_write_vtp(dem, name, FSDEM_VTK_FORMAT_APPENDED) == FSDEM_OK) fsdem_pvd_add(&sand_series, t, name);
         if (frame % 5 == 0)
-            printf("%6.2f %6lld %11.4f %12.5g %10.3f %8.1f %8.1f\n", t, st.steps, x_ave, (double)fsdem_pic_get_stats(pic).fluid_volume,
-                   (double)st.max_solid_fraction, st.seconds_pic, st.seconds_dem);
+            printf("%6.2f %6lld %11.4f %12.5g %10.3f %8.1f %8.1f\n", t, st.coupling.steps, x_ave, (double)fsdem_pic_get_stats(pic).fluid_volume,
+                   (double)st.max_solid_fraction, st.coupling.seconds_fluid, (st.coupling.seconds_dem + st.coupling.seconds_coupling));
         fflush(stdout);
         if (frame * frame_every >= t_end - 1e-9) break;
         frame++;

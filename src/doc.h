@@ -18,20 +18,29 @@
      >>grid     cell grid (uniform spatial binning) shared by DEM, MPS and the couplings
      >>dem      discrete element method: particles, materials, contact laws, walls, integration
      >>linalg   CSR and MAC-grid stencil operators, preconditioned conjugate gradients (Jacobi,
-                IC(0), MIC(0), geometric multigrid) shared by the pressure solves
+                IC(0), MIC(0), geometric multigrid on stencils, smoothed-aggregation algebraic
+                multigrid on CSR matrices) shared by the pressure solves
      >>pic      PIC/FLIP/APIC free-surface solver on a MAC grid: cut-cell obstacles, ghost-fluid
-                pressure, implicit viscosity, density projection (seeds 000 and 004)
+                pressure, implicit viscosity, porosity and density projection (seeds 000 and 004)
      >>swe      shallow-water equations in 1D and 2D: HLL, MUSCL-Hancock, wet/dry, well-balanced
                 (seed 003)
-     >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
      >>mps      MPS free-surface particle solver: fluid, wall and dummy particles, mixed-source
-                pressure equation on the shared PCG, probes and gauges (seed 002)
+                pressure equation on the shared PCG, periodic axes, inflow and outflow, probes and
+                gauges (seed 002)
      >>drag     drag laws of unresolved couplings: Stokes, Schiller-Naumann, Ergun/Wen-Yu (seed 002
-                Eq. 26), Gidaspow blend, Di Felice, Beetstra-van der Hoef-Kuipers
+                Eq. 26), Gidaspow blend, Di Felice, Beetstra-van der Hoef-Kuipers, the GIC law
+                (seed 004)
+     >>couple   what every coupler shares: the staged step (one fluid step, the DEM's substeps),
+                the stable rule, the advance, per-particle records and their CSV, claims on the
+                solvers' coupling arrays, couplers of one fluid stepped together
+     >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
      >>couple_mps  unresolved MPS-DEM, Models A and B: porosity and momentum exchange by local
                 averaging, sequential staggered substepping (seed 002)
      >>couple_pic  resolved cut-cell PIC-DEM: moving discs and spheres in the pressure equation
                 (implicit solid velocity), the gap and contact dissipation, subcycling (seed 000)
+     >>couple_gic  Granule-In-Cell: granules smaller than a cell through volume fractions, the
+                porous projections, drag, pressure-gradient force and virtual mass, sand substeps
+                first (seed 004)
      >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
                 to memory, bit-exact continuation (versioned binary format with a checksum)
      >>io       CSV time series; ParaView .pvd series, valid after every entry; VTK XML snapshots
@@ -58,6 +67,9 @@
                              as the target flags allow: 2 doubles with SSE2 (any x86-64), 4 with
                              -mavx2, 8 with -mavx512f or -march=native on such a CPU. Read only by
                              the implementation's translation unit.
+     FSDEM_NO_OPENMP         no threads even in a build with -fopenmp (the library's loops run on
+                             the calling thread, as without OpenMP). Read only by the
+                             implementation's translation unit.
      FSDEM_VERSION_MAJOR/MINOR/PATCH, FSDEM_VERSION_STRING: the version of this file (read-only).
 
    CONCEPTS
@@ -91,8 +103,10 @@
      Each solver (fsdem_dem, fsdem_pic, fsdem_swe, fsdem_mps) and each coupler (fsdem_swe_dem,
      fsdem_mps_dem, fsdem_pic_dem, fsdem_gic) speaks these verbs; X is the object's name
      (tests/map_check.sh holds every one of them to the table). A solver adds verbs of its own
-     (add_particle, set_bed, ...); a coupler's per-particle record is fsdem_X_get_force(x, index,
-     &record).
+     (add_particle, set_bed, ...); a coupler adds fsdem_X_update(x) (what it writes into the
+     solvers, from the current state, without stepping), fsdem_X_get_force(x, index, &record) (its
+     per-particle record), fsdem_X_write_csv(x, path) (the records) and fsdem_X_coupler(x) (the
+     coupler as any coupler, to step with others of its fluid: fsdem_coupled_step, >>couple).
        fsdem_X_desc fsdem_X_desc_default(dim)      defaults (couplers and fsdem_pcg: no argument)
        fsdem_result fsdem_X_desc_check(desc, message, size)  validation without creating anything
        fsdem_result fsdem_X_create(desc, &x)        *x is NULL on failure; destroy with _destroy
@@ -108,7 +122,8 @@
        fsdem_result fsdem_X_stable_dt(x, &dt)       the stable step of the current state (s)
        double       fsdem_X_time(x)                 simulated time (s), a double everywhere
        fsdem_X_stats fsdem_X_get_stats(x)           counters and figures; starts with
-                                                    long long steps, double time, fsdem_real dt
+                                                    long long steps, double time, fsdem_real dt (a
+                                                    coupler's with fsdem_coupling_stats, which does)
        fsdem_X_particles / fsdem_X_fields fsdem_X_get_particles / _get_fields(x)  views (SoA)
        fsdem_result fsdem_X_write_<what>(x, path)   snapshots: CSV, and VTK XML (.vtp, .vti) with a
                                                     last argument fsdem_vtk_format (>>io); FSDEM_ERR_IO
@@ -146,18 +161,28 @@
              fsdem_pic_set_pressure_extra (an implicit term of the pressure operator, and the
              solids' answer to the solved pressure) and fsdem_pic_exclude_particles, and is read
              through fsdem_pic_get_fields (pressure, open fractions) and fsdem_pic_get_particles.
+       both  fsdem_<solver>_claims and fsdem_claim: a coupler claims the arrays it writes (the
+             DEM's external loads, the fluid's arrays of its kind) for as long as it lives, so two
+             couplers never write one array; couplers of one fluid that write different arrays
+             step together (fsdem_coupled_step, >>couple). tests/map_check.sh refuses a coupler
+             chapter that calls a solver's private helper or reads a solver's struct.
 
    THREAD SAFETY
      No global mutable state. Distinct objects may be used from distinct threads at once; one
      object must not be used from two threads at once.
 
    THREADS
-     Built with OpenMP (-fopenmp), a step runs its loops on OpenMP threads (fsdem_set_threads, or
-     OMP_NUM_THREADS). Results do not depend on the thread count, bit for bit, and equal those of a
-     build without OpenMP: no floating-point atomics; each value is written by one thread, and a sum
-     over many items is taken in an order fixed by the data alone (the PCG's dot products in blocks
-     of FSDEM__DOT_BLOCK entries, added block by block; the contact forces on a particle in the
-     order of the contact list). `make determinism` pins the same hashes at 1, 2, 3 and 4 threads.
+     Built with OpenMP (-fopenmp; FSDEM_NO_OPENMP keeps such a build on one thread), a step runs its
+     loops on OpenMP threads (fsdem_set_threads, or OMP_NUM_THREADS). Results do not depend on the
+     thread count, bit for bit, and equal those of a build without OpenMP: no floating-point
+     atomics; each value is written by one thread, and a sum over many items is taken in an order
+     fixed by the data alone (the PCG's dot products in blocks of FSDEM__DOT_BLOCK entries, added
+     block by block; the contact forces on a particle in the order of the contact list). `make
+     determinism` pins the same hashes at 1, 2, 3 and 4 threads. One rule sizes every team
+     (fsdem__team_for in >>core: the thread count, but no more threads than the loop's items over
+     its grain, nor than its work buffers were sized for); every function that opens a parallel
+     region or runs inside one says so in a `threaded:` line above it; the one wait between threads
+     (the multigrid pipeline's) uses OpenMP atomics and pauses the CPU while it spins.
      Threaded so far: the shallow-water rows (bands of rows, each with its own work rows and a
      copy of the rows beside it), the PCG on stencils (the levels' construction, the operator,
      Jacobi, the multigrid V-cycle as one pipeline per thread, vector updates, dot products), the

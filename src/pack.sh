@@ -15,12 +15,12 @@ cd "$(dirname "$0")"
 
 PUBLIC="
     core/core.h geom/geom.h kernel/kernel.h grid/grid.h
-    dem/dem.h linalg/linalg.h pic/pic.h swe/swe.h couple/swe.h mps/mps.h drag/drag.h
-    couple/mps.h couple/pic.h couple/gic.h restart/restart.h io/io.h"
+    dem/dem.h linalg/linalg.h pic/pic.h swe/swe.h mps/mps.h drag/drag.h
+    couple/couple.h couple/swe.h couple/mps.h couple/pic.h couple/gic.h restart/restart.h io/io.h"
 
 IMPLEMENTATION="
     impl.c
-    core/core.c core/gauges.c core/lane.c
+    core/core.c core/gauges.c core/lane.c core/claims.c
     geom/geom.c
     kernel/kernel.c
     grid/grid.c
@@ -32,13 +32,11 @@ IMPLEMENTATION="
     pic/extrapolate.c pic/viscosity.c pic/projection.c pic/advection.c pic/reseed.c pic/step.c
     pic/views.c pic/output.c
     swe/types.c swe/desc.c swe/object.c swe/sources.c swe/riemann.c swe/row.c swe/step.c swe/diag.c
-    couple/swe.c
     mps/types.c mps/desc.c mps/particles.c mps/open.c mps/neighbours.c mps/operators.c mps/step.c
     mps/views.c mps/probes.c
     drag/drag.c
-    couple/mps.c couple/pic.c couple/gic.c
-    restart/format.c restart/dem.c restart/pic.c restart/swe.c restart/swe_dem.c restart/mps.c
-    restart/mps_dem.c restart/pic_dem.c restart/gic.c restart/api.c
+    couple/head.c couple/step.c couple/records.c couple/swe.c couple/mps.c couple/pic.c couple/gic.c
+    restart/format.c restart/dem.c restart/pic.c restart/swe.c restart/mps.c restart/couplers.c restart/api.c
     io/csv.c io/vtk.c io/pvd.c io/dem.c io/pic.c io/swe.c"
 
 # The float build's names (>>config): "#define X X_f" for every public function X, between the

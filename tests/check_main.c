@@ -19,6 +19,7 @@ int main(void) {
     srunner_add_suite(runner, couple_mps_suite());
     srunner_add_suite(runner, couple_pic_suite());
     srunner_add_suite(runner, couple_gic_suite());
+    srunner_add_suite(runner, couple_suite());
     srunner_add_suite(runner, probing_suite());
     srunner_add_suite(runner, dem_contact_suite());
     srunner_add_suite(runner, dem_periodic_suite());

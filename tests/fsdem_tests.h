@@ -23,6 +23,7 @@ Suite *drag_suite(void);
 Suite *couple_mps_suite(void);
 Suite *couple_pic_suite(void);
 Suite *couple_gic_suite(void);
+Suite *couple_suite(void);
 Suite *probing_suite(void);
 Suite *dem_contact_suite(void);
 Suite *dem_periodic_suite(void);

@@ -310,7 +310,7 @@ START_TEST(test_gic_restart_bit_for_bit) {
         ck_assert(memcmp(qa.position, qb.position, sizeof(fsdem_vec3) * (size_t)qa.count) == 0);
         ck_assert(memcmp(qa.velocity, qb.velocity, sizeof(fsdem_vec3) * (size_t)qa.count) == 0);
         ck_assert(fsdem_gic_time(a.gic) == fsdem_gic_time(b.gic));
-        ck_assert(fsdem_gic_get_stats(a.gic).steps == fsdem_gic_get_stats(b.gic).steps);
+        ck_assert(fsdem_gic_get_stats(a.gic).coupling.steps == fsdem_gic_get_stats(b.gic).coupling.steps);
     }
     free(buf);
     free_gic(&a);
@@ -339,7 +339,9 @@ START_TEST(test_gic_bad_input) {
     ck_assert_msg(strstr(msg, ".pic and .dem") != NULL, "%s", msg);
     d.pic = t.pic;
     d.dem = t.dem;
-    ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_OK);
+    /* the tank's own coupler holds the DEM's loads and the PIC's porosity: a second is refused */
+    ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
+    ck_assert_msg(strstr(msg, "claimed by fsdem_gic") != NULL, "%s", msg);
     for (k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
         fsdem_gic_desc e = d;
         switch (bad[k].which) {
@@ -360,8 +362,9 @@ START_TEST(test_gic_bad_input) {
     d.drag = FSDEM_DRAG_LAW_STOKES; /* needs a viscosity; the PIC here is inviscid */
     ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_msg(strstr(msg, "viscosity") != NULL, "%s", msg);
-    d.viscosity = (fsdem_real)1e-3;
-    ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_OK);
+    d.viscosity = (fsdem_real)1e-6;
+    ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG); /* a viscosity given: the claims are left */
+    ck_assert_msg(strstr(msg, "claimed by fsdem_gic") != NULL, "%s", msg);
     /* NULL objects */
     ck_assert_int_eq(fsdem_gic_step(NULL), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_gic_step_dt(NULL, 1e-3), FSDEM_ERR_INVALID_ARG);
@@ -369,7 +372,7 @@ START_TEST(test_gic_bad_input) {
     ck_assert_int_eq(fsdem_gic_stable_dt(NULL, &dt), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_gic_update(NULL), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_gic_get_force(NULL, 0, &rec), FSDEM_ERR_INVALID_ARG);
-    ck_assert(fsdem_gic_get_stats(NULL).steps == 0 && fsdem_gic_time(NULL) == 0);
+    ck_assert(fsdem_gic_get_stats(NULL).coupling.steps == 0 && fsdem_gic_time(NULL) == 0);
     ck_assert(strstr(fsdem_gic_last_error(NULL), "NULL") != NULL);
     fsdem_gic_destroy(NULL);
     /* refused steps: nothing moves, nothing is counted */
@@ -395,6 +398,8 @@ START_TEST(test_gic_bad_input) {
         p.position = fsdem_v3((fsdem_real)0.05, (fsdem_real)-0.01, 0);
         ck_assert_int_eq(fsdem_dem_add_particle(wide, &p, NULL), FSDEM_OK);
         gd.dem = wide;
+        fsdem_gic_destroy(u.gic); /* its claims on the PIC go with it */
+        u.gic = NULL;
         ck_assert_int_eq(fsdem_gic_create(&gd, &g2), FSDEM_OK);
         ck_assert_int_eq(fsdem_gic_update(g2), FSDEM_ERR_OUT_OF_DOMAIN);
         ck_assert_msg(strstr(fsdem_gic_last_error(g2), "granule 0") != NULL, "%s", fsdem_gic_last_error(g2));
@@ -402,7 +407,7 @@ START_TEST(test_gic_bad_input) {
         fsdem_dem_destroy(wide);
         free_gic(&u);
     }
-    ck_assert(fsdem_gic_get_stats(t.gic).steps == 0 && fsdem_dem_time(t.dem) == 0 && fsdem_pic_time(t.pic) == 0);
+    ck_assert(fsdem_gic_get_stats(t.gic).coupling.steps == 0 && fsdem_dem_time(t.dem) == 0 && fsdem_pic_time(t.pic) == 0);
     {
         /* a porosity out of (0, 1] in the PIC: refused, named, nothing moved */
         fsdem_pic_coupling pc = fsdem_pic_get_coupling(t.pic);

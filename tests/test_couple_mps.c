@@ -286,11 +286,11 @@ START_TEST(test_mps_dem_rest_in_still_water) {
             p.material = neutral;
             ck_assert_int_eq(fsdem_dem_add_particle(t.dem, &p, NULL), FSDEM_OK);
             ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK);
-            dt = fsdem_mps_dem_get_stats(t.cpl).dt;
-            k = (double)fsdem_mps_dem_get_stats(t.cpl).substeps + 16;
+            dt = fsdem_mps_dem_get_stats(t.cpl).coupling.dt;
+            k = (double)fsdem_mps_dem_get_stats(t.cpl).coupling.substeps + 16;
             dv = fsdem_dem_get_particles(t.dem);
             TEST_REPORT("model B, one step of %.3e s in %lld substeps: v = %.9e m/s (Archimedes %.9e), neutral %.2e m/s", dt,
-                        fsdem_mps_dem_get_stats(t.cpl).substeps, (double)dv.velocity[0].z, -g * (1 - rho / 2500) * dt,
+                        fsdem_mps_dem_get_stats(t.cpl).coupling.substeps, (double)dv.velocity[0].z, -g * (1 - rho / 2500) * dt,
                         (double)dv.velocity[1].z);
             ck_assert_msg(fabs(dv.velocity[0].z + 0.6 * g * dt) <= k * TEST_EPS * g * dt, "sphere of 2500 kg/m^3: %.9e m/s",
                           (double)dv.velocity[0].z);
@@ -532,7 +532,7 @@ static test_snapshot test_snapshot_take(test_pair *t) {
     memcpy(s.bytes + need + extra - sizeof(fsdem_vec3) * (size_t)dc.count, dc.force, sizeof(fsdem_vec3) * (size_t)dc.count);
     s.size = need + extra;
     s.stats = fsdem_mps_dem_get_stats(t->cpl);
-    s.stats.seconds_mps = s.stats.seconds_dem = 0; /* CPU time is not state */
+    s.stats.coupling.seconds_fluid = s.stats.coupling.seconds_dem = s.stats.coupling.seconds_coupling = 0; /* CPU time is not state */
     return s;
 }
 
@@ -645,8 +645,8 @@ static void test_force_row(double *r, int id, const fsdem_mps_dem_force *f) {
    disc sinking in the water and a dry one above it; a disc added since the update has no record and
    no row; an unwritable path is FSDEM_ERR_IO naming the path. */
 START_TEST(test_mps_dem_csv_rows_are_the_force_records) {
-    static const char header[] = "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,fluid_u,"
-                                 "fluid_v,fluid_w,porosity,reynolds,wet";
+    static const char header[] = "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,"
+                                 "fluid_velocity_x,fluid_velocity_y,fluid_velocity_z,porosity,reynolds,wet";
     test_pair t = test_pair_new(2, 0.01, FSDEM_MPS_MODEL_B, 1e-6, fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.15f, 0), 0.08, 2500);
     fsdem_mps_dem_force f;
     double e[2 * 16];
@@ -681,8 +681,8 @@ END_TEST
    id 1), and a third row took its id from past the end of the DEM's id array; get_force(2) answered
    FSDEM_OK with the count at 2. */
 START_TEST(test_mps_dem_csv_after_a_removal) {
-    static const char header[] = "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,fluid_u,"
-                                 "fluid_v,fluid_w,porosity,reynolds,wet";
+    static const char header[] = "id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,"
+                                 "fluid_velocity_x,fluid_velocity_y,fluid_velocity_z,porosity,reynolds,wet";
     test_pair t = test_pair_new(2, 0.01, FSDEM_MPS_MODEL_B, 1e-6, fsdem_v3(0, 0, 0), fsdem_v3(0.1f, 0.15f, 0), 0.08, 2500);
     fsdem_mps_dem_force f[3];
     double e[2 * 16];

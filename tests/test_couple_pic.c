@@ -628,7 +628,7 @@ static pic_dem_snapshot pic_dem_snapshot_take(const tank *t) {
     ck_assert_ptr_nonnull(s.bytes);
     ck_assert_int_eq(fsdem_pic_dem_save_memory(t->cp, s.bytes, need, &s.size), FSDEM_OK);
     s.stats = fsdem_pic_dem_get_stats(t->cp);
-    s.stats.seconds_pic = s.stats.seconds_dem = s.stats.seconds_coupling = 0;
+    s.stats.coupling.seconds_fluid = s.stats.coupling.seconds_dem = s.stats.coupling.seconds_coupling = 0;
     return s;
 }
 
@@ -688,8 +688,9 @@ END_TEST
    under water and a free one moving through it); a disc added since the step has no record and no row; an
    unwritable path is FSDEM_ERR_IO naming the path. */
 START_TEST(csv_rows_are_the_force_records) {
-    static const char header[] = "id,pressure_x,pressure_y,pressure_z,viscous_x,viscous_y,viscous_z,torque_x,torque_y,torque_z,"
-                                 "weight_correction_x,weight_correction_y,weight_correction_z,volume,faces";
+    static const char header[] = "id,pressure_force_x,pressure_force_y,pressure_force_z,viscous_force_x,viscous_force_y,"
+                                 "viscous_force_z,torque_x,torque_y,torque_z,weight_correction_x,weight_correction_y,"
+                                 "weight_correction_z,volume,faces";
     tank t = make_tank(2, 0.3, 0.25, 0, G, 0.01, fsdem_v3(0.08, 0.1, 0), 0.03, 2000, 1, fsdem_v3(0, 0, 0), 1e-3);
     fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
     fsdem_pic_dem_force b;

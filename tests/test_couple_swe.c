@@ -132,7 +132,7 @@ START_TEST(hydrostatic_force_matches_quadrature) {
     fsdem_swe_cell back, front;
     double expected;
     ck_assert_int_eq(fsdem_swe_set_cells(w.swe, surface_step, NULL), FSDEM_OK);
-    ck_assert_int_eq(fsdem_swe_dem_update_forces(w.cpl), FSDEM_OK);
+    ck_assert_int_eq(fsdem_swe_dem_update(w.cpl), FSDEM_OK);
     ck_assert_int_eq(fsdem_swe_dem_get_force(w.cpl, 0, &f), FSDEM_OK);
     fsdem_swe_sample_state(w.swe, 2 - r, 0, &back);
     fsdem_swe_sample_state(w.swe, 2 + r, 0, &front);
@@ -181,7 +181,7 @@ START_TEST(momentum_is_exchanged_not_created) {
                exchange is exact, so the total changes by rounding only (1e-12 of what moved). In
                float the rounding that counts is the debris velocity's, eps |v| at each of the K DEM
                kicks: a random walk of eps sqrt(K) m |v0| (4x: 3.8e-5 of what moved, measured 8.6e-6) */
-            const double k_round = 4 * sqrt((double)fsdem_swe_dem_get_stats(w.cpl).substeps_total) * fabs(pd0) / fabs(pd - pd0);
+            const double k_round = 4 * sqrt((double)fsdem_swe_dem_get_stats(w.cpl).coupling.substeps_total) * fabs(pd0) / fabs(pd - pd0);
             ck_assert_msg(fabs((pw.x - pw0.x) + (pd - pd0)) < TOL(1e-12, k_round) * fabs(pd - pd0) + 1e-15,
                           "water %g + debris %g", (double)(pw.x - pw0.x), pd - pd0);
         } else {
@@ -298,7 +298,7 @@ START_TEST(wet_dry_edge_exchanges_momentum) {
     fsdem_swe_dem_force f;
     double gain_two, gain_one, water_two, water_one, pw;
     water_two = edge_step(1, &gain_two, &f, &pw);
-    ck_assert_msg(f.in_water && fabs(f.dynamic.x + f.hydrostatic.x) > 0, "the sphere must feel the water at the edge");
+    ck_assert_msg(f.wet && fabs(f.dynamic.x + f.hydrostatic.x) > 0, "the sphere must feel the water at the edge");
     water_one = edge_step(0, &gain_one, &f, &pw);
     /* the debris gains the same in both runs; the water's difference is the reaction, to rounding:
        the reaction (2.5e-4 N s) is read as the difference of two water momenta of |pw| = 15 N s,
@@ -314,12 +314,12 @@ END_TEST
    the particle's id: a floating sphere in a stream, a fixed one (a row of zeros) and, added after the
    step, one with no record yet (no row); an unwritable path is FSDEM_ERR_IO naming the path. */
 START_TEST(csv_rows_are_the_force_records) {
-    static const char header[] = "id,buoyancy_z,hydrostatic_x,hydrostatic_y,dynamic_x,dynamic_y,heave_z,submerged_volume,"
-                                 "frontal_area,surface,in_water";
+    static const char header[] = "id,buoyancy_x,buoyancy_y,buoyancy_z,hydrostatic_x,hydrostatic_y,hydrostatic_z,dynamic_x,"
+                                 "dynamic_y,dynamic_z,heave_x,heave_y,heave_z,submerged_volume,frontal_area,surface,wet";
     world w = world_new(4, 40, 0.5, 0.4, 0.05, 500, 2, 0.5, 0.5, 1);
     fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
     fsdem_swe_dem_force f;
-    double e[3 * 11];
+    double e[3 * 17];
     int i, n;
     p.position = fsdem_v3(3, 0, 0.45);
     p.radius = 0.04;
@@ -334,13 +334,16 @@ START_TEST(csv_rows_are_the_force_records) {
     ck_assert_int_eq(fsdem_dem_add_particle(w.dem, &p, NULL), FSDEM_OK); /* no record until the next update */
     ck_assert_int_eq(fsdem_swe_dem_get_force(w.cpl, 2, &f), FSDEM_ERR_NOT_FOUND);
     for (n = 0; n < 2; ++n) {
-        double *r = e + 11 * n;
+        double *r = e + 17 * n;
+        fsdem_vec3 v[4];
+        int k;
         ck_assert_int_eq(fsdem_swe_dem_get_force(w.cpl, n, &f), FSDEM_OK);
+        v[0] = f.buoyancy, v[1] = f.hydrostatic, v[2] = f.dynamic, v[3] = f.heave;
         r[0] = fsdem_dem_get_particles(w.dem).id[n];
-        r[1] = f.buoyancy.z, r[2] = f.hydrostatic.x, r[3] = f.hydrostatic.y, r[4] = f.dynamic.x, r[5] = f.dynamic.y;
-        r[6] = f.heave.z, r[7] = f.submerged_volume, r[8] = f.frontal_area, r[9] = f.surface, r[10] = f.in_water;
+        for (k = 0; k < 4; ++k) r[1 + 3 * k] = v[k].x, r[2 + 3 * k] = v[k].y, r[3 + 3 * k] = v[k].z;
+        r[13] = f.submerged_volume, r[14] = f.frontal_area, r[15] = f.surface, r[16] = f.wet;
     }
-    ck_assert_msg(e[1] > 0 && e[10] == 1 && e[11 + 10] == 0, "the floating sphere in water, the fixed one a row of zeros");
+    ck_assert_msg(e[3] > 0 && e[16] == 1 && e[17 + 16] == 0, "the floating sphere in water, the fixed one a row of zeros");
     ck_assert_int_eq(fsdem_swe_dem_write_csv(w.cpl, "build/test_swe_dem.csv"), FSDEM_OK);
     test_csv_expect("build/test_swe_dem.csv", header, 2, e);
     ck_assert_int_eq(fsdem_swe_dem_write_csv(w.cpl, "build/no/such/dir/x.csv"), FSDEM_ERR_IO);

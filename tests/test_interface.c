@@ -720,7 +720,7 @@ static void if_expect(if_policy *p, const char *name, int ok) {
         IF_ZERO(p, "fsdem_" #X "_time(NULL)", fsdem_##X##_time(NULL));                             \
         mark_point();                                                                              \
         st_ = fsdem_##X##_get_stats(NULL);                                                         \
-        IF_ZERO(p, "fsdem_" #X "_get_stats(NULL)", st_.steps + st_.time + st_.dt + st_.substeps + st_.substeps_total); \
+        IF_ZERO(p, "fsdem_" #X "_get_stats(NULL)", st_.coupling.steps + st_.coupling.time + st_.coupling.dt + st_.coupling.substeps + st_.coupling.substeps_total); \
         IF_REFUSED(p, fsdem_##X##_write_csv(NULL, "build/never_null.csv"));                        \
         IF_REFUSED(p, fsdem_##X##_save(NULL, "build/never_null.rst"));                             \
         IF_REFUSED(p, fsdem_##X##_restore(NULL, "build/never_null.rst"));                          \
@@ -1072,7 +1072,7 @@ START_TEST(null_objects_are_refused) {
     }
     /* ---- the couplers: the verbs they share, then their own ---- */
     IF_COUPLER_DIALECT(&p, swe_dem, swe);
-    IF_REFUSED(&p, fsdem_swe_dem_update_forces(NULL));
+    IF_REFUSED(&p, fsdem_swe_dem_update(NULL));
     IF_COUPLER_DIALECT(&p, mps_dem, mps);
     IF_REFUSED(&p, fsdem_mps_dem_update(NULL));
     IF_COUPLER_DIALECT(&p, pic_dem, pic);

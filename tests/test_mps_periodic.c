@@ -201,18 +201,14 @@ static fsdem_mps *test_open_channel(void) {
                                              (1u << FSDEM_SIDE_XMIN) | (1u << FSDEM_SIDE_XMAX), NULL),
                      FSDEM_OK);
     ck_assert_int_eq(fsdem_mps_fill_box(m, fsdem_v3(0, 0, 0), fsdem_v3(L, H, 0), fsdem_v3(U, 0, 0), NULL), FSDEM_OK);
-    memset(&in, 0, sizeof in);
-    in.axis = 0;
-    in.direction = 1;
+    in = fsdem_mps_inflow_desc_default(); /* axis 0, direction +1 */
     in.position = 0;
     in.lo = fsdem_v3(0, 0, 0);
     in.hi = fsdem_v3(0, H, 0);
     in.speed = U;
     ck_assert_int_eq(fsdem_mps_add_inflow(m, &in, &added), FSDEM_OK);
     ck_assert_int_eq(added, 5 * 10); /* ceil(4.1) = 5 layers of 10 */
-    memset(&out, 0, sizeof out);
-    out.axis = 0;
-    out.direction = 1;
+    out = fsdem_mps_outflow_desc_default();
     out.position = L;
     out.hi = fsdem_v3(0, H, 0);
     ck_assert_int_eq(fsdem_mps_add_outflow(m, &out), FSDEM_OK);
@@ -322,10 +318,8 @@ START_TEST(test_mps_open_bad_input) {
     const int n = fsdem_mps_get_particles(m).count;
     fsdem_mps_inflow_desc in;
     fsdem_mps_outflow_desc out;
-    memset(&in, 0, sizeof in);
-    memset(&out, 0, sizeof out);
-    in.axis = 0;
-    in.direction = 1;
+    in = fsdem_mps_inflow_desc_default();
+    out = fsdem_mps_outflow_desc_default();
     in.position = -0.08f; /* the buffer would reach -0.13 m < domain_min.x */
     in.hi = fsdem_v3(0, 0.1f, 0);
     in.speed = 0.1f;

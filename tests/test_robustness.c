@@ -183,7 +183,7 @@ START_TEST(coupled_step_checks_substeps_first) {
     /* with enough substeps allowed the same step goes through */
     ck_assert_int_eq(fsdem_dem_set_dt(dem, 1e-4), FSDEM_OK);
     ck_assert_int_eq(fsdem_swe_dem_step(cpl), FSDEM_OK);
-    ck_assert(fsdem_swe_dem_get_stats(cpl).substeps >= 1 && fsdem_swe_dem_get_stats(cpl).substeps <= 1000);
+    ck_assert(fsdem_swe_dem_get_stats(cpl).coupling.substeps >= 1 && fsdem_swe_dem_get_stats(cpl).coupling.substeps <= 1000);
     fsdem_swe_dem_destroy(cpl);
     fsdem_dem_destroy(dem);
     fsdem_swe_destroy(swe);

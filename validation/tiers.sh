@@ -5,9 +5,12 @@
 #   sh validation/tiers.sh run TIER CASE OUT_ROOT DATA_DIR
 #       runs build/validation/CASE/run --tier=TIER in OUT_ROOT/CASE/ (emptied first): stdout to
 #       checks.txt, stderr to log.txt, then the plots (validation/CASE/plot.gp, when gnuplot is
-#       installed) and meta.txt (tier, commit, fingerprints, CPU and wall time, exit status); copies
-#       checks.txt, meta.txt and the plots into validation/report-TIER/CASE/ (the committed record
-#       of the tier). Prints a summary of the case; exits 0 whatever the case's result.
+#       installed) and meta.txt (tier, commit, fingerprints, CPU and wall time, exit status).
+#       Writes nothing outside OUT_ROOT. Prints a summary of the case; exits 0 whatever the result.
+#   sh validation/tiers.sh publish TIER OUT_ROOT
+#       copies the record of every case run in OUT_ROOT (checks.txt, meta.txt, the plots) and its
+#       run.txt into validation/report-TIER/ (the committed record of the tier), replacing those
+#       cases' earlier records only.
 #   sh validation/tiers.sh render TIER SRC_ROOT OUT_MD [IMG_PREFIX]
 #       writes the Markdown report OUT_MD from the cases in SRC_ROOT/*/meta.txt; plots are linked as
 #       IMG_PREFIX<case>/<png> (IMG_PREFIX: the path from OUT_MD's folder to SRC_ROOT, with a slash).
@@ -15,7 +18,8 @@
 #       one line of totals for the cases named; exits 1 when one of them failed (a CHECK FAIL, a crash,
 #       or no result).
 #   sh validation/tiers.sh status
-#       every case of both committed reports: current, or stale (and why).
+#       every case of both committed reports: current, or stale (and why) against the working tree
+#       and against HEAD.
 #   sh validation/tiers.sh fingerprint CASE [FSDEM_H]
 #       prints `solver=<hash> case=<hash>`: the hash (cksum) of the fsdem.h chapters the case
 #       depends on (validation/CASE/DEPENDS: >>tags; each tag's public chapter and its >>impl_tag
@@ -147,17 +151,6 @@ run_case() { # tier case out_root data_dir
         echo "cores=$(nproc 2>/dev/null || echo unknown)"
         [ -n "$plots" ] && echo "plots=$plots"
     } >"$out/meta.txt"
-    # the committed record of the tier
-    rec="$here/report-$tier/$name"
-    rm -rf "$rec"
-    mkdir -p "$rec"
-    cp "$out/checks.txt" "$out/meta.txt" "$rec/"
-    # the plots, in 32 colours when ImageMagick is there (a third of the size: they are committed)
-    for p in "$out"/*.png; do
-        [ -f "$p" ] || continue
-        if command -v convert >/dev/null 2>&1; then convert "$p" -strip -colors 32 "PNG8:$rec/$(basename "$p")" 2>/dev/null; fi
-        [ -s "$rec/$(basename "$p")" ] || cp "$p" "$rec/"
-    done
     awk -v name="$name" -v rc="$rc" -v wall="$(meta "$out/meta.txt" wall_s)" -v cpu="$(meta "$out/meta.txt" cpu_s)" '
         $1 == "CHECK" { n++; if ($NF != "PASS") { bad++; fails = fails "   " $0 "\n" } }
         $1 == "INFO" && / \(full tier\)$/ { full++ }
@@ -167,6 +160,29 @@ run_case() { # tier case out_root data_dir
             printf "%s", fails
         }' "$out/checks.txt"
     return 0
+}
+
+# ---- publish ----
+
+# The records of the cases run in out_root into the committed report of the tier.
+publish() { # tier out_root
+    tier=$1 root=$2
+    for m in "$root"/*/meta.txt; do
+        [ -f "$m" ] || continue
+        out=$(dirname "$m")
+        rec="$here/report-$tier/$(basename "$out")"
+        rm -rf "$rec"
+        mkdir -p "$rec"
+        cp "$out/checks.txt" "$out/meta.txt" "$rec/"
+        # the plots, in 32 colours when ImageMagick is there (a third of the size: they are committed)
+        for p in "$out"/*.png; do
+            [ -f "$p" ] || continue
+            if command -v convert >/dev/null 2>&1; then convert "$p" -strip -colors 32 "PNG8:$rec/$(basename "$p")" 2>/dev/null; fi
+            [ -s "$rec/$(basename "$p")" ] || cp "$p" "$rec/"
+        done
+        echo "published $(basename "$out") into validation/report-$tier/"
+    done
+    [ ! -f "$root/run.txt" ] || cp "$root/run.txt" "$here/report-$tier/run.txt"
 }
 
 # ---- verdict ----
@@ -200,20 +216,44 @@ staleness() { # case_dir
     cat "$cache"
 }
 
+# Why the fingerprints of a record differ from those of the tree under `root` (fsdem.h and
+# validation/ there), or nothing when they agree.
+changes_in() { # meta root name
+    now=$(here="$2/validation"; top="$2"; fingerprint "$3")
+    why=""
+    if [ "solver=$(meta "$1" solver_fp)" != "$(echo "$now" | cut -d' ' -f1)" ]; then
+        # name the chapters that changed (or, when the list of chapters changed, all of them)
+        changed=$(echo "$now" | cut -d' ' -f3 | sed 's/^chapters=//' | tr , '\n' | grep -vxF -f "$(meta_list "$1")" |
+            sed 's/:.*//; s/^/>>/' | paste -s -d' ' -)
+        why="fsdem.h changed (${changed:-the chapters of DEPENDS})"
+    fi
+    [ "case=$(meta "$1" case_fp)" = "$(echo "$now" | cut -d' ' -f2)" ] || why="${why:+$why; }the case's code changed"
+    echo "$why"
+}
+
+# The committed tree (fsdem.h and validation/ at HEAD), unpacked once; nothing outside git.
+head_tree() {
+    if [ ! -e "$scratch/head.done" ]; then
+        mkdir -p "$scratch/head"
+        (cd "$top" && git archive HEAD fsdem.h validation 2>/dev/null) | tar -x -C "$scratch/head" 2>/dev/null
+        touch "$scratch/head.done"
+    fi
+    [ -f "$scratch/head/fsdem.h" ] && echo "$scratch/head"
+}
+
+# A record is stale when its fingerprints differ from the working tree's (the code it would run on
+# now) or from HEAD's (the code committed with it).
 staleness_of() { # case_dir
     m="$1/meta.txt"
     name=$(meta "$m" case)
     if [ ! -f "$here/$name/main.c" ]; then echo "stale: the case no longer exists"; return; fi
     if [ ! -f "$here/$name/DEPENDS" ]; then echo "stale: validation/$name/DEPENDS is missing"; return; fi
-    now=$(fingerprint "$name")
-    why=""
-    if [ "solver=$(meta "$m" solver_fp)" != "$(echo "$now" | cut -d' ' -f1)" ]; then
-        # name the chapters that changed (or, when the list of chapters changed, all of them)
-        changed=$(echo "$now" | cut -d' ' -f3 | sed 's/^chapters=//' | tr , '\n' | grep -vxF -f "$(meta_list "$m")" |
-            sed 's/:.*//; s/^/>>/' | paste -s -d' ' -)
-        why="fsdem.h changed (${changed:-the chapters of DEPENDS})"
+    why=$(changes_in "$m" "$top" "$name")
+    head=$(head_tree)
+    if [ -z "$why" ] && [ -n "$head" ] && [ -f "$head/validation/$name/DEPENDS" ]; then
+        why=$(changes_in "$m" "$head" "$name")
+        [ -z "$why" ] || why="at HEAD: $why"
     fi
-    [ "case=$(meta "$m" case_fp)" = "$(echo "$now" | cut -d' ' -f2)" ] || why="${why:+$why; }the case's code changed"
     if [ -n "$why" ]; then echo "stale: $why since $(meta "$m" commit)"; else echo current; fi
 }
 
@@ -368,10 +408,11 @@ cmd=${1:-}
 [ $# -gt 0 ] && shift
 case "$cmd" in
 run) [ $# -eq 4 ] || die "usage: run TIER CASE OUT_ROOT DATA_DIR"; run_case "$@" ;;
+publish) [ $# -eq 2 ] || die "usage: publish TIER OUT_ROOT"; publish "$@" ;;
 render) [ $# -ge 3 ] || die "usage: render TIER SRC_ROOT OUT_MD [IMG_PREFIX]"; render "$@" ;;
 verdict) [ $# -ge 1 ] || die "usage: verdict OUT_ROOT CASE..."; verdict "$@" ;;
 status) status ;;
 fingerprint) [ $# -ge 1 ] || die "usage: fingerprint CASE [FSDEM_H]"; fingerprint "$@" ;;
 order) [ $# -ge 1 ] || die "usage: order TIER CASE..."; order "$@" ;;
-*) die "usage: tiers.sh run|render|verdict|status|fingerprint|order ... (see the comment at its top)" ;;
+*) die "usage: tiers.sh run|publish|render|verdict|status|fingerprint|order ... (see the comment at its top)" ;;
 esac

@@ -69,21 +69,21 @@ int main(int argc, char **argv) {
     s1 = fsdem_mps_dem_get_stats(c.cpl);
     m1 = fsdem_mps_get_stats(c.mps);
     if (res != FSDEM_OK) {
-        printf("BENCH mpsdem_dambreak error=%d t=%.5f step=%lld message=\"%s\"\n", (int)res, s1.time, s1.steps, sd_last_error(&c));
+        printf("BENCH mpsdem_dambreak error=%d t=%.5f step=%lld message=\"%s\"\n", (int)res, s1.coupling.time, s1.coupling.steps, sd_last_error(&c));
         if (done == 0) {
             sd_destroy(&c);
             return 1;
         }
     }
-    mps = (s1.seconds_mps - s0.seconds_mps) / done;
-    dem = (s1.seconds_dem - s0.seconds_dem) / done;
+    mps = (s1.coupling.seconds_fluid - s0.coupling.seconds_fluid) / done;
+    dem = (s1.coupling.seconds_dem + s1.coupling.seconds_coupling - s0.coupling.seconds_dem - s0.coupling.seconds_coupling) / done;
     printf("BENCH mpsdem_dambreak mps_s_per_step=%.4g dem_coupling_s_per_step=%.4g particles=%d dem=%d\n", mps, dem,
            m1.fluid + m1.wall + m1.dummy, c.spheres);
     printf("BENCH mpsdem_dambreak r0=%.4g m model=B warmup_steps=%d timed_steps=%d t_start=%.5f s t_end=%.5f s\n", r0, warmup, done,
-           s0.time, s1.time);
+           s0.coupling.time, s1.coupling.time);
     printf("BENCH mpsdem_dambreak particles fluid=%d wall=%d dummy=%d spheres=%d\n", m1.fluid, m1.wall, m1.dummy, c.spheres);
     printf("BENCH mpsdem_dambreak mean_dt=%.4g s dem_dt=%.4g s substeps_per_step=%.1f dem_mps_pairs=%lld\n",
-           (s1.time - s0.time) / done, c.dem_dt, (double)(s1.substeps_total - s0.substeps_total) / done, s1.pairs);
+           (s1.coupling.time - s0.coupling.time) / done, c.dem_dt, (double)(s1.coupling.substeps_total - s0.coupling.substeps_total) / done, s1.pairs);
     printf("BENCH mpsdem_dambreak pressure_iterations_mean=%.1f pressure_share_of_mps=%.1f %% neighbour_pairs=%lld\n",
            (double)(m1.pressure_iterations_total - m0.pressure_iterations_total) / done,
            m1.seconds_total > m0.seconds_total

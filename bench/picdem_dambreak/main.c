@@ -72,20 +72,20 @@ int main(int argc, char **argv) {
     ps = fsdem_pic_get_stats(c.pic);
     cs = fsdem_pic_dem_get_stats(c.cpl);
     if (res != FSDEM_OK)
-        printf("BENCH picdem_dambreak error=%d t=%.5f step=%lld message=\"%s\"\n", (int)res, cs.time, cs.steps, wd_last_error(&c));
+        printf("BENCH picdem_dambreak error=%d t=%.5f step=%lld message=\"%s\"\n", (int)res, cs.coupling.time, cs.coupling.steps, wd_last_error(&c));
     transfers = ps.seconds_total - ps.seconds_pressure - ps.seconds_density;
-    cpu = ps.seconds_total + cs.seconds_dem + cs.seconds_coupling;
-    printf("BENCH picdem_dambreak wall_s=%.2f fluid_steps=%lld dem_substeps=%lld cells=%d particles=%d\n", wall, cs.steps,
-           cs.substeps_total, g.n[0] * g.n[1], ps.particles);
+    cpu = ps.seconds_total + cs.coupling.seconds_dem + cs.coupling.seconds_coupling;
+    printf("BENCH picdem_dambreak wall_s=%.2f fluid_steps=%lld dem_substeps=%lld cells=%d particles=%d\n", wall, cs.coupling.steps,
+           cs.coupling.substeps_total, g.n[0] * g.n[1], ps.particles);
     printf("BENCH picdem_dambreak split cpu_s=%.2f pressure_s=%.2f density_s=%.2f transfers_s=%.2f dem_s=%.2f coupling_s=%.2f\n", cpu,
-           ps.seconds_pressure, ps.seconds_density, transfers, cs.seconds_dem, cs.seconds_coupling);
+           ps.seconds_pressure, ps.seconds_density, transfers, cs.coupling.seconds_dem, cs.coupling.seconds_coupling);
     printf("BENCH picdem_dambreak share pressure=%.1f %% density=%.1f %% transfers=%.1f %% dem=%.1f %% coupling=%.1f %%\n",
-           100 * ps.seconds_pressure / cpu, 100 * ps.seconds_density / cpu, 100 * transfers / cpu, 100 * cs.seconds_dem / cpu,
-           100 * cs.seconds_coupling / cpu);
+           100 * ps.seconds_pressure / cpu, 100 * ps.seconds_density / cpu, 100 * transfers / cpu, 100 * cs.coupling.seconds_dem / cpu,
+           100 * cs.coupling.seconds_coupling / cpu);
     printf("BENCH picdem_dambreak t_end=%.4g s dx=%.4g m layers=%d cylinders=%d beta=%.2g mean_dt=%.4g s dem_dt=%.4g s "
            "substeps_per_step=%.1f pressure_iterations_mean=%.1f\n",
-           cs.time, dx, layers, c.cylinders, beta, cs.steps ? cs.time / (double)cs.steps : 0.0, c.dem_dt,
-           cs.steps ? (double)cs.substeps_total / (double)cs.steps : 0.0, cs.steps ? (double)iterations / (double)cs.steps : 0.0);
+           cs.coupling.time, dx, layers, c.cylinders, beta, cs.coupling.steps ? cs.coupling.time / (double)cs.coupling.steps : 0.0, c.dem_dt,
+           cs.coupling.steps ? (double)cs.coupling.substeps_total / (double)cs.coupling.steps : 0.0, cs.coupling.steps ? (double)iterations / (double)cs.coupling.steps : 0.0);
     printf("BENCH picdem_dambreak arrival_s=%.4f goal_wall_s=120 %s\n", arrival, wall <= 120 ? "met" : "not_met");
     printf("BENCH picdem_dambreak pic_memory_bytes=%zu\n", ps.memory_bytes);
     getrusage(RUSAGE_SELF, &usage);

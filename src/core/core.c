@@ -1,9 +1,9 @@
 /* ===== >>impl_core : results, allocator, messages, vector algebra ================================== */
 
 /* Contents: results and messages, the allocator and growth, the per-step scratch arena, the status
-   every object keeps, finite-value checks, the CSV series of probes, 3-vector algebra,
-   >>core_gauges (the point gauges of the particle solvers) and >>core_lane (short vectors for the
-   batched kernels). */
+   every object keeps, finite-value checks, the CSV series of probes and CSV snapshots of rows,
+   3-vector algebra, >>core_gauges (the point gauges of the particle solvers), >>core_lane (short
+   vectors for the batched kernels) and >>core_claims (who writes a solver's coupling arrays). */
 
 #define FSDEM__PI 3.14159265358979323846
 #define FSDEM__MESSAGE_SIZE 512
@@ -29,11 +29,12 @@
 #define FSDEM__RESTRICT restrict
 #endif
 
-/* OpenMP, when the build has it: FSDEM__OMP(directive) is `#pragma omp directive`, and nothing
-   without -fopenmp (where gcc would warn of an unknown pragma). fsdem__workers() is the team size a
-   parallel region asks for, fsdem__worker() the calling thread's number in its team and fsdem__team()
-   the team's size. */
-#ifdef _OPENMP
+/* OpenMP, when the build has it and FSDEM_NO_OPENMP is not defined (>>doc THREADS):
+   FSDEM__OMP(directive) is `#pragma omp directive`, and nothing otherwise (where gcc would warn of an
+   unknown pragma). fsdem__workers() is the calling thread's OpenMP thread count, fsdem__worker() the
+   calling thread's number in its team and fsdem__team() the team's size. */
+#if defined(_OPENMP) && !defined(FSDEM_NO_OPENMP)
+#define FSDEM__THREADS 1
 #include <omp.h>
 #define FSDEM__PRAGMA(x) _Pragma(#x)
 #define FSDEM__OMP(x) FSDEM__PRAGMA(omp x)
@@ -57,7 +58,31 @@ int fsdem_threads(void) { return fsdem__workers(); }
 #define FSDEM__TEAM_ITEMS 4096
 #endif
 
-/* The calling thread's share [*begin, *end) of n items split evenly over its team, in team order. */
+/* The team of a threaded loop, the one rule every parallel region takes its size from: the calling
+   thread's OpenMP thread count, but no more threads than items / grain (a share of fewer than
+   `grain` items does not pay for a thread) nor than `cap` (the threads the loop's work buffers were
+   sized for; FSDEM__NO_CAP for a loop without), and at least one. Results never depend on it (>>doc
+   THREADS). */
+#define FSDEM__NO_CAP 0x7fffffff
+static int fsdem__team_for(long long items, long long grain, int cap) {
+    long long team = fsdem__workers();
+    if (grain > 0 && items / grain < team) team = items / grain;
+    if (cap < team) team = cap;
+    return team < 1 ? 1 : (int)team;
+}
+
+/* A pause in a spin-wait: the CPU's hint that the thread only waits (x86 PAUSE, ARM YIELD), which
+   frees the core's shared resources for the thread it waits for. */
+#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#define FSDEM__SPIN_PAUSE() __builtin_ia32_pause()
+#elif defined(__GNUC__) && (defined(__aarch64__) || defined(__arm__))
+#define FSDEM__SPIN_PAUSE() __asm__ __volatile__("yield")
+#else
+#define FSDEM__SPIN_PAUSE() ((void)0)
+#endif
+
+/* threaded: inside a team. The calling thread's share [*begin, *end) of n items split evenly over
+   its team, in team order. */
 static void fsdem__share(int n, int *begin, int *end) {
     const int me = fsdem__worker(), size = fsdem__team();
     *begin = (int)((long long)n * me / size);
@@ -344,6 +369,33 @@ static fsdem_result fsdem__series_close(fsdem__series *ser, const fsdem_allocato
 }
 
 
+
+/* CSV snapshots of rows of numbers (the MPS particles, the couplers' records). Fills the values of
+   row `index`; returns 0 when the row is left out. */
+typedef int (*fsdem__row_fn)(const void *object, int index, double *values);
+
+/* Writes `header` and the rows 0 .. rows-1 that `row` gives (as many values as the header has
+   names), with 17 significant digits so that they read back exactly. */
+static fsdem_result fsdem__write_rows(const fsdem__status *status, const char *who, const char *path, const char *header,
+                                      int rows, fsdem__row_fn row, const void *object) {
+    double values[32];
+    int columns = 1, index, k, bad;
+    const char *h;
+    FILE *fp;
+    if (!path) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_INVALID_ARG, "%s: path is NULL", who);
+    for (h = header; *h; ++h) columns += *h == ',';
+    FSDEM_ASSERT(columns <= (int)(sizeof values / sizeof values[0]));
+    if (!(fp = fopen(path, "w"))) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_IO, "%s: cannot open '%s' for writing", who, path);
+    fprintf(fp, "%s\n", header);
+    for (index = 0; index < rows; ++index) {
+        if (!row(object, index, values)) continue;
+        for (k = 0; k < columns; ++k) fprintf(fp, k ? ",%.17g" : "%.17g", values[k]);
+        fputc('\n', fp);
+    }
+    bad = ferror(fp);
+    if (fclose(fp) != 0 || bad) return fsdem__fail((fsdem__status *)status, FSDEM_ERR_IO, "%s: cannot write '%s'", who, path);
+    return fsdem__ok((fsdem__status *)status);
+}
 
 /* A relative tolerance of at least `floor` and of 100 roundings of fsdem_real, so a test written for
    double still holds in float. */

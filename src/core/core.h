@@ -73,6 +73,24 @@ typedef struct fsdem_allocator {
 FSDEM_API void fsdem_set_threads(int count);
 FSDEM_API int fsdem_threads(void);
 
+/* Who writes a solver's coupling arrays. A coupler claims the arrays it writes when it is created
+   and releases them when it is destroyed, so that two writers never share one array: a second claim
+   is refused, naming the first claimant, and writers of different arrays share the solver (>>couple).
+   A solver's arrays are the bits of its enum fsdem_<solver>_arrays; fsdem_<solver>_claims gives its
+   registry, which lives as long as the solver. */
+typedef struct fsdem_claims fsdem_claims;
+/* Claims the arrays of the bits `arrays` for `owner` (any non-NULL pointer; `name` names it in
+   messages and is copied, up to 47 characters). FSDEM_OK, also for arrays the owner holds already;
+   FSDEM_ERR_INVALID_ARG, with nothing claimed, for a NULL argument, a bit the solver does not have,
+   or an array another owner holds: the reason, naming the array and its claimant, goes to `message`
+   (may be NULL). */
+FSDEM_API fsdem_result fsdem_claim(fsdem_claims *claims, unsigned arrays, const void *owner, const char *name, char *message,
+                                   size_t message_size);
+/* Releases the arrays of `arrays` that `owner` holds (the others stay as they are). */
+FSDEM_API void fsdem_release(fsdem_claims *claims, unsigned arrays, const void *owner);
+/* The name of the claimant of the first held array of `arrays`, or NULL when none is held. */
+FSDEM_API const char *fsdem_claimant(const fsdem_claims *claims, unsigned arrays);
+
 /* Vector helpers (inline in every translation unit). */
 static inline fsdem_vec3 fsdem_v3(fsdem_real x, fsdem_real y, fsdem_real z) {
     fsdem_vec3 v;

@@ -1,8 +1,9 @@
 /* ===== >>impl_couple_gic : Granule-In-Cell ===========================================================
 
    Contents: >>couple_gic_object (desc, creation), >>couple_gic_exchange (seed 004 Eq. 5a-5b, 7a, 18:
-   volume fractions, granule forces, the exchange to the grid), >>couple_gic_step (coupled time
-   stepping). The coupler speaks to the PIC and the DEM through their public calls (>>doc). */
+   volume fractions, granule forces, the exchange to the grid), >>couple_gic_step (its stages and
+   verbs on the staged step of >>couple, sand first). The coupler speaks to the PIC and the DEM
+   through their public calls (>>doc). */
 
 /* ---- >>couple_gic_object : desc, creation ---- */
 
@@ -14,12 +15,12 @@ typedef struct fsdem__gic_tally {
 } fsdem__gic_tally;
 
 struct fsdem_gic {
+    fsdem_coupler head;            /* >>couple; its records are `force`, of the last evaluation */
     fsdem_gic_desc desc;
-    fsdem__status status;
-    fsdem_allocator allocator;
     int dim;
     fsdem__mac grid;               /* the PIC's cells (fsdem_pic_get_fields) */
     fsdem_real rho;                /* kg/m^3, the water's */
+    fsdem_real mu;                 /* Pa s, the dynamic viscosity the drag laws use */
     fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC's forces are per metre), 1 in 3D */
     fsdem_real cell_volume;        /* m^dim */
     fsdem_real *solid, *porosity;  /* per cell: alpha_s (Eq. 7a), alpha_f' */
@@ -29,17 +30,16 @@ struct fsdem_gic {
     fsdem_fluid_sample *sample;
     fsdem_gic_force *force;
     fsdem_vec3 *fluid_accel;       /* a_f of Eq. 17 at each granule, for the step under way */
-    int granule_cap, records;
+    int granule_cap;
     /* the sand substeps under way: their length h, count K, the evaluations made, the step's dt */
     fsdem_real h, dt_now;
     long long substeps_now, calls;
     int failed;                    /* an evaluation failed (its message is in status) */
     fsdem__gic_tally tally, last;  /* of the step under way, of the last step */
     fsdem_real max_solid, solid_volume;
-    long long steps, substeps, substeps_total;
-    fsdem_real dt_last;
-    double sec_pic, sec_dem;
 };
+
+static const fsdem__coupler_class *fsdem__gic_class(void);
 
 fsdem_gic_desc fsdem_gic_desc_default(void) {
     fsdem_gic_desc d;
@@ -54,17 +54,10 @@ fsdem_gic_desc fsdem_gic_desc_default(void) {
 }
 
 fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t size) {
-    fsdem_dem_desc dd;
     fsdem_pic_desc pd;
     if (!d) return fsdem__reject(msg, size, "fsdem_gic_desc is NULL");
     if (!d->pic || !d->dem) return fsdem__reject(msg, size, "fsdem_gic_desc.pic and .dem must both be set");
-    dd = fsdem_dem_get_desc(d->dem);
     pd = fsdem_pic_get_desc(d->pic);
-    if (dd.dim != pd.dim) return fsdem__reject(msg, size, "fsdem_gic_desc: the DEM is %dD and the PIC %dD", dd.dim, pd.dim);
-    if (fsdem__norm(fsdem__sub(dd.gravity, pd.gravity)) > 1e-12 * fsdem__norm(pd.gravity))
-        return fsdem__reject(msg, size, "fsdem_gic_desc: the DEM gravity (%g, %g, %g) differs from the PIC's (%g, %g, %g) m/s^2",
-                             (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)pd.gravity.x,
-                             (double)pd.gravity.y, (double)pd.gravity.z);
     if (strcmp(fsdem_drag_law_name(d->drag), "unknown") == 0)
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
     if (d->virtual_mass != 0 && d->virtual_mass != 1)
@@ -72,7 +65,7 @@ fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t siz
     if (!(d->drag_scale > 0) || !fsdem__finite(d->drag_scale))
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag_scale must be > 0 and finite (got %g)", (double)d->drag_scale);
     if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
-        return fsdem__reject(msg, size, "fsdem_gic_desc.viscosity must be >= 0 Pa s and finite (got %g)", (double)d->viscosity);
+        return fsdem__reject(msg, size, "fsdem_gic_desc.viscosity must be >= 0 m^2/s and finite (got %g)", (double)d->viscosity);
     if (d->drag != FSDEM_DRAG_LAW_GIC && d->viscosity == 0 && !(pd.viscosity > 0))
         return fsdem__reject(msg, size,
                              "fsdem_gic_desc.viscosity: the %s drag law needs a viscosity, and it is 0 here and in the (inviscid) PIC",
@@ -86,13 +79,12 @@ fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t siz
         return fsdem__reject(msg, size, "fsdem_gic_desc.max_dt_ratio must be >= 1 and finite (got %g)", (double)d->max_dt_ratio);
     if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag_dt_fraction must be in (0, 1] (got %g)", (double)d->drag_dt_fraction);
-    if (d->max_substeps < 1) return fsdem__reject(msg, size, "fsdem_gic_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
-    return FSDEM_OK;
+    return fsdem__coupler_check(fsdem__gic_class(), "fsdem_gic_desc", d->pic, FSDEM_PIC_ARRAYS_POROSITY | FSDEM_PIC_ARRAYS_ACCELERATION, d->dem,
+                                pd.dim, pd.gravity, d->max_substeps, msg, size);
 }
 
 fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out) {
     char msg[FSDEM__MESSAGE_SIZE];
-    fsdem_allocator al;
     fsdem_gic *c;
     fsdem_pic_fields g;
     fsdem_pic_desc pd;
@@ -102,27 +94,25 @@ fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out) {
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_gic_desc_check(desc, msg, sizeof msg);
-    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
-    c = (fsdem_gic *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL, res == FSDEM_OK ? &al : NULL,
-                                       sizeof *c, "fsdem_gic_create", &res);
+    c = (fsdem_gic *)fsdem__coupler_new(fsdem__gic_class(), res, msg, desc ? desc->pic : NULL, desc ? desc->dem : NULL,
+                                        FSDEM_PIC_ARRAYS_POROSITY | FSDEM_PIC_ARRAYS_ACCELERATION, desc ? desc->max_substeps : 0,
+                                        desc ? desc->log : NULL, desc ? desc->log_user : NULL, sizeof *c, &res);
     if (!c) return res;
     pd = fsdem_pic_get_desc(desc->pic);
     g = fsdem_pic_get_fields(desc->pic);
     c->desc = *desc;
-    c->allocator = al;
-    c->status.log = desc->log;
-    c->status.log_user = desc->log_user;
     c->dim = g.dim;
     c->rho = pd.density;
     c->depth = g.dim == 2 ? fsdem_dem_get_desc(desc->dem).disc_length : 1;
-    if (c->desc.viscosity == 0) c->desc.viscosity = pd.density * pd.viscosity;
+    if (c->desc.viscosity == 0) c->desc.viscosity = pd.viscosity;
+    c->mu = pd.density * c->desc.viscosity;
     if (c->desc.max_solid_fraction == 0) c->desc.max_solid_fraction = (fsdem_real)(g.dim == 3 ? 0.740 : 0.907);
     fsdem__mac_init(&c->grid, g.dim, g.n, g.cell_size, g.origin);
     c->cell_volume = g.cell_size * g.cell_size * (g.dim == 3 ? g.cell_size : 1);
     cells = (size_t)c->grid.ncell;
-    c->solid = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
-    c->porosity = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
-    c->rate = (fsdem_real *)fsdem__alloc(&c->allocator, sizeof(fsdem_real) * cells);
+    c->solid = (fsdem_real *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_real) * cells);
+    c->porosity = (fsdem_real *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_real) * cells);
+    c->rate = (fsdem_real *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_real) * cells);
     if (!c->solid || !c->porosity || !c->rate) {
         fsdem__log_oom(desc->log, desc->log_user, "fsdem_gic_create", 3 * sizeof(fsdem_real) * cells);
         fsdem_gic_destroy(c);
@@ -137,22 +127,24 @@ fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out) {
 }
 
 void fsdem_gic_destroy(fsdem_gic *c) {
-    fsdem_allocator al;
+    const fsdem_allocator *al;
     size_t cells;
     if (!c) return;
-    al = c->allocator;
+    al = &c->head.allocator;
     cells = (size_t)c->grid.ncell;
-    fsdem__free(&al, c->solid, sizeof(fsdem_real) * cells);
-    fsdem__free(&al, c->porosity, sizeof(fsdem_real) * cells);
-    fsdem__free(&al, c->rate, sizeof(fsdem_real) * cells);
-    fsdem__free(&al, c->point, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
-    fsdem__free(&al, c->sample, sizeof(fsdem_fluid_sample) * (size_t)c->granule_cap);
-    fsdem__free(&al, c->force, sizeof(fsdem_gic_force) * (size_t)c->granule_cap);
-    fsdem__free(&al, c->fluid_accel, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
-    fsdem__free(&al, c, sizeof *c);
+    fsdem__free(al, c->solid, sizeof(fsdem_real) * cells);
+    fsdem__free(al, c->porosity, sizeof(fsdem_real) * cells);
+    fsdem__free(al, c->rate, sizeof(fsdem_real) * cells);
+    fsdem__free(al, c->point, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
+    fsdem__free(al, c->sample, sizeof(fsdem_fluid_sample) * (size_t)c->granule_cap);
+    fsdem__free(al, c->force, sizeof(fsdem_gic_force) * (size_t)c->granule_cap);
+    fsdem__free(al, c->fluid_accel, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
+    fsdem__coupler_free(&c->head, sizeof *c);
 }
 
-const char *fsdem_gic_last_error(const fsdem_gic *c) { return c ? c->status.message : "fsdem_gic is NULL"; }
+const char *fsdem_gic_last_error(const fsdem_gic *c) { return c ? c->head.status.message : "fsdem_gic is NULL"; }
+
+fsdem_coupler *fsdem_gic_coupler(fsdem_gic *c) { return c ? &c->head : NULL; }
 
 fsdem_gic_desc fsdem_gic_get_desc(const fsdem_gic *c) {
     fsdem_gic_desc d;
@@ -179,8 +171,8 @@ fsdem_gic_fields fsdem_gic_get_fields(const fsdem_gic *c) {
 static fsdem_result fsdem__gic_reserve(fsdem_gic *c, int count) {
     void **const arrays[4] = {(void **)&c->point, (void **)&c->sample, (void **)&c->force, (void **)&c->fluid_accel};
     const size_t sizes[4] = {sizeof(fsdem_vec3), sizeof(fsdem_fluid_sample), sizeof(fsdem_gic_force), sizeof(fsdem_vec3)};
-    if (fsdem__grow_set(&c->allocator, arrays, sizes, 4, &c->granule_cap, c->records, count) != FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_gic: out of memory (%d granules)", count);
+    if (fsdem__grow_set(&c->head.allocator, arrays, sizes, 4, &c->granule_cap, c->head.records, count) != FSDEM_OK)
+        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_gic: out of memory (%d granules)", count);
     return FSDEM_OK;
 }
 
@@ -213,11 +205,11 @@ fsdem_result fsdem_gic_update(fsdem_gic *c) {
     for (i = 0; i < P.count; ++i) {
         int a, outside = 0;
         if (!fsdem__finite3(P.position[i]))
-            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_gic_update: granule %d (id %d) has a non-finite position", i, P.id[i]);
+            return fsdem__fail(&c->head.status, FSDEM_ERR_NAN, "fsdem_gic_update: granule %d (id %d) has a non-finite position", i, P.id[i]);
         for (a = 0; a < c->dim; ++a)
             outside |= fsdem__comp(P.position[i], a) < fsdem__comp(c->grid.lo, a) || fsdem__comp(P.position[i], a) > fsdem__comp(c->grid.hi, a);
         if (outside) /* its volume would be folded into the boundary cells */
-            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_DOMAIN,
+            return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_DOMAIN,
                                "fsdem_gic_update: granule %d (id %d) at (%g, %g, %g) m is outside the PIC's grid (keep the DEM's walls within it)",
                                i, P.id[i], (double)P.position[i].x, (double)P.position[i].y, (double)P.position[i].z);
     }
@@ -242,7 +234,7 @@ fsdem_result fsdem_gic_update(fsdem_gic *c) {
     }
     c->max_solid = most;
     c->solid_volume = (fsdem_real)(volume * (double)c->cell_volume);
-    return fsdem__ok(&c->status);
+    return fsdem__ok(&c->head.status);
 }
 
 /* The porosity alpha_f' at point p (the cells' values interpolated). */
@@ -292,7 +284,7 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
     (void)time;
     for (i = 0; i < P.count; ++i) c->point[i] = P.position[i];
     res = fsdem_pic_sample(c->desc.pic, P.count, c->point, c->sample);
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+    if (res != FSDEM_OK) return fsdem__fail(&c->head.status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
     if (fsdem_pic_get_stats(c->desc.pic).steps == 0) /* no pressure solved yet: the water's at rest */
         for (i = 0; i < P.count; ++i) c->sample[i].pressure_gradient = fsdem__scale(fsdem_pic_get_desc(c->desc.pic).gravity, c->rho);
     for (i = 0; i < P.count; ++i) {
@@ -313,8 +305,8 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
             continue;
         }
         res = fsdem_drag_coefficient(c->desc.drag, eps, 2 * P.radius[i], fsdem__norm(slip), c->rho,
-                                     c->desc.viscosity > 0 ? c->desc.viscosity : 1, &cv, NULL, why, sizeof why);
-        if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: granule %d (id %d): %s", i, P.id[i], why);
+                                     c->mu > 0 ? c->mu : 1, &cv, NULL, why, sizeof why);
+        if (res != FSDEM_OK) return fsdem__fail(&c->head.status, res, "fsdem_gic: granule %d (id %d): %s", i, P.id[i], why);
         cv *= c->desc.drag_scale;
         rec->pressure = fsdem__scale(s->pressure_gradient, -volume * wet);
         rec->drag = fsdem__scale(slip, cv * volume * wet);
@@ -336,20 +328,21 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
             if (impulse.x != 0 || impulse.y != 0 || impulse.z != 0) {
                 res = fsdem_pic_add_force(c->desc.pic, P.position[i], P.radius[i], fsdem__scale(impulse, 1 / (c->dt_now * c->depth)),
                                           &taken);
-                if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+                if (res != FSDEM_OK) return fsdem__fail(&c->head.status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
                 if (taken) c->tally.to_fluid = fsdem__add(c->tally.to_fluid, impulse);
                 else c->tally.lost = fsdem__add(c->tally.lost, impulse);
             }
         }
     }
     c->tally.wet = wet_count;
-    c->records = P.count;
+    c->head.record = c->force;
+    c->head.records = P.count;
     c->calls++;
     c->failed = 0;
     return FSDEM_OK;
 }
 
-/* ---- >>couple_gic_step : coupled time stepping ---- */
+/* ---- >>couple_gic_step : its stages and verbs (sand first) ---- */
 
 /* The shortest drag relaxation time (s; 0: none) of the granules in the water now or within
    `horizon` (s) of their paths (a granule about to enter the water counts, at its speed against
@@ -373,7 +366,7 @@ static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
         if (!(here.volume_fraction > 0) && !(ahead.volume_fraction > 0)) continue;
         if (!(here.volume_fraction > 0)) here.velocity = fsdem__zero3();
         if (fsdem_drag_coefficient(c->desc.drag, fsdem__gic_porosity_at(c, here.volume_fraction > 0 ? x : y), 2 * P.radius[i],
-                                   fsdem__norm(fsdem__sub(here.velocity, P.velocity[i])), c->rho, c->desc.viscosity > 0 ? c->desc.viscosity : 1,
+                                   fsdem__norm(fsdem__sub(here.velocity, P.velocity[i])), c->rho, c->mu > 0 ? c->mu : 1,
                                    &cv, NULL, NULL, 0) != FSDEM_OK ||
             !(cv > 0))
             continue;
@@ -395,18 +388,16 @@ static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
     return shortest;
 }
 
-/* The stable coupled step of the section (Eq. 33, the drag limit). */
-static fsdem_result fsdem__gic_stable(const fsdem_gic *c, fsdem_real *dt) {
+/* The coupler's limits on the stable step (Eq. 33, the drag limit; the class's limit). */
+static fsdem_result fsdem__gic_limit(const fsdem_coupler *head, fsdem_real *dt) {
+    const fsdem_gic *c = (const fsdem_gic *)(const void *)head;
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
-    fsdem_result res = fsdem_pic_stable_dt(c->desc.pic, dt);
     fsdem_real vmax = 0, limit = c->desc.max_dt_ratio * fsdem_dem_get_desc(c->desc.dem).dt;
     int i;
-    if (res != FSDEM_OK)
-        return fsdem__fail((fsdem__status *)&c->status, res, "fsdem_gic_stable_dt: %s", fsdem_pic_last_error(c->desc.pic));
     for (i = 0; i < P.count; ++i) {
         const fsdem_real v = fsdem__norm(P.velocity[i]);
         if (!fsdem__finite(v))
-            return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NAN, "fsdem_gic: granule %d (id %d) has a non-finite velocity", i,
+            return fsdem__fail((fsdem__status *)&head->status, FSDEM_ERR_NAN, "fsdem_gic: granule %d (id %d) has a non-finite velocity", i,
                                P.id[i]);
         if (v > vmax) vmax = v;
     }
@@ -419,14 +410,29 @@ static fsdem_result fsdem__gic_stable(const fsdem_gic *c, fsdem_real *dt) {
     return FSDEM_OK;
 }
 
-/* One coupled step of dt after the checks: sand substeps with the exchange, fractions, the PIC. */
-static fsdem_result fsdem__gic_run(fsdem_gic *c, fsdem_real dt) {
-    long long substeps = 0;
-    fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_gic");
-    clock_t t0, t1;
+/* A step of dt refused before anything moves: too many substeps, the PIC's own refusal, and for a
+   dt of the caller's the drag limit (a stable dt keeps it by construction). */
+static fsdem_result fsdem__gic_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
+    fsdem_gic *c = (fsdem_gic *)(void *)head;
+    fsdem_result res = fsdem__coupler_substeps_within(head, dt);
     if (res != FSDEM_OK) return res;
     if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
-        return fsdem__fail(&c->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+        return fsdem__fail(&head->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
+    if (chosen) {
+        const fsdem_real drag = fsdem__gic_drag_time(c, dt);
+        if (drag > 0 && dt > c->desc.drag_dt_fraction * drag * (1 + (fsdem_real)1e-6))
+            return fsdem__fail(&head->status, FSDEM_ERR_CFL,
+                               "fsdem_gic_step_dt: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s",
+                               (double)dt, (double)c->desc.drag_dt_fraction, (double)drag);
+    }
+    return FSDEM_OK;
+}
+
+/* Steps 1-2 of >>couple_gic: the sand's substeps over dt, each force evaluation handing its
+   exchange to the water's accelerations, cleared first. */
+static fsdem_result fsdem__gic_sand(fsdem_coupler *head, fsdem_real dt) {
+    fsdem_gic *c = (fsdem_gic *)(void *)head;
+    fsdem_result res;
     if ((res = fsdem__gic_reserve(c, fsdem_dem_get_particles(c->desc.dem).count)) != FSDEM_OK) return res;
     fsdem_dem_substep_count(c->desc.dem, dt, &c->substeps_now);
     c->h = dt / (fsdem_real)c->substeps_now;
@@ -437,89 +443,55 @@ static fsdem_result fsdem__gic_run(fsdem_gic *c, fsdem_real dt) {
     c->tally.drag_dt = fsdem__gic_drag_time(c, dt);
     fsdem__gic_fluid_accelerations(c);
     fsdem_pic_clear_forces(c->desc.pic);
-    t0 = clock();
-    res = fsdem_dem_advance_with(c->desc.dem, dt, fsdem__gic_evaluate, c, &substeps);
-    t1 = clock();
-    c->sec_dem += (double)(t1 - t0) / CLOCKS_PER_SEC;
+    res = fsdem__coupler_substeps(head, dt, fsdem__gic_evaluate, c, "sand substeps", &c->failed);
     c->last = c->tally;
-    c->substeps = substeps;
-    c->substeps_total += substeps;
-    if (res != FSDEM_OK)
-        return c->failed ? res : fsdem__fail(&c->status, res, "fsdem_gic: sand substeps: %s", fsdem_dem_last_error(c->desc.dem));
-    if ((res = fsdem_gic_update(c)) != FSDEM_OK) return res;
-    res = fsdem_pic_step_dt(c->desc.pic, dt);
-    c->sec_pic += (double)(clock() - t1) / CLOCKS_PER_SEC;
-    c->steps++;
-    c->dt_last = dt;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_gic: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
-    return fsdem__ok(&c->status);
+    return res;
 }
 
-fsdem_result fsdem_gic_step(fsdem_gic *c) {
-    fsdem_real dt = 0;
-    fsdem_result res;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if ((res = fsdem__gic_stable(c, &dt)) != FSDEM_OK) return res;
-    return fsdem__gic_run(c, dt);
+/* Step 3 of >>couple_gic at the sand's new positions. */
+static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
+    (void)dt;
+    return fsdem_gic_update((fsdem_gic *)(void *)head);
 }
 
-fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) {
-    fsdem_real drag;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_gic_step_dt: dt = %g s must be > 0 and finite", (double)dt);
-    drag = fsdem__gic_drag_time(c, dt);
-    if (drag > 0 && dt > c->desc.drag_dt_fraction * drag * (1 + (fsdem_real)1e-6))
-        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
-                           "fsdem_gic_step_dt: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s",
-                           (double)dt, (double)c->desc.drag_dt_fraction, (double)drag);
-    return fsdem__gic_run(c, dt);
+static const fsdem__stage fsdem__gic_stages[3] = {{"sand substeps", FSDEM__CLOCK_DEM, fsdem__gic_sand},
+                                                  {"fractions", FSDEM__CLOCK_COUPLING, fsdem__gic_fractions},
+                                                  {"PIC step", FSDEM__CLOCK_FLUID, NULL}};
+
+#define FSDEM__GIC_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_gic_force, name), 0}
+static const fsdem__field fsdem__gic_fields[8] = {
+    FSDEM__GIC_FIELD(id, INT),           FSDEM__GIC_FIELD(pressure, VEC3),       FSDEM__GIC_FIELD(drag, VEC3),
+    FSDEM__GIC_FIELD(virtual_mass, VEC3), FSDEM__GIC_FIELD(fluid_velocity, VEC3), FSDEM__GIC_FIELD(fluid_acceleration, VEC3),
+    FSDEM__GIC_FIELD(porosity, REAL),    FSDEM__GIC_FIELD(liquid, REAL)};
+#undef FSDEM__GIC_FIELD
+
+static const fsdem__coupler_class *fsdem__gic_class(void) {
+    static const fsdem__coupler_class cls = {"fsdem_gic", &fsdem__fluid_pic, sizeof(fsdem_gic_force), fsdem__gic_fields, 8, NULL,
+        NULL, fsdem__gic_limit, fsdem__gic_check, fsdem__gic_stages, 3};
+    return &cls;
 }
 
-/* fsdem__coupled_advance's verbs for this coupler. */
-static double fsdem__gic_now(const void *c) { return fsdem_pic_time(((const fsdem_gic *)c)->desc.pic); }
-
-static fsdem_result fsdem__gic_prepare(void *c, fsdem_real *dt) { return fsdem__gic_stable((const fsdem_gic *)c, dt); }
-
-static fsdem_result fsdem__gic_go(void *c, fsdem_real dt) { return fsdem__gic_run((fsdem_gic *)c, dt); }
-
+fsdem_result fsdem_gic_step(fsdem_gic *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) { return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_gic_step_dt"); }
 fsdem_result fsdem_gic_advance(fsdem_gic *c, fsdem_real duration, long long *steps) {
-    static const fsdem__coupled_verbs verbs = {fsdem__gic_now, fsdem__gic_prepare, fsdem__gic_go};
-    if (steps) *steps = 0;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__coupled_advance(c, &c->status, "fsdem_gic_advance", &verbs, duration, steps);
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_gic_advance");
 }
-
-fsdem_result fsdem_gic_stable_dt(const fsdem_gic *c, fsdem_real *dt) {
-    if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__gic_stable(c, dt);
-}
-
-double fsdem_gic_time(const fsdem_gic *c) { return c ? fsdem_pic_time(c->desc.pic) : 0; }
-
-/* The record of DEM particle `index` from the last step, or -1. */
-static int fsdem__gic_record(const fsdem_gic *c, int index) {
-    return c->records ? fsdem__dem_record_of(c->desc.dem, index, &c->force[0].id, sizeof(fsdem_gic_force), c->records) : -1;
-}
+fsdem_result fsdem_gic_stable_dt(const fsdem_gic *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+double fsdem_gic_time(const fsdem_gic *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
 
 fsdem_result fsdem_gic_get_force(const fsdem_gic *c, int index, fsdem_gic_force *out) {
-    int k;
-    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
-    k = fsdem__gic_record(c, index);
-    if (k < 0) return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_gic_get_force: no record of particle %d", index);
-    *out = c->force[k];
-    return fsdem__ok((fsdem__status *)&c->status);
+    return c ? fsdem__coupler_get_record(&c->head, index, out, "fsdem_gic_get_force") : FSDEM_ERR_INVALID_ARG;
+}
+
+fsdem_result fsdem_gic_write_csv(const fsdem_gic *c, const char *path) {
+    return c ? fsdem__coupler_write_csv(&c->head, path, "fsdem_gic_write_csv") : FSDEM_ERR_INVALID_ARG;
 }
 
 fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *c) {
     fsdem_gic_stats st;
     memset(&st, 0, sizeof st);
     if (!c) return st;
-    st.steps = c->steps;
-    st.time = fsdem_pic_time(c->desc.pic);
-    st.dt = c->dt_last;
-    st.substeps = c->substeps;
-    st.substeps_total = c->substeps_total;
+    st.coupling = fsdem__coupler_stats(&c->head);
     st.wet = c->last.wet;
     st.pressure_impulse = c->last.pressure;
     st.drag_impulse = c->last.drag;
@@ -529,7 +501,5 @@ fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *c) {
     st.drag_dt = c->last.drag_dt;
     st.max_solid_fraction = c->max_solid;
     st.solid_volume = c->solid_volume;
-    st.seconds_pic = c->sec_pic;
-    st.seconds_dem = c->sec_dem;
     return st;
 }

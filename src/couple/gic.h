@@ -51,9 +51,9 @@
    granule, m_i / (s c V_i), or of the water round it, alpha_f rho / (alpha_s s c), since the
    exchange is explicit for the water: c at the granule's slip against the water of the last step,
    for the granules in the water and those that reach it within the step (against water at rest).
-   Ownership: the coupler owns the PIC's porosity and its accelerations (it zeroes them at the start
-   of every step, fsdem_pic_clear_forces, so another coupler's forces on the same PIC would be
-   lost), and the DEM's external forces.
+   Ownership: the coupler claims the PIC's porosity and its accelerations (it zeroes them at the start
+   of every step, fsdem_pic_clear_forces) and the DEM's external forces (>>couple); a resolved
+   PIC-DEM on the same PIC, with its own DEM, steps with it (fsdem_coupled_step).
    Not built yet (issue 22): the concentration-gradient and capillary
    forces (Eq. 21-31), wetting (Eq. 19-20), the granules' flux in the velocity projection. The
    viscous stress of Eq. 3 is the PIC's nu lap(u), not div(alpha_f T). */
@@ -69,8 +69,8 @@ typedef struct fsdem_gic_desc {
     int virtual_mass;             /* 1: the granules' added mass, Eq. 14-17 (see step 1); default 0: */
                                   /*    explicit, it diverged in dense sand entering water at 1 m/s */
                                   /*    (validation/gic_volume); dilute granules take it well */
-    fsdem_real viscosity;         /* Pa s; dynamic viscosity the drag laws use (all but the GIC */
-                                  /*    law need one); 0: rho nu of the PIC; default 0 */
+    fsdem_real viscosity;         /* m^2/s; kinematic viscosity the drag laws use, as the PIC's */
+                                  /*    (all but the GIC law need one); 0: the PIC's; default 0 */
     fsdem_real max_solid_fraction; /* -; cap of alpha_s in (0, 1); 0: 0.740 in 3D, 0.907 in 2D */
                                   /*    (densest packings, §5.1); default 0 */
     fsdem_real cfl;               /* -; Eq. 33: dt <= cfl dx / max |v_granule|, > 0; default 1 */
@@ -133,6 +133,9 @@ typedef struct fsdem_gic_force {
    FSDEM_ERR_NOT_FOUND for a bad index, before the first step (or after a restore), or for a
    particle added since. */
 FSDEM_API fsdem_result fsdem_gic_get_force(const fsdem_gic *coupler, int index, fsdem_gic_force *out);
+/* The records as CSV (>>couple): id, pressure_x .. _z, drag_x .. _z, virtual_mass_x .. _z,
+   fluid_velocity_x .. _z, fluid_acceleration_x .. _z, porosity, liquid. */
+FSDEM_API fsdem_result fsdem_gic_write_csv(const fsdem_gic *coupler, const char *path);
 /* One coupled step of the stable dt. */
 FSDEM_API fsdem_result fsdem_gic_step(fsdem_gic *coupler);
 /* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite or above
@@ -149,11 +152,8 @@ FSDEM_API fsdem_result fsdem_gic_stable_dt(const fsdem_gic *coupler, fsdem_real 
 FSDEM_API double fsdem_gic_time(const fsdem_gic *coupler);
 
 typedef struct fsdem_gic_stats {
-    long long steps;              /* coupled steps */
-    double time;                  /* s */
-    fsdem_real dt;                /* s, the last coupled step */
-    long long substeps;           /* DEM substeps of the last step */
-    long long substeps_total;
+    fsdem_coupling_stats coupling; /* steps, time, dt, substeps, CPU seconds (>>couple; the force */
+                                  /*    evaluations count as the DEM's, in its substeps) */
     int wet;                      /* granules with l > 0 at the last evaluation */
     fsdem_vec3 pressure_impulse;  /* N s; the granules' Eq. 5a impulse over the last step */
     fsdem_vec3 drag_impulse;      /* N s; the granules' drag impulse over the last step */
@@ -165,8 +165,9 @@ typedef struct fsdem_gic_stats {
                                   /*    granule or of a cell's water (0: none; >>couple_gic) */
     fsdem_real max_solid_fraction; /* -; largest alpha_s of the last update, before the cap */
     fsdem_real solid_volume;      /* m^3 (m^2 in 2D); sum of alpha_s dx^dim, = the granules' volume */
-    double seconds_pic;           /* CPU seconds in PIC steps */
-    double seconds_dem;           /* CPU seconds in DEM substeps with the force evaluations */
 } fsdem_gic_stats;
 
 FSDEM_API fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *coupler);
+/* The coupler as any coupler, to step with others on the same PIC (fsdem_coupled_step: a sand bed
+   and resolved bodies at once). */
+FSDEM_API fsdem_coupler *fsdem_gic_coupler(fsdem_gic *coupler);

@@ -1,8 +1,9 @@
 /* ===== >>impl_couple_mps : unresolved MPS-DEM ========================================================
 
    Contents: >>couple_mps_object (desc, creation), >>couple_mps_exchange (seed 002 Eq. 25-36: pairs,
-   porosity, averages, forces, reactions), >>couple_mps_step (coupled time stepping). The coupler
-   reaches the solvers through their coupling functions only (>>doc). */
+   porosity, averages, forces, reactions), >>couple_mps_step (its stages and verbs on the staged
+   step of >>couple). The coupler reaches the solvers through their coupling functions only
+   (>>doc). */
 
 /* ---- >>couple_mps_object : desc, creation ---- */
 
@@ -21,9 +22,8 @@ typedef struct fsdem__mps_dem_tally {
 } fsdem__mps_dem_tally;
 
 struct fsdem_mps_dem {
+    fsdem_coupler head;            /* >>couple; its records are `force` */
     fsdem_mps_dem_desc desc;
-    fsdem__status status;
-    fsdem_allocator allocator;
     int dim;
     fsdem_mps_model model;         /* the MPS desc's */
     fsdem_real rho, mu;            /* fluid density, dynamic viscosity */
@@ -43,8 +43,8 @@ struct fsdem_mps_dem {
                                    /*    the water's drag relaxation time */
     fsdem_real *share;             /* per MPS particle: s_i of step 4 (0 for WALL and DUMMY) */
     int solid_cap;                 /* of solid, rate and share */
-    fsdem_mps_dem_force *force;    /* per DEM particle */
-    int force_cap, forces;         /* forces: DEM particles of the last update (0: none yet) */
+    fsdem_mps_dem_force *force;    /* per DEM particle of the last update (head.records of them) */
+    int force_cap;
     fsdem__mps_dem_tally tally;
     /* what the update of a step overwrote, put back when the step is refused (fsdem__mps_dem_keep) */
     fsdem_real *kept_porosity;     /* per MPS particle */
@@ -53,11 +53,9 @@ struct fsdem_mps_dem {
     fsdem_mps_dem_force *kept_force;
     int kept_mps_cap, kept_dem_cap, kept_forces;
     fsdem__mps_dem_tally kept_tally;
-    /* statistics */
-    long long steps, substeps, substeps_total;
-    fsdem_real dt_last;
-    double sec_mps, sec_dem;
 };
+
+static const fsdem__coupler_class *fsdem__mps_dem_class(void);
 
 fsdem_mps_dem_desc fsdem_mps_dem_desc_default(void) {
     fsdem_mps_dem_desc d;
@@ -96,10 +94,6 @@ fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, si
     }
     if (st.inflow_planes || st.outflow_planes) /* the coupler's per-particle records do not follow removals */
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc: an MPS with inflows or outflows cannot be coupled yet");
-    if (fsdem__norm(fsdem__sub(dd.gravity, md.gravity)) > 1e-12 * fsdem__norm(md.gravity))
-        return fsdem__reject(msg, size, "fsdem_mps_dem_desc: the DEM gravity (%g, %g, %g) differs from the MPS's (%g, %g, %g) m/s^2",
-                             (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)md.gravity.x,
-                             (double)md.gravity.y, (double)md.gravity.z);
     if (strcmp(fsdem_drag_law_name(d->drag), "unknown") == 0)
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
     if (!(d->averaging_radius == 0 ||
@@ -113,14 +107,12 @@ fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *d, char *msg, si
     if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
         return fsdem__reject(msg, size, "fsdem_mps_dem_desc.drag_dt_fraction must be in (0, 1] (got %g)",
                              (double)d->drag_dt_fraction);
-    if (d->max_substeps < 1)
-        return fsdem__reject(msg, size, "fsdem_mps_dem_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
-    return FSDEM_OK;
+    return fsdem__coupler_check(fsdem__mps_dem_class(), "fsdem_mps_dem_desc", d->mps, FSDEM_MPS_ARRAYS_FORCE | FSDEM_MPS_ARRAYS_POROSITY,
+                                d->dem, md.dim, md.gravity, d->max_substeps, msg, size);
 }
 
 fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem **out) {
     char msg[FSDEM__MESSAGE_SIZE];
-    fsdem_allocator al;
     fsdem_mps_dem *c;
     fsdem_mps_desc md;
     fsdem_result res;
@@ -128,15 +120,12 @@ fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem 
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_mps_dem_desc_check(desc, msg, sizeof msg);
-    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
-    c = (fsdem_mps_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                           res == FSDEM_OK ? &al : NULL, sizeof *c, "fsdem_mps_dem_create", &res);
+    c = (fsdem_mps_dem *)fsdem__coupler_new(fsdem__mps_dem_class(), res, msg, desc ? desc->mps : NULL, desc ? desc->dem : NULL,
+                                            FSDEM_MPS_ARRAYS_FORCE | FSDEM_MPS_ARRAYS_POROSITY, desc ? desc->max_substeps : 0,
+                                            desc ? desc->log : NULL, desc ? desc->log_user : NULL, sizeof *c, &res);
     if (!c) return res;
     md = fsdem_mps_get_desc(desc->mps);
     c->desc = *desc;
-    c->allocator = al;
-    c->status.log = desc->log;
-    c->status.log_user = desc->log_user;
     c->dim = md.dim;
     c->model = md.model;
     c->rho = md.density;
@@ -148,7 +137,7 @@ fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem 
     c->ns = (fsdem_real)(10 * FSDEM__PI / 21) * re * re * (c->dim == 3 ? re : 1);
     c->cell_volume = md.r0 * md.r0 * (c->dim == 3 ? md.r0 : 1);
     c->periods = fsdem__periods_of(md.periodic, md.dim, md.domain_min, md.domain_max);
-    if (fsdem_cellgrid_setup_periodic(&c->grid, &c->allocator, c->dim, md.domain_min, md.domain_max, re / 2, 0, md.periodic) !=
+    if (fsdem_cellgrid_setup_periodic(&c->grid, &c->head.allocator, c->dim, md.domain_min, md.domain_max, re / 2, 0, md.periodic) !=
         FSDEM_OK) {
         fsdem__log_oom(desc->log, desc->log_user, "fsdem_mps_dem_create", sizeof c->grid);
         fsdem_mps_dem_destroy(c);
@@ -159,24 +148,24 @@ fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem 
 }
 
 void fsdem_mps_dem_destroy(fsdem_mps_dem *c) {
-    fsdem_allocator al;
+    const fsdem_allocator *al;
     if (!c) return;
-    al = c->allocator;
+    al = &c->head.allocator;
     fsdem_cellgrid_free(&c->grid);
-    fsdem__free(&al, c->start, sizeof(int) * (size_t)c->start_cap);
-    fsdem__free(&al, c->pair, sizeof *c->pair * (size_t)c->pair_cap);
-    fsdem__free(&al, c->solid, sizeof(fsdem_real) * (size_t)c->solid_cap);
-    fsdem__free(&al, c->rate, sizeof(fsdem_real) * (size_t)c->solid_cap);
-    fsdem__free(&al, c->share, sizeof(fsdem_real) * (size_t)c->solid_cap);
-    fsdem__free(&al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
-    fsdem__free(&al, c->kept_porosity, sizeof(fsdem_real) * (size_t)c->kept_mps_cap);
-    fsdem__free(&al, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)c->kept_mps_cap);
-    fsdem__free(&al, c->kept_load, sizeof(fsdem_vec3) * (size_t)c->kept_dem_cap);
-    fsdem__free(&al, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_dem_cap);
-    fsdem__free(&al, c, sizeof *c);
+    fsdem__free(al, c->start, sizeof(int) * (size_t)c->start_cap);
+    fsdem__free(al, c->pair, sizeof *c->pair * (size_t)c->pair_cap);
+    fsdem__free(al, c->solid, sizeof(fsdem_real) * (size_t)c->solid_cap);
+    fsdem__free(al, c->rate, sizeof(fsdem_real) * (size_t)c->solid_cap);
+    fsdem__free(al, c->share, sizeof(fsdem_real) * (size_t)c->solid_cap);
+    fsdem__free(al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
+    fsdem__free(al, c->kept_porosity, sizeof(fsdem_real) * (size_t)c->kept_mps_cap);
+    fsdem__free(al, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)c->kept_mps_cap);
+    fsdem__free(al, c->kept_load, sizeof(fsdem_vec3) * (size_t)c->kept_dem_cap);
+    fsdem__free(al, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_dem_cap);
+    fsdem__coupler_free(&c->head, sizeof *c);
 }
 
-const char *fsdem_mps_dem_last_error(const fsdem_mps_dem *c) { return c ? c->status.message : "fsdem_mps_dem is NULL"; }
+const char *fsdem_mps_dem_last_error(const fsdem_mps_dem *c) { return c ? c->head.status.message : "fsdem_mps_dem is NULL"; }
 
 fsdem_mps_dem_desc fsdem_mps_dem_get_desc(const fsdem_mps_dem *c) {
     fsdem_mps_dem_desc d;
@@ -271,7 +260,7 @@ static fsdem_real fsdem__mps_dem_open_weight(const fsdem_mps_dem *c, const fsdem
 
 /* Makes room for the per-particle arrays (nd DEM, nm MPS particles). */
 static fsdem_result fsdem__mps_dem_room(fsdem_mps_dem *c, int nd, int nm) {
-    const fsdem_allocator *al = &c->allocator;
+    const fsdem_allocator *al = &c->head.allocator;
     int cap = c->force_cap;
     void **const fluid[3] = {(void **)&c->solid, (void **)&c->rate, (void **)&c->share};
     const size_t size[3] = {sizeof(fsdem_real), sizeof(fsdem_real), sizeof(fsdem_real)};
@@ -298,7 +287,7 @@ static fsdem_result fsdem__mps_dem_pairs(fsdem_mps_dem *c, const fsdem_dem_parti
                 const fsdem_real r2 = fsdem__dot(d, d);
                 if (mv->kind[i] == FSDEM_MPS_KIND_DUMMY || !(r2 < re2)) continue;
                 if (n == c->pair_cap &&
-                    fsdem__grow(&c->allocator, (void **)&c->pair, &c->pair_cap, n, n + 1, sizeof *c->pair) != FSDEM_OK)
+                    fsdem__grow(&c->head.allocator, (void **)&c->pair, &c->pair_cap, n, n + 1, sizeof *c->pair) != FSDEM_OK)
                     return FSDEM_ERR_OUT_OF_MEMORY;
                 c->pair[n].particle = i;
                 c->pair[n++].weight = fsdem__mps_dem_weight((fsdem_real)sqrt(r2), re);
@@ -360,19 +349,18 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
     fsdem_mps_particles mv;
     fsdem_mps_coupling mc;
     fsdem_dem_coupling dc;
-    clock_t t0 = clock();
     int i, k, e;
     if (!c) return FSDEM_ERR_INVALID_ARG;
     {
         const fsdem_mps_desc md = fsdem_mps_get_desc(c->desc.mps);
-        if (fsdem__dem_particles_fit(c->desc.dem, md.domain_min, md.domain_max, &c->status, "fsdem_mps_dem_update") != FSDEM_OK)
+        if (fsdem__coupler_particles_fit(&c->head, md.domain_min, md.domain_max, "fsdem_mps_dem_update") != FSDEM_OK)
             return FSDEM_ERR_INVALID_ARG;
     }
     dv = fsdem_dem_get_particles(c->desc.dem);
     mv = fsdem_mps_get_particles(c->desc.mps);
     memset(&c->tally, 0, sizeof c->tally);
     if (fsdem__mps_dem_room(c, dv.count, mv.count) != FSDEM_OK || fsdem__mps_dem_pairs(c, &dv, &mv) != FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem_update: out of memory (%d DEM and %d MPS particles)",
+        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem_update: out of memory (%d DEM and %d MPS particles)",
                            dv.count, mv.count);
     mc = fsdem_mps_get_coupling(c->desc.mps);
     dc = fsdem_dem_get_coupling(c->desc.dem);
@@ -411,7 +399,7 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
             c->tally.wet++;
         }
         if (!fsdem__finite3(c->force[k].total))
-            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_mps_dem_update: the fluid force on DEM particle %d is not finite", k);
+            return fsdem__fail(&c->head.status, FSDEM_ERR_NAN, "fsdem_mps_dem_update: the fluid force on DEM particle %d is not finite", k);
         dc.force[k] = c->force[k].total;
         c->tally.drag_sum = fsdem__add(c->tally.drag_sum, c->force[k].drag);
         c->tally.pressure_sum = fsdem__add(c->tally.pressure_sum, c->force[k].pressure);
@@ -422,24 +410,17 @@ fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *c) {
         c->tally.fluid_sum = fsdem__add(c->tally.fluid_sum, mc.force[i]);
     }
     c->tally.fluid_sum = fsdem__scale(c->tally.fluid_sum, c->depth);
-    c->forces = dv.count;
-    c->sec_dem += (double)(clock() - t0) / CLOCKS_PER_SEC;
-    return fsdem__ok(&c->status);
-}
-
-/* The record of DEM particle `index` (-1: none). */
-static int fsdem__mps_dem_record(const fsdem_mps_dem *c, int index) {
-    return c->forces ? fsdem__dem_record_of(c->desc.dem, index, &c->force[0].id, sizeof *c->force, c->forces) : -1;
+    c->head.record = c->force;
+    c->head.records = dv.count;
+    return fsdem__ok(&c->head.status);
 }
 
 fsdem_result fsdem_mps_dem_get_force(const fsdem_mps_dem *c, int index, fsdem_mps_dem_force *out) {
-    int k;
-    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
-    if ((k = fsdem__mps_dem_record(c, index)) < 0)
-        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_mps_dem_get_force: no particle %d in the last update",
-                           index);
-    *out = c->force[k];
-    return FSDEM_OK;
+    return c ? fsdem__coupler_get_record(&c->head, index, out, "fsdem_mps_dem_get_force") : FSDEM_ERR_INVALID_ARG;
+}
+
+fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *c, const char *path) {
+    return c ? fsdem__coupler_write_csv(&c->head, path, "fsdem_mps_dem_write_csv") : FSDEM_ERR_INVALID_ARG;
 }
 
 /* ---- >>couple_mps_step : coupled time stepping ---- */
@@ -454,23 +435,25 @@ static fsdem_result fsdem__mps_dem_keep(fsdem_mps_dem *c) {
     void **const grain[2] = {(void **)&c->kept_load, (void **)&c->kept_force};
     const size_t fluid_size[2] = {sizeof(fsdem_real), sizeof(fsdem_vec3)};
     const size_t grain_size[2] = {sizeof(fsdem_vec3), sizeof(fsdem_mps_dem_force)};
-    if (fsdem__grow_set(&c->allocator, fluid, fluid_size, 2, &c->kept_mps_cap, 0, mc.count) != FSDEM_OK ||
-        fsdem__grow_set(&c->allocator, grain, grain_size, 2, &c->kept_dem_cap, 0, dc.count > c->forces ? dc.count : c->forces) != FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem: out of memory (%d DEM and %d MPS particles)", dc.count,
+    const int records = c->head.records;
+    if (fsdem__grow_set(&c->head.allocator, fluid, fluid_size, 2, &c->kept_mps_cap, 0, mc.count) != FSDEM_OK ||
+        fsdem__grow_set(&c->head.allocator, grain, grain_size, 2, &c->kept_dem_cap, 0, dc.count > records ? dc.count : records) != FSDEM_OK)
+        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem: out of memory (%d DEM and %d MPS particles)", dc.count,
                            mc.count);
     if (mc.count) {
         memcpy(c->kept_porosity, mc.porosity, sizeof(fsdem_real) * (size_t)mc.count);
         memcpy(c->kept_reaction, mc.force, sizeof(fsdem_vec3) * (size_t)mc.count);
     }
     if (dc.count) memcpy(c->kept_load, dc.force, sizeof(fsdem_vec3) * (size_t)dc.count);
-    if (c->forces) memcpy(c->kept_force, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->forces);
-    c->kept_forces = c->forces;
+    if (records) memcpy(c->kept_force, c->force, sizeof(fsdem_mps_dem_force) * (size_t)records);
+    c->kept_forces = records;
     c->kept_tally = c->tally;
     return FSDEM_OK;
 }
 
-/* Puts back what fsdem__mps_dem_keep kept; passes `res` on. */
-static fsdem_result fsdem__mps_dem_undo(fsdem_mps_dem *c, fsdem_result res) {
+/* Puts back what fsdem__mps_dem_keep kept (the class's undo). */
+static void fsdem__mps_dem_undo(fsdem_coupler *head) {
+    fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
     const fsdem_mps_coupling mc = fsdem_mps_get_coupling(c->desc.mps);
     const fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
     if (mc.count) {
@@ -479,121 +462,85 @@ static fsdem_result fsdem__mps_dem_undo(fsdem_mps_dem *c, fsdem_result res) {
     }
     if (dc.count) memcpy(dc.force, c->kept_load, sizeof(fsdem_vec3) * (size_t)dc.count);
     if (c->kept_forces) memcpy(c->force, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_forces);
-    c->forces = c->kept_forces;
+    c->head.records = c->kept_forces;
     c->tally = c->kept_tally;
-    return res;
 }
 
-/* The update of a step, kept to be undone if the step is refused. */
-static fsdem_result fsdem__mps_dem_update_kept(fsdem_mps_dem *c) {
+/* The update of a step, kept to be undone if the step is refused (the class's prepare). */
+static fsdem_result fsdem__mps_dem_prepare(fsdem_coupler *head) {
+    fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
     fsdem_result res = fsdem__mps_dem_keep(c);
-    if (res == FSDEM_OK && (res = fsdem_mps_dem_update(c)) != FSDEM_OK) fsdem__mps_dem_undo(c, res);
+    if (res == FSDEM_OK && (res = fsdem_mps_dem_update(c)) != FSDEM_OK) fsdem__mps_dem_undo(head);
     return res;
 }
 
-/* The stable coupled step of the last update: the MPS's (Eq. 37) and the drag limit. */
-static fsdem_result fsdem__mps_dem_stable(const fsdem_mps_dem *c, fsdem_real *dt) {
-    const fsdem_result res = fsdem_mps_stable_dt(c->desc.mps, dt);
-    if (res != FSDEM_OK) return res;
+/* The drag limit of the last update on the stable step (>>couple_mps; the class's limit). */
+static fsdem_result fsdem__mps_dem_limit(const fsdem_coupler *head, fsdem_real *dt) {
+    const fsdem_mps_dem *c = (const fsdem_mps_dem *)(const void *)head;
     if (c->tally.drag_dt > 0 && c->desc.drag_dt_fraction * c->tally.drag_dt < *dt) *dt = c->desc.drag_dt_fraction * c->tally.drag_dt;
     return FSDEM_OK;
 }
 
-/* Step 5 of >>couple_mps after a kept update: the MPS step of dt, then the DEM substeps. A step
-   refused before anything moves (too many substeps, the drag limit, the MPS's CFL limits) undoes
-   the update. */
-static fsdem_result fsdem__mps_dem_run(fsdem_mps_dem *c, fsdem_real dt) {
-    long long substeps = 0;
-    fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_mps_dem");
-    clock_t t0, t1;
-    if (res != FSDEM_OK) return fsdem__mps_dem_undo(c, res);
+/* A step of dt refused before anything moves: too many substeps, or past the drag limit. */
+static fsdem_result fsdem__mps_dem_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
+    fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
+    const fsdem_result res = fsdem__coupler_substeps_within(head, dt);
+    (void)chosen;
+    if (res != FSDEM_OK) return res;
     if (c->tally.drag_dt > 0 && dt > c->desc.drag_dt_fraction * c->tally.drag_dt * (1 + (fsdem_real)1e-6))
-        return fsdem__mps_dem_undo(c, fsdem__fail(&c->status, FSDEM_ERR_CFL,
-                                                  "fsdem_mps_dem: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation "
-                                                  "time %g s",
-                                                  (double)dt, (double)c->desc.drag_dt_fraction, (double)c->tally.drag_dt));
-    t0 = clock();
-    res = fsdem_mps_step_dt(c->desc.mps, dt);
-    t1 = clock();
-    c->sec_mps += (double)(t1 - t0) / CLOCKS_PER_SEC;
-    if (res == FSDEM_ERR_CFL) fsdem__mps_dem_undo(c, res); /* refused before it moved */
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_mps_dem: MPS step: %s", fsdem_mps_last_error(c->desc.mps));
-    res = fsdem_dem_advance(c->desc.dem, dt, &substeps);
-    c->sec_dem += (double)(clock() - t1) / CLOCKS_PER_SEC;
-    c->steps++;
-    c->dt_last = dt;
-    c->substeps = substeps;
-    c->substeps_total += substeps;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_mps_dem: DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
-    return fsdem__ok(&c->status);
+        return fsdem__fail(&head->status, FSDEM_ERR_CFL,
+                           "fsdem_mps_dem: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s", (double)dt,
+                           (double)c->desc.drag_dt_fraction, (double)c->tally.drag_dt);
+    return FSDEM_OK;
 }
 
-fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *c) {
-    fsdem_real dt = 0;
-    fsdem_result res;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if ((res = fsdem__mps_dem_update_kept(c)) != FSDEM_OK) return res;
-    if ((res = fsdem__mps_dem_stable(c, &dt)) != FSDEM_OK)
-        return fsdem__mps_dem_undo(c, fsdem__fail(&c->status, res, "fsdem_mps_dem_step: %s", fsdem_mps_last_error(c->desc.mps)));
-    return fsdem__mps_dem_run(c, dt);
+/* Step 5 of >>couple_mps after the MPS step: the DEM over dt with the forces held. */
+static fsdem_result fsdem__mps_dem_substeps(fsdem_coupler *head, fsdem_real dt) {
+    return fsdem__coupler_substeps(head, dt, NULL, NULL, "DEM substeps", NULL);
 }
 
+static const fsdem__stage fsdem__mps_dem_stages[2] = {{"MPS step", FSDEM__CLOCK_FLUID, NULL},
+                                                      {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__mps_dem_substeps}};
+
+#define FSDEM__MPS_DEM_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_mps_dem_force, name), 1}
+static const fsdem__field fsdem__mps_dem_fields[8] = {
+    FSDEM__MPS_DEM_FIELD(id, INT),          FSDEM__MPS_DEM_FIELD(drag, VEC3),     FSDEM__MPS_DEM_FIELD(pressure, VEC3),
+    FSDEM__MPS_DEM_FIELD(total, VEC3),      FSDEM__MPS_DEM_FIELD(fluid_velocity, VEC3), FSDEM__MPS_DEM_FIELD(porosity, REAL),
+    FSDEM__MPS_DEM_FIELD(reynolds, REAL),   FSDEM__MPS_DEM_FIELD(wet, INT)};
+#undef FSDEM__MPS_DEM_FIELD
+
+static const fsdem__coupler_class *fsdem__mps_dem_class(void) {
+    static const fsdem__coupler_class cls = {"fsdem_mps_dem", &fsdem__fluid_mps, sizeof(fsdem_mps_dem_force),
+        fsdem__mps_dem_fields, 8, fsdem__mps_dem_prepare, fsdem__mps_dem_undo, fsdem__mps_dem_limit, fsdem__mps_dem_check,
+        fsdem__mps_dem_stages, 2};
+    return &cls;
+}
+
+fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
 fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *c, fsdem_real dt) {
-    fsdem_result res;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_dem_step_dt: dt = %g s must be > 0 and finite", (double)dt);
-    if ((res = fsdem__mps_dem_update_kept(c)) != FSDEM_OK) return res;
-    return fsdem__mps_dem_run(c, dt);
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_mps_dem_step_dt");
 }
-
-/* fsdem__coupled_advance's verbs for this coupler: the update and its stable step, the step. */
-static double fsdem__mps_dem_now(const void *c) { return fsdem_mps_time(((const fsdem_mps_dem *)c)->desc.mps); }
-
-static fsdem_result fsdem__mps_dem_prepare(void *object, fsdem_real *dt) {
-    fsdem_mps_dem *c = (fsdem_mps_dem *)object;
-    fsdem_result res = fsdem__mps_dem_update_kept(c);
-    if (res == FSDEM_OK && (res = fsdem__mps_dem_stable(c, dt)) != FSDEM_OK)
-        fsdem__mps_dem_undo(c, fsdem__fail(&c->status, res, "fsdem_mps_dem_advance: %s", fsdem_mps_last_error(c->desc.mps)));
-    return res;
-}
-
-static fsdem_result fsdem__mps_dem_go(void *c, fsdem_real dt) { return fsdem__mps_dem_run((fsdem_mps_dem *)c, dt); }
-
 fsdem_result fsdem_mps_dem_advance(fsdem_mps_dem *c, fsdem_real duration, long long *steps) {
-    static const fsdem__coupled_verbs verbs = {fsdem__mps_dem_now, fsdem__mps_dem_prepare, fsdem__mps_dem_go};
-    if (steps) *steps = 0;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__coupled_advance(c, &c->status, "fsdem_mps_dem_advance", &verbs, duration, steps);
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_mps_dem_advance");
 }
-
-fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) {
-    if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__mps_dem_stable(c, dt);
-}
-
-double fsdem_mps_dem_time(const fsdem_mps_dem *c) { return c ? fsdem_mps_time(c->desc.mps) : 0; }
+fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+double fsdem_mps_dem_time(const fsdem_mps_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
+fsdem_coupler *fsdem_mps_dem_coupler(fsdem_mps_dem *c) { return c ? &c->head : NULL; }
 
 fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *c) {
     fsdem_mps_dem_stats st;
     int k;
     memset(&st, 0, sizeof st);
     if (!c) return st;
-    st.steps = c->steps;
-    st.time = fsdem_mps_time(c->desc.mps);
-    st.dt = c->dt_last;
-    st.substeps = c->substeps;
-    st.substeps_total = c->substeps_total;
+    st.coupling = fsdem__coupler_stats(&c->head);
     st.wet = c->tally.wet;
     st.drag = c->tally.drag_sum;
     st.pressure = c->tally.pressure_sum;
     st.to_fluid = c->tally.fluid_sum;
     st.drag_dt = c->tally.drag_dt;
     st.pairs = c->tally.pairs;
-    for (k = 0; k < c->forces; ++k)
+    for (k = 0; k < c->head.records; ++k)
         st.exchanged = fsdem__add(st.exchanged, c->model == FSDEM_MPS_MODEL_A ? c->force[k].drag : c->force[k].total);
     st.exchange_residual = fsdem__norm(fsdem__add(st.to_fluid, st.exchanged));
-    st.seconds_mps = c->sec_mps;
-    st.seconds_dem = c->sec_dem;
     return st;
 }

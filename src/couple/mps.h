@@ -146,6 +146,9 @@ FSDEM_API fsdem_result fsdem_mps_dem_update(fsdem_mps_dem *coupler);
    since do not mix the records up. FSDEM_ERR_NOT_FOUND for a bad index, before the first update, or
    for a particle added since. */
 FSDEM_API fsdem_result fsdem_mps_dem_get_force(const fsdem_mps_dem *coupler, int index, fsdem_mps_dem_force *out);
+/* The records as CSV (>>couple): id, drag_x .. _z, pressure_x .. _z, total_x .. _z,
+   fluid_velocity_x .. _z, porosity, reynolds, wet. */
+FSDEM_API fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *coupler, const char *path);
 /* One coupled step of the stable dt (fsdem_mps_dem_stable_dt after the update). The DEM substep
    count is checked before anything moves (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of
    either solver are passed on with their message. */
@@ -161,11 +164,8 @@ FSDEM_API fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *coupler, fsd
 FSDEM_API double fsdem_mps_dem_time(const fsdem_mps_dem *coupler);
 
 typedef struct fsdem_mps_dem_stats {
-    long long steps;              /* coupled steps */
-    double time;                  /* s */
-    fsdem_real dt;                /* s, the last coupled step */
-    long long substeps;           /* DEM substeps of the last coupled step */
-    long long substeps_total;
+    fsdem_coupling_stats coupling; /* steps, time, dt, substeps, CPU seconds (>>couple; the */
+                                  /*    update's time counts as the coupling's) */
     int wet;                      /* DEM particles in water at the last update */
     fsdem_vec3 drag;              /* N; sum of F^d, last update */
     fsdem_vec3 pressure;          /* N; sum of the pressure parts (-V grad P or -V rho g) */
@@ -177,8 +177,8 @@ typedef struct fsdem_mps_dem_stats {
     fsdem_real drag_dt;           /* s; the shortest drag relaxation time of the last update, of */
                                   /*    a grain or of the water (0: none) */
     long long pairs;              /* DEM-MPS pairs within the radius, last update */
-    double seconds_mps;           /* CPU seconds in MPS steps */
-    double seconds_dem;           /* CPU seconds in DEM substeps and the coupling (updates) */
 } fsdem_mps_dem_stats;
 
 FSDEM_API fsdem_mps_dem_stats fsdem_mps_dem_get_stats(const fsdem_mps_dem *coupler);
+/* The coupler as any coupler (fsdem_coupled_step). */
+FSDEM_API fsdem_coupler *fsdem_mps_dem_coupler(fsdem_mps_dem *coupler);

@@ -3,8 +3,8 @@
    Contents: >>couple_pic_object (desc, creation, per-body storage), >>couple_pic_faces (bodies as
    moving cut-cell solids: face fractions, solid velocities, J, references), >>couple_pic_exchange
    (the implicit pressure term, fluid forces), >>couple_pic_gap (Eq. 20, particles out of bodies),
-   >>couple_pic_step (coupled time stepping). The coupler speaks to the PIC through its public
-   calls only: it indexes the grid through its own MAC layout (fsdem__mac, built from
+   >>couple_pic_step (its stages and verbs on the staged step of >>couple). The coupler speaks to
+   the PIC through its public calls only: it indexes the grid through its own MAC layout (fsdem__mac, built from
    fsdem_pic_get_fields), writes the coupling arrays (fsdem_pic_get_coupling: the coupler owns open,
    solid_velocity, start_velocity and reference, and resets them at every cut) and cuts the faces
    with the cut-cell sampler of >>geom that the PIC cuts its obstacles with, so static obstacles and
@@ -21,9 +21,8 @@ typedef struct fsdem__pic_dem_map {
 } fsdem__pic_dem_map;
 
 struct fsdem_pic_dem {
+    fsdem_coupler head;            /* >>couple; its records are `load` once a step has loaded them */
     fsdem_pic_dem_desc desc;
-    fsdem__status status;
-    fsdem_allocator allocator;
     int dim;
     fsdem_real rho, nu;            /* liquid density, kinematic viscosity */
     fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC works per metre), 1 in 3D */
@@ -33,13 +32,11 @@ struct fsdem_pic_dem {
     unsigned char side_closed[6];  /* the PIC's domain sides that are walls (not outflow) */
     /* per body (DEM particle), `bodies` of them */
     int bodies, body_cap;
-    int *body_id;        /* stable DEM id of each body of the last step */
+    fsdem_pic_dem_force *load;     /* the record of each body: its id and volume from the last cut, */
+                                   /*    its loads from the last step */
     fsdem_vec3 *vstar, *wstar;     /* predicted velocities Q* (step 1) */
     fsdem_real *inv_m, *inv_i;     /* 1/kg and 1/(kg m^2) per metre of depth (0: fixed) */
-    fsdem_vec3 *fp, *fv, *tq;      /* last step's loads on the whole body (N, N m) */
-    fsdem_vec3 *wc;                /* N; the well-balanced weight's correction of the last step */
-    fsdem_real *volume;            /* m^3 (m^2 in 2D) as the faces normal to gravity see it */
-    fsdem_real *weight;            /* that volume over the exact one (desc.discrete_weight), else 1 */
+    fsdem_real *weight;            /* the volume seen over the exact one (desc.discrete_weight), else 1 */
     fsdem_real *relax;             /* s; viscous relaxation time (0: none) */
     /* faces each body covers or cuts: entries face_start[b] .. face_start[b + 1] */
     int *face_start;
@@ -58,13 +55,13 @@ struct fsdem_pic_dem {
     fsdem_vec3 *contact_point;
     int contact_count, contact_cap;
     int operator_set;              /* the pressure term is installed */
-    /* statistics */
-    long long steps, substeps, substeps_total, dissipated, pushed, removed;
-    fsdem_real dt_last, viscous_dt;
+    long long dissipated, pushed, removed;
+    fsdem_real viscous_dt;
     fsdem_vec3 force_sum;
-    double sec_pic, sec_dem, sec_coupling;
-    int loaded;                    /* the loads of a step are in fp, fv, tq */
+    int loaded;                    /* the loads of a step are in `load` */
 };
+
+static const fsdem__coupler_class *fsdem__pic_dem_class(void);
 
 fsdem_pic_dem_desc fsdem_pic_dem_desc_default(void) {
     fsdem_pic_dem_desc d;
@@ -78,17 +75,10 @@ fsdem_pic_dem_desc fsdem_pic_dem_desc_default(void) {
 }
 
 fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *d, char *msg, size_t size) {
-    fsdem_dem_desc dd;
     fsdem_pic_desc pd;
     if (!d) return fsdem__reject(msg, size, "fsdem_pic_dem_desc is NULL");
     if (!d->pic || !d->dem) return fsdem__reject(msg, size, "fsdem_pic_dem_desc.pic and .dem must both be set");
-    dd = fsdem_dem_get_desc(d->dem);
     pd = fsdem_pic_get_desc(d->pic);
-    if (dd.dim != pd.dim) return fsdem__reject(msg, size, "fsdem_pic_dem_desc: the DEM is %dD and the PIC %dD", dd.dim, pd.dim);
-    if (fsdem__norm(fsdem__sub(dd.gravity, pd.gravity)) > 1e-12 * fsdem__norm(pd.gravity))
-        return fsdem__reject(msg, size, "fsdem_pic_dem_desc: the DEM gravity (%g, %g, %g) differs from the PIC's (%g, %g, %g) m/s^2",
-                             (double)dd.gravity.x, (double)dd.gravity.y, (double)dd.gravity.z, (double)pd.gravity.x,
-                             (double)pd.gravity.y, (double)pd.gravity.z);
     if (!(d->dissipation >= 0 && d->dissipation <= 1))
         return fsdem__reject(msg, size, "fsdem_pic_dem_desc.dissipation must be in [0, 1] (got %g)", (double)d->dissipation);
     if (!(d->contact_length >= 0 && d->contact_length <= fsdem__smallest_extent(pd.domain_min, pd.domain_max, pd.dim)))
@@ -100,91 +90,80 @@ fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *d, char *msg, si
                              (double)d->viscous_dt_fraction);
     if (d->discrete_weight != 0 && d->discrete_weight != 1)
         return fsdem__reject(msg, size, "fsdem_pic_dem_desc.discrete_weight must be 0 or 1 (got %d)", d->discrete_weight);
-    if (d->max_substeps < 1)
-        return fsdem__reject(msg, size, "fsdem_pic_dem_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
-    return FSDEM_OK;
+    return fsdem__coupler_check(fsdem__pic_dem_class(), "fsdem_pic_dem_desc", d->pic, FSDEM_PIC_ARRAYS_SOLIDS, d->dem, pd.dim, pd.gravity,
+                                d->max_substeps, msg, size);
 }
 
 static void fsdem__pic_dem_free_bodies(fsdem_pic_dem *c) {
+    const fsdem_allocator *al = &c->head.allocator;
     const size_t n = (size_t)c->body_cap, V = sizeof(fsdem_vec3) * n, R = sizeof(fsdem_real) * n;
-    fsdem__free(&c->allocator, c->vstar, V);
-    fsdem__free(&c->allocator, c->wstar, V);
-    fsdem__free(&c->allocator, c->fp, V);
-    fsdem__free(&c->allocator, c->fv, V);
-    fsdem__free(&c->allocator, c->tq, V);
-    fsdem__free(&c->allocator, c->wc, V);
-    fsdem__free(&c->allocator, c->inv_m, R);
-    fsdem__free(&c->allocator, c->inv_i, R);
-    fsdem__free(&c->allocator, c->volume, R);
-    fsdem__free(&c->allocator, c->weight, R);
-    fsdem__free(&c->allocator, c->relax, R);
-    fsdem__free(&c->allocator, c->face_start, sizeof(int) * (n + 1));
-    fsdem__free(&c->allocator, c->jac_start, sizeof(int) * (n + 1));
-    fsdem__free(&c->allocator, c->body_id, sizeof(int) * n);
-    c->vstar = c->wstar = c->fp = c->fv = c->tq = c->wc = NULL;
-    c->inv_m = c->inv_i = c->volume = c->weight = c->relax = NULL;
-    c->face_start = c->jac_start = c->body_id = NULL;
+    fsdem__free(al, c->load, sizeof(fsdem_pic_dem_force) * n);
+    fsdem__free(al, c->vstar, V);
+    fsdem__free(al, c->wstar, V);
+    fsdem__free(al, c->inv_m, R);
+    fsdem__free(al, c->inv_i, R);
+    fsdem__free(al, c->weight, R);
+    fsdem__free(al, c->relax, R);
+    fsdem__free(al, c->face_start, sizeof(int) * (n + 1));
+    fsdem__free(al, c->jac_start, sizeof(int) * (n + 1));
+    c->load = NULL;
+    c->vstar = c->wstar = NULL;
+    c->inv_m = c->inv_i = c->weight = c->relax = NULL;
+    c->face_start = c->jac_start = NULL;
     c->body_cap = 0;
+    c->head.record = NULL;
+    c->head.records = 0;
 }
 
 /* Per-body arrays for `n` bodies (zeroed). Allocates only when the DEM has more particles than any
    step before. */
 static fsdem_result fsdem__pic_dem_reserve_bodies(fsdem_pic_dem *c, int n) {
+    const fsdem_allocator *al = &c->head.allocator;
     const size_t m = (size_t)(n > 0 ? n : 1), V = sizeof(fsdem_vec3) * m, R = sizeof(fsdem_real) * m;
     if (n <= c->body_cap && c->vstar) return FSDEM_OK;
     fsdem__pic_dem_free_bodies(c);
-    c->vstar = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->wstar = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->fp = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->fv = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->tq = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->wc = (fsdem_vec3 *)fsdem__alloc(&c->allocator, V);
-    c->inv_m = (fsdem_real *)fsdem__alloc(&c->allocator, R);
-    c->inv_i = (fsdem_real *)fsdem__alloc(&c->allocator, R);
-    c->volume = (fsdem_real *)fsdem__alloc(&c->allocator, R);
-    c->weight = (fsdem_real *)fsdem__alloc(&c->allocator, R);
-    c->relax = (fsdem_real *)fsdem__alloc(&c->allocator, R);
-    c->face_start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (m + 1));
-    c->jac_start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (m + 1));
-    c->body_id = (int *)fsdem__alloc(&c->allocator, sizeof(int) * m);
+    c->load = (fsdem_pic_dem_force *)fsdem__alloc(al, sizeof(fsdem_pic_dem_force) * m);
+    c->vstar = (fsdem_vec3 *)fsdem__alloc(al, V);
+    c->wstar = (fsdem_vec3 *)fsdem__alloc(al, V);
+    c->inv_m = (fsdem_real *)fsdem__alloc(al, R);
+    c->inv_i = (fsdem_real *)fsdem__alloc(al, R);
+    c->weight = (fsdem_real *)fsdem__alloc(al, R);
+    c->relax = (fsdem_real *)fsdem__alloc(al, R);
+    c->face_start = (int *)fsdem__alloc(al, sizeof(int) * (m + 1));
+    c->jac_start = (int *)fsdem__alloc(al, sizeof(int) * (m + 1));
     c->body_cap = (int)m;
-    if (!c->vstar || !c->wstar || !c->fp || !c->fv || !c->tq || !c->wc || !c->inv_m || !c->inv_i || !c->volume || !c->weight || !c->relax ||
-        !c->face_start || !c->jac_start || !c->body_id) {
+    if (!c->load || !c->vstar || !c->wstar || !c->inv_m || !c->inv_i || !c->weight || !c->relax || !c->face_start || !c->jac_start) {
         fsdem__pic_dem_free_bodies(c);
         return FSDEM_ERR_OUT_OF_MEMORY;
     }
+    memset(c->load, 0, sizeof(fsdem_pic_dem_force) * m);
     memset(c->vstar, 0, V);
     memset(c->wstar, 0, V);
-    memset(c->fp, 0, V);
-    memset(c->fv, 0, V);
-    memset(c->tq, 0, V);
-    memset(c->wc, 0, V);
-    memset(c->volume, 0, R);
     memset(c->weight, 0, R);
     memset(c->relax, 0, R);
     memset(c->face_start, 0, sizeof(int) * (m + 1));
     memset(c->jac_start, 0, sizeof(int) * (m + 1));
-    memset(c->body_id, 0, sizeof(int) * m);
     c->loaded = 0;
     return FSDEM_OK;
 }
 
 static void fsdem__pic_dem_release(fsdem_pic_dem *c) {
+    const fsdem_allocator *al = &c->head.allocator;
     const int ncell = c->grid.ncell;
     fsdem__pic_dem_free_bodies(c);
-    fsdem__free(&c->allocator, c->face, sizeof(int) * (size_t)c->face_cap);
-    fsdem__free(&c->allocator, c->face_axis, (size_t)c->face_cap);
-    fsdem__free(&c->allocator, c->face_closed, sizeof(fsdem_real) * (size_t)c->face_cap);
-    fsdem__free(&c->allocator, c->jac_cell, sizeof(int) * (size_t)c->jac_cap);
-    fsdem__free(&c->allocator, c->jac_v, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
-    fsdem__free(&c->allocator, c->jac_w, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
-    fsdem__free(&c->allocator, c->slot, sizeof(int) * (size_t)ncell);
-    fsdem__free(&c->allocator, c->body_map.start, sizeof(int) * (size_t)(ncell + 1));
-    fsdem__free(&c->allocator, c->body_map.item, sizeof(int) * (size_t)c->body_map.item_cap);
-    fsdem__free(&c->allocator, c->contact_map.start, sizeof(int) * (size_t)(ncell + 1));
-    fsdem__free(&c->allocator, c->contact_map.item, sizeof(int) * (size_t)c->contact_map.item_cap);
-    fsdem__free(&c->allocator, c->contact, sizeof(fsdem_dem_contact) * (size_t)c->contact_cap);
-    fsdem__free(&c->allocator, c->contact_point, sizeof(fsdem_vec3) * (size_t)c->contact_cap);
+    fsdem__free(al, c->face, sizeof(int) * (size_t)c->face_cap);
+    fsdem__free(al, c->face_axis, (size_t)c->face_cap);
+    fsdem__free(al, c->face_closed, sizeof(fsdem_real) * (size_t)c->face_cap);
+    fsdem__free(al, c->jac_cell, sizeof(int) * (size_t)c->jac_cap);
+    fsdem__free(al, c->jac_v, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
+    fsdem__free(al, c->jac_w, sizeof(fsdem_vec3) * (size_t)c->jac_cap);
+    fsdem__free(al, c->slot, sizeof(int) * (size_t)ncell);
+    fsdem__free(al, c->body_map.start, sizeof(int) * (size_t)(ncell + 1));
+    fsdem__free(al, c->body_map.item, sizeof(int) * (size_t)c->body_map.item_cap);
+    fsdem__free(al, c->contact_map.start, sizeof(int) * (size_t)(ncell + 1));
+    fsdem__free(al, c->contact_map.item, sizeof(int) * (size_t)c->contact_map.item_cap);
+    fsdem__free(al, c->contact, sizeof(fsdem_dem_contact) * (size_t)c->contact_cap);
+    fsdem__free(al, c->contact_point, sizeof(fsdem_vec3) * (size_t)c->contact_cap);
 }
 
 static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt);
@@ -195,7 +174,6 @@ static void fsdem__pic_dem_response(void *user, const fsdem_real *p, fsdem_real 
 
 fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem **out) {
     char msg[FSDEM__MESSAGE_SIZE];
-    fsdem_allocator al;
     fsdem_pic_dem *c;
     fsdem_pic_desc pd;
     fsdem_result res;
@@ -203,15 +181,12 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_pic_dem_desc_check(desc, msg, sizeof msg);
-    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
-    c = (fsdem_pic_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                           res == FSDEM_OK ? &al : NULL, sizeof *c, "fsdem_pic_dem_create", &res);
+    c = (fsdem_pic_dem *)fsdem__coupler_new(fsdem__pic_dem_class(), res, msg, desc ? desc->pic : NULL, desc ? desc->dem : NULL,
+                                            FSDEM_PIC_ARRAYS_SOLIDS, desc ? desc->max_substeps : 0, desc ? desc->log : NULL,
+                                            desc ? desc->log_user : NULL, sizeof *c, &res);
     if (!c) return res;
     pd = fsdem_pic_get_desc(desc->pic);
     c->desc = *desc;
-    c->allocator = al;
-    c->status.log = desc->log;
-    c->status.log_user = desc->log_user;
     c->dim = pd.dim;
     c->rho = pd.density;
     c->nu = pd.viscosity;
@@ -225,14 +200,13 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
     for (i = 0; i < 6; ++i) c->side_closed[i] = (unsigned char)(pd.boundary[i] != FSDEM_PIC_BC_OUTFLOW);
     c->arrays = fsdem_pic_get_coupling(desc->pic);
     ncell = c->grid.ncell;
-    if (fsdem__dem_particles_fit(desc->dem, pd.domain_min, pd.domain_max, &c->status, "fsdem_pic_dem_create") != FSDEM_OK) {
-        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, c->status.message);
-        fsdem__free(&al, c, sizeof *c);
+    if (fsdem__coupler_particles_fit(&c->head, pd.domain_min, pd.domain_max, "fsdem_pic_dem_create") != FSDEM_OK) {
+        fsdem__coupler_free(&c->head, sizeof *c);
         return FSDEM_ERR_INVALID_ARG;
     }
-    c->slot = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)ncell);
-    c->body_map.start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)(ncell + 1));
-    c->contact_map.start = (int *)fsdem__alloc(&c->allocator, sizeof(int) * (size_t)(ncell + 1));
+    c->slot = (int *)fsdem__alloc(&c->head.allocator, sizeof(int) * (size_t)ncell);
+    c->body_map.start = (int *)fsdem__alloc(&c->head.allocator, sizeof(int) * (size_t)(ncell + 1));
+    c->contact_map.start = (int *)fsdem__alloc(&c->head.allocator, sizeof(int) * (size_t)(ncell + 1));
     res = c->slot && c->body_map.start && c->contact_map.start ? FSDEM_OK : FSDEM_ERR_OUT_OF_MEMORY;
     if (res == FSDEM_OK) {
         for (i = 0; i < ncell; ++i) c->slot[i] = -1;
@@ -242,7 +216,7 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
     if (res == FSDEM_OK) res = fsdem__pic_dem_faces(c, 0);
     if (res == FSDEM_OK) res = fsdem_pic_set_pressure_extra(desc->pic, fsdem__pic_dem_operator, fsdem__pic_dem_response, c);
     if (res != FSDEM_OK) {
-        if (desc->log) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, c->status.message[0] ? c->status.message : "fsdem_pic_dem_create: out of memory");
+        if (desc->log && !c->head.status.message[0]) desc->log(desc->log_user, FSDEM_LOG_LEVEL_ERROR, "fsdem_pic_dem_create: out of memory");
         fsdem_pic_dem_destroy(c);
         return res;
     }
@@ -252,16 +226,16 @@ fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem 
 }
 
 void fsdem_pic_dem_destroy(fsdem_pic_dem *c) {
-    fsdem_allocator al;
     if (!c) return;
-    al = c->allocator;
     if (c->operator_set) fsdem_pic_set_pressure_extra(c->desc.pic, NULL, NULL, NULL);
     fsdem__pic_dem_clear_faces(c);
     fsdem__pic_dem_release(c);
-    fsdem__free(&al, c, sizeof *c);
+    fsdem__coupler_free(&c->head, sizeof *c);
 }
 
-const char *fsdem_pic_dem_last_error(const fsdem_pic_dem *c) { return c ? c->status.message : "fsdem_pic_dem is NULL"; }
+fsdem_coupler *fsdem_pic_dem_coupler(fsdem_pic_dem *c) { return c ? &c->head : NULL; }
+
+const char *fsdem_pic_dem_last_error(const fsdem_pic_dem *c) { return c ? c->head.status.message : "fsdem_pic_dem is NULL"; }
 
 fsdem_pic_dem_desc fsdem_pic_dem_get_desc(const fsdem_pic_dem *c) {
     fsdem_pic_dem_desc d;
@@ -307,7 +281,7 @@ static fsdem_result fsdem__pic_dem_jac_add(fsdem_pic_dem *c, int cell, fsdem_vec
     if (e < 0) {
         void **const arrays[3] = {(void **)&c->jac_cell, (void **)&c->jac_v, (void **)&c->jac_w};
         const size_t elem[3] = {sizeof(int), sizeof(fsdem_vec3), sizeof(fsdem_vec3)};
-        if (fsdem__grow_set(&c->allocator, arrays, elem, 3, &c->jac_cap, c->jac_count, c->jac_count + 1) != FSDEM_OK)
+        if (fsdem__grow_set(&c->head.allocator, arrays, elem, 3, &c->jac_cap, c->jac_count, c->jac_count + 1) != FSDEM_OK)
             return FSDEM_ERR_OUT_OF_MEMORY;
         e = c->slot[cell] = c->jac_count++;
         c->jac_cell[e] = cell;
@@ -321,7 +295,7 @@ static fsdem_result fsdem__pic_dem_jac_add(fsdem_pic_dem *c, int cell, fsdem_vec
 static fsdem_result fsdem__pic_dem_face_add(fsdem_pic_dem *c, int a, int f, fsdem_real closed) {
     void **const arrays[3] = {(void **)&c->face, (void **)&c->face_axis, (void **)&c->face_closed};
     const size_t elem[3] = {sizeof(int), 1, sizeof(fsdem_real)};
-    if (fsdem__grow_set(&c->allocator, arrays, elem, 3, &c->face_cap, c->face_count, c->face_count + 1) != FSDEM_OK)
+    if (fsdem__grow_set(&c->head.allocator, arrays, elem, 3, &c->face_cap, c->face_count, c->face_count + 1) != FSDEM_OK)
         return FSDEM_ERR_OUT_OF_MEMORY;
     c->face[c->face_count] = f;
     c->face_axis[c->face_count] = (unsigned char)a;
@@ -465,16 +439,16 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
     int b, e, q;
     fsdem_result res;
     if ((res = fsdem__pic_dem_reserve_bodies(c, P.count)) != FSDEM_OK)
-        return fsdem__fail(&c->status, res, "fsdem_pic_dem: out of memory for the records of %d bodies", P.count);
+        return fsdem__fail(&c->head.status, res, "fsdem_pic_dem: out of memory for the records of %d bodies", P.count);
     fsdem__pic_dem_clear_faces(c);
     c->bodies = P.count;
-    if (P.count) memcpy(c->body_id, P.id, sizeof(int) * (size_t)P.count);
+    for (b = 0; b < P.count; ++b) c->load[b].id = P.id[b];
     for (b = 0; b < P.count; ++b)
         if ((res = fsdem__pic_dem_cut(c, b, P.position[b], P.radius[b])) != FSDEM_OK) {
             c->face_start[b + 1] = c->face_count;
             c->bodies = b + 1;
             for (q = 0; q <= c->bodies; ++q) c->jac_start[q] = 0;
-            return fsdem__fail(&c->status, res, "fsdem_pic_dem: out of memory cutting body %d", b);
+            return fsdem__fail(&c->head.status, res, "fsdem_pic_dem: out of memory cutting body %d", b);
         }
     c->face_start[P.count] = c->face_count;
     /* the faces' closed parts are pending (open = -(their sum)): each body's part is scaled to the
@@ -491,7 +465,7 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
         for (e = c->face_start[b]; e < c->face_start[b + 1]; ++e) axis[c->face_axis[e]] += c->face_closed[e] * cell;
         /* the volume that a pressure gradient along gravity acts on: sum_a (g_a^2 / g^2) V_a */
         for (q = 0; q < c->dim; ++q) seen += g2 > 0 ? fsdem__comp(c->gravity, q) * fsdem__comp(c->gravity, q) / g2 * axis[q] : axis[q] / (fsdem_real)c->dim;
-        c->volume[b] = seen;
+        c->load[b].volume = seen;
         c->weight[b] = c->desc.discrete_weight && seen > 0 ? seen / exact : 1;
         if (P.fixed[b]) {
             c->inv_m[b] = c->inv_i[b] = 0;
@@ -531,7 +505,7 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
         if ((res = fsdem__pic_dem_jacobian(c, b, P.position[b])) != FSDEM_OK) {
             for (q = 0; q <= c->bodies; ++q) c->jac_start[q] = 0;
             c->jac_count = 0;
-            return fsdem__fail(&c->status, res, "fsdem_pic_dem: out of memory for the J of body %d", b);
+            return fsdem__fail(&c->head.status, res, "fsdem_pic_dem: out of memory for the J of body %d", b);
         }
     /* the viscous relaxation time: the fastest component of the viscous solve's pull, visc per
        (closed face, open neighbour) pair (>>pic_viscosity) */
@@ -652,42 +626,47 @@ static fsdem_result fsdem__pic_dem_loads(fsdem_pic_dem *c) {
             F = fsdem__add(F, force);
             Tv = fsdem__add(Tv, fsdem__cross(fsdem__pic_dem_arm(c, e, P.position[b]), force));
         }
-        c->fp[b] = fsdem__scale(G, area * c->depth);
-        c->fv[b] = fsdem__scale(F, c->depth);
-        c->tq[b] = fsdem__scale(fsdem__add(fsdem__scale(T, area), Tv), c->depth);
-        if (!fsdem__finite3(c->fp[b]) || !fsdem__finite3(c->fv[b]) || !fsdem__finite3(c->tq[b]))
-            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "fsdem_pic_dem: the fluid force on body %d is not finite", b);
-        c->force_sum = fsdem__add(c->force_sum, fsdem__add(c->fp[b], c->fv[b]));
+        fsdem_pic_dem_force *r = &c->load[b];
+        r->pressure_force = fsdem__scale(G, area * c->depth);
+        r->viscous_force = fsdem__scale(F, c->depth);
+        r->torque = fsdem__scale(fsdem__add(fsdem__scale(T, area), Tv), c->depth);
+        r->faces = c->face_start[b + 1] - c->face_start[b];
+        if (!fsdem__finite3(r->pressure_force) || !fsdem__finite3(r->viscous_force) || !fsdem__finite3(r->torque))
+            return fsdem__fail(&c->head.status, FSDEM_ERR_NAN, "fsdem_pic_dem: the fluid force on body %d is not finite", b);
+        c->force_sum = fsdem__add(c->force_sum, fsdem__add(r->pressure_force, r->viscous_force));
         if (dc.count > b) {
             /* the well-balanced weight's correction (item 8 of >>couple_pic; 0 for fixed bodies) */
-            c->wc[b] = P.fixed[b] ? fsdem__zero3() : fsdem__scale(c->gravity, P.mass[b] * (c->weight[b] - 1));
-            dc.force[b] = fsdem__add(fsdem__add(c->fp[b], c->fv[b]), c->wc[b]);
-            dc.torque[b] = c->tq[b];
+            r->weight_correction = P.fixed[b] ? fsdem__zero3() : fsdem__scale(c->gravity, P.mass[b] * (c->weight[b] - 1));
+            dc.force[b] = fsdem__add(fsdem__add(r->pressure_force, r->viscous_force), r->weight_correction);
+            dc.torque[b] = r->torque;
         }
     }
     c->loaded = 1;
+    c->head.record = c->load;
+    c->head.records = c->bodies;
     return FSDEM_OK;
 }
 
-/* The load record of DEM particle `index` (-1: none). */
-static int fsdem__pic_dem_record(const fsdem_pic_dem *c, int index) {
-    return c->loaded && c->bodies ? fsdem__dem_record_of(c->desc.dem, index, c->body_id, sizeof(int), c->bodies) : -1;
+fsdem_result fsdem_pic_dem_get_force(const fsdem_pic_dem *c, int index, fsdem_pic_dem_force *out) {
+    return c ? fsdem__coupler_get_record(&c->head, index, out, "fsdem_pic_dem_get_force") : FSDEM_ERR_INVALID_ARG;
 }
 
-fsdem_result fsdem_pic_dem_get_force(const fsdem_pic_dem *c, int index, fsdem_pic_dem_force *out) {
-    int k;
-    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
-    if ((k = fsdem__pic_dem_record(c, index)) < 0)
-        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND, "fsdem_pic_dem_get_force: no body %d in the last step (%d)",
-                           index, c->loaded ? c->bodies : 0);
-    out->id = c->body_id[k];
-    out->pressure_force = c->fp[k];
-    out->viscous_force = c->fv[k];
-    out->torque = c->tq[k];
-    out->weight_correction = c->wc[k];
-    out->volume = c->volume[k];
-    out->faces = c->face_start[k + 1] - c->face_start[k];
-    return fsdem__ok((fsdem__status *)&c->status);
+fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *c, const char *path) {
+    return c ? fsdem__coupler_write_csv(&c->head, path, "fsdem_pic_dem_write_csv") : FSDEM_ERR_INVALID_ARG;
+}
+
+fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
+    fsdem_pic_dem_stats st;
+    memset(&st, 0, sizeof st);
+    if (!c) return st;
+    st.coupling = fsdem__coupler_stats(&c->head);
+    st.fluid_force = c->force_sum;
+    st.viscous_dt = c->viscous_dt;
+    st.contacts = c->contact_count;
+    st.dissipated = c->dissipated;
+    st.pushed = c->pushed;
+    st.removed = c->removed;
+    return st;
 }
 
 /* ---- >>couple_pic_gap : Eq. 20, particles out of bodies ---- */
@@ -717,7 +696,7 @@ static fsdem_result fsdem__pic_dem_map_build(fsdem_pic_dem *c, fsdem__pic_dem_ma
         if (pass == 0) {
             for (i = 0; i < grid->ncell; ++i) map->start[i + 1] += map->start[i];
             total = map->start[grid->ncell];
-            if (fsdem__grow(&c->allocator, (void **)&map->item, &map->item_cap, 0, total > 0 ? total : 1, sizeof(int)) != FSDEM_OK)
+            if (fsdem__grow(&c->head.allocator, (void **)&map->item, &map->item_cap, 0, total > 0 ? total : 1, sizeof(int)) != FSDEM_OK)
                 return FSDEM_ERR_OUT_OF_MEMORY;
         }
     }
@@ -756,10 +735,10 @@ static fsdem_result fsdem__pic_dem_exclude(fsdem_pic_dem *c, int from, int remov
     fsdem_result res;
     if (from >= P.count) return FSDEM_OK;
     if (fsdem__pic_dem_map_build(c, &c->body_map, P.count - from, P.position + from, P.radius + from, 0) != FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the bodies");
+        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the bodies");
     for (e = 0; e < c->body_map.start[c->grid.ncell] && from > 0; ++e) c->body_map.item[e] += from;
     res = fsdem_pic_exclude_particles(c->desc.pic, fsdem__pic_dem_solid, c, remove, &moved);
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
+    if (res != FSDEM_OK) return fsdem__fail(&c->head.status, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
     if (remove) c->removed += moved;
     else c->pushed += moved;
     return FSDEM_OK;
@@ -773,20 +752,20 @@ static fsdem_result fsdem__pic_dem_gap(fsdem_pic_dem *c) {
     const fsdem_pic_particles W = fsdem_pic_get_particles(c->desc.pic);
     const fsdem__mac *grid = &c->grid;
     int n = fsdem_dem_contacts(c->desc.dem, NULL, 0), k, p, e;
-    if (n < 0) return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
+    if (n < 0) return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
     if (n > c->contact_cap) {
         const size_t old = (size_t)c->contact_cap;
-        fsdem__free(&c->allocator, c->contact, sizeof(fsdem_dem_contact) * old);
-        fsdem__free(&c->allocator, c->contact_point, sizeof(fsdem_vec3) * old);
+        fsdem__free(&c->head.allocator, c->contact, sizeof(fsdem_dem_contact) * old);
+        fsdem__free(&c->head.allocator, c->contact_point, sizeof(fsdem_vec3) * old);
         c->contact_cap = 0;
-        c->contact = (fsdem_dem_contact *)fsdem__alloc(&c->allocator, sizeof(fsdem_dem_contact) * (size_t)n);
-        c->contact_point = (fsdem_vec3 *)fsdem__alloc(&c->allocator, sizeof(fsdem_vec3) * (size_t)n);
+        c->contact = (fsdem_dem_contact *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_dem_contact) * (size_t)n);
+        c->contact_point = (fsdem_vec3 *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_vec3) * (size_t)n);
         if (!c->contact || !c->contact_point) {
-            fsdem__free(&c->allocator, c->contact, sizeof(fsdem_dem_contact) * (size_t)n);
-            fsdem__free(&c->allocator, c->contact_point, sizeof(fsdem_vec3) * (size_t)n);
+            fsdem__free(&c->head.allocator, c->contact, sizeof(fsdem_dem_contact) * (size_t)n);
+            fsdem__free(&c->head.allocator, c->contact_point, sizeof(fsdem_vec3) * (size_t)n);
             c->contact = NULL;
             c->contact_point = NULL;
-            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
+            return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory listing contacts");
         }
         c->contact_cap = n;
     }
@@ -798,7 +777,7 @@ static fsdem_result fsdem__pic_dem_gap(fsdem_pic_dem *c) {
         c->contact_point[k] = fsdem__madd(P.position[ct->i], ct->normal, -(P.radius[ct->i] + (offset - ct->overlap) / 2));
     }
     if (fsdem__pic_dem_map_build(c, &c->contact_map, n, c->contact_point, NULL, half) != FSDEM_OK)
-        return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the contacts");
+        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_pic_dem: out of memory mapping the contacts");
     for (p = 0; p < W.count; ++p) {
         const int cell = fsdem__mac_cell_of(grid, W.position[p]);
         for (e = c->contact_map.start[cell]; e < c->contact_map.start[cell + 1]; ++e) {
@@ -813,132 +792,125 @@ static fsdem_result fsdem__pic_dem_gap(fsdem_pic_dem *c) {
     return FSDEM_OK;
 }
 
-/* ---- >>couple_pic_step : coupled time stepping ---- */
+/* ---- >>couple_pic_step : its stages and verbs ---- */
 
-/* The stable coupled step (>>couple_pic, fsdem_pic_dem_stable_dt). */
-static fsdem_result fsdem__pic_dem_stable(const fsdem_pic_dem *c, fsdem_real *dt) {
-    fsdem__status *st = (fsdem__status *)&c->status; /* the message is the object's only mutable part here */
-    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
-    const fsdem_pic_desc pd = fsdem_pic_get_desc(c->desc.pic);
-    const fsdem_real dx = pd.cell_size;
+/* The fastest surface speed of a body, |V| + |w| r (m/s), and the body; -1 when one is not finite. */
+static fsdem_real fsdem__pic_dem_fastest(const fsdem_dem_particles *P, int *which) {
     fsdem_real vmax = 0;
     int b;
-    fsdem_result res = fsdem_pic_stable_dt(c->desc.pic, dt);
-    if (res != FSDEM_OK) return fsdem__fail(st, res, "fsdem_pic_dem: %s", fsdem_pic_last_error(c->desc.pic));
-    for (b = 0; b < P.count; ++b) {
-        const fsdem_real v = fsdem__norm(P.velocity[b]) + fsdem__norm(P.angular_velocity[b]) * P.radius[b];
-        if (!fsdem__finite(v)) return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_pic_dem: body %d has a non-finite velocity", b);
+    *which = -1;
+    for (b = 0; b < P->count; ++b) {
+        const fsdem_real v = fsdem__norm(P->velocity[b]) + fsdem__norm(P->angular_velocity[b]) * P->radius[b];
+        *which = b;
+        if (!fsdem__finite(v)) return -1;
         if (v > vmax) vmax = v;
     }
-    {
-        const fsdem_real body = pd.cfl * dx / (vmax + (fsdem_real)sqrt(fsdem__norm(pd.gravity) * dx));
-        if (body < *dt) *dt = body;
-    }
+    return vmax;
+}
+
+/* The stable step's limits of the bodies (>>couple_pic, fsdem_pic_dem_stable_dt): their speed
+   over the PIC's cfl, and the viscous limit of the last cut (the class's limit). */
+static fsdem_result fsdem__pic_dem_limit(const fsdem_coupler *head, fsdem_real *dt) {
+    const fsdem_pic_dem *c = (const fsdem_pic_dem *)(const void *)head;
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    const fsdem_pic_desc pd = fsdem_pic_get_desc(c->desc.pic);
+    int b;
+    const fsdem_real vmax = fsdem__pic_dem_fastest(&P, &b);
+    fsdem_real body;
+    if (vmax < 0) return fsdem__fail((fsdem__status *)&head->status, FSDEM_ERR_NAN, "fsdem_pic_dem: body %d has a non-finite velocity", b);
+    body = pd.cfl * pd.cell_size / (vmax + (fsdem_real)sqrt(fsdem__norm(pd.gravity) * pd.cell_size));
+    if (body < *dt) *dt = body;
     if (c->viscous_dt > 0 && c->desc.viscous_dt_fraction * c->viscous_dt < *dt) *dt = c->desc.viscous_dt_fraction * c->viscous_dt;
     return FSDEM_OK;
 }
 
-/* One coupled step of dt (steps 1-7 of >>couple_pic). */
-static fsdem_result fsdem__pic_dem_run(fsdem_pic_dem *c, fsdem_real dt) {
-    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+/* A step of dt refused before the cut changes the PIC's coupling arrays: too many substeps, a body
+   that no longer fits, a body moving more than cfl_max cells, the viscous limit of the last cut (the
+   one fsdem_pic_dem_stable_dt gave; the new cut may be a little stricter: the step it limits is the
+   next), the PIC's own refusal. */
+static fsdem_result fsdem__pic_dem_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
+    fsdem_pic_dem *c = (fsdem_pic_dem *)(void *)head;
     const fsdem_pic_desc pd = fsdem_pic_get_desc(c->desc.pic);
-    long long substeps = 0;
-    int b, before = c->bodies;
-    clock_t t0 = clock(), t1, t2;
-    fsdem_result res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_pic_dem");
-    if (res != FSDEM_OK) return res;
-    if ((res = fsdem__dem_particles_fit(c->desc.dem, pd.domain_min, pd.domain_max, &c->status, "fsdem_pic_dem")) != FSDEM_OK) return res;
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    fsdem_result res;
+    int b;
+    (void)chosen;
+    if ((res = fsdem__coupler_substeps_within(head, dt)) != FSDEM_OK) return res;
+    if ((res = fsdem__coupler_particles_fit(head, pd.domain_min, pd.domain_max, "fsdem_pic_dem")) != FSDEM_OK) return res;
     for (b = 0; b < P.count; ++b) {
         const fsdem_real v = fsdem__norm(P.velocity[b]) + fsdem__norm(P.angular_velocity[b]) * P.radius[b];
         if (v * dt > pd.cfl_max * pd.cell_size)
-            return fsdem__fail(&c->status, FSDEM_ERR_CFL, "fsdem_pic_dem: body %d at %g m/s moves %g cells in dt = %g s (cfl_max %g)", b,
+            return fsdem__fail(&head->status, FSDEM_ERR_CFL, "fsdem_pic_dem: body %d at %g m/s moves %g cells in dt = %g s (cfl_max %g)", b,
                                (double)v, (double)(v * dt / pd.cell_size), (double)dt, (double)pd.cfl_max);
     }
-    /* the limit of the last cut, the one fsdem_pic_dem_stable_dt gave (the new cut may be a little
-       stricter: the step it limits is the next) */
     if (c->viscous_dt > 0 && dt > c->desc.viscous_dt_fraction * c->viscous_dt * (1 + (fsdem_real)1e-6))
-        return fsdem__fail(&c->status, FSDEM_ERR_CFL,
+        return fsdem__fail(&head->status, FSDEM_ERR_CFL,
                            "fsdem_pic_dem: dt = %g s exceeds viscous_dt_fraction %g of the shortest viscous relaxation time %g s",
                            (double)dt, (double)c->desc.viscous_dt_fraction, (double)c->viscous_dt);
-    /* the PIC's own refusal too, before the cut below changes its coupling arrays */
     if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
-        return fsdem__fail(&c->status, res, "fsdem_pic_dem: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
-    if (P.count > before && (res = fsdem__pic_dem_exclude(c, before, 1)) != FSDEM_OK) return res;
-    if ((res = fsdem__pic_dem_faces(c, dt)) != FSDEM_OK) return res;
-    t1 = clock();
-    c->sec_coupling += (double)(t1 - t0) / CLOCKS_PER_SEC;
-    res = fsdem_pic_step_dt(c->desc.pic, dt);
-    t2 = clock();
-    c->sec_pic += (double)(t2 - t1) / CLOCKS_PER_SEC;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
-    if ((res = fsdem__pic_dem_loads(c)) != FSDEM_OK) return res;
-    t1 = clock();
-    c->sec_coupling += (double)(t1 - t2) / CLOCKS_PER_SEC;
-    res = fsdem_dem_advance(c->desc.dem, dt, &substeps);
-    t2 = clock();
-    c->sec_dem += (double)(t2 - t1) / CLOCKS_PER_SEC;
-    c->steps++;
-    c->dt_last = dt;
-    c->substeps = substeps;
-    c->substeps_total += substeps;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_pic_dem: DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
-    if ((res = fsdem__pic_dem_gap(c)) == FSDEM_OK) res = fsdem__pic_dem_exclude(c, 0, 0);
-    c->sec_coupling += (double)(clock() - t2) / CLOCKS_PER_SEC;
-    if (res != FSDEM_OK) return res;
-    return fsdem__ok(&c->status);
+        return fsdem__fail(&head->status, res, "fsdem_pic_dem: PIC step: %s", fsdem_pic_last_error(c->desc.pic));
+    return FSDEM_OK;
 }
 
-fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *c) {
-    fsdem_real dt = 0;
+/* Step 7 of >>couple_pic for bodies added since the last cut: the water particles inside them go. */
+static fsdem_result fsdem__pic_dem_new_bodies(fsdem_coupler *head, fsdem_real dt) {
+    fsdem_pic_dem *c = (fsdem_pic_dem *)(void *)head;
+    (void)dt;
+    return fsdem_dem_get_particles(c->desc.dem).count > c->bodies ? fsdem__pic_dem_exclude(c, c->bodies, 1) : FSDEM_OK;
+}
+
+static fsdem_result fsdem__pic_dem_cut_stage(fsdem_coupler *head, fsdem_real dt) {
+    return fsdem__pic_dem_faces((fsdem_pic_dem *)(void *)head, dt);
+}
+
+static fsdem_result fsdem__pic_dem_loads_stage(fsdem_coupler *head, fsdem_real dt) {
+    (void)dt;
+    return fsdem__pic_dem_loads((fsdem_pic_dem *)(void *)head);
+}
+
+static fsdem_result fsdem__pic_dem_substeps(fsdem_coupler *head, fsdem_real dt) {
+    return fsdem__coupler_substeps(head, dt, NULL, NULL, "DEM substeps", NULL);
+}
+
+/* Steps 6-7 of >>couple_pic at the bodies' new positions. */
+static fsdem_result fsdem__pic_dem_gap_stage(fsdem_coupler *head, fsdem_real dt) {
+    fsdem_pic_dem *c = (fsdem_pic_dem *)(void *)head;
+    fsdem_result res = fsdem__pic_dem_gap(c);
+    (void)dt;
+    return res == FSDEM_OK ? fsdem__pic_dem_exclude(c, 0, 0) : res;
+}
+
+static const fsdem__stage fsdem__pic_dem_stages[6] = {
+    {"new bodies", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_new_bodies}, {"cut", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_cut_stage},
+    {"PIC step", FSDEM__CLOCK_FLUID, NULL},                          {"loads", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_loads_stage},
+    {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__pic_dem_substeps},     {"gap", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_gap_stage}};
+
+#define FSDEM__PIC_DEM_FIELD(name, kind, saved) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_pic_dem_force, name), saved}
+static const fsdem__field fsdem__pic_dem_fields[7] = {
+    FSDEM__PIC_DEM_FIELD(id, INT, 1),      FSDEM__PIC_DEM_FIELD(pressure_force, VEC3, 1), FSDEM__PIC_DEM_FIELD(viscous_force, VEC3, 1),
+    FSDEM__PIC_DEM_FIELD(torque, VEC3, 1), FSDEM__PIC_DEM_FIELD(weight_correction, VEC3, 1), FSDEM__PIC_DEM_FIELD(volume, REAL, 1),
+    FSDEM__PIC_DEM_FIELD(faces, INT, 0)};
+#undef FSDEM__PIC_DEM_FIELD
+
+static const fsdem__coupler_class *fsdem__pic_dem_class(void) {
+    static const fsdem__coupler_class cls = {"fsdem_pic_dem", &fsdem__fluid_pic, sizeof(fsdem_pic_dem_force),
+        fsdem__pic_dem_fields, 7, NULL, NULL, fsdem__pic_dem_limit, fsdem__pic_dem_check, fsdem__pic_dem_stages, 6};
+    return &cls;
+}
+
+fsdem_result fsdem_pic_dem_update(fsdem_pic_dem *c) {
     fsdem_result res;
     if (!c) return FSDEM_ERR_INVALID_ARG;
-    if ((res = fsdem__pic_dem_stable(c, &dt)) != FSDEM_OK) return res;
-    return fsdem__pic_dem_run(c, dt);
+    if ((res = fsdem__pic_dem_new_bodies(&c->head, 0)) == FSDEM_OK && (res = fsdem__pic_dem_faces(c, 0)) == FSDEM_OK) fsdem__ok(&c->head.status);
+    return res;
 }
 
+fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
 fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *c, fsdem_real dt) {
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_pic_dem_step_dt: dt = %g s must be > 0 and finite", (double)dt);
-    return fsdem__pic_dem_run(c, dt);
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_pic_dem_step_dt");
 }
-
-/* fsdem__coupled_advance's verbs for this coupler. */
-static double fsdem__pic_dem_now(const void *c) { return fsdem_pic_time(((const fsdem_pic_dem *)c)->desc.pic); }
-static fsdem_result fsdem__pic_dem_prepare(void *c, fsdem_real *dt) { return fsdem__pic_dem_stable((fsdem_pic_dem *)c, dt); }
-static fsdem_result fsdem__pic_dem_go(void *c, fsdem_real dt) { return fsdem__pic_dem_run((fsdem_pic_dem *)c, dt); }
-
 fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *c, fsdem_real duration, long long *steps) {
-    static const fsdem__coupled_verbs verbs = {fsdem__pic_dem_now, fsdem__pic_dem_prepare, fsdem__pic_dem_go};
-    if (steps) *steps = 0;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__coupled_advance(c, &c->status, "fsdem_pic_dem_advance", &verbs, duration, steps);
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_pic_dem_advance");
 }
-
-fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *c, fsdem_real *dt) {
-    if (!c || !dt) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__pic_dem_stable(c, dt);
-}
-
-double fsdem_pic_dem_time(const fsdem_pic_dem *c) { return c ? fsdem_pic_time(c->desc.pic) : 0; }
-
-fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *c) {
-    fsdem_pic_dem_stats st;
-    memset(&st, 0, sizeof st);
-    if (!c) return st;
-    st.steps = c->steps;
-    st.time = fsdem_pic_time(c->desc.pic);
-    st.dt = c->dt_last;
-    st.substeps = c->substeps;
-    st.substeps_total = c->substeps_total;
-    st.fluid_force = c->force_sum;
-    st.viscous_dt = c->viscous_dt;
-    st.contacts = c->contact_count;
-    st.dissipated = c->dissipated;
-    st.pushed = c->pushed;
-    st.removed = c->removed;
-    st.seconds_pic = c->sec_pic;
-    st.seconds_dem = c->sec_dem;
-    st.seconds_coupling = c->sec_coupling;
-    return st;
-}
+fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+double fsdem_pic_dem_time(const fsdem_pic_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }

@@ -91,7 +91,7 @@ FSDEM_API fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *desc, 
    the check (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_pic_dem_destroy
    removes the term and the moving solids from the PIC and leaves both solvers alive. The coupler
    owns the PIC's open, solid_velocity and reference arrays (fsdem_pic_get_coupling): every step
-   resets and rewrites them. */
+   resets and rewrites them (it claims them, >>couple). */
 FSDEM_API fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem **out);
 FSDEM_API void fsdem_pic_dem_destroy(fsdem_pic_dem *coupler);
 FSDEM_API const char *fsdem_pic_dem_last_error(const fsdem_pic_dem *coupler);
@@ -115,6 +115,13 @@ typedef struct fsdem_pic_dem_force {
    not mix the records up. FSDEM_ERR_NOT_FOUND for a bad index, before the first step, or for a
    particle added since. */
 FSDEM_API fsdem_result fsdem_pic_dem_get_force(const fsdem_pic_dem *coupler, int index, fsdem_pic_dem_force *out);
+/* The records as CSV (>>couple): id, pressure_force_x .. _z, viscous_force_x .. _z, torque_x .. _z,
+   weight_correction_x .. _z, volume, faces. */
+FSDEM_API fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *coupler, const char *path);
+/* Steps 2-3 and 7 of the section at the current state, without stepping: the water particles inside
+   bodies added since are removed, and every body is cut into the PIC's coupling arrays at its
+   velocity (no prediction), as at creation. FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_pic_dem_update(fsdem_pic_dem *coupler);
 /* One coupled step of the stable dt. The DEM substep count is checked before anything moves
    (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of either solver are passed on with their
    message. */
@@ -133,20 +140,16 @@ FSDEM_API fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *coupler, fsd
 FSDEM_API double fsdem_pic_dem_time(const fsdem_pic_dem *coupler);
 
 typedef struct fsdem_pic_dem_stats {
-    long long steps;             /* coupled steps */
-    double time;                 /* s */
-    fsdem_real dt;               /* s, the last coupled step */
-    long long substeps;          /* DEM substeps of the last step */
-    long long substeps_total;
+    fsdem_coupling_stats coupling; /* steps, time, dt, substeps, CPU seconds (>>couple) */
     fsdem_vec3 fluid_force;      /* N; sum of the fluid forces on the bodies, last step */
     fsdem_real viscous_dt;       /* s; the viscous limit of the last step (0: none) */
     int contacts;                /* contacts (gap areas) after the last step */
     long long dissipated;        /* particle velocities scaled by Eq. 20, total */
     long long pushed;            /* particles moved out of bodies, total */
     long long removed;           /* particles removed inside new bodies, total */
-    double seconds_pic;          /* CPU seconds in PIC steps */
-    double seconds_dem;          /* CPU seconds in DEM substeps */
-    double seconds_coupling;     /* CPU seconds in the coupling (faces, forces, gap, exclusion) */
 } fsdem_pic_dem_stats;
 
 FSDEM_API fsdem_pic_dem_stats fsdem_pic_dem_get_stats(const fsdem_pic_dem *coupler);
+/* The coupler as any coupler, to step with others on the same PIC (fsdem_coupled_step: a GIC sand
+   bed and resolved bodies at once). */
+FSDEM_API fsdem_coupler *fsdem_pic_dem_coupler(fsdem_pic_dem *coupler);

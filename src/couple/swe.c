@@ -1,24 +1,24 @@
 /* ===== >>impl_couple_swe : SWE-DEM floating debris =================================================
 
    Contents: >>couple_swe_object (desc, creation), >>couple_swe_geometry (submerged parts of a
-   sphere), >>couple_swe_forces (seed 003 Eq. 5-8), >>couple_swe_step (coupled time stepping). The
-   coupler reaches the solvers through their coupling functions only (>>doc). */
+   sphere), >>couple_swe_forces (seed 003 Eq. 5-8), >>couple_swe_step (its stages and verbs on the
+   staged step of >>couple). The coupler reaches the solvers through their coupling functions only
+   (>>doc). */
 
 /* ---- >>couple_swe_object : desc, creation ---- */
 
 struct fsdem_swe_dem {
+    fsdem_coupler head;            /* >>couple; its records are `force` */
     fsdem_swe_dem_desc desc;
-    fsdem__status status;
-    fsdem_allocator allocator;
     fsdem_real rho, g, dry;        /* the SWE's density, |g| and dry depth */
     fsdem_swe_dem_force *force;    /* one per DEM particle of the last update */
-    int force_capacity, records;   /* records: the particles of the last update */
-    long long steps, substeps, substeps_total;
-    fsdem_real dt_last;
-    int in_water;
-    fsdem_vec3 impulse;            /* N s, given to the water */
     fsdem_vec3 *reaction;          /* N, horizontal force on each sphere whose reaction the water took */
+    int force_capacity;            /* of force and reaction */
+    int wet;                       /* spheres in water at the last update */
+    fsdem_vec3 impulse;            /* N s, given to the water */
 };
+
+static const fsdem__coupler_class *fsdem__swe_dem_class(void);
 
 fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void) {
     fsdem_swe_dem_desc d;
@@ -32,15 +32,17 @@ fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void) {
 
 fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *d, char *msg, size_t size) {
     fsdem_dem_desc dd;
+    fsdem_swe_desc sd;
     fsdem_vec3 g;
     fsdem_real gs;
     if (!d) return fsdem__reject(msg, size, "fsdem_swe_dem_desc is NULL");
     if (!d->swe || !d->dem) return fsdem__reject(msg, size, "fsdem_swe_dem_desc.swe and .dem must both be set");
     dd = fsdem_dem_get_desc(d->dem);
+    sd = fsdem_swe_get_desc(d->swe);
     if (dd.dim != 3)
         return fsdem__reject(msg, size, "fsdem_swe_dem_desc.dem must be 3D (spheres, z vertical); it has dim %d", dd.dim);
     g = dd.gravity;
-    gs = -fsdem_swe_get_desc(d->swe).gravity.z;
+    gs = -sd.gravity.z;
     if (g.x != 0 || g.y != 0 || !(fabs(g.z + gs) <= 1e-12 * gs))
         return fsdem__reject(msg, size, "fsdem_swe_dem_desc: the DEM gravity (%g, %g, %g) must be (0, 0, -g) with the SWE's g = %g m/s^2",
                              (double)g.x, (double)g.y, (double)g.z, (double)gs);
@@ -49,22 +51,20 @@ fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *d, char *msg, si
     if (!(d->heave_damping >= 0) || !fsdem__finite(d->heave_damping))
         return fsdem__reject(msg, size, "fsdem_swe_dem_desc.heave_damping must be >= 0 (got %g)",
                              (double)d->heave_damping);
-    if (d->max_substeps < 1)
-        return fsdem__reject(msg, size, "fsdem_swe_dem_desc.max_substeps must be >= 1 (got %lld)", d->max_substeps);
-    return FSDEM_OK;
+    return fsdem__coupler_check(fsdem__swe_dem_class(), "fsdem_swe_dem_desc", d->swe, d->two_way ? (unsigned)FSDEM_SWE_ARRAYS_SOURCE : 0u, d->dem, 0,
+                                sd.gravity, d->max_substeps, msg, size);
 }
 
 fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out) {
     char msg[FSDEM__MESSAGE_SIZE];
-    fsdem_allocator al;
     fsdem_swe_dem *c;
     fsdem_result res;
     if (out) *out = NULL;
     if (!out) return FSDEM_ERR_INVALID_ARG;
     res = fsdem_swe_dem_desc_check(desc, msg, sizeof msg);
-    if (res == FSDEM_OK) al = fsdem_dem_get_desc(desc->dem).allocator;
-    c = (fsdem_swe_dem *)fsdem__object_new(res, msg, desc ? desc->log : NULL, desc ? desc->log_user : NULL,
-                                           res == FSDEM_OK ? &al : NULL, sizeof *c, "fsdem_swe_dem_create", &res);
+    c = (fsdem_swe_dem *)fsdem__coupler_new(fsdem__swe_dem_class(), res, msg, desc ? desc->swe : NULL, desc ? desc->dem : NULL,
+                                            desc && desc->two_way ? (unsigned)FSDEM_SWE_ARRAYS_SOURCE : 0u, desc ? desc->max_substeps : 0,
+                                            desc ? desc->log : NULL, desc ? desc->log_user : NULL, sizeof *c, &res);
     if (!c) return res;
     {
         const fsdem_swe_desc sd = fsdem_swe_get_desc(desc->swe);
@@ -73,23 +73,18 @@ fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem 
         c->dry = sd.dry_depth;
     }
     c->desc = *desc;
-    c->allocator = al;
-    c->status.log = desc->log;
-    c->status.log_user = desc->log_user;
     *out = c;
     return FSDEM_OK;
 }
 
 void fsdem_swe_dem_destroy(fsdem_swe_dem *c) {
-    fsdem_allocator al;
     if (!c) return;
-    al = c->allocator;
-    fsdem__free(&al, c->force, sizeof(fsdem_swe_dem_force) * (size_t)c->force_capacity);
-    fsdem__free(&al, c->reaction, sizeof(fsdem_vec3) * (size_t)c->force_capacity);
-    fsdem__free(&al, c, sizeof *c);
+    fsdem__free(&c->head.allocator, c->force, sizeof(fsdem_swe_dem_force) * (size_t)c->force_capacity);
+    fsdem__free(&c->head.allocator, c->reaction, sizeof(fsdem_vec3) * (size_t)c->force_capacity);
+    fsdem__coupler_free(&c->head, sizeof *c);
 }
 
-const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *c) { return c ? c->status.message : "fsdem_swe_dem is NULL"; }
+const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *c) { return c ? c->head.status.message : "fsdem_swe_dem is NULL"; }
 
 fsdem_swe_dem_desc fsdem_swe_dem_get_desc(const fsdem_swe_dem *c) {
     fsdem_swe_dem_desc d;
@@ -97,6 +92,8 @@ fsdem_swe_dem_desc fsdem_swe_dem_get_desc(const fsdem_swe_dem *c) {
     memset(&d, 0, sizeof d);
     return d;
 }
+
+fsdem_coupler *fsdem_swe_dem_coupler(fsdem_swe_dem *c) { return c ? &c->head : NULL; }
 
 /* ---- >>couple_swe_geometry : submerged parts of a sphere ---- */
 
@@ -154,7 +151,7 @@ static fsdem_real fsdem__swe_dem_vertical(const fsdem_swe_dem *c, const fsdem_de
 
 /* ---- >>couple_swe_forces : seed 003 Eq. 5-8 ---- */
 
-fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
+fsdem_result fsdem_swe_dem_update(fsdem_swe_dem *c) {
     fsdem_swe *swe;
     fsdem_dem_particles pv;
     fsdem_dem_coupling loads;
@@ -167,22 +164,22 @@ fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
     pv = fsdem_dem_get_particles(c->desc.dem);
     n = pv.count;
     if (n > c->force_capacity) {
-        fsdem_swe_dem_force *force = (fsdem_swe_dem_force *)fsdem__alloc(&c->allocator, sizeof *force * (size_t)n);
-        fsdem_vec3 *reaction = (fsdem_vec3 *)fsdem__alloc(&c->allocator, sizeof *reaction * (size_t)n);
+        fsdem_swe_dem_force *force = (fsdem_swe_dem_force *)fsdem__alloc(&c->head.allocator, sizeof *force * (size_t)n);
+        fsdem_vec3 *reaction = (fsdem_vec3 *)fsdem__alloc(&c->head.allocator, sizeof *reaction * (size_t)n);
         if (!force || !reaction) {
-            fsdem__free(&c->allocator, force, sizeof *force * (size_t)n);
-            fsdem__free(&c->allocator, reaction, sizeof *reaction * (size_t)n);
-            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_dem: out of memory for the forces of %d particles", n);
+            fsdem__free(&c->head.allocator, force, sizeof *force * (size_t)n);
+            fsdem__free(&c->head.allocator, reaction, sizeof *reaction * (size_t)n);
+            return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_swe_dem: out of memory for the forces of %d particles", n);
         }
-        fsdem__free(&c->allocator, c->force, sizeof *force * (size_t)c->force_capacity);
-        fsdem__free(&c->allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
+        fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_capacity);
+        fsdem__free(&c->head.allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
         c->force = force;
         c->reaction = reaction;
         c->force_capacity = n;
     }
     loads = fsdem_dem_get_coupling(c->desc.dem);
     if (c->desc.two_way) fsdem_swe_clear_forces(swe);
-    c->in_water = 0;
+    c->wet = 0;
     for (i = 0; i < n; ++i) {
         fsdem_swe_dem_force *out = &c->force[i];
         const fsdem_vec3 p = pv.position[i], w = pv.velocity[i];
@@ -203,8 +200,8 @@ fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
             if (flow.depth < c->dry && front[a].depth > flow.depth) flow = front[a];
         }
         if (flow.depth < c->dry) continue;
-        out->in_water = 1;
-        c->in_water++;
+        out->wet = 1;
+        c->wet++;
         out->surface = centre.eta;
         for (a = 0; a < axes; ++a) {
             /* Eq. 6-7 along axis a */
@@ -235,26 +232,30 @@ fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *c) {
         horizontal.z = fsdem__swe_dem_vertical(c, &pv, i, out);
         loads.force[i] = horizontal;
     }
-    c->records = n;
-    return fsdem__ok(&c->status);
-}
-
-/* The record of DEM particle `index` (-1: none). */
-static int fsdem__swe_dem_record(const fsdem_swe_dem *c, int index) {
-    return c->records ? fsdem__dem_record_of(c->desc.dem, index, &c->force[0].id, sizeof *c->force, c->records) : -1;
+    c->head.record = c->force;
+    c->head.records = n;
+    return fsdem__ok(&c->head.status);
 }
 
 fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *c, int index, fsdem_swe_dem_force *out) {
-    int k;
-    if (!c || !out) return FSDEM_ERR_INVALID_ARG;
-    if ((k = fsdem__swe_dem_record(c, index)) < 0)
-        return fsdem__fail((fsdem__status *)&c->status, FSDEM_ERR_NOT_FOUND,
-                           "fsdem_swe_dem_get_force: no particle %d in the last update", index);
-    *out = c->force[k];
-    return FSDEM_OK;
+    return c ? fsdem__coupler_get_record(&c->head, index, out, "fsdem_swe_dem_get_force") : FSDEM_ERR_INVALID_ARG;
 }
 
-/* ---- >>couple_swe_step : coupled time stepping ---- */
+fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *c, const char *path) {
+    return c ? fsdem__coupler_write_csv(&c->head, path, "fsdem_swe_dem_write_csv") : FSDEM_ERR_INVALID_ARG;
+}
+
+fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
+    fsdem_swe_dem_stats st;
+    memset(&st, 0, sizeof st);
+    if (!c) return st;
+    st.coupling = fsdem__coupler_stats(&c->head);
+    st.wet = c->wet;
+    st.impulse_to_water = c->impulse;
+    return st;
+}
+
+/* ---- >>couple_swe_step : its stages and verbs ---- */
 
 /* fsdem_dem_substep_fn: buoyancy and heave damping of the spheres in water refreshed for the heights
    of every DEM force evaluation, against the water surface held over the fluid step. */
@@ -265,87 +266,52 @@ static fsdem_result fsdem__swe_dem_refresh(void *user, fsdem_dem *dem, double ti
     int i;
     (void)time;
     for (i = 0; i < pv.count; ++i)
-        if (c->force[i].in_water) loads.force[i].z = fsdem__swe_dem_vertical(c, &pv, i, &c->force[i]);
+        if (c->force[i].wet) loads.force[i].z = fsdem__swe_dem_vertical(c, &pv, i, &c->force[i]);
     return FSDEM_OK;
 }
 
-/* One coupled step of dt: the DEM substep count is checked before anything moves; `adaptive` steps
-   the water with fsdem_swe_step (whose dt is the stable dt computed by the caller), otherwise with
-   fsdem_swe_step_dt. */
-static fsdem_result fsdem__swe_dem_step(fsdem_swe_dem *c, fsdem_real dt, int adaptive) {
-    fsdem_result res;
-    long long k, substeps = 0;
-    int count;
-    res = fsdem__dem_substeps_within(c->desc.dem, dt, c->desc.max_substeps, &c->status, "fsdem_swe_dem");
-    if (res != FSDEM_OK) return res;
-    res = fsdem_swe_dem_update_forces(c);
-    if (res != FSDEM_OK) return res;
-    res = adaptive ? fsdem_swe_step(c->desc.swe) : fsdem_swe_step_dt(c->desc.swe, dt);
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: shallow-water step: %s", fsdem_swe_last_error(c->desc.swe));
-    count = fsdem_dem_get_particles(c->desc.dem).count;
-    for (k = 0; k < c->force_capacity && k < count; ++k)
-        c->impulse = fsdem__madd(c->impulse, c->reaction[k], -dt);
-    res = fsdem_dem_advance_with(c->desc.dem, dt, fsdem__swe_dem_refresh, c, &substeps);
-    c->steps++;
-    c->dt_last = dt;
-    c->substeps = substeps;
-    c->substeps_total += substeps;
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "fsdem_swe_dem: DEM substeps: %s", fsdem_dem_last_error(c->desc.dem));
-    return fsdem__ok(&c->status);
+static fsdem_result fsdem__swe_dem_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
+    (void)chosen;
+    return fsdem__coupler_substeps_within(head, dt);
 }
 
-fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c) {
-    fsdem_real dt = 0;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    fsdem_swe_stable_dt(c->desc.swe, &dt);
-    return fsdem__swe_dem_step(c, dt, 1);
+static fsdem_result fsdem__swe_dem_forces(fsdem_coupler *head, fsdem_real dt) {
+    (void)dt;
+    return fsdem_swe_dem_update((fsdem_swe_dem *)(void *)head);
 }
 
+/* The reactions' impulse on the water over the step, then the DEM's substeps. */
+static fsdem_result fsdem__swe_dem_substeps(fsdem_coupler *head, fsdem_real dt) {
+    fsdem_swe_dem *c = (fsdem_swe_dem *)(void *)head;
+    const int count = fsdem_dem_get_particles(c->desc.dem).count;
+    int k;
+    for (k = 0; k < c->force_capacity && k < count; ++k) c->impulse = fsdem__madd(c->impulse, c->reaction[k], -dt);
+    return fsdem__coupler_substeps(head, dt, fsdem__swe_dem_refresh, c, "DEM substeps", NULL);
+}
+
+static const fsdem__stage fsdem__swe_dem_stages[3] = {{"forces", FSDEM__CLOCK_COUPLING, fsdem__swe_dem_forces},
+                                                      {"shallow-water step", FSDEM__CLOCK_FLUID, NULL},
+                                                      {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__swe_dem_substeps}};
+
+#define FSDEM__SWE_DEM_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_swe_dem_force, name), 1}
+static const fsdem__field fsdem__swe_dem_fields[9] = {
+    FSDEM__SWE_DEM_FIELD(id, INT),          FSDEM__SWE_DEM_FIELD(buoyancy, VEC3),         FSDEM__SWE_DEM_FIELD(hydrostatic, VEC3),
+    FSDEM__SWE_DEM_FIELD(dynamic, VEC3),    FSDEM__SWE_DEM_FIELD(heave, VEC3),            FSDEM__SWE_DEM_FIELD(submerged_volume, REAL),
+    FSDEM__SWE_DEM_FIELD(frontal_area, REAL), FSDEM__SWE_DEM_FIELD(surface, REAL),        FSDEM__SWE_DEM_FIELD(wet, INT)};
+#undef FSDEM__SWE_DEM_FIELD
+
+static const fsdem__coupler_class *fsdem__swe_dem_class(void) {
+    static const fsdem__coupler_class cls = {"fsdem_swe_dem", &fsdem__fluid_swe, sizeof(fsdem_swe_dem_force),
+        fsdem__swe_dem_fields, 9, NULL, NULL, NULL, fsdem__swe_dem_check, fsdem__swe_dem_stages, 3};
+    return &cls;
+}
+
+fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
 fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *c, fsdem_real dt) {
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_dem_step_dt: dt must be > 0 (got %g s)", (double)dt);
-    return fsdem__swe_dem_step(c, dt, 0);
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_swe_dem_step_dt");
 }
-
 fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *c, fsdem_real duration, long long *steps) {
-    double end;
-    long long n = 0;
-    fsdem_result res = FSDEM_OK;
-    if (steps) *steps = 0;
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    if (!(duration >= 0) || !fsdem__finite(duration))
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_dem_advance: duration must be >= 0 (got %g s)",
-                           (double)duration);
-    end = fsdem_swe_time(c->desc.swe) + (double)duration;
-    while (res == FSDEM_OK && fsdem_swe_time(c->desc.swe) < end) {
-        fsdem_real dt = 0;
-        const double left = end - fsdem_swe_time(c->desc.swe);
-        fsdem_swe_stable_dt(c->desc.swe, &dt);
-        res = (double)dt >= left ? fsdem__swe_dem_step(c, (fsdem_real)left, 0) : fsdem__swe_dem_step(c, dt, 1);
-        ++n;
-    }
-    if (steps) *steps = n;
-    return res;
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_swe_dem_advance");
 }
-
-fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *c, fsdem_real *dt) {
-    if (!c) return FSDEM_ERR_INVALID_ARG;
-    return fsdem_swe_stable_dt(c->desc.swe, dt);
-}
-
-double fsdem_swe_dem_time(const fsdem_swe_dem *c) { return c ? fsdem_swe_time(c->desc.swe) : 0; }
-
-fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *c) {
-    fsdem_swe_dem_stats st;
-    memset(&st, 0, sizeof st);
-    if (!c) return st;
-    st.steps = c->steps;
-    st.time = fsdem_swe_time(c->desc.swe);
-    st.dt = c->dt_last;
-    st.substeps = c->substeps;
-    st.substeps_total = c->substeps_total;
-    st.in_water = c->in_water;
-    st.impulse_to_water = c->impulse;
-    return st;
-}
+fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+double fsdem_swe_dem_time(const fsdem_swe_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }

@@ -20,7 +20,8 @@
    held water surface: buoyancy is a stiff spring, and holding it over a whole fluid step would let
    bobbing grow without bound. A horizontal force is only applied while wet cells under (or next to)
    the sphere can take its reaction. The coupler owns the SWE's momentum sources and the DEM's
-   external forces, and reaches both solvers through their coupling functions only (>>doc). */
+   external forces (it claims them, >>couple), and reaches both solvers through their coupling
+   functions only (>>doc). */
 
 typedef struct fsdem_swe_dem fsdem_swe_dem;
 
@@ -47,7 +48,7 @@ FSDEM_API fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsde
 FSDEM_API void fsdem_swe_dem_destroy(fsdem_swe_dem *coupler);
 FSDEM_API const char *fsdem_swe_dem_last_error(const fsdem_swe_dem *coupler);
 
-/* Fluid forces on one sphere, as the last fsdem_swe_dem_update_forces computed them. */
+/* Fluid forces on one sphere, as the last update computed them (fsdem_swe_dem_update). */
 typedef struct fsdem_swe_dem_force {
     int id;                       /* stable id of the DEM particle (fsdem_dem_particles.id) */
     fsdem_vec3 buoyancy;          /* N, (0, 0, rho g V_sub) */
@@ -57,19 +58,20 @@ typedef struct fsdem_swe_dem_force {
     fsdem_real submerged_volume;  /* m^3 */
     fsdem_real frontal_area;      /* m^2, submerged area facing +x (S_F of seed 003 along x) */
     fsdem_real surface;           /* m, water surface at the centre, held over the DEM substeps */
-    int in_water;                 /* 1 when water reaches the sphere */
+    int wet;                      /* 1 when water reaches the sphere */
 } fsdem_swe_dem_force;
 
 /* Computes the fluid forces on every free sphere from the current states, writes them to the DEM's
-   external forces and, with two_way, the reactions to the SWE's momentum sources. */
-FSDEM_API fsdem_result fsdem_swe_dem_update_forces(fsdem_swe_dem *coupler);
+   external forces and, with two_way, the reactions to the SWE's momentum sources. A step does it
+   first; call it to see the forces without stepping. FSDEM_ERR_OUT_OF_MEMORY. */
+FSDEM_API fsdem_result fsdem_swe_dem_update(fsdem_swe_dem *coupler);
 /* Forces on particle `index` from the last update (zero for fixed particles and dry spheres), found
    by the particle's id, so removals since do not mix the records up. FSDEM_ERR_NOT_FOUND for a bad
    index or a particle added since the update. */
 FSDEM_API fsdem_result fsdem_swe_dem_get_force(const fsdem_swe_dem *coupler, int index, fsdem_swe_dem_force *out);
-/* One coupled step: update the forces, one adaptive SWE step of at most dt_cap (<= 0: no cap), then
-   the DEM over the same dt in substeps. The step goes to *dt and the substep count to *substeps (both
-   may be NULL). Errors of either solver are passed on with their message. */
+/* The records as CSV (>>couple): id, buoyancy_x .. _z, hydrostatic_x .. _z, dynamic_x .. _z,
+   heave_x .. _z, submerged_volume, frontal_area, surface, wet. */
+FSDEM_API fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *coupler, const char *path);
 /* One coupled step of the SWE's stable dt: update the forces, the SWE step, then the DEM over the
    same dt in substeps. The substep count is checked first, so a step the DEM cannot take (more than
    max_substeps) is refused with FSDEM_ERR_INVALID_ARG before anything moves. Errors of either
@@ -86,13 +88,11 @@ FSDEM_API double fsdem_swe_dem_time(const fsdem_swe_dem *coupler);
 FSDEM_API fsdem_swe_dem_desc fsdem_swe_dem_get_desc(const fsdem_swe_dem *coupler);
 
 typedef struct fsdem_swe_dem_stats {
-    long long steps;              /* coupled steps */
-    double time;                  /* s */
-    fsdem_real dt;                /* s, the last coupled step */
-    long long substeps;           /* DEM substeps of the last coupled step */
-    long long substeps_total;     /* DEM substeps of all coupled steps */
-    int in_water;                 /* spheres in water at the last force update */
+    fsdem_coupling_stats coupling; /* steps, time, dt, substeps, CPU seconds (>>couple) */
+    int wet;                      /* spheres in water at the last update */
     fsdem_vec3 impulse_to_water;  /* N s, momentum given to the water by the reactions, total */
 } fsdem_swe_dem_stats;
 
 FSDEM_API fsdem_swe_dem_stats fsdem_swe_dem_get_stats(const fsdem_swe_dem *coupler);
+/* The coupler as any coupler, to step with others on the same SWE (fsdem_coupled_step). */
+FSDEM_API fsdem_coupler *fsdem_swe_dem_coupler(fsdem_swe_dem *coupler);

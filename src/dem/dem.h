@@ -226,6 +226,14 @@ typedef struct fsdem_dem_coupling {
 
 FSDEM_API fsdem_dem_coupling fsdem_dem_get_coupling(fsdem_dem *dem);
 
+/* The DEM's arrays a coupler claims (fsdem_claim; >>couple: one coupler per DEM). */
+typedef enum fsdem_dem_arrays {
+    FSDEM_DEM_ARRAYS_LOADS = 1    /* the external loads of fsdem_dem_get_coupling */
+} fsdem_dem_arrays;
+
+/* The DEM's claim registry (>>core_claims); NULL for a NULL DEM. */
+FSDEM_API fsdem_claims *fsdem_dem_claims(fsdem_dem *dem);
+
 /* ---- walls ---- */
 
 typedef enum fsdem_dem_wall_type {

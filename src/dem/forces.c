@@ -145,6 +145,7 @@ FSDEM__FORCE_INLINE void fsdem__dem_scatter(fsdem_dem *d, const fsdem__dem_batch
 /* The entries [k0, k1) of the particle-pair list whose pair touches, into `touching`; returns their
    number. With `commit`, the pairs that do not touch lose their spring. Branch-free, and
    instantiated with and without `commit`. */
+/* threaded: inside a team: one chunk of the pair list. */
 FSDEM__FORCE_INLINE int fsdem__dem_touching_range(fsdem_dem *d, int *FSDEM__RESTRICT touching, int k0, int k1, const int commit,
                                                   const int periodic) {
     const fsdem_real off = d->desc.contact_offset;
@@ -167,6 +168,7 @@ FSDEM__FORCE_INLINE int fsdem__dem_touching_range(fsdem_dem *d, int *FSDEM__REST
 
 /* The touching entries of the whole pair list into `touching`, in list order: on `team` threads chunk
    by chunk (each chunk's entries at its own start, then moved together), else in one pass. */
+/* threaded: opens a team over the chunks of the pair list. */
 static int fsdem__dem_touching(fsdem_dem *d, int *touching, int commit, int team, int *chunk_count) {
     const int pairs = d->pp.count, chunks = pairs / FSDEM__DEM_CHUNK + 1, periodic = d->periods.any;
     int q, count = 0;
@@ -190,6 +192,7 @@ static int fsdem__dem_touching(fsdem_dem *d, int *touching, int commit, int team
 
 /* A batch's results into `out` (one per lane), with the rolling-resistance torque where the pair has
    it, its springs committed when `commit`; returns its largest overlap. */
+/* threaded: inside a team: one batch. */
 static fsdem_real fsdem__dem_keep_results(fsdem_dem *d, const fsdem__dem_batch *b, fsdem__dem_result *out, int commit,
                                           fsdem_real h) {
     fsdem_real max_overlap = 0;
@@ -211,6 +214,7 @@ static fsdem_real fsdem__dem_keep_results(fsdem_dem *d, const fsdem__dem_batch *
 /* Adds the results of `count` touching pairs to the particles in [lo, hi), in the order
    fsdem__dem_scatter adds them on one thread: batch by batch, in each the forces and torques pair
    by pair, then the rolling torques. Each thread adds to its own particles only. */
+/* threaded: inside a team: the calling thread's particles. */
 static void fsdem__dem_add_results(fsdem_dem *d, const fsdem__dem_result *res, int count, int lo, int hi) {
     fsdem_vec3 *FSDEM__RESTRICT f = d->f, *FSDEM__RESTRICT t = d->t;
     int b0, c;
@@ -239,6 +243,7 @@ static void fsdem__dem_add_results(fsdem_dem *d, const fsdem__dem_result *res, i
 /* The touching pairs' forces on `team` threads: batches of the contact list evaluated in parallel
    into per-pair results, then added to the particles by their owners in list order, so every
    particle sums the same terms in the same order as on one thread. */
+/* threaded: opens a team over the batches, then over the particles. */
 FSDEM__FORCE_INLINE void fsdem__dem_pairs_threaded(fsdem_dem *d, const int *touching, int nt, fsdem__dem_batch *batches,
                                                fsdem__dem_result *res, fsdem_real *overlaps, int team, fsdem_real h,
                                                int keep, const fsdem_dem_law law, const fsdem__dem_rules *rules) {
@@ -293,8 +298,7 @@ FSDEM__FORCE_INLINE int fsdem__dem_drain(fsdem_dem *d, fsdem__dem_batch *b, int 
    contact law (fsdem__dem_compute_forces). */
 FSDEM__FORCE_INLINE void fsdem__dem_compute_forces_law(fsdem_dem *d, fsdem_real h, int commit, const fsdem_dem_law law) {
     const int n = d->n, keep = commit && (law == FSDEM_DEM_LAW_HERTZ_MINDLIN || law == FSDEM__DEM_LAW_SEED002);
-    const int uniform = d->material_count == 1, workers = fsdem__workers();
-    const int team = d->pp.count > 2 * FSDEM__DEM_CHUNK ? (workers < d->workers ? workers : d->workers) : 1;
+    const int uniform = d->material_count == 1, team = fsdem__team_for(d->pp.count, 2 * FSDEM__DEM_CHUNK, d->workers);
     const fsdem__dem_rules rules = fsdem__dem_rules_of(d);
     fsdem__dem_batch *b, *batches;
     int *touching, *chunk_count = NULL, i, k, c, nt = 0, nw = 0;

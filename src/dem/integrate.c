@@ -16,6 +16,7 @@ static fsdem_vec3 fsdem__dem_spin_rate(const fsdem_dem *d, const fsdem_vec3 *t, 
    particle. (Positions are checked after the drift, velocities after a pass without one.) Written
    once and instantiated per flag, so each pass reads every array it needs once; this part does
    particles [i0, i1), raising *max_disp2 and or-ing *suspect. */
+/* threaded: inside a team: the calling thread's particles. */
 FSDEM__FORCE_INLINE void fsdem__dem_verlet_range(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift,
                                                 const int external, int i0, int i1, fsdem_real *max_disp2, int *suspect) {
     const fsdem_vec3 g = d->desc.gravity, lo = d->desc.domain_min, hi = d->desc.domain_max;
@@ -67,9 +68,10 @@ FSDEM__FORCE_INLINE void fsdem__dem_verlet_range(fsdem_dem *d, fsdem_real h, con
 
 /* The pass over all particles: on one thread, or (many particles) each thread over its share, the
    largest displacement and the suspicion combined (a maximum and an or: the same at any split). */
+/* threaded: opens a team over the particles. */
 FSDEM__FORCE_INLINE int fsdem__dem_verlet_pass(fsdem_dem *d, fsdem_real h, const int drift, fsdem_real h_drift,
                                            const int external) {
-    const int n = d->n, team = n > FSDEM__DEM_CHUNK ? fsdem__workers() : 1;
+    const int n = d->n, team = fsdem__team_for(n, FSDEM__DEM_CHUNK, FSDEM__NO_CAP);
     fsdem_real disp2 = d->max_disp2;
     int k, outside = 0;
     if (team <= 1) fsdem__dem_verlet_range(d, h, drift, h_drift, external, 0, n, &disp2, &outside);
@@ -285,88 +287,6 @@ static fsdem_result fsdem__dem_advance_verlet(fsdem_dem *d, fsdem_real h, long l
         }
     }
     return FSDEM_OK;
-}
-
-/* The smallest extent (m) of the box [lo, hi] along the first `dim` axes. */
-static fsdem_real fsdem__smallest_extent(fsdem_vec3 lo, fsdem_vec3 hi, int dim) {
-    fsdem_real e = hi.x - lo.x;
-    if (hi.y - lo.y < e) e = hi.y - lo.y;
-    if (dim == 3 && hi.z - lo.z < e) e = hi.z - lo.z;
-    return e;
-}
-
-/* A coupler's record of DEM particle `index`. Records k = 0 .. count - 1 were made for particles
-   whose stable ids, the int at ids + k stride bytes, ascend: the DEM keeps its ids in index order
-   (new particles go to the end, removals keep the order), so a particle removed or added since the
-   records were made is told by its id, found by bisection. Returns the record, or -1 for none. */
-static int fsdem__dem_record_of(const fsdem_dem *d, int index, const int *ids, size_t stride, int count) {
-    int lo = 0, hi = count - 1, id;
-    if (index < 0 || index >= d->n) return -1;
-    id = d->id[index];
-    while (lo <= hi) {
-        const int mid = lo + (hi - lo) / 2, at = *(const int *)(const void *)((const char *)ids + (size_t)mid * stride);
-        if (at == id) return mid;
-        if (at < id) lo = mid + 1;
-        else hi = mid - 1;
-    }
-    return -1;
-}
-
-/* A coupler's check that every DEM particle fits in the fluid's domain [lo, hi] (a sphere wider
-   than the domain's smallest extent leaves no fluid around it); the particle goes to `status`. */
-static fsdem_result fsdem__dem_particles_fit(const fsdem_dem *d, fsdem_vec3 lo, fsdem_vec3 hi, fsdem__status *status, const char *who) {
-    const fsdem_real extent = fsdem__smallest_extent(lo, hi, d->desc.dim);
-    int i;
-    for (i = 0; i < d->n; ++i)
-        if (!(2 * d->r[i] < extent))
-            return fsdem__fail(status, FSDEM_ERR_INVALID_ARG,
-                               "%s: DEM particle %d (id %d) of radius %g m does not fit in the fluid's domain (smallest extent %g m)",
-                               who, i, d->id[i], (double)d->r[i], (double)extent);
-    return FSDEM_OK;
-}
-
-/* A coupler's check before a fluid step of dt moves anything: the DEM can follow it in at most
-   `max` substeps; the failure goes to the coupler's `status` under its name `who`. */
-static fsdem_result fsdem__dem_substeps_within(const fsdem_dem *d, fsdem_real dt, long long max, fsdem__status *status,
-                                               const char *who) {
-    long long substeps = 0;
-    const fsdem_result res = fsdem_dem_substep_count(d, dt, &substeps);
-    if (res != FSDEM_OK) return fsdem__fail(status, res, "%s: %s", who, fsdem_dem_last_error(d));
-    if (substeps > max)
-        return fsdem__fail(status, FSDEM_ERR_INVALID_ARG,
-                           "%s: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)", who,
-                           (double)dt, substeps, max, (double)d->dt);
-    return FSDEM_OK;
-}
-
-/* The advance of a coupler whose step is prepared (forces, stable dt) and then run: steps until
-   exactly `duration` later, the last ones shortened to end exactly as the solvers' advances do
-   (fsdem_mps_dem_advance, fsdem_pic_dem_advance). */
-typedef struct fsdem__coupled_verbs {
-    double (*now)(const void *coupler);                        /* the fluid's time (s) */
-    fsdem_result (*prepare)(void *coupler, fsdem_real *dt);    /* the stable dt of the coming step */
-    fsdem_result (*run)(void *coupler, fsdem_real dt);         /* one coupled step of dt */
-} fsdem__coupled_verbs;
-
-static fsdem_result fsdem__coupled_advance(void *c, fsdem__status *status, const char *who, const fsdem__coupled_verbs *v,
-                                           fsdem_real duration, long long *steps) {
-    double end;
-    long long n = 0;
-    fsdem_result res = FSDEM_OK;
-    if (!(duration >= 0) || !fsdem__finite(duration))
-        return fsdem__fail(status, FSDEM_ERR_INVALID_ARG, "%s: duration = %g s must be >= 0", who, (double)duration);
-    end = v->now(c) + (double)duration;
-    while (res == FSDEM_OK && v->now(c) < end - 1e-12 * (end > 1 ? end : 1)) {
-        const double left = end - v->now(c);
-        fsdem_real dt = 0;
-        if ((res = v->prepare(c, &dt)) != FSDEM_OK) break;
-        if ((double)dt >= left) dt = (fsdem_real)left;
-        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
-        res = v->run(c, dt);
-        ++n;
-    }
-    if (steps) *steps = n;
-    return res;
 }
 
 /* fsdem_dem_advance_with, its errors under the public name `who` */

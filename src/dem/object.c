@@ -86,6 +86,7 @@ fsdem_result fsdem_dem_create(const fsdem_dem_desc *desc, fsdem_dem **out) {
     d->allocator = desc->allocator;
     d->status.log = desc->log;
     d->status.log_user = desc->log_user;
+    fsdem__claims_init(&d->claims, "DEM", fsdem__dem_claimable, 1);
     d->dt = desc->dt;
     d->grid.allocator = desc->allocator;
     d->need_rebuild = 1;
@@ -377,6 +378,8 @@ fsdem_dem_particles fsdem_dem_get_particles(const fsdem_dem *d) {
     p.fixed = d->fixed;
     return p;
 }
+
+fsdem_claims *fsdem_dem_claims(fsdem_dem *d) { return d ? &d->claims : NULL; }
 
 fsdem_dem_coupling fsdem_dem_get_coupling(fsdem_dem *d) {
     fsdem_dem_coupling e;

@@ -74,6 +74,7 @@ typedef struct fsdem__dem_wall_hit {
 struct fsdem_dem {
     fsdem_dem_desc desc; /* dt_rule and dt_param resolved */
     fsdem__status status;
+    fsdem_claims claims;             /* who writes its coupling arrays (>>core_claims) */
     fsdem_allocator allocator;
     fsdem_real dt;
     double time;
@@ -115,3 +116,6 @@ struct fsdem_dem {
     int contacts, wall_contacts;
     fsdem_real max_overlap;
 };
+
+/* The arrays of fsdem_dem_arrays, by bit (>>core_claims). */
+static const char *const fsdem__dem_claimable[1] = {"external loads"};

@@ -168,6 +168,14 @@ typedef struct fsdem__periods {
     fsdem_real length[3], inv[3]; /* m, 1/m; 0 along the other axes */
 } fsdem__periods;
 
+/* The smallest extent (m) of the box [lo, hi] along the first `dim` axes. */
+static fsdem_real fsdem__smallest_extent(fsdem_vec3 lo, fsdem_vec3 hi, int dim) {
+    fsdem_real e = hi.x - lo.x;
+    if (hi.y - lo.y < e) e = hi.y - lo.y;
+    if (dim == 3 && hi.z - lo.z < e) e = hi.z - lo.z;
+    return e;
+}
+
 /* The periods of the axes a < dim with periodic[a] set, those of the box [lo, hi]. */
 static fsdem__periods fsdem__periods_of(const int periodic[3], int dim, fsdem_vec3 lo, fsdem_vec3 hi) {
     fsdem__periods p;

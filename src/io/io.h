@@ -135,24 +135,6 @@ FSDEM_API fsdem_result fsdem_mps_write_vtp(const fsdem_mps *mps, const char *pat
    kind,surface,x,y,z,vx,vy,vz,pressure,number_density,porosity (kind a fsdem_mps_kind). */
 FSDEM_API fsdem_result fsdem_mps_write_csv(const fsdem_mps *mps, const char *path);
 
-/* A coupler's per-particle records (fsdem_X_get_force) as CSV, one row per DEM particle that has
-   one, in index order; the first column is the particle's stable id (fsdem_dem_particles.id). A
-   particle added since the last update or step has no record yet and one removed since has no row;
-   before the first update or step the file holds the header alone.
-     SWE-DEM  id,buoyancy_z,hydrostatic_x,hydrostatic_y,dynamic_x,dynamic_y,heave_z,submerged_volume,
-              frontal_area,surface,in_water
-     MPS-DEM  id,drag_x,drag_y,drag_z,pressure_x,pressure_y,pressure_z,total_x,total_y,total_z,
-              fluid_u,fluid_v,fluid_w,porosity,reynolds,wet
-     PIC-DEM  id,pressure_x,pressure_y,pressure_z,viscous_x,viscous_y,viscous_z,torque_x,torque_y,
-              torque_z,weight_correction_x,weight_correction_y,weight_correction_z,volume,faces
-     GIC      id,pressure_x,pressure_y,pressure_z,drag_x,drag_y,drag_z,virtual_mass_x,virtual_mass_y,
-              virtual_mass_z,fluid_u,fluid_v,fluid_w,porosity,liquid
-   Units as in the record types (N, N m, m^3, m^2, m, m/s). */
-FSDEM_API fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *coupler, const char *path);
-FSDEM_API fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *coupler, const char *path);
-FSDEM_API fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *coupler, const char *path);
-FSDEM_API fsdem_result fsdem_gic_write_csv(const fsdem_gic *coupler, const char *path);
-
 /* Shallow-water fields as ImageData (.vti): extent 0..nx x 0..ny x 0..0 points, origin (x_min,
    y_min, 0), spacing (dx, dy, 1); a 1D channel is one cell high, 0..nx x 0..1, origin (x_min, 0, 0),
    spacing (dx, width, 1). Cell data h (m, eta - bed), eta (m), bed (m), velocity (m/s, (u, v, 0) as

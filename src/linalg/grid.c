@@ -69,9 +69,11 @@ static void fsdem__level_ghosts(fsdem__level *L, int dim) {
 }
 
 /* Diagonal of a level from its physical face coefficients and the extra diagonal `extra`. */
+/* threaded: opens a team over the cells. */
 static void fsdem__level_diagonal(fsdem__level *L, int dim, const fsdem_real *extra) {
     int c, a, fluid = 0;
-    FSDEM__OMP(parallel for private(a) reduction(+ : fluid) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
+    FSDEM__OMP(parallel for private(a) reduction(+ : fluid) schedule(static)
+               num_threads(fsdem__team_for(L->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
     for (c = 0; c < L->count; ++c) {
         fsdem_real d = 0;
         if (FSDEM__TYPE(L->type[c]) != FSDEM_STENCIL_CELL_FLUID) {
@@ -104,13 +106,15 @@ static void fsdem__level_offdiagonal(fsdem__level *L, int dim) {
 }
 
 /* Level 0 from the caller's stencil: types, physical coefficients, extra diagonal (to `extra`). */
+/* threaded: opens teams over the rows. */
 static void fsdem__level_from_stencil(fsdem__level *L, const fsdem_stencil *st, fsdem_real *extra) {
     int dim = st->dim, i, j, k, a;
     memset(L->type, FSDEM_STENCIL_CELL_SOLID, (size_t)L->count);
     for (a = 0; a < 3; ++a)
         if (a < dim) memset(L->w[a], 0, sizeof(fsdem_real) * (size_t)L->count);
     memset(extra, 0, sizeof(fsdem_real) * (size_t)L->count);
-    FSDEM__OMP(parallel for collapse(2) private(i) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
+    FSDEM__OMP(parallel for collapse(2) private(i) schedule(static)
+               num_threads(fsdem__team_for(L->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
     for (k = 0; k < L->n[2]; ++k)
         for (j = 0; j < L->n[1]; ++j)
             for (i = 0; i < L->n[0]; ++i)
@@ -123,7 +127,8 @@ static void fsdem__level_from_stencil(fsdem__level *L, const fsdem_stencil *st, 
         ext[1] = L->n[1];
         ext[2] = L->n[2];
         ext[a] += 1;
-        FSDEM__OMP(parallel for collapse(2) private(i) schedule(static) num_threads(fsdem__workers()) if (L->count > FSDEM__DOT_BLOCK))
+        FSDEM__OMP(parallel for collapse(2) private(i) schedule(static)
+                   num_threads(fsdem__team_for(L->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
         for (k = 0; k < ext[2]; ++k)
             for (j = 0; j < ext[1]; ++j)
                 for (i = 0; i < ext[0]; ++i) {
@@ -148,6 +153,7 @@ static void fsdem__level_from_stencil(fsdem__level *L, const fsdem_stencil *st, 
 
 /* Coarse level C from fine level F (physical coefficients, extra diagonal `fextra`); writes the
    coarse extra diagonal to `cextra`. */
+/* threaded: opens teams over the coarse rows. */
 static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim, const fsdem_real *fextra,
                                  fsdem_real *cextra) {
     int I, J, K, a, di, dj, dk;
@@ -155,7 +161,8 @@ static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim
     memset(C->type, FSDEM_STENCIL_CELL_SOLID, (size_t)C->count);
     memset(cextra, 0, sizeof(fsdem_real) * (size_t)C->count);
     for (a = 0; a < dim; ++a) memset(C->w[a], 0, sizeof(fsdem_real) * (size_t)C->count);
-    FSDEM__OMP(parallel for collapse(2) private(I, di, dj, dk) schedule(static) num_threads(fsdem__workers()) if (C->count > FSDEM__DOT_BLOCK))
+    FSDEM__OMP(parallel for collapse(2) private(I, di, dj, dk) schedule(static)
+               num_threads(fsdem__team_for(C->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
     for (K = 0; K < C->n[2]; ++K)
         for (J = 0; J < C->n[1]; ++J)
             for (I = 0; I < C->n[0]; ++I) {
@@ -186,7 +193,8 @@ static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim
         ext[1] = C->n[1];
         ext[2] = C->n[2];
         ext[a] += 1;
-        FSDEM__OMP(parallel for collapse(2) private(I) schedule(static) num_threads(fsdem__workers()) if (C->count > FSDEM__DOT_BLOCK))
+        FSDEM__OMP(parallel for collapse(2) private(I) schedule(static)
+                   num_threads(fsdem__team_for(C->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
         for (K = 0; K < ext[2]; ++K)
             for (J = 0; J < ext[1]; ++J)
                 for (I = 0; I < ext[0]; ++I) {
@@ -225,9 +233,11 @@ static void fsdem__level_coarsen(const fsdem__level *F, fsdem__level *C, int dim
 }
 
 /* Marks fine fluid cells whose interpolation kernel (from level C) contains a solid cell. */
+/* threaded: opens a team over the rows. */
 static void fsdem__level_mark_near_solid(fsdem__level *F, const fsdem__level *C, int dim) {
     int i, j, k;
-    FSDEM__OMP(parallel for collapse(2) private(i) schedule(static) num_threads(fsdem__workers()) if (F->count > FSDEM__DOT_BLOCK))
+    FSDEM__OMP(parallel for collapse(2) private(i) schedule(static)
+               num_threads(fsdem__team_for(F->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
     for (k = 0; k < F->n[2]; ++k)
         for (j = 0; j < F->n[1]; ++j)
             for (i = 0; i < F->n[0]; ++i) {

@@ -1,6 +1,7 @@
 /* ---- >>linalg_kernels : stencil kernels on padded levels ---- */
 
 /* y = A x on slabs [p0, p1) of a level (rows in 2D, planes in 3D; interior cells). */
+/* threaded: inside a team: the calling thread's slabs. */
 FSDEM__FORCE_INLINE void fsdem__level_apply_slabs(const fsdem__level *L, int dim, const fsdem_real *x, fsdem_real *y, int p0,
                                                   int p1) {
     int i, j, k, sy = L->sy, sz = L->sz;
@@ -28,8 +29,9 @@ FSDEM__FORCE_INLINE void fsdem__level_apply_slabs(const fsdem__level *L, int dim
 }
 
 /* y = A x on a level (interior cells; y untouched on ghosts), each thread over its share of slabs. */
+/* threaded: opens a team over the slabs. */
 static void fsdem__level_apply(const fsdem__level *L, int dim, const fsdem_real *x, fsdem_real *y) {
-    const int slabs = dim == 3 ? L->n[2] : L->n[1], team = L->count > FSDEM__DOT_BLOCK ? fsdem__workers() : 1;
+    const int slabs = dim == 3 ? L->n[2] : L->n[1], team = fsdem__team_for(L->count, FSDEM__DOT_BLOCK, FSDEM__NO_CAP);
     if (team <= 1) {
         fsdem__level_apply_slabs(L, dim, x, y, 0, slabs);
         return;
@@ -176,6 +178,7 @@ static void fsdem__mg_prolong_row(const fsdem__level *F, const fsdem__level *C, 
 /* P^T (b - A x) along x of row (j, k) of F into cr (C->n[0] values), the residual formed on the fly
    in r (n0 + 4 reals). b is 0 off fluid cells on every level, so the residual is too (d and the
    couplings vanish there). */
+/* threaded: inside a team: one row of the calling thread's slab. */
 static void fsdem__mg_restrict_x(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *b,
                                  const fsdem_real *x, int j, int k, fsdem_real *r, fsdem_real *cr) {
     int i, I, J, K, oy, oz, crow, f0, n0 = F->n[0], nI = C->n[0], sy = F->sy, sz = F->sz;

@@ -14,6 +14,7 @@ typedef struct fsdem__mg_stage {
 
 /* One stage over the rows of slabs [p0, p1) on the calling thread, with row buffer `buf` (the
    restriction's second pass excepted: fsdem__mg_gather). */
+/* threaded: inside a team: rows of the calling thread's slab. */
 static void fsdem__mg_stage_rows(const fsdem__level *L, const fsdem__level *C, int dim, const fsdem_real *b, fsdem_real *x,
                                  fsdem_real *xc_or_bc, const fsdem__mg_stage *stage, int p0, int p1, fsdem_real *buf) {
     int p, j;
@@ -44,6 +45,7 @@ static void fsdem__mg_pipeline(const fsdem__level *L, const fsdem__level *C, int
 /* The restriction's second pass for coarse slab P: the fine rows' x-restricted residuals
    (`restricted`, row j + k n1) added to the coarse rows of P, fine row after fine row as the
    pipeline adds them, so every coarse entry sums the same terms in the same order. */
+/* threaded: inside a team: one coarse slab. */
 static void fsdem__mg_gather(const fsdem__level *F, const fsdem__level *C, int dim, const fsdem_real *restricted,
                              fsdem_real *bc, int P) {
     const int axis = dim == 3 ? 2 : 1, slabs = F->n[axis], nI = C->n[0];
@@ -60,11 +62,20 @@ static void fsdem__mg_gather(const fsdem__level *F, const fsdem__level *C, int d
     }
 }
 
+/* threaded: inside a team: the pipelines' progress, read and written with OpenMP atomics. */
 /* Progress of the threaded pipeline: the number of stages finished on a slab, published by the
    thread that owns the slab and awaited by its neighbours' owners (integer atomics only). */
-#ifdef _OPENMP
-static int fsdem__mg_progress(const int *done, int p) { return __atomic_load_n(done + p, __ATOMIC_ACQUIRE); }
-static void fsdem__mg_publish(int *done, int p, int stages) { __atomic_store_n(done + p, stages, __ATOMIC_RELEASE); }
+#ifdef FSDEM__THREADS
+static int fsdem__mg_progress(const int *done, int p) {
+    int stages;
+    FSDEM__OMP(atomic read acquire)
+    stages = done[p];
+    return stages;
+}
+static void fsdem__mg_publish(int *done, int p, int stages) {
+    FSDEM__OMP(atomic write release)
+    done[p] = stages + 0; /* (+ 0: gcc 12 takes a bare parameter under an atomic write for unused) */
+}
 #endif
 
 /* The pipeline of one thread over its slabs [p0, p1), downwards or upwards: stage s on slab p waits
@@ -74,18 +85,19 @@ static void fsdem__mg_publish(int *done, int p, int stages) { __atomic_store_n(d
    same bit for bit. Neighbouring threads sweep towards each other's ends or away from them together,
    so they meet in step. The restriction writes each fine row's x-restricted residual
    (`restricted`); fsdem__mg_gather adds them to the coarse level after the pipeline. */
+/* threaded: inside a team: the calling thread's pipeline, waiting on its neighbours' progress. */
 static void fsdem__mg_thread_pipeline(const fsdem_pcg *s, const fsdem__level *L, const fsdem__level *C,
                                       const fsdem_real *b, fsdem_real *x, fsdem_real *xc, const fsdem__mg_stage *stage,
                                       int stages, int p0, int p1, int down, int *done, fsdem_real *buf) {
-#ifdef _OPENMP
+#ifdef FSDEM__THREADS
     const int dim = s->dim, slabs = dim == 3 ? L->n[2] : L->n[1], len = p1 - p0, nI = C ? C->n[0] : 0;
     int t, q, j;
     for (t = 0; t < len + stages - 1; ++t)
         for (q = 0; q < stages; ++q) {
             const int local = t - q, p = down ? p1 - 1 - local : p0 + local;
             if (local < 0 || local >= len) continue;
-            while ((p > 0 && fsdem__mg_progress(done, p - 1) < q) || (p + 1 < slabs && fsdem__mg_progress(done, p + 1) < q)) {
-            }
+            while ((p > 0 && fsdem__mg_progress(done, p - 1) < q) || (p + 1 < slabs && fsdem__mg_progress(done, p + 1) < q))
+                FSDEM__SPIN_PAUSE();
             if (stage[q].kind != FSDEM__STAGE_RESTRICT) fsdem__mg_stage_rows(L, C, dim, b, x, xc, stage + q, p, p + 1, buf);
             else {
                 const int jb = dim == 3 ? 0 : p, je = dim == 3 ? L->n[1] : p + 1, k = dim == 3 ? p : 0;
@@ -103,13 +115,14 @@ static void fsdem__mg_thread_pipeline(const fsdem_pcg *s, const fsdem__level *L,
 /* Runs the stages on level L: on one thread, the pipeline; with threads (and a level large enough
    to pay for them), one pipeline per thread over its share of the slabs (fsdem__mg_thread_pipeline),
    then the restriction's gather over the coarse slabs. The same result bit for bit. */
+/* threaded: opens a team of pipelines over the slabs, then one over the coarse slabs. */
 static void fsdem__mg_run(const fsdem_pcg *s, const fsdem__level *L, const fsdem__level *C, const fsdem_real *b,
                           fsdem_real *x, fsdem_real *xc_or_bc, const fsdem__mg_stage *stage, int stages) {
-    const int dim = s->dim, slabs = dim == 3 ? L->n[2] : L->n[1], workers = fsdem__workers();
-    const int team = workers < s->workers ? (workers < slabs ? workers : slabs) : (s->workers < slabs ? s->workers : slabs);
+    const int dim = s->dim, slabs = dim == 3 ? L->n[2] : L->n[1];
+    const int team = fsdem__team_for(L->count, FSDEM__DOT_BLOCK, s->workers < slabs ? s->workers : slabs);
     const size_t rowbuf = fsdem__mg_rowbuf_length(s);
     int p, P;
-    if (team <= 1 || L->count <= FSDEM__DOT_BLOCK || !s->restricted) {
+    if (team <= 1 || !s->restricted) {
         fsdem__mg_pipeline(L, C, dim, b, x, xc_or_bc, stage, stages, s->rowbuf);
         return;
     }

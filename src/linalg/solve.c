@@ -29,12 +29,14 @@ static void fsdem__pcg_apply(fsdem_pcg *s, const fsdem_real *x, fsdem_real *y) {
 }
 
 /* z = M^-1 r. */
+/* threaded: opens a team for the Jacobi product; IC(0) and MIC(0) run on one thread. */
 static void fsdem__pcg_precondition(fsdem_pcg *s, const fsdem_real *r, fsdem_real *z) {
     int i, n = s->length;
     switch (s->precond) {
     case FSDEM_PRECOND_JACOBI: {
         const fsdem_real *inv = s->kind == FSDEM__KIND_CSR ? s->ic : s->level[0].inv_d;
-        FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (n > FSDEM__DOT_BLOCK))
+        FSDEM__OMP(parallel for schedule(static)
+                   num_threads(fsdem__team_for(n, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
         for (i = 0; i < n; ++i) z[i] = inv[i] * r[i];
         break;
     }
@@ -123,6 +125,7 @@ static void fsdem__pcg_store(const fsdem_pcg *s, const fsdem_real *src, fsdem_re
 }
 
 /* a.b over [lo, hi) with two interleaved accumulators (lo even). */
+/* threaded: inside a team: one block. */
 static double fsdem__pcg_block_dot(const fsdem_real *a, const fsdem_real *b, int lo, int hi) {
     double s0 = 0, s1 = 0;
     int i;
@@ -136,12 +139,14 @@ static double fsdem__pcg_block_dot(const fsdem_real *a, const fsdem_real *b, int
 
 /* a.b over n entries: block by block (FSDEM__DOT_BLOCK), the block sums added in order, so the bits
    do not depend on the threads (a vector of one block gives the block's sum itself). */
+/* threaded: opens a team over the blocks. */
 static double fsdem__pcg_vdot(const fsdem_pcg *s, const fsdem_real *a, const fsdem_real *b, int n) {
     const int blocks = (int)fsdem__dot_blocks(n);
     double *part = s->dot_part, sum = 0;
     int q;
     if (blocks <= 1) return fsdem__pcg_block_dot(a, b, 0, n);
-    FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()))
+    FSDEM__OMP(parallel for schedule(static)
+               num_threads(fsdem__team_for(blocks, 1, FSDEM__NO_CAP)))
     for (q = 0; q < blocks; ++q) {
         const int lo = q * FSDEM__DOT_BLOCK, hi = n - lo < FSDEM__DOT_BLOCK ? n : lo + FSDEM__DOT_BLOCK;
         part[q] = fsdem__pcg_block_dot(a, b, lo, hi);
@@ -154,13 +159,15 @@ static int fsdem__pcg_finite_d(double v) { return v == v && v - v == 0; }
 
 /* x += alpha p, r -= alpha A p (A p in z); returns r.r, summed block by block as fsdem__pcg_vdot
    (one accumulator inside a block). */
+/* threaded: opens a team over the blocks. */
 static double fsdem__pcg_step_x_r(const fsdem_pcg *s, fsdem_real alpha) {
     const int n = s->length, blocks = (int)fsdem__dot_blocks(n);
     fsdem_real *FSDEM__RESTRICT xv = s->x, *FSDEM__RESTRICT rv = s->r;
     const fsdem_real *FSDEM__RESTRICT pv = s->p, *FSDEM__RESTRICT qv = s->z;
     double *part = s->dot_part, sum = 0;
     int q;
-    FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (blocks > 1))
+    FSDEM__OMP(parallel for schedule(static)
+               num_threads(fsdem__team_for(blocks, 1, FSDEM__NO_CAP)))
     for (q = 0; q < blocks; ++q) {
         const int lo = q * FSDEM__DOT_BLOCK, hi = n - lo < FSDEM__DOT_BLOCK ? n : lo + FSDEM__DOT_BLOCK;
         double acc = 0;
@@ -197,6 +204,8 @@ static fsdem_result fsdem__pcg_check_rz(fsdem_pcg *s, double rz, int it) {
     return FSDEM_OK;
 }
 
+/* threaded: opens a team for the search direction; the operator, the preconditioner and the dot
+   products open their own. */
 fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, fsdem_pcg_info *info) {
     fsdem_pcg_info inf;
     double bb, rr, rz = 0, tol2, removed;
@@ -306,7 +315,8 @@ fsdem_result fsdem_pcg_solve(fsdem_pcg *s, const fsdem_real *b, fsdem_real *x, f
             const fsdem_real be = (fsdem_real)beta;
             fsdem_real *pv = s->p;
             const fsdem_real *zv = s->z;
-            FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (n > FSDEM__DOT_BLOCK))
+            FSDEM__OMP(parallel for schedule(static)
+                       num_threads(fsdem__team_for(n, FSDEM__DOT_BLOCK, FSDEM__NO_CAP)))
             for (i = 0; i < n; ++i) pv[i] = zv[i] + be * pv[i];
         }
     }

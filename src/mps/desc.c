@@ -159,6 +159,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     s->bytes = sizeof *s;
     s->status.log = desc->log;
     s->status.log_user = desc->log_user;
+    fsdem__claims_init(&s->claims, "MPS", fsdem__mps_claimable, 2);
     s->dim = desc->dim;
     s->r0 = desc->r0;
     s->re = desc->re > 0 ? desc->re : (fsdem_real)4.1 * desc->r0;

@@ -281,6 +281,9 @@ typedef struct fsdem_mps_inflow_desc {
                          /*    fsdem_mps_fill_box's (components along `axis` ignored) */
     fsdem_real speed;    /* m/s, > 0 and finite */
 } fsdem_mps_inflow_desc;
+/* Defaults: axis 0, direction +1; the plane's position, its extent (lo, hi) and the speed have none
+   and are 0: set them (fsdem_mps_add_inflow refuses a speed of 0, naming it). */
+FSDEM_API fsdem_mps_inflow_desc fsdem_mps_inflow_desc_default(void);
 /* Adds an inflow and fills its buffer (*added particles; may be NULL); the whole buffer, down to
    ceil(re/r0) r0 upstream of the plane, must lie inside the domain. FSDEM_ERR_INVALID_ARG (a field
    named), FSDEM_ERR_OUT_OF_DOMAIN, FSDEM_ERR_OUT_OF_MEMORY; nothing is added on error. */
@@ -293,6 +296,9 @@ typedef struct fsdem_mps_outflow_desc {
     fsdem_vec3 lo, hi;   /* m; the outlet's extent over the other axes (components along `axis` */
                          /*    ignored): liquid past the plane outside it is not touched */
 } fsdem_mps_outflow_desc;
+/* Defaults: axis 0, direction +1; the plane's position and its extent (lo, hi) have none and are 0:
+   set them. */
+FSDEM_API fsdem_mps_outflow_desc fsdem_mps_outflow_desc_default(void);
 /* Adds an outflow. FSDEM_ERR_INVALID_ARG (a field named, or a zone outside the domain),
    FSDEM_ERR_OUT_OF_MEMORY. */
 FSDEM_API fsdem_result fsdem_mps_add_outflow(fsdem_mps *mps, const fsdem_mps_outflow_desc *outflow);
@@ -338,6 +344,15 @@ typedef struct fsdem_mps_coupling {
 } fsdem_mps_coupling;
 
 FSDEM_API fsdem_mps_coupling fsdem_mps_get_coupling(fsdem_mps *mps);
+
+/* The MPS's coupling arrays, as writers claim them (fsdem_claim; fsdem_mps_dem claims both). */
+typedef enum fsdem_mps_arrays {
+    FSDEM_MPS_ARRAYS_FORCE = 1,   /* force */
+    FSDEM_MPS_ARRAYS_POROSITY = 2 /* porosity */
+} fsdem_mps_arrays;
+
+/* The MPS's claim registry (>>core_claims); NULL for a NULL MPS. */
+FSDEM_API fsdem_claims *fsdem_mps_claims(fsdem_mps *mps);
 
 /* ---- particle-interaction operators (seed 002 Eq. 7-10) ---- */
 

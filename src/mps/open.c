@@ -42,6 +42,20 @@ static fsdem_result fsdem__mps_check_open(fsdem_mps *s, const char *what, int ax
     return fsdem__mps_check_box(s, field, f, t);
 }
 
+fsdem_mps_inflow_desc fsdem_mps_inflow_desc_default(void) {
+    fsdem_mps_inflow_desc d;
+    memset(&d, 0, sizeof d);
+    d.direction = 1;
+    return d;
+}
+
+fsdem_mps_outflow_desc fsdem_mps_outflow_desc_default(void) {
+    fsdem_mps_outflow_desc d;
+    memset(&d, 0, sizeof d);
+    d.direction = 1;
+    return d;
+}
+
 fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in, int *added) {
     fsdem_vec3 anchor, from, to, u = fsdem__zero3();
     fsdem_result r;

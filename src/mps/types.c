@@ -16,6 +16,7 @@ typedef struct fsdem__mps_obst {
 struct fsdem_mps {
     fsdem_mps_desc desc;
     fsdem__status status;
+    fsdem_claims claims;             /* who writes its coupling arrays (>>core_claims) */
     fsdem_allocator allocator;
     size_t bytes;                 /* held, besides the pcg */
     int dim;
@@ -78,3 +79,6 @@ struct fsdem_mps {
     double sec_total, sec_pressure, sec_search, sec_assembly, sec_solve;
     long long candidates;         /* pairs the last cell scan examined */
 };
+
+/* The arrays of fsdem_mps_arrays, by bit (>>core_claims). */
+static const char *const fsdem__mps_claimable[2] = {"forces", "porosity"};

@@ -19,6 +19,8 @@ fsdem_mps_particles fsdem_mps_get_particles(fsdem_mps *s) {
     return v;
 }
 
+fsdem_claims *fsdem_mps_claims(fsdem_mps *s) { return s ? &s->claims : NULL; }
+
 fsdem_mps_coupling fsdem_mps_get_coupling(fsdem_mps *s) {
     fsdem_mps_coupling c;
     memset(&c, 0, sizeof c);

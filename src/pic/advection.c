@@ -1,9 +1,11 @@
 /* ---- >>pic_advection : particle motion, solids, outflow ---- */
 
 /* Moves every particle through the grid velocity (threaded: each particle on its own). */
+/* threaded: opens a team over the particles. */
 static void fsdem__pic_advect(fsdem_pic *s, fsdem_real dt) {
     int p;
-    FSDEM__OMP(parallel for schedule(static) num_threads(fsdem__workers()) if (s->np > FSDEM__TEAM_ITEMS))
+    FSDEM__OMP(parallel for schedule(static)
+               num_threads(fsdem__team_for(s->np, FSDEM__TEAM_ITEMS, FSDEM__NO_CAP)))
     for (p = 0; p < s->np; ++p) {
         fsdem_vec3 x = s->px[p], k1, k2, k3;
         k1 = fsdem__pic_interp_vel(s, s->u, x);

@@ -426,6 +426,7 @@ fsdem_result fsdem_pic_create(const fsdem_pic_desc *desc, fsdem_pic **out) {
     s->bytes = sizeof *s;
     s->status.log = desc->log;
     s->status.log_user = desc->log_user;
+    fsdem__claims_init(&s->claims, "PIC", fsdem__pic_claimable, 3);
     fsdem__pic_layout(s, desc);
     for (a = 0; a < s->dim && desc->log; ++a)
         if (fsdem__comp(s->hi, a) != fsdem__comp(desc->domain_max, a)) {

@@ -282,11 +282,12 @@ FSDEM_API fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *pic);
      still gives the water exactly force x dt.
    A cell whose faces are all closed becomes SOLID. Particles are pushed out of static obstacles
    in every step; moving solids are the coupler's (fsdem_pic_exclude_particles). The arrays are read
-   by the next step, which recounts the fluid fractions after this call. Owners: open,
-   solid_velocity, start_velocity and reference describe the moving solids as a whole, so one
-   coupler (fsdem_pic_dem) owns them and rewrites them before every step; porosity describes the
-   granules as a whole and its one owner is the granular coupler (fsdem_gic); acceleration and
-   pressure_rhs are sums that any coupler adds to (fsdem_pic_add_force). */
+   by the next step, which recounts the fluid fractions after this call. Owners, claimed
+   (fsdem_pic_arrays below): open, solid_velocity, start_velocity and reference describe the moving
+   solids as a whole, so one coupler (fsdem_pic_dem) owns them and rewrites them before every step;
+   porosity describes the granules as a whole and acceleration their exchange with the water, so
+   their one owner is the granular coupler (fsdem_gic), which clears the accelerations before every
+   step; pressure_rhs is a sum that any writer adds to. */
 typedef struct fsdem_pic_coupling {
     int dim;
     int n[3];
@@ -302,6 +303,19 @@ typedef struct fsdem_pic_coupling {
 } fsdem_pic_coupling;
 
 FSDEM_API fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *pic);
+
+/* The PIC's coupling arrays, as writers claim them (fsdem_claim): the moving solids (fsdem_pic_dem),
+   the granules' porosity and the accelerations (fsdem_gic), each of one writer; pressure_rhs is a
+   sum any writer adds to. */
+typedef enum fsdem_pic_arrays {
+    FSDEM_PIC_ARRAYS_SOLIDS = 1,      /* open, solid_velocity, start_velocity, reference, and the */
+                                      /*    pressure's extra term (fsdem_pic_set_pressure_extra) */
+    FSDEM_PIC_ARRAYS_POROSITY = 2,    /* porosity */
+    FSDEM_PIC_ARRAYS_ACCELERATION = 4 /* acceleration (fsdem_pic_add_force, fsdem_pic_clear_forces) */
+} fsdem_pic_arrays;
+
+/* The PIC's claim registry (>>core_claims); NULL for a NULL PIC. */
+FSDEM_API fsdem_claims *fsdem_pic_claims(fsdem_pic *pic);
 /* The moving solids' answer to a solved pressure p (Pa, cell layout) over a step of dt (s): it
    sets solid_velocity to their velocity at the end of the step, Q* plus the response that the
    extra term K p stands for. */

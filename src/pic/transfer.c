@@ -130,12 +130,14 @@ FSDEM__FORCE_INLINE int fsdem__pic_g2p_one(fsdem_pic *s, int p, const int quad, 
 
 /* Grid to particles, every particle on its own (threaded); returns the first particle whose velocity
    is not finite, or -1. */
+/* threaded: opens a team over the particles. */
 static int fsdem__pic_g2p(fsdem_pic *s) {
     const int quad = s->desc.kernel == FSDEM_PIC_KERNEL_QUADRATIC, apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC;
     const fsdem_real ratio = s->desc.transfer == FSDEM_PIC_TRANSFER_FLIP ? s->desc.flip_ratio : 0;
     const fsdem_real dfac = 4 * s->inv_dx * s->inv_dx;
     int p, first = s->np;
-    FSDEM__OMP(parallel for schedule(static) reduction(min : first) num_threads(fsdem__workers()) if (s->np > FSDEM__TEAM_ITEMS))
+    FSDEM__OMP(parallel for schedule(static) reduction(min : first)
+               num_threads(fsdem__team_for(s->np, FSDEM__TEAM_ITEMS, FSDEM__NO_CAP)))
     for (p = 0; p < s->np; ++p)
         if (fsdem__pic_g2p_one(s, p, quad, ratio, apic, dfac) && p < first) first = p;
     return first < s->np ? first : -1;

@@ -20,6 +20,7 @@ typedef struct fsdem__pic_obst {
 struct fsdem_pic {
     fsdem_pic_desc desc;
     fsdem__status status;
+    fsdem_claims claims;             /* who writes its coupling arrays (>>core_claims) */
     fsdem_allocator allocator;
     int dim, n[3], ncell;
     int fn[3][3];      /* face grid sizes: fn[a][b] = n[b] + (a == b) */
@@ -86,3 +87,6 @@ struct fsdem_pic {
     double sec_total, sec_pressure, sec_density;
     size_t bytes;
 };
+
+/* The arrays of fsdem_pic_arrays, by bit (>>core_claims). */
+static const char *const fsdem__pic_claimable[3] = {"moving solids", "porosity", "acceleration"};

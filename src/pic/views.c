@@ -22,6 +22,8 @@ fsdem_pic_fields fsdem_pic_get_fields(const fsdem_pic *s) {
     return g;
 }
 
+fsdem_claims *fsdem_pic_claims(fsdem_pic *s) { return s ? &s->claims : NULL; }
+
 fsdem_pic_coupling fsdem_pic_get_coupling(fsdem_pic *s) {
     fsdem_pic_coupling c;
     if (s) {

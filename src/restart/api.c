@@ -91,8 +91,8 @@ static fsdem__restart_object fsdem__restart_of_swe_dem(const fsdem_swe_dem *c) {
     o.sizes[3] = c->force_capacity;
     o.object = (void *)c;
     o.visit = fsdem__restart_swe_dem;
-    o.allocator = &c->allocator;
-    o.status = (fsdem__status *)&c->status;
+    o.allocator = &c->head.allocator;
+    o.status = (fsdem__status *)&c->head.status;
     o.name = "fsdem_swe_dem";
     return o;
 }
@@ -123,12 +123,12 @@ static fsdem__restart_object fsdem__restart_of_mps_dem(const fsdem_mps_dem *c) {
     o.dim = c->dim;
     o.sizes[0] = c->desc.mps->n;
     o.sizes[1] = c->desc.dem->n;
-    o.sizes[2] = c->forces;
+    o.sizes[2] = c->head.records;
     o.sizes[3] = 0;
     o.object = (void *)c;
     o.visit = fsdem__restart_mps_dem;
-    o.allocator = &c->allocator;
-    o.status = (fsdem__status *)&c->status;
+    o.allocator = &c->head.allocator;
+    o.status = (fsdem__status *)&c->head.status;
     o.name = "fsdem_mps_dem";
     return o;
 }
@@ -145,8 +145,8 @@ static fsdem__restart_object fsdem__restart_of_gic(const fsdem_gic *c) {
     o.sizes[3] = 0;
     o.object = (void *)c;
     o.visit = fsdem__restart_gic;
-    o.allocator = &c->allocator;
-    o.status = (fsdem__status *)&c->status;
+    o.allocator = &c->head.allocator;
+    o.status = (fsdem__status *)&c->head.status;
     o.name = "fsdem_gic";
     return o;
 }
@@ -163,8 +163,8 @@ static fsdem__restart_object fsdem__restart_of_pic_dem(const fsdem_pic_dem *c) {
     o.sizes[3] = 0;
     o.object = (void *)c;
     o.visit = fsdem__restart_pic_dem;
-    o.allocator = &c->allocator;
-    o.status = (fsdem__status *)&c->status;
+    o.allocator = &c->head.allocator;
+    o.status = (fsdem__status *)&c->head.status;
     o.name = "fsdem_pic_dem";
     return o;
 }

@@ -1,10 +1,9 @@
 /* ===== >>impl_restart : checkpoint and restart =======================================================
 
    Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
-   every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_swe_dem, >>restart_mps,
-   >>restart_mps_dem, >>restart_pic_dem, >>restart_gic (one visitor per object lists what it saves, in order, and serves saving and
-   restoring alike), >>restart_api
-   (memory and files). A restore runs the visitor three times over the payload: CHECK validates
+   every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_mps, >>restart_couplers
+   (one visitor per object lists what it saves, in order, and serves saving and restoring alike; the
+   couplers' by their field tables), >>restart_api (memory and files). A restore runs the visitor three times over the payload: CHECK validates
    everything and compares the desc, RESERVE allocates, COMMIT writes into the object. Only COMMIT
    changes the object, and it cannot fail. */
 

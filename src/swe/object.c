@@ -138,6 +138,7 @@ fsdem_result fsdem_swe_create(const fsdem_swe_desc *desc, fsdem_swe **out) {
     s->allocator = al;
     s->status.log = desc->log;
     s->status.log_user = desc->log_user;
+    fsdem__claims_init(&s->claims, "shallow-water solver", fsdem__swe_claimable, 1);
     s->dim = desc->dim;
     s->nx = desc->nx;
     s->ny = desc->ny;
@@ -356,6 +357,8 @@ fsdem_swe_fields fsdem_swe_get_fields(const fsdem_swe *s) {
     f.blocked = s->blocked;
     return f;
 }
+
+fsdem_claims *fsdem_swe_claims(fsdem_swe *s) { return s ? &s->claims : NULL; }
 
 fsdem_swe_coupling fsdem_swe_get_coupling(fsdem_swe *s) {
     fsdem_swe_coupling c;

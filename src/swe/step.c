@@ -157,6 +157,7 @@ static void fsdem__swe_load_ring(const fsdem_swe *s, fsdem__swe_work *w, int r) 
 
 /* Copies the state rows beside band [j0, j1) (j0 - 2, j0 - 1, j1, j1 + 1, where they exist) into its
    halo, so the band reads them as they were before any band wrote. */
+/* threaded: inside a team: the calling thread's band. */
 static void fsdem__swe_band_halo(const fsdem_swe *s, fsdem__swe_work *w, int j0, int j1) {
     const int rows[4] = {j0 - 2, j0 - 1, j1, j1 + 1};
     const size_t nx = (size_t)s->nx;
@@ -177,6 +178,7 @@ static void fsdem__swe_band_halo(const fsdem_swe *s, fsdem__swe_work *w, int j0,
    rows beside the band need those rows reconstructed: they are, from the halo, with a copy of the
    context whose tally and boundary volumes are dropped (their own band counts them), and they are
    not finished. Every cell's update is then what one sweep of the whole grid computes. */
+/* threaded: inside a team: the calling thread's band of rows. */
 static void fsdem__swe_band(fsdem_swe *s, fsdem__swe_ctx *c, int j0, int j1) {
     fsdem__swe_ctx beside = *c;
     int j;
@@ -205,11 +207,9 @@ static void fsdem__swe_band(fsdem_swe *s, fsdem__swe_ctx *c, int j0, int j1) {
 /* The 2D sweep: one band of rows per thread (as many as the work rows allow), each band copying the
    rows beside it before any band writes; the tallies are then combined in band order (maxima and
    counts: the same for any split; the first non-finite cell: the lowest band's). */
+/* threaded: opens a team of bands of rows. */
 static void fsdem__swe_sweep(fsdem_swe *s, fsdem__swe_ctx *c) {
-    int bands = fsdem__workers(), b;
-    if (bands > s->workers) bands = s->workers;
-    if (bands > s->ny / FSDEM__SWE_BAND_ROWS) bands = s->ny / FSDEM__SWE_BAND_ROWS;
-    if (bands < 1) bands = 1;
+    int bands = fsdem__team_for(s->ny, FSDEM__SWE_BAND_ROWS, s->workers), b;
     FSDEM__OMP(parallel num_threads(bands))
     {
         const int team = fsdem__team(), w = fsdem__worker();

@@ -152,6 +152,15 @@ typedef struct fsdem_swe_coupling {
 
 FSDEM_API fsdem_swe_coupling fsdem_swe_get_coupling(fsdem_swe *swe);
 
+/* The shallow water's coupling arrays, as writers claim them (fsdem_claim; a two-way fsdem_swe_dem
+   claims them). */
+typedef enum fsdem_swe_arrays {
+    FSDEM_SWE_ARRAYS_SOURCE = 1   /* source_x, source_y (fsdem_swe_add_force, fsdem_swe_clear_forces) */
+} fsdem_swe_arrays;
+
+/* The shallow water's claim registry (>>core_claims); NULL for a NULL solver. */
+FSDEM_API fsdem_claims *fsdem_swe_claims(fsdem_swe *swe);
+
 typedef enum fsdem_swe_field {
     FSDEM_SWE_FIELD_DEPTH = 0, /* m */
     FSDEM_SWE_FIELD_ETA = 1,   /* m */

@@ -100,6 +100,7 @@ typedef struct fsdem__swe_src {
 struct fsdem_swe {
     fsdem_swe_desc desc; /* bed, depth and the boundary series pointers are not kept */
     fsdem__status status;
+    fsdem_claims claims;             /* who writes its coupling arrays (>>core_claims) */
     fsdem_allocator allocator;
     int dim, nx, ny, n;
     fsdem_real dx, dy, area, g, tiny;
@@ -137,3 +138,6 @@ struct fsdem_swe {
     int gauge_count, gauge_capacity;
     fsdem__series gauges; /* the gauge file, h, eta, u, v per gauge */
 };
+
+/* The arrays of fsdem_swe_arrays, by bit (>>core_claims). */
+static const char *const fsdem__swe_claimable[1] = {"momentum sources"};

@@ -116,10 +116,10 @@ static void run_case(run *r) {
     fsdem_csv_close(&csv);
     if (c.cpl) {
         fsdem_mps_dem_stats st = fsdem_mps_dem_get_stats(c.cpl);
-        r->steps = st.steps;
-        r->substeps = st.substeps_total;
-        r->cpu_mps = st.seconds_mps;
-        r->cpu_dem = st.seconds_dem;
+        r->steps = st.coupling.steps;
+        r->substeps = st.coupling.substeps_total;
+        r->cpu_mps = st.coupling.seconds_fluid;
+        r->cpu_dem = (st.coupling.seconds_dem + st.coupling.seconds_coupling);
     } else {
         fsdem_mps_stats st = fsdem_mps_get_stats(c.mps);
         r->steps = st.steps;

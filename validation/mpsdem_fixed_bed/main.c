@@ -154,7 +154,7 @@ static int bed_run_go(bed_run *r, double relaxations, FILE *history) {
         r->us = us_sum / samples;
         r->us_drift = (us_last - us_first) / r->us;
         r->eps_coupler = eps_sum / samples;
-        r->steps = fsdem_mps_dem_get_stats(cpl).steps;
+        r->steps = fsdem_mps_dem_get_stats(cpl).coupling.steps;
     }
     r->cpu = (double)(clock() - t0) / CLOCKS_PER_SEC;
     fsdem_mps_dem_destroy(cpl);

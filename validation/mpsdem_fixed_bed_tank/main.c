@@ -158,7 +158,7 @@ int main(int argc, char **argv) {
         {
             const fsdem_vec3 below_pt = fsdem_v3((fsdem_real)(W / 2), (fsdem_real)(W / 2), (fsdem_real)(zb - GAP * r0));
             const fsdem_vec3 above_pt = fsdem_v3((fsdem_real)(W / 2), (fsdem_real)(W / 2), (fsdem_real)(zb + L + GAP * r0));
-            const double dt = fsdem_mps_dem_get_stats(cpl).dt;
+            const double dt = fsdem_mps_dem_get_stats(cpl).coupling.dt;
             fsdem_real pb, pa, row[10];
             double dp;
             fsdem_mps_probe_pressure(mps, below_pt, (fsdem_real)r0, &pb);
@@ -293,8 +293,8 @@ int main(int argc, char **argv) {
             const double m_drag = nsamp ? s_drag / nsamp : NAN, m_drag_eps = nsamp ? s_drag_eps / nsamp : NAN;
             /* Ergun's drag on the whole bed from the law: per unit volume beta w = eps^2 dP/dx at the
                slip w = U / eps, i.e. sum F^d_z = A L eps Ergun(eps) */
-            vc_info(CASE, "%lld coupled steps (mean dt %.2e s), %d MPS particles, %.1f s CPU (MPS %.1f s)%s", st.steps,
-                    st.steps ? st.time / (double)st.steps : 0, mv.count, st.seconds_mps + st.seconds_dem, st.seconds_mps,
+            vc_info(CASE, "%lld coupled steps (mean dt %.2e s), %d MPS particles, %.1f s CPU (MPS %.1f s)%s", st.coupling.steps,
+                    st.coupling.steps ? st.coupling.time / (double)st.coupling.steps : 0, mv.count, st.coupling.seconds_fluid + (st.coupling.seconds_dem + st.coupling.seconds_coupling), st.coupling.seconds_fluid,
                     failed ? "; FAILED" : "");
             vc_info(CASE, "dP_dyn over [%.2f, %.2f] s: mean %.1f Pa, RMS of its fluctuation %.1f Pa (%.1f%%); per packing length %.0f Pa/m",
                     t_start, t_end, mean, rms, 100 * rms / mean, mean / L);

@@ -184,8 +184,8 @@ static void run_case(int k, int cells, double t_end, double radius, outcome *o) 
             o->failed = 1;
             break;
         }
-        if (fsdem_mps_dem_get_stats(c).steps % 200 == 0)
-            fprintf(stderr, "case %d: t = %.3f s, %lld steps\n", k, fsdem_mps_dem_time(c), fsdem_mps_dem_get_stats(c).steps);
+        if (fsdem_mps_dem_get_stats(c).coupling.steps % 200 == 0)
+            fprintf(stderr, "case %d: t = %.3f s, %lld steps\n", k, fsdem_mps_dem_time(c), fsdem_mps_dem_get_stats(c).coupling.steps);
     }
     fsdem_csv_close(&csv);
     /* mean of the samples (one per step) over each window [t_a, t_a + WINDOW], at its centre */
@@ -198,10 +198,10 @@ static void run_case(int k, int cells, double t_end, double radius, outcome *o) 
     o->sediment_front_end = sediment_front(dem);
     {
         const fsdem_mps_dem_stats st = fsdem_mps_dem_get_stats(c);
-        o->cpu_mps = st.seconds_mps;
-        o->cpu_dem = st.seconds_dem;
-        o->steps = st.steps;
-        o->substeps = st.substeps_total;
+        o->cpu_mps = st.coupling.seconds_fluid;
+        o->cpu_dem = (st.coupling.seconds_dem + st.coupling.seconds_coupling);
+        o->steps = st.coupling.steps;
+        o->substeps = st.coupling.substeps_total;
     }
 done:
     free(bed);

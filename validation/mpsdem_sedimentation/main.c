@@ -230,8 +230,8 @@ static outcome run(const setup *S, fsdem_mps_model model) {
         row[9] = (fsdem_real)mean;
         row[10] = (fsdem_real)vmax;
         row[11] = ms.max_speed;
-        row[12] = cs.dt;
-        row[13] = (fsdem_real)cs.substeps;
+        row[12] = cs.coupling.dt;
+        row[13] = (fsdem_real)cs.coupling.substeps;
         fsdem_csv_row(&csv, row, 14);
         o.t_reached = t;
         {
@@ -273,7 +273,7 @@ static outcome run(const setup *S, fsdem_mps_model model) {
         if (k % 25 == 0) {
             fprintf(stderr, "[%c] t %.3f Ek %.3e p %.1f drag %.3e pz %.4f level %.4f top %.4f vmax %.3g umax %.3g dt %.2e sub %lld  %.0f s\n",
                     tag, t, ek, (double)pb, (double)row[3], (double)cs.pressure.z, (double)level, top, vmax,
-                    (double)ms.max_speed, (double)cs.dt, cs.substeps, now() - t0);
+                    (double)ms.max_speed, (double)cs.coupling.dt, cs.coupling.substeps, now() - t0);
         }
     }
     (void)n_end;
@@ -287,10 +287,10 @@ static outcome run(const setup *S, fsdem_mps_model model) {
     }
     {
         fsdem_mps_dem_stats cs = fsdem_mps_dem_get_stats(cpl);
-        o.steps = cs.steps;
-        o.substeps = cs.substeps_total;
-        o.cpu_mps = cs.seconds_mps;
-        o.cpu_dem = cs.seconds_dem;
+        o.steps = cs.coupling.steps;
+        o.substeps = cs.coupling.substeps_total;
+        o.cpu_mps = cs.coupling.seconds_fluid;
+        o.cpu_dem = (cs.coupling.seconds_dem + cs.coupling.seconds_coupling);
     }
 done:
     fsdem_mps_dem_destroy(cpl);

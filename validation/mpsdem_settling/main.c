@@ -367,11 +367,11 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
     }
     {
         const fsdem_mps_dem_stats st = fsdem_mps_dem_get_stats(cpl);
-        o.steps = (int)st.steps;
-        o.cpu = st.seconds_mps + st.seconds_dem;
-        o.cpu_mps = st.seconds_mps;
-        o.substeps = st.steps ? (double)st.substeps_total / (double)st.steps : 0;
-        o.dt_mean = st.steps ? st.time / (double)st.steps : 0;
+        o.steps = (int)st.coupling.steps;
+        o.cpu = st.coupling.seconds_fluid + (st.coupling.seconds_dem + st.coupling.seconds_coupling);
+        o.cpu_mps = st.coupling.seconds_fluid;
+        o.substeps = st.coupling.steps ? (double)st.coupling.substeps_total / (double)st.coupling.steps : 0;
+        o.dt_mean = st.coupling.steps ? st.coupling.time / (double)st.coupling.steps : 0;
         o.mps_total = fsdem_mps_get_particles(mps).count;
     }
 done:

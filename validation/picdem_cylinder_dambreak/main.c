@@ -120,11 +120,11 @@ static void run(double dx, int layers, double beta, double t_end, result *res) {
     wd_centres(&c, &res->x_ave_end, &res->z_ave_end, &next_row);
     {
         fsdem_pic_dem_stats s = fsdem_pic_dem_get_stats(c.cpl);
-        res->steps = s.steps;
-        res->substeps = s.substeps_total;
-        res->cpu_pic = s.seconds_pic;
-        res->cpu_dem = s.seconds_dem;
-        res->cpu_coupling = s.seconds_coupling;
+        res->steps = s.coupling.steps;
+        res->substeps = s.coupling.substeps_total;
+        res->cpu_pic = s.coupling.seconds_fluid;
+        res->cpu_dem = s.coupling.seconds_dem;
+        res->cpu_coupling = s.coupling.seconds_coupling;
     }
     res->cpu = (double)(clock() - t0) / CLOCKS_PER_SEC;
     wd_destroy(&c);

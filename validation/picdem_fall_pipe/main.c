@@ -376,7 +376,7 @@ static int run(const options *o, int perforated, result *r, FILE *cyl_csv, FILE 
     if (cp) {
         fsdem_pic_dem_stats cs = fsdem_pic_dem_get_stats(cp);
         vc_info(CASE, "%s: %lld coupled steps to t = %.3f s, %.1f s CPU (PIC %.1f, DEM %.1f, coupling %.1f); quiet until t = %.3f s",
-                tag, r->steps, t, r->wall_seconds, cs.seconds_pic, cs.seconds_dem, cs.seconds_coupling, t_quiet);
+                tag, r->steps, t, r->wall_seconds, cs.coupling.seconds_fluid, cs.coupling.seconds_dem, cs.coupling.seconds_coupling, t_quiet);
     }
     if (cp) fsdem_pic_dem_destroy(cp);
     if (pic) fsdem_pic_destroy(pic);

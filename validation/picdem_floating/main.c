@@ -221,8 +221,8 @@ static outcome run(const setup *S) {
     }
     {
         fsdem_pic_dem_stats st = fsdem_pic_dem_get_stats(cpl);
-        o.steps = st.steps;
-        o.substeps = st.substeps_total;
+        o.steps = st.coupling.steps;
+        o.substeps = st.coupling.substeps_total;
     }
 done:
     o.cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;

@@ -201,14 +201,14 @@ int main(int argc, char **argv) {
         row[1] = B.pressure_force.z;
         row[2] = B.viscous_force.z;
         row[3] = B.volume;
-        row[4] = cs.dt;
-        row[5] = (fsdem_real)cs.substeps;
+        row[4] = cs.coupling.dt;
+        row[5] = (fsdem_real)cs.coupling.substeps;
         fsdem_csv_row(&fcsv, row, 6);
-        if ((double)cs.dt < dt_min) dt_min = (double)cs.dt;
-        if ((double)cs.dt > dt_max_seen) dt_max_seen = (double)cs.dt;
+        if ((double)cs.coupling.dt < dt_min) dt_min = (double)cs.coupling.dt;
+        if ((double)cs.coupling.dt > dt_max_seen) dt_max_seen = (double)cs.coupling.dt;
         if (k % 50 == 0) {
             fprintf(stderr, "t %.3f s gap %.5f m w %.5f m/s Fp %.4g Fv %.4g N dt %.3g s (viscous %.3g) CPU %.0f s\n", t,
-                    sgap[ns - 1], sw[ns - 1], (double)B.pressure_force.z, (double)B.viscous_force.z, (double)cs.dt,
+                    sgap[ns - 1], sw[ns - 1], (double)B.pressure_force.z, (double)B.viscous_force.z, (double)cs.coupling.dt,
                     (double)cs.viscous_dt, (double)(clock() - c0) / CLOCKS_PER_SEC);
         }
         /* the sphere has landed once it touches the floor (gap within the contact offset) and has
@@ -273,8 +273,8 @@ int main(int argc, char **argv) {
         rms_gap = sqrt(rms_gap / (ng > 0 ? ng : 1));
         vc_info(CASE, "%lld coupled steps (dt %.3g .. %.3g s, viscous limit %.3g s), %lld DEM substeps, end t = %.3f s, CPU %.0f s "
                       "(PIC %.0f, DEM %.1f, coupling %.1f)",
-                cs.steps, dt_min, dt_max_seen, (double)cs.viscous_dt, cs.substeps_total, fsdem_pic_dem_time(cpl),
-                (double)(clock() - c0) / CLOCKS_PER_SEC, cs.seconds_pic, cs.seconds_dem, cs.seconds_coupling);
+                cs.coupling.steps, dt_min, dt_max_seen, (double)cs.viscous_dt, cs.coupling.substeps_total, fsdem_pic_dem_time(cpl),
+                (double)(clock() - c0) / CLOCKS_PER_SEC, cs.coupling.seconds_fluid, cs.coupling.seconds_dem, cs.coupling.seconds_coupling);
         {
             const fsdem_pic_stats ps = fsdem_pic_get_stats(pic);
             vc_info(CASE, "PIC: %d particles, last step %d pressure / %d viscous iterations, CPU %.0f s in steps (pressure %.0f s)",

@@ -147,7 +147,7 @@ static int run_case(const char *name, double hl, double hr, fsdem_swe_limiter li
                 printf("case %s: %s\n", name, fsdem_swe_dem_last_error(cpl));
                 return 2;
             }
-            t += fsdem_swe_dem_get_stats(cpl).dt;
+            t += fsdem_swe_dem_get_stats(cpl).coupling.dt;
         }
     }
     fsdem_csv_close(&gauges);

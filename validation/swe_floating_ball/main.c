@@ -90,7 +90,7 @@ int main(int argc, char **argv) {
         fsdem_real dt;
         if (t >= next_sample - 1e-12 && ns < MAX_SAMPLES) {
             fsdem_swe_dem_force f;
-            fsdem_swe_dem_update_forces(cpl);
+            fsdem_swe_dem_update(cpl);
             fsdem_swe_dem_get_force(cpl, 0, &f);
             sample_t[ns] = t;
             sample_x[ns] = p.position[0].x;

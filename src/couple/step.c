@@ -1,0 +1,237 @@
+/* ---- >>couple_step : the DEM's checks, the staged step, the stable rule, the advance ---- */
+
+/* Every DEM particle fits in the fluid's domain [lo, hi] (a sphere wider than the domain's smallest
+   extent leaves no fluid around it); the particle goes to the message under the name `who`. */
+static fsdem_result fsdem__coupler_particles_fit(fsdem_coupler *c, fsdem_vec3 lo, fsdem_vec3 hi, const char *who) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->dem);
+    const fsdem_real extent = fsdem__smallest_extent(lo, hi, P.dim);
+    int i;
+    for (i = 0; i < P.count; ++i)
+        if (!(2 * P.radius[i] < extent))
+            return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG,
+                               "%s: DEM particle %d (id %d) of radius %g m does not fit in the fluid's domain (smallest extent %g m)", who,
+                               i, P.id[i], (double)P.radius[i], (double)extent);
+    return FSDEM_OK;
+}
+
+/* Before a step of dt moves anything: the DEM can follow it in at most max_substeps substeps. */
+static fsdem_result fsdem__coupler_substeps_within(fsdem_coupler *c, fsdem_real dt) {
+    long long substeps = 0;
+    const fsdem_result res = fsdem_dem_substep_count(c->dem, dt, &substeps);
+    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "%s: %s", c->cls->name, fsdem_dem_last_error(c->dem));
+    if (substeps > c->max_substeps)
+        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG,
+                           "%s: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)", c->cls->name,
+                           (double)dt, substeps, c->max_substeps, (double)fsdem_dem_get_stats(c->dem).dt);
+    return FSDEM_OK;
+}
+
+/* The coupler's DEM over dt in substeps, `fn` (may be NULL) called at every force evaluation
+   (fsdem_dem_advance_with); the counts go to the head. A failure is named "<what>: <the DEM's
+   message>", unless `fn` failed (*fn_failed set) and named it already. */
+static fsdem_result fsdem__coupler_substeps(fsdem_coupler *c, fsdem_real dt, fsdem_dem_substep_fn fn, void *user, const char *what,
+                                            const int *fn_failed) {
+    long long substeps = 0;
+    const fsdem_result res = fsdem_dem_advance_with(c->dem, dt, fn, user, &substeps);
+    c->substeps = substeps;
+    c->substeps_total += substeps;
+    if (res != FSDEM_OK && !(fn_failed && *fn_failed))
+        return fsdem__fail(&c->status, res, "%s: %s: %s", c->cls->name, what, fsdem_dem_last_error(c->dem));
+    return res;
+}
+
+/* The message of couplers[from] (or a new one, from < 0) given to every coupler of the list. */
+static fsdem_result fsdem__coupled_fail(fsdem_coupler *const *list, int n, int from, fsdem_result res, const char *fmt, ...) {
+    int k;
+    if (from < 0) {
+        va_list ap;
+        va_start(ap, fmt);
+        fsdem__vfail(&list[0]->status, res, fmt, ap);
+        va_end(ap);
+        from = 0;
+    }
+    for (k = 0; k < n; ++k)
+        if (k != from) memcpy(list[k]->status.message, list[from]->status.message, sizeof list[k]->status.message);
+    return res;
+}
+
+/* Puts back what the couplers' prepare did (a refused step); passes `res` on. */
+static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem_result res) {
+    int k;
+    for (k = 0; k < n; ++k)
+        if (list[k]->cls->undo) list[k]->cls->undo(list[k]);
+    return res;
+}
+
+/* A list of couplers that can step together: not empty, no NULL, none twice, one fluid. */
+static fsdem_result fsdem__coupled_list(fsdem_coupler *const *list, int n, const char *who) {
+    int k, j;
+    if (!list || n < 1) return FSDEM_ERR_INVALID_ARG;
+    for (k = 0; k < n; ++k)
+        if (!list[k]) return FSDEM_ERR_INVALID_ARG;
+    for (k = 1; k < n; ++k) {
+        if (list[k]->fluid != list[0]->fluid)
+            return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: couplers %d (%s) and 0 (%s) have different fluids", who, k,
+                                       list[k]->cls->name, list[0]->cls->name);
+        for (j = 0; j < k; ++j)
+            if (list[j] == list[k]) return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: coupler %d is listed twice", who, k);
+    }
+    return FSDEM_OK;
+}
+
+/* The stable dt of couplers of one fluid: the fluid's, cut by every coupler's own limits. */
+static fsdem_result fsdem__coupled_stable(fsdem_coupler *const *list, int n, fsdem_real *dt) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
+    fsdem_result res = f->stable_dt(list[0]->fluid, dt);
+    int k;
+    if (res != FSDEM_OK)
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s stable step: %s", list[0]->cls->name, f->name, f->last_error(list[0]->fluid));
+    for (k = 0; k < n; ++k)
+        if (list[k]->cls->limit && (res = list[k]->cls->limit(list[k], dt)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
+    return FSDEM_OK;
+}
+
+/* The couplers' prepare, in order, timed as coupling (a failure undoes those before), then with
+   `dt` the stable dt. */
+static fsdem_result fsdem__coupled_prepare(fsdem_coupler *const *list, int n, fsdem_real *dt) {
+    fsdem_result res = FSDEM_OK;
+    int k;
+    for (k = 0; k < n && res == FSDEM_OK; ++k)
+        if (list[k]->cls->prepare) {
+            const clock_t t0 = clock();
+            if ((res = list[k]->cls->prepare(list[k])) != FSDEM_OK) fsdem__coupled_fail(list, n, k, fsdem__coupled_undo(list, k, res), NULL);
+            list[k]->seconds[FSDEM__CLOCK_COUPLING] += (double)(clock() - t0) / CLOCKS_PER_SEC;
+        }
+    if (res == FSDEM_OK && dt && (res = fsdem__coupled_stable(list, n, dt)) != FSDEM_OK) fsdem__coupled_undo(list, n, res);
+    return res;
+}
+
+/* The stages of coupler c before its fluid step (after = 0), or after it (after = 1), each timed on
+   its clock; the first failure ends them. */
+static fsdem_result fsdem__coupled_stages(fsdem_coupler *c, fsdem_real dt, int after) {
+    const fsdem__coupler_class *cls = c->cls;
+    fsdem_result res = FSDEM_OK;
+    int s = 0;
+    if (after)
+        while (s < cls->stage_count && cls->stages[s++].run) continue;
+    for (; s < cls->stage_count && res == FSDEM_OK && cls->stages[s].run; ++s) {
+        const clock_t t0 = clock();
+        res = cls->stages[s].run(c, dt);
+        c->seconds[cls->stages[s].clock] += (double)(clock() - t0) / CLOCKS_PER_SEC;
+    }
+    return res;
+}
+
+/* A coupled step of dt after the prepare: every coupler's check (a refusal undoes the prepare), the
+   stages before the fluid's step, the fluid's step (FSDEM_ERR_CFL: refused before it moved, the
+   prepare undone), the stages after it. `chosen`: dt is the caller's, not a stable one. */
+static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_real dt, int chosen) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
+    void *fluid = list[0]->fluid;
+    fsdem_result res;
+    clock_t t0;
+    double seconds;
+    int k;
+    for (k = 0; k < n; ++k)
+        if ((res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
+            return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
+    for (k = 0; k < n; ++k)
+        if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
+    t0 = clock();
+    res = f->step_dt(fluid, dt);
+    seconds = (double)(clock() - t0) / CLOCKS_PER_SEC;
+    for (k = 0; k < n; ++k) list[k]->seconds[FSDEM__CLOCK_FLUID] += seconds;
+    if (res != FSDEM_OK) {
+        if (res == FSDEM_ERR_CFL) fsdem__coupled_undo(list, n, res);
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s step: %s", list[0]->cls->name, f->name, f->last_error(fluid));
+    }
+    for (k = 0; k < n; ++k) {
+        list[k]->steps++;
+        list[k]->dt_last = dt;
+    }
+    for (k = 0; k < n; ++k)
+        if ((res = fsdem__coupled_stages(list[k], dt, 1)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
+    for (k = 0; k < n; ++k) fsdem__ok(&list[k]->status);
+    return FSDEM_OK;
+}
+
+/* The verbs of couplers stepping together, and of each coupler alone (a list of one); `who` names
+   the public function in messages. */
+static fsdem_result fsdem__coupled_step(fsdem_coupler *const *list, int n) {
+    fsdem_real dt = 0;
+    fsdem_result res = fsdem__coupled_prepare(list, n, &dt);
+    return res != FSDEM_OK ? res : fsdem__coupled_go(list, n, dt, 0);
+}
+
+static fsdem_result fsdem__coupled_step_dt(fsdem_coupler *const *list, int n, fsdem_real dt, const char *who) {
+    fsdem_result res;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: dt = %g s must be > 0 and finite", who, (double)dt);
+    if ((res = fsdem__coupled_prepare(list, n, NULL)) != FSDEM_OK) return res;
+    return fsdem__coupled_go(list, n, dt, 1);
+}
+
+/* Steps until exactly `duration` later: when less than one and a half stable steps are left, the
+   last two share them equally, so no step is a sliver; the end is reached to a relative 1e-12. */
+static fsdem_result fsdem__coupled_advance(fsdem_coupler *const *list, int n, fsdem_real duration, long long *steps, const char *who) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
+    const void *fluid = list[0]->fluid;
+    long long count = 0;
+    fsdem_result res = FSDEM_OK;
+    double end;
+    if (steps) *steps = 0;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: duration = %g s must be >= 0", who, (double)duration);
+    end = f->time(fluid) + (double)duration;
+    while (res == FSDEM_OK && f->time(fluid) < end - 1e-12 * (end > 1 ? end : 1)) {
+        const double left = end - f->time(fluid);
+        fsdem_real dt = 0;
+        if ((res = fsdem__coupled_prepare(list, n, &dt)) != FSDEM_OK) break;
+        if ((double)dt >= left) dt = (fsdem_real)left;
+        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
+        res = fsdem__coupled_go(list, n, dt, 0);
+        ++count;
+    }
+    if (steps) *steps = count;
+    return res;
+}
+
+fsdem_result fsdem_coupled_step(fsdem_coupler *const *couplers, int count) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_step");
+    return res != FSDEM_OK ? res : fsdem__coupled_step(couplers, count);
+}
+
+fsdem_result fsdem_coupled_step_dt(fsdem_coupler *const *couplers, int count, fsdem_real dt) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_step_dt");
+    return res != FSDEM_OK ? res : fsdem__coupled_step_dt(couplers, count, dt, "fsdem_coupled_step_dt");
+}
+
+fsdem_result fsdem_coupled_advance(fsdem_coupler *const *couplers, int count, fsdem_real duration, long long *steps) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_advance");
+    if (steps) *steps = 0;
+    return res != FSDEM_OK ? res : fsdem__coupled_advance(couplers, count, duration, steps, "fsdem_coupled_advance");
+}
+
+fsdem_result fsdem_coupled_stable_dt(fsdem_coupler *const *couplers, int count, fsdem_real *dt) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_stable_dt");
+    if (res != FSDEM_OK) return res;
+    if (!dt) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__coupled_stable(couplers, count, dt);
+}
+
+/* The verbs of one coupler (NULL refused), its step a list of one. */
+static fsdem_result fsdem__coupler_step(fsdem_coupler *c) { return c ? fsdem__coupled_step(&c, 1) : FSDEM_ERR_INVALID_ARG; }
+
+static fsdem_result fsdem__coupler_step_dt(fsdem_coupler *c, fsdem_real dt, const char *who) {
+    return c ? fsdem__coupled_step_dt(&c, 1, dt, who) : FSDEM_ERR_INVALID_ARG;
+}
+
+static fsdem_result fsdem__coupler_advance(fsdem_coupler *c, fsdem_real duration, long long *steps, const char *who) {
+    if (steps) *steps = 0;
+    return c ? fsdem__coupled_advance(&c, 1, duration, steps, who) : FSDEM_ERR_INVALID_ARG;
+}
+
+static fsdem_result fsdem__coupler_stable_dt(const fsdem_coupler *c, fsdem_real *dt) {
+    fsdem_coupler *list = (fsdem_coupler *)c; /* only the message changes (a failure's) */
+    return c && dt ? fsdem__coupled_stable(&list, 1, dt) : FSDEM_ERR_INVALID_ARG;
+}
