@@ -3944,6 +3944,19 @@ static fsdem_result fsdem__write_rows(const fsdem__status *status, const char *w
     return fsdem__ok((fsdem__status *)status);
 }
 
+/* A field of a struct, by table: its name, what it holds, where and how long it is. A coupler's
+   record lists its fields so (the CSV columns, >>couple_records), and a restart visitor the desc
+   fields it compares and the scalars it saves (>>restart_format). */
+enum { FSDEM__FIELD_INT, FSDEM__FIELD_LL, FSDEM__FIELD_REAL, FSDEM__FIELD_VEC3, FSDEM__FIELD_BYTES };
+typedef struct fsdem__field {
+    const char *name;
+    int kind;            /* FSDEM__FIELD_*: how to read it (BYTES: only saved, as they are) */
+    size_t offset, size; /* bytes */
+    int saved;           /* part of the restart (a record's field may be left out) */
+} fsdem__field;
+#define FSDEM__FIELD(type, member, name, kind, saved) \
+    { name, FSDEM__FIELD_##kind, offsetof(type, member), sizeof(((type *)0)->member), saved }
+
 /* A relative tolerance of at least `floor` and of 100 roundings of fsdem_real, so a test written for
    double still holds in float. */
 static double fsdem__tolerance(double floor) {
@@ -16935,23 +16948,12 @@ typedef struct fsdem__fluid {
     fsdem_claims *(*claims)(void *fluid);
 } fsdem__fluid;
 
-/* A field of a coupler's per-particle record: CSV columns (_x, _y, _z for a vector) and, when
-   `saved`, part of the coupler's restart file (>>restart_couplers), in the order of the table. The
-   restart's tables of a coupler's own fields use the same type (and long long counts). */
-enum { FSDEM__FIELD_INT = 0, FSDEM__FIELD_REAL = 1, FSDEM__FIELD_VEC3 = 2, FSDEM__FIELD_LL = 3 };
-typedef struct fsdem__field {
-    const char *name;
-    int kind;
-    size_t offset;
-    int saved;
-} fsdem__field;
-
 /* What makes a coupler of one kind. */
 typedef struct fsdem__coupler_class {
     const char *name;                   /* "fsdem_gic": its messages start so */
     const fsdem__fluid *fluid;
     size_t record_size;                 /* bytes of its per-particle record, whose first field is the int id */
-    const fsdem__field *fields;
+    const fsdem__field *fields;         /* the record's fields (>>core), CSV columns and restart */
     int field_count;
     /* its step (>>couple_step): prepare (may be NULL) does what must come before the step's length
        is known, and undo (may be NULL) puts it back when the step is refused; limit (may be NULL)
@@ -17351,14 +17353,6 @@ static fsdem_result fsdem__coupler_get_record(const fsdem_coupler *c, int index,
     return FSDEM_OK;
 }
 
-/* Bytes of a field of kind `kind`. */
-static size_t fsdem__field_size(int kind) {
-    return kind == FSDEM__FIELD_INT    ? sizeof(int)
-           : kind == FSDEM__FIELD_REAL ? sizeof(fsdem_real)
-           : kind == FSDEM__FIELD_VEC3 ? sizeof(fsdem_vec3)
-                                       : sizeof(long long);
-}
-
 /* The values of the record of particle `index` as a CSV row (fsdem__row_fn); 0 without a record. */
 static int fsdem__coupler_row(const void *object, int index, double *v) {
     const fsdem_coupler *c = (const fsdem_coupler *)object;
@@ -17692,7 +17686,7 @@ static const fsdem__stage fsdem__swe_dem_stages[3] = {{"forces", FSDEM__CLOCK_CO
                                                       {"shallow-water step", FSDEM__CLOCK_FLUID, NULL},
                                                       {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__swe_dem_substeps}};
 
-#define FSDEM__SWE_DEM_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_swe_dem_force, name), 1}
+#define FSDEM__SWE_DEM_FIELD(name, kind) FSDEM__FIELD(fsdem_swe_dem_force, name, #name, kind, 1)
 static const fsdem__field fsdem__swe_dem_fields[9] = {
     FSDEM__SWE_DEM_FIELD(id, INT),          FSDEM__SWE_DEM_FIELD(buoyancy, VEC3),         FSDEM__SWE_DEM_FIELD(hydrostatic, VEC3),
     FSDEM__SWE_DEM_FIELD(dynamic, VEC3),    FSDEM__SWE_DEM_FIELD(heave, VEC3),            FSDEM__SWE_DEM_FIELD(submerged_volume, REAL),
@@ -18219,7 +18213,7 @@ static fsdem_result fsdem__mps_dem_substeps(fsdem_coupler *head, fsdem_real dt) 
 static const fsdem__stage fsdem__mps_dem_stages[2] = {{"MPS step", FSDEM__CLOCK_FLUID, NULL},
                                                       {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__mps_dem_substeps}};
 
-#define FSDEM__MPS_DEM_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_mps_dem_force, name), 1}
+#define FSDEM__MPS_DEM_FIELD(name, kind) FSDEM__FIELD(fsdem_mps_dem_force, name, #name, kind, 1)
 static const fsdem__field fsdem__mps_dem_fields[8] = {
     FSDEM__MPS_DEM_FIELD(id, INT),          FSDEM__MPS_DEM_FIELD(drag, VEC3),     FSDEM__MPS_DEM_FIELD(pressure, VEC3),
     FSDEM__MPS_DEM_FIELD(total, VEC3),      FSDEM__MPS_DEM_FIELD(fluid_velocity, VEC3), FSDEM__MPS_DEM_FIELD(porosity, REAL),
@@ -19149,7 +19143,7 @@ static const fsdem__stage fsdem__pic_dem_stages[6] = {
     {"PIC step", FSDEM__CLOCK_FLUID, NULL},                          {"loads", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_loads_stage},
     {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__pic_dem_substeps},     {"gap", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_gap_stage}};
 
-#define FSDEM__PIC_DEM_FIELD(name, kind, saved) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_pic_dem_force, name), saved}
+#define FSDEM__PIC_DEM_FIELD(name, kind, saved) FSDEM__FIELD(fsdem_pic_dem_force, name, #name, kind, saved)
 static const fsdem__field fsdem__pic_dem_fields[7] = {
     FSDEM__PIC_DEM_FIELD(id, INT, 1),      FSDEM__PIC_DEM_FIELD(pressure_force, VEC3, 1), FSDEM__PIC_DEM_FIELD(viscous_force, VEC3, 1),
     FSDEM__PIC_DEM_FIELD(torque, VEC3, 1), FSDEM__PIC_DEM_FIELD(weight_correction, VEC3, 1), FSDEM__PIC_DEM_FIELD(volume, REAL, 1),
@@ -19639,7 +19633,7 @@ static const fsdem__stage fsdem__gic_stages[3] = {{"sand substeps", FSDEM__CLOCK
                                                   {"fractions", FSDEM__CLOCK_COUPLING, fsdem__gic_fractions},
                                                   {"PIC step", FSDEM__CLOCK_FLUID, NULL}};
 
-#define FSDEM__GIC_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_gic_force, name), 0}
+#define FSDEM__GIC_FIELD(name, kind) FSDEM__FIELD(fsdem_gic_force, name, #name, kind, 0)
 static const fsdem__field fsdem__gic_fields[8] = {
     FSDEM__GIC_FIELD(id, INT),           FSDEM__GIC_FIELD(pressure, VEC3),       FSDEM__GIC_FIELD(drag, VEC3),
     FSDEM__GIC_FIELD(virtual_mass, VEC3), FSDEM__GIC_FIELD(fluid_velocity, VEC3), FSDEM__GIC_FIELD(fluid_acceleration, VEC3),
@@ -19940,6 +19934,34 @@ static void *fsdem__restart_block(fsdem__restart *io, const fsdem_allocator *al,
     return NULL;
 }
 
+/* Fields by table (fsdem__field, >>core): a visitor lists the desc fields it compares and the
+   scalars it saves, in the order of the payload: FSDEM__SAME(T, member, kind) is T's desc.member,
+   FSDEM__SAVED(T, member) its member saved as it is. */
+#define FSDEM__SAME(T, member, kind) FSDEM__FIELD(T, desc.member, #member, kind, 1)
+#define FSDEM__SAVED(T, member) FSDEM__FIELD(T, member, #member, BYTES, 1)
+
+/* The desc fields of `object` in `same` compared with the save's (the name prints as desc.<name>). */
+static void fsdem__restart_same_fields(fsdem__restart *io, const void *object, const fsdem__field *same, int n) {
+    int k;
+    for (k = 0; k < n; ++k) {
+        const void *at = (const char *)object + same[k].offset;
+        FSDEM_ASSERT(same[k].kind != FSDEM__FIELD_INT || same[k].size == sizeof(int)); /* (enums included) */
+        switch (same[k].kind) {
+        case FSDEM__FIELD_INT: fsdem__restart_same_int(io, *(const int *)at, same[k].name); break;
+        case FSDEM__FIELD_LL: fsdem__restart_same_ll(io, *(const long long *)at, same[k].name); break;
+        case FSDEM__FIELD_REAL: fsdem__restart_same_real(io, *(const fsdem_real *)at, same[k].name); break;
+        default: fsdem__restart_same_vec3(io, *(const fsdem_vec3 *)at, same[k].name); break;
+        }
+    }
+}
+
+/* The fields of `object` (a struct, or a record) in `fields` that are saved, as data. */
+static void fsdem__restart_fields(fsdem__restart *io, void *object, const fsdem__field *fields, int n) {
+    int k;
+    for (k = 0; k < n; ++k)
+        if (fields[k].saved) fsdem__restart_data(io, object ? (char *)object + fields[k].offset : NULL, fields[k].size);
+}
+
 /* ---- >>restart_dem : discrete elements ---- */
 
 /* One neighbour list: its rows and entries, the row offsets, the row of each entry, the partner keys
@@ -20021,53 +20043,36 @@ static int fsdem__restart_dem_list(fsdem__restart *io, fsdem_dem *d, fsdem__dem_
    predictor-corrector's x0, v0, w0, fa, ta and the walls' force_a (written at the start of each
    such step), capacities, the allocator, log and message. SDF walls keep the object's callbacks. */
 static void fsdem__restart_dem(fsdem__restart *io, void *object) {
+    static const fsdem__field same[22] = {
+        FSDEM__SAME(fsdem_dem, dim, INT), FSDEM__SAME(fsdem_dem, domain_min, VEC3), FSDEM__SAME(fsdem_dem, domain_max, VEC3),
+        FSDEM__SAME(fsdem_dem, gravity, VEC3), FSDEM__SAME(fsdem_dem, law, INT), FSDEM__SAME(fsdem_dem, integrator, INT),
+        FSDEM__SAME(fsdem_dem, dt_rule, INT), FSDEM__SAME(fsdem_dem, dt_param, REAL), FSDEM__SAME(fsdem_dem, skin, REAL),
+        FSDEM__SAME(fsdem_dem, contact_offset, REAL), FSDEM__SAME(fsdem_dem, linear_theta, REAL),
+        FSDEM__SAME(fsdem_dem, linear_dx, REAL), FSDEM__SAME(fsdem_dem, linear_accel, REAL),
+        FSDEM__SAME(fsdem_dem, disc_length, REAL), FSDEM__SAME(fsdem_dem, rotation, INT),
+        FSDEM__SAME(fsdem_dem, tangential_damping, INT), FSDEM__SAME(fsdem_dem, tangential_history, INT),
+        FSDEM__SAME(fsdem_dem, coulomb_limit, INT), FSDEM__SAME(fsdem_dem, linear_stiffness, INT),
+        FSDEM__SAME(fsdem_dem, periodic[0], INT), FSDEM__SAME(fsdem_dem, periodic[1], INT),
+        FSDEM__SAME(fsdem_dem, periodic[2], INT)};
+    static const fsdem__field state[10] = {
+        FSDEM__SAVED(fsdem_dem, dt), FSDEM__SAVED(fsdem_dem, time), FSDEM__SAVED(fsdem_dem, steps),
+        FSDEM__SAVED(fsdem_dem, rebuilds), FSDEM__SAVED(fsdem_dem, stable_dt), FSDEM__SAVED(fsdem_dem, dt_warned),
+        FSDEM__SAVED(fsdem_dem, next_id), FSDEM__SAVED(fsdem_dem, skin), FSDEM__SAVED(fsdem_dem, r_max),
+        FSDEM__SAVED(fsdem_dem, max_disp2)};
+    static const fsdem__field state1[7] = {
+        FSDEM__SAVED(fsdem_dem, forces_valid), FSDEM__SAVED(fsdem_dem, rolling), FSDEM__SAVED(fsdem_dem, external),
+        FSDEM__SAVED(fsdem_dem, forces_cleared), FSDEM__SAVED(fsdem_dem, contacts), FSDEM__SAVED(fsdem_dem, wall_contacts),
+        FSDEM__SAVED(fsdem_dem, max_overlap)};
     fsdem_dem *d = (fsdem_dem *)object;
-    const fsdem_dem_desc *dd = &d->desc;
     const int reserve = io->mode == FSDEM__RESTART_RESERVE, commit = io->mode == FSDEM__RESTART_COMMIT;
     int nm = d->material_count, nw = d->wall_count, n = d->n, stale = d->need_rebuild, inert = d->inert_count;
     int k, longest, pairs = 0, wall_entries = 0;
     fsdem__restart_tag(io, "DEM1");
-    fsdem__restart_same_int(io, dd->dim, "dim");
-    fsdem__restart_same_vec3(io, dd->domain_min, "domain_min");
-    fsdem__restart_same_vec3(io, dd->domain_max, "domain_max");
-    fsdem__restart_same_vec3(io, dd->gravity, "gravity");
-    fsdem__restart_same_int(io, (int)dd->law, "law");
-    fsdem__restart_same_int(io, (int)dd->integrator, "integrator");
-    fsdem__restart_same_int(io, (int)dd->dt_rule, "dt_rule");
-    fsdem__restart_same_real(io, dd->dt_param, "dt_param");
-    fsdem__restart_same_real(io, dd->skin, "skin");
-    fsdem__restart_same_real(io, dd->contact_offset, "contact_offset");
-    fsdem__restart_same_real(io, dd->linear_theta, "linear_theta");
-    fsdem__restart_same_real(io, dd->linear_dx, "linear_dx");
-    fsdem__restart_same_real(io, dd->linear_accel, "linear_accel");
-    fsdem__restart_same_real(io, dd->disc_length, "disc_length");
-    fsdem__restart_same_int(io, dd->rotation, "rotation");
-    fsdem__restart_same_int(io, dd->tangential_damping, "tangential_damping");
-    fsdem__restart_same_int(io, (int)dd->tangential_history, "tangential_history");
-    fsdem__restart_same_int(io, (int)dd->coulomb_limit, "coulomb_limit");
-    fsdem__restart_same_int(io, (int)dd->linear_stiffness, "linear_stiffness");
-    fsdem__restart_same_int(io, dd->periodic[0], "periodic[0]");
-    fsdem__restart_same_int(io, dd->periodic[1], "periodic[1]");
-    fsdem__restart_same_int(io, dd->periodic[2], "periodic[2]");
+    fsdem__restart_same_fields(io, d, same, 22);
 
-    fsdem__restart_data(io, &d->dt, sizeof d->dt);
-    fsdem__restart_data(io, &d->time, sizeof d->time);
-    fsdem__restart_data(io, &d->steps, sizeof d->steps);
-    fsdem__restart_data(io, &d->rebuilds, sizeof d->rebuilds);
-    fsdem__restart_data(io, &d->stable_dt, sizeof d->stable_dt);
-    fsdem__restart_data(io, &d->dt_warned, sizeof d->dt_warned);
-    fsdem__restart_data(io, &d->next_id, sizeof d->next_id);
-    fsdem__restart_data(io, &d->skin, sizeof d->skin);
-    fsdem__restart_data(io, &d->r_max, sizeof d->r_max);
-    fsdem__restart_data(io, &d->max_disp2, sizeof d->max_disp2);
+    fsdem__restart_fields(io, d, state, 10);
     fsdem__restart_int_in(io, &stale, 0, 1, "need_rebuild");
-    fsdem__restart_data(io, &d->forces_valid, sizeof d->forces_valid);
-    fsdem__restart_data(io, &d->rolling, sizeof d->rolling);
-    fsdem__restart_data(io, &d->external, sizeof d->external);
-    fsdem__restart_data(io, &d->forces_cleared, sizeof d->forces_cleared);
-    fsdem__restart_data(io, &d->contacts, sizeof d->contacts);
-    fsdem__restart_data(io, &d->wall_contacts, sizeof d->wall_contacts);
-    fsdem__restart_data(io, &d->max_overlap, sizeof d->max_overlap);
+    fsdem__restart_fields(io, d, state1, 7);
     if (commit) d->need_rebuild = stale;
 
     /* materials and their pair table */
@@ -20212,76 +20217,13 @@ static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fs
     fsdem__restart_data(io, g->radius, sizeof(fsdem_real) * (size_t)ng);
 }
 
-static void fsdem__restart_pic(fsdem__restart *io, void *object) {
-    fsdem_pic *s = (fsdem_pic *)object;
-    const fsdem_pic_desc *pd = &s->desc;
+/* The obstacles, into a fresh array (polygons own their vertices); SDF obstacles keep the object's
+   callbacks. */
+static void fsdem__restart_pic_obstacles(fsdem__restart *io, fsdem_pic *s) {
     const fsdem_allocator *al = &s->allocator;
-    const int commit = io->mode == FSDEM__RESTART_COMMIT, apic = pd->transfer == FSDEM_PIC_TRANSFER_APIC;
-    static const char *bc_names[6] = {"boundary[0]", "boundary[1]", "boundary[2]",
-                                      "boundary[3]", "boundary[4]", "boundary[5]"};
-    static const char *bv_names[6] = {"boundary_velocity[0]", "boundary_velocity[1]", "boundary_velocity[2]",
-                                      "boundary_velocity[3]", "boundary_velocity[4]", "boundary_velocity[5]"};
-    int grid[3], no = s->obst_count, np = s->np, pcap = s->pcap, a, k;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    int no = s->obst_count, k;
     fsdem__pic_obst *obst;
-    size_t cells = sizeof(fsdem_real) * (size_t)s->ncell;
-    fsdem__restart_tag(io, "PIC2");
-    for (a = 0; a < 3; ++a) grid[a] = s->n[a];
-    fsdem__restart_value(io, grid, sizeof grid);
-    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK &&
-        (grid[0] != s->n[0] || grid[1] != s->n[1] || grid[2] != s->n[2]))
-        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
-                            "the grid has %d x %d x %d cells in the save and %d x %d x %d in the object (create the "
-                            "object from the desc it was saved with)",
-                            grid[0], grid[1], grid[2], s->n[0], s->n[1], s->n[2]);
-    fsdem__restart_same_int(io, pd->dim, "dim");
-    fsdem__restart_same_vec3(io, pd->domain_min, "domain_min");
-    fsdem__restart_same_real(io, pd->cell_size, "cell_size");
-    fsdem__restart_same_real(io, pd->density, "density");
-    fsdem__restart_same_real(io, pd->viscosity, "viscosity");
-    fsdem__restart_same_vec3(io, pd->gravity, "gravity");
-    for (k = 0; k < 6; ++k) {
-        fsdem__restart_same_int(io, (int)pd->boundary[k], bc_names[k]);
-        fsdem__restart_same_vec3(io, pd->boundary_velocity[k], bv_names[k]);
-    }
-    fsdem__restart_same_int(io, pd->free_surface, "free_surface");
-    fsdem__restart_same_int(io, (int)pd->transfer, "transfer");
-    fsdem__restart_same_real(io, pd->flip_ratio, "flip_ratio");
-    fsdem__restart_same_int(io, (int)pd->kernel, "kernel");
-    fsdem__restart_same_int(io, pd->particles_per_cell, "particles_per_cell");
-    fsdem__restart_same_real(io, pd->jitter, "jitter");
-    fsdem__restart_same_int(io, pd->min_particles_per_cell, "min_particles_per_cell");
-    fsdem__restart_same_int(io, pd->max_particles_per_cell, "max_particles_per_cell");
-    fsdem__restart_same_int(io, pd->advection_order, "advection_order");
-    fsdem__restart_same_real(io, pd->cfl, "cfl");
-    fsdem__restart_same_real(io, pd->cfl_max, "cfl_max");
-    fsdem__restart_same_real(io, pd->dt_max, "dt_max");
-    fsdem__restart_same_int(io, pd->density_projection, "density_projection");
-    fsdem__restart_same_real(io, pd->ghost_theta_min, "ghost_theta_min");
-    fsdem__restart_same_int(io, pd->extrapolation_layers, "extrapolation_layers");
-    fsdem__restart_same_int(io, (int)pd->pressure_precond, "pressure_precond");
-    fsdem__restart_same_real(io, pd->pressure_tolerance, "pressure_tolerance");
-    fsdem__restart_same_int(io, pd->pressure_max_iterations, "pressure_max_iterations");
-    fsdem__restart_same_int(io, (int)pd->viscosity_precond, "viscosity_precond");
-    fsdem__restart_same_real(io, pd->viscosity_tolerance, "viscosity_tolerance");
-
-    fsdem__restart_data(io, &s->time, sizeof s->time);
-    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
-    fsdem__restart_data(io, &s->steps, sizeof s->steps);
-    fsdem__restart_data(io, &s->rng, sizeof s->rng);
-    fsdem__restart_data(io, &s->cells_fresh, sizeof s->cells_fresh);
-    fsdem__restart_data(io, &s->fluid_cells, sizeof s->fluid_cells);
-    fsdem__restart_data(io, &s->p_iters, sizeof s->p_iters);
-    fsdem__restart_data(io, &s->v_iters, sizeof s->v_iters);
-    fsdem__restart_data(io, &s->d_iters, sizeof s->d_iters);
-    fsdem__restart_data(io, &s->p_res, sizeof s->p_res);
-    fsdem__restart_data(io, &s->max_div, sizeof s->max_div);
-    fsdem__restart_data(io, &s->div_before, sizeof s->div_before);
-    fsdem__restart_data(io, &s->reseeded, sizeof s->reseeded);
-    fsdem__restart_data(io, &s->removed, sizeof s->removed);
-    fsdem__restart_data(io, &s->refused, sizeof s->refused);
-    fsdem__restart_data(io, &s->moved, sizeof s->moved);
-
-    /* obstacles, into a fresh array (polygons own their vertices) */
     fsdem__restart_count(io, &no, 1 << 20, 2 * sizeof(int) + 5 * sizeof(fsdem_vec3) + sizeof(fsdem_real), "obstacle count");
     obst = (fsdem__pic_obst *)fsdem__restart_block(io, al, sizeof(fsdem__pic_obst) * (size_t)no);
     for (k = 0; k < no && io->res == FSDEM_OK; ++k) {
@@ -20331,8 +20273,14 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
         s->bytes += sizeof(fsdem__pic_obst) * (size_t)no;
         for (k = 0; k < no; ++k) s->bytes += sizeof(fsdem_vec3) * (size_t)obst[k].d.vertex_count;
     }
+}
 
-    /* particles, into fresh arrays of the saved capacity */
+/* The particles, into fresh arrays of the saved capacity (a full capacity refuses inflow seeds),
+   with their APIC matrices. */
+static void fsdem__restart_pic_particles(fsdem__restart *io, fsdem_pic *s) {
+    const fsdem_allocator *al = &s->allocator;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT, apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC;
+    int np = s->np, pcap = s->pcap, a;
     fsdem__restart_count(io, &pcap, 1 << 29, 0, "particle capacity");
     fsdem__restart_count(io, &np, pcap, 2 * sizeof(fsdem_vec3), "particle count");
     if (io->res == FSDEM_OK) {
@@ -20363,6 +20311,53 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
     fsdem__restart_data(io, s->px, sizeof(fsdem_vec3) * (size_t)np);
     fsdem__restart_data(io, s->pv, sizeof(fsdem_vec3) * (size_t)np);
     for (a = 0; a < 3 && apic; ++a) fsdem__restart_data(io, s->pc[a], sizeof(fsdem_vec3) * (size_t)np);
+}
+
+static void fsdem__restart_pic(fsdem__restart *io, void *object) {
+    static const fsdem__field same[38] = {
+        FSDEM__SAME(fsdem_pic, dim, INT), FSDEM__SAME(fsdem_pic, domain_min, VEC3), FSDEM__SAME(fsdem_pic, cell_size, REAL),
+        FSDEM__SAME(fsdem_pic, density, REAL), FSDEM__SAME(fsdem_pic, viscosity, REAL), FSDEM__SAME(fsdem_pic, gravity, VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[0], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[0], VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[1], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[1], VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[2], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[2], VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[3], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[3], VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[4], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[4], VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[5], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[5], VEC3),
+        FSDEM__SAME(fsdem_pic, free_surface, INT), FSDEM__SAME(fsdem_pic, transfer, INT),
+        FSDEM__SAME(fsdem_pic, flip_ratio, REAL), FSDEM__SAME(fsdem_pic, kernel, INT),
+        FSDEM__SAME(fsdem_pic, particles_per_cell, INT), FSDEM__SAME(fsdem_pic, jitter, REAL),
+        FSDEM__SAME(fsdem_pic, min_particles_per_cell, INT), FSDEM__SAME(fsdem_pic, max_particles_per_cell, INT),
+        FSDEM__SAME(fsdem_pic, advection_order, INT), FSDEM__SAME(fsdem_pic, cfl, REAL), FSDEM__SAME(fsdem_pic, cfl_max, REAL),
+        FSDEM__SAME(fsdem_pic, dt_max, REAL), FSDEM__SAME(fsdem_pic, density_projection, INT),
+        FSDEM__SAME(fsdem_pic, ghost_theta_min, REAL), FSDEM__SAME(fsdem_pic, extrapolation_layers, INT),
+        FSDEM__SAME(fsdem_pic, pressure_precond, INT), FSDEM__SAME(fsdem_pic, pressure_tolerance, REAL),
+        FSDEM__SAME(fsdem_pic, pressure_max_iterations, INT), FSDEM__SAME(fsdem_pic, viscosity_precond, INT),
+        FSDEM__SAME(fsdem_pic, viscosity_tolerance, REAL)};
+    static const fsdem__field state[16] = {
+        FSDEM__SAVED(fsdem_pic, time), FSDEM__SAVED(fsdem_pic, dt_last), FSDEM__SAVED(fsdem_pic, steps),
+        FSDEM__SAVED(fsdem_pic, rng), FSDEM__SAVED(fsdem_pic, cells_fresh), FSDEM__SAVED(fsdem_pic, fluid_cells),
+        FSDEM__SAVED(fsdem_pic, p_iters), FSDEM__SAVED(fsdem_pic, v_iters), FSDEM__SAVED(fsdem_pic, d_iters),
+        FSDEM__SAVED(fsdem_pic, p_res), FSDEM__SAVED(fsdem_pic, max_div), FSDEM__SAVED(fsdem_pic, div_before),
+        FSDEM__SAVED(fsdem_pic, reseeded), FSDEM__SAVED(fsdem_pic, removed), FSDEM__SAVED(fsdem_pic, refused),
+        FSDEM__SAVED(fsdem_pic, moved)};
+    fsdem_pic *s = (fsdem_pic *)object;
+    int grid[3], a;
+    size_t cells = sizeof(fsdem_real) * (size_t)s->ncell;
+    fsdem__restart_tag(io, "PIC2");
+    for (a = 0; a < 3; ++a) grid[a] = s->n[a];
+    fsdem__restart_value(io, grid, sizeof grid);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK &&
+        (grid[0] != s->n[0] || grid[1] != s->n[1] || grid[2] != s->n[2]))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the grid has %d x %d x %d cells in the save and %d x %d x %d in the object (create the "
+                            "object from the desc it was saved with)",
+                            grid[0], grid[1], grid[2], s->n[0], s->n[1], s->n[2]);
+    fsdem__restart_same_fields(io, s, same, 38);
+
+    fsdem__restart_fields(io, s, state, 16);
+
+    fsdem__restart_pic_obstacles(io, s);
+    fsdem__restart_pic_particles(io, s);
 
     /* grid fields, in place (the grid matches) */
     for (a = 0; a < s->dim; ++a) {
@@ -20439,8 +20434,20 @@ static void fsdem__restart_swe_series(fsdem__restart *io, fsdem_swe *s, fsdem_re
    step; the gauge file, its interval and next output time (restore refuses while a file is open);
    capacities, the allocator, log and message. */
 static void fsdem__restart_swe(fsdem__restart *io, void *object) {
+    static const fsdem__field same[15] = {
+        FSDEM__SAME(fsdem_swe, dim, INT), FSDEM__SAME(fsdem_swe, x_min, REAL), FSDEM__SAME(fsdem_swe, x_max, REAL),
+        FSDEM__SAME(fsdem_swe, y_min, REAL), FSDEM__SAME(fsdem_swe, y_max, REAL), FSDEM__SAME(fsdem_swe, width, REAL),
+        FSDEM__SAME(fsdem_swe, gravity, VEC3), FSDEM__SAME(fsdem_swe, density, REAL), FSDEM__SAME(fsdem_swe, cfl, REAL),
+        FSDEM__SAME(fsdem_swe, dt_max, REAL), FSDEM__SAME(fsdem_swe, order, INT), FSDEM__SAME(fsdem_swe, limiter, INT),
+        FSDEM__SAME(fsdem_swe, dry_depth, REAL), FSDEM__SAME(fsdem_swe, manning, REAL),
+        FSDEM__SAME(fsdem_swe, eddy_viscosity, REAL)};
+    static const fsdem__field state[14] = {
+        FSDEM__SAVED(fsdem_swe, time), FSDEM__SAVED(fsdem_swe, dt_last), FSDEM__SAVED(fsdem_swe, steps),
+        FSDEM__SAVED(fsdem_swe, fallbacks), FSDEM__SAVED(fsdem_swe, max_wave), FSDEM__SAVED(fsdem_swe, max_accel),
+        FSDEM__SAVED(fsdem_swe, max_speed), FSDEM__SAVED(fsdem_swe, max_depth), FSDEM__SAVED(fsdem_swe, wet_cells),
+        FSDEM__SAVED(fsdem_swe, vol_boundary), FSDEM__SAVED(fsdem_swe, vol_source), FSDEM__SAVED(fsdem_swe, vol_clipped),
+        FSDEM__SAVED(fsdem_swe, rain), FSDEM__SAVED(fsdem_swe, sources_used)};
     fsdem_swe *s = (fsdem_swe *)object;
-    const fsdem_swe_desc *sd = &s->desc;
     const fsdem_allocator *al = &s->allocator;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
     const size_t cells = sizeof(fsdem_real) * (size_t)s->n;
@@ -20457,40 +20464,13 @@ static void fsdem__restart_swe(fsdem__restart *io, void *object) {
                             "the grid has %d x %d cells in the save and %d x %d in the object (create the object from "
                             "the desc it was saved with)",
                             grid[0], grid[1], s->nx, s->ny);
-    fsdem__restart_same_int(io, sd->dim, "dim");
-    fsdem__restart_same_real(io, sd->x_min, "x_min");
-    fsdem__restart_same_real(io, sd->x_max, "x_max");
-    fsdem__restart_same_real(io, sd->y_min, "y_min");
-    fsdem__restart_same_real(io, sd->y_max, "y_max");
-    fsdem__restart_same_real(io, sd->width, "width");
-    fsdem__restart_same_vec3(io, sd->gravity, "gravity");
-    fsdem__restart_same_real(io, sd->density, "density");
-    fsdem__restart_same_real(io, sd->cfl, "cfl");
-    fsdem__restart_same_real(io, sd->dt_max, "dt_max");
-    fsdem__restart_same_int(io, sd->order, "order");
-    fsdem__restart_same_int(io, (int)sd->limiter, "limiter");
-    fsdem__restart_same_real(io, sd->dry_depth, "dry_depth");
-    fsdem__restart_same_real(io, sd->manning, "manning");
-    fsdem__restart_same_real(io, sd->eddy_viscosity, "eddy_viscosity");
+    fsdem__restart_same_fields(io, s, same, 15);
     if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file)
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                             "the object has a gauge file open: close it (fsdem_swe_gauges_close) before restoring and "
                             "open it again afterwards");
 
-    fsdem__restart_data(io, &s->time, sizeof s->time);
-    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
-    fsdem__restart_data(io, &s->steps, sizeof s->steps);
-    fsdem__restart_data(io, &s->fallbacks, sizeof s->fallbacks);
-    fsdem__restart_data(io, &s->max_wave, sizeof s->max_wave);
-    fsdem__restart_data(io, &s->max_accel, sizeof s->max_accel);
-    fsdem__restart_data(io, &s->max_speed, sizeof s->max_speed);
-    fsdem__restart_data(io, &s->max_depth, sizeof s->max_depth);
-    fsdem__restart_data(io, &s->wet_cells, sizeof s->wet_cells);
-    fsdem__restart_data(io, &s->vol_boundary, sizeof s->vol_boundary);
-    fsdem__restart_data(io, &s->vol_source, sizeof s->vol_source);
-    fsdem__restart_data(io, &s->vol_clipped, sizeof s->vol_clipped);
-    fsdem__restart_data(io, &s->rain, sizeof s->rain);
-    fsdem__restart_data(io, &s->sources_used, sizeof s->sources_used);
+    fsdem__restart_fields(io, s, state, 14);
 
     /* the state, exactly, in place */
     fsdem__restart_data(io, s->eta, cells);
@@ -20594,8 +20574,23 @@ static void fsdem__restart_mps_planes(fsdem__restart *io, int dim, int count, in
    density, surface flags, pressure gradients) are saved. The neighbour rows and the matrix are
    rebuilt by every step; their memory stays. */
 static void fsdem__restart_mps(fsdem__restart *io, void *object) {
+    static const fsdem__field same[27] = {
+        FSDEM__SAME(fsdem_mps, dim, INT), FSDEM__SAME(fsdem_mps, r0, REAL), FSDEM__SAME(fsdem_mps, re, REAL),
+        FSDEM__SAME(fsdem_mps, re_laplacian, REAL), FSDEM__SAME(fsdem_mps, density, REAL),
+        FSDEM__SAME(fsdem_mps, viscosity, REAL), FSDEM__SAME(fsdem_mps, gravity, VEC3), FSDEM__SAME(fsdem_mps, gamma, REAL),
+        FSDEM__SAME(fsdem_mps, model, INT), FSDEM__SAME(fsdem_mps, beta, REAL), FSDEM__SAME(fsdem_mps, alpha, REAL),
+        FSDEM__SAME(fsdem_mps, cfl, REAL), FSDEM__SAME(fsdem_mps, dt_max, REAL), FSDEM__SAME(fsdem_mps, domain_min, VEC3),
+        FSDEM__SAME(fsdem_mps, domain_max, VEC3), FSDEM__SAME(fsdem_mps, periodic[0], INT),
+        FSDEM__SAME(fsdem_mps, periodic[1], INT), FSDEM__SAME(fsdem_mps, periodic[2], INT), FSDEM__SAME(fsdem_mps, gradient, INT),
+        FSDEM__SAME(fsdem_mps, wall_viscosity, INT), FSDEM__SAME(fsdem_mps, clamp_negative_pressure, INT),
+        FSDEM__SAME(fsdem_mps, collision_distance, REAL), FSDEM__SAME(fsdem_mps, restitution, REAL),
+        FSDEM__SAME(fsdem_mps, shifting, REAL), FSDEM__SAME(fsdem_mps, pressure_precond, INT),
+        FSDEM__SAME(fsdem_mps, pressure_tolerance, REAL), FSDEM__SAME(fsdem_mps, pressure_max_iterations, INT)};
+    static const fsdem__field state[8] = {
+        FSDEM__SAVED(fsdem_mps, time), FSDEM__SAVED(fsdem_mps, dt_last), FSDEM__SAVED(fsdem_mps, steps),
+        FSDEM__SAVED(fsdem_mps, iters_total), FSDEM__SAVED(fsdem_mps, iters), FSDEM__SAVED(fsdem_mps, residual),
+        FSDEM__SAVED(fsdem_mps, surface_count), FSDEM__SAVED(fsdem_mps, pair_count)};
     fsdem_mps *s = (fsdem_mps *)object;
-    const fsdem_mps_desc *d = &s->desc;
     const fsdem_allocator *al = &s->allocator;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
     int no = s->obst_n, nin = s->inflow_n, nout = s->outflow_n, n = s->n, cap = s->cap, i, a;
@@ -20603,42 +20598,9 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem_mps_inflow_desc *inflows;
     fsdem_mps_outflow_desc *outflows;
     fsdem__restart_tag(io, "MPS5");
-    fsdem__restart_same_int(io, d->dim, "dim");
-    fsdem__restart_same_real(io, d->r0, "r0");
-    fsdem__restart_same_real(io, d->re, "re");
-    fsdem__restart_same_real(io, d->re_laplacian, "re_laplacian");
-    fsdem__restart_same_real(io, d->density, "density");
-    fsdem__restart_same_real(io, d->viscosity, "viscosity");
-    fsdem__restart_same_vec3(io, d->gravity, "gravity");
-    fsdem__restart_same_real(io, d->gamma, "gamma");
-    fsdem__restart_same_int(io, (int)d->model, "model");
-    fsdem__restart_same_real(io, d->beta, "beta");
-    fsdem__restart_same_real(io, d->alpha, "alpha");
-    fsdem__restart_same_real(io, d->cfl, "cfl");
-    fsdem__restart_same_real(io, d->dt_max, "dt_max");
-    fsdem__restart_same_vec3(io, d->domain_min, "domain_min");
-    fsdem__restart_same_vec3(io, d->domain_max, "domain_max");
-    fsdem__restart_same_int(io, d->periodic[0], "periodic[0]");
-    fsdem__restart_same_int(io, d->periodic[1], "periodic[1]");
-    fsdem__restart_same_int(io, d->periodic[2], "periodic[2]");
-    fsdem__restart_same_int(io, (int)d->gradient, "gradient");
-    fsdem__restart_same_int(io, (int)d->wall_viscosity, "wall_viscosity");
-    fsdem__restart_same_int(io, d->clamp_negative_pressure, "clamp_negative_pressure");
-    fsdem__restart_same_real(io, d->collision_distance, "collision_distance");
-    fsdem__restart_same_real(io, d->restitution, "restitution");
-    fsdem__restart_same_real(io, d->shifting, "shifting");
-    fsdem__restart_same_int(io, (int)d->pressure_precond, "pressure_precond");
-    fsdem__restart_same_real(io, d->pressure_tolerance, "pressure_tolerance");
-    fsdem__restart_same_int(io, d->pressure_max_iterations, "pressure_max_iterations");
+    fsdem__restart_same_fields(io, s, same, 27);
 
-    fsdem__restart_data(io, &s->time, sizeof s->time);
-    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
-    fsdem__restart_data(io, &s->steps, sizeof s->steps);
-    fsdem__restart_data(io, &s->iters_total, sizeof s->iters_total);
-    fsdem__restart_data(io, &s->iters, sizeof s->iters);
-    fsdem__restart_data(io, &s->residual, sizeof s->residual);
-    fsdem__restart_data(io, &s->surface_count, sizeof s->surface_count);
-    fsdem__restart_data(io, &s->pair_count, sizeof s->pair_count);
+    fsdem__restart_fields(io, s, state, 8);
 
     /* obstacles, into a fresh array */
     fsdem__restart_count(io, &no, 1 << 24, sizeof(fsdem__mps_obst), "obstacle count");
@@ -20737,29 +20699,6 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
    pointers, the claims, the allocator, log and message, the CPU times, and what every step rebuilds
    (pair lists, grids, cuts). */
 
-#define FSDEM__RESTART_FIELD(type, name, kind, field) {name, FSDEM__FIELD_##kind, offsetof(type, field), 1}
-
-/* The desc fields of `object` in `same` compared with the save's (the name prints as desc.<name>). */
-static void fsdem__restart_same_fields(fsdem__restart *io, const void *object, const fsdem__field *same, int n) {
-    int k;
-    for (k = 0; k < n; ++k) {
-        const void *at = (const char *)object + same[k].offset;
-        switch (same[k].kind) {
-        case FSDEM__FIELD_INT: fsdem__restart_same_int(io, *(const int *)at, same[k].name); break;
-        case FSDEM__FIELD_LL: fsdem__restart_same_ll(io, *(const long long *)at, same[k].name); break;
-        case FSDEM__FIELD_REAL: fsdem__restart_same_real(io, *(const fsdem_real *)at, same[k].name); break;
-        default: fsdem__restart_same_vec3(io, *(const fsdem_vec3 *)at, same[k].name); break;
-        }
-    }
-}
-
-/* The fields of `object` (a struct, or a record) in `fields` that are saved, as data. */
-static void fsdem__restart_fields(fsdem__restart *io, void *object, const fsdem__field *fields, int n) {
-    int k;
-    for (k = 0; k < n; ++k)
-        if (fields[k].saved) fsdem__restart_data(io, object ? (char *)object + fields[k].offset : NULL, fsdem__field_size(fields[k].kind));
-}
-
 /* `count` records of the coupler's kind at `records` (NULL while checking and reserving: nothing is
    stored then), their saved fields. */
 static void fsdem__restart_records(fsdem__restart *io, const fsdem_coupler *c, void *records, int count) {
@@ -20773,7 +20712,7 @@ static size_t fsdem__restart_record_bytes(const fsdem_coupler *c) {
     size_t bytes = 0;
     int k;
     for (k = 0; k < c->cls->field_count; ++k)
-        if (c->cls->fields[k].saved) bytes += fsdem__field_size(c->cls->fields[k].kind);
+        if (c->cls->fields[k].saved) bytes += c->cls->fields[k].size;
     return bytes;
 }
 
@@ -20799,14 +20738,14 @@ static void *fsdem__restart_here(const fsdem__restart *io, void *records) {
    reactions of every particle slot (the next step's impulse reads the reactions). */
 static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
     static const fsdem__field same[7] = {
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "beta", REAL, desc.beta),           FSDEM__RESTART_FIELD(fsdem_swe_dem, "two_way", INT, desc.two_way),
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "heave_damping", REAL, desc.heave_damping), FSDEM__RESTART_FIELD(fsdem_swe_dem, "max_substeps", LL, desc.max_substeps),
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "swe.density", REAL, rho),          FSDEM__RESTART_FIELD(fsdem_swe_dem, "swe.gravity", REAL, g),
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "swe.dry_depth", REAL, dry)};
+        FSDEM__SAME(fsdem_swe_dem, beta, REAL), FSDEM__SAME(fsdem_swe_dem, two_way, INT),
+        FSDEM__SAME(fsdem_swe_dem, heave_damping, REAL), FSDEM__SAME(fsdem_swe_dem, max_substeps, LL),
+        FSDEM__FIELD(fsdem_swe_dem, rho, "swe.density", REAL, 1), FSDEM__FIELD(fsdem_swe_dem, g, "swe.gravity", REAL, 1),
+        FSDEM__FIELD(fsdem_swe_dem, dry, "swe.dry_depth", REAL, 1)};
     static const fsdem__field state[6] = {
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "", LL, head.steps),  FSDEM__RESTART_FIELD(fsdem_swe_dem, "", LL, head.substeps),
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "", LL, head.substeps_total), FSDEM__RESTART_FIELD(fsdem_swe_dem, "", REAL, head.dt_last),
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "", INT, wet),         FSDEM__RESTART_FIELD(fsdem_swe_dem, "", VEC3, impulse)};
+        FSDEM__SAVED(fsdem_swe_dem, head.steps), FSDEM__SAVED(fsdem_swe_dem, head.substeps),
+        FSDEM__SAVED(fsdem_swe_dem, head.substeps_total), FSDEM__SAVED(fsdem_swe_dem, head.dt_last),
+        FSDEM__SAVED(fsdem_swe_dem, wet), FSDEM__SAVED(fsdem_swe_dem, impulse)};
     fsdem_swe_dem *c = (fsdem_swe_dem *)object;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
     int count = c->force_capacity, records = c->head.records;
@@ -20839,16 +20778,15 @@ static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
    by every update. */
 static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
     static const fsdem__field same[5] = {
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "drag", INT, desc.drag), FSDEM__RESTART_FIELD(fsdem_mps_dem, "averaging_radius", REAL, desc.averaging_radius),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "min_porosity", REAL, desc.min_porosity),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "drag_dt_fraction", REAL, desc.drag_dt_fraction),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "max_substeps", LL, desc.max_substeps)};
+        FSDEM__SAME(fsdem_mps_dem, drag, INT), FSDEM__SAME(fsdem_mps_dem, averaging_radius, REAL),
+        FSDEM__SAME(fsdem_mps_dem, min_porosity, REAL), FSDEM__SAME(fsdem_mps_dem, drag_dt_fraction, REAL),
+        FSDEM__SAME(fsdem_mps_dem, max_substeps, LL)};
     static const fsdem__field state[10] = {
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, head.steps),         FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, head.substeps),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, head.substeps_total), FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, tally.pairs),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", REAL, head.dt_last),      FSDEM__RESTART_FIELD(fsdem_mps_dem, "", REAL, tally.drag_dt),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", INT, tally.wet),          FSDEM__RESTART_FIELD(fsdem_mps_dem, "", VEC3, tally.drag_sum),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", VEC3, tally.pressure_sum), FSDEM__RESTART_FIELD(fsdem_mps_dem, "", VEC3, tally.fluid_sum)};
+        FSDEM__SAVED(fsdem_mps_dem, head.steps), FSDEM__SAVED(fsdem_mps_dem, head.substeps),
+        FSDEM__SAVED(fsdem_mps_dem, head.substeps_total), FSDEM__SAVED(fsdem_mps_dem, tally.pairs),
+        FSDEM__SAVED(fsdem_mps_dem, head.dt_last), FSDEM__SAVED(fsdem_mps_dem, tally.drag_dt),
+        FSDEM__SAVED(fsdem_mps_dem, tally.wet), FSDEM__SAVED(fsdem_mps_dem, tally.drag_sum),
+        FSDEM__SAVED(fsdem_mps_dem, tally.pressure_sum), FSDEM__SAVED(fsdem_mps_dem, tally.fluid_sum)};
     fsdem_mps_dem *c = (fsdem_mps_dem *)object;
     int count = c->head.records;
     fsdem_mps_dem_force *force;
@@ -20873,17 +20811,14 @@ static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
    not saved; the viscous limit of the saved step is: the run goes on bit for bit. */
 static void fsdem__restart_pic_dem(fsdem__restart *io, void *object) {
     static const fsdem__field same[5] = {
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "dissipation", REAL, desc.dissipation),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "contact_length", REAL, desc.contact_length),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "viscous_dt_fraction", REAL, desc.viscous_dt_fraction),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "discrete_weight", INT, desc.discrete_weight),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "max_substeps", LL, desc.max_substeps)};
+        FSDEM__SAME(fsdem_pic_dem, dissipation, REAL), FSDEM__SAME(fsdem_pic_dem, contact_length, REAL),
+        FSDEM__SAME(fsdem_pic_dem, viscous_dt_fraction, REAL), FSDEM__SAME(fsdem_pic_dem, discrete_weight, INT),
+        FSDEM__SAME(fsdem_pic_dem, max_substeps, LL)};
     static const fsdem__field state[9] = {
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, head.steps),   FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, head.substeps),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, head.substeps_total), FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, dissipated),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, pushed),       FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, removed),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", REAL, head.dt_last), FSDEM__RESTART_FIELD(fsdem_pic_dem, "", REAL, viscous_dt),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", VEC3, force_sum)};
+        FSDEM__SAVED(fsdem_pic_dem, head.steps), FSDEM__SAVED(fsdem_pic_dem, head.substeps),
+        FSDEM__SAVED(fsdem_pic_dem, head.substeps_total), FSDEM__SAVED(fsdem_pic_dem, dissipated),
+        FSDEM__SAVED(fsdem_pic_dem, pushed), FSDEM__SAVED(fsdem_pic_dem, removed), FSDEM__SAVED(fsdem_pic_dem, head.dt_last),
+        FSDEM__SAVED(fsdem_pic_dem, viscous_dt), FSDEM__SAVED(fsdem_pic_dem, force_sum)};
     fsdem_pic_dem *c = (fsdem_pic_dem *)object;
     int count = c->loaded ? c->bodies : 0, b;
     fsdem__restart_coupler(io, &c->head, "PDM1", fsdem__restart_pic, "water (PIC)", "bodies (DEM)", same, 5);
@@ -20907,20 +20842,16 @@ static void fsdem__restart_pic_dem(fsdem__restart *io, void *object) {
    counters. The force records are rebuilt by the next step's evaluations. */
 static void fsdem__restart_gic(fsdem__restart *io, void *object) {
     static const fsdem__field same[9] = {
-        FSDEM__RESTART_FIELD(fsdem_gic, "drag", INT, desc.drag),          FSDEM__RESTART_FIELD(fsdem_gic, "drag_scale", REAL, desc.drag_scale),
-        FSDEM__RESTART_FIELD(fsdem_gic, "virtual_mass", INT, desc.virtual_mass), FSDEM__RESTART_FIELD(fsdem_gic, "viscosity", REAL, mu),
-        FSDEM__RESTART_FIELD(fsdem_gic, "max_solid_fraction", REAL, desc.max_solid_fraction), FSDEM__RESTART_FIELD(fsdem_gic, "cfl", REAL, desc.cfl),
-        FSDEM__RESTART_FIELD(fsdem_gic, "max_dt_ratio", REAL, desc.max_dt_ratio),
-        FSDEM__RESTART_FIELD(fsdem_gic, "drag_dt_fraction", REAL, desc.drag_dt_fraction),
-        FSDEM__RESTART_FIELD(fsdem_gic, "max_substeps", LL, desc.max_substeps)};
+        FSDEM__SAME(fsdem_gic, drag, INT), FSDEM__SAME(fsdem_gic, drag_scale, REAL), FSDEM__SAME(fsdem_gic, virtual_mass, INT),
+        FSDEM__FIELD(fsdem_gic, mu, "viscosity", REAL, 1), FSDEM__SAME(fsdem_gic, max_solid_fraction, REAL),
+        FSDEM__SAME(fsdem_gic, cfl, REAL), FSDEM__SAME(fsdem_gic, max_dt_ratio, REAL),
+        FSDEM__SAME(fsdem_gic, drag_dt_fraction, REAL), FSDEM__SAME(fsdem_gic, max_substeps, LL)};
     static const fsdem__field state[13] = {
-        FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, max_solid),       FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, solid_volume),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.pressure),   FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.drag),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.virtual_mass), FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.to_fluid),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.lost),       FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, last.drag_dt),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", INT, last.wet),         FSDEM__RESTART_FIELD(fsdem_gic, "", LL, head.steps),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", LL, head.substeps),     FSDEM__RESTART_FIELD(fsdem_gic, "", LL, head.substeps_total),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, head.dt_last)};
+        FSDEM__SAVED(fsdem_gic, max_solid), FSDEM__SAVED(fsdem_gic, solid_volume), FSDEM__SAVED(fsdem_gic, last.pressure),
+        FSDEM__SAVED(fsdem_gic, last.drag), FSDEM__SAVED(fsdem_gic, last.virtual_mass), FSDEM__SAVED(fsdem_gic, last.to_fluid),
+        FSDEM__SAVED(fsdem_gic, last.lost), FSDEM__SAVED(fsdem_gic, last.drag_dt), FSDEM__SAVED(fsdem_gic, last.wet),
+        FSDEM__SAVED(fsdem_gic, head.steps), FSDEM__SAVED(fsdem_gic, head.substeps), FSDEM__SAVED(fsdem_gic, head.substeps_total),
+        FSDEM__SAVED(fsdem_gic, head.dt_last)};
     fsdem_gic *c = (fsdem_gic *)object;
     const size_t cells = sizeof(fsdem_real) * (size_t)c->grid.ncell;
     fsdem__restart_coupler(io, &c->head, "GIC1", fsdem__restart_pic, "water (PIC)", "granules (DEM)", same, 9);
@@ -20931,7 +20862,6 @@ static void fsdem__restart_gic(fsdem__restart *io, void *object) {
     fsdem__restart_tag(io, "GIC.");
 }
 
-#undef FSDEM__RESTART_FIELD
 
 /* ---- >>restart_api : memory and files ---- */
 

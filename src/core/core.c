@@ -397,6 +397,19 @@ static fsdem_result fsdem__write_rows(const fsdem__status *status, const char *w
     return fsdem__ok((fsdem__status *)status);
 }
 
+/* A field of a struct, by table: its name, what it holds, where and how long it is. A coupler's
+   record lists its fields so (the CSV columns, >>couple_records), and a restart visitor the desc
+   fields it compares and the scalars it saves (>>restart_format). */
+enum { FSDEM__FIELD_INT, FSDEM__FIELD_LL, FSDEM__FIELD_REAL, FSDEM__FIELD_VEC3, FSDEM__FIELD_BYTES };
+typedef struct fsdem__field {
+    const char *name;
+    int kind;            /* FSDEM__FIELD_*: how to read it (BYTES: only saved, as they are) */
+    size_t offset, size; /* bytes */
+    int saved;           /* part of the restart (a record's field may be left out) */
+} fsdem__field;
+#define FSDEM__FIELD(type, member, name, kind, saved) \
+    { name, FSDEM__FIELD_##kind, offsetof(type, member), sizeof(((type *)0)->member), saved }
+
 /* A relative tolerance of at least `floor` and of 100 roundings of fsdem_real, so a test written for
    double still holds in float. */
 static double fsdem__tolerance(double floor) {

@@ -458,7 +458,7 @@ static const fsdem__stage fsdem__gic_stages[3] = {{"sand substeps", FSDEM__CLOCK
                                                   {"fractions", FSDEM__CLOCK_COUPLING, fsdem__gic_fractions},
                                                   {"PIC step", FSDEM__CLOCK_FLUID, NULL}};
 
-#define FSDEM__GIC_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_gic_force, name), 0}
+#define FSDEM__GIC_FIELD(name, kind) FSDEM__FIELD(fsdem_gic_force, name, #name, kind, 0)
 static const fsdem__field fsdem__gic_fields[8] = {
     FSDEM__GIC_FIELD(id, INT),           FSDEM__GIC_FIELD(pressure, VEC3),       FSDEM__GIC_FIELD(drag, VEC3),
     FSDEM__GIC_FIELD(virtual_mass, VEC3), FSDEM__GIC_FIELD(fluid_velocity, VEC3), FSDEM__GIC_FIELD(fluid_acceleration, VEC3),

@@ -29,23 +29,12 @@ typedef struct fsdem__fluid {
     fsdem_claims *(*claims)(void *fluid);
 } fsdem__fluid;
 
-/* A field of a coupler's per-particle record: CSV columns (_x, _y, _z for a vector) and, when
-   `saved`, part of the coupler's restart file (>>restart_couplers), in the order of the table. The
-   restart's tables of a coupler's own fields use the same type (and long long counts). */
-enum { FSDEM__FIELD_INT = 0, FSDEM__FIELD_REAL = 1, FSDEM__FIELD_VEC3 = 2, FSDEM__FIELD_LL = 3 };
-typedef struct fsdem__field {
-    const char *name;
-    int kind;
-    size_t offset;
-    int saved;
-} fsdem__field;
-
 /* What makes a coupler of one kind. */
 typedef struct fsdem__coupler_class {
     const char *name;                   /* "fsdem_gic": its messages start so */
     const fsdem__fluid *fluid;
     size_t record_size;                 /* bytes of its per-particle record, whose first field is the int id */
-    const fsdem__field *fields;
+    const fsdem__field *fields;         /* the record's fields (>>core), CSV columns and restart */
     int field_count;
     /* its step (>>couple_step): prepare (may be NULL) does what must come before the step's length
        is known, and undo (may be NULL) puts it back when the step is refused; limit (may be NULL)

@@ -502,7 +502,7 @@ static fsdem_result fsdem__mps_dem_substeps(fsdem_coupler *head, fsdem_real dt) 
 static const fsdem__stage fsdem__mps_dem_stages[2] = {{"MPS step", FSDEM__CLOCK_FLUID, NULL},
                                                       {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__mps_dem_substeps}};
 
-#define FSDEM__MPS_DEM_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_mps_dem_force, name), 1}
+#define FSDEM__MPS_DEM_FIELD(name, kind) FSDEM__FIELD(fsdem_mps_dem_force, name, #name, kind, 1)
 static const fsdem__field fsdem__mps_dem_fields[8] = {
     FSDEM__MPS_DEM_FIELD(id, INT),          FSDEM__MPS_DEM_FIELD(drag, VEC3),     FSDEM__MPS_DEM_FIELD(pressure, VEC3),
     FSDEM__MPS_DEM_FIELD(total, VEC3),      FSDEM__MPS_DEM_FIELD(fluid_velocity, VEC3), FSDEM__MPS_DEM_FIELD(porosity, REAL),

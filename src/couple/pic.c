@@ -885,7 +885,7 @@ static const fsdem__stage fsdem__pic_dem_stages[6] = {
     {"PIC step", FSDEM__CLOCK_FLUID, NULL},                          {"loads", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_loads_stage},
     {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__pic_dem_substeps},     {"gap", FSDEM__CLOCK_COUPLING, fsdem__pic_dem_gap_stage}};
 
-#define FSDEM__PIC_DEM_FIELD(name, kind, saved) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_pic_dem_force, name), saved}
+#define FSDEM__PIC_DEM_FIELD(name, kind, saved) FSDEM__FIELD(fsdem_pic_dem_force, name, #name, kind, saved)
 static const fsdem__field fsdem__pic_dem_fields[7] = {
     FSDEM__PIC_DEM_FIELD(id, INT, 1),      FSDEM__PIC_DEM_FIELD(pressure_force, VEC3, 1), FSDEM__PIC_DEM_FIELD(viscous_force, VEC3, 1),
     FSDEM__PIC_DEM_FIELD(torque, VEC3, 1), FSDEM__PIC_DEM_FIELD(weight_correction, VEC3, 1), FSDEM__PIC_DEM_FIELD(volume, REAL, 1),

@@ -31,14 +31,6 @@ static fsdem_result fsdem__coupler_get_record(const fsdem_coupler *c, int index,
     return FSDEM_OK;
 }
 
-/* Bytes of a field of kind `kind`. */
-static size_t fsdem__field_size(int kind) {
-    return kind == FSDEM__FIELD_INT    ? sizeof(int)
-           : kind == FSDEM__FIELD_REAL ? sizeof(fsdem_real)
-           : kind == FSDEM__FIELD_VEC3 ? sizeof(fsdem_vec3)
-                                       : sizeof(long long);
-}
-
 /* The values of the record of particle `index` as a CSV row (fsdem__row_fn); 0 without a record. */
 static int fsdem__coupler_row(const void *object, int index, double *v) {
     const fsdem_coupler *c = (const fsdem_coupler *)object;

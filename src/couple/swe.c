@@ -293,7 +293,7 @@ static const fsdem__stage fsdem__swe_dem_stages[3] = {{"forces", FSDEM__CLOCK_CO
                                                       {"shallow-water step", FSDEM__CLOCK_FLUID, NULL},
                                                       {"DEM substeps", FSDEM__CLOCK_DEM, fsdem__swe_dem_substeps}};
 
-#define FSDEM__SWE_DEM_FIELD(name, kind) {#name, FSDEM__FIELD_##kind, offsetof(fsdem_swe_dem_force, name), 1}
+#define FSDEM__SWE_DEM_FIELD(name, kind) FSDEM__FIELD(fsdem_swe_dem_force, name, #name, kind, 1)
 static const fsdem__field fsdem__swe_dem_fields[9] = {
     FSDEM__SWE_DEM_FIELD(id, INT),          FSDEM__SWE_DEM_FIELD(buoyancy, VEC3),         FSDEM__SWE_DEM_FIELD(hydrostatic, VEC3),
     FSDEM__SWE_DEM_FIELD(dynamic, VEC3),    FSDEM__SWE_DEM_FIELD(heave, VEC3),            FSDEM__SWE_DEM_FIELD(submerged_volume, REAL),

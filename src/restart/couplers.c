@@ -7,29 +7,6 @@
    pointers, the claims, the allocator, log and message, the CPU times, and what every step rebuilds
    (pair lists, grids, cuts). */
 
-#define FSDEM__RESTART_FIELD(type, name, kind, field) {name, FSDEM__FIELD_##kind, offsetof(type, field), 1}
-
-/* The desc fields of `object` in `same` compared with the save's (the name prints as desc.<name>). */
-static void fsdem__restart_same_fields(fsdem__restart *io, const void *object, const fsdem__field *same, int n) {
-    int k;
-    for (k = 0; k < n; ++k) {
-        const void *at = (const char *)object + same[k].offset;
-        switch (same[k].kind) {
-        case FSDEM__FIELD_INT: fsdem__restart_same_int(io, *(const int *)at, same[k].name); break;
-        case FSDEM__FIELD_LL: fsdem__restart_same_ll(io, *(const long long *)at, same[k].name); break;
-        case FSDEM__FIELD_REAL: fsdem__restart_same_real(io, *(const fsdem_real *)at, same[k].name); break;
-        default: fsdem__restart_same_vec3(io, *(const fsdem_vec3 *)at, same[k].name); break;
-        }
-    }
-}
-
-/* The fields of `object` (a struct, or a record) in `fields` that are saved, as data. */
-static void fsdem__restart_fields(fsdem__restart *io, void *object, const fsdem__field *fields, int n) {
-    int k;
-    for (k = 0; k < n; ++k)
-        if (fields[k].saved) fsdem__restart_data(io, object ? (char *)object + fields[k].offset : NULL, fsdem__field_size(fields[k].kind));
-}
-
 /* `count` records of the coupler's kind at `records` (NULL while checking and reserving: nothing is
    stored then), their saved fields. */
 static void fsdem__restart_records(fsdem__restart *io, const fsdem_coupler *c, void *records, int count) {
@@ -43,7 +20,7 @@ static size_t fsdem__restart_record_bytes(const fsdem_coupler *c) {
     size_t bytes = 0;
     int k;
     for (k = 0; k < c->cls->field_count; ++k)
-        if (c->cls->fields[k].saved) bytes += fsdem__field_size(c->cls->fields[k].kind);
+        if (c->cls->fields[k].saved) bytes += c->cls->fields[k].size;
     return bytes;
 }
 
@@ -69,14 +46,14 @@ static void *fsdem__restart_here(const fsdem__restart *io, void *records) {
    reactions of every particle slot (the next step's impulse reads the reactions). */
 static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
     static const fsdem__field same[7] = {
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "beta", REAL, desc.beta),           FSDEM__RESTART_FIELD(fsdem_swe_dem, "two_way", INT, desc.two_way),
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "heave_damping", REAL, desc.heave_damping), FSDEM__RESTART_FIELD(fsdem_swe_dem, "max_substeps", LL, desc.max_substeps),
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "swe.density", REAL, rho),          FSDEM__RESTART_FIELD(fsdem_swe_dem, "swe.gravity", REAL, g),
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "swe.dry_depth", REAL, dry)};
+        FSDEM__SAME(fsdem_swe_dem, beta, REAL), FSDEM__SAME(fsdem_swe_dem, two_way, INT),
+        FSDEM__SAME(fsdem_swe_dem, heave_damping, REAL), FSDEM__SAME(fsdem_swe_dem, max_substeps, LL),
+        FSDEM__FIELD(fsdem_swe_dem, rho, "swe.density", REAL, 1), FSDEM__FIELD(fsdem_swe_dem, g, "swe.gravity", REAL, 1),
+        FSDEM__FIELD(fsdem_swe_dem, dry, "swe.dry_depth", REAL, 1)};
     static const fsdem__field state[6] = {
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "", LL, head.steps),  FSDEM__RESTART_FIELD(fsdem_swe_dem, "", LL, head.substeps),
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "", LL, head.substeps_total), FSDEM__RESTART_FIELD(fsdem_swe_dem, "", REAL, head.dt_last),
-        FSDEM__RESTART_FIELD(fsdem_swe_dem, "", INT, wet),         FSDEM__RESTART_FIELD(fsdem_swe_dem, "", VEC3, impulse)};
+        FSDEM__SAVED(fsdem_swe_dem, head.steps), FSDEM__SAVED(fsdem_swe_dem, head.substeps),
+        FSDEM__SAVED(fsdem_swe_dem, head.substeps_total), FSDEM__SAVED(fsdem_swe_dem, head.dt_last),
+        FSDEM__SAVED(fsdem_swe_dem, wet), FSDEM__SAVED(fsdem_swe_dem, impulse)};
     fsdem_swe_dem *c = (fsdem_swe_dem *)object;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
     int count = c->force_capacity, records = c->head.records;
@@ -109,16 +86,15 @@ static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
    by every update. */
 static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
     static const fsdem__field same[5] = {
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "drag", INT, desc.drag), FSDEM__RESTART_FIELD(fsdem_mps_dem, "averaging_radius", REAL, desc.averaging_radius),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "min_porosity", REAL, desc.min_porosity),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "drag_dt_fraction", REAL, desc.drag_dt_fraction),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "max_substeps", LL, desc.max_substeps)};
+        FSDEM__SAME(fsdem_mps_dem, drag, INT), FSDEM__SAME(fsdem_mps_dem, averaging_radius, REAL),
+        FSDEM__SAME(fsdem_mps_dem, min_porosity, REAL), FSDEM__SAME(fsdem_mps_dem, drag_dt_fraction, REAL),
+        FSDEM__SAME(fsdem_mps_dem, max_substeps, LL)};
     static const fsdem__field state[10] = {
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, head.steps),         FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, head.substeps),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, head.substeps_total), FSDEM__RESTART_FIELD(fsdem_mps_dem, "", LL, tally.pairs),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", REAL, head.dt_last),      FSDEM__RESTART_FIELD(fsdem_mps_dem, "", REAL, tally.drag_dt),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", INT, tally.wet),          FSDEM__RESTART_FIELD(fsdem_mps_dem, "", VEC3, tally.drag_sum),
-        FSDEM__RESTART_FIELD(fsdem_mps_dem, "", VEC3, tally.pressure_sum), FSDEM__RESTART_FIELD(fsdem_mps_dem, "", VEC3, tally.fluid_sum)};
+        FSDEM__SAVED(fsdem_mps_dem, head.steps), FSDEM__SAVED(fsdem_mps_dem, head.substeps),
+        FSDEM__SAVED(fsdem_mps_dem, head.substeps_total), FSDEM__SAVED(fsdem_mps_dem, tally.pairs),
+        FSDEM__SAVED(fsdem_mps_dem, head.dt_last), FSDEM__SAVED(fsdem_mps_dem, tally.drag_dt),
+        FSDEM__SAVED(fsdem_mps_dem, tally.wet), FSDEM__SAVED(fsdem_mps_dem, tally.drag_sum),
+        FSDEM__SAVED(fsdem_mps_dem, tally.pressure_sum), FSDEM__SAVED(fsdem_mps_dem, tally.fluid_sum)};
     fsdem_mps_dem *c = (fsdem_mps_dem *)object;
     int count = c->head.records;
     fsdem_mps_dem_force *force;
@@ -143,17 +119,14 @@ static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
    not saved; the viscous limit of the saved step is: the run goes on bit for bit. */
 static void fsdem__restart_pic_dem(fsdem__restart *io, void *object) {
     static const fsdem__field same[5] = {
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "dissipation", REAL, desc.dissipation),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "contact_length", REAL, desc.contact_length),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "viscous_dt_fraction", REAL, desc.viscous_dt_fraction),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "discrete_weight", INT, desc.discrete_weight),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "max_substeps", LL, desc.max_substeps)};
+        FSDEM__SAME(fsdem_pic_dem, dissipation, REAL), FSDEM__SAME(fsdem_pic_dem, contact_length, REAL),
+        FSDEM__SAME(fsdem_pic_dem, viscous_dt_fraction, REAL), FSDEM__SAME(fsdem_pic_dem, discrete_weight, INT),
+        FSDEM__SAME(fsdem_pic_dem, max_substeps, LL)};
     static const fsdem__field state[9] = {
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, head.steps),   FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, head.substeps),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, head.substeps_total), FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, dissipated),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, pushed),       FSDEM__RESTART_FIELD(fsdem_pic_dem, "", LL, removed),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", REAL, head.dt_last), FSDEM__RESTART_FIELD(fsdem_pic_dem, "", REAL, viscous_dt),
-        FSDEM__RESTART_FIELD(fsdem_pic_dem, "", VEC3, force_sum)};
+        FSDEM__SAVED(fsdem_pic_dem, head.steps), FSDEM__SAVED(fsdem_pic_dem, head.substeps),
+        FSDEM__SAVED(fsdem_pic_dem, head.substeps_total), FSDEM__SAVED(fsdem_pic_dem, dissipated),
+        FSDEM__SAVED(fsdem_pic_dem, pushed), FSDEM__SAVED(fsdem_pic_dem, removed), FSDEM__SAVED(fsdem_pic_dem, head.dt_last),
+        FSDEM__SAVED(fsdem_pic_dem, viscous_dt), FSDEM__SAVED(fsdem_pic_dem, force_sum)};
     fsdem_pic_dem *c = (fsdem_pic_dem *)object;
     int count = c->loaded ? c->bodies : 0, b;
     fsdem__restart_coupler(io, &c->head, "PDM1", fsdem__restart_pic, "water (PIC)", "bodies (DEM)", same, 5);
@@ -177,20 +150,16 @@ static void fsdem__restart_pic_dem(fsdem__restart *io, void *object) {
    counters. The force records are rebuilt by the next step's evaluations. */
 static void fsdem__restart_gic(fsdem__restart *io, void *object) {
     static const fsdem__field same[9] = {
-        FSDEM__RESTART_FIELD(fsdem_gic, "drag", INT, desc.drag),          FSDEM__RESTART_FIELD(fsdem_gic, "drag_scale", REAL, desc.drag_scale),
-        FSDEM__RESTART_FIELD(fsdem_gic, "virtual_mass", INT, desc.virtual_mass), FSDEM__RESTART_FIELD(fsdem_gic, "viscosity", REAL, mu),
-        FSDEM__RESTART_FIELD(fsdem_gic, "max_solid_fraction", REAL, desc.max_solid_fraction), FSDEM__RESTART_FIELD(fsdem_gic, "cfl", REAL, desc.cfl),
-        FSDEM__RESTART_FIELD(fsdem_gic, "max_dt_ratio", REAL, desc.max_dt_ratio),
-        FSDEM__RESTART_FIELD(fsdem_gic, "drag_dt_fraction", REAL, desc.drag_dt_fraction),
-        FSDEM__RESTART_FIELD(fsdem_gic, "max_substeps", LL, desc.max_substeps)};
+        FSDEM__SAME(fsdem_gic, drag, INT), FSDEM__SAME(fsdem_gic, drag_scale, REAL), FSDEM__SAME(fsdem_gic, virtual_mass, INT),
+        FSDEM__FIELD(fsdem_gic, mu, "viscosity", REAL, 1), FSDEM__SAME(fsdem_gic, max_solid_fraction, REAL),
+        FSDEM__SAME(fsdem_gic, cfl, REAL), FSDEM__SAME(fsdem_gic, max_dt_ratio, REAL),
+        FSDEM__SAME(fsdem_gic, drag_dt_fraction, REAL), FSDEM__SAME(fsdem_gic, max_substeps, LL)};
     static const fsdem__field state[13] = {
-        FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, max_solid),       FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, solid_volume),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.pressure),   FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.drag),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.virtual_mass), FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.to_fluid),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", VEC3, last.lost),       FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, last.drag_dt),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", INT, last.wet),         FSDEM__RESTART_FIELD(fsdem_gic, "", LL, head.steps),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", LL, head.substeps),     FSDEM__RESTART_FIELD(fsdem_gic, "", LL, head.substeps_total),
-        FSDEM__RESTART_FIELD(fsdem_gic, "", REAL, head.dt_last)};
+        FSDEM__SAVED(fsdem_gic, max_solid), FSDEM__SAVED(fsdem_gic, solid_volume), FSDEM__SAVED(fsdem_gic, last.pressure),
+        FSDEM__SAVED(fsdem_gic, last.drag), FSDEM__SAVED(fsdem_gic, last.virtual_mass), FSDEM__SAVED(fsdem_gic, last.to_fluid),
+        FSDEM__SAVED(fsdem_gic, last.lost), FSDEM__SAVED(fsdem_gic, last.drag_dt), FSDEM__SAVED(fsdem_gic, last.wet),
+        FSDEM__SAVED(fsdem_gic, head.steps), FSDEM__SAVED(fsdem_gic, head.substeps), FSDEM__SAVED(fsdem_gic, head.substeps_total),
+        FSDEM__SAVED(fsdem_gic, head.dt_last)};
     fsdem_gic *c = (fsdem_gic *)object;
     const size_t cells = sizeof(fsdem_real) * (size_t)c->grid.ncell;
     fsdem__restart_coupler(io, &c->head, "GIC1", fsdem__restart_pic, "water (PIC)", "granules (DEM)", same, 9);
@@ -201,4 +170,3 @@ static void fsdem__restart_gic(fsdem__restart *io, void *object) {
     fsdem__restart_tag(io, "GIC.");
 }
 
-#undef FSDEM__RESTART_FIELD

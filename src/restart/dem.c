@@ -79,53 +79,36 @@ static int fsdem__restart_dem_list(fsdem__restart *io, fsdem_dem *d, fsdem__dem_
    predictor-corrector's x0, v0, w0, fa, ta and the walls' force_a (written at the start of each
    such step), capacities, the allocator, log and message. SDF walls keep the object's callbacks. */
 static void fsdem__restart_dem(fsdem__restart *io, void *object) {
+    static const fsdem__field same[22] = {
+        FSDEM__SAME(fsdem_dem, dim, INT), FSDEM__SAME(fsdem_dem, domain_min, VEC3), FSDEM__SAME(fsdem_dem, domain_max, VEC3),
+        FSDEM__SAME(fsdem_dem, gravity, VEC3), FSDEM__SAME(fsdem_dem, law, INT), FSDEM__SAME(fsdem_dem, integrator, INT),
+        FSDEM__SAME(fsdem_dem, dt_rule, INT), FSDEM__SAME(fsdem_dem, dt_param, REAL), FSDEM__SAME(fsdem_dem, skin, REAL),
+        FSDEM__SAME(fsdem_dem, contact_offset, REAL), FSDEM__SAME(fsdem_dem, linear_theta, REAL),
+        FSDEM__SAME(fsdem_dem, linear_dx, REAL), FSDEM__SAME(fsdem_dem, linear_accel, REAL),
+        FSDEM__SAME(fsdem_dem, disc_length, REAL), FSDEM__SAME(fsdem_dem, rotation, INT),
+        FSDEM__SAME(fsdem_dem, tangential_damping, INT), FSDEM__SAME(fsdem_dem, tangential_history, INT),
+        FSDEM__SAME(fsdem_dem, coulomb_limit, INT), FSDEM__SAME(fsdem_dem, linear_stiffness, INT),
+        FSDEM__SAME(fsdem_dem, periodic[0], INT), FSDEM__SAME(fsdem_dem, periodic[1], INT),
+        FSDEM__SAME(fsdem_dem, periodic[2], INT)};
+    static const fsdem__field state[10] = {
+        FSDEM__SAVED(fsdem_dem, dt), FSDEM__SAVED(fsdem_dem, time), FSDEM__SAVED(fsdem_dem, steps),
+        FSDEM__SAVED(fsdem_dem, rebuilds), FSDEM__SAVED(fsdem_dem, stable_dt), FSDEM__SAVED(fsdem_dem, dt_warned),
+        FSDEM__SAVED(fsdem_dem, next_id), FSDEM__SAVED(fsdem_dem, skin), FSDEM__SAVED(fsdem_dem, r_max),
+        FSDEM__SAVED(fsdem_dem, max_disp2)};
+    static const fsdem__field state1[7] = {
+        FSDEM__SAVED(fsdem_dem, forces_valid), FSDEM__SAVED(fsdem_dem, rolling), FSDEM__SAVED(fsdem_dem, external),
+        FSDEM__SAVED(fsdem_dem, forces_cleared), FSDEM__SAVED(fsdem_dem, contacts), FSDEM__SAVED(fsdem_dem, wall_contacts),
+        FSDEM__SAVED(fsdem_dem, max_overlap)};
     fsdem_dem *d = (fsdem_dem *)object;
-    const fsdem_dem_desc *dd = &d->desc;
     const int reserve = io->mode == FSDEM__RESTART_RESERVE, commit = io->mode == FSDEM__RESTART_COMMIT;
     int nm = d->material_count, nw = d->wall_count, n = d->n, stale = d->need_rebuild, inert = d->inert_count;
     int k, longest, pairs = 0, wall_entries = 0;
     fsdem__restart_tag(io, "DEM1");
-    fsdem__restart_same_int(io, dd->dim, "dim");
-    fsdem__restart_same_vec3(io, dd->domain_min, "domain_min");
-    fsdem__restart_same_vec3(io, dd->domain_max, "domain_max");
-    fsdem__restart_same_vec3(io, dd->gravity, "gravity");
-    fsdem__restart_same_int(io, (int)dd->law, "law");
-    fsdem__restart_same_int(io, (int)dd->integrator, "integrator");
-    fsdem__restart_same_int(io, (int)dd->dt_rule, "dt_rule");
-    fsdem__restart_same_real(io, dd->dt_param, "dt_param");
-    fsdem__restart_same_real(io, dd->skin, "skin");
-    fsdem__restart_same_real(io, dd->contact_offset, "contact_offset");
-    fsdem__restart_same_real(io, dd->linear_theta, "linear_theta");
-    fsdem__restart_same_real(io, dd->linear_dx, "linear_dx");
-    fsdem__restart_same_real(io, dd->linear_accel, "linear_accel");
-    fsdem__restart_same_real(io, dd->disc_length, "disc_length");
-    fsdem__restart_same_int(io, dd->rotation, "rotation");
-    fsdem__restart_same_int(io, dd->tangential_damping, "tangential_damping");
-    fsdem__restart_same_int(io, (int)dd->tangential_history, "tangential_history");
-    fsdem__restart_same_int(io, (int)dd->coulomb_limit, "coulomb_limit");
-    fsdem__restart_same_int(io, (int)dd->linear_stiffness, "linear_stiffness");
-    fsdem__restart_same_int(io, dd->periodic[0], "periodic[0]");
-    fsdem__restart_same_int(io, dd->periodic[1], "periodic[1]");
-    fsdem__restart_same_int(io, dd->periodic[2], "periodic[2]");
+    fsdem__restart_same_fields(io, d, same, 22);
 
-    fsdem__restart_data(io, &d->dt, sizeof d->dt);
-    fsdem__restart_data(io, &d->time, sizeof d->time);
-    fsdem__restart_data(io, &d->steps, sizeof d->steps);
-    fsdem__restart_data(io, &d->rebuilds, sizeof d->rebuilds);
-    fsdem__restart_data(io, &d->stable_dt, sizeof d->stable_dt);
-    fsdem__restart_data(io, &d->dt_warned, sizeof d->dt_warned);
-    fsdem__restart_data(io, &d->next_id, sizeof d->next_id);
-    fsdem__restart_data(io, &d->skin, sizeof d->skin);
-    fsdem__restart_data(io, &d->r_max, sizeof d->r_max);
-    fsdem__restart_data(io, &d->max_disp2, sizeof d->max_disp2);
+    fsdem__restart_fields(io, d, state, 10);
     fsdem__restart_int_in(io, &stale, 0, 1, "need_rebuild");
-    fsdem__restart_data(io, &d->forces_valid, sizeof d->forces_valid);
-    fsdem__restart_data(io, &d->rolling, sizeof d->rolling);
-    fsdem__restart_data(io, &d->external, sizeof d->external);
-    fsdem__restart_data(io, &d->forces_cleared, sizeof d->forces_cleared);
-    fsdem__restart_data(io, &d->contacts, sizeof d->contacts);
-    fsdem__restart_data(io, &d->wall_contacts, sizeof d->wall_contacts);
-    fsdem__restart_data(io, &d->max_overlap, sizeof d->max_overlap);
+    fsdem__restart_fields(io, d, state1, 7);
     if (commit) d->need_rebuild = stale;
 
     /* materials and their pair table */

@@ -252,3 +252,31 @@ static void *fsdem__restart_block(fsdem__restart *io, const fsdem_allocator *al,
     else io->block_count++;
     return NULL;
 }
+
+/* Fields by table (fsdem__field, >>core): a visitor lists the desc fields it compares and the
+   scalars it saves, in the order of the payload: FSDEM__SAME(T, member, kind) is T's desc.member,
+   FSDEM__SAVED(T, member) its member saved as it is. */
+#define FSDEM__SAME(T, member, kind) FSDEM__FIELD(T, desc.member, #member, kind, 1)
+#define FSDEM__SAVED(T, member) FSDEM__FIELD(T, member, #member, BYTES, 1)
+
+/* The desc fields of `object` in `same` compared with the save's (the name prints as desc.<name>). */
+static void fsdem__restart_same_fields(fsdem__restart *io, const void *object, const fsdem__field *same, int n) {
+    int k;
+    for (k = 0; k < n; ++k) {
+        const void *at = (const char *)object + same[k].offset;
+        FSDEM_ASSERT(same[k].kind != FSDEM__FIELD_INT || same[k].size == sizeof(int)); /* (enums included) */
+        switch (same[k].kind) {
+        case FSDEM__FIELD_INT: fsdem__restart_same_int(io, *(const int *)at, same[k].name); break;
+        case FSDEM__FIELD_LL: fsdem__restart_same_ll(io, *(const long long *)at, same[k].name); break;
+        case FSDEM__FIELD_REAL: fsdem__restart_same_real(io, *(const fsdem_real *)at, same[k].name); break;
+        default: fsdem__restart_same_vec3(io, *(const fsdem_vec3 *)at, same[k].name); break;
+        }
+    }
+}
+
+/* The fields of `object` (a struct, or a record) in `fields` that are saved, as data. */
+static void fsdem__restart_fields(fsdem__restart *io, void *object, const fsdem__field *fields, int n) {
+    int k;
+    for (k = 0; k < n; ++k)
+        if (fields[k].saved) fsdem__restart_data(io, object ? (char *)object + fields[k].offset : NULL, fields[k].size);
+}

@@ -33,8 +33,23 @@ static void fsdem__restart_mps_planes(fsdem__restart *io, int dim, int count, in
    density, surface flags, pressure gradients) are saved. The neighbour rows and the matrix are
    rebuilt by every step; their memory stays. */
 static void fsdem__restart_mps(fsdem__restart *io, void *object) {
+    static const fsdem__field same[27] = {
+        FSDEM__SAME(fsdem_mps, dim, INT), FSDEM__SAME(fsdem_mps, r0, REAL), FSDEM__SAME(fsdem_mps, re, REAL),
+        FSDEM__SAME(fsdem_mps, re_laplacian, REAL), FSDEM__SAME(fsdem_mps, density, REAL),
+        FSDEM__SAME(fsdem_mps, viscosity, REAL), FSDEM__SAME(fsdem_mps, gravity, VEC3), FSDEM__SAME(fsdem_mps, gamma, REAL),
+        FSDEM__SAME(fsdem_mps, model, INT), FSDEM__SAME(fsdem_mps, beta, REAL), FSDEM__SAME(fsdem_mps, alpha, REAL),
+        FSDEM__SAME(fsdem_mps, cfl, REAL), FSDEM__SAME(fsdem_mps, dt_max, REAL), FSDEM__SAME(fsdem_mps, domain_min, VEC3),
+        FSDEM__SAME(fsdem_mps, domain_max, VEC3), FSDEM__SAME(fsdem_mps, periodic[0], INT),
+        FSDEM__SAME(fsdem_mps, periodic[1], INT), FSDEM__SAME(fsdem_mps, periodic[2], INT), FSDEM__SAME(fsdem_mps, gradient, INT),
+        FSDEM__SAME(fsdem_mps, wall_viscosity, INT), FSDEM__SAME(fsdem_mps, clamp_negative_pressure, INT),
+        FSDEM__SAME(fsdem_mps, collision_distance, REAL), FSDEM__SAME(fsdem_mps, restitution, REAL),
+        FSDEM__SAME(fsdem_mps, shifting, REAL), FSDEM__SAME(fsdem_mps, pressure_precond, INT),
+        FSDEM__SAME(fsdem_mps, pressure_tolerance, REAL), FSDEM__SAME(fsdem_mps, pressure_max_iterations, INT)};
+    static const fsdem__field state[8] = {
+        FSDEM__SAVED(fsdem_mps, time), FSDEM__SAVED(fsdem_mps, dt_last), FSDEM__SAVED(fsdem_mps, steps),
+        FSDEM__SAVED(fsdem_mps, iters_total), FSDEM__SAVED(fsdem_mps, iters), FSDEM__SAVED(fsdem_mps, residual),
+        FSDEM__SAVED(fsdem_mps, surface_count), FSDEM__SAVED(fsdem_mps, pair_count)};
     fsdem_mps *s = (fsdem_mps *)object;
-    const fsdem_mps_desc *d = &s->desc;
     const fsdem_allocator *al = &s->allocator;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
     int no = s->obst_n, nin = s->inflow_n, nout = s->outflow_n, n = s->n, cap = s->cap, i, a;
@@ -42,42 +57,9 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem_mps_inflow_desc *inflows;
     fsdem_mps_outflow_desc *outflows;
     fsdem__restart_tag(io, "MPS5");
-    fsdem__restart_same_int(io, d->dim, "dim");
-    fsdem__restart_same_real(io, d->r0, "r0");
-    fsdem__restart_same_real(io, d->re, "re");
-    fsdem__restart_same_real(io, d->re_laplacian, "re_laplacian");
-    fsdem__restart_same_real(io, d->density, "density");
-    fsdem__restart_same_real(io, d->viscosity, "viscosity");
-    fsdem__restart_same_vec3(io, d->gravity, "gravity");
-    fsdem__restart_same_real(io, d->gamma, "gamma");
-    fsdem__restart_same_int(io, (int)d->model, "model");
-    fsdem__restart_same_real(io, d->beta, "beta");
-    fsdem__restart_same_real(io, d->alpha, "alpha");
-    fsdem__restart_same_real(io, d->cfl, "cfl");
-    fsdem__restart_same_real(io, d->dt_max, "dt_max");
-    fsdem__restart_same_vec3(io, d->domain_min, "domain_min");
-    fsdem__restart_same_vec3(io, d->domain_max, "domain_max");
-    fsdem__restart_same_int(io, d->periodic[0], "periodic[0]");
-    fsdem__restart_same_int(io, d->periodic[1], "periodic[1]");
-    fsdem__restart_same_int(io, d->periodic[2], "periodic[2]");
-    fsdem__restart_same_int(io, (int)d->gradient, "gradient");
-    fsdem__restart_same_int(io, (int)d->wall_viscosity, "wall_viscosity");
-    fsdem__restart_same_int(io, d->clamp_negative_pressure, "clamp_negative_pressure");
-    fsdem__restart_same_real(io, d->collision_distance, "collision_distance");
-    fsdem__restart_same_real(io, d->restitution, "restitution");
-    fsdem__restart_same_real(io, d->shifting, "shifting");
-    fsdem__restart_same_int(io, (int)d->pressure_precond, "pressure_precond");
-    fsdem__restart_same_real(io, d->pressure_tolerance, "pressure_tolerance");
-    fsdem__restart_same_int(io, d->pressure_max_iterations, "pressure_max_iterations");
+    fsdem__restart_same_fields(io, s, same, 27);
 
-    fsdem__restart_data(io, &s->time, sizeof s->time);
-    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
-    fsdem__restart_data(io, &s->steps, sizeof s->steps);
-    fsdem__restart_data(io, &s->iters_total, sizeof s->iters_total);
-    fsdem__restart_data(io, &s->iters, sizeof s->iters);
-    fsdem__restart_data(io, &s->residual, sizeof s->residual);
-    fsdem__restart_data(io, &s->surface_count, sizeof s->surface_count);
-    fsdem__restart_data(io, &s->pair_count, sizeof s->pair_count);
+    fsdem__restart_fields(io, s, state, 8);
 
     /* obstacles, into a fresh array */
     fsdem__restart_count(io, &no, 1 << 24, sizeof(fsdem__mps_obst), "obstacle count");

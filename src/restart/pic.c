@@ -39,76 +39,13 @@ static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fs
     fsdem__restart_data(io, g->radius, sizeof(fsdem_real) * (size_t)ng);
 }
 
-static void fsdem__restart_pic(fsdem__restart *io, void *object) {
-    fsdem_pic *s = (fsdem_pic *)object;
-    const fsdem_pic_desc *pd = &s->desc;
+/* The obstacles, into a fresh array (polygons own their vertices); SDF obstacles keep the object's
+   callbacks. */
+static void fsdem__restart_pic_obstacles(fsdem__restart *io, fsdem_pic *s) {
     const fsdem_allocator *al = &s->allocator;
-    const int commit = io->mode == FSDEM__RESTART_COMMIT, apic = pd->transfer == FSDEM_PIC_TRANSFER_APIC;
-    static const char *bc_names[6] = {"boundary[0]", "boundary[1]", "boundary[2]",
-                                      "boundary[3]", "boundary[4]", "boundary[5]"};
-    static const char *bv_names[6] = {"boundary_velocity[0]", "boundary_velocity[1]", "boundary_velocity[2]",
-                                      "boundary_velocity[3]", "boundary_velocity[4]", "boundary_velocity[5]"};
-    int grid[3], no = s->obst_count, np = s->np, pcap = s->pcap, a, k;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT;
+    int no = s->obst_count, k;
     fsdem__pic_obst *obst;
-    size_t cells = sizeof(fsdem_real) * (size_t)s->ncell;
-    fsdem__restart_tag(io, "PIC2");
-    for (a = 0; a < 3; ++a) grid[a] = s->n[a];
-    fsdem__restart_value(io, grid, sizeof grid);
-    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK &&
-        (grid[0] != s->n[0] || grid[1] != s->n[1] || grid[2] != s->n[2]))
-        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
-                            "the grid has %d x %d x %d cells in the save and %d x %d x %d in the object (create the "
-                            "object from the desc it was saved with)",
-                            grid[0], grid[1], grid[2], s->n[0], s->n[1], s->n[2]);
-    fsdem__restart_same_int(io, pd->dim, "dim");
-    fsdem__restart_same_vec3(io, pd->domain_min, "domain_min");
-    fsdem__restart_same_real(io, pd->cell_size, "cell_size");
-    fsdem__restart_same_real(io, pd->density, "density");
-    fsdem__restart_same_real(io, pd->viscosity, "viscosity");
-    fsdem__restart_same_vec3(io, pd->gravity, "gravity");
-    for (k = 0; k < 6; ++k) {
-        fsdem__restart_same_int(io, (int)pd->boundary[k], bc_names[k]);
-        fsdem__restart_same_vec3(io, pd->boundary_velocity[k], bv_names[k]);
-    }
-    fsdem__restart_same_int(io, pd->free_surface, "free_surface");
-    fsdem__restart_same_int(io, (int)pd->transfer, "transfer");
-    fsdem__restart_same_real(io, pd->flip_ratio, "flip_ratio");
-    fsdem__restart_same_int(io, (int)pd->kernel, "kernel");
-    fsdem__restart_same_int(io, pd->particles_per_cell, "particles_per_cell");
-    fsdem__restart_same_real(io, pd->jitter, "jitter");
-    fsdem__restart_same_int(io, pd->min_particles_per_cell, "min_particles_per_cell");
-    fsdem__restart_same_int(io, pd->max_particles_per_cell, "max_particles_per_cell");
-    fsdem__restart_same_int(io, pd->advection_order, "advection_order");
-    fsdem__restart_same_real(io, pd->cfl, "cfl");
-    fsdem__restart_same_real(io, pd->cfl_max, "cfl_max");
-    fsdem__restart_same_real(io, pd->dt_max, "dt_max");
-    fsdem__restart_same_int(io, pd->density_projection, "density_projection");
-    fsdem__restart_same_real(io, pd->ghost_theta_min, "ghost_theta_min");
-    fsdem__restart_same_int(io, pd->extrapolation_layers, "extrapolation_layers");
-    fsdem__restart_same_int(io, (int)pd->pressure_precond, "pressure_precond");
-    fsdem__restart_same_real(io, pd->pressure_tolerance, "pressure_tolerance");
-    fsdem__restart_same_int(io, pd->pressure_max_iterations, "pressure_max_iterations");
-    fsdem__restart_same_int(io, (int)pd->viscosity_precond, "viscosity_precond");
-    fsdem__restart_same_real(io, pd->viscosity_tolerance, "viscosity_tolerance");
-
-    fsdem__restart_data(io, &s->time, sizeof s->time);
-    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
-    fsdem__restart_data(io, &s->steps, sizeof s->steps);
-    fsdem__restart_data(io, &s->rng, sizeof s->rng);
-    fsdem__restart_data(io, &s->cells_fresh, sizeof s->cells_fresh);
-    fsdem__restart_data(io, &s->fluid_cells, sizeof s->fluid_cells);
-    fsdem__restart_data(io, &s->p_iters, sizeof s->p_iters);
-    fsdem__restart_data(io, &s->v_iters, sizeof s->v_iters);
-    fsdem__restart_data(io, &s->d_iters, sizeof s->d_iters);
-    fsdem__restart_data(io, &s->p_res, sizeof s->p_res);
-    fsdem__restart_data(io, &s->max_div, sizeof s->max_div);
-    fsdem__restart_data(io, &s->div_before, sizeof s->div_before);
-    fsdem__restart_data(io, &s->reseeded, sizeof s->reseeded);
-    fsdem__restart_data(io, &s->removed, sizeof s->removed);
-    fsdem__restart_data(io, &s->refused, sizeof s->refused);
-    fsdem__restart_data(io, &s->moved, sizeof s->moved);
-
-    /* obstacles, into a fresh array (polygons own their vertices) */
     fsdem__restart_count(io, &no, 1 << 20, 2 * sizeof(int) + 5 * sizeof(fsdem_vec3) + sizeof(fsdem_real), "obstacle count");
     obst = (fsdem__pic_obst *)fsdem__restart_block(io, al, sizeof(fsdem__pic_obst) * (size_t)no);
     for (k = 0; k < no && io->res == FSDEM_OK; ++k) {
@@ -158,8 +95,14 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
         s->bytes += sizeof(fsdem__pic_obst) * (size_t)no;
         for (k = 0; k < no; ++k) s->bytes += sizeof(fsdem_vec3) * (size_t)obst[k].d.vertex_count;
     }
+}
 
-    /* particles, into fresh arrays of the saved capacity */
+/* The particles, into fresh arrays of the saved capacity (a full capacity refuses inflow seeds),
+   with their APIC matrices. */
+static void fsdem__restart_pic_particles(fsdem__restart *io, fsdem_pic *s) {
+    const fsdem_allocator *al = &s->allocator;
+    const int commit = io->mode == FSDEM__RESTART_COMMIT, apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC;
+    int np = s->np, pcap = s->pcap, a;
     fsdem__restart_count(io, &pcap, 1 << 29, 0, "particle capacity");
     fsdem__restart_count(io, &np, pcap, 2 * sizeof(fsdem_vec3), "particle count");
     if (io->res == FSDEM_OK) {
@@ -190,6 +133,53 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
     fsdem__restart_data(io, s->px, sizeof(fsdem_vec3) * (size_t)np);
     fsdem__restart_data(io, s->pv, sizeof(fsdem_vec3) * (size_t)np);
     for (a = 0; a < 3 && apic; ++a) fsdem__restart_data(io, s->pc[a], sizeof(fsdem_vec3) * (size_t)np);
+}
+
+static void fsdem__restart_pic(fsdem__restart *io, void *object) {
+    static const fsdem__field same[38] = {
+        FSDEM__SAME(fsdem_pic, dim, INT), FSDEM__SAME(fsdem_pic, domain_min, VEC3), FSDEM__SAME(fsdem_pic, cell_size, REAL),
+        FSDEM__SAME(fsdem_pic, density, REAL), FSDEM__SAME(fsdem_pic, viscosity, REAL), FSDEM__SAME(fsdem_pic, gravity, VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[0], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[0], VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[1], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[1], VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[2], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[2], VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[3], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[3], VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[4], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[4], VEC3),
+        FSDEM__SAME(fsdem_pic, boundary[5], INT), FSDEM__SAME(fsdem_pic, boundary_velocity[5], VEC3),
+        FSDEM__SAME(fsdem_pic, free_surface, INT), FSDEM__SAME(fsdem_pic, transfer, INT),
+        FSDEM__SAME(fsdem_pic, flip_ratio, REAL), FSDEM__SAME(fsdem_pic, kernel, INT),
+        FSDEM__SAME(fsdem_pic, particles_per_cell, INT), FSDEM__SAME(fsdem_pic, jitter, REAL),
+        FSDEM__SAME(fsdem_pic, min_particles_per_cell, INT), FSDEM__SAME(fsdem_pic, max_particles_per_cell, INT),
+        FSDEM__SAME(fsdem_pic, advection_order, INT), FSDEM__SAME(fsdem_pic, cfl, REAL), FSDEM__SAME(fsdem_pic, cfl_max, REAL),
+        FSDEM__SAME(fsdem_pic, dt_max, REAL), FSDEM__SAME(fsdem_pic, density_projection, INT),
+        FSDEM__SAME(fsdem_pic, ghost_theta_min, REAL), FSDEM__SAME(fsdem_pic, extrapolation_layers, INT),
+        FSDEM__SAME(fsdem_pic, pressure_precond, INT), FSDEM__SAME(fsdem_pic, pressure_tolerance, REAL),
+        FSDEM__SAME(fsdem_pic, pressure_max_iterations, INT), FSDEM__SAME(fsdem_pic, viscosity_precond, INT),
+        FSDEM__SAME(fsdem_pic, viscosity_tolerance, REAL)};
+    static const fsdem__field state[16] = {
+        FSDEM__SAVED(fsdem_pic, time), FSDEM__SAVED(fsdem_pic, dt_last), FSDEM__SAVED(fsdem_pic, steps),
+        FSDEM__SAVED(fsdem_pic, rng), FSDEM__SAVED(fsdem_pic, cells_fresh), FSDEM__SAVED(fsdem_pic, fluid_cells),
+        FSDEM__SAVED(fsdem_pic, p_iters), FSDEM__SAVED(fsdem_pic, v_iters), FSDEM__SAVED(fsdem_pic, d_iters),
+        FSDEM__SAVED(fsdem_pic, p_res), FSDEM__SAVED(fsdem_pic, max_div), FSDEM__SAVED(fsdem_pic, div_before),
+        FSDEM__SAVED(fsdem_pic, reseeded), FSDEM__SAVED(fsdem_pic, removed), FSDEM__SAVED(fsdem_pic, refused),
+        FSDEM__SAVED(fsdem_pic, moved)};
+    fsdem_pic *s = (fsdem_pic *)object;
+    int grid[3], a;
+    size_t cells = sizeof(fsdem_real) * (size_t)s->ncell;
+    fsdem__restart_tag(io, "PIC2");
+    for (a = 0; a < 3; ++a) grid[a] = s->n[a];
+    fsdem__restart_value(io, grid, sizeof grid);
+    if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK &&
+        (grid[0] != s->n[0] || grid[1] != s->n[1] || grid[2] != s->n[2]))
+        fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
+                            "the grid has %d x %d x %d cells in the save and %d x %d x %d in the object (create the "
+                            "object from the desc it was saved with)",
+                            grid[0], grid[1], grid[2], s->n[0], s->n[1], s->n[2]);
+    fsdem__restart_same_fields(io, s, same, 38);
+
+    fsdem__restart_fields(io, s, state, 16);
+
+    fsdem__restart_pic_obstacles(io, s);
+    fsdem__restart_pic_particles(io, s);
 
     /* grid fields, in place (the grid matches) */
     for (a = 0; a < s->dim; ++a) {

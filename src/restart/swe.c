@@ -44,8 +44,20 @@ static void fsdem__restart_swe_series(fsdem__restart *io, fsdem_swe *s, fsdem_re
    step; the gauge file, its interval and next output time (restore refuses while a file is open);
    capacities, the allocator, log and message. */
 static void fsdem__restart_swe(fsdem__restart *io, void *object) {
+    static const fsdem__field same[15] = {
+        FSDEM__SAME(fsdem_swe, dim, INT), FSDEM__SAME(fsdem_swe, x_min, REAL), FSDEM__SAME(fsdem_swe, x_max, REAL),
+        FSDEM__SAME(fsdem_swe, y_min, REAL), FSDEM__SAME(fsdem_swe, y_max, REAL), FSDEM__SAME(fsdem_swe, width, REAL),
+        FSDEM__SAME(fsdem_swe, gravity, VEC3), FSDEM__SAME(fsdem_swe, density, REAL), FSDEM__SAME(fsdem_swe, cfl, REAL),
+        FSDEM__SAME(fsdem_swe, dt_max, REAL), FSDEM__SAME(fsdem_swe, order, INT), FSDEM__SAME(fsdem_swe, limiter, INT),
+        FSDEM__SAME(fsdem_swe, dry_depth, REAL), FSDEM__SAME(fsdem_swe, manning, REAL),
+        FSDEM__SAME(fsdem_swe, eddy_viscosity, REAL)};
+    static const fsdem__field state[14] = {
+        FSDEM__SAVED(fsdem_swe, time), FSDEM__SAVED(fsdem_swe, dt_last), FSDEM__SAVED(fsdem_swe, steps),
+        FSDEM__SAVED(fsdem_swe, fallbacks), FSDEM__SAVED(fsdem_swe, max_wave), FSDEM__SAVED(fsdem_swe, max_accel),
+        FSDEM__SAVED(fsdem_swe, max_speed), FSDEM__SAVED(fsdem_swe, max_depth), FSDEM__SAVED(fsdem_swe, wet_cells),
+        FSDEM__SAVED(fsdem_swe, vol_boundary), FSDEM__SAVED(fsdem_swe, vol_source), FSDEM__SAVED(fsdem_swe, vol_clipped),
+        FSDEM__SAVED(fsdem_swe, rain), FSDEM__SAVED(fsdem_swe, sources_used)};
     fsdem_swe *s = (fsdem_swe *)object;
-    const fsdem_swe_desc *sd = &s->desc;
     const fsdem_allocator *al = &s->allocator;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
     const size_t cells = sizeof(fsdem_real) * (size_t)s->n;
@@ -62,40 +74,13 @@ static void fsdem__restart_swe(fsdem__restart *io, void *object) {
                             "the grid has %d x %d cells in the save and %d x %d in the object (create the object from "
                             "the desc it was saved with)",
                             grid[0], grid[1], s->nx, s->ny);
-    fsdem__restart_same_int(io, sd->dim, "dim");
-    fsdem__restart_same_real(io, sd->x_min, "x_min");
-    fsdem__restart_same_real(io, sd->x_max, "x_max");
-    fsdem__restart_same_real(io, sd->y_min, "y_min");
-    fsdem__restart_same_real(io, sd->y_max, "y_max");
-    fsdem__restart_same_real(io, sd->width, "width");
-    fsdem__restart_same_vec3(io, sd->gravity, "gravity");
-    fsdem__restart_same_real(io, sd->density, "density");
-    fsdem__restart_same_real(io, sd->cfl, "cfl");
-    fsdem__restart_same_real(io, sd->dt_max, "dt_max");
-    fsdem__restart_same_int(io, sd->order, "order");
-    fsdem__restart_same_int(io, (int)sd->limiter, "limiter");
-    fsdem__restart_same_real(io, sd->dry_depth, "dry_depth");
-    fsdem__restart_same_real(io, sd->manning, "manning");
-    fsdem__restart_same_real(io, sd->eddy_viscosity, "eddy_viscosity");
+    fsdem__restart_same_fields(io, s, same, 15);
     if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file)
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                             "the object has a gauge file open: close it (fsdem_swe_gauges_close) before restoring and "
                             "open it again afterwards");
 
-    fsdem__restart_data(io, &s->time, sizeof s->time);
-    fsdem__restart_data(io, &s->dt_last, sizeof s->dt_last);
-    fsdem__restart_data(io, &s->steps, sizeof s->steps);
-    fsdem__restart_data(io, &s->fallbacks, sizeof s->fallbacks);
-    fsdem__restart_data(io, &s->max_wave, sizeof s->max_wave);
-    fsdem__restart_data(io, &s->max_accel, sizeof s->max_accel);
-    fsdem__restart_data(io, &s->max_speed, sizeof s->max_speed);
-    fsdem__restart_data(io, &s->max_depth, sizeof s->max_depth);
-    fsdem__restart_data(io, &s->wet_cells, sizeof s->wet_cells);
-    fsdem__restart_data(io, &s->vol_boundary, sizeof s->vol_boundary);
-    fsdem__restart_data(io, &s->vol_source, sizeof s->vol_source);
-    fsdem__restart_data(io, &s->vol_clipped, sizeof s->vol_clipped);
-    fsdem__restart_data(io, &s->rain, sizeof s->rain);
-    fsdem__restart_data(io, &s->sources_used, sizeof s->sources_used);
+    fsdem__restart_fields(io, s, state, 14);
 
     /* the state, exactly, in place */
     fsdem__restart_data(io, s->eta, cells);
