@@ -2046,7 +2046,7 @@ FSDEM_API fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *nor
    (Laplacian) at particles whose neighbourhood is a full regular lattice; they are first and
    second order only in that sense (consistency is lost near the surface and in disordered regions).
    Still water. The drift is quoted one way: the largest displacement of a FLUID particle from its
-   start after 0.5 s, in r0 (issue 11 asks below 0.1 r0), with the top row's mean sinking beside it.
+   start after 0.5 s, in r0 (the goal: below 0.1 r0), with the top row's mean sinking beside it.
    In a tank 0.2 m deep at r0 = 0.01 m with the defaults: 2D 0.86 r0, top row 0.47 r0
    (test_mps_still_water, validation/mps_hydrostatic); 3D 3.87 r0, top row 0.91 r0; 2D with the
    sum form of Eq. 8 1.1 r0. The figures below are of the sum form without collisions unless said. Two causes, measured:
@@ -3099,8 +3099,8 @@ FSDEM_API fsdem_coupler *fsdem_pic_dem_coupler(fsdem_pic_dem *coupler);
    Ownership: the coupler claims the PIC's porosity and its accelerations (it zeroes them at the start
    of every step, fsdem_pic_clear_forces) and the DEM's external forces (>>couple); a resolved
    PIC-DEM on the same PIC, with its own DEM, steps with it (fsdem_coupled_step).
-   Not built yet (issue 22): the concentration-gradient and capillary
-   forces (Eq. 21-31), wetting (Eq. 19-20), the granules' flux in the velocity projection. The
+   Not built yet: the concentration-gradient and capillary forces (Eq. 21-31), wetting (Eq. 19-20),
+   the granules' flux in the velocity projection. The
    viscous stress of Eq. 3 is the PIC's nu lap(u), not div(alpha_f T). */
 
 typedef struct fsdem_gic fsdem_gic;
@@ -19690,7 +19690,7 @@ fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *c) {
 
 /* ---- >>restart_format : header, checksum, cursor ---- */
 
-#define FSDEM__RESTART_VERSION 4u /* 2: DEM contact options and material-pair tables (issue 23); 3: the PIC's start
+#define FSDEM__RESTART_VERSION 4u /* 2: DEM contact options and material-pair tables; 3: the PIC's start
                                       velocities of moving solids at any viscosity; 4: the PIC's porosity */
 #define FSDEM__RESTART_HEADER 64
 #define FSDEM__RESTART_BOM 0x01020304u

@@ -54,8 +54,8 @@
    Ownership: the coupler claims the PIC's porosity and its accelerations (it zeroes them at the start
    of every step, fsdem_pic_clear_forces) and the DEM's external forces (>>couple); a resolved
    PIC-DEM on the same PIC, with its own DEM, steps with it (fsdem_coupled_step).
-   Not built yet (issue 22): the concentration-gradient and capillary
-   forces (Eq. 21-31), wetting (Eq. 19-20), the granules' flux in the velocity projection. The
+   Not built yet: the concentration-gradient and capillary forces (Eq. 21-31), wetting (Eq. 19-20),
+   the granules' flux in the velocity projection. The
    viscous stress of Eq. 3 is the PIC's nu lap(u), not div(alpha_f T). */
 
 typedef struct fsdem_gic fsdem_gic;

@@ -49,7 +49,7 @@
    (Laplacian) at particles whose neighbourhood is a full regular lattice; they are first and
    second order only in that sense (consistency is lost near the surface and in disordered regions).
    Still water. The drift is quoted one way: the largest displacement of a FLUID particle from its
-   start after 0.5 s, in r0 (issue 11 asks below 0.1 r0), with the top row's mean sinking beside it.
+   start after 0.5 s, in r0 (the goal: below 0.1 r0), with the top row's mean sinking beside it.
    In a tank 0.2 m deep at r0 = 0.01 m with the defaults: 2D 0.86 r0, top row 0.47 r0
    (test_mps_still_water, validation/mps_hydrostatic); 3D 3.87 r0, top row 0.91 r0; 2D with the
    sum form of Eq. 8 1.1 r0. The figures below are of the sum form without collisions unless said. Two causes, measured:

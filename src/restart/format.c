@@ -9,7 +9,7 @@
 
 /* ---- >>restart_format : header, checksum, cursor ---- */
 
-#define FSDEM__RESTART_VERSION 4u /* 2: DEM contact options and material-pair tables (issue 23); 3: the PIC's start
+#define FSDEM__RESTART_VERSION 4u /* 2: DEM contact options and material-pair tables; 3: the PIC's start
                                       velocities of moving solids at any viscosity; 4: the PIC's porosity */
 #define FSDEM__RESTART_HEADER 64
 #define FSDEM__RESTART_BOM 0x01020304u
