@@ -29,7 +29,8 @@ help:
 	@echo "make test       Check suite (installs Check with apt-get when missing and run as root)"
 	@echo "make test-float the Check suite with fsdem_real = float (-DFSDEM_USE_FLOAT)"
 	@echo "make determinism  the same results from gcc and clang at -O0/-O2/-march=native/no SIMD"
-	@echo "make valgrind   the suite under Valgrind (no errors, no leaks)"
+	@echo "make valgrind   the suite under Valgrind (no errors, no leaks), its heavy tests sized down"
+	@echo "                 (FSDEM_TEST_LIGHT=1, tests/fsdem_tests.h)"
 	@echo "make test-omp   the suite built with OpenMP, on OMP_THREADS (2) threads"
 	@echo "make tsan       ThreadSanitizer on the threaded solvers at 2 and 4 threads (clang, libomp-dev)"
 	@echo "make sanitize   the suite with AddressSanitizer and UndefinedBehaviorSanitizer"
@@ -170,8 +171,11 @@ tsan: | $(BUILD) check-deps
 	done
 	@echo "tsan: the determinism scenes and the suites $(TSAN_SUITES) at 2 and 4 threads: no data race"
 
+# Every test under Valgrind, no errors and no leaks. FSDEM_TEST_LIGHT=1 sizes the heavy tests down
+# (shorter runs, fewer cases, coarser grids; test_light in tests/fsdem_tests.h) so that the whole
+# suite takes minutes instead of hours; each such test then asserts what holds at its smaller size.
 valgrind: $(BUILD)/check_fsdem
-	CK_FORK=no valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=all -q $(BUILD)/check_fsdem
+	CK_FORK=no FSDEM_TEST_LIGHT=1 valgrind --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=all -q $(BUILD)/check_fsdem
 
 sanitize: $(TEST_SRC) fsdem.h | $(BUILD) check-deps
 	$(CC) $(STD) $(WARN) -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer $(CHECK_CFLAGS) -I. \

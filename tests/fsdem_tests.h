@@ -77,6 +77,16 @@ static inline double test_tol(double tol, double k, const char *file, int line) 
         }                                                                                          \
     } while (0)
 
+/* True when FSDEM_TEST_LIGHT is set (and not "0"), as `make valgrind` sets it: the heavy tests are
+   sized down (fewer steps, shorter runs, fewer cases, coarser grids) so that memory checking covers
+   every test and code path in minutes. Each such test says next to its "(light: ...)" comment what
+   it asserts at that size, which is what still holds there; without the switch every test runs at
+   its full size with its full assertions. */
+static inline int test_light(void) {
+    const char *light = getenv("FSDEM_TEST_LIGHT");
+    return light && light[0] && light[0] != '0';
+}
+
 /* Reads a CSV snapshot written by a fsdem_X_write_csv (tests/test_io.c): its header line must be
    `header`, then exactly `rows` rows equal bit for bit to `expected` (row-major, the header's column
    count per row; may be NULL when rows is 0). */

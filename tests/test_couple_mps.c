@@ -343,21 +343,26 @@ static double test_terminal(double eps, double d, double rho_s, double rho, doub
    radius about r_e / 2, not to have set that blob moving: in Stokes flow it would reach about
    d / r_e of the sphere's speed (6%) after the viscous time (r_e / 2)^2 / nu = 0.6 s, far longer
    than the runs here (about 0.01-0.15 s after release; the fluid at the sphere is reported).
-   Model B (the seed's choice); 3D. */
+   Model B (the seed's choice); 3D.
+   (light: Re 0.1 alone, its sphere released at once into the water at rest: the 0.1 s of settling
+   are nine tenths of the run's steps, and the still-water noise, which starts in the surface band,
+   does not reach the sphere 10 r0 below it in the 0.01 s to its terminal velocity (measured
+   -0.01 %); the same 3 % line.) */
 START_TEST(test_mps_dem_terminal_velocity) {
     static const struct {
         double nu, d, r0, Re_lo, Re_hi, settle;
     } cases[] = {{1e-4, 0.00107, 0.004, 0.05, 0.2, 0.1}, {1e-6, 0.0003, 0.004, 5, 20, 0.1}, {1e-6, 0.0009, 0.004, 50, 200, 0.1}};
     const double rho = 1000, rho_s = 2500, g = 9.81;
+    const int light = test_light();
     int c;
-    for (c = 0; c < 3; ++c) {
+    for (c = 0; c < (light ? 1 : 3); ++c) {
         const double r0 = cases[c].r0, d = cases[c].d, mu = rho * cases[c].nu;
         const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3((fsdem_real)(8 * r0), (fsdem_real)(8 * r0), (fsdem_real)(30 * r0));
         test_pair t = test_pair_new(3, r0, FSDEM_MPS_MODEL_B, cases[c].nu, lo, hi, 28 * r0, rho_s);
         fsdem_mps_dem_force f;
         double ut, w, Re, tau, t_end, sim = 0;
         fsdem_dem_particles dv;
-        const double settle = cases[c].settle;
+        const double settle = light ? 0 : cases[c].settle;
         double umax;
         ck_assert_int_eq(fsdem_mps_advance(t.mps, (fsdem_real)settle, NULL), FSDEM_OK);
         umax = fsdem_mps_get_stats(t.mps).max_speed;

@@ -373,9 +373,12 @@ END_TEST
    kernel-averaged pressure at mid-depth is within 5% of rho g (h - y), the water stays in the tank
    and keeps its level, and no particle drifts far. The issue's bound of 0.1 r0 on the drift is NOT
    reached by this solver yet (1.10 r0 double, 1.38 r0 float are measured, with particle shifting
-   off, the default; shifting did not lower it, see the >>mps notes); the test holds it to 1.5 r0. */
+   off, the default; shifting did not lower it, see the >>mps notes); the test holds it to 1.5 r0.
+   (light: 0.2 s, 200 steps instead of 500; pressure (-1.3 %), level and PCG iterations hold as at
+   0.5 s, the drift has grown to 0.66 r0 (0.86 r0 at 0.5 s): the same bounds, a weaker guard on
+   the drift.) */
 START_TEST(test_mps_still_water) {
-    const double r0 = 0.01, h = 0.2, rho = 1000, g = 9.81;
+    const double r0 = 0.01, h = 0.2, rho = 1000, g = 9.81, duration = test_light() ? 0.2 : 0.5;
     fsdem_mps *m = test_tank(r0, 1000);
     fsdem_mps_particles p = fsdem_mps_get_particles(m);
     fsdem_mps_stats st;
@@ -384,8 +387,8 @@ START_TEST(test_mps_still_water) {
     double ps = 0, ws = 0, maxd = 0, top = 0, pmid, iters;
     int i;
     for (i = 0; i < p.count; ++i) x0[i] = p.position[i];
-    ck_assert_int_eq(fsdem_mps_advance(m, 0.5f, &steps), FSDEM_OK);
-    ck_assert(fabs(fsdem_mps_time(m) - 0.5) < 1e-9);
+    ck_assert_int_eq(fsdem_mps_advance(m, (fsdem_real)duration, &steps), FSDEM_OK);
+    ck_assert(fabs(fsdem_mps_time(m) - (fsdem_real)duration) < 1e-9); /* the duration as fsdem_real holds it */
     p = fsdem_mps_get_particles(m);
     st = fsdem_mps_get_stats(m);
     for (i = 0; i < p.count; ++i) {

@@ -823,13 +823,15 @@ static fsdem_pic *aligned_box_tank(int dim, double shift) {
    the box with fixed steps: the same pressure and density iterations every step and the same particles
    to 1e-9 m. Before the face samples were snapped to the surface, the aligned box left its interior
    cells joined by faces open by 1e-14 and the pressure solve took 31-41 multigrid iterations per step
-   instead of 8. */
+   instead of 8.
+   (light: 0.18 s instead of 0.3 s; the surge reaches the box at 0.13 s (2D) and 0.15 s (3D) and is
+   running up it by 0.18 s, so the impact is still in the run; the same bounds.) */
 static void check_aligned_box(int dim) {
     fsdem_pic *s[3];
-    const double shift[3] = {0, 1e-9, -1e-9}, dt = dim == 2 ? 2e-3 : 4e-3;
+    const double shift[3] = {0, 1e-9, -1e-9}, dt = dim == 2 ? 2e-3 : 4e-3, duration = test_light() ? 0.18 : 0.3;
     int k, m, p, most = 0;
     for (m = 0; m < 3; ++m) s[m] = aligned_box_tank(dim, shift[m]);
-    for (k = 0; k < (int)(0.3 / dt); ++k) {
+    for (k = 0; k < (int)(duration / dt); ++k) {
         fsdem_pic_stats st[3];
         for (m = 0; m < 3; ++m) {
             ck_assert_int_eq(fsdem_pic_step_dt(s[m], (fsdem_real)dt), FSDEM_OK);
