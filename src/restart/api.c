@@ -25,148 +25,88 @@ static const char *fsdem__restart_kind_name(unsigned int kind) {
     return "unknown object";
 }
 
-static fsdem__restart_object fsdem__restart_of_dem(const fsdem_dem *d) {
+/* An object as the API sees it (a zeroed one, object NULL, for a NULL handle): its kind and
+   dimension and four counts go to the header, where a restore into another object contradicts
+   them. */
+static fsdem__restart_object fsdem__restart_object_of(const void *object, unsigned int kind, int dim, const int sizes[4],
+                                                      fsdem__restart_visit_fn visit, const fsdem_allocator *allocator,
+                                                      const fsdem__status *status) {
     fsdem__restart_object o;
     memset(&o, 0, sizeof o);
-    if (!d) return o;
-    o.kind = FSDEM__RESTART_DEM;
-    o.dim = d->desc.dim;
-    o.sizes[0] = d->n;
-    o.sizes[1] = d->material_count;
-    o.sizes[2] = d->wall_count;
-    o.sizes[3] = d->pp.count;
-    o.object = (void *)d;
-    o.visit = fsdem__restart_dem;
-    o.allocator = &d->allocator;
-    o.status = (fsdem__status *)&d->status;
-    o.name = "fsdem_dem";
+    if (!object) return o;
+    o.kind = kind;
+    o.dim = dim;
+    memcpy(o.sizes, sizes, sizeof o.sizes);
+    o.object = (void *)object;
+    o.visit = visit;
+    o.allocator = allocator;
+    o.status = (fsdem__status *)status;
+    o.name = fsdem__restart_kind_name(kind);
     return o;
+}
+
+static fsdem__restart_object fsdem__restart_of_dem(const fsdem_dem *d) {
+    if (!d) return fsdem__restart_object_of(NULL, 0, 0, NULL, NULL, NULL, NULL);
+    {
+        const int sizes[4] = {d->n, d->material_count, d->wall_count, d->pp.count};
+        return fsdem__restart_object_of(d, FSDEM__RESTART_DEM, d->desc.dim, sizes, fsdem__restart_dem, &d->allocator, &d->status);
+    }
 }
 
 static fsdem__restart_object fsdem__restart_of_pic(const fsdem_pic *s) {
-    fsdem__restart_object o;
-    memset(&o, 0, sizeof o);
-    if (!s) return o;
-    o.kind = FSDEM__RESTART_PIC;
-    o.dim = s->dim;
-    o.sizes[0] = s->n[0];
-    o.sizes[1] = s->n[1];
-    o.sizes[2] = s->n[2];
-    o.sizes[3] = s->np;
-    o.object = (void *)s;
-    o.visit = fsdem__restart_pic;
-    o.allocator = &s->allocator;
-    o.status = (fsdem__status *)&s->status;
-    o.name = "fsdem_pic";
-    return o;
+    if (!s) return fsdem__restart_object_of(NULL, 0, 0, NULL, NULL, NULL, NULL);
+    {
+        const int sizes[4] = {s->n[0], s->n[1], s->n[2], s->np};
+        return fsdem__restart_object_of(s, FSDEM__RESTART_PIC, s->dim, sizes, fsdem__restart_pic, &s->allocator, &s->status);
+    }
 }
 
 static fsdem__restart_object fsdem__restart_of_swe(const fsdem_swe *s) {
-    fsdem__restart_object o;
-    memset(&o, 0, sizeof o);
-    if (!s) return o;
-    o.kind = FSDEM__RESTART_SWE;
-    o.dim = s->dim;
-    o.sizes[0] = s->nx;
-    o.sizes[1] = s->ny;
-    o.sizes[2] = s->src_count;
-    o.sizes[3] = s->gauge_count;
-    o.object = (void *)s;
-    o.visit = fsdem__restart_swe;
-    o.allocator = &s->allocator;
-    o.status = (fsdem__status *)&s->status;
-    o.name = "fsdem_swe";
-    return o;
+    if (!s) return fsdem__restart_object_of(NULL, 0, 0, NULL, NULL, NULL, NULL);
+    {
+        const int sizes[4] = {s->nx, s->ny, s->src_count, s->gauge_count};
+        return fsdem__restart_object_of(s, FSDEM__RESTART_SWE, s->dim, sizes, fsdem__restart_swe, &s->allocator, &s->status);
+    }
 }
 
 static fsdem__restart_object fsdem__restart_of_swe_dem(const fsdem_swe_dem *c) {
-    fsdem__restart_object o;
-    memset(&o, 0, sizeof o);
-    if (!c) return o;
-    o.kind = FSDEM__RESTART_SWE_DEM;
-    o.dim = c->desc.swe->dim;
-    o.sizes[0] = c->desc.swe->nx;
-    o.sizes[1] = c->desc.swe->ny;
-    o.sizes[2] = c->desc.dem->n;
-    o.sizes[3] = c->force_capacity;
-    o.object = (void *)c;
-    o.visit = fsdem__restart_swe_dem;
-    o.allocator = &c->head.allocator;
-    o.status = (fsdem__status *)&c->head.status;
-    o.name = "fsdem_swe_dem";
-    return o;
+    if (!c) return fsdem__restart_object_of(NULL, 0, 0, NULL, NULL, NULL, NULL);
+    {
+        const int sizes[4] = {c->desc.swe->nx, c->desc.swe->ny, c->desc.dem->n, c->force_capacity};
+        return fsdem__restart_object_of(c, FSDEM__RESTART_SWE_DEM, c->desc.swe->dim, sizes, fsdem__restart_swe_dem, &c->head.allocator, &c->head.status);
+    }
 }
 
 static fsdem__restart_object fsdem__restart_of_mps(const fsdem_mps *s) {
-    fsdem__restart_object o;
-    memset(&o, 0, sizeof o);
-    if (!s) return o;
-    o.kind = FSDEM__RESTART_MPS;
-    o.dim = s->dim;
-    o.sizes[0] = s->n;
-    o.sizes[1] = s->counts[FSDEM_MPS_KIND_FLUID];
-    o.sizes[2] = s->obst_n;
-    o.sizes[3] = 0;
-    o.object = (void *)s;
-    o.visit = fsdem__restart_mps;
-    o.allocator = &s->allocator;
-    o.status = (fsdem__status *)&s->status;
-    o.name = "fsdem_mps";
-    return o;
+    if (!s) return fsdem__restart_object_of(NULL, 0, 0, NULL, NULL, NULL, NULL);
+    {
+        const int sizes[4] = {s->n, s->counts[FSDEM_MPS_KIND_FLUID], s->obst_n, 0};
+        return fsdem__restart_object_of(s, FSDEM__RESTART_MPS, s->dim, sizes, fsdem__restart_mps, &s->allocator, &s->status);
+    }
 }
 
 static fsdem__restart_object fsdem__restart_of_mps_dem(const fsdem_mps_dem *c) {
-    fsdem__restart_object o;
-    memset(&o, 0, sizeof o);
-    if (!c) return o;
-    o.kind = FSDEM__RESTART_MPS_DEM;
-    o.dim = c->dim;
-    o.sizes[0] = c->desc.mps->n;
-    o.sizes[1] = c->desc.dem->n;
-    o.sizes[2] = c->head.records;
-    o.sizes[3] = 0;
-    o.object = (void *)c;
-    o.visit = fsdem__restart_mps_dem;
-    o.allocator = &c->head.allocator;
-    o.status = (fsdem__status *)&c->head.status;
-    o.name = "fsdem_mps_dem";
-    return o;
+    if (!c) return fsdem__restart_object_of(NULL, 0, 0, NULL, NULL, NULL, NULL);
+    {
+        const int sizes[4] = {c->desc.mps->n, c->desc.dem->n, c->head.records, 0};
+        return fsdem__restart_object_of(c, FSDEM__RESTART_MPS_DEM, c->dim, sizes, fsdem__restart_mps_dem, &c->head.allocator, &c->head.status);
+    }
 }
 
 static fsdem__restart_object fsdem__restart_of_gic(const fsdem_gic *c) {
-    fsdem__restart_object o;
-    memset(&o, 0, sizeof o);
-    if (!c) return o;
-    o.kind = FSDEM__RESTART_GIC;
-    o.dim = c->dim;
-    o.sizes[0] = fsdem_pic_get_particles(c->desc.pic).count;
-    o.sizes[1] = fsdem_dem_get_particles(c->desc.dem).count;
-    o.sizes[2] = c->grid.ncell;
-    o.sizes[3] = 0;
-    o.object = (void *)c;
-    o.visit = fsdem__restart_gic;
-    o.allocator = &c->head.allocator;
-    o.status = (fsdem__status *)&c->head.status;
-    o.name = "fsdem_gic";
-    return o;
+    if (!c) return fsdem__restart_object_of(NULL, 0, 0, NULL, NULL, NULL, NULL);
+    {
+        const int sizes[4] = {fsdem_pic_get_particles(c->desc.pic).count, fsdem_dem_get_particles(c->desc.dem).count, c->grid.ncell, 0};
+        return fsdem__restart_object_of(c, FSDEM__RESTART_GIC, c->dim, sizes, fsdem__restart_gic, &c->head.allocator, &c->head.status);
+    }
 }
 
 static fsdem__restart_object fsdem__restart_of_pic_dem(const fsdem_pic_dem *c) {
-    fsdem__restart_object o;
-    memset(&o, 0, sizeof o);
-    if (!c) return o;
-    o.kind = FSDEM__RESTART_PIC_DEM;
-    o.dim = c->dim;
-    o.sizes[0] = c->desc.pic->np;
-    o.sizes[1] = c->desc.dem->n;
-    o.sizes[2] = c->loaded ? c->bodies : 0;
-    o.sizes[3] = 0;
-    o.object = (void *)c;
-    o.visit = fsdem__restart_pic_dem;
-    o.allocator = &c->head.allocator;
-    o.status = (fsdem__status *)&c->head.status;
-    o.name = "fsdem_pic_dem";
-    return o;
+    if (!c) return fsdem__restart_object_of(NULL, 0, 0, NULL, NULL, NULL, NULL);
+    {
+        const int sizes[4] = {c->desc.pic->np, c->desc.dem->n, c->loaded ? c->bodies : 0, 0};
+        return fsdem__restart_object_of(c, FSDEM__RESTART_PIC_DEM, c->dim, sizes, fsdem__restart_pic_dem, &c->head.allocator, &c->head.status);
+    }
 }
 
 /* A cursor for `verb` of object o ("save", "restore_memory", ...). */
@@ -377,168 +317,168 @@ static fsdem_result fsdem__restart_load_memory(const fsdem__restart_object *o, c
 
 /* fsdem_dem (>>restart): the discrete elements. */
 fsdem_result fsdem_dem_save(const fsdem_dem *dem, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_dem(dem);
+    const fsdem__restart_object o = fsdem__restart_of_dem(dem);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_dem_restore(fsdem_dem *dem, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_dem(dem);
+    const fsdem__restart_object o = fsdem__restart_of_dem(dem);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_dem_save_memory(const fsdem_dem *dem, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o = fsdem__restart_of_dem(dem);
+    const fsdem__restart_object o = fsdem__restart_of_dem(dem);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_dem_restore_memory(fsdem_dem *dem, const void *buffer, size_t size) {
-    fsdem__restart_object o = fsdem__restart_of_dem(dem);
+    const fsdem__restart_object o = fsdem__restart_of_dem(dem);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* fsdem_pic (>>restart): the PIC/FLIP solver. */
 fsdem_result fsdem_pic_save(const fsdem_pic *pic, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_pic(pic);
+    const fsdem__restart_object o = fsdem__restart_of_pic(pic);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_pic_restore(fsdem_pic *pic, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_pic(pic);
+    const fsdem__restart_object o = fsdem__restart_of_pic(pic);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_pic_save_memory(const fsdem_pic *pic, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o = fsdem__restart_of_pic(pic);
+    const fsdem__restart_object o = fsdem__restart_of_pic(pic);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_pic_restore_memory(fsdem_pic *pic, const void *buffer, size_t size) {
-    fsdem__restart_object o = fsdem__restart_of_pic(pic);
+    const fsdem__restart_object o = fsdem__restart_of_pic(pic);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* fsdem_swe (>>restart): the shallow-water solver. */
 fsdem_result fsdem_swe_save(const fsdem_swe *swe, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_swe(swe);
+    const fsdem__restart_object o = fsdem__restart_of_swe(swe);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_swe_restore(fsdem_swe *swe, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_swe(swe);
+    const fsdem__restart_object o = fsdem__restart_of_swe(swe);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_swe_save_memory(const fsdem_swe *swe, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o = fsdem__restart_of_swe(swe);
+    const fsdem__restart_object o = fsdem__restart_of_swe(swe);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_swe_restore_memory(fsdem_swe *swe, const void *buffer, size_t size) {
-    fsdem__restart_object o = fsdem__restart_of_swe(swe);
+    const fsdem__restart_object o = fsdem__restart_of_swe(swe);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* fsdem_swe_dem (>>restart): the SWE-DEM coupler with its two solvers. */
 fsdem_result fsdem_swe_dem_save(const fsdem_swe_dem *coupler, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_swe_dem_restore(fsdem_swe_dem *coupler, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_swe_dem_save_memory(const fsdem_swe_dem *coupler, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_swe_dem_restore_memory(fsdem_swe_dem *coupler, const void *buffer, size_t size) {
-    fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_swe_dem(coupler);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* fsdem_mps (>>restart): the MPS solver. */
 fsdem_result fsdem_mps_save(const fsdem_mps *mps, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_mps(mps);
+    const fsdem__restart_object o = fsdem__restart_of_mps(mps);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_mps_restore(fsdem_mps *mps, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_mps(mps);
+    const fsdem__restart_object o = fsdem__restart_of_mps(mps);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_mps_save_memory(const fsdem_mps *mps, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o = fsdem__restart_of_mps(mps);
+    const fsdem__restart_object o = fsdem__restart_of_mps(mps);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_mps_restore_memory(fsdem_mps *mps, const void *buffer, size_t size) {
-    fsdem__restart_object o = fsdem__restart_of_mps(mps);
+    const fsdem__restart_object o = fsdem__restart_of_mps(mps);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* fsdem_mps_dem (>>restart): the MPS-DEM coupler with its two solvers. */
 fsdem_result fsdem_mps_dem_save(const fsdem_mps_dem *coupler, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_mps_dem_restore(fsdem_mps_dem *coupler, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_mps_dem_save_memory(const fsdem_mps_dem *coupler, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_mps_dem_restore_memory(fsdem_mps_dem *coupler, const void *buffer, size_t size) {
-    fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_mps_dem(coupler);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* fsdem_pic_dem (>>restart): the PIC-DEM coupler with its two solvers. */
 fsdem_result fsdem_pic_dem_save(const fsdem_pic_dem *coupler, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_pic_dem_restore(fsdem_pic_dem *coupler, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_pic_dem_save_memory(const fsdem_pic_dem *coupler, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_pic_dem_restore_memory(fsdem_pic_dem *coupler, const void *buffer, size_t size) {
-    fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_pic_dem(coupler);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
 
 /* fsdem_gic (>>restart): the Granule-In-Cell coupler with its two solvers. */
 fsdem_result fsdem_gic_save(const fsdem_gic *coupler, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_gic(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_gic(coupler);
     return fsdem__restart_save_file(&o, path);
 }
 
 fsdem_result fsdem_gic_restore(fsdem_gic *coupler, const char *path) {
-    fsdem__restart_object o = fsdem__restart_of_gic(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_gic(coupler);
     return fsdem__restart_load_file(&o, path);
 }
 
 fsdem_result fsdem_gic_save_memory(const fsdem_gic *coupler, void *buffer, size_t capacity, size_t *size) {
-    fsdem__restart_object o = fsdem__restart_of_gic(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_gic(coupler);
     return fsdem__restart_save_memory(&o, buffer, capacity, size);
 }
 
 fsdem_result fsdem_gic_restore_memory(fsdem_gic *coupler, const void *buffer, size_t size) {
-    fsdem__restart_object o = fsdem__restart_of_gic(coupler);
+    const fsdem__restart_object o = fsdem__restart_of_gic(coupler);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
