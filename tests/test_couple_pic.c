@@ -196,6 +196,36 @@ START_TEST(archimedes_2d_and_3d) {
 }
 END_TEST
 
+/* fsdem_pic_dem_update cuts the bodies at the current state without stepping: a disc added to the
+   DEM after the coupler was made takes the water particles inside it out (counted in `removed`)
+   and closes the PIC's faces it covers, and time does not move. A second update changes nothing. */
+START_TEST(update_cuts_without_stepping) {
+    const double R = 0.04, dx = 0.01;
+    tank t = make_tank(2, 0.3, 0.25, 0, G, dx, fsdem_v3(0.08, 0.1, 0), 0.03, 2000, 1, fsdem_v3(0, 0, 0), 0);
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    const int before = fsdem_pic_get_particles(t.pic).count, removed_at_creation = (int)fsdem_pic_dem_get_stats(t.cp).removed;
+    fsdem_pic_particles w;
+    fsdem_pic_coupling pc;
+    int k, inside = 0, removed;
+    p.position = fsdem_v3(0.2, 0.12, 0);
+    p.radius = (fsdem_real)R;
+    ck_assert_int_eq(fsdem_dem_add_particle(t.dem, &p, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_update(t.cp), FSDEM_OK);
+    removed = (int)fsdem_pic_dem_get_stats(t.cp).removed - removed_at_creation;
+    w = fsdem_pic_get_particles(t.pic);
+    for (k = 0; k < w.count; ++k) inside += hypot(w.position[k].x - 0.2, w.position[k].y - 0.12) < R;
+    ck_assert_msg(removed > 0 && w.count == before - removed && inside == 0, "removed %d of %d, %d left inside", removed, before,
+                  inside);
+    pc = fsdem_pic_get_coupling(t.pic);
+    /* the x-face at the disc's centre, (0.2, 0.12): i = 20, j = 12 of a 31-wide face row */
+    ck_assert(pc.open[0][12 * 31 + 20] == 0);
+    ck_assert(fsdem_pic_dem_time(t.cp) == 0 && fsdem_pic_dem_get_stats(t.cp).coupling.steps == 0);
+    ck_assert_int_eq(fsdem_pic_dem_update(t.cp), FSDEM_OK);
+    ck_assert(fsdem_pic_get_particles(t.pic).count == w.count && fsdem_pic_dem_get_stats(t.cp).removed == removed_at_creation + removed);
+    free_tank(&t);
+}
+END_TEST
+
 /* A disc held in a full box with no gravity moving at constant velocity: the water volume stays
    (particles are moved out of the disc, never removed), no particle is inside the disc after any
    step, and in every step the pressure impulses of water, disc and walls balance. The first step
@@ -738,6 +768,7 @@ Suite *couple_pic_suite(void) {
     tcase_add_test(tc, light_disc_rises_with_the_implicit_solid_velocity);
     tcase_add_test(tc, neutral_disc_stays_put);
     tcase_add_test(tc, still_water_stays_still_next_to_a_body_at_rest);
+    tcase_add_test(tc, update_cuts_without_stepping);
     tcase_add_test(tc, refused_step_changes_nothing);
     tcase_add_test(tc, contact_area_dissipation_is_eq_20);
     tcase_add_test(tc, bad_input_is_refused);

@@ -1076,6 +1076,10 @@ START_TEST(null_objects_are_refused) {
     IF_COUPLER_DIALECT(&p, mps_dem, mps);
     IF_REFUSED(&p, fsdem_mps_dem_update(NULL));
     IF_COUPLER_DIALECT(&p, pic_dem, pic);
+    IF_REFUSED(&p, fsdem_pic_dem_update(NULL));
+    IF_TRUE(&p, "the couplers' fsdem_X_coupler(NULL) are NULL",
+            !fsdem_swe_dem_coupler(NULL) && !fsdem_mps_dem_coupler(NULL) && !fsdem_pic_dem_coupler(NULL) && !fsdem_gic_coupler(NULL));
+    IF_REFUSED(&p, fsdem_coupled_step(NULL, 1));
     TEST_REPORT("%d calls with a NULL object, %d answered wrong", p.calls, p.count);
     ck_assert_msg(p.count == 0, "%d of %d calls with a NULL object answered wrong: %s", p.count, p.calls, p.failed);
 }
