@@ -3586,6 +3586,7 @@ FSDEM_API fsdem_result fsdem_swe_write_vti(const fsdem_swe *swe, const char *pat
 #define FSDEM__PRAGMA(x) _Pragma(#x)
 #define FSDEM__OMP(x) FSDEM__PRAGMA(omp x)
 static int fsdem__workers(void) { return omp_get_max_threads(); }
+/* threaded: inside a team: the calling thread's number and the team's size. */
 static int fsdem__worker(void) { return omp_get_thread_num(); }
 static int fsdem__team(void) { return omp_get_num_threads(); }
 void fsdem_set_threads(int count) {
@@ -5268,6 +5269,7 @@ typedef struct fsdem__dem_batch {
 /* Copies contact 0 into the lanes after `count` up to a whole lane, so the kernel sees real data
    there: the pair input for a batch of particle pairs (`pairs`), the contact otherwise, and the
    coefficients unless the batch is `uniform`. */
+/* threaded: inside a team as on one thread: the calling thread's batch. */
 static void fsdem__dem_batch_pad(fsdem__dem_batch *b, int pairs, int uniform) {
     int c, a;
     for (c = b->count; c % FSDEM__LANES; ++c) {
@@ -5488,6 +5490,7 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_cohesion(fsdem__lane coh, fsdem__lane
    branch-free, and inlined with a constant `law` and `pairs`. h is the step the spring and seed
    000's one-step tangential spring (Eq. 8) use. The normal force the law gives goes to b->fn
    (rolling resistance and Coulomb's limit take it); cohesion is added to the force after. */
+/* threaded: inside a team as on one thread: the calling thread's batch. */
 FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_dem_law law, fsdem_real h, const int pairs,
                                           fsdem_real off, const fsdem__dem_pair *uniform, const fsdem__dem_rules *rules) {
     const fsdem__lane one = fsdem__lane_set(1), zero = fsdem__lane_set(0);
@@ -6614,6 +6617,7 @@ static void fsdem__dem_gather_pair_coefficients(const fsdem_dem *d, fsdem__dem_b
 
 /* Contact `k` of the particle-pair list into lane c of a batch; the coefficients of its material
    pair unless the batch is `uniform`, the mean mass only for the law that uses it. */
+/* threaded: inside a team as on one thread: one lane of the calling thread's batch. */
 FSDEM__FORCE_INLINE void fsdem__dem_gather_pair(const fsdem_dem *d, fsdem__dem_batch *FSDEM__RESTRICT b, int c, int k, const fsdem_dem_law law,
                                             int uniform) {
     const int i = d->pp.first[k], key = d->pp.key[k], j = FSDEM__DEM_PARTNER(key);
@@ -7502,6 +7506,7 @@ struct fsdem_pcg {
 
 /* ---- >>linalg_check : validation of operators ---- */
 
+/* threaded: inside a team as on one thread: reads the stencil only. */
 static fsdem_real fsdem__stencil_face(const fsdem_stencil *st, int axis, int i, int j, int k) {
     const fsdem_real *f = st->face[axis];
     int n0 = st->n[0], n1 = st->n[1];
@@ -7511,6 +7516,7 @@ static fsdem_real fsdem__stencil_face(const fsdem_stencil *st, int axis, int i, 
     return f[((size_t)k * n1 + j) * (size_t)n0 + i];
 }
 
+/* threaded: inside a team as on one thread: reads the stencil only. */
 static int fsdem__stencil_type(const fsdem_stencil *st, int i, int j, int k) {
     if (!st->cell) return FSDEM_STENCIL_CELL_FLUID;
     return st->cell[((size_t)k * st->n[1] + j) * (size_t)st->n[0] + i];
@@ -7823,6 +7829,7 @@ static void fsdem__level_geometry(fsdem__level *L, int dim, const int n[3]) {
     L->count = dim == 3 ? L->sz * (L->n[2] + 2) : L->sz;
 }
 
+/* threaded: inside a team as on one thread: pure. */
 static int fsdem__level_index(const fsdem__level *L, int dim, int i, int j, int k) {
     return (i + 1) + (j + 1) * L->sy + (dim == 3 ? (k + 1) * L->sz : 0);
 }
@@ -11049,6 +11056,7 @@ static fsdem_real fsdem__pic_interp_face(const fsdem_pic *s, const fsdem_real *f
     return sum;
 }
 
+/* threaded: inside a team as on one thread: reads the grid only. */
 static fsdem_vec3 fsdem__pic_interp_vel(const fsdem_pic *s, fsdem_real *const f[3], fsdem_vec3 x) {
     fsdem_vec3 v;
     v.x = fsdem__pic_interp_face(s, f[0], 0, x);
@@ -11100,6 +11108,7 @@ static void fsdem__pic_p2g(fsdem_pic *s) {
 
 /* The grid-to-particle transfer of particle p (`du` holds u_new - u_old (FLIP) in uold); returns
    nonzero when its new velocity is not finite. */
+/* threaded: inside a team: one particle, written by its thread alone. */
 FSDEM__FORCE_INLINE int fsdem__pic_g2p_one(fsdem_pic *s, int p, const int quad, fsdem_real ratio, const int apic, fsdem_real dfac) {
     int a, q0, q1, q2, b, bad = 0;
     fsdem__kernel kw;

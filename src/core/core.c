@@ -39,6 +39,7 @@
 #define FSDEM__PRAGMA(x) _Pragma(#x)
 #define FSDEM__OMP(x) FSDEM__PRAGMA(omp x)
 static int fsdem__workers(void) { return omp_get_max_threads(); }
+/* threaded: inside a team: the calling thread's number and the team's size. */
 static int fsdem__worker(void) { return omp_get_thread_num(); }
 static int fsdem__team(void) { return omp_get_num_threads(); }
 void fsdem_set_threads(int count) {

@@ -30,6 +30,7 @@ static void fsdem__dem_gather_pair_coefficients(const fsdem_dem *d, fsdem__dem_b
 
 /* Contact `k` of the particle-pair list into lane c of a batch; the coefficients of its material
    pair unless the batch is `uniform`, the mean mass only for the law that uses it. */
+/* threaded: inside a team as on one thread: one lane of the calling thread's batch. */
 FSDEM__FORCE_INLINE void fsdem__dem_gather_pair(const fsdem_dem *d, fsdem__dem_batch *FSDEM__RESTRICT b, int c, int k, const fsdem_dem_law law,
                                             int uniform) {
     const int i = d->pp.first[k], key = d->pp.key[k], j = FSDEM__DEM_PARTNER(key);

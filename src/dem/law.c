@@ -151,6 +151,7 @@ typedef struct fsdem__dem_batch {
 /* Copies contact 0 into the lanes after `count` up to a whole lane, so the kernel sees real data
    there: the pair input for a batch of particle pairs (`pairs`), the contact otherwise, and the
    coefficients unless the batch is `uniform`. */
+/* threaded: inside a team as on one thread: the calling thread's batch. */
 static void fsdem__dem_batch_pad(fsdem__dem_batch *b, int pairs, int uniform) {
     int c, a;
     for (c = b->count; c % FSDEM__LANES; ++c) {
@@ -371,6 +372,7 @@ FSDEM__FORCE_INLINE fsdem__lane fsdem__dem_cohesion(fsdem__lane coh, fsdem__lane
    branch-free, and inlined with a constant `law` and `pairs`. h is the step the spring and seed
    000's one-step tangential spring (Eq. 8) use. The normal force the law gives goes to b->fn
    (rolling resistance and Coulomb's limit take it); cohesion is added to the force after. */
+/* threaded: inside a team as on one thread: the calling thread's batch. */
 FSDEM__FORCE_INLINE void fsdem__dem_batch_law(fsdem__dem_batch *b, const fsdem_dem_law law, fsdem_real h, const int pairs,
                                           fsdem_real off, const fsdem__dem_pair *uniform, const fsdem__dem_rules *rules) {
     const fsdem__lane one = fsdem__lane_set(1), zero = fsdem__lane_set(0);

@@ -1,5 +1,6 @@
 /* ---- >>linalg_check : validation of operators ---- */
 
+/* threaded: inside a team as on one thread: reads the stencil only. */
 static fsdem_real fsdem__stencil_face(const fsdem_stencil *st, int axis, int i, int j, int k) {
     const fsdem_real *f = st->face[axis];
     int n0 = st->n[0], n1 = st->n[1];
@@ -9,6 +10,7 @@ static fsdem_real fsdem__stencil_face(const fsdem_stencil *st, int axis, int i, 
     return f[((size_t)k * n1 + j) * (size_t)n0 + i];
 }
 
+/* threaded: inside a team as on one thread: reads the stencil only. */
 static int fsdem__stencil_type(const fsdem_stencil *st, int i, int j, int k) {
     if (!st->cell) return FSDEM_STENCIL_CELL_FLUID;
     return st->cell[((size_t)k * st->n[1] + j) * (size_t)st->n[0] + i];

@@ -9,6 +9,7 @@ static void fsdem__level_geometry(fsdem__level *L, int dim, const int n[3]) {
     L->count = dim == 3 ? L->sz * (L->n[2] + 2) : L->sz;
 }
 
+/* threaded: inside a team as on one thread: pure. */
 static int fsdem__level_index(const fsdem__level *L, int dim, int i, int j, int k) {
     return (i + 1) + (j + 1) * L->sy + (dim == 3 ? (k + 1) * L->sz : 0);
 }

@@ -29,6 +29,7 @@ static fsdem_real fsdem__pic_interp_face(const fsdem_pic *s, const fsdem_real *f
     return sum;
 }
 
+/* threaded: inside a team as on one thread: reads the grid only. */
 static fsdem_vec3 fsdem__pic_interp_vel(const fsdem_pic *s, fsdem_real *const f[3], fsdem_vec3 x) {
     fsdem_vec3 v;
     v.x = fsdem__pic_interp_face(s, f[0], 0, x);
@@ -80,6 +81,7 @@ static void fsdem__pic_p2g(fsdem_pic *s) {
 
 /* The grid-to-particle transfer of particle p (`du` holds u_new - u_old (FLIP) in uold); returns
    nonzero when its new velocity is not finite. */
+/* threaded: inside a team: one particle, written by its thread alone. */
 FSDEM__FORCE_INLINE int fsdem__pic_g2p_one(fsdem_pic *s, int p, const int quad, fsdem_real ratio, const int apic, fsdem_real dfac) {
     int a, q0, q1, q2, b, bad = 0;
     fsdem__kernel kw;
