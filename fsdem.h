@@ -110,7 +110,7 @@
        fsdem_X_desc fsdem_X_desc_default(dim)      defaults (couplers and fsdem_pcg: no argument)
        fsdem_result fsdem_X_desc_check(desc, message, size)  validation without creating anything
        fsdem_result fsdem_X_create(desc, &x)        *x is NULL on failure; destroy with _destroy
-       void         fsdem_X_destroy(x)              NULL is allowed
+       void         fsdem_X_destroy(x)              NULL is allowed; a coupler before its solvers
        const char  *fsdem_X_last_error(x)           message of the last failed call ("" after success)
        fsdem_X_desc fsdem_X_get_desc(x)             the desc in force (with values resolved)
        fsdem_result fsdem_X_step(x)                 one step of the object's own size: the DEM's dt,
@@ -145,7 +145,7 @@
    COUPLING INTERFACE
      A coupler is named fsdem_<fluid>_dem (fsdem_swe_dem, fsdem_mps_dem, fsdem_pic_dem), or after
      its method (fsdem_gic, Granule-In-Cell, PIC with granules), and holds non-owning pointers to a
-     fluid and a DEM. It reaches them only through these functions:
+     fluid and a DEM (destroy it before them). It reaches them only through these functions:
        DEM   fsdem_dem_get_particles (read), fsdem_dem_get_desc, fsdem_dem_get_coupling (writable
              external loads), fsdem_dem_substep_count, fsdem_dem_advance_with (substeps with a
              callback at every force evaluation, Verlet substeps fused)
@@ -2561,14 +2561,16 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
        avoided by halving the two);
      - time: the fluid's; get_stats starts with the fsdem_coupling_stats below;
      - update: what the coupler writes into the solvers, from the current state, without stepping;
-     - get_force(index): the record of DEM particle `index` from the last update, found by the
-       particle's stable id (so particles removed since do not mix the records up; FSDEM_ERR_NOT_FOUND
-       for a bad index, before the first update or for a particle added since), and
-       write_csv(path): the records as CSV, one row per DEM particle that has one, in index order,
-       the record's fields as columns (a vector as name_x, name_y, name_z), the first the particle's
-       stable id; before the first update the file holds the header alone (FSDEM_ERR_IO);
-   A coupler claims the solvers' arrays it writes when it is created and releases them when it is
-   destroyed (fsdem_claim): the DEM's external loads, and the fluid's arrays of its kind (SWE-DEM the
+     - get_force(index): the record of DEM particle `index` from the last update (SWE-DEM, MPS-DEM)
+       or step (PIC-DEM, GIC), found by the particle's stable id, so particles removed since do not
+       mix the records up (FSDEM_ERR_NOT_FOUND for a bad index, before the first update or step, or
+       for a particle added since), and write_csv(path): the records as CSV, one row per DEM
+       particle that has one, in index order, the record's fields as columns (a vector as name_x,
+       name_y, name_z), the first the particle's stable id; before the first update or step the file
+       holds the header alone; a file that cannot be written is FSDEM_ERR_IO;
+   A coupler holds pointers to its solvers and does not own them: destroy it before them. It claims
+   the solvers' arrays it writes when it is created and releases them when it is destroyed
+   (fsdem_claim): the DEM's external loads, and the fluid's arrays of its kind (SWE-DEM the
    SWE's momentum sources; MPS-DEM the MPS's forces and porosities; PIC-DEM the PIC's moving solids;
    GIC the PIC's porosity and accelerations). A second coupler that would write a claimed array is
    refused at creation, naming the first. Couplers that write different arrays of one fluid, each
@@ -2647,7 +2649,7 @@ FSDEM_API fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void);
 /* Creates a coupler. FSDEM_ERR_INVALID_ARG (missing solver, DEM not 3D, gravity not along -z or
    different from the SWE's, beta <= 0, negative damping; the reason goes to desc->log and to
    `message` of fsdem_swe_dem_desc_check), FSDEM_ERR_OUT_OF_MEMORY. Destroy with fsdem_swe_dem_destroy
-   (which leaves the solvers alive). */
+   before the solvers (it leaves them alive). */
 FSDEM_API fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *desc, char *message, size_t message_size);
 FSDEM_API fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out);
 FSDEM_API void fsdem_swe_dem_destroy(fsdem_swe_dem *coupler);
@@ -2821,8 +2823,8 @@ FSDEM_API fsdem_mps_dem_desc fsdem_mps_dem_desc_default(void);
    NULL). */
 FSDEM_API fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *desc, char *message, size_t message_size);
 /* Creates a coupler (its memory from the DEM's allocator). FSDEM_ERR_INVALID_ARG as the check
-   (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_mps_dem_destroy leaves the
-   solvers alive. */
+   (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_mps_dem_destroy, before the
+   solvers, leaves them alive. */
 FSDEM_API fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem **out);
 FSDEM_API void fsdem_mps_dem_destroy(fsdem_mps_dem *coupler);
 FSDEM_API const char *fsdem_mps_dem_last_error(const fsdem_mps_dem *coupler);
@@ -2977,8 +2979,8 @@ FSDEM_API fsdem_pic_dem_desc fsdem_pic_dem_desc_default(void);
 FSDEM_API fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *desc, char *message, size_t message_size);
 /* Creates a coupler (its memory from the DEM's allocator), removes the water particles inside the
    bodies and installs the implicit term in the PIC's pressure operator. FSDEM_ERR_INVALID_ARG as
-   the check (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_pic_dem_destroy
-   removes the term and the moving solids from the PIC and leaves both solvers alive. The coupler
+   the check (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_pic_dem_destroy,
+   before the solvers, removes the term and the moving solids from the PIC and leaves both alive. The coupler
    owns the PIC's open, solid_velocity and reference arrays (fsdem_pic_get_coupling): every step
    resets and rewrites them (it claims them, >>couple). */
 FSDEM_API fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem **out);
@@ -3134,8 +3136,8 @@ FSDEM_API fsdem_gic_desc fsdem_gic_desc_default(void);
    `message` (may be NULL). */
 FSDEM_API fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *desc, char *message, size_t message_size);
 /* Creates a coupler (its memory from the DEM's allocator). FSDEM_ERR_INVALID_ARG as the check (the
-   reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_gic_destroy leaves the solvers
-   alive. */
+   reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_gic_destroy, before the solvers,
+   leaves them alive. */
 FSDEM_API fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out);
 FSDEM_API void fsdem_gic_destroy(fsdem_gic *coupler);
 FSDEM_API const char *fsdem_gic_last_error(const fsdem_gic *coupler);
@@ -8432,18 +8434,19 @@ static void fsdem__mg_gather(const fsdem__level *F, const fsdem__level *C, int d
     }
 }
 
-/* threaded: inside a team: the pipelines' progress, read and written with OpenMP atomics. */
-/* Progress of the threaded pipeline: the number of stages finished on a slab, published by the
-   thread that owns the slab and awaited by its neighbours' owners (integer atomics only). */
+/* threaded: inside a team. Progress of the threaded pipeline: the number of stages finished on a
+   slab, published by the thread that owns the slab and awaited by its neighbours' owners, through
+   sequentially consistent OpenMP atomics (OpenMP 4.0; each implies the flush that makes the slab's
+   values visible before its count). */
 #ifdef FSDEM__THREADS
 static int fsdem__mg_progress(const int *done, int p) {
     int stages;
-    FSDEM__OMP(atomic read acquire)
+    FSDEM__OMP(atomic read seq_cst)
     stages = done[p];
     return stages;
 }
 static void fsdem__mg_publish(int *done, int p, int stages) {
-    FSDEM__OMP(atomic write release)
+    FSDEM__OMP(atomic write seq_cst)
     done[p] = stages + 0; /* (+ 0: gcc 12 takes a bare parameter under an atomic write for unused) */
 }
 #endif
@@ -16938,8 +16941,9 @@ fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsd
 /* Where a stage's CPU time goes (fsdem_coupling_stats). */
 enum { FSDEM__CLOCK_FLUID = 0, FSDEM__CLOCK_DEM = 1, FSDEM__CLOCK_COUPLING = 2 };
 
-/* One stage of a coupled step of dt; it names what failed in the coupler's message. The fluid's step
-   is the stage whose run is NULL: the driver takes it once for all couplers of the fluid. */
+/* One stage of a coupled step of dt: a failure's message names the coupler and the stage ("fsdem_gic:
+   sand substeps: ..."). The fluid's step is the stage whose run is NULL: the driver takes it once
+   for all couplers of the fluid. */
 typedef struct fsdem__stage {
     const char *name;
     int clock;
@@ -16988,6 +16992,7 @@ struct fsdem_coupler {
     long long steps, substeps, substeps_total;
     fsdem_real dt_last;
     double seconds[3];                  /* CPU seconds, by clock */
+    const char *stage;                  /* the name of the stage under way, for its messages */
     const void *record;                 /* the records of the last update (cls->record_size bytes */
     int records;                        /*    each, ids ascending), `records` of them (0: none) */
 };
@@ -17120,16 +17125,15 @@ static fsdem_result fsdem__coupler_substeps_within(fsdem_coupler *c, fsdem_real 
 }
 
 /* The coupler's DEM over dt in substeps, `fn` (may be NULL) called at every force evaluation
-   (fsdem_dem_advance_with); the counts go to the head. A failure is named "<what>: <the DEM's
+   (fsdem_dem_advance_with); the counts go to the head. A failure is named "<stage>: <the DEM's
    message>", unless `fn` failed (*fn_failed set) and named it already. */
-static fsdem_result fsdem__coupler_substeps(fsdem_coupler *c, fsdem_real dt, fsdem_dem_substep_fn fn, void *user, const char *what,
-                                            const int *fn_failed) {
+static fsdem_result fsdem__coupler_substeps(fsdem_coupler *c, fsdem_real dt, fsdem_dem_substep_fn fn, void *user, const int *fn_failed) {
     long long substeps = 0;
     const fsdem_result res = fsdem_dem_advance_with(c->dem, dt, fn, user, &substeps);
     c->substeps = substeps;
     c->substeps_total += substeps;
     if (res != FSDEM_OK && !(fn_failed && *fn_failed))
-        return fsdem__fail(&c->status, res, "%s: %s: %s", c->cls->name, what, fsdem_dem_last_error(c->dem));
+        return fsdem__fail(&c->status, res, "%s: %s: %s", c->cls->name, c->stage, fsdem_dem_last_error(c->dem));
     return res;
 }
 
@@ -17144,7 +17148,7 @@ static fsdem_result fsdem__coupled_fail(fsdem_coupler *const *list, int n, int f
         from = 0;
     }
     for (k = 0; k < n; ++k)
-        if (k != from) memcpy(list[k]->status.message, list[from]->status.message, sizeof list[k]->status.message);
+        if (list[k] != list[from]) memcpy(list[k]->status.message, list[from]->status.message, sizeof list[k]->status.message);
     return res;
 }
 
@@ -17209,10 +17213,18 @@ static fsdem_result fsdem__coupled_stages(fsdem_coupler *c, fsdem_real dt, int a
         while (s < cls->stage_count && cls->stages[s++].run) continue;
     for (; s < cls->stage_count && res == FSDEM_OK && cls->stages[s].run; ++s) {
         const clock_t t0 = clock();
+        c->stage = cls->stages[s].name;
         res = cls->stages[s].run(c, dt);
         c->seconds[cls->stages[s].clock] += (double)(clock() - t0) / CLOCKS_PER_SEC;
     }
     return res;
+}
+
+/* The name of the coupler's fluid-step stage ("PIC step"). */
+static const char *fsdem__coupler_fluid_stage(const fsdem_coupler *c) {
+    int s = 0;
+    while (c->cls->stages[s].run) ++s;
+    return c->cls->stages[s].name;
 }
 
 /* A coupled step of dt after the prepare: every coupler's check (a refusal undoes the prepare), the
@@ -17236,7 +17248,8 @@ static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_r
     for (k = 0; k < n; ++k) list[k]->seconds[FSDEM__CLOCK_FLUID] += seconds;
     if (res != FSDEM_OK) {
         if (res == FSDEM_ERR_CFL) fsdem__coupled_undo(list, n, res);
-        return fsdem__coupled_fail(list, n, -1, res, "%s: %s step: %s", list[0]->cls->name, f->name, f->last_error(fluid));
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s: %s", list[0]->cls->name, fsdem__coupler_fluid_stage(list[0]),
+                                   f->last_error(fluid));
     }
     for (k = 0; k < n; ++k) {
         list[k]->steps++;
@@ -17389,14 +17402,14 @@ static fsdem_result fsdem__coupler_write_csv(const fsdem_coupler *c, const char 
     char header[1024];
     size_t used = 0;
     int k;
-    for (k = 0; k < c->cls->field_count; ++k) {
+    for (k = 0; k < c->cls->field_count && used < sizeof header; ++k) {
         const fsdem__field *f = &c->cls->fields[k];
         const char *sep = k ? "," : "";
         used += (size_t)(f->kind == FSDEM__FIELD_VEC3
                              ? snprintf(header + used, sizeof header - used, "%s%s_x,%s_y,%s_z", sep, f->name, f->name, f->name)
                              : snprintf(header + used, sizeof header - used, "%s%s", sep, f->name));
-        FSDEM_ASSERT(used < sizeof header);
     }
+    FSDEM_ASSERT(used < sizeof header); /* the record types' fields fit with room to spare */
     return fsdem__write_rows(&c->status, who, path, header, fsdem_dem_get_particles(c->dem).count, fsdem__coupler_row, c);
 }
 
@@ -17688,7 +17701,7 @@ static fsdem_result fsdem__swe_dem_substeps(fsdem_coupler *head, fsdem_real dt) 
     const int count = fsdem_dem_get_particles(c->desc.dem).count;
     int k;
     for (k = 0; k < c->force_capacity && k < count; ++k) c->impulse = fsdem__madd(c->impulse, c->reaction[k], -dt);
-    return fsdem__coupler_substeps(head, dt, fsdem__swe_dem_refresh, c, "DEM substeps", NULL);
+    return fsdem__coupler_substeps(head, dt, fsdem__swe_dem_refresh, c, NULL);
 }
 
 static const fsdem__stage fsdem__swe_dem_stages[3] = {{"forces", FSDEM__CLOCK_COUPLING, fsdem__swe_dem_forces},
@@ -17978,16 +17991,18 @@ static fsdem_real fsdem__mps_dem_open_weight(const fsdem_mps_dem *c, const fsdem
     return walls < (fsdem_real)0.9 * c->ns ? c->ns - walls : (fsdem_real)0.1 * c->ns;
 }
 
-/* Makes room for the per-particle arrays (nd DEM, nm MPS particles). */
+/* Makes room for the per-particle arrays (nd DEM, nm MPS particles); the records of the last update
+   move with their array, so an update that fails later leaves them readable. */
 static fsdem_result fsdem__mps_dem_room(fsdem_mps_dem *c, int nd, int nm) {
     const fsdem_allocator *al = &c->head.allocator;
     int cap = c->force_cap;
     void **const fluid[3] = {(void **)&c->solid, (void **)&c->rate, (void **)&c->share};
     const size_t size[3] = {sizeof(fsdem_real), sizeof(fsdem_real), sizeof(fsdem_real)};
-    if (fsdem__grow(al, (void **)&c->start, &c->start_cap, 0, nd + 1, sizeof(int)) != FSDEM_OK ||
-        fsdem__grow(al, (void **)&c->force, &cap, 0, nd, sizeof(fsdem_mps_dem_force)) != FSDEM_OK)
-        return FSDEM_ERR_OUT_OF_MEMORY;
+    const fsdem_result res = fsdem__grow(al, (void **)&c->force, &cap, c->head.records, nd, sizeof(fsdem_mps_dem_force));
     c->force_cap = cap;
+    c->head.record = c->force;
+    if (res != FSDEM_OK || fsdem__grow(al, (void **)&c->start, &c->start_cap, 0, nd + 1, sizeof(int)) != FSDEM_OK)
+        return FSDEM_ERR_OUT_OF_MEMORY;
     return fsdem__grow_set(al, fluid, size, 3, &c->solid_cap, 0, nm);
 }
 
@@ -18182,6 +18197,7 @@ static void fsdem__mps_dem_undo(fsdem_coupler *head) {
     }
     if (dc.count) memcpy(dc.force, c->kept_load, sizeof(fsdem_vec3) * (size_t)dc.count);
     if (c->kept_forces) memcpy(c->force, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_forces);
+    c->head.record = c->force;
     c->head.records = c->kept_forces;
     c->tally = c->kept_tally;
 }
@@ -18216,7 +18232,7 @@ static fsdem_result fsdem__mps_dem_check(fsdem_coupler *head, fsdem_real dt, int
 
 /* Step 5 of >>couple_mps after the MPS step: the DEM over dt with the forces held. */
 static fsdem_result fsdem__mps_dem_substeps(fsdem_coupler *head, fsdem_real dt) {
-    return fsdem__coupler_substeps(head, dt, NULL, NULL, "DEM substeps", NULL);
+    return fsdem__coupler_substeps(head, dt, NULL, NULL, NULL);
 }
 
 static const fsdem__stage fsdem__mps_dem_stages[2] = {{"MPS step", FSDEM__CLOCK_FLUID, NULL},
@@ -18708,6 +18724,10 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
     if ((res = fsdem__pic_dem_reserve_bodies(c, P.count)) != FSDEM_OK)
         return fsdem__fail(&c->head.status, res, "fsdem_pic_dem: out of memory for the records of %d bodies", P.count);
     fsdem__pic_dem_clear_faces(c);
+    /* the records hold the last step's loads of the bodies as they were then: a new cut retires
+       them until its step's loads (fsdem__pic_dem_loads) */
+    c->loaded = 0;
+    c->head.records = 0;
     c->bodies = P.count;
     for (b = 0; b < P.count; ++b) c->load[b].id = P.id[b];
     for (b = 0; b < P.count; ++b)
@@ -19136,7 +19156,7 @@ static fsdem_result fsdem__pic_dem_loads_stage(fsdem_coupler *head, fsdem_real d
 }
 
 static fsdem_result fsdem__pic_dem_substeps(fsdem_coupler *head, fsdem_real dt) {
-    return fsdem__coupler_substeps(head, dt, NULL, NULL, "DEM substeps", NULL);
+    return fsdem__coupler_substeps(head, dt, NULL, NULL, NULL);
 }
 
 /* Steps 6-7 of >>couple_pic at the bodies' new positions. */
@@ -19351,12 +19371,14 @@ fsdem_gic_fields fsdem_gic_get_fields(const fsdem_gic *c) {
     return f;
 }
 
-/* Room for `count` granules in the per-granule arrays (outside the substeps). */
+/* Room for `count` granules in the per-granule arrays (outside the substeps); the records of the
+   last step move with their array. */
 static fsdem_result fsdem__gic_reserve(fsdem_gic *c, int count) {
     void **const arrays[4] = {(void **)&c->point, (void **)&c->sample, (void **)&c->force, (void **)&c->fluid_accel};
     const size_t sizes[4] = {sizeof(fsdem_vec3), sizeof(fsdem_fluid_sample), sizeof(fsdem_gic_force), sizeof(fsdem_vec3)};
     if (fsdem__grow_set(&c->head.allocator, arrays, sizes, 4, &c->granule_cap, c->head.records, count) != FSDEM_OK)
         return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_gic: out of memory (%d granules)", count);
+    c->head.record = c->force;
     return FSDEM_OK;
 }
 
@@ -19606,7 +19628,7 @@ static fsdem_result fsdem__gic_check(fsdem_coupler *head, fsdem_real dt, int cho
         const fsdem_real drag = fsdem__gic_drag_time(c, dt);
         if (drag > 0 && dt > c->desc.drag_dt_fraction * drag * (1 + (fsdem_real)1e-6))
             return fsdem__fail(&head->status, FSDEM_ERR_CFL,
-                               "fsdem_gic_step_dt: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s",
+                               "fsdem_gic: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s",
                                (double)dt, (double)c->desc.drag_dt_fraction, (double)drag);
     }
     return FSDEM_OK;
@@ -19627,7 +19649,7 @@ static fsdem_result fsdem__gic_sand(fsdem_coupler *head, fsdem_real dt) {
     c->tally.drag_dt = fsdem__gic_drag_time(c, dt);
     fsdem__gic_fluid_accelerations(c);
     fsdem_pic_clear_forces(c->desc.pic);
-    res = fsdem__coupler_substeps(head, dt, fsdem__gic_evaluate, c, "sand substeps", &c->failed);
+    res = fsdem__coupler_substeps(head, dt, fsdem__gic_evaluate, c, &c->failed);
     c->last = c->tally;
     return res;
 }
@@ -20763,7 +20785,7 @@ static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
     fsdem__restart_coupler(io, &c->head, "SWD1", fsdem__restart_swe, "shallow water", "debris (DEM)", same, 7);
     fsdem__restart_fields(io, c, state, 6);
     fsdem__restart_count(io, &count, 1 << 29, fsdem__restart_record_bytes(&c->head) + sizeof(fsdem_vec3), "force record count");
-    fsdem__restart_data(io, &records, sizeof records);
+    fsdem__restart_value(io, &records, sizeof records); /* checked before it is used */
     if (io->res == FSDEM_OK && (records < 0 || records > count)) fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "bad record count");
     force = (fsdem_swe_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
     reaction = (fsdem_vec3 *)fsdem__restart_block(io, &c->head.allocator, sizeof *reaction * (size_t)count);

@@ -110,7 +110,7 @@
        fsdem_X_desc fsdem_X_desc_default(dim)      defaults (couplers and fsdem_pcg: no argument)
        fsdem_result fsdem_X_desc_check(desc, message, size)  validation without creating anything
        fsdem_result fsdem_X_create(desc, &x)        *x is NULL on failure; destroy with _destroy
-       void         fsdem_X_destroy(x)              NULL is allowed
+       void         fsdem_X_destroy(x)              NULL is allowed; a coupler before its solvers
        const char  *fsdem_X_last_error(x)           message of the last failed call ("" after success)
        fsdem_X_desc fsdem_X_get_desc(x)             the desc in force (with values resolved)
        fsdem_result fsdem_X_step(x)                 one step of the object's own size: the DEM's dt,
@@ -145,7 +145,7 @@
    COUPLING INTERFACE
      A coupler is named fsdem_<fluid>_dem (fsdem_swe_dem, fsdem_mps_dem, fsdem_pic_dem), or after
      its method (fsdem_gic, Granule-In-Cell, PIC with granules), and holds non-owning pointers to a
-     fluid and a DEM. It reaches them only through these functions:
+     fluid and a DEM (destroy it before them). It reaches them only through these functions:
        DEM   fsdem_dem_get_particles (read), fsdem_dem_get_desc, fsdem_dem_get_coupling (writable
              external loads), fsdem_dem_substep_count, fsdem_dem_advance_with (substeps with a
              callback at every force evaluation, Verlet substeps fused)

@@ -636,6 +636,71 @@ START_TEST(test_mps_dem_bad_input) {
 }
 END_TEST
 
+/* An allocator that refuses once `refusals_after` further allocations have been granted (-1: never). */
+static int test_refusals_after = -1;
+static void *test_refusing_alloc(void *user, size_t size) {
+    (void)user;
+    if (test_refusals_after == 0) return NULL;
+    if (test_refusals_after > 0) test_refusals_after--;
+    return malloc(size);
+}
+static void test_refusing_free(void *user, void *ptr, size_t size) {
+    (void)user, (void)size;
+    free(ptr);
+}
+
+/* An update that runs out of memory after the DEM has grown keeps the last update's records
+   readable: get_force and write_csv give them as they were (the coupler's record array, grown for
+   the new particles, carries them along; it once left the head pointing at the freed array). */
+START_TEST(test_mps_dem_failed_update_keeps_its_records) {
+    fsdem_mps_desc md = fsdem_mps_desc_default(2);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    fsdem_mps *mps = NULL;
+    fsdem_dem *dem = NULL;
+    fsdem_mps_dem *cpl = NULL;
+    fsdem_mps_dem_force before, after;
+    fsdem_result res;
+    int k;
+    md.domain_min = fsdem_v3(-0.06f, -0.06f, 0);
+    md.domain_max = fsdem_v3(0.26f, 0.26f, 0);
+    ck_assert_int_eq(fsdem_mps_create(&md, &mps), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_add_box_walls(mps, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.2f, 0), 1u << FSDEM_SIDE_YMAX, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_fill_box(mps, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.1f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+    dd.domain_min = fsdem_v3(-0.06f, -0.06f, -1);
+    dd.domain_max = fsdem_v3(0.26f, 0.26f, 1);
+    dd.allocator.alloc = test_refusing_alloc;
+    dd.allocator.free = test_refusing_free;
+    ck_assert_int_eq(fsdem_dem_create(&dd, &dem), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_add_material(dem, &m, NULL), FSDEM_OK);
+    p.radius = 0.004f;
+    p.position = fsdem_v3(0.1f, 0.05f, 0);
+    ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+    cd.mps = mps;
+    cd.dem = dem;
+    ck_assert_int_eq(fsdem_mps_dem_create(&cd, &cpl), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_dem_update(cpl), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_dem_get_force(cpl, 0, &before), FSDEM_OK);
+    for (k = 0; k < 16; ++k) { /* past the record array's first capacity (16) */
+        p.position = fsdem_v3((fsdem_real)(0.02 + 0.01 * k), 0.08f, 0);
+        ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+    }
+    test_refusals_after = 1; /* the record array grows, the next allocation is refused */
+    res = fsdem_mps_dem_update(cpl);
+    test_refusals_after = -1;
+    ck_assert_int_eq(res, FSDEM_ERR_OUT_OF_MEMORY);
+    ck_assert_int_eq(fsdem_mps_dem_get_force(cpl, 0, &after), FSDEM_OK);
+    ck_assert(memcmp(&before, &after, sizeof before) == 0);
+    ck_assert_int_eq(fsdem_mps_dem_get_force(cpl, 1, &after), FSDEM_ERR_NOT_FOUND); /* added since */
+    ck_assert_int_eq(fsdem_mps_dem_write_csv(cpl, "build/test_mps_dem_failed_update.csv"), FSDEM_OK);
+    fsdem_mps_dem_destroy(cpl);
+    fsdem_dem_destroy(dem);
+    fsdem_mps_destroy(mps);
+}
+END_TEST
+
 /* The record of fsdem_mps_dem_get_force as a row of fsdem_mps_dem_write_csv (its documented columns). */
 static void test_force_row(double *r, int id, const fsdem_mps_dem_force *f) {
     const fsdem_vec3 v[4] = {f->drag, f->pressure, f->total, f->fluid_velocity};
@@ -720,6 +785,7 @@ Suite *couple_mps_suite(void) {
     tcase_add_test(tc, test_mps_dem_refused_step_changes_nothing);
     tcase_add_test(tc, test_mps_dem_bad_input);
     tcase_add_test(tc, test_mps_dem_csv_rows_are_the_force_records);
+    tcase_add_test(tc, test_mps_dem_failed_update_keeps_its_records);
     tcase_add_test(tc, test_mps_dem_csv_after_a_removal);
     suite_add_tcase(s, tc);
     return s;

@@ -197,8 +197,9 @@ START_TEST(archimedes_2d_and_3d) {
 END_TEST
 
 /* fsdem_pic_dem_update cuts the bodies at the current state without stepping: a disc added to the
-   DEM after the coupler was made takes the water particles inside it out (counted in `removed`)
-   and closes the PIC's faces it covers, and time does not move. A second update changes nothing. */
+   DEM after a step takes the water particles inside it out (counted in `removed`) and closes the
+   PIC's faces it covers, time does not move, and the step's load records retire (they belong to the
+   bodies as that step cut them) until the next step. A second update changes nothing. */
 START_TEST(update_cuts_without_stepping) {
     const double R = 0.04, dx = 0.01;
     tank t = make_tank(2, 0.3, 0.25, 0, G, dx, fsdem_v3(0.08, 0.1, 0), 0.03, 2000, 1, fsdem_v3(0, 0, 0), 0);
@@ -207,10 +208,14 @@ START_TEST(update_cuts_without_stepping) {
     fsdem_pic_particles w;
     fsdem_pic_coupling pc;
     int k, inside = 0, removed;
+    fsdem_pic_dem_force f;
+    ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)1e-3), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 0, &f), FSDEM_OK);
     p.position = fsdem_v3(0.2, 0.12, 0);
     p.radius = (fsdem_real)R;
     ck_assert_int_eq(fsdem_dem_add_particle(t.dem, &p, NULL), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_dem_update(t.cp), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 0, &f), FSDEM_ERR_NOT_FOUND);
     removed = (int)fsdem_pic_dem_get_stats(t.cp).removed - removed_at_creation;
     w = fsdem_pic_get_particles(t.pic);
     for (k = 0; k < w.count; ++k) inside += hypot(w.position[k].x - 0.2, w.position[k].y - 0.12) < R;
@@ -219,9 +224,11 @@ START_TEST(update_cuts_without_stepping) {
     pc = fsdem_pic_get_coupling(t.pic);
     /* the x-face at the disc's centre, (0.2, 0.12): i = 20, j = 12 of a 31-wide face row */
     ck_assert(pc.open[0][12 * 31 + 20] == 0);
-    ck_assert(fsdem_pic_dem_time(t.cp) == 0 && fsdem_pic_dem_get_stats(t.cp).coupling.steps == 0);
+    ck_assert(fsdem_pic_dem_time(t.cp) == (fsdem_real)1e-3 && fsdem_pic_dem_get_stats(t.cp).coupling.steps == 1);
     ck_assert_int_eq(fsdem_pic_dem_update(t.cp), FSDEM_OK);
     ck_assert(fsdem_pic_get_particles(t.pic).count == w.count && fsdem_pic_dem_get_stats(t.cp).removed == removed_at_creation + removed);
+    ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)1e-3), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_dem_get_force(t.cp, 1, &f), FSDEM_OK);
     free_tank(&t);
 }
 END_TEST

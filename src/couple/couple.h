@@ -14,14 +14,16 @@
        avoided by halving the two);
      - time: the fluid's; get_stats starts with the fsdem_coupling_stats below;
      - update: what the coupler writes into the solvers, from the current state, without stepping;
-     - get_force(index): the record of DEM particle `index` from the last update, found by the
-       particle's stable id (so particles removed since do not mix the records up; FSDEM_ERR_NOT_FOUND
-       for a bad index, before the first update or for a particle added since), and
-       write_csv(path): the records as CSV, one row per DEM particle that has one, in index order,
-       the record's fields as columns (a vector as name_x, name_y, name_z), the first the particle's
-       stable id; before the first update the file holds the header alone (FSDEM_ERR_IO);
-   A coupler claims the solvers' arrays it writes when it is created and releases them when it is
-   destroyed (fsdem_claim): the DEM's external loads, and the fluid's arrays of its kind (SWE-DEM the
+     - get_force(index): the record of DEM particle `index` from the last update (SWE-DEM, MPS-DEM)
+       or step (PIC-DEM, GIC), found by the particle's stable id, so particles removed since do not
+       mix the records up (FSDEM_ERR_NOT_FOUND for a bad index, before the first update or step, or
+       for a particle added since), and write_csv(path): the records as CSV, one row per DEM
+       particle that has one, in index order, the record's fields as columns (a vector as name_x,
+       name_y, name_z), the first the particle's stable id; before the first update or step the file
+       holds the header alone; a file that cannot be written is FSDEM_ERR_IO;
+   A coupler holds pointers to its solvers and does not own them: destroy it before them. It claims
+   the solvers' arrays it writes when it is created and releases them when it is destroyed
+   (fsdem_claim): the DEM's external loads, and the fluid's arrays of its kind (SWE-DEM the
    SWE's momentum sources; MPS-DEM the MPS's forces and porosities; PIC-DEM the PIC's moving solids;
    GIC the PIC's porosity and accelerations). A second coupler that would write a claimed array is
    refused at creation, naming the first. Couplers that write different arrays of one fluid, each

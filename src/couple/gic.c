@@ -167,12 +167,14 @@ fsdem_gic_fields fsdem_gic_get_fields(const fsdem_gic *c) {
     return f;
 }
 
-/* Room for `count` granules in the per-granule arrays (outside the substeps). */
+/* Room for `count` granules in the per-granule arrays (outside the substeps); the records of the
+   last step move with their array. */
 static fsdem_result fsdem__gic_reserve(fsdem_gic *c, int count) {
     void **const arrays[4] = {(void **)&c->point, (void **)&c->sample, (void **)&c->force, (void **)&c->fluid_accel};
     const size_t sizes[4] = {sizeof(fsdem_vec3), sizeof(fsdem_fluid_sample), sizeof(fsdem_gic_force), sizeof(fsdem_vec3)};
     if (fsdem__grow_set(&c->head.allocator, arrays, sizes, 4, &c->granule_cap, c->head.records, count) != FSDEM_OK)
         return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_gic: out of memory (%d granules)", count);
+    c->head.record = c->force;
     return FSDEM_OK;
 }
 
@@ -422,7 +424,7 @@ static fsdem_result fsdem__gic_check(fsdem_coupler *head, fsdem_real dt, int cho
         const fsdem_real drag = fsdem__gic_drag_time(c, dt);
         if (drag > 0 && dt > c->desc.drag_dt_fraction * drag * (1 + (fsdem_real)1e-6))
             return fsdem__fail(&head->status, FSDEM_ERR_CFL,
-                               "fsdem_gic_step_dt: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s",
+                               "fsdem_gic: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s",
                                (double)dt, (double)c->desc.drag_dt_fraction, (double)drag);
     }
     return FSDEM_OK;
@@ -443,7 +445,7 @@ static fsdem_result fsdem__gic_sand(fsdem_coupler *head, fsdem_real dt) {
     c->tally.drag_dt = fsdem__gic_drag_time(c, dt);
     fsdem__gic_fluid_accelerations(c);
     fsdem_pic_clear_forces(c->desc.pic);
-    res = fsdem__coupler_substeps(head, dt, fsdem__gic_evaluate, c, "sand substeps", &c->failed);
+    res = fsdem__coupler_substeps(head, dt, fsdem__gic_evaluate, c, &c->failed);
     c->last = c->tally;
     return res;
 }

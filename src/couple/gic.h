@@ -89,8 +89,8 @@ FSDEM_API fsdem_gic_desc fsdem_gic_desc_default(void);
    `message` (may be NULL). */
 FSDEM_API fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *desc, char *message, size_t message_size);
 /* Creates a coupler (its memory from the DEM's allocator). FSDEM_ERR_INVALID_ARG as the check (the
-   reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_gic_destroy leaves the solvers
-   alive. */
+   reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_gic_destroy, before the solvers,
+   leaves them alive. */
 FSDEM_API fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out);
 FSDEM_API void fsdem_gic_destroy(fsdem_gic *coupler);
 FSDEM_API const char *fsdem_gic_last_error(const fsdem_gic *coupler);

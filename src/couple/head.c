@@ -10,8 +10,9 @@
 /* Where a stage's CPU time goes (fsdem_coupling_stats). */
 enum { FSDEM__CLOCK_FLUID = 0, FSDEM__CLOCK_DEM = 1, FSDEM__CLOCK_COUPLING = 2 };
 
-/* One stage of a coupled step of dt; it names what failed in the coupler's message. The fluid's step
-   is the stage whose run is NULL: the driver takes it once for all couplers of the fluid. */
+/* One stage of a coupled step of dt: a failure's message names the coupler and the stage ("fsdem_gic:
+   sand substeps: ..."). The fluid's step is the stage whose run is NULL: the driver takes it once
+   for all couplers of the fluid. */
 typedef struct fsdem__stage {
     const char *name;
     int clock;
@@ -60,6 +61,7 @@ struct fsdem_coupler {
     long long steps, substeps, substeps_total;
     fsdem_real dt_last;
     double seconds[3];                  /* CPU seconds, by clock */
+    const char *stage;                  /* the name of the stage under way, for its messages */
     const void *record;                 /* the records of the last update (cls->record_size bytes */
     int records;                        /*    each, ids ascending), `records` of them (0: none) */
 };

@@ -258,16 +258,18 @@ static fsdem_real fsdem__mps_dem_open_weight(const fsdem_mps_dem *c, const fsdem
     return walls < (fsdem_real)0.9 * c->ns ? c->ns - walls : (fsdem_real)0.1 * c->ns;
 }
 
-/* Makes room for the per-particle arrays (nd DEM, nm MPS particles). */
+/* Makes room for the per-particle arrays (nd DEM, nm MPS particles); the records of the last update
+   move with their array, so an update that fails later leaves them readable. */
 static fsdem_result fsdem__mps_dem_room(fsdem_mps_dem *c, int nd, int nm) {
     const fsdem_allocator *al = &c->head.allocator;
     int cap = c->force_cap;
     void **const fluid[3] = {(void **)&c->solid, (void **)&c->rate, (void **)&c->share};
     const size_t size[3] = {sizeof(fsdem_real), sizeof(fsdem_real), sizeof(fsdem_real)};
-    if (fsdem__grow(al, (void **)&c->start, &c->start_cap, 0, nd + 1, sizeof(int)) != FSDEM_OK ||
-        fsdem__grow(al, (void **)&c->force, &cap, 0, nd, sizeof(fsdem_mps_dem_force)) != FSDEM_OK)
-        return FSDEM_ERR_OUT_OF_MEMORY;
+    const fsdem_result res = fsdem__grow(al, (void **)&c->force, &cap, c->head.records, nd, sizeof(fsdem_mps_dem_force));
     c->force_cap = cap;
+    c->head.record = c->force;
+    if (res != FSDEM_OK || fsdem__grow(al, (void **)&c->start, &c->start_cap, 0, nd + 1, sizeof(int)) != FSDEM_OK)
+        return FSDEM_ERR_OUT_OF_MEMORY;
     return fsdem__grow_set(al, fluid, size, 3, &c->solid_cap, 0, nm);
 }
 
@@ -462,6 +464,7 @@ static void fsdem__mps_dem_undo(fsdem_coupler *head) {
     }
     if (dc.count) memcpy(dc.force, c->kept_load, sizeof(fsdem_vec3) * (size_t)dc.count);
     if (c->kept_forces) memcpy(c->force, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_forces);
+    c->head.record = c->force;
     c->head.records = c->kept_forces;
     c->tally = c->kept_tally;
 }
@@ -496,7 +499,7 @@ static fsdem_result fsdem__mps_dem_check(fsdem_coupler *head, fsdem_real dt, int
 
 /* Step 5 of >>couple_mps after the MPS step: the DEM over dt with the forces held. */
 static fsdem_result fsdem__mps_dem_substeps(fsdem_coupler *head, fsdem_real dt) {
-    return fsdem__coupler_substeps(head, dt, NULL, NULL, "DEM substeps", NULL);
+    return fsdem__coupler_substeps(head, dt, NULL, NULL, NULL);
 }
 
 static const fsdem__stage fsdem__mps_dem_stages[2] = {{"MPS step", FSDEM__CLOCK_FLUID, NULL},

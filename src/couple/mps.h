@@ -117,8 +117,8 @@ FSDEM_API fsdem_mps_dem_desc fsdem_mps_dem_desc_default(void);
    NULL). */
 FSDEM_API fsdem_result fsdem_mps_dem_desc_check(const fsdem_mps_dem_desc *desc, char *message, size_t message_size);
 /* Creates a coupler (its memory from the DEM's allocator). FSDEM_ERR_INVALID_ARG as the check
-   (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_mps_dem_destroy leaves the
-   solvers alive. */
+   (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_mps_dem_destroy, before the
+   solvers, leaves them alive. */
 FSDEM_API fsdem_result fsdem_mps_dem_create(const fsdem_mps_dem_desc *desc, fsdem_mps_dem **out);
 FSDEM_API void fsdem_mps_dem_destroy(fsdem_mps_dem *coupler);
 FSDEM_API const char *fsdem_mps_dem_last_error(const fsdem_mps_dem *coupler);

@@ -441,6 +441,10 @@ static fsdem_result fsdem__pic_dem_faces(fsdem_pic_dem *c, fsdem_real dt) {
     if ((res = fsdem__pic_dem_reserve_bodies(c, P.count)) != FSDEM_OK)
         return fsdem__fail(&c->head.status, res, "fsdem_pic_dem: out of memory for the records of %d bodies", P.count);
     fsdem__pic_dem_clear_faces(c);
+    /* the records hold the last step's loads of the bodies as they were then: a new cut retires
+       them until its step's loads (fsdem__pic_dem_loads) */
+    c->loaded = 0;
+    c->head.records = 0;
     c->bodies = P.count;
     for (b = 0; b < P.count; ++b) c->load[b].id = P.id[b];
     for (b = 0; b < P.count; ++b)
@@ -869,7 +873,7 @@ static fsdem_result fsdem__pic_dem_loads_stage(fsdem_coupler *head, fsdem_real d
 }
 
 static fsdem_result fsdem__pic_dem_substeps(fsdem_coupler *head, fsdem_real dt) {
-    return fsdem__coupler_substeps(head, dt, NULL, NULL, "DEM substeps", NULL);
+    return fsdem__coupler_substeps(head, dt, NULL, NULL, NULL);
 }
 
 /* Steps 6-7 of >>couple_pic at the bodies' new positions. */

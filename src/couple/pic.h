@@ -88,8 +88,8 @@ FSDEM_API fsdem_pic_dem_desc fsdem_pic_dem_desc_default(void);
 FSDEM_API fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *desc, char *message, size_t message_size);
 /* Creates a coupler (its memory from the DEM's allocator), removes the water particles inside the
    bodies and installs the implicit term in the PIC's pressure operator. FSDEM_ERR_INVALID_ARG as
-   the check (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_pic_dem_destroy
-   removes the term and the moving solids from the PIC and leaves both solvers alive. The coupler
+   the check (the reason also goes to desc->log), FSDEM_ERR_OUT_OF_MEMORY. fsdem_pic_dem_destroy,
+   before the solvers, removes the term and the moving solids from the PIC and leaves both alive. The coupler
    owns the PIC's open, solid_velocity and reference arrays (fsdem_pic_get_coupling): every step
    resets and rewrites them (it claims them, >>couple). */
 FSDEM_API fsdem_result fsdem_pic_dem_create(const fsdem_pic_dem_desc *desc, fsdem_pic_dem **out);

@@ -27,16 +27,15 @@ static fsdem_result fsdem__coupler_substeps_within(fsdem_coupler *c, fsdem_real 
 }
 
 /* The coupler's DEM over dt in substeps, `fn` (may be NULL) called at every force evaluation
-   (fsdem_dem_advance_with); the counts go to the head. A failure is named "<what>: <the DEM's
+   (fsdem_dem_advance_with); the counts go to the head. A failure is named "<stage>: <the DEM's
    message>", unless `fn` failed (*fn_failed set) and named it already. */
-static fsdem_result fsdem__coupler_substeps(fsdem_coupler *c, fsdem_real dt, fsdem_dem_substep_fn fn, void *user, const char *what,
-                                            const int *fn_failed) {
+static fsdem_result fsdem__coupler_substeps(fsdem_coupler *c, fsdem_real dt, fsdem_dem_substep_fn fn, void *user, const int *fn_failed) {
     long long substeps = 0;
     const fsdem_result res = fsdem_dem_advance_with(c->dem, dt, fn, user, &substeps);
     c->substeps = substeps;
     c->substeps_total += substeps;
     if (res != FSDEM_OK && !(fn_failed && *fn_failed))
-        return fsdem__fail(&c->status, res, "%s: %s: %s", c->cls->name, what, fsdem_dem_last_error(c->dem));
+        return fsdem__fail(&c->status, res, "%s: %s: %s", c->cls->name, c->stage, fsdem_dem_last_error(c->dem));
     return res;
 }
 
@@ -51,7 +50,7 @@ static fsdem_result fsdem__coupled_fail(fsdem_coupler *const *list, int n, int f
         from = 0;
     }
     for (k = 0; k < n; ++k)
-        if (k != from) memcpy(list[k]->status.message, list[from]->status.message, sizeof list[k]->status.message);
+        if (list[k] != list[from]) memcpy(list[k]->status.message, list[from]->status.message, sizeof list[k]->status.message);
     return res;
 }
 
@@ -116,10 +115,18 @@ static fsdem_result fsdem__coupled_stages(fsdem_coupler *c, fsdem_real dt, int a
         while (s < cls->stage_count && cls->stages[s++].run) continue;
     for (; s < cls->stage_count && res == FSDEM_OK && cls->stages[s].run; ++s) {
         const clock_t t0 = clock();
+        c->stage = cls->stages[s].name;
         res = cls->stages[s].run(c, dt);
         c->seconds[cls->stages[s].clock] += (double)(clock() - t0) / CLOCKS_PER_SEC;
     }
     return res;
+}
+
+/* The name of the coupler's fluid-step stage ("PIC step"). */
+static const char *fsdem__coupler_fluid_stage(const fsdem_coupler *c) {
+    int s = 0;
+    while (c->cls->stages[s].run) ++s;
+    return c->cls->stages[s].name;
 }
 
 /* A coupled step of dt after the prepare: every coupler's check (a refusal undoes the prepare), the
@@ -143,7 +150,8 @@ static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_r
     for (k = 0; k < n; ++k) list[k]->seconds[FSDEM__CLOCK_FLUID] += seconds;
     if (res != FSDEM_OK) {
         if (res == FSDEM_ERR_CFL) fsdem__coupled_undo(list, n, res);
-        return fsdem__coupled_fail(list, n, -1, res, "%s: %s step: %s", list[0]->cls->name, f->name, f->last_error(fluid));
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s: %s", list[0]->cls->name, fsdem__coupler_fluid_stage(list[0]),
+                                   f->last_error(fluid));
     }
     for (k = 0; k < n; ++k) {
         list[k]->steps++;

@@ -286,7 +286,7 @@ static fsdem_result fsdem__swe_dem_substeps(fsdem_coupler *head, fsdem_real dt) 
     const int count = fsdem_dem_get_particles(c->desc.dem).count;
     int k;
     for (k = 0; k < c->force_capacity && k < count; ++k) c->impulse = fsdem__madd(c->impulse, c->reaction[k], -dt);
-    return fsdem__coupler_substeps(head, dt, fsdem__swe_dem_refresh, c, "DEM substeps", NULL);
+    return fsdem__coupler_substeps(head, dt, fsdem__swe_dem_refresh, c, NULL);
 }
 
 static const fsdem__stage fsdem__swe_dem_stages[3] = {{"forces", FSDEM__CLOCK_COUPLING, fsdem__swe_dem_forces},

@@ -42,7 +42,7 @@ FSDEM_API fsdem_swe_dem_desc fsdem_swe_dem_desc_default(void);
 /* Creates a coupler. FSDEM_ERR_INVALID_ARG (missing solver, DEM not 3D, gravity not along -z or
    different from the SWE's, beta <= 0, negative damping; the reason goes to desc->log and to
    `message` of fsdem_swe_dem_desc_check), FSDEM_ERR_OUT_OF_MEMORY. Destroy with fsdem_swe_dem_destroy
-   (which leaves the solvers alive). */
+   before the solvers (it leaves them alive). */
 FSDEM_API fsdem_result fsdem_swe_dem_desc_check(const fsdem_swe_dem_desc *desc, char *message, size_t message_size);
 FSDEM_API fsdem_result fsdem_swe_dem_create(const fsdem_swe_dem_desc *desc, fsdem_swe_dem **out);
 FSDEM_API void fsdem_swe_dem_destroy(fsdem_swe_dem *coupler);

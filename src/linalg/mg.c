@@ -62,18 +62,19 @@ static void fsdem__mg_gather(const fsdem__level *F, const fsdem__level *C, int d
     }
 }
 
-/* threaded: inside a team: the pipelines' progress, read and written with OpenMP atomics. */
-/* Progress of the threaded pipeline: the number of stages finished on a slab, published by the
-   thread that owns the slab and awaited by its neighbours' owners (integer atomics only). */
+/* threaded: inside a team. Progress of the threaded pipeline: the number of stages finished on a
+   slab, published by the thread that owns the slab and awaited by its neighbours' owners, through
+   sequentially consistent OpenMP atomics (OpenMP 4.0; each implies the flush that makes the slab's
+   values visible before its count). */
 #ifdef FSDEM__THREADS
 static int fsdem__mg_progress(const int *done, int p) {
     int stages;
-    FSDEM__OMP(atomic read acquire)
+    FSDEM__OMP(atomic read seq_cst)
     stages = done[p];
     return stages;
 }
 static void fsdem__mg_publish(int *done, int p, int stages) {
-    FSDEM__OMP(atomic write release)
+    FSDEM__OMP(atomic write seq_cst)
     done[p] = stages + 0; /* (+ 0: gcc 12 takes a bare parameter under an atomic write for unused) */
 }
 #endif

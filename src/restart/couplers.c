@@ -62,7 +62,7 @@ static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
     fsdem__restart_coupler(io, &c->head, "SWD1", fsdem__restart_swe, "shallow water", "debris (DEM)", same, 7);
     fsdem__restart_fields(io, c, state, 6);
     fsdem__restart_count(io, &count, 1 << 29, fsdem__restart_record_bytes(&c->head) + sizeof(fsdem_vec3), "force record count");
-    fsdem__restart_data(io, &records, sizeof records);
+    fsdem__restart_value(io, &records, sizeof records); /* checked before it is used */
     if (io->res == FSDEM_OK && (records < 0 || records > count)) fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "bad record count");
     force = (fsdem_swe_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
     reaction = (fsdem_vec3 *)fsdem__restart_block(io, &c->head.allocator, sizeof *reaction * (size_t)count);
