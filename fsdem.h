@@ -32,7 +32,7 @@
                 (seed 004)
      >>couple   what every coupler shares: the staged step (one fluid step, the DEM's substeps),
                 the stable rule, the advance, per-particle records and their CSV, claims on the
-                solvers' coupling arrays, couplers of one fluid stepped together
+                solvers' coupling arrays
      >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
      >>couple_mps  unresolved MPS-DEM, Models A and B: porosity and momentum exchange by local
                 averaging, sequential staggered substepping (seed 002)
@@ -43,6 +43,8 @@
                 first (seed 004)
      >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
                 to memory, bit-exact continuation (versioned binary format with a checksum)
+     >>couple_step  the coupled step, taken whole or not at all (a failure once something moved
+                puts the state back), couplers of one fluid stepped together
      >>io       CSV time series; ParaView .pvd series, valid after every entry; VTK XML snapshots
                 of every solver (ascii, inline base64 or appended raw): DEM particles, walls and
                 contacts (.vtp), PIC particles (.vtp) and grid (.vti), shallow-water fields (.vti),
@@ -2545,7 +2547,7 @@ FSDEM_API fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real por
 /* Name of a law ("ergun_wen_yu", ...), "unknown" for other values. Never NULL. */
 FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
 
-/* ===== >>couple : what every coupler shares, and couplers stepped together ======================== */
+/* ===== >>couple : what every coupler shares ====================================================== */
 
 /* A coupler (fsdem_swe_dem, fsdem_mps_dem, fsdem_pic_dem, fsdem_gic) joins one fluid and one DEM.
    Its step is a list of named stages around one step of the fluid: the fluid first for SWE-DEM,
@@ -2555,7 +2557,7 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
      - step: its stable dt, the fluid's stable dt cut by the coupler's own limits (drag or viscous
        relaxation, bodies' speed); step_dt(dt): that dt, refused with FSDEM_ERR_CFL above the
        coupler's hard limits; either refuses before anything moves when the DEM would need more
-       than desc.max_substeps substeps;
+       than desc.max_substeps substeps, and a step is taken whole or not at all (>>couple_step);
      - advance(duration): steps of the stable dt until exactly `duration` later, the last two
        shortened to end there (never a sliver: a last step shorter than half a stable one is
        avoided by halving the two);
@@ -2574,7 +2576,7 @@ FSDEM_API const char *fsdem_drag_law_name(fsdem_drag_law law);
    SWE's momentum sources; MPS-DEM the MPS's forces and porosities; PIC-DEM the PIC's moving solids;
    GIC the PIC's porosity and accelerations). A second coupler that would write a claimed array is
    refused at creation, naming the first. Couplers that write different arrays of one fluid, each
-   with its own DEM, share that fluid and step together with fsdem_coupled_step: one PIC then
+   with its own DEM, share that fluid and step together with fsdem_coupled_step (>>couple_step): one PIC then
    carries a granular bed (fsdem_gic) and resolved bodies (fsdem_pic_dem) at once. */
 
 /* Figures every coupler keeps (the head of its fsdem_X_stats). */
@@ -2593,17 +2595,6 @@ typedef struct fsdem_coupling_stats {
 /* Any coupler, as fsdem_swe_dem_coupler, fsdem_mps_dem_coupler, fsdem_pic_dem_coupler and
    fsdem_gic_coupler give it (the same object: destroy it as what it is). */
 typedef struct fsdem_coupler fsdem_coupler;
-
-/* Couplers of one fluid stepped together: every coupler's stages before the fluid step, in the
-   order of the list, one step of the fluid, then every coupler's stages after it. The step is the
-   smallest stable dt of them all (fsdem_coupled_stable_dt), or dt; each coupler refuses it as its
-   own step would, before anything moves. FSDEM_ERR_INVALID_ARG for an empty list, a NULL entry,
-   a coupler listed twice or couplers of different fluids. A failure's message goes to every
-   coupler of the list (fsdem_X_last_error). A list of one is that coupler's own step. */
-FSDEM_API fsdem_result fsdem_coupled_step(fsdem_coupler *const *couplers, int count);
-FSDEM_API fsdem_result fsdem_coupled_step_dt(fsdem_coupler *const *couplers, int count, fsdem_real dt);
-FSDEM_API fsdem_result fsdem_coupled_advance(fsdem_coupler *const *couplers, int count, fsdem_real duration, long long *steps);
-FSDEM_API fsdem_result fsdem_coupled_stable_dt(fsdem_coupler *const *couplers, int count, fsdem_real *dt);
 
 /* ===== >>couple_swe : SWE-DEM floating debris (seed 003) ========================================== */
 
@@ -3361,6 +3352,30 @@ FSDEM_API fsdem_result fsdem_gic_save(const fsdem_gic *coupler, const char *path
 FSDEM_API fsdem_result fsdem_gic_restore(fsdem_gic *coupler, const char *path);
 FSDEM_API fsdem_result fsdem_gic_save_memory(const fsdem_gic *coupler, void *buffer, size_t capacity, size_t *size);
 FSDEM_API fsdem_result fsdem_gic_restore_memory(fsdem_gic *coupler, const void *buffer, size_t size);
+
+/* ===== >>couple_step : a coupled step that is taken whole or not at all, couplers stepped together */
+
+/* Every coupler's step, step_dt and advance (>>couple), and the coupled calls below, follow one rule:
+   all that can refuse the step (the fluid's and the coupler's limits, max_substeps, a DEM particle
+   that does not fit or is not finite) is checked before anything moves; a failure that can only be
+   seen once something moved (a NaN in a result, a solver's refusal during its step) puts coupler,
+   fluid and DEM back as they were before the call, bit for bit, from a copy of their saved state
+   taken before the step (>>restart, without its checksum: the copy never leaves the process). The
+   copy costs one save of the coupled run per step, in memory the coupler keeps (grown when the run
+   grows, FSDEM_ERR_OUT_OF_MEMORY before anything moves when it cannot be). One exception: a fluid
+   with a gauge file open (fsdem_X_gauges_open) cannot be put back, since the file has been
+   written; the message then says so. */
+
+/* Couplers of one fluid stepped together: every coupler's stages before the fluid step, in the
+   order of the list, one step of the fluid, then every coupler's stages after it. The step is the
+   smallest stable dt of them all (fsdem_coupled_stable_dt), or dt; each coupler refuses it as its
+   own step would, before anything moves. FSDEM_ERR_INVALID_ARG for an empty list, a NULL entry,
+   a coupler listed twice or couplers of different fluids. A failure's message goes to every
+   coupler of the list (fsdem_X_last_error). A list of one is that coupler's own step. */
+FSDEM_API fsdem_result fsdem_coupled_step(fsdem_coupler *const *couplers, int count);
+FSDEM_API fsdem_result fsdem_coupled_step_dt(fsdem_coupler *const *couplers, int count, fsdem_real dt);
+FSDEM_API fsdem_result fsdem_coupled_advance(fsdem_coupler *const *couplers, int count, fsdem_real duration, long long *steps);
+FSDEM_API fsdem_result fsdem_coupled_stable_dt(fsdem_coupler *const *couplers, int count, fsdem_real *dt);
 
 /* ===== >>io : CSV time series, ParaView series, VTK XML snapshots ================================== */
 
@@ -16932,9 +16947,9 @@ fsdem_result fsdem_drag_coefficient(fsdem_drag_law law, fsdem_real porosity, fsd
 /* ===== >>impl_couple : the coupler head, the fluids, the staged step, records =====================
 
    Contents: the head every coupler starts with, its class and its creation (below);
-   >>couple_fluids (the three fluids through their public calls), >>couple_step (the DEM's checks,
-   the staged step of couplers sharing a fluid, the stable rule, the advance), >>couple_records (the
-   per-particle records by their fields: lookup, CSV). A coupler, this chapter included, reaches the
+   >>couple_fluids (the three fluids through their public calls), >>couple_dem (the DEM's checks
+   and substeps), >>couple_records (the per-particle records by their fields: lookup, CSV). The
+   staged step itself is >>impl_couple_step, after >>impl_restart, whose saves it keeps. A coupler, this chapter included, reaches the
    solvers through their public calls only (>>doc; tests/map_check.sh holds every coupler chapter to
    it). */
 
@@ -16968,7 +16983,7 @@ typedef struct fsdem__coupler_class {
     size_t record_size;                 /* bytes of its per-particle record, whose first field is the int id */
     const fsdem__field *fields;         /* the record's fields (>>core), CSV columns and restart */
     int field_count;
-    /* its step (>>couple_step): prepare (may be NULL) does what must come before the step's length
+    /* its step (>>impl_couple_step): prepare (may be NULL) does what must come before the step's length
        is known, and undo (may be NULL) puts it back when the step is refused; limit (may be NULL)
        cuts the fluid's stable dt by the coupler's own limits; check refuses a dt before anything
        moves (chosen: the caller's dt, not a stable one); then the stages in order */
@@ -16995,6 +17010,9 @@ struct fsdem_coupler {
     const char *stage;                  /* the name of the stage under way, for its messages */
     const void *record;                 /* the records of the last update (cls->record_size bytes */
     int records;                        /*    each, ids ascending), `records` of them (0: none) */
+    unsigned char *kept;                /* the state before the step under way (fsdem__coupler_keep): */
+    size_t kept_saved, kept_capacity;   /*    its saved bytes, then its records (not every field of */
+    int kept_records;                   /*    a record is saved) */
 };
 
 /* The desc checks every coupler shares: a fluid of dimension fluid_dim and gravity fluid_g and a DEM
@@ -17050,6 +17068,7 @@ static void *fsdem__coupler_new(const fsdem__coupler_class *cls, fsdem_result ch
 /* Releases the coupler's claims and frees its `size` bytes (its own arrays freed before). */
 static void fsdem__coupler_free(fsdem_coupler *c, size_t size) {
     const fsdem_allocator al = c->allocator;
+    fsdem__free(&al, c->kept, c->kept_capacity);
     fsdem_release(fsdem_dem_claims(c->dem), FSDEM_DEM_ARRAYS_LOADS, c);
     fsdem_release(c->cls->fluid->claims(c->fluid), c->fluid_arrays, c);
     fsdem__free(&al, c, size);
@@ -17096,7 +17115,7 @@ static fsdem_claims *fsdem__fluid_swe_claims(void *f) { return fsdem_swe_claims(
 static const fsdem__fluid fsdem__fluid_swe = {"shallow-water", "swe", fsdem__fluid_swe_time, fsdem__fluid_swe_stable, fsdem__fluid_swe_step,
                                               fsdem__fluid_swe_error, fsdem__fluid_swe_claims};
 
-/* ---- >>couple_step : the DEM's checks, the staged step, the stable rule, the advance ---- */
+/* ---- >>couple_dem : the DEM's checks and substeps ---- */
 
 /* Every DEM particle fits in the fluid's domain [lo, hi] (a sphere wider than the domain's smallest
    extent leaves no fluid around it); the particle goes to the message under the name `who`. */
@@ -17137,209 +17156,23 @@ static fsdem_result fsdem__coupler_substeps(fsdem_coupler *c, fsdem_real dt, fsd
     return res;
 }
 
-/* The message of couplers[from] (or a new one, from < 0) given to every coupler of the list. */
-static fsdem_result fsdem__coupled_fail(fsdem_coupler *const *list, int n, int from, fsdem_result res, const char *fmt, ...) {
-    int k;
-    if (from < 0) {
-        va_list ap;
-        va_start(ap, fmt);
-        fsdem__vfail(&list[0]->status, res, fmt, ap);
-        va_end(ap);
-        from = 0;
-    }
-    for (k = 0; k < n; ++k)
-        if (list[k] != list[from]) memcpy(list[k]->status.message, list[from]->status.message, sizeof list[k]->status.message);
-    return res;
-}
-
-/* Puts back what the couplers' prepare did (a refused step); passes `res` on. */
-static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem_result res) {
-    int k;
-    for (k = 0; k < n; ++k)
-        if (list[k]->cls->undo) list[k]->cls->undo(list[k]);
-    return res;
-}
-
-/* A list of couplers that can step together: not empty, no NULL, none twice, one fluid. */
-static fsdem_result fsdem__coupled_list(fsdem_coupler *const *list, int n, const char *who) {
-    int k, j;
-    if (!list || n < 1) return FSDEM_ERR_INVALID_ARG;
-    for (k = 0; k < n; ++k)
-        if (!list[k]) return FSDEM_ERR_INVALID_ARG;
-    for (k = 1; k < n; ++k) {
-        if (list[k]->fluid != list[0]->fluid)
-            return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: couplers %d (%s) and 0 (%s) have different fluids", who, k,
-                                       list[k]->cls->name, list[0]->cls->name);
-        for (j = 0; j < k; ++j)
-            if (list[j] == list[k]) return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: coupler %d is listed twice", who, k);
+/* Every DEM particle's position and velocity finite, and the particle inside the DEM's domain: a
+   step of a DEM that holds a NaN or a particle outside is refused before anything moves (the DEM
+   would find it only in its first substep). */
+static fsdem_result fsdem__coupler_particles_valid(fsdem_coupler *c) {
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->dem);
+    const fsdem_dem_desc dd = fsdem_dem_get_desc(c->dem);
+    int i, a;
+    for (i = 0; i < P.count; ++i) {
+        if (!fsdem__finite3(P.position[i]) || !fsdem__finite3(P.velocity[i]) || !fsdem__finite3(P.angular_velocity[i]))
+            return fsdem__fail(&c->status, FSDEM_ERR_NAN, "%s: DEM particle %d (id %d) has a non-finite position or velocity", c->cls->name, i,
+                               P.id[i]);
+        for (a = 0; a < dd.dim; ++a)
+            if (!(fsdem__comp(P.position[i], a) >= fsdem__comp(dd.domain_min, a) && fsdem__comp(P.position[i], a) <= fsdem__comp(dd.domain_max, a)))
+                return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_DOMAIN, "%s: DEM particle %d (id %d) at (%g, %g, %g) m is outside the DEM's domain",
+                                   c->cls->name, i, P.id[i], (double)P.position[i].x, (double)P.position[i].y, (double)P.position[i].z);
     }
     return FSDEM_OK;
-}
-
-/* The stable dt of couplers of one fluid: the fluid's, cut by every coupler's own limits. */
-static fsdem_result fsdem__coupled_stable(fsdem_coupler *const *list, int n, fsdem_real *dt) {
-    const fsdem__fluid *f = list[0]->cls->fluid;
-    fsdem_result res = f->stable_dt(list[0]->fluid, dt);
-    int k;
-    if (res != FSDEM_OK)
-        return fsdem__coupled_fail(list, n, -1, res, "%s: %s stable step: %s", list[0]->cls->name, f->name, f->last_error(list[0]->fluid));
-    for (k = 0; k < n; ++k)
-        if (list[k]->cls->limit && (res = list[k]->cls->limit(list[k], dt)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
-    return FSDEM_OK;
-}
-
-/* The couplers' prepare, in order, timed as coupling (a failure undoes those before), then with
-   `dt` the stable dt. */
-static fsdem_result fsdem__coupled_prepare(fsdem_coupler *const *list, int n, fsdem_real *dt) {
-    fsdem_result res = FSDEM_OK;
-    int k;
-    for (k = 0; k < n && res == FSDEM_OK; ++k)
-        if (list[k]->cls->prepare) {
-            const clock_t t0 = clock();
-            if ((res = list[k]->cls->prepare(list[k])) != FSDEM_OK) fsdem__coupled_fail(list, n, k, fsdem__coupled_undo(list, k, res), NULL);
-            list[k]->seconds[FSDEM__CLOCK_COUPLING] += (double)(clock() - t0) / CLOCKS_PER_SEC;
-        }
-    if (res == FSDEM_OK && dt && (res = fsdem__coupled_stable(list, n, dt)) != FSDEM_OK) fsdem__coupled_undo(list, n, res);
-    return res;
-}
-
-/* The stages of coupler c before its fluid step (after = 0), or after it (after = 1), each timed on
-   its clock; the first failure ends them. */
-static fsdem_result fsdem__coupled_stages(fsdem_coupler *c, fsdem_real dt, int after) {
-    const fsdem__coupler_class *cls = c->cls;
-    fsdem_result res = FSDEM_OK;
-    int s = 0;
-    if (after)
-        while (s < cls->stage_count && cls->stages[s++].run) continue;
-    for (; s < cls->stage_count && res == FSDEM_OK && cls->stages[s].run; ++s) {
-        const clock_t t0 = clock();
-        c->stage = cls->stages[s].name;
-        res = cls->stages[s].run(c, dt);
-        c->seconds[cls->stages[s].clock] += (double)(clock() - t0) / CLOCKS_PER_SEC;
-    }
-    return res;
-}
-
-/* The name of the coupler's fluid-step stage ("PIC step"). */
-static const char *fsdem__coupler_fluid_stage(const fsdem_coupler *c) {
-    int s = 0;
-    while (c->cls->stages[s].run) ++s;
-    return c->cls->stages[s].name;
-}
-
-/* A coupled step of dt after the prepare: every coupler's check (a refusal undoes the prepare), the
-   stages before the fluid's step, the fluid's step (FSDEM_ERR_CFL: refused before it moved, the
-   prepare undone), the stages after it. `chosen`: dt is the caller's, not a stable one. */
-static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_real dt, int chosen) {
-    const fsdem__fluid *f = list[0]->cls->fluid;
-    void *fluid = list[0]->fluid;
-    fsdem_result res;
-    clock_t t0;
-    double seconds;
-    int k;
-    for (k = 0; k < n; ++k)
-        if ((res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
-            return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
-    for (k = 0; k < n; ++k)
-        if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
-    t0 = clock();
-    res = f->step_dt(fluid, dt);
-    seconds = (double)(clock() - t0) / CLOCKS_PER_SEC;
-    for (k = 0; k < n; ++k) list[k]->seconds[FSDEM__CLOCK_FLUID] += seconds;
-    if (res != FSDEM_OK) {
-        if (res == FSDEM_ERR_CFL) fsdem__coupled_undo(list, n, res);
-        return fsdem__coupled_fail(list, n, -1, res, "%s: %s: %s", list[0]->cls->name, fsdem__coupler_fluid_stage(list[0]),
-                                   f->last_error(fluid));
-    }
-    for (k = 0; k < n; ++k) {
-        list[k]->steps++;
-        list[k]->dt_last = dt;
-    }
-    for (k = 0; k < n; ++k)
-        if ((res = fsdem__coupled_stages(list[k], dt, 1)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
-    for (k = 0; k < n; ++k) fsdem__ok(&list[k]->status);
-    return FSDEM_OK;
-}
-
-/* The verbs of couplers stepping together, and of each coupler alone (a list of one); `who` names
-   the public function in messages. */
-static fsdem_result fsdem__coupled_step(fsdem_coupler *const *list, int n) {
-    fsdem_real dt = 0;
-    fsdem_result res = fsdem__coupled_prepare(list, n, &dt);
-    return res != FSDEM_OK ? res : fsdem__coupled_go(list, n, dt, 0);
-}
-
-static fsdem_result fsdem__coupled_step_dt(fsdem_coupler *const *list, int n, fsdem_real dt, const char *who) {
-    fsdem_result res;
-    if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: dt = %g s must be > 0 and finite", who, (double)dt);
-    if ((res = fsdem__coupled_prepare(list, n, NULL)) != FSDEM_OK) return res;
-    return fsdem__coupled_go(list, n, dt, 1);
-}
-
-/* Steps until exactly `duration` later: when less than one and a half stable steps are left, the
-   last two share them equally, so no step is a sliver; the end is reached to a relative 1e-12. */
-static fsdem_result fsdem__coupled_advance(fsdem_coupler *const *list, int n, fsdem_real duration, long long *steps, const char *who) {
-    const fsdem__fluid *f = list[0]->cls->fluid;
-    const void *fluid = list[0]->fluid;
-    long long count = 0;
-    fsdem_result res = FSDEM_OK;
-    double end;
-    if (steps) *steps = 0;
-    if (!(duration >= 0) || !fsdem__finite(duration))
-        return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: duration = %g s must be >= 0", who, (double)duration);
-    end = f->time(fluid) + (double)duration;
-    while (res == FSDEM_OK && f->time(fluid) < end - 1e-12 * (end > 1 ? end : 1)) {
-        const double left = end - f->time(fluid);
-        fsdem_real dt = 0;
-        if ((res = fsdem__coupled_prepare(list, n, &dt)) != FSDEM_OK) break;
-        if ((double)dt >= left) dt = (fsdem_real)left;
-        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
-        res = fsdem__coupled_go(list, n, dt, 0);
-        ++count;
-    }
-    if (steps) *steps = count;
-    return res;
-}
-
-fsdem_result fsdem_coupled_step(fsdem_coupler *const *couplers, int count) {
-    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_step");
-    return res != FSDEM_OK ? res : fsdem__coupled_step(couplers, count);
-}
-
-fsdem_result fsdem_coupled_step_dt(fsdem_coupler *const *couplers, int count, fsdem_real dt) {
-    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_step_dt");
-    return res != FSDEM_OK ? res : fsdem__coupled_step_dt(couplers, count, dt, "fsdem_coupled_step_dt");
-}
-
-fsdem_result fsdem_coupled_advance(fsdem_coupler *const *couplers, int count, fsdem_real duration, long long *steps) {
-    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_advance");
-    if (steps) *steps = 0;
-    return res != FSDEM_OK ? res : fsdem__coupled_advance(couplers, count, duration, steps, "fsdem_coupled_advance");
-}
-
-fsdem_result fsdem_coupled_stable_dt(fsdem_coupler *const *couplers, int count, fsdem_real *dt) {
-    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_stable_dt");
-    if (res != FSDEM_OK) return res;
-    if (!dt) return FSDEM_ERR_INVALID_ARG;
-    return fsdem__coupled_stable(couplers, count, dt);
-}
-
-/* The verbs of one coupler (NULL refused), its step a list of one. */
-static fsdem_result fsdem__coupler_step(fsdem_coupler *c) { return c ? fsdem__coupled_step(&c, 1) : FSDEM_ERR_INVALID_ARG; }
-
-static fsdem_result fsdem__coupler_step_dt(fsdem_coupler *c, fsdem_real dt, const char *who) {
-    return c ? fsdem__coupled_step_dt(&c, 1, dt, who) : FSDEM_ERR_INVALID_ARG;
-}
-
-static fsdem_result fsdem__coupler_advance(fsdem_coupler *c, fsdem_real duration, long long *steps, const char *who) {
-    if (steps) *steps = 0;
-    return c ? fsdem__coupled_advance(&c, 1, duration, steps, who) : FSDEM_ERR_INVALID_ARG;
-}
-
-static fsdem_result fsdem__coupler_stable_dt(const fsdem_coupler *c, fsdem_real *dt) {
-    fsdem_coupler *list = (fsdem_coupler *)c; /* only the message changes (a failure's) */
-    return c && dt ? fsdem__coupled_stable(&list, 1, dt) : FSDEM_ERR_INVALID_ARG;
 }
 
 /* ---- >>couple_records : per-particle records by their fields ---- */
@@ -17721,14 +17554,6 @@ static const fsdem__coupler_class *fsdem__swe_dem_class(void) {
     return &cls;
 }
 
-fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
-fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *c, fsdem_real dt) {
-    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_swe_dem_step_dt");
-}
-fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *c, fsdem_real duration, long long *steps) {
-    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_swe_dem_advance");
-}
-fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
 double fsdem_swe_dem_time(const fsdem_swe_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
 
 /* ===== >>impl_couple_mps : unresolved MPS-DEM ========================================================
@@ -18252,14 +18077,6 @@ static const fsdem__coupler_class *fsdem__mps_dem_class(void) {
     return &cls;
 }
 
-fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
-fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *c, fsdem_real dt) {
-    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_mps_dem_step_dt");
-}
-fsdem_result fsdem_mps_dem_advance(fsdem_mps_dem *c, fsdem_real duration, long long *steps) {
-    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_mps_dem_advance");
-}
-fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
 double fsdem_mps_dem_time(const fsdem_mps_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
 fsdem_coupler *fsdem_mps_dem_coupler(fsdem_mps_dem *c) { return c ? &c->head : NULL; }
 
@@ -19192,14 +19009,6 @@ fsdem_result fsdem_pic_dem_update(fsdem_pic_dem *c) {
     return res;
 }
 
-fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
-fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *c, fsdem_real dt) {
-    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_pic_dem_step_dt");
-}
-fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *c, fsdem_real duration, long long *steps) {
-    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_pic_dem_advance");
-}
-fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
 double fsdem_pic_dem_time(const fsdem_pic_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
 
 /* ===== >>impl_couple_gic : Granule-In-Cell ===========================================================
@@ -19399,6 +19208,24 @@ static void fsdem__gic_kernel(const fsdem_gic *c, fsdem_vec3 p, fsdem__kernel *k
     fsdem__kernel_weights(kw, c->dim, s, c->grid.n, 0);
 }
 
+/* Every granule finite and inside the PIC's grid (the volume of one outside would be folded into the
+   boundary cells); `who` names the call in the message. */
+static fsdem_result fsdem__gic_granules_inside(fsdem_gic *c, const fsdem_dem_particles *P, const char *who) {
+    int i, a;
+    for (i = 0; i < P->count; ++i) {
+        int outside = 0;
+        if (!fsdem__finite3(P->position[i]))
+            return fsdem__fail(&c->head.status, FSDEM_ERR_NAN, "%s: granule %d (id %d) has a non-finite position", who, i, P->id[i]);
+        for (a = 0; a < c->dim; ++a)
+            outside |= fsdem__comp(P->position[i], a) < fsdem__comp(c->grid.lo, a) || fsdem__comp(P->position[i], a) > fsdem__comp(c->grid.hi, a);
+        if (outside)
+            return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_DOMAIN,
+                               "%s: granule %d (id %d) at (%g, %g, %g) m is outside the PIC's grid (keep the DEM's walls within it)", who, i,
+                               P->id[i], (double)P->position[i].x, (double)P->position[i].y, (double)P->position[i].z);
+    }
+    return FSDEM_OK;
+}
+
 /* Step 3 of >>couple_gic: alpha_s (Eq. 7a) and the porosity, into the PIC. */
 fsdem_result fsdem_gic_update(fsdem_gic *c) {
     fsdem_dem_particles P;
@@ -19406,19 +19233,10 @@ fsdem_result fsdem_gic_update(fsdem_gic *c) {
     int i, k, q0, q1, q2;
     double volume = 0;
     fsdem_real most = 0;
+    fsdem_result res;
     if (!c) return FSDEM_ERR_INVALID_ARG;
     P = fsdem_dem_get_particles(c->desc.dem);
-    for (i = 0; i < P.count; ++i) {
-        int a, outside = 0;
-        if (!fsdem__finite3(P.position[i]))
-            return fsdem__fail(&c->head.status, FSDEM_ERR_NAN, "fsdem_gic_update: granule %d (id %d) has a non-finite position", i, P.id[i]);
-        for (a = 0; a < c->dim; ++a)
-            outside |= fsdem__comp(P.position[i], a) < fsdem__comp(c->grid.lo, a) || fsdem__comp(P.position[i], a) > fsdem__comp(c->grid.hi, a);
-        if (outside) /* its volume would be folded into the boundary cells */
-            return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_DOMAIN,
-                               "fsdem_gic_update: granule %d (id %d) at (%g, %g, %g) m is outside the PIC's grid (keep the DEM's walls within it)",
-                               i, P.id[i], (double)P.position[i].x, (double)P.position[i].y, (double)P.position[i].z);
-    }
+    if ((res = fsdem__gic_granules_inside(c, &P, "fsdem_gic_update")) != FSDEM_OK) return res;
     memset(c->solid, 0, sizeof(fsdem_real) * (size_t)c->grid.ncell);
     for (i = 0; i < P.count; ++i) {
         const fsdem_real share = fsdem__gic_volume(c, P.radius[i]) / (c->cell_volume * c->depth);
@@ -19616,12 +19434,14 @@ static fsdem_result fsdem__gic_limit(const fsdem_coupler *head, fsdem_real *dt) 
     return FSDEM_OK;
 }
 
-/* A step of dt refused before anything moves: too many substeps, the PIC's own refusal, and for a
-   dt of the caller's the drag limit (a stable dt keeps it by construction). */
+/* A step of dt refused before anything moves: too many substeps, a granule outside the grid, the
+   PIC's own refusal, and for a dt of the caller's the drag limit (a stable dt keeps it by
+   construction). */
 static fsdem_result fsdem__gic_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
     fsdem_gic *c = (fsdem_gic *)(void *)head;
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     fsdem_result res = fsdem__coupler_substeps_within(head, dt);
-    if (res != FSDEM_OK) return res;
+    if (res != FSDEM_OK || (res = fsdem__gic_granules_inside(c, &P, "fsdem_gic")) != FSDEM_OK) return res;
     if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
         return fsdem__fail(&head->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
     if (chosen) {
@@ -19677,12 +19497,6 @@ static const fsdem__coupler_class *fsdem__gic_class(void) {
     return &cls;
 }
 
-fsdem_result fsdem_gic_step(fsdem_gic *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
-fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) { return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_gic_step_dt"); }
-fsdem_result fsdem_gic_advance(fsdem_gic *c, fsdem_real duration, long long *steps) {
-    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_gic_advance");
-}
-fsdem_result fsdem_gic_stable_dt(const fsdem_gic *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
 double fsdem_gic_time(const fsdem_gic *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
 
 fsdem_result fsdem_gic_get_force(const fsdem_gic *c, int index, fsdem_gic_force *out) {
@@ -19715,9 +19529,10 @@ fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *c) {
    Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
    every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_mps, >>restart_couplers
    (one visitor per object lists what it saves, in order, and serves saving and restoring alike; the
-   couplers' by their field tables), >>restart_api (memory and files). A restore runs the visitor three times over the payload: CHECK validates
-   everything and compares the desc, RESERVE allocates, COMMIT writes into the object. Only COMMIT
-   changes the object, and it cannot fail. */
+   couplers' by their field tables), >>restart_api (memory and files), >>restart_journal (the state
+   a coupled step keeps, to put back should it fail). A restore runs the visitor three times over
+   the payload: CHECK validates everything and compares the desc, RESERVE allocates, COMMIT writes
+   into the object. Only COMMIT changes the object, and it cannot fail. */
 
 /* ---- >>restart_format : header, checksum, cursor ---- */
 
@@ -19757,6 +19572,8 @@ typedef struct fsdem__restart {
     const unsigned char *in;     /* reading: the payload */
     size_t pos, size;            /* cursor; bytes of the payload (WRITE to memory: room for it) */
     unsigned long long hash;     /* FNV-1a of the header and of the bytes written so far */
+    int unchecked;               /* no checksum written or verified: a coupled step's kept state */
+                                 /*    (>>restart_journal), which never leaves the process */
     fsdem_result res;            /* the first failure, FSDEM_OK so far */
     char fn[48];                 /* public function, first in every message */
     const char *section;         /* the solver being read in a coupler's file, or NULL */
@@ -19813,7 +19630,7 @@ static void fsdem__restart_data(fsdem__restart *io, void *p, size_t bytes) {
             memcpy(io->out + io->pos, p, bytes);
         } else if (io->file)
             fwrite(p, 1, bytes, io->file); /* errors: ferror at the end (fsdem__restart_save_file) */
-        if (io->out || io->file) io->hash = fsdem__restart_fnv(io->hash, (const unsigned char *)p, bytes);
+        if ((io->out || io->file) && !io->unchecked) io->hash = fsdem__restart_fnv(io->hash, (const unsigned char *)p, bytes);
         io->pos += bytes;
         return;
     }
@@ -21054,14 +20871,16 @@ static void fsdem__restart_prepare(fsdem__restart *io, const fsdem__restart_obje
     io->pos = 0;
 }
 
-/* Saves o to `buffer` (`capacity` bytes; NULL: only the size). The payload is measured first, so a
-   buffer too small is refused before anything is written. */
-static fsdem_result fsdem__restart_save_memory(const fsdem__restart_object *o, void *buffer, size_t capacity,
-                                               size_t *size) {
+/* Saves o to `buffer` (`capacity` bytes; NULL: only the size) for `verb`, with its checksum unless
+   `unchecked`. The payload is measured first, so a buffer too small is refused before anything is
+   written. */
+static fsdem_result fsdem__restart_save_to(const fsdem__restart_object *o, void *buffer, size_t capacity, size_t *size,
+                                           const char *verb, int unchecked) {
     fsdem__restart io;
     unsigned char header[FSDEM__RESTART_HEADER];
     if (!o->object) return FSDEM_ERR_INVALID_ARG; /* a NULL handle: no object to hold a message */
-    fsdem__restart_begin(&io, o, "save_memory", FSDEM__RESTART_WRITE);
+    fsdem__restart_begin(&io, o, verb, FSDEM__RESTART_WRITE);
+    io.unchecked = unchecked;
     if (!size) {
         fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "size is NULL");
         return fsdem__restart_end(&io, o);
@@ -21079,6 +20898,11 @@ static fsdem_result fsdem__restart_save_memory(const fsdem__restart_object *o, v
         memcpy(buffer, header, FSDEM__RESTART_HEADER);
     }
     return fsdem__restart_end(&io, o);
+}
+
+static fsdem_result fsdem__restart_save_memory(const fsdem__restart_object *o, void *buffer, size_t capacity,
+                                               size_t *size) {
+    return fsdem__restart_save_to(o, buffer, capacity, size, "save_memory", 0);
 }
 
 /* Saves o to the file `path` in one pass: header, payload, then the checksum into the header. */
@@ -21110,7 +20934,7 @@ static fsdem_result fsdem__restart_save_file(const fsdem__restart_object *o, con
 }
 
 /* Checks the header of `size` bytes at `data` against o: magic, version, byte order, precision,
-   kind, dimension, the announced size, then the checksum. */
+   kind, dimension, the announced size, then the checksum (unless io->unchecked). */
 static void fsdem__restart_check_header(fsdem__restart *io, const fsdem__restart_object *o, const unsigned char *data,
                                         size_t size) {
     unsigned long long payload, sum;
@@ -21146,19 +20970,20 @@ static void fsdem__restart_check_header(fsdem__restart *io, const fsdem__restart
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s: %llu bytes after the header, %llu announced",
                             payload > (unsigned long long)(size - FSDEM__RESTART_HEADER) ? "truncated" : "trailing bytes",
                             (unsigned long long)(size - FSDEM__RESTART_HEADER), payload);
-    else if (fsdem__restart_fnv(fsdem__restart_fnv(FSDEM__RESTART_FNV_BASIS, data, 56), data + FSDEM__RESTART_HEADER,
+    else if (!io->unchecked && fsdem__restart_fnv(fsdem__restart_fnv(FSDEM__RESTART_FNV_BASIS, data, 56), data + FSDEM__RESTART_HEADER,
                                 (size_t)payload) != sum)
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "checksum mismatch: the data are corrupted");
 }
 
-/* Restores o from `size` bytes at `data`: the header, then the visitor's CHECK, RESERVE and COMMIT
-   passes over the payload. */
-static fsdem_result fsdem__restart_load(const fsdem__restart_object *o, const char *verb, const unsigned char *data,
-                                        size_t size) {
+/* Restores o from `size` bytes at `data` for `verb`: the header (its checksum unless `unchecked`),
+   then the visitor's CHECK, RESERVE and COMMIT passes over the payload. */
+static fsdem_result fsdem__restart_load(const fsdem__restart_object *o, const char *verb, const unsigned char *data, size_t size,
+                                        int unchecked) {
     fsdem__restart io;
     static const fsdem__restart_mode passes[3] = {FSDEM__RESTART_CHECK, FSDEM__RESTART_RESERVE, FSDEM__RESTART_COMMIT};
     int pass;
     fsdem__restart_begin(&io, o, verb, FSDEM__RESTART_CHECK);
+    io.unchecked = unchecked;
     fsdem__restart_check_header(&io, o, data, size);
     for (pass = 0; pass < 3 && io.res == FSDEM_OK; ++pass) {
         io.mode = passes[pass];
@@ -21196,7 +21021,7 @@ static fsdem_result fsdem__restart_load_file(const fsdem__restart_object *o, con
     else if (fread(data, 1, (size_t)length, fp) != (size_t)length)
         fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot read '%s'", path);
     if (fp) fclose(fp);
-    res = io.res == FSDEM_OK ? fsdem__restart_load(o, "restore", data, (size_t)length) : fsdem__restart_end(&io, o);
+    res = io.res == FSDEM_OK ? fsdem__restart_load(o, "restore", data, (size_t)length, 0) : fsdem__restart_end(&io, o);
     fsdem__free(o->allocator, data, length > 0 ? (size_t)length : 1);
     return res;
 }
@@ -21204,7 +21029,7 @@ static fsdem_result fsdem__restart_load_file(const fsdem__restart_object *o, con
 /* Restores o from the `size` bytes at `buffer` (a save_memory image). */
 static fsdem_result fsdem__restart_load_memory(const fsdem__restart_object *o, const void *buffer, size_t size) {
     if (!o->object) return FSDEM_ERR_INVALID_ARG; /* a NULL handle: no object to hold a message */
-    return fsdem__restart_load(o, "restore_memory", (const unsigned char *)buffer, size);
+    return fsdem__restart_load(o, "restore_memory", (const unsigned char *)buffer, size, 0);
 }
 
 /* The public functions: save and restore, to files and to memory, for each of the four objects:
@@ -21378,6 +21203,324 @@ fsdem_result fsdem_gic_restore_memory(fsdem_gic *coupler, const void *buffer, si
     const fsdem__restart_object o = fsdem__restart_of_gic(coupler);
     return fsdem__restart_load_memory(&o, buffer, size);
 }
+
+/* ---- >>restart_journal : the state a coupled step keeps, to put back should it fail ---- */
+
+/* A coupler as the API sees it (>>restart_api), whatever its kind. */
+static fsdem__restart_object fsdem__restart_of_coupler(const fsdem_coupler *c) {
+    if (c->cls == fsdem__swe_dem_class()) return fsdem__restart_of_swe_dem((const fsdem_swe_dem *)(const void *)c);
+    if (c->cls == fsdem__mps_dem_class()) return fsdem__restart_of_mps_dem((const fsdem_mps_dem *)(const void *)c);
+    if (c->cls == fsdem__pic_dem_class()) return fsdem__restart_of_pic_dem((const fsdem_pic_dem *)(const void *)c);
+    return fsdem__restart_of_gic((const fsdem_gic *)(const void *)c);
+}
+
+/* Keeps what coupler c's step may change, before anything moves: its saved bytes (>>restart_couplers:
+   the fluid and the DEM with it) without their checksum (they never leave the process), then its
+   records (not every field of a record is saved), in c->kept, which grows with them and is not
+   allocated again once they fit. */
+static fsdem_result fsdem__restart_keep(fsdem_coupler *c) {
+    const fsdem__restart_object o = fsdem__restart_of_coupler(c);
+    const size_t records = c->cls->record_size * (size_t)c->records;
+    size_t need = 0, saved = 0;
+    fsdem_result res = fsdem__restart_save_to(&o, NULL, 0, &need, "keep", 1);
+    if (res == FSDEM_OK && need + records > c->kept_capacity) {
+        const size_t capacity = need + records + (need + records) / 4;
+        unsigned char *fresh = (unsigned char *)fsdem__alloc(&c->allocator, capacity);
+        if (!fresh)
+            return fsdem__fail(&c->status, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory keeping the state before the step (%.0f bytes)",
+                               c->cls->name, (double)capacity);
+        fsdem__free(&c->allocator, c->kept, c->kept_capacity);
+        c->kept = fresh;
+        c->kept_capacity = capacity;
+    }
+    if (res == FSDEM_OK) res = fsdem__restart_save_to(&o, c->kept, c->kept_capacity, &saved, "keep", 1);
+    if (res != FSDEM_OK) return res;
+    if (records) memcpy(c->kept + saved, c->record, records);
+    c->kept_saved = saved;
+    c->kept_records = c->records;
+    return FSDEM_OK;
+}
+
+/* Puts back what fsdem__restart_keep kept. The record storage is the coupler's own (the pointer is
+   const for its readers), and a restore leaves it at least as long as the kept records. */
+static fsdem_result fsdem__restart_put_back(fsdem_coupler *c) {
+    const fsdem__restart_object o = fsdem__restart_of_coupler(c);
+    const fsdem_result res = fsdem__restart_load(&o, "put_back", c->kept, c->kept_saved, 1);
+    if (res == FSDEM_OK && c->kept_records) {
+        memcpy((void *)c->record, c->kept + c->kept_saved, c->cls->record_size * (size_t)c->kept_records);
+        c->records = c->kept_records;
+    }
+    return res;
+}
+
+/* ===== >>impl_couple_step : the staged step, the stable rule, the advance ===========================
+
+   Contents: the step of one coupler or of couplers sharing a fluid (>>couple_step): the prepare, the
+   checks that refuse before anything moves, the state kept (>>restart_journal), the stages around
+   the fluid's step, the state put back on a failure after something moved; the stable rule; the
+   advance; the verbs of each coupler on them. It follows >>impl_restart, whose saves it keeps. */
+
+/* The message of couplers[from] (or a new one, from < 0) given to every coupler of the list. */
+static fsdem_result fsdem__coupled_fail(fsdem_coupler *const *list, int n, int from, fsdem_result res, const char *fmt, ...) {
+    int k;
+    if (from < 0) {
+        va_list ap;
+        va_start(ap, fmt);
+        fsdem__vfail(&list[0]->status, res, fmt, ap);
+        va_end(ap);
+        from = 0;
+    }
+    for (k = 0; k < n; ++k)
+        if (list[k] != list[from]) memcpy(list[k]->status.message, list[from]->status.message, sizeof list[k]->status.message);
+    return res;
+}
+
+/* Puts back what the couplers' prepare did (a refused step); passes `res` on. */
+static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem_result res) {
+    int k;
+    for (k = 0; k < n; ++k)
+        if (list[k]->cls->undo) list[k]->cls->undo(list[k]);
+    return res;
+}
+
+/* A step of the list failed after something moved, with the message of couplers[from]: every
+   coupler, fluid and DEM put back as kept, the prepare undone, the message (and a put-back that
+   failed, which cannot happen short of memory) to every coupler; passes `res` on. */
+static fsdem_result fsdem__coupled_put_back(fsdem_coupler *const *list, int n, int from, fsdem_result res) {
+    char message[FSDEM__MESSAGE_SIZE];
+    int k, lost = -1;
+    memcpy(message, list[from]->status.message, sizeof message);
+    for (k = 0; k < n; ++k)
+        if (fsdem__restart_put_back(list[k]) != FSDEM_OK && lost < 0) lost = k;
+    fsdem__coupled_undo(list, n, res);
+    if (lost >= 0)
+        return fsdem__coupled_fail(list, n, -1, res, "%s; and the state before the step could not be put back: %s", message,
+                                   list[lost]->status.message);
+    return fsdem__coupled_fail(list, n, -1, res, "%s", message);
+}
+
+/* A list of couplers that can step together: not empty, no NULL, none twice, one fluid. */
+static fsdem_result fsdem__coupled_list(fsdem_coupler *const *list, int n, const char *who) {
+    int k, j;
+    if (!list || n < 1) return FSDEM_ERR_INVALID_ARG;
+    for (k = 0; k < n; ++k)
+        if (!list[k]) return FSDEM_ERR_INVALID_ARG;
+    for (k = 1; k < n; ++k) {
+        if (list[k]->fluid != list[0]->fluid)
+            return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: couplers %d (%s) and 0 (%s) have different fluids", who, k,
+                                       list[k]->cls->name, list[0]->cls->name);
+        for (j = 0; j < k; ++j)
+            if (list[j] == list[k]) return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: coupler %d is listed twice", who, k);
+    }
+    return FSDEM_OK;
+}
+
+/* The stable dt of couplers of one fluid: the fluid's, cut by every coupler's own limits. */
+static fsdem_result fsdem__coupled_stable(fsdem_coupler *const *list, int n, fsdem_real *dt) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
+    fsdem_result res = f->stable_dt(list[0]->fluid, dt);
+    int k;
+    if (res != FSDEM_OK)
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s stable step: %s", list[0]->cls->name, f->name, f->last_error(list[0]->fluid));
+    for (k = 0; k < n; ++k)
+        if (list[k]->cls->limit && (res = list[k]->cls->limit(list[k], dt)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
+    return FSDEM_OK;
+}
+
+/* The couplers' prepare, in order, timed as coupling (a failure undoes those before), then with
+   `dt` the stable dt. */
+static fsdem_result fsdem__coupled_prepare(fsdem_coupler *const *list, int n, fsdem_real *dt) {
+    fsdem_result res = FSDEM_OK;
+    int k;
+    for (k = 0; k < n && res == FSDEM_OK; ++k)
+        if (list[k]->cls->prepare) {
+            const clock_t t0 = clock();
+            if ((res = list[k]->cls->prepare(list[k])) != FSDEM_OK) fsdem__coupled_fail(list, n, k, fsdem__coupled_undo(list, k, res), NULL);
+            list[k]->seconds[FSDEM__CLOCK_COUPLING] += (double)(clock() - t0) / CLOCKS_PER_SEC;
+        }
+    if (res == FSDEM_OK && dt && (res = fsdem__coupled_stable(list, n, dt)) != FSDEM_OK) fsdem__coupled_undo(list, n, res);
+    return res;
+}
+
+/* The stages of coupler c before its fluid step (after = 0), or after it (after = 1), each timed on
+   its clock; the first failure ends them. */
+static fsdem_result fsdem__coupled_stages(fsdem_coupler *c, fsdem_real dt, int after) {
+    const fsdem__coupler_class *cls = c->cls;
+    fsdem_result res = FSDEM_OK;
+    int s = 0;
+    if (after)
+        while (s < cls->stage_count && cls->stages[s++].run) continue;
+    for (; s < cls->stage_count && res == FSDEM_OK && cls->stages[s].run; ++s) {
+        const clock_t t0 = clock();
+        c->stage = cls->stages[s].name;
+        res = cls->stages[s].run(c, dt);
+        c->seconds[cls->stages[s].clock] += (double)(clock() - t0) / CLOCKS_PER_SEC;
+    }
+    return res;
+}
+
+/* The name of the coupler's fluid-step stage ("PIC step"). */
+static const char *fsdem__coupler_fluid_stage(const fsdem_coupler *c) {
+    int s = 0;
+    while (c->cls->stages[s].run) ++s;
+    return c->cls->stages[s].name;
+}
+
+/* A coupled step of dt after the prepare: every coupler's checks (a refusal undoes the prepare),
+   the state kept, the stages before the fluid's step, the fluid's step, the stages after it. A
+   failure once the state is kept puts it back (fsdem__coupled_put_back), so a refused step leaves
+   couplers, fluid and DEMs as they were. `chosen`: dt is the caller's, not a stable one. */
+static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_real dt, int chosen) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
+    void *fluid = list[0]->fluid;
+    fsdem_result res;
+    clock_t t0;
+    double seconds;
+    int k;
+    for (k = 0; k < n; ++k)
+        if ((res = fsdem__coupler_particles_valid(list[k])) != FSDEM_OK || (res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
+            return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
+    for (k = 0; k < n; ++k) {
+        t0 = clock();
+        res = fsdem__restart_keep(list[k]);
+        list[k]->seconds[FSDEM__CLOCK_COUPLING] += (double)(clock() - t0) / CLOCKS_PER_SEC;
+        if (res != FSDEM_OK) return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
+    }
+    for (k = 0; k < n; ++k)
+        if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);
+    t0 = clock();
+    res = f->step_dt(fluid, dt);
+    seconds = (double)(clock() - t0) / CLOCKS_PER_SEC;
+    for (k = 0; k < n; ++k) list[k]->seconds[FSDEM__CLOCK_FLUID] += seconds;
+    if (res != FSDEM_OK) {
+        fsdem__fail(&list[0]->status, res, "%s: %s: %s", list[0]->cls->name, fsdem__coupler_fluid_stage(list[0]), f->last_error(fluid));
+        return fsdem__coupled_put_back(list, n, 0, res);
+    }
+    for (k = 0; k < n; ++k) {
+        list[k]->steps++;
+        list[k]->dt_last = dt;
+    }
+    for (k = 0; k < n; ++k)
+        if ((res = fsdem__coupled_stages(list[k], dt, 1)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);
+    for (k = 0; k < n; ++k) fsdem__ok(&list[k]->status);
+    return FSDEM_OK;
+}
+
+/* The verbs of couplers stepping together, and of each coupler alone (a list of one); `who` names
+   the public function in messages. */
+static fsdem_result fsdem__coupled_step(fsdem_coupler *const *list, int n) {
+    fsdem_real dt = 0;
+    fsdem_result res = fsdem__coupled_prepare(list, n, &dt);
+    return res != FSDEM_OK ? res : fsdem__coupled_go(list, n, dt, 0);
+}
+
+static fsdem_result fsdem__coupled_step_dt(fsdem_coupler *const *list, int n, fsdem_real dt, const char *who) {
+    fsdem_result res;
+    if (!(dt > 0) || !fsdem__finite(dt))
+        return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: dt = %g s must be > 0 and finite", who, (double)dt);
+    if ((res = fsdem__coupled_prepare(list, n, NULL)) != FSDEM_OK) return res;
+    return fsdem__coupled_go(list, n, dt, 1);
+}
+
+/* Steps until exactly `duration` later: when less than one and a half stable steps are left, the
+   last two share them equally, so no step is a sliver; the end is reached to a relative 1e-12. */
+static fsdem_result fsdem__coupled_advance(fsdem_coupler *const *list, int n, fsdem_real duration, long long *steps, const char *who) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
+    const void *fluid = list[0]->fluid;
+    long long count = 0;
+    fsdem_result res = FSDEM_OK;
+    double end;
+    if (steps) *steps = 0;
+    if (!(duration >= 0) || !fsdem__finite(duration))
+        return fsdem__coupled_fail(list, n, -1, FSDEM_ERR_INVALID_ARG, "%s: duration = %g s must be >= 0", who, (double)duration);
+    end = f->time(fluid) + (double)duration;
+    while (res == FSDEM_OK && f->time(fluid) < end - 1e-12 * (end > 1 ? end : 1)) {
+        const double left = end - f->time(fluid);
+        fsdem_real dt = 0;
+        if ((res = fsdem__coupled_prepare(list, n, &dt)) != FSDEM_OK) break;
+        if ((double)dt >= left) dt = (fsdem_real)left;
+        else if (1.5 * (double)dt > left) dt = (fsdem_real)(left / 2);
+        res = fsdem__coupled_go(list, n, dt, 0);
+        ++count;
+    }
+    if (steps) *steps = count;
+    return res;
+}
+
+fsdem_result fsdem_coupled_step(fsdem_coupler *const *couplers, int count) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_step");
+    return res != FSDEM_OK ? res : fsdem__coupled_step(couplers, count);
+}
+
+fsdem_result fsdem_coupled_step_dt(fsdem_coupler *const *couplers, int count, fsdem_real dt) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_step_dt");
+    return res != FSDEM_OK ? res : fsdem__coupled_step_dt(couplers, count, dt, "fsdem_coupled_step_dt");
+}
+
+fsdem_result fsdem_coupled_advance(fsdem_coupler *const *couplers, int count, fsdem_real duration, long long *steps) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_advance");
+    if (steps) *steps = 0;
+    return res != FSDEM_OK ? res : fsdem__coupled_advance(couplers, count, duration, steps, "fsdem_coupled_advance");
+}
+
+fsdem_result fsdem_coupled_stable_dt(fsdem_coupler *const *couplers, int count, fsdem_real *dt) {
+    const fsdem_result res = fsdem__coupled_list(couplers, count, "fsdem_coupled_stable_dt");
+    if (res != FSDEM_OK) return res;
+    if (!dt) return FSDEM_ERR_INVALID_ARG;
+    return fsdem__coupled_stable(couplers, count, dt);
+}
+
+/* The verbs of one coupler (NULL refused), its step a list of one. */
+static fsdem_result fsdem__coupler_step(fsdem_coupler *c) { return c ? fsdem__coupled_step(&c, 1) : FSDEM_ERR_INVALID_ARG; }
+
+static fsdem_result fsdem__coupler_step_dt(fsdem_coupler *c, fsdem_real dt, const char *who) {
+    return c ? fsdem__coupled_step_dt(&c, 1, dt, who) : FSDEM_ERR_INVALID_ARG;
+}
+
+static fsdem_result fsdem__coupler_advance(fsdem_coupler *c, fsdem_real duration, long long *steps, const char *who) {
+    if (steps) *steps = 0;
+    return c ? fsdem__coupled_advance(&c, 1, duration, steps, who) : FSDEM_ERR_INVALID_ARG;
+}
+
+static fsdem_result fsdem__coupler_stable_dt(const fsdem_coupler *c, fsdem_real *dt) {
+    fsdem_coupler *list = (fsdem_coupler *)c; /* only the message changes (a failure's) */
+    return c && dt ? fsdem__coupled_stable(&list, 1, dt) : FSDEM_ERR_INVALID_ARG;
+}
+
+/* The verbs of each coupler (>>couple_swe, >>couple_mps, >>couple_pic, >>couple_gic). */
+fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *c, fsdem_real dt) {
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_swe_dem_step_dt");
+}
+fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *c, fsdem_real duration, long long *steps) {
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_swe_dem_advance");
+}
+fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+
+fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *c, fsdem_real dt) {
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_mps_dem_step_dt");
+}
+fsdem_result fsdem_mps_dem_advance(fsdem_mps_dem *c, fsdem_real duration, long long *steps) {
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_mps_dem_advance");
+}
+fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+
+fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *c, fsdem_real dt) {
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_pic_dem_step_dt");
+}
+fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *c, fsdem_real duration, long long *steps) {
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_pic_dem_advance");
+}
+fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+
+fsdem_result fsdem_gic_step(fsdem_gic *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) { return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_gic_step_dt"); }
+fsdem_result fsdem_gic_advance(fsdem_gic *c, fsdem_real duration, long long *steps) {
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_gic_advance");
+}
+fsdem_result fsdem_gic_stable_dt(const fsdem_gic *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
 
 /* ===== >>impl_io : CSV, ParaView series, VTK XML ====================================================
 

@@ -32,7 +32,7 @@
                 (seed 004)
      >>couple   what every coupler shares: the staged step (one fluid step, the DEM's substeps),
                 the stable rule, the advance, per-particle records and their CSV, claims on the
-                solvers' coupling arrays, couplers of one fluid stepped together
+                solvers' coupling arrays
      >>couple_swe  SWE-DEM floating debris: buoyancy, hydrostatic and dynamic pressure (seed 003)
      >>couple_mps  unresolved MPS-DEM, Models A and B: porosity and momentum exchange by local
                 averaging, sequential staggered substepping (seed 002)
@@ -43,6 +43,8 @@
                 first (seed 004)
      >>restart  checkpoint and restart: save / restore of every solver and coupler, to a file or
                 to memory, bit-exact continuation (versioned binary format with a checksum)
+     >>couple_step  the coupled step, taken whole or not at all (a failure once something moved
+                puts the state back), couplers of one fluid stepped together
      >>io       CSV time series; ParaView .pvd series, valid after every entry; VTK XML snapshots
                 of every solver (ascii, inline base64 or appended raw): DEM particles, walls and
                 contacts (.vtp), PIC particles (.vtp) and grid (.vti), shallow-water fields (.vti),

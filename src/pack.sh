@@ -16,7 +16,7 @@ cd "$(dirname "$0")"
 PUBLIC="
     core/core.h geom/geom.h kernel/kernel.h grid/grid.h
     dem/dem.h linalg/linalg.h pic/pic.h swe/swe.h mps/mps.h drag/drag.h
-    couple/couple.h couple/swe.h couple/mps.h couple/pic.h couple/gic.h restart/restart.h io/io.h"
+    couple/couple.h couple/swe.h couple/mps.h couple/pic.h couple/gic.h restart/restart.h couple/step.h io/io.h"
 
 IMPLEMENTATION="
     impl.c
@@ -35,8 +35,10 @@ IMPLEMENTATION="
     mps/types.c mps/desc.c mps/particles.c mps/open.c mps/neighbours.c mps/operators.c mps/step.c
     mps/views.c mps/probes.c
     drag/drag.c
-    couple/head.c couple/step.c couple/records.c couple/swe.c couple/mps.c couple/pic.c couple/gic.c
+    couple/head.c couple/dem.c couple/records.c couple/swe.c couple/mps.c couple/pic.c couple/gic.c
     restart/format.c restart/dem.c restart/pic.c restart/swe.c restart/mps.c restart/couplers.c restart/api.c
+    restart/journal.c
+    couple/step.c
     io/csv.c io/vtk.c io/pvd.c io/dem.c io/pic.c io/swe.c"
 
 # The float build's names (>>config): "#define X X_f" for every public function X, between the

@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 #include "fsdem.h"
 
 Suite *core_suite(void);
@@ -91,6 +92,35 @@ static inline int test_light(void) {
    `header`, then exactly `rows` rows equal bit for bit to `expected` (row-major, the header's column
    count per row; may be NULL when rows is 0). */
 void test_csv_expect(const char *path, const char *header, int rows, const double *expected);
+
+/* The whole state of a coupler: its saved bytes (its fsdem_X_save_memory, the fluid and the DEM
+   with them) and the counts of its fsdem_coupling_stats (CPU times are not state). TEST_KEEP(save,
+   c, stats, &kept) takes it; test_kept_same(&before, &after, what) asserts that nothing changed and
+   frees both. */
+typedef struct test_kept {
+    unsigned char *bytes;
+    size_t size;
+    fsdem_coupling_stats stats;
+} test_kept;
+
+#define TEST_KEEP(save, c, coupling_stats, kept)                                                   \
+    do {                                                                                           \
+        size_t need_ = 0;                                                                          \
+        ck_assert_int_eq(save((c), NULL, 0, &need_), FSDEM_OK);                                    \
+        (kept)->bytes = (unsigned char *)malloc(need_);                                            \
+        ck_assert_ptr_nonnull((kept)->bytes);                                                      \
+        ck_assert_int_eq(save((c), (kept)->bytes, need_, &(kept)->size), FSDEM_OK);                \
+        (kept)->stats = (coupling_stats);                                                          \
+    } while (0)
+
+static inline void test_kept_same(test_kept *before, test_kept *after, const char *what) {
+    const fsdem_coupling_stats a = before->stats, b = after->stats;
+    ck_assert_msg(before->size == after->size && memcmp(before->bytes, after->bytes, before->size) == 0, "%s: the state changed", what);
+    ck_assert_msg(a.steps == b.steps && a.time == b.time && a.dt == b.dt && a.substeps == b.substeps && a.substeps_total == b.substeps_total,
+                  "%s: the statistics changed", what);
+    free(before->bytes);
+    free(after->bytes);
+}
 
 /* True when every component is finite. */
 static inline int test_finite3(fsdem_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }

@@ -324,6 +324,54 @@ START_TEST(test_gic_restart_bit_for_bit) {
 END_TEST
 
 /* Bad input: each desc field named, NULL objects, refused steps that change nothing. */
+/* A step that fails once something moved (>>couple_step): a granule that leaves the PIC's grid in
+   the sand substeps (the DEM's domain reaches beyond it), found by the volume fractions that follow.
+   Coupler, PIC and DEM are put back as they were (saved bytes and statistics), and with the granule
+   back inside the same step runs. */
+START_TEST(test_gic_failure_after_moving_puts_everything_back) {
+    fsdem_pic_desc pd = fsdem_pic_desc_default(2);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+    fsdem_gic_desc gd = fsdem_gic_desc_default();
+    fsdem_dem_material m = fsdem_dem_material_default();
+    gic_tank t;
+    fsdem_dem_particles P;
+    test_kept before, after;
+    fsdem_real dt = 0;
+    pd.cell_size = (fsdem_real)0.01;
+    pd.domain_max = fsdem_v3((fsdem_real)0.1, (fsdem_real)0.1, 0);
+    pd.gravity = dd.gravity = fsdem_v3(0, (fsdem_real)-G, 0);
+    ck_assert_int_eq(fsdem_pic_create(&pd, &t.pic), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_fill_box(t.pic, fsdem_v3(0, 0, 0), fsdem_v3((fsdem_real)0.1, (fsdem_real)0.05, 0), fsdem_v3(0, 0, 0), NULL),
+                     FSDEM_OK);
+    dd.domain_min = fsdem_v3((fsdem_real)-0.1, (fsdem_real)-0.1, -1);
+    dd.domain_max = fsdem_v3((fsdem_real)0.2, (fsdem_real)0.2, 1);
+    dd.law = FSDEM_DEM_LAW_GIC;
+    dd.dt = (fsdem_real)1e-4;
+    ck_assert_int_eq(fsdem_dem_create(&dd, &t.dem), FSDEM_OK);
+    m.density = 2650;
+    m.young_modulus = (fsdem_real)1e6;
+    ck_assert_int_eq(fsdem_dem_add_material(t.dem, &m, NULL), FSDEM_OK);
+    gd.pic = t.pic;
+    gd.dem = t.dem;
+    ck_assert_int_eq(fsdem_gic_create(&gd, &t.gic), FSDEM_OK);
+    add_granule(&t, fsdem_v3((fsdem_real)0.05, (fsdem_real)0.02, 0), 0.001, 0, fsdem_v3(0, 0, 0));
+    ck_assert_int_eq(fsdem_gic_step(t.gic), FSDEM_OK);
+    P = fsdem_dem_get_particles(t.dem);
+    ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, P.position[0], fsdem_v3(1, 0, 0), fsdem_v3(0, 0, 0)), FSDEM_OK);
+    ck_assert_int_eq(fsdem_gic_stable_dt(t.gic, &dt), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3((fsdem_real)(0.1 - 0.5 * dt), P.position[0].y, 0), fsdem_v3(1, 0, 0),
+                                                  fsdem_v3(0, 0, 0)),
+                     FSDEM_OK); /* at 1 m/s: out of the grid half-way through the step */
+    TEST_KEEP(fsdem_gic_save_memory, t.gic, fsdem_gic_get_stats(t.gic).coupling, &before);
+    ck_assert_int_eq(fsdem_gic_step_dt(t.gic, dt), FSDEM_ERR_OUT_OF_DOMAIN);
+    TEST_KEEP(fsdem_gic_save_memory, t.gic, fsdem_gic_get_stats(t.gic).coupling, &after);
+    test_kept_same(&before, &after, "GIC");
+    ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3(0.05f, P.position[0].y, 0), fsdem_v3(1, 0, 0), fsdem_v3(0, 0, 0)), FSDEM_OK);
+    ck_assert_msg(fsdem_gic_step_dt(t.gic, dt) == FSDEM_OK, "%s", fsdem_gic_last_error(t.gic));
+    free_gic(&t);
+}
+END_TEST
+
 START_TEST(test_gic_bad_input) {
     gic_tank t = make_gic(2, 0.1, 0.01, 0.05, 2500);
     fsdem_gic_desc d = fsdem_gic_desc_default();
@@ -441,6 +489,7 @@ Suite *couple_gic_suite(void) {
     tcase_add_test(tc, test_gic_virtual_mass_inertia);
     tcase_add_test(tc, test_gic_restart_bit_for_bit);
     tcase_add_test(tc, test_gic_bad_input);
+    tcase_add_test(tc, test_gic_failure_after_moving_puts_everything_back);
     suite_add_tcase(s, tc);
     return s;
 }

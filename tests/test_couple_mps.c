@@ -597,6 +597,35 @@ START_TEST(test_mps_dem_refused_step_changes_nothing) {
 }
 END_TEST
 
+/* A step that fails once something moved (>>couple_step): a sphere that leaves the DEM's domain in
+   its substeps, after the MPS has stepped. Coupler, MPS and DEM are put back as they were (saved
+   bytes and statistics), and with the sphere back inside the same step runs. */
+START_TEST(test_mps_dem_failure_after_moving_puts_everything_back) {
+    const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3(0.08f, 0.08f, 0.08f);
+    test_pair t = test_pair_new(3, 0.01, FSDEM_MPS_MODEL_B, 1e-6, lo, hi, 0.06, 2500);
+    const fsdem_dem_desc dd = fsdem_dem_get_desc(t.dem);
+    fsdem_dem_particles P;
+    test_kept before, after;
+    fsdem_real dt = 0;
+    test_add_sphere(&t, fsdem_v3(0.04f, 0.04f, 0.03f), fsdem_v3(1, 0, 0), 0.002);
+    P = fsdem_dem_get_particles(t.dem);
+    ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_dem_stable_dt(t.cpl, &dt), FSDEM_OK);
+    dt /= 2;                                                        /* room for the drag limit at the new place */
+    ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3(dd.domain_max.x - (fsdem_real)0.5 * dt, P.position[0].y, P.position[0].z),
+                                                  P.velocity[0], P.angular_velocity[0]),
+                     FSDEM_OK); /* at 1 m/s: out half-way through the step */
+    TEST_KEEP(fsdem_mps_dem_save_memory, t.cpl, fsdem_mps_dem_get_stats(t.cpl).coupling, &before);
+    ck_assert_int_eq(fsdem_mps_dem_step_dt(t.cpl, dt), FSDEM_ERR_OUT_OF_DOMAIN);
+    ck_assert_ptr_nonnull(strstr(fsdem_mps_dem_last_error(t.cpl), "DEM substeps"));
+    TEST_KEEP(fsdem_mps_dem_save_memory, t.cpl, fsdem_mps_dem_get_stats(t.cpl).coupling, &after);
+    test_kept_same(&before, &after, "MPS-DEM");
+    ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3(0.04f, 0.04f, 0.03f), P.velocity[0], P.angular_velocity[0]), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_dem_step_dt(t.cpl, dt), FSDEM_OK);
+    test_pair_free(&t);
+}
+END_TEST
+
 /* Bad input: a desc without solvers, mismatched dims or gravity, bad ranges; the message names the
    field and nothing is created. */
 START_TEST(test_mps_dem_bad_input) {
@@ -783,6 +812,7 @@ Suite *couple_mps_suite(void) {
     tcase_add_test(tc, test_mps_dem_periodic_images);
     tcase_add_test(tc, test_mps_dem_periodic_exchange);
     tcase_add_test(tc, test_mps_dem_refused_step_changes_nothing);
+    tcase_add_test(tc, test_mps_dem_failure_after_moving_puts_everything_back);
     tcase_add_test(tc, test_mps_dem_bad_input);
     tcase_add_test(tc, test_mps_dem_csv_rows_are_the_force_records);
     tcase_add_test(tc, test_mps_dem_failed_update_keeps_its_records);

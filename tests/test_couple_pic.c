@@ -722,6 +722,32 @@ START_TEST(refused_step_changes_nothing) {
 }
 END_TEST
 
+/* A step that fails once something moved (>>couple_step): a body that leaves the DEM's domain in
+   its substeps, after the PIC has stepped. Coupler, PIC and DEM are put back as they were (saved
+   bytes and statistics), and with the body back inside the same step runs. */
+START_TEST(failure_after_moving_puts_everything_back) {
+    tank t = make_tank(2, 0.4, 0.3, 0, G, 0.01, fsdem_v3(0.2, 0.1, 0), 0.04, 2000, 0, fsdem_v3(0, 0, 0), 0);
+    const fsdem_dem_particles P = fsdem_dem_get_particles(t.dem);
+    const fsdem_real dt = (fsdem_real)1e-3;
+    pic_dem_snapshot before, after;
+    ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, dt), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3((fsdem_real)(0.4 - 0.5 * dt), P.position[0].y, 0), fsdem_v3(1, 0, 0),
+                                                  fsdem_v3(0, 0, 0)),
+                     FSDEM_OK); /* at 1 m/s: out half-way through the step */
+    before = pic_dem_snapshot_take(&t);
+    ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, dt), FSDEM_ERR_OUT_OF_DOMAIN);
+    ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "DEM substeps"));
+    after = pic_dem_snapshot_take(&t);
+    ck_assert_msg(after.size == before.size && memcmp(after.bytes, before.bytes, after.size) == 0, "the state changed");
+    ck_assert_msg(memcmp(&after.stats, &before.stats, sizeof after.stats) == 0, "the statistics changed");
+    free(before.bytes);
+    free(after.bytes);
+    ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3(0.2f, P.position[0].y, 0), fsdem_v3(1, 0, 0), fsdem_v3(0, 0, 0)), FSDEM_OK);
+    ck_assert_msg(fsdem_pic_dem_step_dt(t.cp, dt) == FSDEM_OK, "%s", fsdem_pic_dem_last_error(t.cp));
+    free_tank(&t);
+}
+END_TEST
+
 /* fsdem_pic_dem_write_csv: the header alone before the first step (when fsdem_pic_dem_get_force has no
    record either), then one row per body of the last step, equal to its record and id (a disc held
    under water and a free one moving through it); a disc added since the step has no record and no row; an
@@ -777,6 +803,7 @@ Suite *couple_pic_suite(void) {
     tcase_add_test(tc, still_water_stays_still_next_to_a_body_at_rest);
     tcase_add_test(tc, update_cuts_without_stepping);
     tcase_add_test(tc, refused_step_changes_nothing);
+    tcase_add_test(tc, failure_after_moving_puts_everything_back);
     tcase_add_test(tc, contact_area_dissipation_is_eq_20);
     tcase_add_test(tc, bad_input_is_refused);
     tcase_add_test(tc, csv_rows_are_the_force_records);

@@ -336,6 +336,30 @@ END_TEST
    no record either), then one row per particle with a record, equal to fsdem_swe_dem_get_force and
    the particle's id: a floating sphere in a stream, a fixed one (a row of zeros) and, added after the
    step, one with no record yet (no row); an unwritable path is FSDEM_ERR_IO naming the path. */
+/* A step that fails once something moved (>>couple_step): a sphere that leaves the DEM's domain in
+   its substeps, after the water has stepped. Coupler, SWE and DEM are put back as they were (saved
+   bytes and statistics), and with the sphere back inside the same step runs. */
+START_TEST(failure_after_moving_puts_everything_back) {
+    world w = world_new(10, 100, 1, 0.5, 0.2, 500, 5, 1, 0, 1);
+    const fsdem_dem_particles P = fsdem_dem_get_particles(w.dem);
+    test_kept before, after;
+    fsdem_real dt = 0;
+    ck_assert_int_eq(capped_step(w.cpl, 0, &dt), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_set_particle_state(w.dem, 0, fsdem_v3((fsdem_real)(10 - dt), P.position[0].y, P.position[0].z), fsdem_v3(2, 0, 0),
+                                                  fsdem_v3(0, 0, 0)),
+                     FSDEM_OK); /* at 2 m/s: out half-way through the step */
+    TEST_KEEP(fsdem_swe_dem_save_memory, w.cpl, fsdem_swe_dem_get_stats(w.cpl).coupling, &before);
+    ck_assert_int_eq(fsdem_swe_dem_step_dt(w.cpl, dt), FSDEM_ERR_OUT_OF_DOMAIN);
+    ck_assert_ptr_nonnull(strstr(fsdem_swe_dem_last_error(w.cpl), "DEM substeps"));
+    TEST_KEEP(fsdem_swe_dem_save_memory, w.cpl, fsdem_swe_dem_get_stats(w.cpl).coupling, &after);
+    test_kept_same(&before, &after, "SWE-DEM");
+    ck_assert_int_eq(fsdem_dem_set_particle_state(w.dem, 0, fsdem_v3(5, P.position[0].y, P.position[0].z), fsdem_v3(2, 0, 0), fsdem_v3(0, 0, 0)),
+                     FSDEM_OK);
+    ck_assert_msg(fsdem_swe_dem_step_dt(w.cpl, dt) == FSDEM_OK, "%s", fsdem_swe_dem_last_error(w.cpl));
+    world_free(&w);
+}
+END_TEST
+
 START_TEST(csv_rows_are_the_force_records) {
     static const char header[] = "id,buoyancy_x,buoyancy_y,buoyancy_z,hydrostatic_x,hydrostatic_y,hydrostatic_z,dynamic_x,"
                                  "dynamic_y,dynamic_z,heave_x,heave_y,heave_z,submerged_volume,frontal_area,surface,wet";
@@ -387,6 +411,7 @@ Suite *couple_swe_suite(void) {
     tcase_add_test(tc, wet_dry_edge_exchanges_momentum);
     tcase_add_test(tc, csv_rows_are_the_force_records);
     tcase_add_test(tc, checkpoint_before_the_first_update_restores);
+    tcase_add_test(tc, failure_after_moving_puts_everything_back);
     suite_add_tcase(s, tc);
     return s;
 }

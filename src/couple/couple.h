@@ -1,4 +1,4 @@
-/* ===== >>couple : what every coupler shares, and couplers stepped together ======================== */
+/* ===== >>couple : what every coupler shares ====================================================== */
 
 /* A coupler (fsdem_swe_dem, fsdem_mps_dem, fsdem_pic_dem, fsdem_gic) joins one fluid and one DEM.
    Its step is a list of named stages around one step of the fluid: the fluid first for SWE-DEM,
@@ -8,7 +8,7 @@
      - step: its stable dt, the fluid's stable dt cut by the coupler's own limits (drag or viscous
        relaxation, bodies' speed); step_dt(dt): that dt, refused with FSDEM_ERR_CFL above the
        coupler's hard limits; either refuses before anything moves when the DEM would need more
-       than desc.max_substeps substeps;
+       than desc.max_substeps substeps, and a step is taken whole or not at all (>>couple_step);
      - advance(duration): steps of the stable dt until exactly `duration` later, the last two
        shortened to end there (never a sliver: a last step shorter than half a stable one is
        avoided by halving the two);
@@ -27,7 +27,7 @@
    SWE's momentum sources; MPS-DEM the MPS's forces and porosities; PIC-DEM the PIC's moving solids;
    GIC the PIC's porosity and accelerations). A second coupler that would write a claimed array is
    refused at creation, naming the first. Couplers that write different arrays of one fluid, each
-   with its own DEM, share that fluid and step together with fsdem_coupled_step: one PIC then
+   with its own DEM, share that fluid and step together with fsdem_coupled_step (>>couple_step): one PIC then
    carries a granular bed (fsdem_gic) and resolved bodies (fsdem_pic_dem) at once. */
 
 /* Figures every coupler keeps (the head of its fsdem_X_stats). */
@@ -46,14 +46,3 @@ typedef struct fsdem_coupling_stats {
 /* Any coupler, as fsdem_swe_dem_coupler, fsdem_mps_dem_coupler, fsdem_pic_dem_coupler and
    fsdem_gic_coupler give it (the same object: destroy it as what it is). */
 typedef struct fsdem_coupler fsdem_coupler;
-
-/* Couplers of one fluid stepped together: every coupler's stages before the fluid step, in the
-   order of the list, one step of the fluid, then every coupler's stages after it. The step is the
-   smallest stable dt of them all (fsdem_coupled_stable_dt), or dt; each coupler refuses it as its
-   own step would, before anything moves. FSDEM_ERR_INVALID_ARG for an empty list, a NULL entry,
-   a coupler listed twice or couplers of different fluids. A failure's message goes to every
-   coupler of the list (fsdem_X_last_error). A list of one is that coupler's own step. */
-FSDEM_API fsdem_result fsdem_coupled_step(fsdem_coupler *const *couplers, int count);
-FSDEM_API fsdem_result fsdem_coupled_step_dt(fsdem_coupler *const *couplers, int count, fsdem_real dt);
-FSDEM_API fsdem_result fsdem_coupled_advance(fsdem_coupler *const *couplers, int count, fsdem_real duration, long long *steps);
-FSDEM_API fsdem_result fsdem_coupled_stable_dt(fsdem_coupler *const *couplers, int count, fsdem_real *dt);

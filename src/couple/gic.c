@@ -195,6 +195,24 @@ static void fsdem__gic_kernel(const fsdem_gic *c, fsdem_vec3 p, fsdem__kernel *k
     fsdem__kernel_weights(kw, c->dim, s, c->grid.n, 0);
 }
 
+/* Every granule finite and inside the PIC's grid (the volume of one outside would be folded into the
+   boundary cells); `who` names the call in the message. */
+static fsdem_result fsdem__gic_granules_inside(fsdem_gic *c, const fsdem_dem_particles *P, const char *who) {
+    int i, a;
+    for (i = 0; i < P->count; ++i) {
+        int outside = 0;
+        if (!fsdem__finite3(P->position[i]))
+            return fsdem__fail(&c->head.status, FSDEM_ERR_NAN, "%s: granule %d (id %d) has a non-finite position", who, i, P->id[i]);
+        for (a = 0; a < c->dim; ++a)
+            outside |= fsdem__comp(P->position[i], a) < fsdem__comp(c->grid.lo, a) || fsdem__comp(P->position[i], a) > fsdem__comp(c->grid.hi, a);
+        if (outside)
+            return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_DOMAIN,
+                               "%s: granule %d (id %d) at (%g, %g, %g) m is outside the PIC's grid (keep the DEM's walls within it)", who, i,
+                               P->id[i], (double)P->position[i].x, (double)P->position[i].y, (double)P->position[i].z);
+    }
+    return FSDEM_OK;
+}
+
 /* Step 3 of >>couple_gic: alpha_s (Eq. 7a) and the porosity, into the PIC. */
 fsdem_result fsdem_gic_update(fsdem_gic *c) {
     fsdem_dem_particles P;
@@ -202,19 +220,10 @@ fsdem_result fsdem_gic_update(fsdem_gic *c) {
     int i, k, q0, q1, q2;
     double volume = 0;
     fsdem_real most = 0;
+    fsdem_result res;
     if (!c) return FSDEM_ERR_INVALID_ARG;
     P = fsdem_dem_get_particles(c->desc.dem);
-    for (i = 0; i < P.count; ++i) {
-        int a, outside = 0;
-        if (!fsdem__finite3(P.position[i]))
-            return fsdem__fail(&c->head.status, FSDEM_ERR_NAN, "fsdem_gic_update: granule %d (id %d) has a non-finite position", i, P.id[i]);
-        for (a = 0; a < c->dim; ++a)
-            outside |= fsdem__comp(P.position[i], a) < fsdem__comp(c->grid.lo, a) || fsdem__comp(P.position[i], a) > fsdem__comp(c->grid.hi, a);
-        if (outside) /* its volume would be folded into the boundary cells */
-            return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_DOMAIN,
-                               "fsdem_gic_update: granule %d (id %d) at (%g, %g, %g) m is outside the PIC's grid (keep the DEM's walls within it)",
-                               i, P.id[i], (double)P.position[i].x, (double)P.position[i].y, (double)P.position[i].z);
-    }
+    if ((res = fsdem__gic_granules_inside(c, &P, "fsdem_gic_update")) != FSDEM_OK) return res;
     memset(c->solid, 0, sizeof(fsdem_real) * (size_t)c->grid.ncell);
     for (i = 0; i < P.count; ++i) {
         const fsdem_real share = fsdem__gic_volume(c, P.radius[i]) / (c->cell_volume * c->depth);
@@ -412,12 +421,14 @@ static fsdem_result fsdem__gic_limit(const fsdem_coupler *head, fsdem_real *dt) 
     return FSDEM_OK;
 }
 
-/* A step of dt refused before anything moves: too many substeps, the PIC's own refusal, and for a
-   dt of the caller's the drag limit (a stable dt keeps it by construction). */
+/* A step of dt refused before anything moves: too many substeps, a granule outside the grid, the
+   PIC's own refusal, and for a dt of the caller's the drag limit (a stable dt keeps it by
+   construction). */
 static fsdem_result fsdem__gic_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
     fsdem_gic *c = (fsdem_gic *)(void *)head;
+    const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     fsdem_result res = fsdem__coupler_substeps_within(head, dt);
-    if (res != FSDEM_OK) return res;
+    if (res != FSDEM_OK || (res = fsdem__gic_granules_inside(c, &P, "fsdem_gic")) != FSDEM_OK) return res;
     if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
         return fsdem__fail(&head->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
     if (chosen) {
@@ -473,12 +484,6 @@ static const fsdem__coupler_class *fsdem__gic_class(void) {
     return &cls;
 }
 
-fsdem_result fsdem_gic_step(fsdem_gic *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
-fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) { return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_gic_step_dt"); }
-fsdem_result fsdem_gic_advance(fsdem_gic *c, fsdem_real duration, long long *steps) {
-    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_gic_advance");
-}
-fsdem_result fsdem_gic_stable_dt(const fsdem_gic *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
 double fsdem_gic_time(const fsdem_gic *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
 
 fsdem_result fsdem_gic_get_force(const fsdem_gic *c, int index, fsdem_gic_force *out) {

@@ -1,9 +1,9 @@
 /* ===== >>impl_couple : the coupler head, the fluids, the staged step, records =====================
 
    Contents: the head every coupler starts with, its class and its creation (below);
-   >>couple_fluids (the three fluids through their public calls), >>couple_step (the DEM's checks,
-   the staged step of couplers sharing a fluid, the stable rule, the advance), >>couple_records (the
-   per-particle records by their fields: lookup, CSV). A coupler, this chapter included, reaches the
+   >>couple_fluids (the three fluids through their public calls), >>couple_dem (the DEM's checks
+   and substeps), >>couple_records (the per-particle records by their fields: lookup, CSV). The
+   staged step itself is >>impl_couple_step, after >>impl_restart, whose saves it keeps. A coupler, this chapter included, reaches the
    solvers through their public calls only (>>doc; tests/map_check.sh holds every coupler chapter to
    it). */
 
@@ -37,7 +37,7 @@ typedef struct fsdem__coupler_class {
     size_t record_size;                 /* bytes of its per-particle record, whose first field is the int id */
     const fsdem__field *fields;         /* the record's fields (>>core), CSV columns and restart */
     int field_count;
-    /* its step (>>couple_step): prepare (may be NULL) does what must come before the step's length
+    /* its step (>>impl_couple_step): prepare (may be NULL) does what must come before the step's length
        is known, and undo (may be NULL) puts it back when the step is refused; limit (may be NULL)
        cuts the fluid's stable dt by the coupler's own limits; check refuses a dt before anything
        moves (chosen: the caller's dt, not a stable one); then the stages in order */
@@ -64,6 +64,9 @@ struct fsdem_coupler {
     const char *stage;                  /* the name of the stage under way, for its messages */
     const void *record;                 /* the records of the last update (cls->record_size bytes */
     int records;                        /*    each, ids ascending), `records` of them (0: none) */
+    unsigned char *kept;                /* the state before the step under way (fsdem__coupler_keep): */
+    size_t kept_saved, kept_capacity;   /*    its saved bytes, then its records (not every field of */
+    int kept_records;                   /*    a record is saved) */
 };
 
 /* The desc checks every coupler shares: a fluid of dimension fluid_dim and gravity fluid_g and a DEM
@@ -119,6 +122,7 @@ static void *fsdem__coupler_new(const fsdem__coupler_class *cls, fsdem_result ch
 /* Releases the coupler's claims and frees its `size` bytes (its own arrays freed before). */
 static void fsdem__coupler_free(fsdem_coupler *c, size_t size) {
     const fsdem_allocator al = c->allocator;
+    fsdem__free(&al, c->kept, c->kept_capacity);
     fsdem_release(fsdem_dem_claims(c->dem), FSDEM_DEM_ARRAYS_LOADS, c);
     fsdem_release(c->cls->fluid->claims(c->fluid), c->fluid_arrays, c);
     fsdem__free(&al, c, size);

@@ -519,14 +519,6 @@ static const fsdem__coupler_class *fsdem__mps_dem_class(void) {
     return &cls;
 }
 
-fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
-fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *c, fsdem_real dt) {
-    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_mps_dem_step_dt");
-}
-fsdem_result fsdem_mps_dem_advance(fsdem_mps_dem *c, fsdem_real duration, long long *steps) {
-    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_mps_dem_advance");
-}
-fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
 double fsdem_mps_dem_time(const fsdem_mps_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }
 fsdem_coupler *fsdem_mps_dem_coupler(fsdem_mps_dem *c) { return c ? &c->head : NULL; }
 

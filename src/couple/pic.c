@@ -909,12 +909,4 @@ fsdem_result fsdem_pic_dem_update(fsdem_pic_dem *c) {
     return res;
 }
 
-fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
-fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *c, fsdem_real dt) {
-    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_pic_dem_step_dt");
-}
-fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *c, fsdem_real duration, long long *steps) {
-    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_pic_dem_advance");
-}
-fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
 double fsdem_pic_dem_time(const fsdem_pic_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }

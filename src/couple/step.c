@@ -1,43 +1,9 @@
-/* ---- >>couple_step : the DEM's checks, the staged step, the stable rule, the advance ---- */
+/* ===== >>impl_couple_step : the staged step, the stable rule, the advance ===========================
 
-/* Every DEM particle fits in the fluid's domain [lo, hi] (a sphere wider than the domain's smallest
-   extent leaves no fluid around it); the particle goes to the message under the name `who`. */
-static fsdem_result fsdem__coupler_particles_fit(fsdem_coupler *c, fsdem_vec3 lo, fsdem_vec3 hi, const char *who) {
-    const fsdem_dem_particles P = fsdem_dem_get_particles(c->dem);
-    const fsdem_real extent = fsdem__smallest_extent(lo, hi, P.dim);
-    int i;
-    for (i = 0; i < P.count; ++i)
-        if (!(2 * P.radius[i] < extent))
-            return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG,
-                               "%s: DEM particle %d (id %d) of radius %g m does not fit in the fluid's domain (smallest extent %g m)", who,
-                               i, P.id[i], (double)P.radius[i], (double)extent);
-    return FSDEM_OK;
-}
-
-/* Before a step of dt moves anything: the DEM can follow it in at most max_substeps substeps. */
-static fsdem_result fsdem__coupler_substeps_within(fsdem_coupler *c, fsdem_real dt) {
-    long long substeps = 0;
-    const fsdem_result res = fsdem_dem_substep_count(c->dem, dt, &substeps);
-    if (res != FSDEM_OK) return fsdem__fail(&c->status, res, "%s: %s", c->cls->name, fsdem_dem_last_error(c->dem));
-    if (substeps > c->max_substeps)
-        return fsdem__fail(&c->status, FSDEM_ERR_INVALID_ARG,
-                           "%s: the fluid step %g s needs %lld DEM substeps, more than max_substeps %lld (DEM dt %g s)", c->cls->name,
-                           (double)dt, substeps, c->max_substeps, (double)fsdem_dem_get_stats(c->dem).dt);
-    return FSDEM_OK;
-}
-
-/* The coupler's DEM over dt in substeps, `fn` (may be NULL) called at every force evaluation
-   (fsdem_dem_advance_with); the counts go to the head. A failure is named "<stage>: <the DEM's
-   message>", unless `fn` failed (*fn_failed set) and named it already. */
-static fsdem_result fsdem__coupler_substeps(fsdem_coupler *c, fsdem_real dt, fsdem_dem_substep_fn fn, void *user, const int *fn_failed) {
-    long long substeps = 0;
-    const fsdem_result res = fsdem_dem_advance_with(c->dem, dt, fn, user, &substeps);
-    c->substeps = substeps;
-    c->substeps_total += substeps;
-    if (res != FSDEM_OK && !(fn_failed && *fn_failed))
-        return fsdem__fail(&c->status, res, "%s: %s: %s", c->cls->name, c->stage, fsdem_dem_last_error(c->dem));
-    return res;
-}
+   Contents: the step of one coupler or of couplers sharing a fluid (>>couple_step): the prepare, the
+   checks that refuse before anything moves, the state kept (>>restart_journal), the stages around
+   the fluid's step, the state put back on a failure after something moved; the stable rule; the
+   advance; the verbs of each coupler on them. It follows >>impl_restart, whose saves it keeps. */
 
 /* The message of couplers[from] (or a new one, from < 0) given to every coupler of the list. */
 static fsdem_result fsdem__coupled_fail(fsdem_coupler *const *list, int n, int from, fsdem_result res, const char *fmt, ...) {
@@ -60,6 +26,22 @@ static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem
     for (k = 0; k < n; ++k)
         if (list[k]->cls->undo) list[k]->cls->undo(list[k]);
     return res;
+}
+
+/* A step of the list failed after something moved, with the message of couplers[from]: every
+   coupler, fluid and DEM put back as kept, the prepare undone, the message (and a put-back that
+   failed, which cannot happen short of memory) to every coupler; passes `res` on. */
+static fsdem_result fsdem__coupled_put_back(fsdem_coupler *const *list, int n, int from, fsdem_result res) {
+    char message[FSDEM__MESSAGE_SIZE];
+    int k, lost = -1;
+    memcpy(message, list[from]->status.message, sizeof message);
+    for (k = 0; k < n; ++k)
+        if (fsdem__restart_put_back(list[k]) != FSDEM_OK && lost < 0) lost = k;
+    fsdem__coupled_undo(list, n, res);
+    if (lost >= 0)
+        return fsdem__coupled_fail(list, n, -1, res, "%s; and the state before the step could not be put back: %s", message,
+                                   list[lost]->status.message);
+    return fsdem__coupled_fail(list, n, -1, res, "%s", message);
 }
 
 /* A list of couplers that can step together: not empty, no NULL, none twice, one fluid. */
@@ -129,9 +111,10 @@ static const char *fsdem__coupler_fluid_stage(const fsdem_coupler *c) {
     return c->cls->stages[s].name;
 }
 
-/* A coupled step of dt after the prepare: every coupler's check (a refusal undoes the prepare), the
-   stages before the fluid's step, the fluid's step (FSDEM_ERR_CFL: refused before it moved, the
-   prepare undone), the stages after it. `chosen`: dt is the caller's, not a stable one. */
+/* A coupled step of dt after the prepare: every coupler's checks (a refusal undoes the prepare),
+   the state kept, the stages before the fluid's step, the fluid's step, the stages after it. A
+   failure once the state is kept puts it back (fsdem__coupled_put_back), so a refused step leaves
+   couplers, fluid and DEMs as they were. `chosen`: dt is the caller's, not a stable one. */
 static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_real dt, int chosen) {
     const fsdem__fluid *f = list[0]->cls->fluid;
     void *fluid = list[0]->fluid;
@@ -140,25 +123,30 @@ static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_r
     double seconds;
     int k;
     for (k = 0; k < n; ++k)
-        if ((res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
+        if ((res = fsdem__coupler_particles_valid(list[k])) != FSDEM_OK || (res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
             return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
+    for (k = 0; k < n; ++k) {
+        t0 = clock();
+        res = fsdem__restart_keep(list[k]);
+        list[k]->seconds[FSDEM__CLOCK_COUPLING] += (double)(clock() - t0) / CLOCKS_PER_SEC;
+        if (res != FSDEM_OK) return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
+    }
     for (k = 0; k < n; ++k)
-        if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
+        if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);
     t0 = clock();
     res = f->step_dt(fluid, dt);
     seconds = (double)(clock() - t0) / CLOCKS_PER_SEC;
     for (k = 0; k < n; ++k) list[k]->seconds[FSDEM__CLOCK_FLUID] += seconds;
     if (res != FSDEM_OK) {
-        if (res == FSDEM_ERR_CFL) fsdem__coupled_undo(list, n, res);
-        return fsdem__coupled_fail(list, n, -1, res, "%s: %s: %s", list[0]->cls->name, fsdem__coupler_fluid_stage(list[0]),
-                                   f->last_error(fluid));
+        fsdem__fail(&list[0]->status, res, "%s: %s: %s", list[0]->cls->name, fsdem__coupler_fluid_stage(list[0]), f->last_error(fluid));
+        return fsdem__coupled_put_back(list, n, 0, res);
     }
     for (k = 0; k < n; ++k) {
         list[k]->steps++;
         list[k]->dt_last = dt;
     }
     for (k = 0; k < n; ++k)
-        if ((res = fsdem__coupled_stages(list[k], dt, 1)) != FSDEM_OK) return fsdem__coupled_fail(list, n, k, res, NULL);
+        if ((res = fsdem__coupled_stages(list[k], dt, 1)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);
     for (k = 0; k < n; ++k) fsdem__ok(&list[k]->status);
     return FSDEM_OK;
 }
@@ -243,3 +231,38 @@ static fsdem_result fsdem__coupler_stable_dt(const fsdem_coupler *c, fsdem_real 
     fsdem_coupler *list = (fsdem_coupler *)c; /* only the message changes (a failure's) */
     return c && dt ? fsdem__coupled_stable(&list, 1, dt) : FSDEM_ERR_INVALID_ARG;
 }
+
+/* The verbs of each coupler (>>couple_swe, >>couple_mps, >>couple_pic, >>couple_gic). */
+fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *c, fsdem_real dt) {
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_swe_dem_step_dt");
+}
+fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *c, fsdem_real duration, long long *steps) {
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_swe_dem_advance");
+}
+fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+
+fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_mps_dem_step_dt(fsdem_mps_dem *c, fsdem_real dt) {
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_mps_dem_step_dt");
+}
+fsdem_result fsdem_mps_dem_advance(fsdem_mps_dem *c, fsdem_real duration, long long *steps) {
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_mps_dem_advance");
+}
+fsdem_result fsdem_mps_dem_stable_dt(const fsdem_mps_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+
+fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_pic_dem_step_dt(fsdem_pic_dem *c, fsdem_real dt) {
+    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_pic_dem_step_dt");
+}
+fsdem_result fsdem_pic_dem_advance(fsdem_pic_dem *c, fsdem_real duration, long long *steps) {
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_pic_dem_advance");
+}
+fsdem_result fsdem_pic_dem_stable_dt(const fsdem_pic_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
+
+fsdem_result fsdem_gic_step(fsdem_gic *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
+fsdem_result fsdem_gic_step_dt(fsdem_gic *c, fsdem_real dt) { return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_gic_step_dt"); }
+fsdem_result fsdem_gic_advance(fsdem_gic *c, fsdem_real duration, long long *steps) {
+    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_gic_advance");
+}
+fsdem_result fsdem_gic_stable_dt(const fsdem_gic *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }

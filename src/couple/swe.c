@@ -306,12 +306,4 @@ static const fsdem__coupler_class *fsdem__swe_dem_class(void) {
     return &cls;
 }
 
-fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *c) { return fsdem__coupler_step(c ? &c->head : NULL); }
-fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *c, fsdem_real dt) {
-    return fsdem__coupler_step_dt(c ? &c->head : NULL, dt, "fsdem_swe_dem_step_dt");
-}
-fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *c, fsdem_real duration, long long *steps) {
-    return fsdem__coupler_advance(c ? &c->head : NULL, duration, steps, "fsdem_swe_dem_advance");
-}
-fsdem_result fsdem_swe_dem_stable_dt(const fsdem_swe_dem *c, fsdem_real *dt) { return fsdem__coupler_stable_dt(c ? &c->head : NULL, dt); }
 double fsdem_swe_dem_time(const fsdem_swe_dem *c) { return c ? fsdem__coupler_time(&c->head) : 0; }

@@ -158,14 +158,16 @@ static void fsdem__restart_prepare(fsdem__restart *io, const fsdem__restart_obje
     io->pos = 0;
 }
 
-/* Saves o to `buffer` (`capacity` bytes; NULL: only the size). The payload is measured first, so a
-   buffer too small is refused before anything is written. */
-static fsdem_result fsdem__restart_save_memory(const fsdem__restart_object *o, void *buffer, size_t capacity,
-                                               size_t *size) {
+/* Saves o to `buffer` (`capacity` bytes; NULL: only the size) for `verb`, with its checksum unless
+   `unchecked`. The payload is measured first, so a buffer too small is refused before anything is
+   written. */
+static fsdem_result fsdem__restart_save_to(const fsdem__restart_object *o, void *buffer, size_t capacity, size_t *size,
+                                           const char *verb, int unchecked) {
     fsdem__restart io;
     unsigned char header[FSDEM__RESTART_HEADER];
     if (!o->object) return FSDEM_ERR_INVALID_ARG; /* a NULL handle: no object to hold a message */
-    fsdem__restart_begin(&io, o, "save_memory", FSDEM__RESTART_WRITE);
+    fsdem__restart_begin(&io, o, verb, FSDEM__RESTART_WRITE);
+    io.unchecked = unchecked;
     if (!size) {
         fsdem__restart_fail(&io, FSDEM_ERR_INVALID_ARG, "size is NULL");
         return fsdem__restart_end(&io, o);
@@ -183,6 +185,11 @@ static fsdem_result fsdem__restart_save_memory(const fsdem__restart_object *o, v
         memcpy(buffer, header, FSDEM__RESTART_HEADER);
     }
     return fsdem__restart_end(&io, o);
+}
+
+static fsdem_result fsdem__restart_save_memory(const fsdem__restart_object *o, void *buffer, size_t capacity,
+                                               size_t *size) {
+    return fsdem__restart_save_to(o, buffer, capacity, size, "save_memory", 0);
 }
 
 /* Saves o to the file `path` in one pass: header, payload, then the checksum into the header. */
@@ -214,7 +221,7 @@ static fsdem_result fsdem__restart_save_file(const fsdem__restart_object *o, con
 }
 
 /* Checks the header of `size` bytes at `data` against o: magic, version, byte order, precision,
-   kind, dimension, the announced size, then the checksum. */
+   kind, dimension, the announced size, then the checksum (unless io->unchecked). */
 static void fsdem__restart_check_header(fsdem__restart *io, const fsdem__restart_object *o, const unsigned char *data,
                                         size_t size) {
     unsigned long long payload, sum;
@@ -250,19 +257,20 @@ static void fsdem__restart_check_header(fsdem__restart *io, const fsdem__restart
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "%s: %llu bytes after the header, %llu announced",
                             payload > (unsigned long long)(size - FSDEM__RESTART_HEADER) ? "truncated" : "trailing bytes",
                             (unsigned long long)(size - FSDEM__RESTART_HEADER), payload);
-    else if (fsdem__restart_fnv(fsdem__restart_fnv(FSDEM__RESTART_FNV_BASIS, data, 56), data + FSDEM__RESTART_HEADER,
+    else if (!io->unchecked && fsdem__restart_fnv(fsdem__restart_fnv(FSDEM__RESTART_FNV_BASIS, data, 56), data + FSDEM__RESTART_HEADER,
                                 (size_t)payload) != sum)
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "checksum mismatch: the data are corrupted");
 }
 
-/* Restores o from `size` bytes at `data`: the header, then the visitor's CHECK, RESERVE and COMMIT
-   passes over the payload. */
-static fsdem_result fsdem__restart_load(const fsdem__restart_object *o, const char *verb, const unsigned char *data,
-                                        size_t size) {
+/* Restores o from `size` bytes at `data` for `verb`: the header (its checksum unless `unchecked`),
+   then the visitor's CHECK, RESERVE and COMMIT passes over the payload. */
+static fsdem_result fsdem__restart_load(const fsdem__restart_object *o, const char *verb, const unsigned char *data, size_t size,
+                                        int unchecked) {
     fsdem__restart io;
     static const fsdem__restart_mode passes[3] = {FSDEM__RESTART_CHECK, FSDEM__RESTART_RESERVE, FSDEM__RESTART_COMMIT};
     int pass;
     fsdem__restart_begin(&io, o, verb, FSDEM__RESTART_CHECK);
+    io.unchecked = unchecked;
     fsdem__restart_check_header(&io, o, data, size);
     for (pass = 0; pass < 3 && io.res == FSDEM_OK; ++pass) {
         io.mode = passes[pass];
@@ -300,7 +308,7 @@ static fsdem_result fsdem__restart_load_file(const fsdem__restart_object *o, con
     else if (fread(data, 1, (size_t)length, fp) != (size_t)length)
         fsdem__restart_fail(&io, FSDEM_ERR_IO, "cannot read '%s'", path);
     if (fp) fclose(fp);
-    res = io.res == FSDEM_OK ? fsdem__restart_load(o, "restore", data, (size_t)length) : fsdem__restart_end(&io, o);
+    res = io.res == FSDEM_OK ? fsdem__restart_load(o, "restore", data, (size_t)length, 0) : fsdem__restart_end(&io, o);
     fsdem__free(o->allocator, data, length > 0 ? (size_t)length : 1);
     return res;
 }
@@ -308,7 +316,7 @@ static fsdem_result fsdem__restart_load_file(const fsdem__restart_object *o, con
 /* Restores o from the `size` bytes at `buffer` (a save_memory image). */
 static fsdem_result fsdem__restart_load_memory(const fsdem__restart_object *o, const void *buffer, size_t size) {
     if (!o->object) return FSDEM_ERR_INVALID_ARG; /* a NULL handle: no object to hold a message */
-    return fsdem__restart_load(o, "restore_memory", (const unsigned char *)buffer, size);
+    return fsdem__restart_load(o, "restore_memory", (const unsigned char *)buffer, size, 0);
 }
 
 /* The public functions: save and restore, to files and to memory, for each of the four objects:

@@ -3,9 +3,10 @@
    Contents: >>restart_format (header, checksum, and the one cursor that writes, checks and reads
    every object), >>restart_dem, >>restart_pic, >>restart_swe, >>restart_mps, >>restart_couplers
    (one visitor per object lists what it saves, in order, and serves saving and restoring alike; the
-   couplers' by their field tables), >>restart_api (memory and files). A restore runs the visitor three times over the payload: CHECK validates
-   everything and compares the desc, RESERVE allocates, COMMIT writes into the object. Only COMMIT
-   changes the object, and it cannot fail. */
+   couplers' by their field tables), >>restart_api (memory and files), >>restart_journal (the state
+   a coupled step keeps, to put back should it fail). A restore runs the visitor three times over
+   the payload: CHECK validates everything and compares the desc, RESERVE allocates, COMMIT writes
+   into the object. Only COMMIT changes the object, and it cannot fail. */
 
 /* ---- >>restart_format : header, checksum, cursor ---- */
 
@@ -45,6 +46,8 @@ typedef struct fsdem__restart {
     const unsigned char *in;     /* reading: the payload */
     size_t pos, size;            /* cursor; bytes of the payload (WRITE to memory: room for it) */
     unsigned long long hash;     /* FNV-1a of the header and of the bytes written so far */
+    int unchecked;               /* no checksum written or verified: a coupled step's kept state */
+                                 /*    (>>restart_journal), which never leaves the process */
     fsdem_result res;            /* the first failure, FSDEM_OK so far */
     char fn[48];                 /* public function, first in every message */
     const char *section;         /* the solver being read in a coupler's file, or NULL */
@@ -101,7 +104,7 @@ static void fsdem__restart_data(fsdem__restart *io, void *p, size_t bytes) {
             memcpy(io->out + io->pos, p, bytes);
         } else if (io->file)
             fwrite(p, 1, bytes, io->file); /* errors: ferror at the end (fsdem__restart_save_file) */
-        if (io->out || io->file) io->hash = fsdem__restart_fnv(io->hash, (const unsigned char *)p, bytes);
+        if ((io->out || io->file) && !io->unchecked) io->hash = fsdem__restart_fnv(io->hash, (const unsigned char *)p, bytes);
         io->pos += bytes;
         return;
     }
