@@ -603,9 +603,12 @@ typedef struct fsdem_allocator {
 /* Threads. Built with OpenMP (-fopenmp), the solvers run their loops on the calling thread's OpenMP
    team, and every result is the same bit for bit at any thread count and as in a build without
    OpenMP (>>doc THREADS). The count is OpenMP's own (OMP_NUM_THREADS, omp_set_num_threads):
-   fsdem_set_threads(n >= 1) sets it for the calling thread, fsdem_threads() reads it. Without OpenMP
-   no thread is created, fsdem_set_threads does nothing and fsdem_threads() is 1. */
-FSDEM_API void fsdem_set_threads(int count);
+   fsdem_set_threads(n) sets it for the calling thread, fsdem_threads() reads it. n from 1 to four
+   per processor (omp_get_num_procs(), at least 4): FSDEM_ERR_INVALID_ARG otherwise, the count
+   unchanged (more threads than that cannot run at once and only wait at the solvers' barriers;
+   OMP_NUM_THREADS is OpenMP's and not checked). Without OpenMP no thread is created,
+   fsdem_set_threads does nothing (n >= 1 is still required) and fsdem_threads() is 1. */
+FSDEM_API fsdem_result fsdem_set_threads(int count);
 FSDEM_API int fsdem_threads(void);
 
 /* Who writes a solver's coupling arrays. A coupler claims the arrays it writes when it is created
@@ -1454,8 +1457,9 @@ FSDEM_API fsdem_pic_particles fsdem_pic_get_particles(fsdem_pic *pic);
    limit), FSDEM_ERR_CFL (the projected velocity moved particles more than cfl_max cells). */
 FSDEM_API fsdem_result fsdem_pic_step(fsdem_pic *pic);
 /* One step of a given dt (s). FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite, FSDEM_ERR_CFL when
-   u_max dt / dx > cfl_max (the message names the fastest particle); in both cases nothing moved.
-   Otherwise as fsdem_pic_step. */
+   (u_max + |g| dt) dt / dx > cfl_max: the fastest particle, or liquid falling freely over the
+   step, would cross more than cfl_max cells (the message names the fastest particle); in both
+   cases nothing moved. Otherwise as fsdem_pic_step. */
 FSDEM_API fsdem_result fsdem_pic_step_dt(fsdem_pic *pic, fsdem_real dt);
 /* FSDEM_OK when fsdem_pic_step_dt would take a step of dt, else the refusal it would return, with
    its message (a coupler checks before it changes anything). */
@@ -3102,19 +3106,24 @@ typedef struct fsdem_gic_desc {
     fsdem_pic *pic;               /* water; not owned; must outlive the coupler */
     fsdem_dem *dem;               /* granules; same dim and gravity as the PIC; not owned */
     fsdem_drag_law drag;          /* default FSDEM_DRAG_LAW_GIC (seed 004 Eq. 5b) */
-    fsdem_real drag_scale;        /* -; factor on the law's coefficient, > 0; default 1 (0.1 with */
-                                  /*    the GIC law is the seed's mu = 0.044 of §6.1) */
+    fsdem_real drag_scale;        /* -; factor on the law's coefficient, in [1e-3, 1e3] (a */
+                                  /*    calibration, not another law); default 1 (0.1 with the */
+                                  /*    GIC law is the seed's mu = 0.044 of §6.1) */
     int virtual_mass;             /* 1: the granules' added mass, Eq. 14-17 (see step 1); default 0: */
                                   /*    explicit, it diverged in dense sand entering water at 1 m/s */
                                   /*    (validation/gic_volume); dilute granules take it well */
     fsdem_real viscosity;         /* m^2/s; kinematic viscosity the drag laws use, as the PIC's */
                                   /*    (all but the GIC law need one); 0: the PIC's; default 0 */
-    fsdem_real max_solid_fraction; /* -; cap of alpha_s in (0, 1); 0: 0.740 in 3D, 0.907 in 2D */
-                                  /*    (densest packings, §5.1); default 0 */
-    fsdem_real cfl;               /* -; Eq. 33: dt <= cfl dx / max |v_granule|, > 0; default 1 */
+    fsdem_real max_solid_fraction; /* -; cap of alpha_s in [0.5, 1) (below random loose */
+                                  /*    packing, 0.55, it would cap beds of touching granules); */
+                                  /*    0: 0.740 in 3D, 0.907 in 2D (densest packings, §5.1); */
+                                  /*    default 0 */
+    fsdem_real cfl;               /* -; Eq. 33: dt <= cfl dx / max |v_granule|, in [0.01, 1] (a */
+                                  /*    granule crosses at most one cell a step; below 0.01 the */
+                                  /*    step only shrinks); default 1 */
     fsdem_real max_dt_ratio;      /* -; Eq. 33: dt <= this x the DEM's dt, >= 1; default 1000 */
-    fsdem_real drag_dt_fraction;  /* -; dt <= this x the shortest drag relaxation time, in (0, 1]; */
-                                  /*    default 0.5 */
+    fsdem_real drag_dt_fraction;  /* -; dt <= this x the shortest drag relaxation time, in */
+                                  /*    [0.01, 1]; default 0.5 */
     long long max_substeps;       /* DEM substeps one coupled step may take; a longer step is */
                                   /*    refused before anything moves; default 100000 */
     fsdem_log_fn log;             /* optional; default NULL */
@@ -3606,15 +3615,20 @@ static int fsdem__workers(void) { return omp_get_max_threads(); }
 /* threaded: inside a team: the calling thread's number and the team's size. */
 static int fsdem__worker(void) { return omp_get_thread_num(); }
 static int fsdem__team(void) { return omp_get_num_threads(); }
-void fsdem_set_threads(int count) {
-    if (count >= 1) omp_set_num_threads(count);
+/* More threads than four per processor cannot run at once, and each of the multigrid pipeline's
+   stages then waits for a time slice (issue 34: 10000 threads on two cores stalled a 128^2 PIC). */
+fsdem_result fsdem_set_threads(int count) {
+    const int most = omp_get_num_procs() > 1 ? 4 * omp_get_num_procs() : 4;
+    if (count < 1 || count > most || count > omp_get_thread_limit()) return FSDEM_ERR_INVALID_ARG;
+    omp_set_num_threads(count);
+    return FSDEM_OK;
 }
 #else
 #define FSDEM__OMP(x)
 static int fsdem__workers(void) { return 1; }
 static int fsdem__worker(void) { return 0; }
 static int fsdem__team(void) { return 1; }
-void fsdem_set_threads(int count) { (void)count; }
+fsdem_result fsdem_set_threads(int count) { return count >= 1 ? FSDEM_OK : FSDEM_ERR_INVALID_ARG; }
 #endif
 int fsdem_threads(void) { return fsdem__workers(); }
 
@@ -9011,9 +9025,9 @@ static int fsdem__amg_prolongation(const fsdem_allocator *al, fsdem__amg *g, fsd
     return fsdem__amg_transpose(al, g, L);
 }
 
-/* Level vectors and 1/a_ii of level L (its A set). Returns 0 on an allocation failure or a
-   non-positive diagonal (not positive definite). */
-static int fsdem__amg_level_arrays(const fsdem_allocator *al, fsdem__amg *g, fsdem__amg_level *L) {
+/* Level vectors and 1/a_ii of level L (its A set). Returns 0 on an allocation failure, and on a
+   non-positive diagonal (the matrix is not positive definite) sets *indefinite too. */
+static int fsdem__amg_level_arrays(const fsdem_allocator *al, fsdem__amg *g, fsdem__amg_level *L, int *indefinite) {
     int i, e;
     L->inv_diag = (fsdem_real *)fsdem__amg_array(al, g, (size_t)L->n, sizeof(fsdem_real));
     L->x = (fsdem_real *)fsdem__amg_array(al, g, (size_t)L->n, sizeof(fsdem_real));
@@ -9024,7 +9038,7 @@ static int fsdem__amg_level_arrays(const fsdem_allocator *al, fsdem__amg *g, fsd
         L->inv_diag[i] = 0;
         for (e = L->a_start[i]; e < L->a_start[i + 1]; ++e)
             if (L->a_col[e] == i && L->a_val[e] > 0) L->inv_diag[i] = 1 / L->a_val[e];
-        if (!(L->inv_diag[i] > 0)) return 0;
+        if (!(L->inv_diag[i] > 0)) return !(*indefinite = 1);
     }
     return 1;
 }
@@ -9054,15 +9068,16 @@ static int fsdem__amg_factor(const fsdem_allocator *al, fsdem__amg *g, const fsd
     return 1;
 }
 
-/* Builds the hierarchy of matrix m into a new object (*out); NULL and 0 on failure (out of
-   memory, or a diagonal entry that is not positive). */
-static int fsdem__amg_build(const fsdem_allocator *al, const fsdem_pcg_desc *desc, const fsdem_csr *m, fsdem__amg **out) {
+/* Builds the hierarchy of matrix m into a new object (*out); on failure *out is NULL and the result
+   FSDEM_ERR_INVALID_ARG when a level's diagonal entry is not positive (m is not positive definite),
+   FSDEM_ERR_OUT_OF_MEMORY otherwise. */
+static fsdem_result fsdem__amg_build(const fsdem_allocator *al, const fsdem_pcg_desc *desc, const fsdem_csr *m, fsdem__amg **out) {
     fsdem__amg *g = (fsdem__amg *)fsdem__alloc(al, sizeof *g);
     fsdem__amg_work wk;
     const size_t n = (size_t)m->rows;
-    int ok, l;
+    int ok, l, indefinite = 0;
     *out = NULL;
-    if (!g) return 0;
+    if (!g) return FSDEM_ERR_OUT_OF_MEMORY;
     memset(g, 0, sizeof *g);
     g->bytes = sizeof *g;
     wk.mark = (int *)fsdem__alloc(al, sizeof(int) * n);
@@ -9081,7 +9096,7 @@ static int fsdem__amg_build(const fsdem_allocator *al, const fsdem_pcg_desc *des
         g->lv[0].a_start = m->row_start;
         g->lv[0].a_col = m->col;
         g->lv[0].a_val = m->val;
-        ok = fsdem__amg_level_arrays(al, g, &g->lv[0]);
+        ok = fsdem__amg_level_arrays(al, g, &g->lv[0], &indefinite);
     }
     for (l = 0; ok; ++l) {
         fsdem__amg_level *L = &g->lv[l], *C;
@@ -9111,7 +9126,7 @@ static int fsdem__amg_build(const fsdem_allocator *al, const fsdem_pcg_desc *des
         C->a_start = C->own_start;
         C->a_col = C->own_col;
         C->a_val = C->own_val;
-        if (ok) ok = fsdem__amg_level_arrays(al, g, C);
+        if (ok) ok = fsdem__amg_level_arrays(al, g, C, &indefinite);
     }
     if (ok) {
         const fsdem__amg_level *last = &g->lv[g->levels - 1];
@@ -9126,10 +9141,10 @@ static int fsdem__amg_build(const fsdem_allocator *al, const fsdem_pcg_desc *des
     fsdem__free(al, wk.w, sizeof(fsdem_real) * n);
     if (!ok) {
         fsdem__amg_free(al, g);
-        return 0;
+        return indefinite ? FSDEM_ERR_INVALID_ARG : FSDEM_ERR_OUT_OF_MEMORY;
     }
     *out = g;
-    return 1;
+    return FSDEM_OK;
 }
 
 /* Gauss-Seidel sweeps on level L, forward or backward. */
@@ -9434,10 +9449,11 @@ static fsdem_result fsdem__pcg_setup_csr_valid(fsdem_pcg *s, const fsdem_csr *m)
     for (i = 0; i < m->rows; ++i)
         for (e = m->row_start[i]; e < m->row_start[i + 1]; ++e)
             if (m->col[e] >= i) upper++;
-    if (pc == FSDEM_PRECOND_AMG && !fsdem__amg_build(&s->allocator, &s->desc, m, &amg))
-        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY,
-                           "fsdem_pcg_setup_csr: out of memory building the AMG hierarchy of %d rows (or a diagonal entry "
-                           "is not positive)",
+    if (pc == FSDEM_PRECOND_AMG && (res = fsdem__amg_build(&s->allocator, &s->desc, m, &amg)) != FSDEM_OK)
+        return fsdem__fail(&s->status, res,
+                           res == FSDEM_ERR_INVALID_ARG ? "fsdem_pcg_setup_csr: the matrix of %d rows is not positive definite (a diagonal "
+                                                          "entry of it or of a coarse AMG level is not positive)"
+                                                        : "fsdem_pcg_setup_csr: out of memory building the AMG hierarchy of %d rows",
                            m->rows);
     {
         fsdem_pcg probe = *s;
@@ -10048,7 +10064,8 @@ static fsdem_result fsdem__pic_check(const fsdem_pic_desc *d, char *msg, size_t 
         FSDEM__PIC_BAD("fsdem_pic_desc.pressure_precond = %d must be a fsdem_precond for a stencil (AUTO, NONE, JACOBI, IC0, "
                        "MIC0, MG)", (int)d->pressure_precond);
     if ((int)d->viscosity_precond < 0 || (int)d->viscosity_precond > 5)
-        FSDEM__PIC_BAD("fsdem_pic_desc.viscosity_precond = %d is not a fsdem_precond", (int)d->viscosity_precond);
+        FSDEM__PIC_BAD("fsdem_pic_desc.viscosity_precond = %d must be a fsdem_precond for a stencil (AUTO, NONE, JACOBI, IC0, "
+                       "MIC0, MG; AMG takes CSR matrices only)", (int)d->viscosity_precond);
     if (!(d->pressure_tolerance > 0 && d->pressure_tolerance < 1))
         FSDEM__PIC_BAD("fsdem_pic_desc.pressure_tolerance = %g must be in (0, 1)", (double)d->pressure_tolerance);
     if (!(d->viscosity_tolerance > 0 && d->viscosity_tolerance < 1))
@@ -12218,15 +12235,17 @@ fsdem_result fsdem_pic_check_dt(const fsdem_pic *s, fsdem_real dt) {
     umax = fsdem__pic_umax(s, &who);
     if (!fsdem__finite(umax))
         return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_pic: particle %d has a non-finite velocity", who);
-    cfl = umax * dt * s->inv_dx;
+    cfl = (umax + s->gmag * dt) * dt * s->inv_dx; /* gravity's share: liquid falling freely over the step */
     if (cfl > s->desc.cfl_max) {
-        if (who >= 0)
-            return fsdem__fail(st, FSDEM_ERR_CFL,
-                               "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (particle %d at %g m/s; dt <= %g s)", (double)dt,
-                               (double)cfl, (double)s->desc.cfl_max, who, (double)umax,
-                               (double)(s->desc.cfl_max * s->dx / umax));
-        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s side velocity %g m/s)",
-                           (double)dt, (double)cfl, (double)s->desc.cfl_max, fsdem__pic_side_name(-2 - who), (double)umax);
+        /* the longest dt allowed: the root of |g| dt^2 + u_max dt = cfl_max dx */
+        const double c = (double)(s->desc.cfl_max * s->dx), u = (double)umax, g = (double)s->gmag;
+        const double most = g > 0 ? 2 * c / (u + sqrt(u * u + 4 * g * c)) : c / u;
+        char fastest[96];
+        if (who >= 0) snprintf(fastest, sizeof fastest, "particle %d at %g m/s", who, u);
+        else if (who < -1) snprintf(fastest, sizeof fastest, "%s side velocity %g m/s", fsdem__pic_side_name(-2 - who), u);
+        else snprintf(fastest, sizeof fastest, "still liquid");
+        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s, gravity %g m/s^2; dt <= %g s)",
+                           (double)dt, (double)cfl, (double)s->desc.cfl_max, fastest, g, most);
     }
     return fsdem__ok(st);
 }
@@ -15378,10 +15397,12 @@ static fsdem_result fsdem__mps_lattice_fill(fsdem_mps *s, const char *fn, fsdem_
     if (added) *added = 0;
     for (a = 0; a < 3; ++a) {
         const double l = (double)fsdem__comp(lo, a), r0 = (double)s->r0;
-        i0[a] = a < s->dim ? (int)ceil(((double)fsdem__comp(from, a) - l) / r0 - 0.5 - 1e-9) : 0;
-        i1[a] = a < s->dim ? (int)floor(((double)fsdem__comp(to, a) - l) / r0 - 0.5 + 1e-9) : 0;
-        if (a < s->dim && (double)(i1[a] - i0[a]) > 1e7)
+        const double first = ceil(((double)fsdem__comp(from, a) - l) / r0 - 0.5 - 1e-9), last = floor(((double)fsdem__comp(to, a) - l) / r0 - 0.5 + 1e-9);
+        /* bounded before the conversion to int, which would overflow first */
+        if (a < s->dim && !(last - first <= 1e7 && fabs(first) <= 1e9 && fabs(last) <= 1e9))
             return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "%s: the box holds too many lattice points", fn);
+        i0[a] = a < s->dim ? (int)first : 0;
+        i1[a] = a < s->dim ? (int)last : 0;
     }
     for (pass = 0; pass < 2; ++pass) {
         int i, j, k, c = 0;
@@ -15592,6 +15613,53 @@ static fsdem_result fsdem__mps_check_open(fsdem_mps *s, const char *what, int ax
     return fsdem__mps_check_box(s, field, f, t);
 }
 
+/* An MPS that can take an open boundary: no coupler claims its arrays, and none was handed them. */
+static fsdem_result fsdem__mps_open_allowed(fsdem_mps *s, const char *fn) {
+    const char *holder = fsdem_claimant(&s->claims, FSDEM_MPS_ARRAYS_FORCE | FSDEM_MPS_ARRAYS_POROSITY);
+    if (holder || s->external)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: the MPS is coupled (%s): open boundaries need an MPS without a coupler",
+                           fn, holder ? holder : "its coupling arrays were handed out");
+    return FSDEM_OK;
+}
+
+/* An inflow's buffer zone (from-to) inside the domain and free of particles: a buffer over liquid,
+   over walls or over another buffer would place particles on top of others. */
+static fsdem_result fsdem__mps_zone_free(fsdem_mps *s, fsdem_vec3 from, fsdem_vec3 to) {
+    int i, a, inside;
+    for (a = 0; a < s->dim; ++a)
+        if (!(fsdem__comp(from, a) >= fsdem__comp(s->desc.domain_min, a) && fsdem__comp(to, a) <= fsdem__comp(s->desc.domain_max, a)))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                               "fsdem_mps_inflow_desc.lo/hi: the buffer zone from %g to %g m along %c must lie inside the domain (%g to %g m)",
+                               (double)fsdem__comp(from, a), (double)fsdem__comp(to, a), "xyz"[a], (double)fsdem__comp(s->desc.domain_min, a),
+                               (double)fsdem__comp(s->desc.domain_max, a));
+    for (i = 0; i < s->n; ++i) {
+        for (a = 0, inside = 1; a < s->dim && inside; ++a)
+            inside = fsdem__comp(s->x[i], a) > fsdem__comp(from, a) && fsdem__comp(s->x[i], a) < fsdem__comp(to, a);
+        if (inside)
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                               "fsdem_mps_inflow_desc: the buffer zone from (%g, %g, %g) to (%g, %g, %g) m holds particle %d at (%g, %g, %g) m: "
+                               "it must be free (not in the liquid, the walls or another inflow's buffer)",
+                               (double)from.x, (double)from.y, (double)from.z, (double)to.x, (double)to.y, (double)to.z, i,
+                               (double)s->x[i].x, (double)s->x[i].y, (double)s->x[i].z);
+    }
+    return FSDEM_OK;
+}
+
+/* An inflow and an outflow across the same stream (one axis, extents that overlap over the
+   others): the outflow must face the same way and lie downstream of the inflow's plane, else it
+   removes the liquid the inflow feeds. */
+static fsdem_result fsdem__mps_open_ordered(fsdem_mps *s, const fsdem_mps_inflow_desc *in, const fsdem_mps_outflow_desc *out) {
+    int a, across = in->axis == out->axis;
+    for (a = 0; a < s->dim && across; ++a)
+        across = a == in->axis || (fsdem__comp(in->lo, a) < fsdem__comp(out->hi, a) && fsdem__comp(out->lo, a) < fsdem__comp(in->hi, a));
+    if (across && (in->direction != out->direction || !((out->position - in->position) * (fsdem_real)in->direction > 0)))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_mps: the outflow at %c = %g m (direction %+d) is not downstream of the inflow at %c = %g m (direction %+d) "
+                           "across the same stream",
+                           "xyz"[out->axis], (double)out->position, out->direction, "xyz"[in->axis], (double)in->position, in->direction);
+    return FSDEM_OK;
+}
+
 fsdem_mps_inflow_desc fsdem_mps_inflow_desc_default(void) {
     fsdem_mps_inflow_desc d;
     memset(&d, 0, sizeof d);
@@ -15613,13 +15681,16 @@ fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in,
     if (added) *added = 0;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!in) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_inflow: inflow is NULL");
-    if (s->external) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_inflow: the MPS is coupled");
+    if ((r = fsdem__mps_open_allowed(s, "fsdem_mps_add_inflow")) != FSDEM_OK) return r;
     if ((r = fsdem__mps_check_open(s, "fsdem_mps_inflow_desc", in->axis, in->direction, in->position, 1, in->lo, in->hi, &anchor,
                                    &from, &to)) != FSDEM_OK)
         return r;
     if (!(in->speed > 0 && in->speed <= FSDEM_MAX_SPEED))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_inflow_desc.speed = %g m/s must be in (0, FSDEM_MAX_SPEED]",
                            (double)in->speed);
+    if ((r = fsdem__mps_zone_free(s, from, to)) != FSDEM_OK) return r;
+    for (i = 0; i < s->outflow_n; ++i)
+        if ((r = fsdem__mps_open_ordered(s, in, &s->outflows[i])) != FSDEM_OK) return r;
     fsdem__set_comp(&u, in->axis, in->speed * (fsdem_real)in->direction);
     if (!fsdem__mps_list_room(s, (void **)&s->inflows, &s->inflow_cap, s->inflow_n, sizeof *s->inflows))
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_inflow: out of memory");
@@ -15635,12 +15706,15 @@ fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in,
 
 fsdem_result fsdem_mps_add_outflow(fsdem_mps *s, const fsdem_mps_outflow_desc *out) {
     fsdem_result r;
+    int k;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!out) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_outflow: outflow is NULL");
-    if (s->external) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_outflow: the MPS is coupled");
+    if ((r = fsdem__mps_open_allowed(s, "fsdem_mps_add_outflow")) != FSDEM_OK) return r;
     if ((r = fsdem__mps_check_open(s, "fsdem_mps_outflow_desc", out->axis, out->direction, out->position, 0, out->lo, out->hi, NULL,
                                    NULL, NULL)) != FSDEM_OK)
         return r;
+    for (k = 0; k < s->inflow_n; ++k)
+        if ((r = fsdem__mps_open_ordered(s, &s->inflows[k], out)) != FSDEM_OK) return r;
     if (!fsdem__mps_list_room(s, (void **)&s->outflows, &s->outflow_cap, s->outflow_n, sizeof *s->outflows))
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_outflow: out of memory");
     s->outflows[s->outflow_n++] = *out;
@@ -17037,6 +17111,17 @@ static fsdem_result fsdem__coupler_check(const fsdem__coupler_class *cls, const 
     return FSDEM_OK;
 }
 
+/* A DEM without periodic axes, for a fluid that has none (`desc` names the desc, `fluid` the fluid):
+   a particle that wraps around would jump across the fluid. */
+static fsdem_result fsdem__coupler_aperiodic(const char *desc, fsdem_dem *dem, const char *fluid, char *msg, size_t size) {
+    const fsdem_dem_desc dd = fsdem_dem_get_desc(dem);
+    int a;
+    for (a = 0; a < dd.dim; ++a)
+        if (dd.periodic[a])
+            return fsdem__reject(msg, size, "%s.dem is periodic along %c and the %s has no periodic axes", desc, "xyz"[a], fluid);
+    return FSDEM_OK;
+}
+
 /* A new coupler of `size` bytes whose desc check gave `checked` (and `why`): zeroed, its memory from
    the DEM's allocator, its head set, the DEM's loads and the fluid's `arrays` claimed. NULL, with
    *res and the reason logged, on failure. */
@@ -18190,6 +18275,7 @@ fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *d, char *msg, si
                              (double)d->viscous_dt_fraction);
     if (d->discrete_weight != 0 && d->discrete_weight != 1)
         return fsdem__reject(msg, size, "fsdem_pic_dem_desc.discrete_weight must be 0 or 1 (got %d)", d->discrete_weight);
+    if (fsdem__coupler_aperiodic("fsdem_pic_dem_desc", d->dem, "PIC", msg, size) != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     return fsdem__coupler_check(fsdem__pic_dem_class(), "fsdem_pic_dem_desc", d->pic, FSDEM_PIC_ARRAYS_SOLIDS, d->dem, pd.dim, pd.gravity,
                                 d->max_substeps, msg, size);
 }
@@ -19075,23 +19161,24 @@ fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t siz
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
     if (d->virtual_mass != 0 && d->virtual_mass != 1)
         return fsdem__reject(msg, size, "fsdem_gic_desc.virtual_mass must be 0 or 1 (got %d)", d->virtual_mass);
-    if (!(d->drag_scale > 0) || !fsdem__finite(d->drag_scale))
-        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_scale must be > 0 and finite (got %g)", (double)d->drag_scale);
+    if (!(d->drag_scale >= 1e-3 && d->drag_scale <= 1e3))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_scale must be in [1e-3, 1e3] (got %g)", (double)d->drag_scale);
     if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
         return fsdem__reject(msg, size, "fsdem_gic_desc.viscosity must be >= 0 m^2/s and finite (got %g)", (double)d->viscosity);
     if (d->drag != FSDEM_DRAG_LAW_GIC && d->viscosity == 0 && !(pd.viscosity > 0))
         return fsdem__reject(msg, size,
                              "fsdem_gic_desc.viscosity: the %s drag law needs a viscosity, and it is 0 here and in the (inviscid) PIC",
                              fsdem_drag_law_name(d->drag));
-    if (!(d->max_solid_fraction == 0 || (d->max_solid_fraction > 0 && d->max_solid_fraction < 1)))
-        return fsdem__reject(msg, size, "fsdem_gic_desc.max_solid_fraction must be 0 (densest packing) or in (0, 1) (got %g)",
+    if (!(d->max_solid_fraction == 0 || (d->max_solid_fraction >= 0.5 && d->max_solid_fraction < 1)))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.max_solid_fraction must be 0 (densest packing) or in [0.5, 1) (got %g)",
                              (double)d->max_solid_fraction);
-    if (!(d->cfl > 0) || !fsdem__finite(d->cfl))
-        return fsdem__reject(msg, size, "fsdem_gic_desc.cfl must be > 0 and finite (got %g)", (double)d->cfl);
+    if (!(d->cfl >= 0.01 && d->cfl <= 1))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.cfl must be in [0.01, 1] (got %g)", (double)d->cfl);
     if (!(d->max_dt_ratio >= 1) || !fsdem__finite(d->max_dt_ratio))
         return fsdem__reject(msg, size, "fsdem_gic_desc.max_dt_ratio must be >= 1 and finite (got %g)", (double)d->max_dt_ratio);
-    if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
-        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_dt_fraction must be in (0, 1] (got %g)", (double)d->drag_dt_fraction);
+    if (!(d->drag_dt_fraction >= 0.01 && d->drag_dt_fraction <= 1))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_dt_fraction must be in [0.01, 1] (got %g)", (double)d->drag_dt_fraction);
+    if (fsdem__coupler_aperiodic("fsdem_gic_desc", d->dem, "PIC", msg, size) != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     return fsdem__coupler_check(fsdem__gic_class(), "fsdem_gic_desc", d->pic, FSDEM_PIC_ARRAYS_POROSITY | FSDEM_PIC_ARRAYS_ACCELERATION, d->dem,
                                 pd.dim, pd.gravity, d->max_substeps, msg, size);
 }
@@ -19441,7 +19528,9 @@ static fsdem_result fsdem__gic_check(fsdem_coupler *head, fsdem_real dt, int cho
     fsdem_gic *c = (fsdem_gic *)(void *)head;
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     fsdem_result res = fsdem__coupler_substeps_within(head, dt);
-    if (res != FSDEM_OK || (res = fsdem__gic_granules_inside(c, &P, "fsdem_gic")) != FSDEM_OK) return res;
+    if (res != FSDEM_OK || (res = fsdem__gic_granules_inside(c, &P, "fsdem_gic")) != FSDEM_OK ||
+        (res = fsdem__coupler_particles_fit(head, c->grid.lo, c->grid.hi, "fsdem_gic")) != FSDEM_OK)
+        return res;
     if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
         return fsdem__fail(&head->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
     if (chosen) {
@@ -21285,7 +21374,7 @@ static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem
 
 /* A step of the list failed after something moved, with the message of couplers[from]: every
    coupler, fluid and DEM put back as kept, the prepare undone, the message (and a put-back that
-   failed, which cannot happen short of memory) to every coupler; passes `res` on. */
+   failed: out of memory, or a fluid with a gauge file open) to every coupler; passes `res` on. */
 static fsdem_result fsdem__coupled_put_back(fsdem_coupler *const *list, int n, int from, fsdem_result res) {
     char message[FSDEM__MESSAGE_SIZE];
     int k, lost = -1;

@@ -183,6 +183,47 @@ START_TEST(coupled_lists_are_checked) {
 }
 END_TEST
 
+/* Couplers stepped together take the step whole or not at all (>>couple_step): a sand bed (GIC) and
+   a disc (PIC-DEM) on one PIC, the disc leaving its DEM's domain in the substeps after the PIC has
+   stepped. Both couplers, the PIC and both DEMs are put back as they were (saved bytes and
+   statistics), both couplers carry the message, and with the disc back inside the step runs. */
+START_TEST(a_failed_coupled_step_puts_every_solver_back) {
+    const double dt = 1e-3;
+    fsdem_pic *pic = still_water(0.2, 0.01, 0.1);
+    fsdem_dem *sand = dem_over(pic, 2650, 1), *bodies = dem_over(pic, 1500, 0);
+    fsdem_gic *gic;
+    fsdem_pic_dem *body;
+    fsdem_coupler *list[2];
+    test_kept sand_before, sand_after, body_before, body_after;
+    add_bed(sand, 0.2, 0.02);
+    add_disc(bodies, 0.1, 0.06, 0.02, 0);
+    gic = gic_on(pic, sand);
+    body = pic_dem_on(pic, bodies);
+    list[0] = fsdem_gic_coupler(gic);
+    list[1] = fsdem_pic_dem_coupler(body);
+    ck_assert_int_eq(fsdem_coupled_step_dt(list, 2, (fsdem_real)dt), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_set_particle_state(bodies, 0, fsdem_v3((fsdem_real)(0.2 - 0.5 * dt), 0.06f, 0), fsdem_v3(1, 0, 0),
+                                                  fsdem_v3(0, 0, 0)),
+                     FSDEM_OK); /* at 1 m/s: out half-way through the step */
+    TEST_KEEP(fsdem_gic_save_memory, gic, fsdem_gic_get_stats(gic).coupling, &sand_before);
+    TEST_KEEP(fsdem_pic_dem_save_memory, body, fsdem_pic_dem_get_stats(body).coupling, &body_before);
+    ck_assert_int_eq(fsdem_coupled_step_dt(list, 2, (fsdem_real)dt), FSDEM_ERR_OUT_OF_DOMAIN);
+    ck_assert_msg(strstr(fsdem_gic_last_error(gic), "DEM substeps") && strstr(fsdem_pic_dem_last_error(body), "DEM substeps"), "%s",
+                  fsdem_gic_last_error(gic));
+    TEST_KEEP(fsdem_gic_save_memory, gic, fsdem_gic_get_stats(gic).coupling, &sand_after);
+    TEST_KEEP(fsdem_pic_dem_save_memory, body, fsdem_pic_dem_get_stats(body).coupling, &body_after);
+    test_kept_same(&sand_before, &sand_after, "the sand bed's coupler");
+    test_kept_same(&body_before, &body_after, "the disc's coupler");
+    ck_assert_int_eq(fsdem_dem_set_particle_state(bodies, 0, fsdem_v3(0.1f, 0.06f, 0), fsdem_v3(0, 0, 0), fsdem_v3(0, 0, 0)), FSDEM_OK);
+    ck_assert_msg(fsdem_coupled_step_dt(list, 2, (fsdem_real)dt) == FSDEM_OK, "%s", fsdem_gic_last_error(gic));
+    fsdem_pic_dem_destroy(body);
+    fsdem_gic_destroy(gic);
+    fsdem_dem_destroy(sand);
+    fsdem_dem_destroy(bodies);
+    fsdem_pic_destroy(pic);
+}
+END_TEST
+
 /* One PIC serves a sand bed and a body at once: a fixed bed of granules (GIC: the water keeps the
    porosity alpha_f' the bed leaves it) under still water, and a disc of the water's density above
    it (PIC-DEM, the well-balanced weight), stepped together. The discrete hydrostatic state is exact
@@ -269,6 +310,7 @@ Suite *couple_suite(void) {
     tcase_add_test(tc, claims_name_the_holder);
     tcase_add_test(tc, couplers_claim_what_they_write);
     tcase_add_test(tc, coupled_lists_are_checked);
+    tcase_add_test(tc, a_failed_coupled_step_puts_every_solver_back);
     tcase_add_test(tc, one_pic_serves_a_sand_bed_and_a_body);
     suite_add_tcase(s, tc);
     return s;

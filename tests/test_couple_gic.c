@@ -323,7 +323,31 @@ START_TEST(test_gic_restart_bit_for_bit) {
 }
 END_TEST
 
-/* Bad input: each desc field named, NULL objects, refused steps that change nothing. */
+/* Issue 34 rows 2-3: a dt of 1 s ran all 20,000 sand substeps before the PIC refused it, and then
+   returned with both moved. It is refused before anything moves (the cost bound: the substeps do
+   not run), and coupler, PIC and DEM are as they were, with a granule or none: the PIC refuses it
+   (water falling freely would cross 490 cells in the step). */
+START_TEST(test_gic_long_dt_is_refused_before_the_substeps) {
+    int granules;
+    for (granules = 0; granules < 2; ++granules) {
+        gic_tank t = make_gic(2, 0.1, 0.01, 0.05, 2650);
+        test_kept before, after;
+        fsdem_result res;
+        if (granules) add_granule(&t, fsdem_v3((fsdem_real)0.05, (fsdem_real)0.02, 0), 0.001, 0, fsdem_v3(0, 0, 0));
+        ck_assert_int_eq(fsdem_gic_step(t.gic), FSDEM_OK);
+        TEST_KEEP(fsdem_gic_save_memory, t.gic, fsdem_gic_get_stats(t.gic).coupling, &before);
+        res = fsdem_gic_step_dt(t.gic, 1);
+        ck_assert_int_eq(res, FSDEM_ERR_CFL);
+        ck_assert_msg(strstr(fsdem_gic_last_error(t.gic), "cfl_max") != NULL, "%s", fsdem_gic_last_error(t.gic));
+        TEST_KEEP(fsdem_gic_save_memory, t.gic, fsdem_gic_get_stats(t.gic).coupling, &after);
+        ck_assert_msg(after.stats.substeps_total == before.stats.substeps_total, "%lld substeps ran",
+                      after.stats.substeps_total - before.stats.substeps_total);
+        test_kept_same(&before, &after, "GIC, dt = 1 s");
+        free_gic(&t);
+    }
+}
+END_TEST
+
 /* A step that fails once something moved (>>couple_step): a granule that leaves the PIC's grid in
    the sand substeps (the DEM's domain reaches beyond it), found by the volume fractions that follow.
    Coupler, PIC and DEM are put back as they were (saved bytes and statistics), and with the granule
@@ -372,6 +396,7 @@ START_TEST(test_gic_failure_after_moving_puts_everything_back) {
 }
 END_TEST
 
+/* Bad input: each desc field named, NULL objects, refused steps that change nothing. */
 START_TEST(test_gic_bad_input) {
     gic_tank t = make_gic(2, 0.1, 0.01, 0.05, 2500);
     fsdem_gic_desc d = fsdem_gic_desc_default();
@@ -386,7 +411,9 @@ START_TEST(test_gic_bad_input) {
         double value;
     } bad[] = {{"drag_scale", 0, 0}, {"drag_scale", 0, NAN}, {"viscosity", 1, -1}, {"max_solid_fraction", 2, 1},
                {"cfl", 3, 0}, {"max_dt_ratio", 4, 0.5}, {"drag_dt_fraction", 5, 1.5}, {"max_substeps", 6, 0},
-               {"virtual_mass", 7, 2}};
+               {"virtual_mass", 7, 2},
+               /* issue 34: accepted at create, the first step then failed with another message */
+               {"drag_scale", 0, 1e300}, {"max_solid_fraction", 2, 1e-300}, {"cfl", 3, 1e-300}, {"drag_dt_fraction", 5, 1e-300}};
     ck_assert_int_eq(fsdem_gic_desc_check(NULL, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_msg(strstr(msg, ".pic and .dem") != NULL, "%s", msg);
@@ -489,6 +516,7 @@ Suite *couple_gic_suite(void) {
     tcase_add_test(tc, test_gic_virtual_mass_inertia);
     tcase_add_test(tc, test_gic_restart_bit_for_bit);
     tcase_add_test(tc, test_gic_bad_input);
+    tcase_add_test(tc, test_gic_long_dt_is_refused_before_the_substeps);
     tcase_add_test(tc, test_gic_failure_after_moving_puts_everything_back);
     suite_add_tcase(s, tc);
     return s;

@@ -626,6 +626,23 @@ START_TEST(test_mps_dem_failure_after_moving_puts_everything_back) {
 }
 END_TEST
 
+/* Issue 34 row 1: a dt of 1 s on a small scene moved the MPS to t = 1 s, left the DEM at 0 and
+   returned an error. It is refused, and coupler, MPS and DEM are as they were. */
+START_TEST(test_mps_dem_long_dt_changes_nothing) {
+    const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3(0.08f, 0.08f, 0.08f);
+    test_pair t = test_pair_new(3, 0.01, FSDEM_MPS_MODEL_B, 1e-6, lo, hi, 0.06, 2500);
+    test_kept before, after;
+    test_add_sphere(&t, fsdem_v3(0.04f, 0.04f, 0.03f), fsdem_v3(0, 0, 0), 0.002);
+    ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK);
+    TEST_KEEP(fsdem_mps_dem_save_memory, t.cpl, fsdem_mps_dem_get_stats(t.cpl).coupling, &before);
+    ck_assert_int_ne(fsdem_mps_dem_step_dt(t.cpl, 1), FSDEM_OK);
+    TEST_REPORT("MPS-DEM dt = 1 s: %s", fsdem_mps_dem_last_error(t.cpl));
+    TEST_KEEP(fsdem_mps_dem_save_memory, t.cpl, fsdem_mps_dem_get_stats(t.cpl).coupling, &after);
+    test_kept_same(&before, &after, "MPS-DEM, dt = 1 s");
+    test_pair_free(&t);
+}
+END_TEST
+
 /* Bad input: a desc without solvers, mismatched dims or gravity, bad ranges; the message names the
    field and nothing is created. */
 START_TEST(test_mps_dem_bad_input) {
@@ -813,6 +830,7 @@ Suite *couple_mps_suite(void) {
     tcase_add_test(tc, test_mps_dem_periodic_exchange);
     tcase_add_test(tc, test_mps_dem_refused_step_changes_nothing);
     tcase_add_test(tc, test_mps_dem_failure_after_moving_puts_everything_back);
+    tcase_add_test(tc, test_mps_dem_long_dt_changes_nothing);
     tcase_add_test(tc, test_mps_dem_bad_input);
     tcase_add_test(tc, test_mps_dem_csv_rows_are_the_force_records);
     tcase_add_test(tc, test_mps_dem_failed_update_keeps_its_records);

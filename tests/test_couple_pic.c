@@ -748,6 +748,25 @@ START_TEST(failure_after_moving_puts_everything_back) {
 }
 END_TEST
 
+/* Issue 34 row 1: a dt of 1 s on a small scene moved the PIC to t = 1 s, left the DEM at 0 and
+   returned an error. It is refused before anything moves (the PIC's limit: water falling freely
+   would cross 490 cells), and coupler, PIC and DEM are as they were. */
+START_TEST(long_dt_changes_nothing) {
+    tank t = make_tank(2, 0.4, 0.3, 0, G, 0.01, fsdem_v3(0.2, 0.1, 0), 0.04, 2000, 0, fsdem_v3(0, 0, 0), 0);
+    pic_dem_snapshot before, after;
+    ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)1e-3), FSDEM_OK);
+    before = pic_dem_snapshot_take(&t);
+    ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, 1), FSDEM_ERR_CFL);
+    ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "cfl_max"));
+    after = pic_dem_snapshot_take(&t);
+    ck_assert_msg(after.size == before.size && memcmp(after.bytes, before.bytes, after.size) == 0, "the state changed");
+    ck_assert_msg(memcmp(&after.stats, &before.stats, sizeof after.stats) == 0, "the statistics changed");
+    free(before.bytes);
+    free(after.bytes);
+    free_tank(&t);
+}
+END_TEST
+
 /* fsdem_pic_dem_write_csv: the header alone before the first step (when fsdem_pic_dem_get_force has no
    record either), then one row per body of the last step, equal to its record and id (a disc held
    under water and a free one moving through it); a disc added since the step has no record and no row; an
@@ -804,6 +823,7 @@ Suite *couple_pic_suite(void) {
     tcase_add_test(tc, update_cuts_without_stepping);
     tcase_add_test(tc, refused_step_changes_nothing);
     tcase_add_test(tc, failure_after_moving_puts_everything_back);
+    tcase_add_test(tc, long_dt_changes_nothing);
     tcase_add_test(tc, contact_area_dissipation_is_eq_20);
     tcase_add_test(tc, bad_input_is_refused);
     tcase_add_test(tc, csv_rows_are_the_force_records);

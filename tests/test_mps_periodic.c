@@ -355,12 +355,39 @@ START_TEST(test_mps_open_bad_input) {
     out.position = 0.38f; /* its zone would end at 0.43 m > domain_max.x */
     ck_assert_int_eq(fsdem_mps_add_outflow(m, &out), FSDEM_ERR_INVALID_ARG);
     ck_assert(strstr(fsdem_mps_last_error(m), "fsdem_mps_outflow_desc.position"));
+    /* issue 34: an inlet of +-1e300 m overflowed the lattice count; the same plane twice, or a plane
+       in the liquid, put particles on top of others; an outflow on the inflow plane or upstream of
+       it removed the liquid fed in */
+    in.axis = 0;
+    in.lo = fsdem_v3(0, (fsdem_real)(TEST_FLOAT ? -1e30 : -1e300), 0); /* float's range ends near 3e38 */
+    in.hi = fsdem_v3(0, (fsdem_real)(TEST_FLOAT ? 1e30 : 1e300), 0);
+    ck_assert_int_eq(fsdem_mps_add_inflow(m, &in, NULL), FSDEM_ERR_INVALID_ARG);
+    ck_assert(strstr(fsdem_mps_last_error(m), "fsdem_mps_inflow_desc.lo/hi"));
+    in.lo = fsdem_v3(0, 0, 0);
+    in.hi = fsdem_v3(0, 0.1f, 0);
+    ck_assert_int_eq(fsdem_mps_add_inflow(m, &in, NULL), FSDEM_ERR_INVALID_ARG); /* the channel's own inflow again */
+    ck_assert(strstr(fsdem_mps_last_error(m), "buffer zone"));
+    in.position = 0.15f; /* its buffer, 0.10 to 0.15 m, in the liquid */
+    ck_assert_int_eq(fsdem_mps_add_inflow(m, &in, NULL), FSDEM_ERR_INVALID_ARG);
+    ck_assert(strstr(fsdem_mps_last_error(m), "buffer zone"));
+    out.position = 0; /* on the inflow plane */
+    ck_assert_int_eq(fsdem_mps_add_outflow(m, &out), FSDEM_ERR_INVALID_ARG);
+    ck_assert(strstr(fsdem_mps_last_error(m), "not downstream"));
+    out.position = -0.02f; /* upstream of it */
+    ck_assert_int_eq(fsdem_mps_add_outflow(m, &out), FSDEM_ERR_INVALID_ARG);
+    ck_assert(strstr(fsdem_mps_last_error(m), "not downstream"));
+    out.position = 0.2f; /* downstream, but facing back at the inflow */
+    out.direction = -1;
+    ck_assert_int_eq(fsdem_mps_add_outflow(m, &out), FSDEM_ERR_INVALID_ARG);
+    ck_assert(strstr(fsdem_mps_last_error(m), "not downstream"));
     ck_assert_int_eq(fsdem_mps_get_particles(m).count, n);
     ck_assert_int_eq(fsdem_mps_get_stats(m).inflow_planes, 1);
     ck_assert_int_eq(fsdem_mps_get_stats(m).outflow_planes, 1);
     {   /* a coupler cannot follow the particles open planes add and remove */
         fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+        fsdem_mps_desc md = fsdem_mps_desc_default(2);
         fsdem_dem *dem = NULL;
+        fsdem_mps_dem *c = NULL;
         fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
         char msg[256];
         dd.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
@@ -371,6 +398,22 @@ START_TEST(test_mps_open_bad_input) {
         cd.dem = dem;
         ck_assert_int_eq(fsdem_mps_dem_desc_check(&cd, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
         ck_assert(strstr(msg, "inflows or outflows"));
+        /* ... nor can open planes be added to an MPS a coupler holds, before its first step too */
+        fsdem_mps_destroy(m);
+        md.gravity = dd.gravity;
+        md.domain_min = dd.domain_min;
+        md.domain_max = dd.domain_max;
+        ck_assert_int_eq(fsdem_mps_create(&md, &m), FSDEM_OK);
+        cd.mps = m;
+        ck_assert_int_eq(fsdem_mps_dem_create(&cd, &c), FSDEM_OK);
+        in.position = 0;
+        ck_assert_int_eq(fsdem_mps_add_inflow(m, &in, NULL), FSDEM_ERR_INVALID_ARG);
+        ck_assert(strstr(fsdem_mps_last_error(m), "fsdem_mps_dem"));
+        out.direction = 1;
+        out.position = 0.3f;
+        ck_assert_int_eq(fsdem_mps_add_outflow(m, &out), FSDEM_ERR_INVALID_ARG);
+        ck_assert(strstr(fsdem_mps_last_error(m), "fsdem_mps_dem"));
+        fsdem_mps_dem_destroy(c);
         fsdem_dem_destroy(dem);
     }
     fsdem_mps_destroy(m);

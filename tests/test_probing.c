@@ -111,7 +111,8 @@ END_TEST
 
 /* A 2D water tank with one disc; `late`: then a step, two more discs added to the DEM, and the
    step that cuts them is the one that fails. The coupler's face and J arrays grew one by one (frees
-   of the wrong size), and the body records' failure left the step's result without a message. */
+   of the wrong size), and the body records' failure left the step's result without a message. The
+   refused step leaves the run as it was (issue 34), unless its put-back is what ran out of memory. */
 static int pic_dem_run(int late, long n) {
     sized h = {0, 0, 0, 0};
     log_capture log;
@@ -124,6 +125,7 @@ static int pic_dem_run(int late, long n) {
     fsdem_dem *dem = NULL;
     fsdem_pic_dem *c = NULL;
     fsdem_result res;
+    test_kept before, after;
     char message[512];
     log.last[0] = '\0';
     pd.cell_size = (fsdem_real)0.02;
@@ -157,9 +159,16 @@ static int pic_dem_run(int late, long n) {
         ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
         p.position = fsdem_v3(0.3f, 0.15f, 0);
         ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+        TEST_KEEP(fsdem_pic_dem_save_memory, c, fsdem_pic_dem_get_stats(c).coupling, &before);
         arm(&h, n);
         res = fsdem_pic_dem_step(c);
         snprintf(message, sizeof message, "%s", fsdem_pic_dem_last_error(c));
+        TEST_KEEP(fsdem_pic_dem_save_memory, c, fsdem_pic_dem_get_stats(c).coupling, &after);
+        if (res == FSDEM_OK || strstr(message, "could not be put back")) { /* taken; or the put-back itself ran out of memory */
+            free(before.bytes);
+            free(after.bytes);
+        } else
+            test_kept_same(&before, &after, "fsdem_pic_dem_step out of memory"); /* a refused step changes nothing (>>couple_step) */
     }
     fsdem_pic_dem_destroy(c);
     fsdem_dem_destroy(dem);
@@ -383,6 +392,99 @@ START_TEST(implausible_coupler_input_is_refused) {
 }
 END_TEST
 
+/* Issue 34, refused at the call that is wrong: a GIC or a PIC-DEM over a DEM periodic along x with
+   a PIC that has no periodic axes (accepted; the steps failed later), a viscosity preconditioner
+   the viscous stencil cannot take (refused as "= 6 is not a fsdem_precond"), a granule wider than
+   the PIC's domain (refused at the step, before anything moves, naming it). */
+START_TEST(mismatched_coupling_input_is_refused_where_given) {
+    fsdem_pic_desc pd = fsdem_pic_desc_default(2);
+    fsdem_dem_desc dd = fsdem_dem_desc_default(2);
+    fsdem_gic_desc gd = fsdem_gic_desc_default();
+    fsdem_pic_dem_desc cd = fsdem_pic_dem_desc_default();
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    fsdem_pic *pic = NULL;
+    fsdem_dem *dem = NULL;
+    fsdem_gic *g = NULL;
+    char msg[512];
+    double t0;
+    pd.cell_size = (fsdem_real)0.01;
+    pd.domain_max = fsdem_v3((fsdem_real)0.1, (fsdem_real)0.1, 0);
+    pd.viscosity_precond = FSDEM_PRECOND_AMG;
+    REFUSED(fsdem_pic_desc_check(&pd, msg, sizeof msg), msg, "AMG takes CSR matrices only");
+    pd.viscosity_precond = FSDEM_PRECOND_AUTO;
+    ck_assert_int_eq(fsdem_pic_create(&pd, &pic), FSDEM_OK);
+    dd.domain_max = pd.domain_max;
+    dd.gravity = pd.gravity;
+    dd.law = FSDEM_DEM_LAW_GIC;
+    dd.periodic[0] = 1;
+    ck_assert_int_eq(fsdem_dem_create(&dd, &dem), FSDEM_OK);
+    gd.pic = cd.pic = pic;
+    gd.dem = cd.dem = dem;
+    REFUSED(fsdem_gic_desc_check(&gd, msg, sizeof msg), msg, "periodic along x");
+    REFUSED(fsdem_pic_dem_desc_check(&cd, msg, sizeof msg), msg, "periodic along x");
+    fsdem_dem_destroy(dem);
+    dd.periodic[0] = 0;
+    dd.domain_min = fsdem_v3(-1, -1, 0);
+    dd.domain_max = fsdem_v3(1, 1, 0);
+    ck_assert_int_eq(fsdem_dem_create(&dd, &dem), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_add_material(dem, &m, NULL), FSDEM_OK);
+    p.position = fsdem_v3((fsdem_real)0.05, (fsdem_real)0.05, 0);
+    p.radius = (fsdem_real)0.06; /* 0.12 m across, in a 0.1 m domain */
+    ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+    gd.dem = dem;
+    ck_assert_int_eq(fsdem_gic_create(&gd, &g), FSDEM_OK);
+    t0 = fsdem_dem_time(dem);
+    REFUSED(fsdem_gic_step(g), fsdem_gic_last_error(g), "does not fit");
+    ck_assert(fsdem_dem_time(dem) == t0 && fsdem_pic_time(pic) == 0);
+    fsdem_gic_destroy(g);
+    fsdem_dem_destroy(dem);
+    fsdem_pic_destroy(pic);
+}
+END_TEST
+
+/* Issue 34: a symmetric matrix that is not positive definite given to AMG was refused as out of
+   memory; it is FSDEM_ERR_INVALID_ARG, said so, and the solver stays usable (the same object then
+   takes a positive definite matrix). */
+START_TEST(amg_refuses_an_indefinite_matrix_as_such) {
+    static const int start[4] = {0, 2, 5, 7}, col[7] = {0, 1, 0, 1, 2, 1, 2};
+    static const fsdem_real bad[7] = {2, -1, -1, -1, -1, -1, 2}, good[7] = {2, -1, -1, 2, -1, -1, 2};
+    fsdem_pcg_desc d = fsdem_pcg_desc_default();
+    fsdem_csr m;
+    fsdem_pcg *s = NULL;
+    d.preconditioner = FSDEM_PRECOND_AMG;
+    ck_assert_int_eq(fsdem_pcg_create(&d, &s), FSDEM_OK);
+    m.rows = 3;
+    m.row_start = start;
+    m.col = col;
+    m.val = bad;
+    REFUSED(fsdem_pcg_setup_csr(s, &m), fsdem_pcg_last_error(s), "not positive definite");
+    m.val = good;
+    ck_assert_int_eq(fsdem_pcg_setup_csr(s, &m), FSDEM_OK);
+    fsdem_pcg_destroy(s);
+}
+END_TEST
+
+/* Issue 34: fsdem_set_threads(10000) was taken on a two-core machine and the next 128^2 PIC did not
+   finish in a minute. Counts below 1 or above four per processor are refused and change nothing
+   (10000 is above the bound on any machine of fewer than 2,500 processors); without OpenMP there
+   is no thread to set, and any count from 1 is taken as doing nothing. */
+START_TEST(thread_counts_the_machine_cannot_run_are_refused) {
+    const int before = fsdem_threads();
+    ck_assert_int_eq(fsdem_set_threads(0), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_set_threads(-3), FSDEM_ERR_INVALID_ARG);
+#if defined(_OPENMP) && !defined(FSDEM_NO_OPENMP)
+    ck_assert_int_eq(fsdem_set_threads(10000), FSDEM_ERR_INVALID_ARG);
+    ck_assert_int_eq(fsdem_threads(), before);
+    ck_assert_int_eq(fsdem_set_threads(before), FSDEM_OK);
+#else
+    ck_assert_int_eq(fsdem_set_threads(10000), FSDEM_OK);
+    ck_assert_int_eq(fsdem_threads(), 1);
+#endif
+    ck_assert_int_eq(fsdem_threads(), before);
+}
+END_TEST
+
 /* ---- drag laws over their range ------------------------------------------------------------------ */
 
 /* Every law is finite from Re = 0 to the largest slip (FSDEM_MAX_SPEED) for grains of 1 um to
@@ -459,6 +561,9 @@ Suite *probing_suite(void) {
     tcase_add_test(tc, implausible_dem_input_is_refused);
     tcase_add_test(tc, implausible_pic_and_swe_input_is_refused);
     tcase_add_test(tc, implausible_coupler_input_is_refused);
+    tcase_add_test(tc, mismatched_coupling_input_is_refused_where_given);
+    tcase_add_test(tc, amg_refuses_an_indefinite_matrix_as_such);
+    tcase_add_test(tc, thread_counts_the_machine_cannot_run_are_refused);
     tcase_add_test(tc, drag_laws_are_finite_over_their_range);
     tcase_add_test(tc, beetstra_reaches_its_large_reynolds_limit);
     tcase_add_test(tc, dem_messages_name_the_function_called);

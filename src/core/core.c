@@ -42,15 +42,20 @@ static int fsdem__workers(void) { return omp_get_max_threads(); }
 /* threaded: inside a team: the calling thread's number and the team's size. */
 static int fsdem__worker(void) { return omp_get_thread_num(); }
 static int fsdem__team(void) { return omp_get_num_threads(); }
-void fsdem_set_threads(int count) {
-    if (count >= 1) omp_set_num_threads(count);
+/* More threads than four per processor cannot run at once, and each of the multigrid pipeline's
+   stages then waits for a time slice (issue 34: 10000 threads on two cores stalled a 128^2 PIC). */
+fsdem_result fsdem_set_threads(int count) {
+    const int most = omp_get_num_procs() > 1 ? 4 * omp_get_num_procs() : 4;
+    if (count < 1 || count > most || count > omp_get_thread_limit()) return FSDEM_ERR_INVALID_ARG;
+    omp_set_num_threads(count);
+    return FSDEM_OK;
 }
 #else
 #define FSDEM__OMP(x)
 static int fsdem__workers(void) { return 1; }
 static int fsdem__worker(void) { return 0; }
 static int fsdem__team(void) { return 1; }
-void fsdem_set_threads(int count) { (void)count; }
+fsdem_result fsdem_set_threads(int count) { return count >= 1 ? FSDEM_OK : FSDEM_ERR_INVALID_ARG; }
 #endif
 int fsdem_threads(void) { return fsdem__workers(); }
 

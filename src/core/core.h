@@ -68,9 +68,12 @@ typedef struct fsdem_allocator {
 /* Threads. Built with OpenMP (-fopenmp), the solvers run their loops on the calling thread's OpenMP
    team, and every result is the same bit for bit at any thread count and as in a build without
    OpenMP (>>doc THREADS). The count is OpenMP's own (OMP_NUM_THREADS, omp_set_num_threads):
-   fsdem_set_threads(n >= 1) sets it for the calling thread, fsdem_threads() reads it. Without OpenMP
-   no thread is created, fsdem_set_threads does nothing and fsdem_threads() is 1. */
-FSDEM_API void fsdem_set_threads(int count);
+   fsdem_set_threads(n) sets it for the calling thread, fsdem_threads() reads it. n from 1 to four
+   per processor (omp_get_num_procs(), at least 4): FSDEM_ERR_INVALID_ARG otherwise, the count
+   unchanged (more threads than that cannot run at once and only wait at the solvers' barriers;
+   OMP_NUM_THREADS is OpenMP's and not checked). Without OpenMP no thread is created,
+   fsdem_set_threads does nothing (n >= 1 is still required) and fsdem_threads() is 1. */
+FSDEM_API fsdem_result fsdem_set_threads(int count);
 FSDEM_API int fsdem_threads(void);
 
 /* Who writes a solver's coupling arrays. A coupler claims the arrays it writes when it is created

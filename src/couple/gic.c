@@ -62,23 +62,24 @@ fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t siz
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
     if (d->virtual_mass != 0 && d->virtual_mass != 1)
         return fsdem__reject(msg, size, "fsdem_gic_desc.virtual_mass must be 0 or 1 (got %d)", d->virtual_mass);
-    if (!(d->drag_scale > 0) || !fsdem__finite(d->drag_scale))
-        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_scale must be > 0 and finite (got %g)", (double)d->drag_scale);
+    if (!(d->drag_scale >= 1e-3 && d->drag_scale <= 1e3))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_scale must be in [1e-3, 1e3] (got %g)", (double)d->drag_scale);
     if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
         return fsdem__reject(msg, size, "fsdem_gic_desc.viscosity must be >= 0 m^2/s and finite (got %g)", (double)d->viscosity);
     if (d->drag != FSDEM_DRAG_LAW_GIC && d->viscosity == 0 && !(pd.viscosity > 0))
         return fsdem__reject(msg, size,
                              "fsdem_gic_desc.viscosity: the %s drag law needs a viscosity, and it is 0 here and in the (inviscid) PIC",
                              fsdem_drag_law_name(d->drag));
-    if (!(d->max_solid_fraction == 0 || (d->max_solid_fraction > 0 && d->max_solid_fraction < 1)))
-        return fsdem__reject(msg, size, "fsdem_gic_desc.max_solid_fraction must be 0 (densest packing) or in (0, 1) (got %g)",
+    if (!(d->max_solid_fraction == 0 || (d->max_solid_fraction >= 0.5 && d->max_solid_fraction < 1)))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.max_solid_fraction must be 0 (densest packing) or in [0.5, 1) (got %g)",
                              (double)d->max_solid_fraction);
-    if (!(d->cfl > 0) || !fsdem__finite(d->cfl))
-        return fsdem__reject(msg, size, "fsdem_gic_desc.cfl must be > 0 and finite (got %g)", (double)d->cfl);
+    if (!(d->cfl >= 0.01 && d->cfl <= 1))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.cfl must be in [0.01, 1] (got %g)", (double)d->cfl);
     if (!(d->max_dt_ratio >= 1) || !fsdem__finite(d->max_dt_ratio))
         return fsdem__reject(msg, size, "fsdem_gic_desc.max_dt_ratio must be >= 1 and finite (got %g)", (double)d->max_dt_ratio);
-    if (!(d->drag_dt_fraction > 0 && d->drag_dt_fraction <= 1))
-        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_dt_fraction must be in (0, 1] (got %g)", (double)d->drag_dt_fraction);
+    if (!(d->drag_dt_fraction >= 0.01 && d->drag_dt_fraction <= 1))
+        return fsdem__reject(msg, size, "fsdem_gic_desc.drag_dt_fraction must be in [0.01, 1] (got %g)", (double)d->drag_dt_fraction);
+    if (fsdem__coupler_aperiodic("fsdem_gic_desc", d->dem, "PIC", msg, size) != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     return fsdem__coupler_check(fsdem__gic_class(), "fsdem_gic_desc", d->pic, FSDEM_PIC_ARRAYS_POROSITY | FSDEM_PIC_ARRAYS_ACCELERATION, d->dem,
                                 pd.dim, pd.gravity, d->max_substeps, msg, size);
 }
@@ -428,7 +429,9 @@ static fsdem_result fsdem__gic_check(fsdem_coupler *head, fsdem_real dt, int cho
     fsdem_gic *c = (fsdem_gic *)(void *)head;
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     fsdem_result res = fsdem__coupler_substeps_within(head, dt);
-    if (res != FSDEM_OK || (res = fsdem__gic_granules_inside(c, &P, "fsdem_gic")) != FSDEM_OK) return res;
+    if (res != FSDEM_OK || (res = fsdem__gic_granules_inside(c, &P, "fsdem_gic")) != FSDEM_OK ||
+        (res = fsdem__coupler_particles_fit(head, c->grid.lo, c->grid.hi, "fsdem_gic")) != FSDEM_OK)
+        return res;
     if ((res = fsdem_pic_check_dt(c->desc.pic, dt)) != FSDEM_OK)
         return fsdem__fail(&head->status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
     if (chosen) {

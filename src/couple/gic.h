@@ -64,19 +64,24 @@ typedef struct fsdem_gic_desc {
     fsdem_pic *pic;               /* water; not owned; must outlive the coupler */
     fsdem_dem *dem;               /* granules; same dim and gravity as the PIC; not owned */
     fsdem_drag_law drag;          /* default FSDEM_DRAG_LAW_GIC (seed 004 Eq. 5b) */
-    fsdem_real drag_scale;        /* -; factor on the law's coefficient, > 0; default 1 (0.1 with */
-                                  /*    the GIC law is the seed's mu = 0.044 of §6.1) */
+    fsdem_real drag_scale;        /* -; factor on the law's coefficient, in [1e-3, 1e3] (a */
+                                  /*    calibration, not another law); default 1 (0.1 with the */
+                                  /*    GIC law is the seed's mu = 0.044 of §6.1) */
     int virtual_mass;             /* 1: the granules' added mass, Eq. 14-17 (see step 1); default 0: */
                                   /*    explicit, it diverged in dense sand entering water at 1 m/s */
                                   /*    (validation/gic_volume); dilute granules take it well */
     fsdem_real viscosity;         /* m^2/s; kinematic viscosity the drag laws use, as the PIC's */
                                   /*    (all but the GIC law need one); 0: the PIC's; default 0 */
-    fsdem_real max_solid_fraction; /* -; cap of alpha_s in (0, 1); 0: 0.740 in 3D, 0.907 in 2D */
-                                  /*    (densest packings, §5.1); default 0 */
-    fsdem_real cfl;               /* -; Eq. 33: dt <= cfl dx / max |v_granule|, > 0; default 1 */
+    fsdem_real max_solid_fraction; /* -; cap of alpha_s in [0.5, 1) (below random loose */
+                                  /*    packing, 0.55, it would cap beds of touching granules); */
+                                  /*    0: 0.740 in 3D, 0.907 in 2D (densest packings, §5.1); */
+                                  /*    default 0 */
+    fsdem_real cfl;               /* -; Eq. 33: dt <= cfl dx / max |v_granule|, in [0.01, 1] (a */
+                                  /*    granule crosses at most one cell a step; below 0.01 the */
+                                  /*    step only shrinks); default 1 */
     fsdem_real max_dt_ratio;      /* -; Eq. 33: dt <= this x the DEM's dt, >= 1; default 1000 */
-    fsdem_real drag_dt_fraction;  /* -; dt <= this x the shortest drag relaxation time, in (0, 1]; */
-                                  /*    default 0.5 */
+    fsdem_real drag_dt_fraction;  /* -; dt <= this x the shortest drag relaxation time, in */
+                                  /*    [0.01, 1]; default 0.5 */
     long long max_substeps;       /* DEM substeps one coupled step may take; a longer step is */
                                   /*    refused before anything moves; default 100000 */
     fsdem_log_fn log;             /* optional; default NULL */

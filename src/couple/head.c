@@ -91,6 +91,17 @@ static fsdem_result fsdem__coupler_check(const fsdem__coupler_class *cls, const 
     return FSDEM_OK;
 }
 
+/* A DEM without periodic axes, for a fluid that has none (`desc` names the desc, `fluid` the fluid):
+   a particle that wraps around would jump across the fluid. */
+static fsdem_result fsdem__coupler_aperiodic(const char *desc, fsdem_dem *dem, const char *fluid, char *msg, size_t size) {
+    const fsdem_dem_desc dd = fsdem_dem_get_desc(dem);
+    int a;
+    for (a = 0; a < dd.dim; ++a)
+        if (dd.periodic[a])
+            return fsdem__reject(msg, size, "%s.dem is periodic along %c and the %s has no periodic axes", desc, "xyz"[a], fluid);
+    return FSDEM_OK;
+}
+
 /* A new coupler of `size` bytes whose desc check gave `checked` (and `why`): zeroed, its memory from
    the DEM's allocator, its head set, the DEM's loads and the fluid's `arrays` claimed. NULL, with
    *res and the reason logged, on failure. */

@@ -90,6 +90,7 @@ fsdem_result fsdem_pic_dem_desc_check(const fsdem_pic_dem_desc *d, char *msg, si
                              (double)d->viscous_dt_fraction);
     if (d->discrete_weight != 0 && d->discrete_weight != 1)
         return fsdem__reject(msg, size, "fsdem_pic_dem_desc.discrete_weight must be 0 or 1 (got %d)", d->discrete_weight);
+    if (fsdem__coupler_aperiodic("fsdem_pic_dem_desc", d->dem, "PIC", msg, size) != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     return fsdem__coupler_check(fsdem__pic_dem_class(), "fsdem_pic_dem_desc", d->pic, FSDEM_PIC_ARRAYS_SOLIDS, d->dem, pd.dim, pd.gravity,
                                 d->max_substeps, msg, size);
 }

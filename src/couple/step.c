@@ -30,7 +30,7 @@ static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem
 
 /* A step of the list failed after something moved, with the message of couplers[from]: every
    coupler, fluid and DEM put back as kept, the prepare undone, the message (and a put-back that
-   failed, which cannot happen short of memory) to every coupler; passes `res` on. */
+   failed: out of memory, or a fluid with a gauge file open) to every coupler; passes `res` on. */
 static fsdem_result fsdem__coupled_put_back(fsdem_coupler *const *list, int n, int from, fsdem_result res) {
     char message[FSDEM__MESSAGE_SIZE];
     int k, lost = -1;

@@ -284,9 +284,9 @@ static int fsdem__amg_prolongation(const fsdem_allocator *al, fsdem__amg *g, fsd
     return fsdem__amg_transpose(al, g, L);
 }
 
-/* Level vectors and 1/a_ii of level L (its A set). Returns 0 on an allocation failure or a
-   non-positive diagonal (not positive definite). */
-static int fsdem__amg_level_arrays(const fsdem_allocator *al, fsdem__amg *g, fsdem__amg_level *L) {
+/* Level vectors and 1/a_ii of level L (its A set). Returns 0 on an allocation failure, and on a
+   non-positive diagonal (the matrix is not positive definite) sets *indefinite too. */
+static int fsdem__amg_level_arrays(const fsdem_allocator *al, fsdem__amg *g, fsdem__amg_level *L, int *indefinite) {
     int i, e;
     L->inv_diag = (fsdem_real *)fsdem__amg_array(al, g, (size_t)L->n, sizeof(fsdem_real));
     L->x = (fsdem_real *)fsdem__amg_array(al, g, (size_t)L->n, sizeof(fsdem_real));
@@ -297,7 +297,7 @@ static int fsdem__amg_level_arrays(const fsdem_allocator *al, fsdem__amg *g, fsd
         L->inv_diag[i] = 0;
         for (e = L->a_start[i]; e < L->a_start[i + 1]; ++e)
             if (L->a_col[e] == i && L->a_val[e] > 0) L->inv_diag[i] = 1 / L->a_val[e];
-        if (!(L->inv_diag[i] > 0)) return 0;
+        if (!(L->inv_diag[i] > 0)) return !(*indefinite = 1);
     }
     return 1;
 }
@@ -327,15 +327,16 @@ static int fsdem__amg_factor(const fsdem_allocator *al, fsdem__amg *g, const fsd
     return 1;
 }
 
-/* Builds the hierarchy of matrix m into a new object (*out); NULL and 0 on failure (out of
-   memory, or a diagonal entry that is not positive). */
-static int fsdem__amg_build(const fsdem_allocator *al, const fsdem_pcg_desc *desc, const fsdem_csr *m, fsdem__amg **out) {
+/* Builds the hierarchy of matrix m into a new object (*out); on failure *out is NULL and the result
+   FSDEM_ERR_INVALID_ARG when a level's diagonal entry is not positive (m is not positive definite),
+   FSDEM_ERR_OUT_OF_MEMORY otherwise. */
+static fsdem_result fsdem__amg_build(const fsdem_allocator *al, const fsdem_pcg_desc *desc, const fsdem_csr *m, fsdem__amg **out) {
     fsdem__amg *g = (fsdem__amg *)fsdem__alloc(al, sizeof *g);
     fsdem__amg_work wk;
     const size_t n = (size_t)m->rows;
-    int ok, l;
+    int ok, l, indefinite = 0;
     *out = NULL;
-    if (!g) return 0;
+    if (!g) return FSDEM_ERR_OUT_OF_MEMORY;
     memset(g, 0, sizeof *g);
     g->bytes = sizeof *g;
     wk.mark = (int *)fsdem__alloc(al, sizeof(int) * n);
@@ -354,7 +355,7 @@ static int fsdem__amg_build(const fsdem_allocator *al, const fsdem_pcg_desc *des
         g->lv[0].a_start = m->row_start;
         g->lv[0].a_col = m->col;
         g->lv[0].a_val = m->val;
-        ok = fsdem__amg_level_arrays(al, g, &g->lv[0]);
+        ok = fsdem__amg_level_arrays(al, g, &g->lv[0], &indefinite);
     }
     for (l = 0; ok; ++l) {
         fsdem__amg_level *L = &g->lv[l], *C;
@@ -384,7 +385,7 @@ static int fsdem__amg_build(const fsdem_allocator *al, const fsdem_pcg_desc *des
         C->a_start = C->own_start;
         C->a_col = C->own_col;
         C->a_val = C->own_val;
-        if (ok) ok = fsdem__amg_level_arrays(al, g, C);
+        if (ok) ok = fsdem__amg_level_arrays(al, g, C, &indefinite);
     }
     if (ok) {
         const fsdem__amg_level *last = &g->lv[g->levels - 1];
@@ -399,10 +400,10 @@ static int fsdem__amg_build(const fsdem_allocator *al, const fsdem_pcg_desc *des
     fsdem__free(al, wk.w, sizeof(fsdem_real) * n);
     if (!ok) {
         fsdem__amg_free(al, g);
-        return 0;
+        return indefinite ? FSDEM_ERR_INVALID_ARG : FSDEM_ERR_OUT_OF_MEMORY;
     }
     *out = g;
-    return 1;
+    return FSDEM_OK;
 }
 
 /* Gauss-Seidel sweeps on level L, forward or backward. */

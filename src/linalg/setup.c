@@ -247,10 +247,11 @@ static fsdem_result fsdem__pcg_setup_csr_valid(fsdem_pcg *s, const fsdem_csr *m)
     for (i = 0; i < m->rows; ++i)
         for (e = m->row_start[i]; e < m->row_start[i + 1]; ++e)
             if (m->col[e] >= i) upper++;
-    if (pc == FSDEM_PRECOND_AMG && !fsdem__amg_build(&s->allocator, &s->desc, m, &amg))
-        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY,
-                           "fsdem_pcg_setup_csr: out of memory building the AMG hierarchy of %d rows (or a diagonal entry "
-                           "is not positive)",
+    if (pc == FSDEM_PRECOND_AMG && (res = fsdem__amg_build(&s->allocator, &s->desc, m, &amg)) != FSDEM_OK)
+        return fsdem__fail(&s->status, res,
+                           res == FSDEM_ERR_INVALID_ARG ? "fsdem_pcg_setup_csr: the matrix of %d rows is not positive definite (a diagonal "
+                                                          "entry of it or of a coarse AMG level is not positive)"
+                                                        : "fsdem_pcg_setup_csr: out of memory building the AMG hierarchy of %d rows",
                            m->rows);
     {
         fsdem_pcg probe = *s;

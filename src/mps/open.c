@@ -42,6 +42,53 @@ static fsdem_result fsdem__mps_check_open(fsdem_mps *s, const char *what, int ax
     return fsdem__mps_check_box(s, field, f, t);
 }
 
+/* An MPS that can take an open boundary: no coupler claims its arrays, and none was handed them. */
+static fsdem_result fsdem__mps_open_allowed(fsdem_mps *s, const char *fn) {
+    const char *holder = fsdem_claimant(&s->claims, FSDEM_MPS_ARRAYS_FORCE | FSDEM_MPS_ARRAYS_POROSITY);
+    if (holder || s->external)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: the MPS is coupled (%s): open boundaries need an MPS without a coupler",
+                           fn, holder ? holder : "its coupling arrays were handed out");
+    return FSDEM_OK;
+}
+
+/* An inflow's buffer zone (from-to) inside the domain and free of particles: a buffer over liquid,
+   over walls or over another buffer would place particles on top of others. */
+static fsdem_result fsdem__mps_zone_free(fsdem_mps *s, fsdem_vec3 from, fsdem_vec3 to) {
+    int i, a, inside;
+    for (a = 0; a < s->dim; ++a)
+        if (!(fsdem__comp(from, a) >= fsdem__comp(s->desc.domain_min, a) && fsdem__comp(to, a) <= fsdem__comp(s->desc.domain_max, a)))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                               "fsdem_mps_inflow_desc.lo/hi: the buffer zone from %g to %g m along %c must lie inside the domain (%g to %g m)",
+                               (double)fsdem__comp(from, a), (double)fsdem__comp(to, a), "xyz"[a], (double)fsdem__comp(s->desc.domain_min, a),
+                               (double)fsdem__comp(s->desc.domain_max, a));
+    for (i = 0; i < s->n; ++i) {
+        for (a = 0, inside = 1; a < s->dim && inside; ++a)
+            inside = fsdem__comp(s->x[i], a) > fsdem__comp(from, a) && fsdem__comp(s->x[i], a) < fsdem__comp(to, a);
+        if (inside)
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                               "fsdem_mps_inflow_desc: the buffer zone from (%g, %g, %g) to (%g, %g, %g) m holds particle %d at (%g, %g, %g) m: "
+                               "it must be free (not in the liquid, the walls or another inflow's buffer)",
+                               (double)from.x, (double)from.y, (double)from.z, (double)to.x, (double)to.y, (double)to.z, i,
+                               (double)s->x[i].x, (double)s->x[i].y, (double)s->x[i].z);
+    }
+    return FSDEM_OK;
+}
+
+/* An inflow and an outflow across the same stream (one axis, extents that overlap over the
+   others): the outflow must face the same way and lie downstream of the inflow's plane, else it
+   removes the liquid the inflow feeds. */
+static fsdem_result fsdem__mps_open_ordered(fsdem_mps *s, const fsdem_mps_inflow_desc *in, const fsdem_mps_outflow_desc *out) {
+    int a, across = in->axis == out->axis;
+    for (a = 0; a < s->dim && across; ++a)
+        across = a == in->axis || (fsdem__comp(in->lo, a) < fsdem__comp(out->hi, a) && fsdem__comp(out->lo, a) < fsdem__comp(in->hi, a));
+    if (across && (in->direction != out->direction || !((out->position - in->position) * (fsdem_real)in->direction > 0)))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_mps: the outflow at %c = %g m (direction %+d) is not downstream of the inflow at %c = %g m (direction %+d) "
+                           "across the same stream",
+                           "xyz"[out->axis], (double)out->position, out->direction, "xyz"[in->axis], (double)in->position, in->direction);
+    return FSDEM_OK;
+}
+
 fsdem_mps_inflow_desc fsdem_mps_inflow_desc_default(void) {
     fsdem_mps_inflow_desc d;
     memset(&d, 0, sizeof d);
@@ -63,13 +110,16 @@ fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in,
     if (added) *added = 0;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!in) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_inflow: inflow is NULL");
-    if (s->external) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_inflow: the MPS is coupled");
+    if ((r = fsdem__mps_open_allowed(s, "fsdem_mps_add_inflow")) != FSDEM_OK) return r;
     if ((r = fsdem__mps_check_open(s, "fsdem_mps_inflow_desc", in->axis, in->direction, in->position, 1, in->lo, in->hi, &anchor,
                                    &from, &to)) != FSDEM_OK)
         return r;
     if (!(in->speed > 0 && in->speed <= FSDEM_MAX_SPEED))
         return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_inflow_desc.speed = %g m/s must be in (0, FSDEM_MAX_SPEED]",
                            (double)in->speed);
+    if ((r = fsdem__mps_zone_free(s, from, to)) != FSDEM_OK) return r;
+    for (i = 0; i < s->outflow_n; ++i)
+        if ((r = fsdem__mps_open_ordered(s, in, &s->outflows[i])) != FSDEM_OK) return r;
     fsdem__set_comp(&u, in->axis, in->speed * (fsdem_real)in->direction);
     if (!fsdem__mps_list_room(s, (void **)&s->inflows, &s->inflow_cap, s->inflow_n, sizeof *s->inflows))
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_inflow: out of memory");
@@ -85,12 +135,15 @@ fsdem_result fsdem_mps_add_inflow(fsdem_mps *s, const fsdem_mps_inflow_desc *in,
 
 fsdem_result fsdem_mps_add_outflow(fsdem_mps *s, const fsdem_mps_outflow_desc *out) {
     fsdem_result r;
+    int k;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (!out) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_outflow: outflow is NULL");
-    if (s->external) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_add_outflow: the MPS is coupled");
+    if ((r = fsdem__mps_open_allowed(s, "fsdem_mps_add_outflow")) != FSDEM_OK) return r;
     if ((r = fsdem__mps_check_open(s, "fsdem_mps_outflow_desc", out->axis, out->direction, out->position, 0, out->lo, out->hi, NULL,
                                    NULL, NULL)) != FSDEM_OK)
         return r;
+    for (k = 0; k < s->inflow_n; ++k)
+        if ((r = fsdem__mps_open_ordered(s, &s->inflows[k], out)) != FSDEM_OK) return r;
     if (!fsdem__mps_list_room(s, (void **)&s->outflows, &s->outflow_cap, s->outflow_n, sizeof *s->outflows))
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_add_outflow: out of memory");
     s->outflows[s->outflow_n++] = *out;

@@ -115,10 +115,12 @@ static fsdem_result fsdem__mps_lattice_fill(fsdem_mps *s, const char *fn, fsdem_
     if (added) *added = 0;
     for (a = 0; a < 3; ++a) {
         const double l = (double)fsdem__comp(lo, a), r0 = (double)s->r0;
-        i0[a] = a < s->dim ? (int)ceil(((double)fsdem__comp(from, a) - l) / r0 - 0.5 - 1e-9) : 0;
-        i1[a] = a < s->dim ? (int)floor(((double)fsdem__comp(to, a) - l) / r0 - 0.5 + 1e-9) : 0;
-        if (a < s->dim && (double)(i1[a] - i0[a]) > 1e7)
+        const double first = ceil(((double)fsdem__comp(from, a) - l) / r0 - 0.5 - 1e-9), last = floor(((double)fsdem__comp(to, a) - l) / r0 - 0.5 + 1e-9);
+        /* bounded before the conversion to int, which would overflow first */
+        if (a < s->dim && !(last - first <= 1e7 && fabs(first) <= 1e9 && fabs(last) <= 1e9))
             return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "%s: the box holds too many lattice points", fn);
+        i0[a] = a < s->dim ? (int)first : 0;
+        i1[a] = a < s->dim ? (int)last : 0;
     }
     for (pass = 0; pass < 2; ++pass) {
         int i, j, k, c = 0;

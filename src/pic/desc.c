@@ -137,7 +137,8 @@ static fsdem_result fsdem__pic_check(const fsdem_pic_desc *d, char *msg, size_t 
         FSDEM__PIC_BAD("fsdem_pic_desc.pressure_precond = %d must be a fsdem_precond for a stencil (AUTO, NONE, JACOBI, IC0, "
                        "MIC0, MG)", (int)d->pressure_precond);
     if ((int)d->viscosity_precond < 0 || (int)d->viscosity_precond > 5)
-        FSDEM__PIC_BAD("fsdem_pic_desc.viscosity_precond = %d is not a fsdem_precond", (int)d->viscosity_precond);
+        FSDEM__PIC_BAD("fsdem_pic_desc.viscosity_precond = %d must be a fsdem_precond for a stencil (AUTO, NONE, JACOBI, IC0, "
+                       "MIC0, MG; AMG takes CSR matrices only)", (int)d->viscosity_precond);
     if (!(d->pressure_tolerance > 0 && d->pressure_tolerance < 1))
         FSDEM__PIC_BAD("fsdem_pic_desc.pressure_tolerance = %g must be in (0, 1)", (double)d->pressure_tolerance);
     if (!(d->viscosity_tolerance > 0 && d->viscosity_tolerance < 1))

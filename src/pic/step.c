@@ -169,15 +169,17 @@ fsdem_result fsdem_pic_check_dt(const fsdem_pic *s, fsdem_real dt) {
     umax = fsdem__pic_umax(s, &who);
     if (!fsdem__finite(umax))
         return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_pic: particle %d has a non-finite velocity", who);
-    cfl = umax * dt * s->inv_dx;
+    cfl = (umax + s->gmag * dt) * dt * s->inv_dx; /* gravity's share: liquid falling freely over the step */
     if (cfl > s->desc.cfl_max) {
-        if (who >= 0)
-            return fsdem__fail(st, FSDEM_ERR_CFL,
-                               "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (particle %d at %g m/s; dt <= %g s)", (double)dt,
-                               (double)cfl, (double)s->desc.cfl_max, who, (double)umax,
-                               (double)(s->desc.cfl_max * s->dx / umax));
-        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s side velocity %g m/s)",
-                           (double)dt, (double)cfl, (double)s->desc.cfl_max, fsdem__pic_side_name(-2 - who), (double)umax);
+        /* the longest dt allowed: the root of |g| dt^2 + u_max dt = cfl_max dx */
+        const double c = (double)(s->desc.cfl_max * s->dx), u = (double)umax, g = (double)s->gmag;
+        const double most = g > 0 ? 2 * c / (u + sqrt(u * u + 4 * g * c)) : c / u;
+        char fastest[96];
+        if (who >= 0) snprintf(fastest, sizeof fastest, "particle %d at %g m/s", who, u);
+        else if (who < -1) snprintf(fastest, sizeof fastest, "%s side velocity %g m/s", fsdem__pic_side_name(-2 - who), u);
+        else snprintf(fastest, sizeof fastest, "still liquid");
+        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s, gravity %g m/s^2; dt <= %g s)",
+                           (double)dt, (double)cfl, (double)s->desc.cfl_max, fastest, g, most);
     }
     return fsdem__ok(st);
 }
