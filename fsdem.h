@@ -200,9 +200,11 @@
      fsdem_<object>_last_error(). Bad input is rejected before anything changes, so the object stays
      as it was and usable. Beyond NaN and infinity, values no flow could have are bad input too: the
      plausibility bounds of >>core (FSDEM_MAX_SPEED, FSDEM_MAX_ACCELERATION, FSDEM_MAX_LENGTH,
-     FSDEM_MAX_MODULUS) refuse a speed of 1e200 m/s at the call instead of a NaN steps later. A step that produces a non-finite value or moves a particle out of the
-     domain completes, returns FSDEM_ERR_NAN or FSDEM_ERR_OUT_OF_DOMAIN and names the particle; the
-     caller may remove it and go on. The library never prints and never exits; an optional log
+     FSDEM_MAX_MODULUS) refuse a speed of 1e200 m/s at the call instead of a NaN steps later. A
+     solver's step that produces a non-finite value or moves a particle out of the domain completes,
+     returns FSDEM_ERR_NAN or FSDEM_ERR_OUT_OF_DOMAIN and names the particle; the caller may remove
+     it and go on. A coupled step is taken whole or not at all: a failure of either solver puts the
+     coupler, the fluid and the DEM back as they were before the call (>>couple_step). The library never prints and never exits; an optional log
      callback in each desc receives the same messages. FSDEM_ASSERT guards programmer errors only
      (out-of-range indices into arrays the caller owns).
 */
@@ -318,6 +320,7 @@
 #define fsdem_mps_add_outflow fsdem_mps_add_outflow_f
 #define fsdem_mps_add_particles fsdem_mps_add_particles_f
 #define fsdem_mps_advance fsdem_mps_advance_f
+#define fsdem_mps_check_dt fsdem_mps_check_dt_f
 #define fsdem_mps_claims fsdem_mps_claims_f
 #define fsdem_mps_create fsdem_mps_create_f
 #define fsdem_mps_dem_advance fsdem_mps_dem_advance_f
@@ -461,6 +464,7 @@
 #define fsdem_swe_block_box fsdem_swe_block_box_f
 #define fsdem_swe_block_polygon fsdem_swe_block_polygon_f
 #define fsdem_swe_cell_at fsdem_swe_cell_at_f
+#define fsdem_swe_check_dt fsdem_swe_check_dt_f
 #define fsdem_swe_claims fsdem_swe_claims_f
 #define fsdem_swe_clear_forces fsdem_swe_clear_forces_f
 #define fsdem_swe_copy_field fsdem_swe_copy_field_f
@@ -1457,9 +1461,10 @@ FSDEM_API fsdem_pic_particles fsdem_pic_get_particles(fsdem_pic *pic);
    limit), FSDEM_ERR_CFL (the projected velocity moved particles more than cfl_max cells). */
 FSDEM_API fsdem_result fsdem_pic_step(fsdem_pic *pic);
 /* One step of a given dt (s). FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite, FSDEM_ERR_CFL when
-   (u_max + |g| dt) dt / dx > cfl_max: the fastest particle, or liquid falling freely over the
-   step, would cross more than cfl_max cells (the message names the fastest particle); in both
-   cases nothing moved. Otherwise as fsdem_pic_step. */
+   (u_max + sqrt(|g| dx)) dt / dx > cfl_max, the CFL number of the stable rule's speed (of the
+   fastest particle, and of gravity waves a cell long: still water refuses a dt that would let it
+   fall far; the message names the fastest particle); in both cases nothing moved. Otherwise as
+   fsdem_pic_step. */
 FSDEM_API fsdem_result fsdem_pic_step_dt(fsdem_pic *pic, fsdem_real dt);
 /* FSDEM_OK when fsdem_pic_step_dt would take a step of dt, else the refusal it would return, with
    its message (a coupler checks before it changes anything). */
@@ -1944,6 +1949,9 @@ FSDEM_API fsdem_result fsdem_swe_step(fsdem_swe *swe);
 /* Advances by exactly dt (s). FSDEM_ERR_CFL, with nothing changed, when dt exceeds the stability
    limit (Courant number > 1); FSDEM_ERR_INVALID_ARG for dt <= 0; otherwise as fsdem_swe_step. */
 FSDEM_API fsdem_result fsdem_swe_step_dt(fsdem_swe *swe, fsdem_real dt);
+/* FSDEM_OK when fsdem_swe_step_dt would take a step of dt, else the refusal it would return, with
+   its message (a coupler checks before it changes anything). */
+FSDEM_API fsdem_result fsdem_swe_check_dt(const fsdem_swe *swe, fsdem_real dt);
 /* Adaptive steps until `duration` (s) has elapsed exactly (the last step is shortened); the number
    of steps goes to *steps (may be NULL). Stops at the first error. */
 FSDEM_API fsdem_result fsdem_swe_advance(fsdem_swe *swe, fsdem_real duration, long long *steps);
@@ -2389,6 +2397,9 @@ FSDEM_API fsdem_result fsdem_mps_step(fsdem_mps *mps);
    u_max dt / r0 > cfl (Eq. 37; the message names the fastest particle); nothing changes then.
    Otherwise as fsdem_mps_step. */
 FSDEM_API fsdem_result fsdem_mps_step_dt(fsdem_mps *mps, fsdem_real dt);
+/* FSDEM_OK when fsdem_mps_step_dt would take a step of dt, else the refusal it would return, with
+   its message (a coupler checks before it changes anything). */
+FSDEM_API fsdem_result fsdem_mps_check_dt(const fsdem_mps *mps, fsdem_real dt);
 /* Adaptive steps until `duration` (s) later exactly (the last steps shortened); the number of
    steps goes to *steps (may be NULL). Stops at the first error. */
 FSDEM_API fsdem_result fsdem_mps_advance(fsdem_mps *mps, fsdem_real duration, long long *steps);
@@ -2677,9 +2688,10 @@ FSDEM_API fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *coupler, con
 /* One coupled step of the SWE's stable dt: update the forces, the SWE step, then the DEM over the
    same dt in substeps. The substep count is checked first, so a step the DEM cannot take (more than
    max_substeps) is refused with FSDEM_ERR_INVALID_ARG before anything moves. Errors of either
-   solver are passed on with their message. */
+   solver are passed on with their message, and the step is put back (>>couple_step). */
 FSDEM_API fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *coupler);
-/* One coupled step of dt (s); FSDEM_ERR_CFL (nothing moved) when it is unstable for the SWE. */
+/* One coupled step of dt (s); FSDEM_ERR_CFL (nothing moved) when it is unstable for the SWE
+   (fsdem_swe_check_dt). */
 FSDEM_API fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *coupler, fsdem_real dt);
 /* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
 FSDEM_API fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *coupler, fsdem_real duration, long long *steps);
@@ -2852,7 +2864,7 @@ FSDEM_API fsdem_result fsdem_mps_dem_get_force(const fsdem_mps_dem *coupler, int
 FSDEM_API fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *coupler, const char *path);
 /* One coupled step of the stable dt (fsdem_mps_dem_stable_dt after the update). The DEM substep
    count is checked before anything moves (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of
-   either solver are passed on with their message. */
+   either solver are passed on with their message, and the step is put back (>>couple_step). */
 FSDEM_API fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *coupler);
 /* One coupled step of exactly dt (s): FSDEM_ERR_CFL, nothing moved, when dt exceeds the MPS CFL
    step (Eq. 37) or the drag limit of the section. */
@@ -3010,7 +3022,7 @@ FSDEM_API fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *coupler, con
 FSDEM_API fsdem_result fsdem_pic_dem_update(fsdem_pic_dem *coupler);
 /* One coupled step of the stable dt. The DEM substep count is checked before anything moves
    (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of either solver are passed on with their
-   message. */
+   message, and the step is put back (>>couple_step). */
 FSDEM_API fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *coupler);
 /* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite or above
    max_substeps DEM substeps, FSDEM_ERR_CFL when dt exceeds the PIC's cfl_max (fsdem_pic_check_dt),
@@ -3187,8 +3199,8 @@ FSDEM_API fsdem_result fsdem_gic_write_csv(const fsdem_gic *coupler, const char 
 FSDEM_API fsdem_result fsdem_gic_step(fsdem_gic *coupler);
 /* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite or above
    max_substeps DEM substeps, FSDEM_ERR_CFL when dt exceeds the PIC's cfl_max (fsdem_pic_check_dt)
-   or the drag limit; nothing moved then. Errors of either solver during the step
-   are passed on with their message. */
+   or the drag limit; nothing moved then. Errors of either solver during the step are passed on
+   with their message, and the step is put back (>>couple_step). */
 FSDEM_API fsdem_result fsdem_gic_step_dt(fsdem_gic *coupler, fsdem_real dt);
 /* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
 FSDEM_API fsdem_result fsdem_gic_advance(fsdem_gic *coupler, fsdem_real duration, long long *steps);
@@ -12226,7 +12238,7 @@ static fsdem_result fsdem__pic_check_porosity(const fsdem_pic *s, const char *wh
 fsdem_result fsdem_pic_check_dt(const fsdem_pic *s, fsdem_real dt) {
     fsdem__status *st;
     int who;
-    fsdem_real umax, cfl;
+    fsdem_real umax, speed, cfl;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (fsdem__pic_check_porosity(s, "fsdem_pic_step_dt") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     st = (fsdem__status *)&s->status; /* the message is the object's only mutable part here */
@@ -12235,17 +12247,16 @@ fsdem_result fsdem_pic_check_dt(const fsdem_pic *s, fsdem_real dt) {
     umax = fsdem__pic_umax(s, &who);
     if (!fsdem__finite(umax))
         return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_pic: particle %d has a non-finite velocity", who);
-    cfl = (umax + s->gmag * dt) * dt * s->inv_dx; /* gravity's share: liquid falling freely over the step */
+    speed = umax + (fsdem_real)sqrt(s->gmag * s->dx); /* the stable rule's speed: gravity waves too */
+    cfl = speed * dt * s->inv_dx;
     if (cfl > s->desc.cfl_max) {
-        /* the longest dt allowed: the root of |g| dt^2 + u_max dt = cfl_max dx */
-        const double c = (double)(s->desc.cfl_max * s->dx), u = (double)umax, g = (double)s->gmag;
-        const double most = g > 0 ? 2 * c / (u + sqrt(u * u + 4 * g * c)) : c / u;
         char fastest[96];
-        if (who >= 0) snprintf(fastest, sizeof fastest, "particle %d at %g m/s", who, u);
-        else if (who < -1) snprintf(fastest, sizeof fastest, "%s side velocity %g m/s", fsdem__pic_side_name(-2 - who), u);
+        if (who >= 0) snprintf(fastest, sizeof fastest, "particle %d at %g m/s", who, (double)umax);
+        else if (who < -1) snprintf(fastest, sizeof fastest, "%s side velocity %g m/s", fsdem__pic_side_name(-2 - who), (double)umax);
         else snprintf(fastest, sizeof fastest, "still liquid");
-        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s, gravity %g m/s^2; dt <= %g s)",
-                           (double)dt, (double)cfl, (double)s->desc.cfl_max, fastest, g, most);
+        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s, and sqrt(|g| dx) = %g m/s; dt <= %g s)",
+                           (double)dt, (double)cfl, (double)s->desc.cfl_max, fastest, sqrt((double)(s->gmag * s->dx)),
+                           (double)(s->desc.cfl_max * s->dx / speed));
     }
     return fsdem__ok(st);
 }
@@ -14699,17 +14710,23 @@ fsdem_result fsdem_swe_step(fsdem_swe *s) {
     return fsdem__swe_do_step(s, fsdem__swe_dt_for(s, s->desc.cfl));
 }
 
-fsdem_result fsdem_swe_step_dt(fsdem_swe *s, fsdem_real dt) {
+fsdem_result fsdem_swe_check_dt(const fsdem_swe *s, fsdem_real dt) {
+    fsdem__status *st;
     fsdem_real courant;
     if (!s) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&s->status; /* the message is the object's only mutable part here */
     if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_step_dt: dt must be > 0 (got %g s)", (double)dt);
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "fsdem_swe_step_dt: dt must be > 0 (got %g s)", (double)dt);
     courant = dt * fsdem__swe_rate(s) + dt * dt * s->max_accel;
     if (courant > 1)
-        return fsdem__fail(&s->status, FSDEM_ERR_CFL,
-                           "fsdem_swe_step_dt: dt = %g s gives Courant number %g > 1 (stable dt at cfl 1: %g s)",
+        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_swe_step_dt: dt = %g s gives Courant number %g > 1 (stable dt at cfl 1: %g s)",
                            (double)dt, (double)courant, (double)fsdem__swe_dt_for(s, 1));
-    return fsdem__swe_do_step(s, dt);
+    return fsdem__ok(st);
+}
+
+fsdem_result fsdem_swe_step_dt(fsdem_swe *s, fsdem_real dt) {
+    const fsdem_result res = fsdem_swe_check_dt(s, dt);
+    return res == FSDEM_OK ? fsdem__swe_do_step(s, dt) : res;
 }
 
 fsdem_result fsdem_swe_advance(fsdem_swe *s, fsdem_real duration, long long *steps) {
@@ -16624,27 +16641,34 @@ fsdem_result fsdem_mps_step(fsdem_mps *s) {
     return fsdem__mps_do_step(s, dt);
 }
 
-fsdem_result fsdem_mps_step_dt(fsdem_mps *s, fsdem_real dt) {
+fsdem_result fsdem_mps_check_dt(const fsdem_mps *s, fsdem_real dt) {
+    fsdem__status *st;
     int who;
     fsdem_real umax;
     if (!s) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&s->status; /* the message is the object's only mutable part here */
     if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_step_dt: dt = %g s must be > 0 and finite", (double)dt);
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "fsdem_mps_step_dt: dt = %g s must be > 0 and finite", (double)dt);
     umax = fsdem__mps_umax(s, &who);
     if (!fsdem__finite(umax))
-        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_mps_step_dt: particle %d has a non-finite velocity", who);
+        return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_mps_step_dt: particle %d has a non-finite velocity", who);
     if (umax * dt > s->desc.cfl * s->r0 * (1 + (fsdem_real)1e-5))
-        return fsdem__fail(&s->status, FSDEM_ERR_CFL,
+        return fsdem__fail(st, FSDEM_ERR_CFL,
                            "fsdem_mps_step_dt: dt = %g s gives u_max dt / r0 = %g > cfl = %g (seed 002 Eq. 37; particle %d at %g m/s; "
                            "dt <= %g s)",
                            (double)dt, (double)(umax * dt / s->r0), (double)s->desc.cfl, who, (double)umax,
                            (double)(s->desc.cfl * s->r0 / umax));
     if (dt > fsdem__mps_dt_viscous(s) * (1 + (fsdem_real)1e-5))
-        return fsdem__fail(&s->status, FSDEM_ERR_CFL,
+        return fsdem__fail(st, FSDEM_ERR_CFL,
                            "fsdem_mps_step_dt: dt = %g s exceeds the viscous limit %g s of the explicit viscous term (nu = %g m^2/s; "
                            "dt nu <= 0.8 lambda eps_min / (2d))",
                            (double)dt, (double)fsdem__mps_dt_viscous(s), (double)s->desc.viscosity);
-    return fsdem__mps_do_step(s, dt);
+    return fsdem__ok(st);
+}
+
+fsdem_result fsdem_mps_step_dt(fsdem_mps *s, fsdem_real dt) {
+    const fsdem_result res = fsdem_mps_check_dt(s, dt);
+    return res == FSDEM_OK ? fsdem__mps_do_step(s, dt) : res;
 }
 
 fsdem_result fsdem_mps_advance(fsdem_mps *s, fsdem_real duration, long long *steps) {
@@ -17603,9 +17627,14 @@ static fsdem_result fsdem__swe_dem_refresh(void *user, fsdem_dem *dem, double ti
     return FSDEM_OK;
 }
 
+/* A step of dt refused before anything moves: too many substeps, or the SWE's own refusal. */
 static fsdem_result fsdem__swe_dem_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
+    fsdem_swe_dem *c = (fsdem_swe_dem *)(void *)head;
+    fsdem_result res = fsdem__coupler_substeps_within(head, dt);
     (void)chosen;
-    return fsdem__coupler_substeps_within(head, dt);
+    if (res == FSDEM_OK && (res = fsdem_swe_check_dt(c->desc.swe, dt)) != FSDEM_OK)
+        return fsdem__fail(&head->status, res, "fsdem_swe_dem: SWE step: %s", fsdem_swe_last_error(c->desc.swe));
+    return res;
 }
 
 static fsdem_result fsdem__swe_dem_forces(fsdem_coupler *head, fsdem_real dt) {
@@ -18127,12 +18156,15 @@ static fsdem_result fsdem__mps_dem_limit(const fsdem_coupler *head, fsdem_real *
     return FSDEM_OK;
 }
 
-/* A step of dt refused before anything moves: too many substeps, or past the drag limit. */
+/* A step of dt refused before anything moves: too many substeps, the MPS's own refusal, or past the
+   drag limit. */
 static fsdem_result fsdem__mps_dem_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
     fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
-    const fsdem_result res = fsdem__coupler_substeps_within(head, dt);
+    fsdem_result res = fsdem__coupler_substeps_within(head, dt);
     (void)chosen;
     if (res != FSDEM_OK) return res;
+    if ((res = fsdem_mps_check_dt(c->desc.mps, dt)) != FSDEM_OK)
+        return fsdem__fail(&head->status, res, "fsdem_mps_dem: MPS step: %s", fsdem_mps_last_error(c->desc.mps));
     if (c->tally.drag_dt > 0 && dt > c->desc.drag_dt_fraction * c->tally.drag_dt * (1 + (fsdem_real)1e-6))
         return fsdem__fail(&head->status, FSDEM_ERR_CFL,
                            "fsdem_mps_dem: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s", (double)dt,

@@ -200,9 +200,11 @@
      fsdem_<object>_last_error(). Bad input is rejected before anything changes, so the object stays
      as it was and usable. Beyond NaN and infinity, values no flow could have are bad input too: the
      plausibility bounds of >>core (FSDEM_MAX_SPEED, FSDEM_MAX_ACCELERATION, FSDEM_MAX_LENGTH,
-     FSDEM_MAX_MODULUS) refuse a speed of 1e200 m/s at the call instead of a NaN steps later. A step that produces a non-finite value or moves a particle out of the
-     domain completes, returns FSDEM_ERR_NAN or FSDEM_ERR_OUT_OF_DOMAIN and names the particle; the
-     caller may remove it and go on. The library never prints and never exits; an optional log
+     FSDEM_MAX_MODULUS) refuse a speed of 1e200 m/s at the call instead of a NaN steps later. A
+     solver's step that produces a non-finite value or moves a particle out of the domain completes,
+     returns FSDEM_ERR_NAN or FSDEM_ERR_OUT_OF_DOMAIN and names the particle; the caller may remove
+     it and go on. A coupled step is taken whole or not at all: a failure of either solver puts the
+     coupler, the fluid and the DEM back as they were before the call (>>couple_step). The library never prints and never exits; an optional log
      callback in each desc receives the same messages. FSDEM_ASSERT guards programmer errors only
      (out-of-range indices into arrays the caller owns).
 */

@@ -323,10 +323,47 @@ START_TEST(test_gic_restart_bit_for_bit) {
 }
 END_TEST
 
+/* The house error rule (>>couple_step): a step that fsdem_gic_step_dt refuses before anything moves
+   (too many sand substeps, the drag limit) leaves coupler, PIC and DEM as they were, saved bytes
+   and statistics, and the same step at an allowed dt then runs. */
+START_TEST(test_gic_refused_step_changes_nothing) {
+    int path;
+    for (path = 0; path < 2; ++path) {
+        gic_tank t = make_gic(2, 0.1, 0.01, 0.05, 2650);
+        const fsdem_real dem_dt = fsdem_dem_get_desc(t.dem).dt;
+        test_kept before, after;
+        fsdem_result res;
+        fsdem_real dt = 0;
+        add_granule(&t, fsdem_v3((fsdem_real)0.05, (fsdem_real)0.02, 0), 0.001, 0, fsdem_v3(0, 0, 0));
+        ck_assert_int_eq(fsdem_gic_step(t.gic), FSDEM_OK);
+        ck_assert_int_eq(fsdem_gic_stable_dt(t.gic, &dt), FSDEM_OK);
+        if (path == 0) {
+            fsdem_gic_desc gd = fsdem_gic_get_desc(t.gic);
+            fsdem_gic_destroy(t.gic);
+            gd.max_substeps = 3;
+            ck_assert_int_eq(fsdem_gic_create(&gd, &t.gic), FSDEM_OK);
+            dt = 2 * dem_dt;
+        }
+        TEST_KEEP(fsdem_gic_save_memory, t.gic, fsdem_gic_get_stats(t.gic).coupling, &before);
+        if (path == 0) {
+            ck_assert_int_eq(fsdem_gic_step_dt(t.gic, 10 * dem_dt), FSDEM_ERR_INVALID_ARG);
+            ck_assert_ptr_nonnull(strstr(fsdem_gic_last_error(t.gic), "max_substeps"));
+        } else {
+            res = fsdem_gic_step_dt(t.gic, (fsdem_real)0.1); /* the granule's drag time is 24 ms, the PIC's limit 0.16 s */
+            ck_assert_msg(res == FSDEM_ERR_CFL && strstr(fsdem_gic_last_error(t.gic), "drag"), "%s", fsdem_gic_last_error(t.gic));
+        }
+        TEST_KEEP(fsdem_gic_save_memory, t.gic, fsdem_gic_get_stats(t.gic).coupling, &after);
+        test_kept_same(&before, &after, path == 0 ? "max_substeps" : "the drag limit");
+        ck_assert_msg(fsdem_gic_step_dt(t.gic, dt) == FSDEM_OK, "%s", fsdem_gic_last_error(t.gic));
+        free_gic(&t);
+    }
+}
+END_TEST
+
 /* Issue 34 rows 2-3: a dt of 1 s ran all 20,000 sand substeps before the PIC refused it, and then
    returned with both moved. It is refused before anything moves (the cost bound: the substeps do
    not run), and coupler, PIC and DEM are as they were, with a granule or none: the PIC refuses it
-   (water falling freely would cross 490 cells in the step). */
+   (at the speed of gravity waves a cell long, sqrt(g dx) = 0.31 m/s, it crosses 31 cells). */
 START_TEST(test_gic_long_dt_is_refused_before_the_substeps) {
     int granules;
     for (granules = 0; granules < 2; ++granules) {
@@ -412,8 +449,10 @@ START_TEST(test_gic_bad_input) {
     } bad[] = {{"drag_scale", 0, 0}, {"drag_scale", 0, NAN}, {"viscosity", 1, -1}, {"max_solid_fraction", 2, 1},
                {"cfl", 3, 0}, {"max_dt_ratio", 4, 0.5}, {"drag_dt_fraction", 5, 1.5}, {"max_substeps", 6, 0},
                {"virtual_mass", 7, 2},
-               /* issue 34: accepted at create, the first step then failed with another message */
-               {"drag_scale", 0, 1e300}, {"max_solid_fraction", 2, 1e-300}, {"cfl", 3, 1e-300}, {"drag_dt_fraction", 5, 1e-300}};
+               /* issue 34: accepted at create, the first step then failed with another message (1e-300 is
+                  0 in float, which means the default for max_solid_fraction: 1e-30 there) */
+               {"drag_scale", 0, 1e300}, {"max_solid_fraction", 2, TEST_FLOAT ? 1e-30 : 1e-300}, {"cfl", 3, 1e-300},
+               {"drag_dt_fraction", 5, 1e-300}};
     ck_assert_int_eq(fsdem_gic_desc_check(NULL, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_int_eq(fsdem_gic_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);
     ck_assert_msg(strstr(msg, ".pic and .dem") != NULL, "%s", msg);
@@ -516,6 +555,7 @@ Suite *couple_gic_suite(void) {
     tcase_add_test(tc, test_gic_virtual_mass_inertia);
     tcase_add_test(tc, test_gic_restart_bit_for_bit);
     tcase_add_test(tc, test_gic_bad_input);
+    tcase_add_test(tc, test_gic_refused_step_changes_nothing);
     tcase_add_test(tc, test_gic_long_dt_is_refused_before_the_substeps);
     tcase_add_test(tc, test_gic_failure_after_moving_puts_everything_back);
     suite_add_tcase(s, tc);

@@ -749,8 +749,9 @@ START_TEST(failure_after_moving_puts_everything_back) {
 END_TEST
 
 /* Issue 34 row 1: a dt of 1 s on a small scene moved the PIC to t = 1 s, left the DEM at 0 and
-   returned an error. It is refused before anything moves (the PIC's limit: water falling freely
-   would cross 490 cells), and coupler, PIC and DEM are as they were. */
+   returned an error. It is refused before anything moves (the PIC's limit: at the speed of gravity
+   waves a cell long, sqrt(g dx) = 0.31 m/s, it crosses 31 cells), and coupler, PIC and DEM are as
+   they were. */
 START_TEST(long_dt_changes_nothing) {
     tank t = make_tank(2, 0.4, 0.3, 0, G, 0.01, fsdem_v3(0.2, 0.1, 0), 0.04, 2000, 0, fsdem_v3(0, 0, 0), 0);
     pic_dem_snapshot before, after;

@@ -336,6 +336,40 @@ END_TEST
    no record either), then one row per particle with a record, equal to fsdem_swe_dem_get_force and
    the particle's id: a floating sphere in a stream, a fixed one (a row of zeros) and, added after the
    step, one with no record yet (no row); an unwritable path is FSDEM_ERR_IO naming the path. */
+/* The house error rule (>>couple_step): a step that fsdem_swe_dem_step_dt refuses (the SWE's Courant
+   limit, too many DEM substeps) is refused before anything moves, the forces stage included, and
+   leaves coupler, SWE and DEM as they were, saved bytes and statistics; the objects stay usable. */
+START_TEST(refused_step_changes_nothing) {
+    int path;
+    for (path = 0; path < 2; ++path) {
+        world w = world_new(10, 100, 1, 0.5, 0.2, 500, 5, 1, 0, 1);
+        const fsdem_real dem_dt = fsdem_dem_get_desc(w.dem).dt;
+        test_kept before, after;
+        fsdem_real dt = 0;
+        ck_assert_int_eq(capped_step(w.cpl, 0, &dt), FSDEM_OK);
+        if (path == 1) {
+            fsdem_swe_dem_desc cd = fsdem_swe_dem_get_desc(w.cpl);
+            fsdem_swe_dem_destroy(w.cpl);
+            cd.max_substeps = 3;
+            ck_assert_int_eq(fsdem_swe_dem_create(&cd, &w.cpl), FSDEM_OK);
+            dt = 2 * dem_dt;
+        }
+        TEST_KEEP(fsdem_swe_dem_save_memory, w.cpl, fsdem_swe_dem_get_stats(w.cpl).coupling, &before);
+        if (path == 0) {
+            ck_assert_int_eq(fsdem_swe_dem_step_dt(w.cpl, 10 * dt), FSDEM_ERR_CFL);
+            ck_assert_ptr_nonnull(strstr(fsdem_swe_dem_last_error(w.cpl), "Courant"));
+        } else {
+            ck_assert_int_eq(fsdem_swe_dem_step_dt(w.cpl, 10 * dem_dt), FSDEM_ERR_INVALID_ARG);
+            ck_assert_ptr_nonnull(strstr(fsdem_swe_dem_last_error(w.cpl), "max_substeps"));
+        }
+        TEST_KEEP(fsdem_swe_dem_save_memory, w.cpl, fsdem_swe_dem_get_stats(w.cpl).coupling, &after);
+        test_kept_same(&before, &after, path == 0 ? "the SWE's Courant limit" : "max_substeps");
+        ck_assert_msg(fsdem_swe_dem_step_dt(w.cpl, dt) == FSDEM_OK, "%s", fsdem_swe_dem_last_error(w.cpl));
+        world_free(&w);
+    }
+}
+END_TEST
+
 /* A step that fails once something moved (>>couple_step): a sphere that leaves the DEM's domain in
    its substeps, after the water has stepped. Coupler, SWE and DEM are put back as they were (saved
    bytes and statistics), and with the sphere back inside the same step runs. */
@@ -412,6 +446,7 @@ Suite *couple_swe_suite(void) {
     tcase_add_test(tc, csv_rows_are_the_force_records);
     tcase_add_test(tc, checkpoint_before_the_first_update_restores);
     tcase_add_test(tc, failure_after_moving_puts_everything_back);
+    tcase_add_test(tc, refused_step_changes_nothing);
     suite_add_tcase(s, tc);
     return s;
 }

@@ -145,8 +145,8 @@ FSDEM_API fsdem_result fsdem_gic_write_csv(const fsdem_gic *coupler, const char 
 FSDEM_API fsdem_result fsdem_gic_step(fsdem_gic *coupler);
 /* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite or above
    max_substeps DEM substeps, FSDEM_ERR_CFL when dt exceeds the PIC's cfl_max (fsdem_pic_check_dt)
-   or the drag limit; nothing moved then. Errors of either solver during the step
-   are passed on with their message. */
+   or the drag limit; nothing moved then. Errors of either solver during the step are passed on
+   with their message, and the step is put back (>>couple_step). */
 FSDEM_API fsdem_result fsdem_gic_step_dt(fsdem_gic *coupler, fsdem_real dt);
 /* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
 FSDEM_API fsdem_result fsdem_gic_advance(fsdem_gic *coupler, fsdem_real duration, long long *steps);

@@ -484,12 +484,15 @@ static fsdem_result fsdem__mps_dem_limit(const fsdem_coupler *head, fsdem_real *
     return FSDEM_OK;
 }
 
-/* A step of dt refused before anything moves: too many substeps, or past the drag limit. */
+/* A step of dt refused before anything moves: too many substeps, the MPS's own refusal, or past the
+   drag limit. */
 static fsdem_result fsdem__mps_dem_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
     fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
-    const fsdem_result res = fsdem__coupler_substeps_within(head, dt);
+    fsdem_result res = fsdem__coupler_substeps_within(head, dt);
     (void)chosen;
     if (res != FSDEM_OK) return res;
+    if ((res = fsdem_mps_check_dt(c->desc.mps, dt)) != FSDEM_OK)
+        return fsdem__fail(&head->status, res, "fsdem_mps_dem: MPS step: %s", fsdem_mps_last_error(c->desc.mps));
     if (c->tally.drag_dt > 0 && dt > c->desc.drag_dt_fraction * c->tally.drag_dt * (1 + (fsdem_real)1e-6))
         return fsdem__fail(&head->status, FSDEM_ERR_CFL,
                            "fsdem_mps_dem: dt = %g s exceeds drag_dt_fraction %g of the shortest drag relaxation time %g s", (double)dt,

@@ -151,7 +151,7 @@ FSDEM_API fsdem_result fsdem_mps_dem_get_force(const fsdem_mps_dem *coupler, int
 FSDEM_API fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *coupler, const char *path);
 /* One coupled step of the stable dt (fsdem_mps_dem_stable_dt after the update). The DEM substep
    count is checked before anything moves (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of
-   either solver are passed on with their message. */
+   either solver are passed on with their message, and the step is put back (>>couple_step). */
 FSDEM_API fsdem_result fsdem_mps_dem_step(fsdem_mps_dem *coupler);
 /* One coupled step of exactly dt (s): FSDEM_ERR_CFL, nothing moved, when dt exceeds the MPS CFL
    step (Eq. 37) or the drag limit of the section. */

@@ -124,7 +124,7 @@ FSDEM_API fsdem_result fsdem_pic_dem_write_csv(const fsdem_pic_dem *coupler, con
 FSDEM_API fsdem_result fsdem_pic_dem_update(fsdem_pic_dem *coupler);
 /* One coupled step of the stable dt. The DEM substep count is checked before anything moves
    (FSDEM_ERR_INVALID_ARG above max_substeps). Errors of either solver are passed on with their
-   message. */
+   message, and the step is put back (>>couple_step). */
 FSDEM_API fsdem_result fsdem_pic_dem_step(fsdem_pic_dem *coupler);
 /* One coupled step of exactly dt (s): FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite or above
    max_substeps DEM substeps, FSDEM_ERR_CFL when dt exceeds the PIC's cfl_max (fsdem_pic_check_dt),

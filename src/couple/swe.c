@@ -270,9 +270,14 @@ static fsdem_result fsdem__swe_dem_refresh(void *user, fsdem_dem *dem, double ti
     return FSDEM_OK;
 }
 
+/* A step of dt refused before anything moves: too many substeps, or the SWE's own refusal. */
 static fsdem_result fsdem__swe_dem_check(fsdem_coupler *head, fsdem_real dt, int chosen) {
+    fsdem_swe_dem *c = (fsdem_swe_dem *)(void *)head;
+    fsdem_result res = fsdem__coupler_substeps_within(head, dt);
     (void)chosen;
-    return fsdem__coupler_substeps_within(head, dt);
+    if (res == FSDEM_OK && (res = fsdem_swe_check_dt(c->desc.swe, dt)) != FSDEM_OK)
+        return fsdem__fail(&head->status, res, "fsdem_swe_dem: SWE step: %s", fsdem_swe_last_error(c->desc.swe));
+    return res;
 }
 
 static fsdem_result fsdem__swe_dem_forces(fsdem_coupler *head, fsdem_real dt) {

@@ -75,9 +75,10 @@ FSDEM_API fsdem_result fsdem_swe_dem_write_csv(const fsdem_swe_dem *coupler, con
 /* One coupled step of the SWE's stable dt: update the forces, the SWE step, then the DEM over the
    same dt in substeps. The substep count is checked first, so a step the DEM cannot take (more than
    max_substeps) is refused with FSDEM_ERR_INVALID_ARG before anything moves. Errors of either
-   solver are passed on with their message. */
+   solver are passed on with their message, and the step is put back (>>couple_step). */
 FSDEM_API fsdem_result fsdem_swe_dem_step(fsdem_swe_dem *coupler);
-/* One coupled step of dt (s); FSDEM_ERR_CFL (nothing moved) when it is unstable for the SWE. */
+/* One coupled step of dt (s); FSDEM_ERR_CFL (nothing moved) when it is unstable for the SWE
+   (fsdem_swe_check_dt). */
 FSDEM_API fsdem_result fsdem_swe_dem_step_dt(fsdem_swe_dem *coupler, fsdem_real dt);
 /* Coupled steps until exactly `duration` (s) later; their number goes to *steps (may be NULL). */
 FSDEM_API fsdem_result fsdem_swe_dem_advance(fsdem_swe_dem *coupler, fsdem_real duration, long long *steps);

@@ -386,6 +386,9 @@ FSDEM_API fsdem_result fsdem_mps_step(fsdem_mps *mps);
    u_max dt / r0 > cfl (Eq. 37; the message names the fastest particle); nothing changes then.
    Otherwise as fsdem_mps_step. */
 FSDEM_API fsdem_result fsdem_mps_step_dt(fsdem_mps *mps, fsdem_real dt);
+/* FSDEM_OK when fsdem_mps_step_dt would take a step of dt, else the refusal it would return, with
+   its message (a coupler checks before it changes anything). */
+FSDEM_API fsdem_result fsdem_mps_check_dt(const fsdem_mps *mps, fsdem_real dt);
 /* Adaptive steps until `duration` (s) later exactly (the last steps shortened); the number of
    steps goes to *steps (may be NULL). Stops at the first error. */
 FSDEM_API fsdem_result fsdem_mps_advance(fsdem_mps *mps, fsdem_real duration, long long *steps);

@@ -465,27 +465,34 @@ fsdem_result fsdem_mps_step(fsdem_mps *s) {
     return fsdem__mps_do_step(s, dt);
 }
 
-fsdem_result fsdem_mps_step_dt(fsdem_mps *s, fsdem_real dt) {
+fsdem_result fsdem_mps_check_dt(const fsdem_mps *s, fsdem_real dt) {
+    fsdem__status *st;
     int who;
     fsdem_real umax;
     if (!s) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&s->status; /* the message is the object's only mutable part here */
     if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_step_dt: dt = %g s must be > 0 and finite", (double)dt);
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "fsdem_mps_step_dt: dt = %g s must be > 0 and finite", (double)dt);
     umax = fsdem__mps_umax(s, &who);
     if (!fsdem__finite(umax))
-        return fsdem__fail(&s->status, FSDEM_ERR_NAN, "fsdem_mps_step_dt: particle %d has a non-finite velocity", who);
+        return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_mps_step_dt: particle %d has a non-finite velocity", who);
     if (umax * dt > s->desc.cfl * s->r0 * (1 + (fsdem_real)1e-5))
-        return fsdem__fail(&s->status, FSDEM_ERR_CFL,
+        return fsdem__fail(st, FSDEM_ERR_CFL,
                            "fsdem_mps_step_dt: dt = %g s gives u_max dt / r0 = %g > cfl = %g (seed 002 Eq. 37; particle %d at %g m/s; "
                            "dt <= %g s)",
                            (double)dt, (double)(umax * dt / s->r0), (double)s->desc.cfl, who, (double)umax,
                            (double)(s->desc.cfl * s->r0 / umax));
     if (dt > fsdem__mps_dt_viscous(s) * (1 + (fsdem_real)1e-5))
-        return fsdem__fail(&s->status, FSDEM_ERR_CFL,
+        return fsdem__fail(st, FSDEM_ERR_CFL,
                            "fsdem_mps_step_dt: dt = %g s exceeds the viscous limit %g s of the explicit viscous term (nu = %g m^2/s; "
                            "dt nu <= 0.8 lambda eps_min / (2d))",
                            (double)dt, (double)fsdem__mps_dt_viscous(s), (double)s->desc.viscosity);
-    return fsdem__mps_do_step(s, dt);
+    return fsdem__ok(st);
+}
+
+fsdem_result fsdem_mps_step_dt(fsdem_mps *s, fsdem_real dt) {
+    const fsdem_result res = fsdem_mps_check_dt(s, dt);
+    return res == FSDEM_OK ? fsdem__mps_do_step(s, dt) : res;
 }
 
 fsdem_result fsdem_mps_advance(fsdem_mps *s, fsdem_real duration, long long *steps) {

@@ -200,9 +200,10 @@ FSDEM_API fsdem_pic_particles fsdem_pic_get_particles(fsdem_pic *pic);
    limit), FSDEM_ERR_CFL (the projected velocity moved particles more than cfl_max cells). */
 FSDEM_API fsdem_result fsdem_pic_step(fsdem_pic *pic);
 /* One step of a given dt (s). FSDEM_ERR_INVALID_ARG for dt <= 0 or not finite, FSDEM_ERR_CFL when
-   (u_max + |g| dt) dt / dx > cfl_max: the fastest particle, or liquid falling freely over the
-   step, would cross more than cfl_max cells (the message names the fastest particle); in both
-   cases nothing moved. Otherwise as fsdem_pic_step. */
+   (u_max + sqrt(|g| dx)) dt / dx > cfl_max, the CFL number of the stable rule's speed (of the
+   fastest particle, and of gravity waves a cell long: still water refuses a dt that would let it
+   fall far; the message names the fastest particle); in both cases nothing moved. Otherwise as
+   fsdem_pic_step. */
 FSDEM_API fsdem_result fsdem_pic_step_dt(fsdem_pic *pic, fsdem_real dt);
 /* FSDEM_OK when fsdem_pic_step_dt would take a step of dt, else the refusal it would return, with
    its message (a coupler checks before it changes anything). */

@@ -160,7 +160,7 @@ static fsdem_result fsdem__pic_check_porosity(const fsdem_pic *s, const char *wh
 fsdem_result fsdem_pic_check_dt(const fsdem_pic *s, fsdem_real dt) {
     fsdem__status *st;
     int who;
-    fsdem_real umax, cfl;
+    fsdem_real umax, speed, cfl;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     if (fsdem__pic_check_porosity(s, "fsdem_pic_step_dt") != FSDEM_OK) return FSDEM_ERR_INVALID_ARG;
     st = (fsdem__status *)&s->status; /* the message is the object's only mutable part here */
@@ -169,17 +169,16 @@ fsdem_result fsdem_pic_check_dt(const fsdem_pic *s, fsdem_real dt) {
     umax = fsdem__pic_umax(s, &who);
     if (!fsdem__finite(umax))
         return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_pic: particle %d has a non-finite velocity", who);
-    cfl = (umax + s->gmag * dt) * dt * s->inv_dx; /* gravity's share: liquid falling freely over the step */
+    speed = umax + (fsdem_real)sqrt(s->gmag * s->dx); /* the stable rule's speed: gravity waves too */
+    cfl = speed * dt * s->inv_dx;
     if (cfl > s->desc.cfl_max) {
-        /* the longest dt allowed: the root of |g| dt^2 + u_max dt = cfl_max dx */
-        const double c = (double)(s->desc.cfl_max * s->dx), u = (double)umax, g = (double)s->gmag;
-        const double most = g > 0 ? 2 * c / (u + sqrt(u * u + 4 * g * c)) : c / u;
         char fastest[96];
-        if (who >= 0) snprintf(fastest, sizeof fastest, "particle %d at %g m/s", who, u);
-        else if (who < -1) snprintf(fastest, sizeof fastest, "%s side velocity %g m/s", fsdem__pic_side_name(-2 - who), u);
+        if (who >= 0) snprintf(fastest, sizeof fastest, "particle %d at %g m/s", who, (double)umax);
+        else if (who < -1) snprintf(fastest, sizeof fastest, "%s side velocity %g m/s", fsdem__pic_side_name(-2 - who), (double)umax);
         else snprintf(fastest, sizeof fastest, "still liquid");
-        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s, gravity %g m/s^2; dt <= %g s)",
-                           (double)dt, (double)cfl, (double)s->desc.cfl_max, fastest, g, most);
+        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_pic_step_dt: dt = %g s gives CFL %g > cfl_max %g (%s, and sqrt(|g| dx) = %g m/s; dt <= %g s)",
+                           (double)dt, (double)cfl, (double)s->desc.cfl_max, fastest, sqrt((double)(s->gmag * s->dx)),
+                           (double)(s->desc.cfl_max * s->dx / speed));
     }
     return fsdem__ok(st);
 }

@@ -320,17 +320,23 @@ fsdem_result fsdem_swe_step(fsdem_swe *s) {
     return fsdem__swe_do_step(s, fsdem__swe_dt_for(s, s->desc.cfl));
 }
 
-fsdem_result fsdem_swe_step_dt(fsdem_swe *s, fsdem_real dt) {
+fsdem_result fsdem_swe_check_dt(const fsdem_swe *s, fsdem_real dt) {
+    fsdem__status *st;
     fsdem_real courant;
     if (!s) return FSDEM_ERR_INVALID_ARG;
+    st = (fsdem__status *)&s->status; /* the message is the object's only mutable part here */
     if (!(dt > 0) || !fsdem__finite(dt))
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_swe_step_dt: dt must be > 0 (got %g s)", (double)dt);
+        return fsdem__fail(st, FSDEM_ERR_INVALID_ARG, "fsdem_swe_step_dt: dt must be > 0 (got %g s)", (double)dt);
     courant = dt * fsdem__swe_rate(s) + dt * dt * s->max_accel;
     if (courant > 1)
-        return fsdem__fail(&s->status, FSDEM_ERR_CFL,
-                           "fsdem_swe_step_dt: dt = %g s gives Courant number %g > 1 (stable dt at cfl 1: %g s)",
+        return fsdem__fail(st, FSDEM_ERR_CFL, "fsdem_swe_step_dt: dt = %g s gives Courant number %g > 1 (stable dt at cfl 1: %g s)",
                            (double)dt, (double)courant, (double)fsdem__swe_dt_for(s, 1));
-    return fsdem__swe_do_step(s, dt);
+    return fsdem__ok(st);
+}
+
+fsdem_result fsdem_swe_step_dt(fsdem_swe *s, fsdem_real dt) {
+    const fsdem_result res = fsdem_swe_check_dt(s, dt);
+    return res == FSDEM_OK ? fsdem__swe_do_step(s, dt) : res;
 }
 
 fsdem_result fsdem_swe_advance(fsdem_swe *s, fsdem_real duration, long long *steps) {

@@ -256,6 +256,9 @@ FSDEM_API fsdem_result fsdem_swe_step(fsdem_swe *swe);
 /* Advances by exactly dt (s). FSDEM_ERR_CFL, with nothing changed, when dt exceeds the stability
    limit (Courant number > 1); FSDEM_ERR_INVALID_ARG for dt <= 0; otherwise as fsdem_swe_step. */
 FSDEM_API fsdem_result fsdem_swe_step_dt(fsdem_swe *swe, fsdem_real dt);
+/* FSDEM_OK when fsdem_swe_step_dt would take a step of dt, else the refusal it would return, with
+   its message (a coupler checks before it changes anything). */
+FSDEM_API fsdem_result fsdem_swe_check_dt(const fsdem_swe *swe, fsdem_real dt);
 /* Adaptive steps until `duration` (s) has elapsed exactly (the last step is shortened); the number
    of steps goes to *steps (may be NULL). Stops at the first error. */
 FSDEM_API fsdem_result fsdem_swe_advance(fsdem_swe *swe, fsdem_real duration, long long *steps);
