@@ -360,7 +360,28 @@ START_TEST(test_gic_refused_step_changes_nothing) {
 }
 END_TEST
 
-/* Issue 34 rows 2-3: a dt of 1 s ran all 20,000 sand substeps before the PIC refused it, and then
+/* Issue 34 row 3: a granule whose position became NaN (written here through the view, as a hostile
+   caller can) gave FSDEM_ERR_NAN after the DEM had advanced and the PIC had not. It is refused
+   before anything moves, naming the granule, and coupler, PIC and DEM are as they were. */
+START_TEST(test_gic_nan_granule_is_refused_before_anything_moves) {
+    gic_tank t = make_gic(2, 0.1, 0.01, 0.05, 2650);
+    test_kept before, after;
+    fsdem_dem_particles P;
+    add_granule(&t, fsdem_v3((fsdem_real)0.05, (fsdem_real)0.02, 0), 0.001, 0, fsdem_v3(0, 0, 0));
+    add_granule(&t, fsdem_v3((fsdem_real)0.03, (fsdem_real)0.02, 0), 0.001, 0, fsdem_v3(0, 0, 0));
+    ck_assert_int_eq(fsdem_gic_step(t.gic), FSDEM_OK);
+    P = fsdem_dem_get_particles(t.dem);
+    ((fsdem_vec3 *)P.position)[1].y = (fsdem_real)NAN;
+    TEST_KEEP(fsdem_gic_save_memory, t.gic, fsdem_gic_get_stats(t.gic).coupling, &before);
+    ck_assert_int_eq(fsdem_gic_step(t.gic), FSDEM_ERR_NAN);
+    ck_assert_msg(strstr(fsdem_gic_last_error(t.gic), "particle 1"), "%s", fsdem_gic_last_error(t.gic));
+    TEST_KEEP(fsdem_gic_save_memory, t.gic, fsdem_gic_get_stats(t.gic).coupling, &after);
+    test_kept_same(&before, &after, "a NaN granule");
+    free_gic(&t);
+}
+END_TEST
+
+/* Issue 34 row 2: a dt of 1 s ran all 20,000 sand substeps before the PIC refused it, and then
    returned with both moved. It is refused before anything moves (the cost bound: the substeps do
    not run), and coupler, PIC and DEM are as they were, with a granule or none: the PIC refuses it
    (at the speed of gravity waves a cell long, sqrt(g dx) = 0.31 m/s, it crosses 31 cells). */
@@ -556,6 +577,7 @@ Suite *couple_gic_suite(void) {
     tcase_add_test(tc, test_gic_restart_bit_for_bit);
     tcase_add_test(tc, test_gic_bad_input);
     tcase_add_test(tc, test_gic_refused_step_changes_nothing);
+    tcase_add_test(tc, test_gic_nan_granule_is_refused_before_anything_moves);
     tcase_add_test(tc, test_gic_long_dt_is_refused_before_the_substeps);
     tcase_add_test(tc, test_gic_failure_after_moving_puts_everything_back);
     suite_add_tcase(s, tc);

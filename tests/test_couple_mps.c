@@ -598,7 +598,8 @@ START_TEST(test_mps_dem_refused_step_changes_nothing) {
 END_TEST
 
 /* A step that fails once something moved (>>couple_step): a sphere that leaves the DEM's domain in
-   its substeps, after the MPS has stepped. Coupler, MPS and DEM are put back as they were (saved
+   its substeps, after the MPS has stepped, a second sphere removed since the last step (so the
+   records kept are more than the step's). Coupler, MPS and DEM are put back as they were (saved
    bytes and statistics), and with the sphere back inside the same step runs. */
 START_TEST(test_mps_dem_failure_after_moving_puts_everything_back) {
     const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3(0.08f, 0.08f, 0.08f);
@@ -608,8 +609,10 @@ START_TEST(test_mps_dem_failure_after_moving_puts_everything_back) {
     test_kept before, after;
     fsdem_real dt = 0;
     test_add_sphere(&t, fsdem_v3(0.04f, 0.04f, 0.03f), fsdem_v3(1, 0, 0), 0.002);
-    P = fsdem_dem_get_particles(t.dem);
+    test_add_sphere(&t, fsdem_v3(0.02f, 0.04f, 0.03f), fsdem_v3(0, 0, 0), 0.002);
     ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_remove_particle(t.dem, 1), FSDEM_OK); /* the kept records outnumber the step's */
+    P = fsdem_dem_get_particles(t.dem);
     ck_assert_int_eq(fsdem_mps_dem_stable_dt(t.cpl, &dt), FSDEM_OK);
     dt /= 2;                                                        /* room for the drag limit at the new place */
     ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3(dd.domain_max.x - (fsdem_real)0.5 * dt, P.position[0].y, P.position[0].z),

@@ -652,25 +652,6 @@ START_TEST(still_water_stays_still_next_to_a_body_at_rest) {
 }
 END_TEST
 
-/* The coupler's saved bytes and statistics (CPU times excepted: they are not state). */
-typedef struct pic_dem_snapshot {
-    unsigned char *bytes;
-    size_t size;
-    fsdem_pic_dem_stats stats;
-} pic_dem_snapshot;
-
-static pic_dem_snapshot pic_dem_snapshot_take(const tank *t) {
-    pic_dem_snapshot s;
-    size_t need = 0;
-    fsdem_pic_dem_save_memory(t->cp, NULL, 0, &need);
-    s.bytes = (unsigned char *)malloc(need);
-    ck_assert_ptr_nonnull(s.bytes);
-    ck_assert_int_eq(fsdem_pic_dem_save_memory(t->cp, s.bytes, need, &s.size), FSDEM_OK);
-    s.stats = fsdem_pic_dem_get_stats(t->cp);
-    s.stats.coupling.seconds_fluid = s.stats.coupling.seconds_dem = s.stats.coupling.seconds_coupling = 0;
-    return s;
-}
-
 /* The house error rule (issue 21 item 6): a step that fsdem_pic_dem_step_dt refuses (the PIC's
    cfl_max, the viscous limit, too many DEM substeps) leaves coupler, PIC and DEM exactly as they
    were, saved bytes and statistics, even with a body added since the last step (whose water the
@@ -681,7 +662,7 @@ START_TEST(refused_step_changes_nothing) {
     for (path = 0; path < 3; ++path) {
         tank t = make_tank(2, 0.4, 0.3, 0, G, 0.01, fsdem_v3(0.2, 0.1, 0), 0.04, 2000, 0, fsdem_v3(0, 0, 0), path == 1 ? 1e-3 : 0);
         fsdem_dem_particle_desc extra = fsdem_dem_particle_desc_default();
-        pic_dem_snapshot before, after;
+        test_kept before, after;
         fsdem_real dt = (fsdem_real)1e-3;
         int i;
         ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, dt), FSDEM_OK);
@@ -698,7 +679,7 @@ START_TEST(refused_step_changes_nothing) {
             ck_assert_int_eq(fsdem_pic_dem_create(&cd, &t.cp), FSDEM_OK);
             dt = (fsdem_real)(2 * fsdem_dem_get_desc(t.dem).dt);
         }
-        before = pic_dem_snapshot_take(&t);
+        TEST_KEEP(fsdem_pic_dem_save_memory, t.cp, fsdem_pic_dem_get_stats(t.cp).coupling, &before);
         if (path == 0) {
             ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)0.05), FSDEM_ERR_CFL);
             ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "cfl_max"));
@@ -711,11 +692,8 @@ START_TEST(refused_step_changes_nothing) {
             ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)(10 * fsdem_dem_get_desc(t.dem).dt)), FSDEM_ERR_INVALID_ARG);
             ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "max_substeps"));
         }
-        after = pic_dem_snapshot_take(&t);
-        ck_assert_msg(after.size == before.size && memcmp(after.bytes, before.bytes, after.size) == 0, "path %d: the state changed", path);
-        ck_assert_msg(memcmp(&after.stats, &before.stats, sizeof after.stats) == 0, "path %d: the statistics changed", path);
-        free(before.bytes);
-        free(after.bytes);
+        TEST_KEEP(fsdem_pic_dem_save_memory, t.cp, fsdem_pic_dem_get_stats(t.cp).coupling, &after);
+        test_kept_same(&before, &after, path == 0 ? "cfl_max" : path == 1 ? "the viscous limit" : "max_substeps");
         ck_assert_msg(fsdem_pic_dem_step_dt(t.cp, dt) == FSDEM_OK, "path %d: %s", path, fsdem_pic_dem_last_error(t.cp));
         free_tank(&t);
     }
@@ -729,19 +707,16 @@ START_TEST(failure_after_moving_puts_everything_back) {
     tank t = make_tank(2, 0.4, 0.3, 0, G, 0.01, fsdem_v3(0.2, 0.1, 0), 0.04, 2000, 0, fsdem_v3(0, 0, 0), 0);
     const fsdem_dem_particles P = fsdem_dem_get_particles(t.dem);
     const fsdem_real dt = (fsdem_real)1e-3;
-    pic_dem_snapshot before, after;
+    test_kept before, after;
     ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, dt), FSDEM_OK);
     ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3((fsdem_real)(0.4 - 0.5 * dt), P.position[0].y, 0), fsdem_v3(1, 0, 0),
                                                   fsdem_v3(0, 0, 0)),
                      FSDEM_OK); /* at 1 m/s: out half-way through the step */
-    before = pic_dem_snapshot_take(&t);
+    TEST_KEEP(fsdem_pic_dem_save_memory, t.cp, fsdem_pic_dem_get_stats(t.cp).coupling, &before);
     ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, dt), FSDEM_ERR_OUT_OF_DOMAIN);
     ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "DEM substeps"));
-    after = pic_dem_snapshot_take(&t);
-    ck_assert_msg(after.size == before.size && memcmp(after.bytes, before.bytes, after.size) == 0, "the state changed");
-    ck_assert_msg(memcmp(&after.stats, &before.stats, sizeof after.stats) == 0, "the statistics changed");
-    free(before.bytes);
-    free(after.bytes);
+    TEST_KEEP(fsdem_pic_dem_save_memory, t.cp, fsdem_pic_dem_get_stats(t.cp).coupling, &after);
+    test_kept_same(&before, &after, "PIC-DEM");
     ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3(0.2f, P.position[0].y, 0), fsdem_v3(1, 0, 0), fsdem_v3(0, 0, 0)), FSDEM_OK);
     ck_assert_msg(fsdem_pic_dem_step_dt(t.cp, dt) == FSDEM_OK, "%s", fsdem_pic_dem_last_error(t.cp));
     free_tank(&t);
@@ -754,16 +729,13 @@ END_TEST
    they were. */
 START_TEST(long_dt_changes_nothing) {
     tank t = make_tank(2, 0.4, 0.3, 0, G, 0.01, fsdem_v3(0.2, 0.1, 0), 0.04, 2000, 0, fsdem_v3(0, 0, 0), 0);
-    pic_dem_snapshot before, after;
+    test_kept before, after;
     ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, (fsdem_real)1e-3), FSDEM_OK);
-    before = pic_dem_snapshot_take(&t);
+    TEST_KEEP(fsdem_pic_dem_save_memory, t.cp, fsdem_pic_dem_get_stats(t.cp).coupling, &before);
     ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, 1), FSDEM_ERR_CFL);
     ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "cfl_max"));
-    after = pic_dem_snapshot_take(&t);
-    ck_assert_msg(after.size == before.size && memcmp(after.bytes, before.bytes, after.size) == 0, "the state changed");
-    ck_assert_msg(memcmp(&after.stats, &before.stats, sizeof after.stats) == 0, "the statistics changed");
-    free(before.bytes);
-    free(after.bytes);
+    TEST_KEEP(fsdem_pic_dem_save_memory, t.cp, fsdem_pic_dem_get_stats(t.cp).coupling, &after);
+    test_kept_same(&before, &after, "PIC-DEM");
     free_tank(&t);
 }
 END_TEST

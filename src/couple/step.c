@@ -1,9 +1,9 @@
 /* ===== >>impl_couple_step : the staged step, the stable rule, the advance ===========================
 
-   Contents: the step of one coupler or of couplers sharing a fluid (>>couple_step): the prepare, the
-   checks that refuse before anything moves, the state kept (>>restart_journal), the stages around
-   the fluid's step, the state put back on a failure after something moved; the stable rule; the
-   advance; the verbs of each coupler on them. It follows >>impl_restart, whose saves it keeps. */
+   Contents: the step of one coupler or of couplers sharing a fluid (>>couple_step): the state kept
+   (>>restart_journal) and the prepare, the checks that refuse before anything moves, the stages
+   around the fluid's step, the state put back on a failure after something moved; the stable
+   rule; the advance; the verbs of each coupler on them. It follows >>impl_restart, whose saves it keeps. */
 
 /* The message of couplers[from] (or a new one, from < 0) given to every coupler of the list. */
 static fsdem_result fsdem__coupled_fail(fsdem_coupler *const *list, int n, int from, fsdem_result res, const char *fmt, ...) {
@@ -29,7 +29,7 @@ static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem
 }
 
 /* A step of the list failed after something moved, with the message of couplers[from]: every
-   coupler, fluid and DEM put back as kept, the prepare undone, the message (and a put-back that
+   coupler, fluid and DEM put back as kept before the prepare, the message (and a put-back that
    failed: out of memory, or a fluid with a gauge file open) to every coupler; passes `res` on. */
 static fsdem_result fsdem__coupled_put_back(fsdem_coupler *const *list, int n, int from, fsdem_result res) {
     char message[FSDEM__MESSAGE_SIZE];
@@ -37,7 +37,6 @@ static fsdem_result fsdem__coupled_put_back(fsdem_coupler *const *list, int n, i
     memcpy(message, list[from]->status.message, sizeof message);
     for (k = 0; k < n; ++k)
         if (fsdem__restart_put_back(list[k]) != FSDEM_OK && lost < 0) lost = k;
-    fsdem__coupled_undo(list, n, res);
     if (lost >= 0)
         return fsdem__coupled_fail(list, n, -1, res, "%s; and the state before the step could not be put back: %s", message,
                                    list[lost]->status.message);
@@ -72,11 +71,17 @@ static fsdem_result fsdem__coupled_stable(fsdem_coupler *const *list, int n, fsd
     return FSDEM_OK;
 }
 
-/* The couplers' prepare, in order, timed as coupling (a failure undoes those before), then with
-   `dt` the stable dt. */
+/* Every coupler's state kept (>>restart_journal; a failure to keep it, out of memory, refuses the
+   step), then the couplers' prepare, in order, timed as coupling (a failure undoes those before),
+   then with `dt` the stable dt. */
 static fsdem_result fsdem__coupled_prepare(fsdem_coupler *const *list, int n, fsdem_real *dt) {
     fsdem_result res = FSDEM_OK;
     int k;
+    for (k = 0; k < n && res == FSDEM_OK; ++k) {
+        const clock_t t0 = clock();
+        if ((res = fsdem__restart_keep(list[k])) != FSDEM_OK) fsdem__coupled_fail(list, n, k, res, NULL);
+        list[k]->seconds[FSDEM__CLOCK_COUPLING] += (double)(clock() - t0) / CLOCKS_PER_SEC;
+    }
     for (k = 0; k < n && res == FSDEM_OK; ++k)
         if (list[k]->cls->prepare) {
             const clock_t t0 = clock();
@@ -111,10 +116,10 @@ static const char *fsdem__coupler_fluid_stage(const fsdem_coupler *c) {
     return c->cls->stages[s].name;
 }
 
-/* A coupled step of dt after the prepare: every coupler's checks (a refusal undoes the prepare),
-   the state kept, the stages before the fluid's step, the fluid's step, the stages after it. A
-   failure once the state is kept puts it back (fsdem__coupled_put_back), so a refused step leaves
-   couplers, fluid and DEMs as they were. `chosen`: dt is the caller's, not a stable one. */
+/* A coupled step of dt after the prepare (which kept the state): every coupler's checks (a refusal
+   undoes the prepare), the stages before the fluid's step, the fluid's step, the stages after it.
+   A failure once a stage ran puts the kept state back (fsdem__coupled_put_back), so a refused step
+   leaves couplers, fluid and DEMs as they were. `chosen`: dt is the caller's, not a stable one. */
 static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_real dt, int chosen) {
     const fsdem__fluid *f = list[0]->cls->fluid;
     void *fluid = list[0]->fluid;
@@ -125,12 +130,6 @@ static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_r
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupler_particles_valid(list[k])) != FSDEM_OK || (res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
             return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
-    for (k = 0; k < n; ++k) {
-        t0 = clock();
-        res = fsdem__restart_keep(list[k]);
-        list[k]->seconds[FSDEM__CLOCK_COUPLING] += (double)(clock() - t0) / CLOCKS_PER_SEC;
-        if (res != FSDEM_OK) return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
-    }
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);
     t0 = clock();
