@@ -350,6 +350,7 @@
 #define fsdem_mps_fill_box fsdem_mps_fill_box_f
 #define fsdem_mps_gauge fsdem_mps_gauge_f
 #define fsdem_mps_gauges_close fsdem_mps_gauges_close_f
+#define fsdem_mps_gauges_hold fsdem_mps_gauges_hold_f
 #define fsdem_mps_gauges_open fsdem_mps_gauges_open_f
 #define fsdem_mps_get_coupling fsdem_mps_get_coupling_f
 #define fsdem_mps_get_desc fsdem_mps_get_desc_f
@@ -420,6 +421,7 @@
 #define fsdem_pic_fill_sdf fsdem_pic_fill_sdf_f
 #define fsdem_pic_gauge fsdem_pic_gauge_f
 #define fsdem_pic_gauges_close fsdem_pic_gauges_close_f
+#define fsdem_pic_gauges_hold fsdem_pic_gauges_hold_f
 #define fsdem_pic_gauges_open fsdem_pic_gauges_open_f
 #define fsdem_pic_get_coupling fsdem_pic_get_coupling_f
 #define fsdem_pic_get_desc fsdem_pic_get_desc_f
@@ -494,6 +496,7 @@
 #define fsdem_swe_destroy fsdem_swe_destroy_f
 #define fsdem_swe_gauge fsdem_swe_gauge_f
 #define fsdem_swe_gauges_close fsdem_swe_gauges_close_f
+#define fsdem_swe_gauges_hold fsdem_swe_gauges_hold_f
 #define fsdem_swe_gauges_open fsdem_swe_gauges_open_f
 #define fsdem_swe_get_coupling fsdem_swe_get_coupling_f
 #define fsdem_swe_get_desc fsdem_swe_get_desc_f
@@ -1645,6 +1648,11 @@ FSDEM_API fsdem_result fsdem_pic_gauge(const fsdem_pic *pic, int id, fsdem_real 
 FSDEM_API fsdem_result fsdem_pic_gauges_open(fsdem_pic *pic, const char *path, fsdem_real interval);
 /* Closes the gauge file (also done by fsdem_pic_destroy). FSDEM_ERR_IO. */
 FSDEM_API fsdem_result fsdem_pic_gauges_close(fsdem_pic *pic);
+/* Holds the gauge rows of the steps to come (hold = 1): a step's rows wait, unwritten, until the next
+   step begins or the hold ends (hold = 0 writes them). A coupler holds them through its step, so
+   that a step it puts back leaves the file as it was (>>couple_step). Without an open gauge file
+   there is nothing to hold. FSDEM_ERR_IO when rows could not be written. */
+FSDEM_API fsdem_result fsdem_pic_gauges_hold(fsdem_pic *pic, int hold);
 
 /* ---- diagnostics ---- */
 
@@ -2003,6 +2011,11 @@ FSDEM_API fsdem_result fsdem_swe_gauge(const fsdem_swe *swe, int id, fsdem_swe_c
 FSDEM_API fsdem_result fsdem_swe_gauges_open(fsdem_swe *swe, const char *path, fsdem_real interval);
 /* Closes the gauge file (also done by fsdem_swe_destroy). FSDEM_ERR_IO. */
 FSDEM_API fsdem_result fsdem_swe_gauges_close(fsdem_swe *swe);
+/* Holds the gauge rows of the steps to come (hold = 1): a step's rows wait, unwritten, until the next
+   step begins or the hold ends (hold = 0 writes them). A coupler holds them through its step, so
+   that a step it puts back leaves the file as it was (>>couple_step). Without an open gauge file
+   there is nothing to hold. FSDEM_ERR_IO when rows could not be written. */
+FSDEM_API fsdem_result fsdem_swe_gauges_hold(fsdem_swe *swe, int hold);
 
 /* Signed distance from p to the SWE bed surface z = z_b(x, y), for fsdem_dem_wall_sdf(fsdem_swe_bed_sdf,
    swe, material): (z - z_b)/sqrt(1 + |grad z_b|^2) with the bed normal; exact on planar beds. `user` is
@@ -2482,6 +2495,11 @@ FSDEM_API fsdem_result fsdem_mps_gauge(const fsdem_mps *mps, int id, fsdem_real 
 FSDEM_API fsdem_result fsdem_mps_gauges_open(fsdem_mps *mps, const char *path, fsdem_real interval);
 /* Closes the gauge file (also done by fsdem_mps_destroy). FSDEM_ERR_IO. */
 FSDEM_API fsdem_result fsdem_mps_gauges_close(fsdem_mps *mps);
+/* Holds the gauge rows of the steps to come (hold = 1): a step's rows wait, unwritten, until the next
+   step begins or the hold ends (hold = 0 writes them). A coupler holds them through its step, so
+   that a step it puts back leaves the file as it was (>>couple_step). Without an open gauge file
+   there is nothing to hold. FSDEM_ERR_IO when rows could not be written. */
+FSDEM_API fsdem_result fsdem_mps_gauges_hold(fsdem_mps *mps, int hold);
 
 /* Force (N; N per metre of depth in 2D) of the liquid on the box obstacle `id`
    (fsdem_mps_add_box_obstacle) in the last step: the pressure of the step on its faces, each WALL
@@ -3383,9 +3401,10 @@ FSDEM_API fsdem_result fsdem_gic_restore_memory(fsdem_gic *coupler, const void *
    fluid and DEM back as they were before the call, bit for bit, from a copy of their saved state
    taken before the step (>>restart, without its checksum: the copy never leaves the process). The
    copy costs one save of the coupled run per step, in memory the coupler keeps (grown when the run
-   grows, FSDEM_ERR_OUT_OF_MEMORY before anything moves when it cannot be). One exception: a fluid
-   with a gauge file open (fsdem_X_gauges_open) cannot be put back, since the file has been
-   written; the message then says so. */
+   grows; FSDEM_ERR_OUT_OF_MEMORY before anything moves when it cannot be). The fluid's gauge rows
+   of the step (fsdem_X_gauges_open) wait until the step is taken (fsdem_X_gauges_hold), so a step
+   put back leaves the gauge file as it was too; FSDEM_ERR_IO when they cannot be written then (the
+   step is taken). */
 
 /* Couplers of one fluid stepped together: every coupler's stages before the fluid step, in the
    order of the list, one step of the fluid, then every coupler's stages after it. The step is the
@@ -3881,7 +3900,9 @@ static int fsdem__finite(fsdem_real x) { return x == x && x - x == 0; }
    start and the end of the step that passed each one (interval 0: one row per step). The series
    samples its solver itself: a solver's step calls fsdem__series_begin first and fsdem__series_step
    last, and nothing else. `before` holds the values at the start of the step in flight, `now` those
-   at its end. */
+   at its end. Held (fsdem__series_hold), the rows of a step wait, unwritten, until the next step
+   begins or the hold ends; a coupled step holds them, so that a step it puts back (>>couple_step)
+   drops them (fsdem__series_drop) and leaves the file as it was. */
 typedef void (*fsdem__series_sample_fn)(const void *solver, fsdem_real *out);
 typedef struct fsdem__series {
     void *file;            /* FILE*, NULL when closed */
@@ -3890,6 +3911,9 @@ typedef struct fsdem__series {
     fsdem_real *before, *now;
     fsdem__series_sample_fn sample;
     const void *solver;
+    int hold;              /* the rows of a step wait */
+    int pending;           /* the rows of the step from pending_t0 to pending_t1 wait (its values in */
+    double pending_t0, pending_t1; /* before and now) */
 } fsdem__series;
 
 /* Writes the row of time t with the values in ser->now. */
@@ -3926,17 +3950,10 @@ static fsdem_result fsdem__series_open(fsdem__series *ser, const fsdem_allocator
     return FSDEM_OK;
 }
 
-/* Before a step: the values at its start, from which the rows inside it are interpolated. */
-static void fsdem__series_begin(fsdem__series *ser) {
-    if (ser->file && ser->interval > 0) ser->sample(ser->solver, ser->before);
-}
-
-/* After a step from t0 to t1: samples its end and writes the rows it passed. */
-static fsdem_result fsdem__series_step(fsdem__series *ser, double t0, double t1) {
+/* Writes the rows of the step from t0 to t1 (its values in before and now). */
+static fsdem_result fsdem__series_write(fsdem__series *ser, double t0, double t1) {
     FILE *fp = (FILE *)ser->file;
     int k;
-    if (!fp) return FSDEM_OK;
-    ser->sample(ser->solver, ser->now);
     if (ser->interval <= 0) fsdem__series_row(ser, t1);
     for (; ser->interval > 0 && ser->next <= t1 * (1 + 1e-12); ser->next += ser->interval) {
         const double w = t1 > t0 ? (ser->next - t0) / (t1 - t0) : 1;
@@ -3947,10 +3964,52 @@ static fsdem_result fsdem__series_step(fsdem__series *ser, double t0, double t1)
     return ferror(fp) ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
+/* Writes the rows that wait, if any. */
+static fsdem_result fsdem__series_release(fsdem__series *ser) {
+    if (!ser->pending) return FSDEM_OK;
+    ser->pending = 0;
+    return fsdem__series_write(ser, ser->pending_t0, ser->pending_t1);
+}
+
+/* Holds the rows of the steps to come (hold = 1), or ends the hold and writes the rows that wait. */
+static fsdem_result fsdem__series_hold(fsdem__series *ser, int hold) {
+    ser->hold = hold;
+    return hold ? FSDEM_OK : fsdem__series_release(ser);
+}
+
+/* fsdem_X_gauges_hold of a solver whose series is `ser` (its status st, its public name fn). */
+static fsdem_result fsdem__series_hold_call(fsdem__series *ser, fsdem__status *st, const char *fn, int hold) {
+    if (!ser->file) return fsdem__ok(st);
+    return fsdem__series_hold(ser, hold != 0) == FSDEM_OK ? fsdem__ok(st) : fsdem__fail(st, FSDEM_ERR_IO, "%s: write error", fn);
+}
+
+/* Forgets the rows that wait (their step was put back). */
+static void fsdem__series_drop(fsdem__series *ser) { ser->pending = 0; }
+
+/* Before a step: the rows of a step held before it written, then the values at its start, from which
+   the rows inside it are interpolated. */
+static void fsdem__series_begin(fsdem__series *ser) {
+    if (!ser->file) return;
+    fsdem__series_release(ser); /* a write error stays in the file's error flag for the step to report */
+    if (ser->interval > 0) ser->sample(ser->solver, ser->before);
+}
+
+/* After a step from t0 to t1: samples its end and writes the rows it passed, or holds them. */
+static fsdem_result fsdem__series_step(fsdem__series *ser, double t0, double t1) {
+    if (!ser->file) return FSDEM_OK;
+    ser->sample(ser->solver, ser->now);
+    if (!ser->hold) return fsdem__series_write(ser, t0, t1);
+    ser->pending = 1;
+    ser->pending_t0 = t0;
+    ser->pending_t1 = t1;
+    return FSDEM_OK;
+}
+
 /* Closes the file (a last newline) and frees the rows. FSDEM_ERR_IO when writing failed. */
 static fsdem_result fsdem__series_close(fsdem__series *ser, const fsdem_allocator *al) {
     int bad;
     if (!ser->file) return FSDEM_OK;
+    fsdem__series_release(ser);
     fputc('\n', (FILE *)ser->file);
     bad = ferror((FILE *)ser->file);
     bad |= fclose((FILE *)ser->file) != 0;
@@ -12627,6 +12686,10 @@ fsdem_result fsdem_pic_gauges_open(fsdem_pic *s, const char *path, fsdem_real in
                               fsdem__pic_gauge_values, s);
 }
 
+fsdem_result fsdem_pic_gauges_hold(fsdem_pic *s, int hold) {
+    return s ? fsdem__series_hold_call(&s->gauges.series, &s->status, "fsdem_pic_gauges_hold", hold) : FSDEM_ERR_INVALID_ARG;
+}
+
 fsdem_result fsdem_pic_gauges_close(fsdem_pic *s) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
     return fsdem__gauges_close(&s->gauges, &s->status, &s->allocator, "fsdem_pic_gauges_close");
@@ -14889,6 +14952,10 @@ fsdem_result fsdem_swe_gauges_open(fsdem_swe *s, const char *path, fsdem_real in
     return fsdem__ok(&s->status);
 }
 
+fsdem_result fsdem_swe_gauges_hold(fsdem_swe *s, int hold) {
+    return s ? fsdem__series_hold_call(&s->gauges, &s->status, "fsdem_swe_gauges_hold", hold) : FSDEM_ERR_INVALID_ARG;
+}
+
 fsdem_result fsdem_swe_gauges_close(fsdem_swe *s) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
     return fsdem__series_close(&s->gauges, &s->allocator) == FSDEM_OK
@@ -16904,6 +16971,10 @@ fsdem_result fsdem_mps_gauges_open(fsdem_mps *s, const char *path, fsdem_real in
                               fsdem__mps_gauge_values, s);
 }
 
+fsdem_result fsdem_mps_gauges_hold(fsdem_mps *s, int hold) {
+    return s ? fsdem__series_hold_call(&s->gauges.series, &s->status, "fsdem_mps_gauges_hold", hold) : FSDEM_ERR_INVALID_ARG;
+}
+
 fsdem_result fsdem_mps_gauges_close(fsdem_mps *s) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
     return fsdem__gauges_close(&s->gauges, &s->status, &s->allocator, "fsdem_mps_gauges_close");
@@ -17072,6 +17143,7 @@ typedef struct fsdem__fluid {
     fsdem_result (*step_dt)(void *fluid, fsdem_real dt);
     const char *(*last_error)(const void *fluid);
     fsdem_claims *(*claims)(void *fluid);
+    fsdem_result (*gauges_hold)(void *fluid, int hold);
 } fsdem__fluid;
 
 /* What makes a coupler of one kind. */
@@ -17205,24 +17277,27 @@ static fsdem_result fsdem__fluid_pic_stable(const void *f, fsdem_real *dt) { ret
 static fsdem_result fsdem__fluid_pic_step(void *f, fsdem_real dt) { return fsdem_pic_step_dt((fsdem_pic *)f, dt); }
 static const char *fsdem__fluid_pic_error(const void *f) { return fsdem_pic_last_error((const fsdem_pic *)f); }
 static fsdem_claims *fsdem__fluid_pic_claims(void *f) { return fsdem_pic_claims((fsdem_pic *)f); }
+static fsdem_result fsdem__fluid_pic_hold(void *f, int hold) { return fsdem_pic_gauges_hold((fsdem_pic *)f, hold); }
 static const fsdem__fluid fsdem__fluid_pic = {"PIC", "pic", fsdem__fluid_pic_time, fsdem__fluid_pic_stable, fsdem__fluid_pic_step,
-                                              fsdem__fluid_pic_error, fsdem__fluid_pic_claims};
+                                              fsdem__fluid_pic_error, fsdem__fluid_pic_claims, fsdem__fluid_pic_hold};
 
 static double fsdem__fluid_mps_time(const void *f) { return fsdem_mps_time((const fsdem_mps *)f); }
 static fsdem_result fsdem__fluid_mps_stable(const void *f, fsdem_real *dt) { return fsdem_mps_stable_dt((const fsdem_mps *)f, dt); }
 static fsdem_result fsdem__fluid_mps_step(void *f, fsdem_real dt) { return fsdem_mps_step_dt((fsdem_mps *)f, dt); }
 static const char *fsdem__fluid_mps_error(const void *f) { return fsdem_mps_last_error((const fsdem_mps *)f); }
 static fsdem_claims *fsdem__fluid_mps_claims(void *f) { return fsdem_mps_claims((fsdem_mps *)f); }
+static fsdem_result fsdem__fluid_mps_hold(void *f, int hold) { return fsdem_mps_gauges_hold((fsdem_mps *)f, hold); }
 static const fsdem__fluid fsdem__fluid_mps = {"MPS", "mps", fsdem__fluid_mps_time, fsdem__fluid_mps_stable, fsdem__fluid_mps_step,
-                                              fsdem__fluid_mps_error, fsdem__fluid_mps_claims};
+                                              fsdem__fluid_mps_error, fsdem__fluid_mps_claims, fsdem__fluid_mps_hold};
 
 static double fsdem__fluid_swe_time(const void *f) { return fsdem_swe_time((const fsdem_swe *)f); }
 static fsdem_result fsdem__fluid_swe_stable(const void *f, fsdem_real *dt) { return fsdem_swe_stable_dt((const fsdem_swe *)f, dt); }
 static fsdem_result fsdem__fluid_swe_step(void *f, fsdem_real dt) { return fsdem_swe_step_dt((fsdem_swe *)f, dt); }
 static const char *fsdem__fluid_swe_error(const void *f) { return fsdem_swe_last_error((const fsdem_swe *)f); }
 static fsdem_claims *fsdem__fluid_swe_claims(void *f) { return fsdem_swe_claims((fsdem_swe *)f); }
+static fsdem_result fsdem__fluid_swe_hold(void *f, int hold) { return fsdem_swe_gauges_hold((fsdem_swe *)f, hold); }
 static const fsdem__fluid fsdem__fluid_swe = {"shallow-water", "swe", fsdem__fluid_swe_time, fsdem__fluid_swe_stable, fsdem__fluid_swe_step,
-                                              fsdem__fluid_swe_error, fsdem__fluid_swe_claims};
+                                              fsdem__fluid_swe_error, fsdem__fluid_swe_claims, fsdem__fluid_swe_hold};
 
 /* ---- >>couple_dem : the DEM's checks and substeps ---- */
 
@@ -20161,20 +20236,26 @@ static void fsdem__restart_dem(fsdem__restart *io, void *object) {
    keep the object's callbacks; a pressure-extra operator stays as set. */
 /* The gauges of a PIC solver (positions, kinds, radii); their file is not part of the state. */
 /* Point gauges (fsdem__gauges) into fresh arrays; refused while their file is open (`close` names
-   the function that closes it). */
+   the function that closes it), but for a coupled step's put-back (io->unchecked): its gauges are
+   the step's, and their series stays open, the rows the step held dropped. */
 static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fsdem_allocator *al, const char *close) {
     int ng = g->count;
-    fsdem_vec3 *at;
-    int *kind;
-    fsdem_real *radius;
-    if (io->mode == FSDEM__RESTART_CHECK && g->series.file)
+    fsdem_vec3 *at = g->at;
+    int *kind = g->kind;
+    fsdem_real *radius = g->radius;
+    if (io->mode == FSDEM__RESTART_CHECK && g->series.file && !io->unchecked)
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                             "the object has a gauge file open: close it (%s) before restoring and open it again afterwards", close);
     fsdem__restart_count(io, &ng, 1 << 24, sizeof(fsdem_vec3) + sizeof(int) + sizeof(fsdem_real), "gauge count");
-    at = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)ng);
-    kind = (int *)fsdem__restart_block(io, al, sizeof(int) * (size_t)ng);
-    radius = (fsdem_real *)fsdem__restart_block(io, al, sizeof(fsdem_real) * (size_t)ng);
-    if (io->mode == FSDEM__RESTART_COMMIT) {
+    if (io->unchecked) {
+        if (io->res == FSDEM_OK && ng != g->count) fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the gauges changed");
+        if (io->mode == FSDEM__RESTART_COMMIT) fsdem__series_drop(&g->series);
+    } else {
+        at = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)ng);
+        kind = (int *)fsdem__restart_block(io, al, sizeof(int) * (size_t)ng);
+        radius = (fsdem_real *)fsdem__restart_block(io, al, sizeof(fsdem_real) * (size_t)ng);
+    }
+    if (io->mode == FSDEM__RESTART_COMMIT && !io->unchecked) {
         fsdem__gauges_free(g, al);
         g->at = at;
         g->kind = kind;
@@ -20434,10 +20515,11 @@ static void fsdem__restart_swe(fsdem__restart *io, void *object) {
                             "the desc it was saved with)",
                             grid[0], grid[1], s->nx, s->ny);
     fsdem__restart_same_fields(io, s, same, 15);
-    if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file)
+    if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file && !io->unchecked) /* a put-back keeps it (fsdem__restart_gauges) */
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                             "the object has a gauge file open: close it (fsdem_swe_gauges_close) before restoring and "
                             "open it again afterwards");
+    if (io->mode == FSDEM__RESTART_COMMIT && io->unchecked) fsdem__series_drop(&s->gauges);
 
     fsdem__restart_fields(io, s, state, 14);
 
@@ -21405,14 +21487,16 @@ static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem
 }
 
 /* A step of the list failed after something moved, with the message of couplers[from]: every
-   coupler, fluid and DEM put back as kept before the prepare, the message (and a put-back that
-   failed: out of memory, or a fluid with a gauge file open) to every coupler; passes `res` on. */
+   coupler, fluid and DEM put back as kept before the prepare, the fluid's gauge rows of the step
+   dropped, the message (and a put-back that failed, out of memory) to every coupler; passes `res`
+   on. */
 static fsdem_result fsdem__coupled_put_back(fsdem_coupler *const *list, int n, int from, fsdem_result res) {
     char message[FSDEM__MESSAGE_SIZE];
     int k, lost = -1;
     memcpy(message, list[from]->status.message, sizeof message);
     for (k = 0; k < n; ++k)
         if (fsdem__restart_put_back(list[k]) != FSDEM_OK && lost < 0) lost = k;
+    list[0]->cls->fluid->gauges_hold(list[0]->fluid, 0); /* the rows it held were dropped with the step */
     if (lost >= 0)
         return fsdem__coupled_fail(list, n, -1, res, "%s; and the state before the step could not be put back: %s", message,
                                    list[lost]->status.message);
@@ -21506,6 +21590,7 @@ static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_r
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupler_particles_valid(list[k])) != FSDEM_OK || (res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
             return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
+    f->gauges_hold(fluid, 1); /* the fluid's gauge rows of the step wait until it is taken */
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);
     t0 = clock();
@@ -21522,6 +21607,8 @@ static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_r
     }
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupled_stages(list[k], dt, 1)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);
+    if ((res = f->gauges_hold(fluid, 0)) != FSDEM_OK) /* the step is taken; its rows could not be written */
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s", list[0]->cls->name, f->last_error(fluid));
     for (k = 0; k < n; ++k) fsdem__ok(&list[k]->status);
     return FSDEM_OK;
 }

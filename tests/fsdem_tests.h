@@ -122,6 +122,32 @@ static inline void test_kept_same(test_kept *before, test_kept *after, const cha
     free(after->bytes);
 }
 
+/* The bytes of file `path` now (malloc'ed, *size of them); a gauge file open for writing reads as
+   written so far (the series flushes every row). */
+static inline unsigned char *test_file_bytes(const char *path, size_t *size) {
+    FILE *fp = fopen(path, "rb");
+    unsigned char *bytes = NULL;
+    long n;
+    ck_assert_ptr_nonnull(fp);
+    ck_assert(fseek(fp, 0, SEEK_END) == 0 && (n = ftell(fp)) >= 0 && fseek(fp, 0, SEEK_SET) == 0);
+    bytes = (unsigned char *)malloc((size_t)n + 1);
+    ck_assert_ptr_nonnull(bytes);
+    ck_assert(fread(bytes, 1, (size_t)n, fp) == (size_t)n);
+    fclose(fp);
+    *size = (size_t)n;
+    return bytes;
+}
+
+/* Asserts that file `path` holds the `size` bytes `expected` now (grown = 1: begins with them and
+   is longer). */
+static inline void test_file_is(const char *path, const unsigned char *expected, size_t size, int grown, const char *what) {
+    size_t now = 0;
+    unsigned char *bytes = test_file_bytes(path, &now);
+    ck_assert_msg((grown ? now > size : now == size) && memcmp(bytes, expected, size) == 0, "%s: %s has %lu bytes, %s %lu", what, path,
+                  (unsigned long)now, grown ? "expected more than" : "expected", (unsigned long)size);
+    free(bytes);
+}
+
 /* True when every component is finite. */
 static inline int test_finite3(fsdem_vec3 v) { return isfinite(v.x) && isfinite(v.y) && isfinite(v.z); }
 

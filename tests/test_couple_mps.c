@@ -600,14 +600,20 @@ END_TEST
 /* A step that fails once something moved (>>couple_step): a sphere that leaves the DEM's domain in
    its substeps, after the MPS has stepped, a second sphere removed since the last step (so the
    records kept are more than the step's). Coupler, MPS and DEM are put back as they were (saved
-   bytes and statistics), and with the sphere back inside the same step runs. */
+   bytes and statistics), the MPS's gauge file too, and with the sphere back inside the same step
+   runs. */
 START_TEST(test_mps_dem_failure_after_moving_puts_everything_back) {
     const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3(0.08f, 0.08f, 0.08f);
     test_pair t = test_pair_new(3, 0.01, FSDEM_MPS_MODEL_B, 1e-6, lo, hi, 0.06, 2500);
     const fsdem_dem_desc dd = fsdem_dem_get_desc(t.dem);
+    const char *path = "build/test_mps_dem_put_back_gauges.csv";
     fsdem_dem_particles P;
     test_kept before, after;
+    unsigned char *rows;
+    size_t size;
     fsdem_real dt = 0;
+    ck_assert_int_eq(fsdem_mps_add_gauge(t.mps, FSDEM_MPS_GAUGE_KIND_LEVEL, fsdem_v3(0.02f, 0.02f, 0), 0, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_mps_gauges_open(t.mps, path, 0), FSDEM_OK); /* a row every step */
     test_add_sphere(&t, fsdem_v3(0.04f, 0.04f, 0.03f), fsdem_v3(1, 0, 0), 0.002);
     test_add_sphere(&t, fsdem_v3(0.02f, 0.04f, 0.03f), fsdem_v3(0, 0, 0), 0.002);
     ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK);
@@ -619,12 +625,17 @@ START_TEST(test_mps_dem_failure_after_moving_puts_everything_back) {
                                                   P.velocity[0], P.angular_velocity[0]),
                      FSDEM_OK); /* at 1 m/s: out half-way through the step */
     TEST_KEEP(fsdem_mps_dem_save_memory, t.cpl, fsdem_mps_dem_get_stats(t.cpl).coupling, &before);
+    rows = test_file_bytes(path, &size);
     ck_assert_int_eq(fsdem_mps_dem_step_dt(t.cpl, dt), FSDEM_ERR_OUT_OF_DOMAIN);
     ck_assert_ptr_nonnull(strstr(fsdem_mps_dem_last_error(t.cpl), "DEM substeps"));
     TEST_KEEP(fsdem_mps_dem_save_memory, t.cpl, fsdem_mps_dem_get_stats(t.cpl).coupling, &after);
     test_kept_same(&before, &after, "MPS-DEM");
+    test_file_is(path, rows, size, 0, "the row of the step put back"); /* not written */
     ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3(0.04f, 0.04f, 0.03f), P.velocity[0], P.angular_velocity[0]), FSDEM_OK);
     ck_assert_int_eq(fsdem_mps_dem_step_dt(t.cpl, dt), FSDEM_OK);
+    test_file_is(path, rows, size, 1, "the row of the step taken");
+    ck_assert_int_eq(fsdem_mps_gauges_close(t.mps), FSDEM_OK);
+    free(rows);
     test_pair_free(&t);
 }
 END_TEST

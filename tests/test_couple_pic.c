@@ -702,23 +702,34 @@ END_TEST
 
 /* A step that fails once something moved (>>couple_step): a body that leaves the DEM's domain in
    its substeps, after the PIC has stepped. Coupler, PIC and DEM are put back as they were (saved
-   bytes and statistics), and with the body back inside the same step runs. */
+   bytes and statistics), the PIC's gauge file too (its row of the step is held, then dropped), and
+   with the body back inside the same step runs. */
 START_TEST(failure_after_moving_puts_everything_back) {
     tank t = make_tank(2, 0.4, 0.3, 0, G, 0.01, fsdem_v3(0.2, 0.1, 0), 0.04, 2000, 0, fsdem_v3(0, 0, 0), 0);
     const fsdem_dem_particles P = fsdem_dem_get_particles(t.dem);
     const fsdem_real dt = (fsdem_real)1e-3;
+    const char *path = "build/test_pic_dem_put_back_gauges.csv";
     test_kept before, after;
+    unsigned char *rows;
+    size_t size;
+    ck_assert_int_eq(fsdem_pic_add_gauge(t.pic, FSDEM_PIC_GAUGE_KIND_LEVEL, fsdem_v3(0.1f, 0.15f, 0), 0, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_gauges_open(t.pic, path, 0), FSDEM_OK); /* a row every step */
     ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, dt), FSDEM_OK);
     ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3((fsdem_real)(0.4 - 0.5 * dt), P.position[0].y, 0), fsdem_v3(1, 0, 0),
                                                   fsdem_v3(0, 0, 0)),
                      FSDEM_OK); /* at 1 m/s: out half-way through the step */
     TEST_KEEP(fsdem_pic_dem_save_memory, t.cp, fsdem_pic_dem_get_stats(t.cp).coupling, &before);
+    rows = test_file_bytes(path, &size);
     ck_assert_int_eq(fsdem_pic_dem_step_dt(t.cp, dt), FSDEM_ERR_OUT_OF_DOMAIN);
     ck_assert_ptr_nonnull(strstr(fsdem_pic_dem_last_error(t.cp), "DEM substeps"));
     TEST_KEEP(fsdem_pic_dem_save_memory, t.cp, fsdem_pic_dem_get_stats(t.cp).coupling, &after);
     test_kept_same(&before, &after, "PIC-DEM");
+    test_file_is(path, rows, size, 0, "the row of the step put back"); /* not written */
     ck_assert_int_eq(fsdem_dem_set_particle_state(t.dem, 0, fsdem_v3(0.2f, P.position[0].y, 0), fsdem_v3(1, 0, 0), fsdem_v3(0, 0, 0)), FSDEM_OK);
     ck_assert_msg(fsdem_pic_dem_step_dt(t.cp, dt) == FSDEM_OK, "%s", fsdem_pic_dem_last_error(t.cp));
+    test_file_is(path, rows, size, 1, "the row of the step taken");
+    ck_assert_int_eq(fsdem_pic_gauges_close(t.pic), FSDEM_OK);
+    free(rows);
     free_tank(&t);
 }
 END_TEST

@@ -372,24 +372,35 @@ END_TEST
 
 /* A step that fails once something moved (>>couple_step): a sphere that leaves the DEM's domain in
    its substeps, after the water has stepped. Coupler, SWE and DEM are put back as they were (saved
-   bytes and statistics), and with the sphere back inside the same step runs. */
+   bytes and statistics), the SWE's gauge file too, and with the sphere back inside the same step
+   runs. */
 START_TEST(failure_after_moving_puts_everything_back) {
     world w = world_new(10, 100, 1, 0.5, 0.2, 500, 5, 1, 0, 1);
     const fsdem_dem_particles P = fsdem_dem_get_particles(w.dem);
+    const char *path = "build/test_swe_dem_put_back_gauges.csv";
     test_kept before, after;
+    unsigned char *rows;
+    size_t size;
     fsdem_real dt = 0;
+    ck_assert_int_eq(fsdem_swe_add_gauge(w.swe, 3, 0, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_swe_gauges_open(w.swe, path, 0), FSDEM_OK); /* a row every step */
     ck_assert_int_eq(capped_step(w.cpl, 0, &dt), FSDEM_OK);
     ck_assert_int_eq(fsdem_dem_set_particle_state(w.dem, 0, fsdem_v3((fsdem_real)(10 - dt), P.position[0].y, P.position[0].z), fsdem_v3(2, 0, 0),
                                                   fsdem_v3(0, 0, 0)),
                      FSDEM_OK); /* at 2 m/s: out half-way through the step */
     TEST_KEEP(fsdem_swe_dem_save_memory, w.cpl, fsdem_swe_dem_get_stats(w.cpl).coupling, &before);
+    rows = test_file_bytes(path, &size);
     ck_assert_int_eq(fsdem_swe_dem_step_dt(w.cpl, dt), FSDEM_ERR_OUT_OF_DOMAIN);
     ck_assert_ptr_nonnull(strstr(fsdem_swe_dem_last_error(w.cpl), "DEM substeps"));
     TEST_KEEP(fsdem_swe_dem_save_memory, w.cpl, fsdem_swe_dem_get_stats(w.cpl).coupling, &after);
     test_kept_same(&before, &after, "SWE-DEM");
+    test_file_is(path, rows, size, 0, "the row of the step put back"); /* not written */
     ck_assert_int_eq(fsdem_dem_set_particle_state(w.dem, 0, fsdem_v3(5, P.position[0].y, P.position[0].z), fsdem_v3(2, 0, 0), fsdem_v3(0, 0, 0)),
                      FSDEM_OK);
     ck_assert_msg(fsdem_swe_dem_step_dt(w.cpl, dt) == FSDEM_OK, "%s", fsdem_swe_dem_last_error(w.cpl));
+    test_file_is(path, rows, size, 1, "the row of the step taken");
+    ck_assert_int_eq(fsdem_swe_gauges_close(w.swe), FSDEM_OK);
+    free(rows);
     world_free(&w);
 }
 END_TEST

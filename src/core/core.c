@@ -296,7 +296,9 @@ static int fsdem__finite(fsdem_real x) { return x == x && x - x == 0; }
    start and the end of the step that passed each one (interval 0: one row per step). The series
    samples its solver itself: a solver's step calls fsdem__series_begin first and fsdem__series_step
    last, and nothing else. `before` holds the values at the start of the step in flight, `now` those
-   at its end. */
+   at its end. Held (fsdem__series_hold), the rows of a step wait, unwritten, until the next step
+   begins or the hold ends; a coupled step holds them, so that a step it puts back (>>couple_step)
+   drops them (fsdem__series_drop) and leaves the file as it was. */
 typedef void (*fsdem__series_sample_fn)(const void *solver, fsdem_real *out);
 typedef struct fsdem__series {
     void *file;            /* FILE*, NULL when closed */
@@ -305,6 +307,9 @@ typedef struct fsdem__series {
     fsdem_real *before, *now;
     fsdem__series_sample_fn sample;
     const void *solver;
+    int hold;              /* the rows of a step wait */
+    int pending;           /* the rows of the step from pending_t0 to pending_t1 wait (its values in */
+    double pending_t0, pending_t1; /* before and now) */
 } fsdem__series;
 
 /* Writes the row of time t with the values in ser->now. */
@@ -341,17 +346,10 @@ static fsdem_result fsdem__series_open(fsdem__series *ser, const fsdem_allocator
     return FSDEM_OK;
 }
 
-/* Before a step: the values at its start, from which the rows inside it are interpolated. */
-static void fsdem__series_begin(fsdem__series *ser) {
-    if (ser->file && ser->interval > 0) ser->sample(ser->solver, ser->before);
-}
-
-/* After a step from t0 to t1: samples its end and writes the rows it passed. */
-static fsdem_result fsdem__series_step(fsdem__series *ser, double t0, double t1) {
+/* Writes the rows of the step from t0 to t1 (its values in before and now). */
+static fsdem_result fsdem__series_write(fsdem__series *ser, double t0, double t1) {
     FILE *fp = (FILE *)ser->file;
     int k;
-    if (!fp) return FSDEM_OK;
-    ser->sample(ser->solver, ser->now);
     if (ser->interval <= 0) fsdem__series_row(ser, t1);
     for (; ser->interval > 0 && ser->next <= t1 * (1 + 1e-12); ser->next += ser->interval) {
         const double w = t1 > t0 ? (ser->next - t0) / (t1 - t0) : 1;
@@ -362,10 +360,52 @@ static fsdem_result fsdem__series_step(fsdem__series *ser, double t0, double t1)
     return ferror(fp) ? FSDEM_ERR_IO : FSDEM_OK;
 }
 
+/* Writes the rows that wait, if any. */
+static fsdem_result fsdem__series_release(fsdem__series *ser) {
+    if (!ser->pending) return FSDEM_OK;
+    ser->pending = 0;
+    return fsdem__series_write(ser, ser->pending_t0, ser->pending_t1);
+}
+
+/* Holds the rows of the steps to come (hold = 1), or ends the hold and writes the rows that wait. */
+static fsdem_result fsdem__series_hold(fsdem__series *ser, int hold) {
+    ser->hold = hold;
+    return hold ? FSDEM_OK : fsdem__series_release(ser);
+}
+
+/* fsdem_X_gauges_hold of a solver whose series is `ser` (its status st, its public name fn). */
+static fsdem_result fsdem__series_hold_call(fsdem__series *ser, fsdem__status *st, const char *fn, int hold) {
+    if (!ser->file) return fsdem__ok(st);
+    return fsdem__series_hold(ser, hold != 0) == FSDEM_OK ? fsdem__ok(st) : fsdem__fail(st, FSDEM_ERR_IO, "%s: write error", fn);
+}
+
+/* Forgets the rows that wait (their step was put back). */
+static void fsdem__series_drop(fsdem__series *ser) { ser->pending = 0; }
+
+/* Before a step: the rows of a step held before it written, then the values at its start, from which
+   the rows inside it are interpolated. */
+static void fsdem__series_begin(fsdem__series *ser) {
+    if (!ser->file) return;
+    fsdem__series_release(ser); /* a write error stays in the file's error flag for the step to report */
+    if (ser->interval > 0) ser->sample(ser->solver, ser->before);
+}
+
+/* After a step from t0 to t1: samples its end and writes the rows it passed, or holds them. */
+static fsdem_result fsdem__series_step(fsdem__series *ser, double t0, double t1) {
+    if (!ser->file) return FSDEM_OK;
+    ser->sample(ser->solver, ser->now);
+    if (!ser->hold) return fsdem__series_write(ser, t0, t1);
+    ser->pending = 1;
+    ser->pending_t0 = t0;
+    ser->pending_t1 = t1;
+    return FSDEM_OK;
+}
+
 /* Closes the file (a last newline) and frees the rows. FSDEM_ERR_IO when writing failed. */
 static fsdem_result fsdem__series_close(fsdem__series *ser, const fsdem_allocator *al) {
     int bad;
     if (!ser->file) return FSDEM_OK;
+    fsdem__series_release(ser);
     fputc('\n', (FILE *)ser->file);
     bad = ferror((FILE *)ser->file);
     bad |= fclose((FILE *)ser->file) != 0;

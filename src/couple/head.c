@@ -28,6 +28,7 @@ typedef struct fsdem__fluid {
     fsdem_result (*step_dt)(void *fluid, fsdem_real dt);
     const char *(*last_error)(const void *fluid);
     fsdem_claims *(*claims)(void *fluid);
+    fsdem_result (*gauges_hold)(void *fluid, int hold);
 } fsdem__fluid;
 
 /* What makes a coupler of one kind. */
@@ -161,21 +162,24 @@ static fsdem_result fsdem__fluid_pic_stable(const void *f, fsdem_real *dt) { ret
 static fsdem_result fsdem__fluid_pic_step(void *f, fsdem_real dt) { return fsdem_pic_step_dt((fsdem_pic *)f, dt); }
 static const char *fsdem__fluid_pic_error(const void *f) { return fsdem_pic_last_error((const fsdem_pic *)f); }
 static fsdem_claims *fsdem__fluid_pic_claims(void *f) { return fsdem_pic_claims((fsdem_pic *)f); }
+static fsdem_result fsdem__fluid_pic_hold(void *f, int hold) { return fsdem_pic_gauges_hold((fsdem_pic *)f, hold); }
 static const fsdem__fluid fsdem__fluid_pic = {"PIC", "pic", fsdem__fluid_pic_time, fsdem__fluid_pic_stable, fsdem__fluid_pic_step,
-                                              fsdem__fluid_pic_error, fsdem__fluid_pic_claims};
+                                              fsdem__fluid_pic_error, fsdem__fluid_pic_claims, fsdem__fluid_pic_hold};
 
 static double fsdem__fluid_mps_time(const void *f) { return fsdem_mps_time((const fsdem_mps *)f); }
 static fsdem_result fsdem__fluid_mps_stable(const void *f, fsdem_real *dt) { return fsdem_mps_stable_dt((const fsdem_mps *)f, dt); }
 static fsdem_result fsdem__fluid_mps_step(void *f, fsdem_real dt) { return fsdem_mps_step_dt((fsdem_mps *)f, dt); }
 static const char *fsdem__fluid_mps_error(const void *f) { return fsdem_mps_last_error((const fsdem_mps *)f); }
 static fsdem_claims *fsdem__fluid_mps_claims(void *f) { return fsdem_mps_claims((fsdem_mps *)f); }
+static fsdem_result fsdem__fluid_mps_hold(void *f, int hold) { return fsdem_mps_gauges_hold((fsdem_mps *)f, hold); }
 static const fsdem__fluid fsdem__fluid_mps = {"MPS", "mps", fsdem__fluid_mps_time, fsdem__fluid_mps_stable, fsdem__fluid_mps_step,
-                                              fsdem__fluid_mps_error, fsdem__fluid_mps_claims};
+                                              fsdem__fluid_mps_error, fsdem__fluid_mps_claims, fsdem__fluid_mps_hold};
 
 static double fsdem__fluid_swe_time(const void *f) { return fsdem_swe_time((const fsdem_swe *)f); }
 static fsdem_result fsdem__fluid_swe_stable(const void *f, fsdem_real *dt) { return fsdem_swe_stable_dt((const fsdem_swe *)f, dt); }
 static fsdem_result fsdem__fluid_swe_step(void *f, fsdem_real dt) { return fsdem_swe_step_dt((fsdem_swe *)f, dt); }
 static const char *fsdem__fluid_swe_error(const void *f) { return fsdem_swe_last_error((const fsdem_swe *)f); }
 static fsdem_claims *fsdem__fluid_swe_claims(void *f) { return fsdem_swe_claims((fsdem_swe *)f); }
+static fsdem_result fsdem__fluid_swe_hold(void *f, int hold) { return fsdem_swe_gauges_hold((fsdem_swe *)f, hold); }
 static const fsdem__fluid fsdem__fluid_swe = {"shallow-water", "swe", fsdem__fluid_swe_time, fsdem__fluid_swe_stable, fsdem__fluid_swe_step,
-                                              fsdem__fluid_swe_error, fsdem__fluid_swe_claims};
+                                              fsdem__fluid_swe_error, fsdem__fluid_swe_claims, fsdem__fluid_swe_hold};

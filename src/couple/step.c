@@ -29,14 +29,16 @@ static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem
 }
 
 /* A step of the list failed after something moved, with the message of couplers[from]: every
-   coupler, fluid and DEM put back as kept before the prepare, the message (and a put-back that
-   failed: out of memory, or a fluid with a gauge file open) to every coupler; passes `res` on. */
+   coupler, fluid and DEM put back as kept before the prepare, the fluid's gauge rows of the step
+   dropped, the message (and a put-back that failed, out of memory) to every coupler; passes `res`
+   on. */
 static fsdem_result fsdem__coupled_put_back(fsdem_coupler *const *list, int n, int from, fsdem_result res) {
     char message[FSDEM__MESSAGE_SIZE];
     int k, lost = -1;
     memcpy(message, list[from]->status.message, sizeof message);
     for (k = 0; k < n; ++k)
         if (fsdem__restart_put_back(list[k]) != FSDEM_OK && lost < 0) lost = k;
+    list[0]->cls->fluid->gauges_hold(list[0]->fluid, 0); /* the rows it held were dropped with the step */
     if (lost >= 0)
         return fsdem__coupled_fail(list, n, -1, res, "%s; and the state before the step could not be put back: %s", message,
                                    list[lost]->status.message);
@@ -130,6 +132,7 @@ static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_r
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupler_particles_valid(list[k])) != FSDEM_OK || (res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
             return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
+    f->gauges_hold(fluid, 1); /* the fluid's gauge rows of the step wait until it is taken */
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);
     t0 = clock();
@@ -146,6 +149,8 @@ static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_r
     }
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupled_stages(list[k], dt, 1)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);
+    if ((res = f->gauges_hold(fluid, 0)) != FSDEM_OK) /* the step is taken; its rows could not be written */
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s", list[0]->cls->name, f->last_error(fluid));
     for (k = 0; k < n; ++k) fsdem__ok(&list[k]->status);
     return FSDEM_OK;
 }

@@ -7,9 +7,10 @@
    fluid and DEM back as they were before the call, bit for bit, from a copy of their saved state
    taken before the step (>>restart, without its checksum: the copy never leaves the process). The
    copy costs one save of the coupled run per step, in memory the coupler keeps (grown when the run
-   grows, FSDEM_ERR_OUT_OF_MEMORY before anything moves when it cannot be). One exception: a fluid
-   with a gauge file open (fsdem_X_gauges_open) cannot be put back, since the file has been
-   written; the message then says so. */
+   grows; FSDEM_ERR_OUT_OF_MEMORY before anything moves when it cannot be). The fluid's gauge rows
+   of the step (fsdem_X_gauges_open) wait until the step is taken (fsdem_X_gauges_hold), so a step
+   put back leaves the gauge file as it was too; FSDEM_ERR_IO when they cannot be written then (the
+   step is taken). */
 
 /* Couplers of one fluid stepped together: every coupler's stages before the fluid step, in the
    order of the list, one step of the fluid, then every coupler's stages after it. The step is the

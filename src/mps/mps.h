@@ -471,6 +471,11 @@ FSDEM_API fsdem_result fsdem_mps_gauge(const fsdem_mps *mps, int id, fsdem_real 
 FSDEM_API fsdem_result fsdem_mps_gauges_open(fsdem_mps *mps, const char *path, fsdem_real interval);
 /* Closes the gauge file (also done by fsdem_mps_destroy). FSDEM_ERR_IO. */
 FSDEM_API fsdem_result fsdem_mps_gauges_close(fsdem_mps *mps);
+/* Holds the gauge rows of the steps to come (hold = 1): a step's rows wait, unwritten, until the next
+   step begins or the hold ends (hold = 0 writes them). A coupler holds them through its step, so
+   that a step it puts back leaves the file as it was (>>couple_step). Without an open gauge file
+   there is nothing to hold. FSDEM_ERR_IO when rows could not be written. */
+FSDEM_API fsdem_result fsdem_mps_gauges_hold(fsdem_mps *mps, int hold);
 
 /* Force (N; N per metre of depth in 2D) of the liquid on the box obstacle `id`
    (fsdem_mps_add_box_obstacle) in the last step: the pressure of the step on its faces, each WALL

@@ -123,6 +123,10 @@ fsdem_result fsdem_mps_gauges_open(fsdem_mps *s, const char *path, fsdem_real in
                               fsdem__mps_gauge_values, s);
 }
 
+fsdem_result fsdem_mps_gauges_hold(fsdem_mps *s, int hold) {
+    return s ? fsdem__series_hold_call(&s->gauges.series, &s->status, "fsdem_mps_gauges_hold", hold) : FSDEM_ERR_INVALID_ARG;
+}
+
 fsdem_result fsdem_mps_gauges_close(fsdem_mps *s) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
     return fsdem__gauges_close(&s->gauges, &s->status, &s->allocator, "fsdem_mps_gauges_close");

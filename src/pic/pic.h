@@ -384,6 +384,11 @@ FSDEM_API fsdem_result fsdem_pic_gauge(const fsdem_pic *pic, int id, fsdem_real 
 FSDEM_API fsdem_result fsdem_pic_gauges_open(fsdem_pic *pic, const char *path, fsdem_real interval);
 /* Closes the gauge file (also done by fsdem_pic_destroy). FSDEM_ERR_IO. */
 FSDEM_API fsdem_result fsdem_pic_gauges_close(fsdem_pic *pic);
+/* Holds the gauge rows of the steps to come (hold = 1): a step's rows wait, unwritten, until the next
+   step begins or the hold ends (hold = 0 writes them). A coupler holds them through its step, so
+   that a step it puts back leaves the file as it was (>>couple_step). Without an open gauge file
+   there is nothing to hold. FSDEM_ERR_IO when rows could not be written. */
+FSDEM_API fsdem_result fsdem_pic_gauges_hold(fsdem_pic *pic, int hold);
 
 /* ---- diagnostics ---- */
 

@@ -320,6 +320,10 @@ fsdem_result fsdem_pic_gauges_open(fsdem_pic *s, const char *path, fsdem_real in
                               fsdem__pic_gauge_values, s);
 }
 
+fsdem_result fsdem_pic_gauges_hold(fsdem_pic *s, int hold) {
+    return s ? fsdem__series_hold_call(&s->gauges.series, &s->status, "fsdem_pic_gauges_hold", hold) : FSDEM_ERR_INVALID_ARG;
+}
+
 fsdem_result fsdem_pic_gauges_close(fsdem_pic *s) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
     return fsdem__gauges_close(&s->gauges, &s->status, &s->allocator, "fsdem_pic_gauges_close");

@@ -14,20 +14,26 @@
    keep the object's callbacks; a pressure-extra operator stays as set. */
 /* The gauges of a PIC solver (positions, kinds, radii); their file is not part of the state. */
 /* Point gauges (fsdem__gauges) into fresh arrays; refused while their file is open (`close` names
-   the function that closes it). */
+   the function that closes it), but for a coupled step's put-back (io->unchecked): its gauges are
+   the step's, and their series stays open, the rows the step held dropped. */
 static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fsdem_allocator *al, const char *close) {
     int ng = g->count;
-    fsdem_vec3 *at;
-    int *kind;
-    fsdem_real *radius;
-    if (io->mode == FSDEM__RESTART_CHECK && g->series.file)
+    fsdem_vec3 *at = g->at;
+    int *kind = g->kind;
+    fsdem_real *radius = g->radius;
+    if (io->mode == FSDEM__RESTART_CHECK && g->series.file && !io->unchecked)
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                             "the object has a gauge file open: close it (%s) before restoring and open it again afterwards", close);
     fsdem__restart_count(io, &ng, 1 << 24, sizeof(fsdem_vec3) + sizeof(int) + sizeof(fsdem_real), "gauge count");
-    at = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)ng);
-    kind = (int *)fsdem__restart_block(io, al, sizeof(int) * (size_t)ng);
-    radius = (fsdem_real *)fsdem__restart_block(io, al, sizeof(fsdem_real) * (size_t)ng);
-    if (io->mode == FSDEM__RESTART_COMMIT) {
+    if (io->unchecked) {
+        if (io->res == FSDEM_OK && ng != g->count) fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the gauges changed");
+        if (io->mode == FSDEM__RESTART_COMMIT) fsdem__series_drop(&g->series);
+    } else {
+        at = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)ng);
+        kind = (int *)fsdem__restart_block(io, al, sizeof(int) * (size_t)ng);
+        radius = (fsdem_real *)fsdem__restart_block(io, al, sizeof(fsdem_real) * (size_t)ng);
+    }
+    if (io->mode == FSDEM__RESTART_COMMIT && !io->unchecked) {
         fsdem__gauges_free(g, al);
         g->at = at;
         g->kind = kind;

@@ -75,10 +75,11 @@ static void fsdem__restart_swe(fsdem__restart *io, void *object) {
                             "the desc it was saved with)",
                             grid[0], grid[1], s->nx, s->ny);
     fsdem__restart_same_fields(io, s, same, 15);
-    if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file)
+    if (io->mode == FSDEM__RESTART_CHECK && s->gauges.file && !io->unchecked) /* a put-back keeps it (fsdem__restart_gauges) */
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                             "the object has a gauge file open: close it (fsdem_swe_gauges_close) before restoring and "
                             "open it again afterwards");
+    if (io->mode == FSDEM__RESTART_COMMIT && io->unchecked) fsdem__series_drop(&s->gauges);
 
     fsdem__restart_fields(io, s, state, 14);
 

@@ -117,6 +117,10 @@ fsdem_result fsdem_swe_gauges_open(fsdem_swe *s, const char *path, fsdem_real in
     return fsdem__ok(&s->status);
 }
 
+fsdem_result fsdem_swe_gauges_hold(fsdem_swe *s, int hold) {
+    return s ? fsdem__series_hold_call(&s->gauges, &s->status, "fsdem_swe_gauges_hold", hold) : FSDEM_ERR_INVALID_ARG;
+}
+
 fsdem_result fsdem_swe_gauges_close(fsdem_swe *s) {
     if (!s) return FSDEM_ERR_INVALID_ARG;
     return fsdem__series_close(&s->gauges, &s->allocator) == FSDEM_OK

@@ -310,6 +310,11 @@ FSDEM_API fsdem_result fsdem_swe_gauge(const fsdem_swe *swe, int id, fsdem_swe_c
 FSDEM_API fsdem_result fsdem_swe_gauges_open(fsdem_swe *swe, const char *path, fsdem_real interval);
 /* Closes the gauge file (also done by fsdem_swe_destroy). FSDEM_ERR_IO. */
 FSDEM_API fsdem_result fsdem_swe_gauges_close(fsdem_swe *swe);
+/* Holds the gauge rows of the steps to come (hold = 1): a step's rows wait, unwritten, until the next
+   step begins or the hold ends (hold = 0 writes them). A coupler holds them through its step, so
+   that a step it puts back leaves the file as it was (>>couple_step). Without an open gauge file
+   there is nothing to hold. FSDEM_ERR_IO when rows could not be written. */
+FSDEM_API fsdem_result fsdem_swe_gauges_hold(fsdem_swe *swe, int hold);
 
 /* Signed distance from p to the SWE bed surface z = z_b(x, y), for fsdem_dem_wall_sdf(fsdem_swe_bed_sdf,
    swe, material): (z - z_b)/sqrt(1 + |grad z_b|^2) with the bed normal; exact on planar beds. `user` is
