@@ -365,6 +365,7 @@
 #define fsdem_mps_pressure_matrix fsdem_mps_pressure_matrix_f
 #define fsdem_mps_probe_height fsdem_mps_probe_height_f
 #define fsdem_mps_probe_pressure fsdem_mps_probe_pressure_f
+#define fsdem_mps_reserve fsdem_mps_reserve_f
 #define fsdem_mps_restore fsdem_mps_restore_f
 #define fsdem_mps_restore_memory fsdem_mps_restore_memory_f
 #define fsdem_mps_save fsdem_mps_save_f
@@ -2260,6 +2261,11 @@ FSDEM_API fsdem_mps_desc fsdem_mps_get_desc(const fsdem_mps *mps);
    domain), FSDEM_ERR_OUT_OF_MEMORY. Allocates (outside any step). */
 FSDEM_API fsdem_result fsdem_mps_add_particles(fsdem_mps *mps, fsdem_mps_kind kind, int count,
                                                const fsdem_vec3 *positions, const fsdem_vec3 *velocities);
+/* Makes room for `count` particles more than those present and those its inflows add in the next
+   step, so that the next step allocates no particle storage (a step grows it when it must; a
+   coupled step reserves first, so that a step it puts back allocates nothing). FSDEM_ERR_INVALID_ARG
+   (count < 0), FSDEM_ERR_OUT_OF_MEMORY; nothing changes on failure. */
+FSDEM_API fsdem_result fsdem_mps_reserve(fsdem_mps *mps, int count);
 /* Fills the box [lo, hi] with FLUID particles on the r0 lattice anchored at lo: centres at
    lo + (i + 1/2) r0 per axis, those inside the box and outside every box obstacle, all with
    `velocity`. The number added goes to *added (may be NULL). Errors as fsdem_mps_add_particles,
@@ -3287,6 +3293,10 @@ FSDEM_API fsdem_coupler *fsdem_gic_coupler(fsdem_gic *coupler);
                     fsdem_dem, its fractions, counters and the drag limit of its last step (the
                     per-granule force records are not kept: fsdem_gic_get_force finds none until
                     the next step).
+   A restore writes into the object's own arrays wherever they hold what the save has (the PIC's
+   and the MPS's particle arrays when their capacity is the saved one), so restoring into an object
+   of the sizes saved allocates nothing: a coupled step that fails puts its state back so
+   (>>couple_step).
    What must match (else FSDEM_ERR_INVALID_ARG naming the field): the desc fields that steps read.
    DEM: dim, domain, gravity, law, integrator, dt_rule, dt_param, skin, contact_offset, linear_*,
    disc_length, rotation, the contact options (tangential_*, coulomb_limit), periodic. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,
@@ -15468,6 +15478,15 @@ fsdem_result fsdem_mps_add_particles(fsdem_mps *s, fsdem_mps_kind kind, int coun
     return fsdem__ok(&s->status);
 }
 
+fsdem_result fsdem_mps_reserve(fsdem_mps *s, int count) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (count < 0) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_reserve: count = %d < 0", count);
+    if (count > (1 << 29) - s->n - s->buffered || fsdem__mps_reserve(s, s->n + s->buffered + count) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_reserve: no memory for %d particles",
+                           s->n + s->buffered + count);
+    return fsdem__ok(&s->status);
+}
+
 /* What a lattice walk does with a point: the kind to add, or -1 to skip it. */
 typedef int (*fsdem__mps_classify_fn)(const fsdem_mps *s, const void *user, fsdem_vec3 p);
 
@@ -17144,6 +17163,9 @@ typedef struct fsdem__fluid {
     const char *(*last_error)(const void *fluid);
     fsdem_claims *(*claims)(void *fluid);
     fsdem_result (*gauges_hold)(void *fluid, int hold);
+    fsdem_result (*reserve)(void *fluid); /* may be NULL: the room its next step would allocate, made */
+                                          /*    before a coupled step keeps the state (a capacity */
+                                          /*    saved with it), so that a put-back allocates nothing */
 } fsdem__fluid;
 
 /* What makes a coupler of one kind. */
@@ -17153,12 +17175,11 @@ typedef struct fsdem__coupler_class {
     size_t record_size;                 /* bytes of its per-particle record, whose first field is the int id */
     const fsdem__field *fields;         /* the record's fields (>>core), CSV columns and restart */
     int field_count;
-    /* its step (>>impl_couple_step): prepare (may be NULL) does what must come before the step's length
-       is known, and undo (may be NULL) puts it back when the step is refused; limit (may be NULL)
-       cuts the fluid's stable dt by the coupler's own limits; check refuses a dt before anything
-       moves (chosen: the caller's dt, not a stable one); then the stages in order */
+    /* its step (>>impl_couple_step): prepare (may be NULL) does what must come before the step's
+       length is known; limit (may be NULL) cuts the fluid's stable dt by the coupler's own limits;
+       check refuses a dt before anything moves (chosen: the caller's dt, not a stable one); then the
+       stages in order. A refusal after the state was kept puts it back. */
     fsdem_result (*prepare)(fsdem_coupler *c);
-    void (*undo)(fsdem_coupler *c);
     fsdem_result (*limit)(const fsdem_coupler *c, fsdem_real *dt);
     fsdem_result (*check)(fsdem_coupler *c, fsdem_real dt, int chosen);
     const fsdem__stage *stages;
@@ -17279,7 +17300,7 @@ static const char *fsdem__fluid_pic_error(const void *f) { return fsdem_pic_last
 static fsdem_claims *fsdem__fluid_pic_claims(void *f) { return fsdem_pic_claims((fsdem_pic *)f); }
 static fsdem_result fsdem__fluid_pic_hold(void *f, int hold) { return fsdem_pic_gauges_hold((fsdem_pic *)f, hold); }
 static const fsdem__fluid fsdem__fluid_pic = {"PIC", "pic", fsdem__fluid_pic_time, fsdem__fluid_pic_stable, fsdem__fluid_pic_step,
-                                              fsdem__fluid_pic_error, fsdem__fluid_pic_claims, fsdem__fluid_pic_hold};
+                                              fsdem__fluid_pic_error, fsdem__fluid_pic_claims, fsdem__fluid_pic_hold, NULL};
 
 static double fsdem__fluid_mps_time(const void *f) { return fsdem_mps_time((const fsdem_mps *)f); }
 static fsdem_result fsdem__fluid_mps_stable(const void *f, fsdem_real *dt) { return fsdem_mps_stable_dt((const fsdem_mps *)f, dt); }
@@ -17287,8 +17308,10 @@ static fsdem_result fsdem__fluid_mps_step(void *f, fsdem_real dt) { return fsdem
 static const char *fsdem__fluid_mps_error(const void *f) { return fsdem_mps_last_error((const fsdem_mps *)f); }
 static fsdem_claims *fsdem__fluid_mps_claims(void *f) { return fsdem_mps_claims((fsdem_mps *)f); }
 static fsdem_result fsdem__fluid_mps_hold(void *f, int hold) { return fsdem_mps_gauges_hold((fsdem_mps *)f, hold); }
+static fsdem_result fsdem__fluid_mps_reserve(void *f) { return fsdem_mps_reserve((fsdem_mps *)f, 0); }
 static const fsdem__fluid fsdem__fluid_mps = {"MPS", "mps", fsdem__fluid_mps_time, fsdem__fluid_mps_stable, fsdem__fluid_mps_step,
-                                              fsdem__fluid_mps_error, fsdem__fluid_mps_claims, fsdem__fluid_mps_hold};
+                                              fsdem__fluid_mps_error, fsdem__fluid_mps_claims, fsdem__fluid_mps_hold,
+                                              fsdem__fluid_mps_reserve};
 
 static double fsdem__fluid_swe_time(const void *f) { return fsdem_swe_time((const fsdem_swe *)f); }
 static fsdem_result fsdem__fluid_swe_stable(const void *f, fsdem_real *dt) { return fsdem_swe_stable_dt((const fsdem_swe *)f, dt); }
@@ -17297,7 +17320,7 @@ static const char *fsdem__fluid_swe_error(const void *f) { return fsdem_swe_last
 static fsdem_claims *fsdem__fluid_swe_claims(void *f) { return fsdem_swe_claims((fsdem_swe *)f); }
 static fsdem_result fsdem__fluid_swe_hold(void *f, int hold) { return fsdem_swe_gauges_hold((fsdem_swe *)f, hold); }
 static const fsdem__fluid fsdem__fluid_swe = {"shallow-water", "swe", fsdem__fluid_swe_time, fsdem__fluid_swe_stable, fsdem__fluid_swe_step,
-                                              fsdem__fluid_swe_error, fsdem__fluid_swe_claims, fsdem__fluid_swe_hold};
+                                              fsdem__fluid_swe_error, fsdem__fluid_swe_claims, fsdem__fluid_swe_hold, NULL};
 
 /* ---- >>couple_dem : the DEM's checks and substeps ---- */
 
@@ -17739,7 +17762,7 @@ static const fsdem__field fsdem__swe_dem_fields[9] = {
 
 static const fsdem__coupler_class *fsdem__swe_dem_class(void) {
     static const fsdem__coupler_class cls = {"fsdem_swe_dem", &fsdem__fluid_swe, sizeof(fsdem_swe_dem_force),
-        fsdem__swe_dem_fields, 9, NULL, NULL, NULL, fsdem__swe_dem_check, fsdem__swe_dem_stages, 3};
+        fsdem__swe_dem_fields, 9, NULL, NULL, fsdem__swe_dem_check, fsdem__swe_dem_stages, 3};
     return &cls;
 }
 
@@ -17793,13 +17816,6 @@ struct fsdem_mps_dem {
     fsdem_mps_dem_force *force;    /* per DEM particle of the last update (head.records of them) */
     int force_cap;
     fsdem__mps_dem_tally tally;
-    /* what the update of a step overwrote, put back when the step is refused (fsdem__mps_dem_keep) */
-    fsdem_real *kept_porosity;     /* per MPS particle */
-    fsdem_vec3 *kept_reaction;     /* per MPS particle */
-    fsdem_vec3 *kept_load;         /* per DEM particle: its external force */
-    fsdem_mps_dem_force *kept_force;
-    int kept_mps_cap, kept_dem_cap, kept_forces;
-    fsdem__mps_dem_tally kept_tally;
 };
 
 static const fsdem__coupler_class *fsdem__mps_dem_class(void);
@@ -17905,10 +17921,6 @@ void fsdem_mps_dem_destroy(fsdem_mps_dem *c) {
     fsdem__free(al, c->rate, sizeof(fsdem_real) * (size_t)c->solid_cap);
     fsdem__free(al, c->share, sizeof(fsdem_real) * (size_t)c->solid_cap);
     fsdem__free(al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
-    fsdem__free(al, c->kept_porosity, sizeof(fsdem_real) * (size_t)c->kept_mps_cap);
-    fsdem__free(al, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)c->kept_mps_cap);
-    fsdem__free(al, c->kept_load, sizeof(fsdem_vec3) * (size_t)c->kept_dem_cap);
-    fsdem__free(al, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_dem_cap);
     fsdem__coupler_free(&c->head, sizeof *c);
 }
 
@@ -18174,55 +18186,8 @@ fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *c, const char *path) {
 
 /* ---- >>couple_mps_step : coupled time stepping ---- */
 
-/* Keeps what the update of a step overwrites (the MPS's porosities and reactions, the DEM's loads,
-   the force records and the tally), so that a step refused after its update leaves coupler, MPS
-   and DEM as they were (fsdem__mps_dem_undo). */
-static fsdem_result fsdem__mps_dem_keep(fsdem_mps_dem *c) {
-    const fsdem_mps_coupling mc = fsdem_mps_get_coupling(c->desc.mps);
-    const fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
-    void **const fluid[2] = {(void **)&c->kept_porosity, (void **)&c->kept_reaction};
-    void **const grain[2] = {(void **)&c->kept_load, (void **)&c->kept_force};
-    const size_t fluid_size[2] = {sizeof(fsdem_real), sizeof(fsdem_vec3)};
-    const size_t grain_size[2] = {sizeof(fsdem_vec3), sizeof(fsdem_mps_dem_force)};
-    const int records = c->head.records;
-    if (fsdem__grow_set(&c->head.allocator, fluid, fluid_size, 2, &c->kept_mps_cap, 0, mc.count) != FSDEM_OK ||
-        fsdem__grow_set(&c->head.allocator, grain, grain_size, 2, &c->kept_dem_cap, 0, dc.count > records ? dc.count : records) != FSDEM_OK)
-        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem: out of memory (%d DEM and %d MPS particles)", dc.count,
-                           mc.count);
-    if (mc.count) {
-        memcpy(c->kept_porosity, mc.porosity, sizeof(fsdem_real) * (size_t)mc.count);
-        memcpy(c->kept_reaction, mc.force, sizeof(fsdem_vec3) * (size_t)mc.count);
-    }
-    if (dc.count) memcpy(c->kept_load, dc.force, sizeof(fsdem_vec3) * (size_t)dc.count);
-    if (records) memcpy(c->kept_force, c->force, sizeof(fsdem_mps_dem_force) * (size_t)records);
-    c->kept_forces = records;
-    c->kept_tally = c->tally;
-    return FSDEM_OK;
-}
-
-/* Puts back what fsdem__mps_dem_keep kept (the class's undo). */
-static void fsdem__mps_dem_undo(fsdem_coupler *head) {
-    fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
-    const fsdem_mps_coupling mc = fsdem_mps_get_coupling(c->desc.mps);
-    const fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
-    if (mc.count) {
-        memcpy(mc.porosity, c->kept_porosity, sizeof(fsdem_real) * (size_t)mc.count);
-        memcpy(mc.force, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)mc.count);
-    }
-    if (dc.count) memcpy(dc.force, c->kept_load, sizeof(fsdem_vec3) * (size_t)dc.count);
-    if (c->kept_forces) memcpy(c->force, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_forces);
-    c->head.record = c->force;
-    c->head.records = c->kept_forces;
-    c->tally = c->kept_tally;
-}
-
-/* The update of a step, kept to be undone if the step is refused (the class's prepare). */
-static fsdem_result fsdem__mps_dem_prepare(fsdem_coupler *head) {
-    fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
-    fsdem_result res = fsdem__mps_dem_keep(c);
-    if (res == FSDEM_OK && (res = fsdem_mps_dem_update(c)) != FSDEM_OK) fsdem__mps_dem_undo(head);
-    return res;
-}
+/* The update of a step (the class's prepare). */
+static fsdem_result fsdem__mps_dem_prepare(fsdem_coupler *head) { return fsdem_mps_dem_update((fsdem_mps_dem *)(void *)head); }
 
 /* The drag limit of the last update on the stable step (>>couple_mps; the class's limit). */
 static fsdem_result fsdem__mps_dem_limit(const fsdem_coupler *head, fsdem_real *dt) {
@@ -18264,7 +18229,7 @@ static const fsdem__field fsdem__mps_dem_fields[8] = {
 
 static const fsdem__coupler_class *fsdem__mps_dem_class(void) {
     static const fsdem__coupler_class cls = {"fsdem_mps_dem", &fsdem__fluid_mps, sizeof(fsdem_mps_dem_force),
-        fsdem__mps_dem_fields, 8, fsdem__mps_dem_prepare, fsdem__mps_dem_undo, fsdem__mps_dem_limit, fsdem__mps_dem_check,
+        fsdem__mps_dem_fields, 8, fsdem__mps_dem_prepare, fsdem__mps_dem_limit, fsdem__mps_dem_check,
         fsdem__mps_dem_stages, 2};
     return &cls;
 }
@@ -18409,33 +18374,27 @@ static void fsdem__pic_dem_free_bodies(fsdem_pic_dem *c) {
 }
 
 /* Per-body arrays for `n` bodies (zeroed). Allocates only when the DEM has more particles than any
-   step before. */
+   step before; all of them or, out of memory, none (nothing changes). */
 static fsdem_result fsdem__pic_dem_reserve_bodies(fsdem_pic_dem *c, int n) {
     const fsdem_allocator *al = &c->head.allocator;
     const size_t m = (size_t)(n > 0 ? n : 1), V = sizeof(fsdem_vec3) * m, R = sizeof(fsdem_real) * m;
+    void **const arrays[9] = {(void **)&c->load,  (void **)&c->vstar,  (void **)&c->wstar,      (void **)&c->inv_m,    (void **)&c->inv_i,
+                              (void **)&c->weight, (void **)&c->relax, (void **)&c->face_start, (void **)&c->jac_start};
+    const size_t bytes[9] = {sizeof(fsdem_pic_dem_force) * m, V, V, R, R, R, R, sizeof(int) * (m + 1), sizeof(int) * (m + 1)};
+    void *fresh[9];
+    int k;
     if (n <= c->body_cap && c->vstar) return FSDEM_OK;
+    for (k = 0; k < 9; ++k)
+        if (!(fresh[k] = fsdem__alloc(al, bytes[k]))) {
+            while (k-- > 0) fsdem__free(al, fresh[k], bytes[k]);
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        }
     fsdem__pic_dem_free_bodies(c);
-    c->load = (fsdem_pic_dem_force *)fsdem__alloc(al, sizeof(fsdem_pic_dem_force) * m);
-    c->vstar = (fsdem_vec3 *)fsdem__alloc(al, V);
-    c->wstar = (fsdem_vec3 *)fsdem__alloc(al, V);
-    c->inv_m = (fsdem_real *)fsdem__alloc(al, R);
-    c->inv_i = (fsdem_real *)fsdem__alloc(al, R);
-    c->weight = (fsdem_real *)fsdem__alloc(al, R);
-    c->relax = (fsdem_real *)fsdem__alloc(al, R);
-    c->face_start = (int *)fsdem__alloc(al, sizeof(int) * (m + 1));
-    c->jac_start = (int *)fsdem__alloc(al, sizeof(int) * (m + 1));
-    c->body_cap = (int)m;
-    if (!c->load || !c->vstar || !c->wstar || !c->inv_m || !c->inv_i || !c->weight || !c->relax || !c->face_start || !c->jac_start) {
-        fsdem__pic_dem_free_bodies(c);
-        return FSDEM_ERR_OUT_OF_MEMORY;
+    for (k = 0; k < 9; ++k) {
+        memset(fresh[k], 0, bytes[k]);
+        *arrays[k] = fresh[k];
     }
-    memset(c->load, 0, sizeof(fsdem_pic_dem_force) * m);
-    memset(c->vstar, 0, V);
-    memset(c->wstar, 0, V);
-    memset(c->weight, 0, R);
-    memset(c->relax, 0, R);
-    memset(c->face_start, 0, sizeof(int) * (m + 1));
-    memset(c->jac_start, 0, sizeof(int) * (m + 1));
+    c->body_cap = (int)m;
     c->loaded = 0;
     return FSDEM_OK;
 }
@@ -19191,7 +19150,7 @@ static const fsdem__field fsdem__pic_dem_fields[7] = {
 
 static const fsdem__coupler_class *fsdem__pic_dem_class(void) {
     static const fsdem__coupler_class cls = {"fsdem_pic_dem", &fsdem__fluid_pic, sizeof(fsdem_pic_dem_force),
-        fsdem__pic_dem_fields, 7, NULL, NULL, fsdem__pic_dem_limit, fsdem__pic_dem_check, fsdem__pic_dem_stages, 6};
+        fsdem__pic_dem_fields, 7, NULL, fsdem__pic_dem_limit, fsdem__pic_dem_check, fsdem__pic_dem_stages, 6};
     return &cls;
 }
 
@@ -19689,7 +19648,7 @@ static const fsdem__field fsdem__gic_fields[8] = {
 
 static const fsdem__coupler_class *fsdem__gic_class(void) {
     static const fsdem__coupler_class cls = {"fsdem_gic", &fsdem__fluid_pic, sizeof(fsdem_gic_force), fsdem__gic_fields, 8, NULL,
-        NULL, fsdem__gic_limit, fsdem__gic_check, fsdem__gic_stages, 3};
+        fsdem__gic_limit, fsdem__gic_check, fsdem__gic_stages, 3};
     return &cls;
 }
 
@@ -20235,11 +20194,12 @@ static void fsdem__restart_dem(fsdem__restart *io, void *object) {
    linear solvers (set up at every use), CPU times, the allocator, log and message. SDF obstacles
    keep the object's callbacks; a pressure-extra operator stays as set. */
 /* The gauges of a PIC solver (positions, kinds, radii); their file is not part of the state. */
-/* Point gauges (fsdem__gauges) into fresh arrays; refused while their file is open (`close` names
-   the function that closes it), but for a coupled step's put-back (io->unchecked): its gauges are
-   the step's, and their series stays open, the rows the step held dropped. */
+/* Point gauges (fsdem__gauges), into the object's arrays when they hold them (else fresh ones);
+   refused while their file is open (`close` names the function that closes it), but for a coupled
+   step's put-back (io->unchecked): its gauges are the step's, and their series stays open, the rows
+   the step held dropped. */
 static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fsdem_allocator *al, const char *close) {
-    int ng = g->count;
+    int ng = g->count, in_place;
     fsdem_vec3 *at = g->at;
     int *kind = g->kind;
     fsdem_real *radius = g->radius;
@@ -20247,39 +20207,43 @@ static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fs
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                             "the object has a gauge file open: close it (%s) before restoring and open it again afterwards", close);
     fsdem__restart_count(io, &ng, 1 << 24, sizeof(fsdem_vec3) + sizeof(int) + sizeof(fsdem_real), "gauge count");
-    if (io->unchecked) {
-        if (io->res == FSDEM_OK && ng != g->count) fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the gauges changed");
-        if (io->mode == FSDEM__RESTART_COMMIT) fsdem__series_drop(&g->series);
-    } else {
+    in_place = ng <= g->capacity;
+    if (!in_place) {
         at = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)ng);
         kind = (int *)fsdem__restart_block(io, al, sizeof(int) * (size_t)ng);
         radius = (fsdem_real *)fsdem__restart_block(io, al, sizeof(fsdem_real) * (size_t)ng);
     }
-    if (io->mode == FSDEM__RESTART_COMMIT && !io->unchecked) {
-        fsdem__gauges_free(g, al);
-        g->at = at;
-        g->kind = kind;
-        g->radius = radius;
-        g->count = g->capacity = ng;
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        if (io->unchecked) fsdem__series_drop(&g->series);
+        if (!in_place) {
+            fsdem__gauges_free(g, al);
+            g->at = at;
+            g->kind = kind;
+            g->radius = radius;
+            g->capacity = ng;
+        }
+        g->count = ng;
     }
     fsdem__restart_data(io, g->at, sizeof(fsdem_vec3) * (size_t)ng);
     fsdem__restart_ints(io, g->kind, ng, FSDEM__GAUGE_LEVEL, FSDEM__GAUGE_PRESSURE, "gauge kind");
     fsdem__restart_data(io, g->radius, sizeof(fsdem_real) * (size_t)ng);
 }
 
-/* The obstacles, into a fresh array (polygons own their vertices); SDF obstacles keep the object's
-   callbacks. */
+/* The obstacles (polygons own their vertices), written into the object's arrays where they hold
+   them, else into fresh ones; SDF obstacles keep the object's callbacks. */
 static void fsdem__restart_pic_obstacles(fsdem__restart *io, fsdem_pic *s) {
     const fsdem_allocator *al = &s->allocator;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
-    int no = s->obst_count, k;
+    int no = s->obst_count, k, in_place;
     fsdem__pic_obst *obst;
     fsdem__restart_count(io, &no, 1 << 20, 2 * sizeof(int) + 5 * sizeof(fsdem_vec3) + sizeof(fsdem_real), "obstacle count");
-    obst = (fsdem__pic_obst *)fsdem__restart_block(io, al, sizeof(fsdem__pic_obst) * (size_t)no);
+    in_place = no <= s->obst_capacity;
+    obst = in_place ? s->obst : (fsdem__pic_obst *)fsdem__restart_block(io, al, sizeof(fsdem__pic_obst) * (size_t)no);
     for (k = 0; k < no && io->res == FSDEM_OK; ++k) {
+        const fsdem__pic_obst *own = k < s->obst_count ? &s->obst[k] : NULL; /* the object's obstacle k */
         fsdem__pic_obst o;
         fsdem_vec3 *verts;
-        int type, nv;
+        int type, nv, own_verts;
         if (io->mode == FSDEM__RESTART_WRITE) o = s->obst[k];
         else memset(&o, 0, sizeof o);
         type = (int)o.d.type;
@@ -20294,20 +20258,23 @@ static void fsdem__restart_pic_obstacles(fsdem__restart *io, fsdem_pic *s) {
         fsdem__restart_count(io, &nv, 1 << 24, sizeof(fsdem_vec3), "polygon vertex count");
         if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && (type == FSDEM_PIC_OBSTACLE_TYPE_POLYGON) != (nv >= 3))
             fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "obstacle %d has %d vertices (corrupted data)", k, nv);
-        verts = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)nv);
+        own_verts = own && own->verts && own->d.vertex_count == nv;
+        verts = own_verts ? own->verts : (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)nv);
         fsdem__restart_data(io, io->mode == FSDEM__RESTART_WRITE ? o.verts : verts, sizeof(fsdem_vec3) * (size_t)nv);
         if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_PIC_OBSTACLE_TYPE_SDF) {
-            if (k >= s->obst_count || s->obst[k].d.type != FSDEM_PIC_OBSTACLE_TYPE_SDF)
+            if (!own || own->d.type != FSDEM_PIC_OBSTACLE_TYPE_SDF)
                 fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                                     "obstacle %d is an SDF obstacle in the save: add the same SDF obstacles "
                                     "(fsdem_pic_obstacle_sdf), in the same order, to the object before restoring",
                                     k);
             else {
-                o.d.sdf = s->obst[k].d.sdf;
-                o.d.sdf_user = s->obst[k].d.sdf_user;
+                o.d.sdf = own->d.sdf;
+                o.d.sdf_user = own->d.sdf_user;
             }
         }
         if (commit) {
+            if (own && own->verts && !own_verts) fsdem__pic_release(s, own->verts, sizeof(fsdem_vec3) * (size_t)own->d.vertex_count);
+            if (!own_verts) s->bytes += sizeof(fsdem_vec3) * (size_t)nv;
             o.d.type = (fsdem_pic_obstacle_type)type;
             o.d.vertex_count = nv;
             o.d.vertices = o.verts = verts;
@@ -20315,25 +20282,27 @@ static void fsdem__restart_pic_obstacles(fsdem__restart *io, fsdem_pic *s) {
         }
     }
     if (commit) {
-        for (k = 0; k < s->obst_count; ++k)
+        for (k = no; k < s->obst_count; ++k)
             if (s->obst[k].verts) fsdem__pic_release(s, s->obst[k].verts, sizeof(fsdem_vec3) * (size_t)s->obst[k].d.vertex_count);
-        fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
-        s->obst = obst;
-        s->obst_count = s->obst_capacity = no;
-        s->bytes += sizeof(fsdem__pic_obst) * (size_t)no;
-        for (k = 0; k < no; ++k) s->bytes += sizeof(fsdem_vec3) * (size_t)obst[k].d.vertex_count;
+        if (!in_place) {
+            fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
+            s->obst = obst;
+            s->obst_capacity = no;
+            s->bytes += sizeof(fsdem__pic_obst) * (size_t)no;
+        }
+        s->obst_count = no;
     }
 }
 
-/* The particles, into fresh arrays of the saved capacity (a full capacity refuses inflow seeds),
-   with their APIC matrices. */
+/* The particles, with their APIC matrices, into arrays of the saved capacity (a full capacity
+   refuses inflow seeds): the object's own when it has that capacity, else fresh ones. */
 static void fsdem__restart_pic_particles(fsdem__restart *io, fsdem_pic *s) {
     const fsdem_allocator *al = &s->allocator;
     const int commit = io->mode == FSDEM__RESTART_COMMIT, apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC;
     int np = s->np, pcap = s->pcap, a;
     fsdem__restart_count(io, &pcap, 1 << 29, 0, "particle capacity");
     fsdem__restart_count(io, &np, pcap, 2 * sizeof(fsdem_vec3), "particle count");
-    if (io->res == FSDEM_OK) {
+    if (io->res == FSDEM_OK && pcap != s->pcap) {
         const size_t vb = sizeof(fsdem_vec3) * (size_t)pcap, ib = sizeof(int) * (size_t)pcap;
         fsdem_vec3 *px = (fsdem_vec3 *)fsdem__restart_block(io, al, vb), *pv = (fsdem_vec3 *)fsdem__restart_block(io, al, vb);
         fsdem_vec3 *pt = (fsdem_vec3 *)fsdem__restart_block(io, al, vb), *pc[3] = {NULL, NULL, NULL};
@@ -20352,11 +20321,13 @@ static void fsdem__restart_pic_particles(fsdem__restart *io, fsdem_pic *s) {
             s->pcell = pcell;
             s->pidx = pidx;
             s->pflag = pflag;
-            if (pflag) memset(pflag, 0, (size_t)pcap);
             s->pcap = pcap;
-            s->np = np;
             s->bytes += (apic ? 6 : 3) * vb + 2 * ib + (size_t)pcap;
         }
+    }
+    if (commit) {
+        if (s->pflag) memset(s->pflag, 0, (size_t)pcap);
+        s->np = np;
     }
     fsdem__restart_data(io, s->px, sizeof(fsdem_vec3) * (size_t)np);
     fsdem__restart_data(io, s->pv, sizeof(fsdem_vec3) * (size_t)np);
@@ -20440,38 +20411,44 @@ static void fsdem__restart_pic(fsdem__restart *io, void *object) {
 
 /* ---- >>restart_swe : shallow water ---- */
 
-/* The per-cell masks of the SWE: the blocked cells, when there are any (nx*ny flags); `masks`
-   counts them, so data with a mask this build does not know are refused. */
+/* The per-cell masks of the SWE: the blocked cells, when there are any (nx*ny flags; into the
+   object's array when it has one); `masks` counts them, so data with a mask this build does not know
+   are refused. */
 static void fsdem__restart_swe_masks(fsdem__restart *io, fsdem_swe *s) {
     int masks = s->blocked ? 1 : 0, k, count = 0;
     unsigned char *blocked;
     fsdem__restart_int_in(io, &masks, 0, 1, "the number of per-cell masks (data of a newer build)");
-    blocked = masks ? (unsigned char *)fsdem__restart_block(io, &s->allocator, (size_t)s->n) : NULL;
-    if (masks) fsdem__restart_flags(io, io->mode == FSDEM__RESTART_WRITE ? s->blocked : blocked, s->n, 1, "blocked flag of cell");
+    blocked = !masks || s->blocked ? s->blocked : (unsigned char *)fsdem__restart_block(io, &s->allocator, (size_t)s->n);
+    if (masks) fsdem__restart_flags(io, blocked, s->n, 1, "blocked flag of cell");
     if (io->mode != FSDEM__RESTART_COMMIT) return;
-    fsdem__free(&s->allocator, s->blocked, (size_t)s->n);
+    if (!masks) {
+        fsdem__free(&s->allocator, s->blocked, (size_t)s->n);
+        blocked = NULL;
+    }
     s->blocked = blocked;
     for (k = 0; blocked && k < s->n; ++k) count += blocked[k];
     s->blocked_count = count;
 }
 
-/* A series of n points (times and values): written, or read into fresh arrays that COMMIT hands to
-   *t and *v after freeing the old ones. */
+/* A series of n points (times and values): written, or read into *t and *v when they have that
+   length, else into fresh arrays that COMMIT hands to *t and *v after freeing the old ones. */
 static void fsdem__restart_swe_series(fsdem__restart *io, fsdem_swe *s, fsdem_real **t, fsdem_real **v, int *n,
                                       const char *what) {
     int count = *n;
-    fsdem_real *ft, *fv;
+    fsdem_real *ft = *t, *fv = *v;
     fsdem__restart_count(io, &count, 1 << 28, 2 * sizeof(fsdem_real), what);
-    ft = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
-    fv = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
-    if (io->mode == FSDEM__RESTART_COMMIT) {
-        fsdem__swe_free_series(s, t, v, n);
-        *t = ft;
-        *v = fv;
-        *n = count;
+    if (count != *n) {
+        ft = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
+        fv = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
+        if (io->mode == FSDEM__RESTART_COMMIT) {
+            fsdem__swe_free_series(s, t, v, n);
+            *t = ft;
+            *v = fv;
+            *n = count;
+        }
     }
-    fsdem__restart_data(io, *t, sizeof(fsdem_real) * (size_t)count);
-    fsdem__restart_data(io, *v, sizeof(fsdem_real) * (size_t)count);
+    fsdem__restart_data(io, ft, sizeof(fsdem_real) * (size_t)count);
+    fsdem__restart_data(io, fv, sizeof(fsdem_real) * (size_t)count);
 }
 
 /* Everything of a shallow-water solver, in order. State: time, last dt, counters, the bound of the
@@ -20555,10 +20532,11 @@ static void fsdem__restart_swe(fsdem__restart *io, void *object) {
         }
     }
 
-    /* point sources, into a fresh array */
+    /* point sources and gauge positions (the gauge file is not part of the state), into the object's
+       arrays when they hold them, else into fresh ones */
     fsdem__restart_count(io, &ns, 1 << 24, sizeof(fsdem_real) + 4 * sizeof(int), "point source count");
     fsdem__restart_value(io, &next_id, sizeof next_id);
-    src = (fsdem__swe_src *)fsdem__restart_block(io, al, sizeof(fsdem__swe_src) * (size_t)ns);
+    src = ns <= s->src_capacity ? s->src : (fsdem__swe_src *)fsdem__restart_block(io, al, sizeof(fsdem__swe_src) * (size_t)ns);
     for (k = 0; k < ns && io->res == FSDEM_OK; ++k) {
         fsdem__swe_src q;
         if (io->mode == FSDEM__RESTART_WRITE) q = s->src[k];
@@ -20567,24 +20545,31 @@ static void fsdem__restart_swe(fsdem__restart *io, void *object) {
         fsdem__restart_int_in(io, &q.cell, 0, s->n - 1, "point source cell");
         fsdem__restart_value(io, &q.id, sizeof q.id);
         fsdem__restart_int_in(io, &q.active, 0, 1, "point source active flag");
+        if (io->mode != FSDEM__RESTART_WRITE && k < s->src_count) { /* its series into the object's source k's */
+            q.t = s->src[k].t;
+            q.v = s->src[k].v;
+            q.n = s->src[k].n;
+        }
         fsdem__restart_swe_series(io, s, &q.t, &q.v, &q.n, "point source series length");
         if (commit) src[k] = q;
     }
-    if (commit) {
-        for (k = 0; k < s->src_count; ++k) fsdem__swe_free_series(s, &s->src[k].t, &s->src[k].v, &s->src[k].n);
-        fsdem__free(al, s->src, sizeof(fsdem__swe_src) * (size_t)s->src_capacity);
-        s->src = src;
-        s->src_count = s->src_capacity = ns;
-        s->src_next_id = next_id;
-    }
-
-    /* gauge positions (the file is not part of the state) */
     fsdem__restart_count(io, &ng, 1 << 24, 2 * sizeof(fsdem_real), "gauge count");
-    xy = (fsdem_real *)fsdem__restart_block(io, al, 2 * sizeof(fsdem_real) * (size_t)ng);
+    xy = ng <= s->gauge_capacity ? s->gauge : (fsdem_real *)fsdem__restart_block(io, al, 2 * sizeof(fsdem_real) * (size_t)ng);
     if (commit) {
-        fsdem__free(al, s->gauge, 2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
-        s->gauge = xy;
-        s->gauge_count = s->gauge_capacity = ng;
+        for (k = ns; k < s->src_count; ++k) fsdem__swe_free_series(s, &s->src[k].t, &s->src[k].v, &s->src[k].n);
+        if (src != s->src) {
+            fsdem__free(al, s->src, sizeof(fsdem__swe_src) * (size_t)s->src_capacity);
+            s->src = src;
+            s->src_capacity = ns;
+        }
+        s->src_count = ns;
+        s->src_next_id = next_id;
+        if (xy != s->gauge) {
+            fsdem__free(al, s->gauge, 2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+            s->gauge = xy;
+            s->gauge_capacity = ng;
+        }
+        s->gauge_count = ng;
     }
     fsdem__restart_data(io, s->gauge, 2 * sizeof(fsdem_real) * (size_t)ng);
     fsdem__restart_tag(io, "SWE.");
@@ -20618,8 +20603,9 @@ static void fsdem__restart_mps_planes(fsdem__restart *io, int dim, int count, in
     }
 }
 
-/* The particles go into fresh arrays of the saved capacity (all FSDEM__MPS_ARRAYS of them and the
-   four row-offset arrays, as fsdem__mps_reserve makes them); of their contents the state that the
+/* The particles go into arrays of the saved capacity (all FSDEM__MPS_ARRAYS of them and the four
+   row-offset arrays, as fsdem__mps_reserve makes them; the object's own when it has that capacity,
+   so a coupled step's put-back allocates nothing); of their contents the state that the
    next step reads (positions, velocities, pressures: the pressure solve starts from them, kinds,
    porosities, a coupler's forces, obstacle membership) and the views of the last step (number
    density, surface flags, pressure gradients) are saved. The neighbour rows and the matrix are
@@ -20653,31 +20639,38 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
 
     fsdem__restart_fields(io, s, state, 8);
 
-    /* obstacles, into a fresh array */
+    /* obstacles and open boundaries, into the object's arrays when they hold them (else fresh ones) */
     fsdem__restart_count(io, &no, 1 << 24, sizeof(fsdem__mps_obst), "obstacle count");
-    obst = (fsdem__mps_obst *)fsdem__restart_block(io, al, sizeof *obst * (size_t)no);
-    if (commit) {
+    obst = no <= s->obst_cap ? s->obst : (fsdem__mps_obst *)fsdem__restart_block(io, al, sizeof *obst * (size_t)no);
+    if (commit && obst != s->obst) {
         fsdem__free(al, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
         s->bytes += sizeof *obst * (size_t)no - sizeof *s->obst * (size_t)s->obst_cap;
         s->obst = obst;
-        s->obst_n = s->obst_cap = no;
+        s->obst_cap = no;
     }
+    if (commit) s->obst_n = no;
     fsdem__restart_data(io, s->obst, sizeof *s->obst * (size_t)no);
 
-    /* open boundaries, into fresh arrays */
     fsdem__restart_count(io, &nin, 1 << 24, sizeof(fsdem_mps_inflow_desc), "inflow count");
-    inflows = (fsdem_mps_inflow_desc *)fsdem__restart_block(io, al, sizeof *inflows * (size_t)nin);
+    inflows = nin <= s->inflow_cap ? s->inflows : (fsdem_mps_inflow_desc *)fsdem__restart_block(io, al, sizeof *inflows * (size_t)nin);
     fsdem__restart_count(io, &nout, 1 << 24, sizeof(fsdem_mps_outflow_desc), "outflow count");
-    outflows = (fsdem_mps_outflow_desc *)fsdem__restart_block(io, al, sizeof *outflows * (size_t)nout);
-    if (commit) {
+    outflows = nout <= s->outflow_cap ? s->outflows
+                                      : (fsdem_mps_outflow_desc *)fsdem__restart_block(io, al, sizeof *outflows * (size_t)nout);
+    if (commit && inflows != s->inflows) {
         fsdem__free(al, s->inflows, sizeof *s->inflows * (size_t)s->inflow_cap);
-        fsdem__free(al, s->outflows, sizeof *s->outflows * (size_t)s->outflow_cap);
         s->bytes += sizeof *inflows * (size_t)nin - sizeof *s->inflows * (size_t)s->inflow_cap;
-        s->bytes += sizeof *outflows * (size_t)nout - sizeof *s->outflows * (size_t)s->outflow_cap;
         s->inflows = inflows;
-        s->inflow_n = s->inflow_cap = nin;
+        s->inflow_cap = nin;
+    }
+    if (commit && outflows != s->outflows) {
+        fsdem__free(al, s->outflows, sizeof *s->outflows * (size_t)s->outflow_cap);
+        s->bytes += sizeof *outflows * (size_t)nout - sizeof *s->outflows * (size_t)s->outflow_cap;
         s->outflows = outflows;
-        s->outflow_n = s->outflow_cap = nout;
+        s->outflow_cap = nout;
+    }
+    if (commit) {
+        s->inflow_n = nin;
+        s->outflow_n = nout;
     }
     fsdem__restart_mps_planes(io, s->dim, nin, 1);
     fsdem__restart_data(io, s->inflows, sizeof *s->inflows * (size_t)nin);
@@ -20686,10 +20679,10 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_data(io, &s->inflow_total, sizeof s->inflow_total);
     fsdem__restart_data(io, &s->outflow_total, sizeof s->outflow_total);
 
-    /* particles, into fresh arrays of the saved capacity */
+    /* particles, into arrays of the saved capacity: the object's own when it has that capacity */
     fsdem__restart_count(io, &cap, 1 << 29, 0, "particle capacity");
     fsdem__restart_count(io, &n, cap, 2 * sizeof(fsdem_vec3), "particle count");
-    if (io->res == FSDEM_OK && (io->mode == FSDEM__RESTART_RESERVE || commit)) {
+    if (io->res == FSDEM_OK && cap != s->cap && (io->mode == FSDEM__RESTART_RESERVE || commit)) {
         void **ptr[FSDEM__MPS_ARRAYS];
         size_t elem[FSDEM__MPS_ARRAYS];
         void *fresh[FSDEM__MPS_ARRAYS + 4];
@@ -20706,13 +20699,16 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
                 int **rows = fsdem__mps_rows(s, a);
                 fsdem__free(al, *rows, sizeof(int) * (size_t)(s->cap + 1));
                 *rows = (int *)fresh[k + a];
-                memset(*rows, 0, sizeof(int) * (size_t)(cap + 1));
             }
             s->bytes += 4 * sizeof(int) * (size_t)cap - 4 * sizeof(int) * (size_t)s->cap;
             s->cap = cap;
-            s->n = n;
-            s->rows = 0; /* the pressure matrix of the last step is not kept */
         }
+    }
+    if (commit) {
+        for (a = 0; a < 4; ++a)
+            if (*fsdem__mps_rows(s, a)) memset(*fsdem__mps_rows(s, a), 0, sizeof(int) * (size_t)(cap + 1));
+        s->n = n;
+        s->rows = 0; /* the pressure matrix of the last step is not kept */
     }
     fsdem__restart_data(io, s->x, sizeof *s->x * (size_t)n);
     fsdem__restart_data(io, s->v, sizeof *s->v * (size_t)n);
@@ -20786,7 +20782,8 @@ static void *fsdem__restart_here(const fsdem__restart *io, void *records) {
 }
 
 /* SWE-DEM: the counters, the last step, the impulse given to the water, and the force records and
-   reactions of every particle slot (the next step's impulse reads the reactions). */
+   reactions of its last update (files of older builds hold them for every slot of the arrays: `count`
+   slots, of which the first `records` are records). */
 static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
     static const fsdem__field same[7] = {
         FSDEM__SAME(fsdem_swe_dem, beta, REAL), FSDEM__SAME(fsdem_swe_dem, two_way, INT),
@@ -20799,24 +20796,26 @@ static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
         FSDEM__SAVED(fsdem_swe_dem, wet), FSDEM__SAVED(fsdem_swe_dem, impulse)};
     fsdem_swe_dem *c = (fsdem_swe_dem *)object;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
-    int count = c->force_capacity, records = c->head.records;
-    fsdem_swe_dem_force *force;
-    fsdem_vec3 *reaction;
+    int count = c->head.records, records = c->head.records;
     fsdem__restart_coupler(io, &c->head, "SWD1", fsdem__restart_swe, "shallow water", "debris (DEM)", same, 7);
     fsdem__restart_fields(io, c, state, 6);
     fsdem__restart_count(io, &count, 1 << 29, fsdem__restart_record_bytes(&c->head) + sizeof(fsdem_vec3), "force record count");
     fsdem__restart_value(io, &records, sizeof records); /* checked before it is used */
     if (io->res == FSDEM_OK && (records < 0 || records > count)) fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "bad record count");
-    force = (fsdem_swe_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
-    reaction = (fsdem_vec3 *)fsdem__restart_block(io, &c->head.allocator, sizeof *reaction * (size_t)count);
+    if (count > c->force_capacity) { /* else into the object's arrays */
+        fsdem_swe_dem_force *force = (fsdem_swe_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
+        fsdem_vec3 *reaction = (fsdem_vec3 *)fsdem__restart_block(io, &c->head.allocator, sizeof *reaction * (size_t)count);
+        if (commit) {
+            fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_capacity);
+            fsdem__free(&c->head.allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
+            c->force = force;
+            c->reaction = reaction;
+            c->force_capacity = count;
+        }
+    }
     if (commit) {
-        fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_capacity);
-        fsdem__free(&c->head.allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
-        c->force = force;
-        c->reaction = reaction;
-        c->force_capacity = count;
-        if (force) memset(force, 0, sizeof *force * (size_t)count);
-        c->head.record = force;
+        if (c->force) memset(c->force, 0, sizeof *c->force * (size_t)count);
+        c->head.record = c->force;
         c->head.records = records;
     }
     fsdem__restart_records(io, &c->head, fsdem__restart_here(io, c->force), count);
@@ -20844,11 +20843,13 @@ static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
     fsdem__restart_coupler(io, &c->head, "MPD1", fsdem__restart_mps, "water (MPS)", "sediment (DEM)", same, 5);
     fsdem__restart_fields(io, c, state, 10);
     fsdem__restart_count(io, &count, 1 << 29, fsdem__restart_record_bytes(&c->head), "force record count");
-    force = (fsdem_mps_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
+    force = count <= c->force_cap ? c->force : (fsdem_mps_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
     if (io->mode == FSDEM__RESTART_COMMIT) {
-        fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_cap);
-        c->force = force;
-        c->force_cap = count;
+        if (force != c->force) {
+            fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_cap);
+            c->force = force;
+            c->force_cap = count;
+        }
         if (force) memset(force, 0, sizeof *force * (size_t)count);
         c->head.record = force;
         c->head.records = count;
@@ -20988,7 +20989,7 @@ static fsdem__restart_object fsdem__restart_of_swe(const fsdem_swe *s) {
 static fsdem__restart_object fsdem__restart_of_swe_dem(const fsdem_swe_dem *c) {
     if (!c) return fsdem__restart_object_of(NULL, 0, 0, NULL, NULL, NULL, NULL);
     {
-        const int sizes[4] = {c->desc.swe->nx, c->desc.swe->ny, c->desc.dem->n, c->force_capacity};
+        const int sizes[4] = {c->desc.swe->nx, c->desc.swe->ny, c->desc.dem->n, c->head.records};
         return fsdem__restart_object_of(c, FSDEM__RESTART_SWE_DEM, c->desc.swe->dim, sizes, fsdem__restart_swe_dem, &c->head.allocator, &c->head.status);
     }
 }
@@ -21478,18 +21479,11 @@ static fsdem_result fsdem__coupled_fail(fsdem_coupler *const *list, int n, int f
     return res;
 }
 
-/* Puts back what the couplers' prepare did (a refused step); passes `res` on. */
-static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem_result res) {
-    int k;
-    for (k = 0; k < n; ++k)
-        if (list[k]->cls->undo) list[k]->cls->undo(list[k]);
-    return res;
-}
-
-/* A step of the list failed after something moved, with the message of couplers[from]: every
+/* A step of the list failed after its state was kept, with the message of couplers[from]: every
    coupler, fluid and DEM put back as kept before the prepare, the fluid's gauge rows of the step
-   dropped, the message (and a put-back that failed, out of memory) to every coupler; passes `res`
-   on. */
+   dropped, the message (and a put-back that failed) to every coupler; passes `res` on. The
+   restores write into the objects' own arrays, whose capacities the step did not change (the
+   fluid's reserve ran before the keep), so they allocate nothing. */
 static fsdem_result fsdem__coupled_put_back(fsdem_coupler *const *list, int n, int from, fsdem_result res) {
     char message[FSDEM__MESSAGE_SIZE];
     int k, lost = -1;
@@ -21531,12 +21525,15 @@ static fsdem_result fsdem__coupled_stable(fsdem_coupler *const *list, int n, fsd
     return FSDEM_OK;
 }
 
-/* Every coupler's state kept (>>restart_journal; a failure to keep it, out of memory, refuses the
-   step), then the couplers' prepare, in order, timed as coupling (a failure undoes those before),
-   then with `dt` the stable dt. */
+/* The fluid's reserve, then every coupler's state kept (>>restart_journal; a failure of either, out
+   of memory, refuses the step with nothing moved), then the couplers' prepare, in order, timed as
+   coupling, then with `dt` the stable dt; a failure after the keep puts the state back. */
 static fsdem_result fsdem__coupled_prepare(fsdem_coupler *const *list, int n, fsdem_real *dt) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
     fsdem_result res = FSDEM_OK;
     int k;
+    if (f->reserve && (res = f->reserve(list[0]->fluid)) != FSDEM_OK)
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s: %s", list[0]->cls->name, f->name, f->last_error(list[0]->fluid));
     for (k = 0; k < n && res == FSDEM_OK; ++k) {
         const clock_t t0 = clock();
         if ((res = fsdem__restart_keep(list[k])) != FSDEM_OK) fsdem__coupled_fail(list, n, k, res, NULL);
@@ -21545,10 +21542,10 @@ static fsdem_result fsdem__coupled_prepare(fsdem_coupler *const *list, int n, fs
     for (k = 0; k < n && res == FSDEM_OK; ++k)
         if (list[k]->cls->prepare) {
             const clock_t t0 = clock();
-            if ((res = list[k]->cls->prepare(list[k])) != FSDEM_OK) fsdem__coupled_fail(list, n, k, fsdem__coupled_undo(list, k, res), NULL);
+            if ((res = list[k]->cls->prepare(list[k])) != FSDEM_OK) fsdem__coupled_put_back(list, n, k, res);
             list[k]->seconds[FSDEM__CLOCK_COUPLING] += (double)(clock() - t0) / CLOCKS_PER_SEC;
         }
-    if (res == FSDEM_OK && dt && (res = fsdem__coupled_stable(list, n, dt)) != FSDEM_OK) fsdem__coupled_undo(list, n, res);
+    if (res == FSDEM_OK && dt && (res = fsdem__coupled_stable(list, n, dt)) != FSDEM_OK) fsdem__coupled_put_back(list, n, 0, res);
     return res;
 }
 
@@ -21576,10 +21573,10 @@ static const char *fsdem__coupler_fluid_stage(const fsdem_coupler *c) {
     return c->cls->stages[s].name;
 }
 
-/* A coupled step of dt after the prepare (which kept the state): every coupler's checks (a refusal
-   undoes the prepare), the stages before the fluid's step, the fluid's step, the stages after it.
-   A failure once a stage ran puts the kept state back (fsdem__coupled_put_back), so a refused step
-   leaves couplers, fluid and DEMs as they were. `chosen`: dt is the caller's, not a stable one. */
+/* A coupled step of dt after the prepare (which kept the state): every coupler's checks, the stages
+   before the fluid's step, the fluid's step, the stages after it. A refusal or a failure puts the
+   kept state back (fsdem__coupled_put_back), so a refused step leaves couplers, fluid and DEMs as
+   they were. `chosen`: dt is the caller's, not a stable one. */
 static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_real dt, int chosen) {
     const fsdem__fluid *f = list[0]->cls->fluid;
     void *fluid = list[0]->fluid;
@@ -21589,7 +21586,7 @@ static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_r
     int k;
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupler_particles_valid(list[k])) != FSDEM_OK || (res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
-            return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
+            return fsdem__coupled_put_back(list, n, k, res);
     f->gauges_hold(fluid, 1); /* the fluid's gauge rows of the step wait until it is taken */
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);

@@ -12,9 +12,11 @@
 
 /* Each block carries the size it was allocated with in a header; a free with another size is
    counted (a pool allocator keyed by size would corrupt), and so is every block still live. The
-   allocation numbered `fail_at` (counted from 1 after arming) returns NULL. */
+   allocation numbered `fail_at` (counted from 1 after arming) returns NULL, and with `lasting` every
+   one after it too (the memory is gone, not just one request refused). */
 typedef struct sized {
     long count, fail_at, bad_frees, live;
+    int lasting;
 } sized;
 
 #define SIZED_HEADER 16 /* keeps the blocks aligned for any fsdem type */
@@ -22,7 +24,7 @@ typedef struct sized {
 static void *sized_alloc(void *user, size_t size) {
     sized *h = (sized *)user;
     size_t *block;
-    if (++h->count == h->fail_at) return NULL;
+    if (++h->count == h->fail_at || (h->lasting && h->count > h->fail_at)) return NULL;
     block = (size_t *)malloc(size + SIZED_HEADER);
     if (!block) return NULL;
     block[0] = size;
@@ -73,7 +75,7 @@ static void capture(void *user, fsdem_log_level level, const char *message) {
 /* The gauges keep three arrays of one capacity; the first grew and the second failed, so the first
    was later freed with the old capacity's size. Every failure point of forty gauges, MPS and PIC. */
 static int gauges_run(int pic, long n) {
-    sized h = {0, 0, 0, 0};
+    sized h = {0, 0, 0, 0, 0};
     fsdem_result res = FSDEM_OK;
     char message[512];
     int k;
@@ -112,9 +114,10 @@ END_TEST
 /* A 2D water tank with one disc; `late`: then a step, two more discs added to the DEM, and the
    step that cuts them is the one that fails. The coupler's face and J arrays grew one by one (frees
    of the wrong size), and the body records' failure left the step's result without a message. The
-   refused step leaves the run as it was (issue 34), unless its put-back is what ran out of memory. */
-static int pic_dem_run(int late, long n) {
-    sized h = {0, 0, 0, 0};
+   refused step leaves the run as it was (issue 34), at every allocation that fails, and when
+   (`lasting`) no allocation succeeds after it: the put-back allocates nothing. */
+static int pic_dem_run(int late, int lasting, long n) {
+    sized h = {0, 0, 0, 0, 0};
     log_capture log;
     fsdem_pic_desc pd = fsdem_pic_desc_default(2);
     fsdem_dem_desc dd = fsdem_dem_desc_default(2);
@@ -161,14 +164,16 @@ static int pic_dem_run(int late, long n) {
         ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
         TEST_KEEP(fsdem_pic_dem_save_memory, c, fsdem_pic_dem_get_stats(c).coupling, &before);
         arm(&h, n);
+        h.lasting = lasting;
         res = fsdem_pic_dem_step(c);
+        h.lasting = 0;
         snprintf(message, sizeof message, "%s", fsdem_pic_dem_last_error(c));
         TEST_KEEP(fsdem_pic_dem_save_memory, c, fsdem_pic_dem_get_stats(c).coupling, &after);
-        if (res == FSDEM_OK || strstr(message, "could not be put back")) { /* taken; or the put-back itself ran out of memory */
+        if (res == FSDEM_OK) { /* taken */
             free(before.bytes);
             free(after.bytes);
-        } else
-            test_kept_same(&before, &after, "fsdem_pic_dem_step out of memory"); /* a refused step changes nothing (>>couple_step) */
+        } else /* a refused step changes nothing (>>couple_step), the put-back allocating nothing */
+            test_kept_same(&before, &after, "fsdem_pic_dem_step out of memory");
     }
     fsdem_pic_dem_destroy(c);
     fsdem_dem_destroy(dem);
@@ -178,10 +183,114 @@ static int pic_dem_run(int late, long n) {
 
 START_TEST(pic_dem_out_of_memory_frees_at_size_and_says_so) {
     long n;
-    for (n = 1; pic_dem_run(0, n); ++n) {
+    for (n = 1; pic_dem_run(0, 0, n); ++n) {
     }
-    for (n = 1; pic_dem_run(1, n); ++n) {
+    for (n = 1; pic_dem_run(1, 0, n); ++n) {
     }
+    for (n = 1; pic_dem_run(1, 1, n); ++n) {
+    }
+}
+END_TEST
+
+/* Issue 34: a coupled step refused out of memory leaves coupler, fluid and DEM byte for byte as they
+   were, at every allocation that fails and when none succeeds after it (`lasting`: the put-back
+   allocates nothing). MPS-DEM: a water tank with a disc, sixteen discs added since its last step
+   (the force records grow in the step's update); SWE-DEM: a channel with a floating sphere and one
+   added since its last step (its force and reaction arrays grow in the step). */
+static int coupled_oom_run(int mps, int lasting, long n) {
+    sized h = {0, 0, 0, 0, 0};
+    fsdem_dem_desc dd = fsdem_dem_desc_default(mps ? 2 : 3);
+    fsdem_dem_material m = fsdem_dem_material_default();
+    fsdem_dem_particle_desc p = fsdem_dem_particle_desc_default();
+    fsdem_mps *water = NULL;
+    fsdem_swe *channel = NULL;
+    fsdem_dem *dem = NULL;
+    fsdem_mps_dem *md = NULL;
+    fsdem_swe_dem *sd = NULL;
+    fsdem_result res;
+    test_kept before, after;
+    char message[512];
+    int k;
+    dd.allocator = sized_allocator(&h);
+    if (mps) {
+        fsdem_mps_desc d = fsdem_mps_desc_default(2);
+        d.domain_min = fsdem_v3(-0.06f, -0.06f, 0);
+        d.domain_max = fsdem_v3(0.26f, 0.26f, 0);
+        d.allocator = sized_allocator(&h);
+        ck_assert_int_eq(fsdem_mps_create(&d, &water), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_add_box_walls(water, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.2f, 0), 1u << FSDEM_SIDE_YMAX, NULL), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_fill_box(water, fsdem_v3(0, 0, 0), fsdem_v3(0.2f, 0.1f, 0), fsdem_v3(0, 0, 0), NULL), FSDEM_OK);
+        dd.domain_min = fsdem_v3(-0.06f, -0.06f, -1);
+        dd.domain_max = fsdem_v3(0.26f, 0.26f, 1);
+        p.radius = 0.004f;
+        p.position = fsdem_v3(0.1f, 0.05f, 0);
+    } else {
+        fsdem_swe_desc d = fsdem_swe_desc_default(1);
+        fsdem_real depth[100];
+        for (k = 0; k < 100; ++k) depth[k] = 1;
+        d.nx = 100;
+        d.x_max = 10;
+        d.depth = depth;
+        d.allocator = sized_allocator(&h);
+        ck_assert_int_eq(fsdem_swe_create(&d, &channel), FSDEM_OK);
+        dd.domain_min = fsdem_v3(0, -1, -1);
+        dd.domain_max = fsdem_v3(10, 1, 2);
+        dd.dt = (fsdem_real)1e-4;
+        m.density = 500;
+        p.radius = 0.2f;
+        p.position = fsdem_v3(3, 0, 1);
+    }
+    ck_assert_int_eq(fsdem_dem_create(&dd, &dem), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_add_material(dem, &m, NULL), FSDEM_OK);
+    ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+    if (mps) {
+        fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
+        cd.mps = water;
+        cd.dem = dem;
+        ck_assert_int_eq(fsdem_mps_dem_create(&cd, &md), FSDEM_OK);
+        ck_assert_int_eq(fsdem_mps_dem_step(md), FSDEM_OK);
+        for (k = 0; k < 16; ++k) {
+            p.position = fsdem_v3((fsdem_real)(0.02 + 0.01 * k), 0.08f, 0);
+            ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+        }
+        TEST_KEEP(fsdem_mps_dem_save_memory, md, fsdem_mps_dem_get_stats(md).coupling, &before);
+    } else {
+        fsdem_swe_dem_desc cd = fsdem_swe_dem_desc_default();
+        cd.swe = channel;
+        cd.dem = dem;
+        ck_assert_int_eq(fsdem_swe_dem_create(&cd, &sd), FSDEM_OK);
+        ck_assert_int_eq(fsdem_swe_dem_step(sd), FSDEM_OK);
+        p.position = fsdem_v3(6, 0, 1);
+        ck_assert_int_eq(fsdem_dem_add_particle(dem, &p, NULL), FSDEM_OK);
+        TEST_KEEP(fsdem_swe_dem_save_memory, sd, fsdem_swe_dem_get_stats(sd).coupling, &before);
+    }
+    arm(&h, n);
+    h.lasting = lasting;
+    res = mps ? fsdem_mps_dem_step(md) : fsdem_swe_dem_step(sd);
+    h.lasting = 0;
+    snprintf(message, sizeof message, "%s", mps ? fsdem_mps_dem_last_error(md) : fsdem_swe_dem_last_error(sd));
+    if (mps) TEST_KEEP(fsdem_mps_dem_save_memory, md, fsdem_mps_dem_get_stats(md).coupling, &after);
+    else TEST_KEEP(fsdem_swe_dem_save_memory, sd, fsdem_swe_dem_get_stats(sd).coupling, &after);
+    if (res == FSDEM_OK) {
+        free(before.bytes);
+        free(after.bytes);
+    } else
+        test_kept_same(&before, &after, mps ? "fsdem_mps_dem_step out of memory" : "fsdem_swe_dem_step out of memory");
+    fsdem_mps_dem_destroy(md);
+    fsdem_swe_dem_destroy(sd);
+    fsdem_dem_destroy(dem);
+    fsdem_mps_destroy(water);
+    fsdem_swe_destroy(channel);
+    return audited(&h, res, message, mps ? "fsdem_mps_dem_step" : "fsdem_swe_dem_step");
+}
+
+START_TEST(coupled_step_out_of_memory_changes_nothing) {
+    int mps, lasting;
+    long n;
+    for (mps = 0; mps < 2; ++mps)
+        for (lasting = 0; lasting < 2; ++lasting)
+            for (n = 1; coupled_oom_run(mps, lasting, n); ++n) {
+            }
 }
 END_TEST
 
@@ -189,7 +298,7 @@ END_TEST
    boundary's series (its third and fourth allocations). */
 static int swe_run(long n) {
     static const fsdem_real t[2] = {0, 1}, q[2] = {0.1f, 0.2f};
-    sized h = {0, 0, 0, 0};
+    sized h = {0, 0, 0, 0, 0};
     log_capture log;
     fsdem_swe_desc d = fsdem_swe_desc_default(1);
     fsdem_swe *s = NULL;
@@ -556,6 +665,7 @@ Suite *probing_suite(void) {
     tcase_set_timeout(tc, 60);
     tcase_add_test(tc, gauge_growth_failure_frees_at_the_size_allocated);
     tcase_add_test(tc, pic_dem_out_of_memory_frees_at_size_and_says_so);
+    tcase_add_test(tc, coupled_step_out_of_memory_changes_nothing);
     tcase_add_test(tc, swe_create_out_of_memory_is_logged);
     tcase_add_test(tc, implausible_mps_input_is_refused);
     tcase_add_test(tc, implausible_dem_input_is_refused);

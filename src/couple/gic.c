@@ -483,7 +483,7 @@ static const fsdem__field fsdem__gic_fields[8] = {
 
 static const fsdem__coupler_class *fsdem__gic_class(void) {
     static const fsdem__coupler_class cls = {"fsdem_gic", &fsdem__fluid_pic, sizeof(fsdem_gic_force), fsdem__gic_fields, 8, NULL,
-        NULL, fsdem__gic_limit, fsdem__gic_check, fsdem__gic_stages, 3};
+        fsdem__gic_limit, fsdem__gic_check, fsdem__gic_stages, 3};
     return &cls;
 }
 

@@ -29,6 +29,9 @@ typedef struct fsdem__fluid {
     const char *(*last_error)(const void *fluid);
     fsdem_claims *(*claims)(void *fluid);
     fsdem_result (*gauges_hold)(void *fluid, int hold);
+    fsdem_result (*reserve)(void *fluid); /* may be NULL: the room its next step would allocate, made */
+                                          /*    before a coupled step keeps the state (a capacity */
+                                          /*    saved with it), so that a put-back allocates nothing */
 } fsdem__fluid;
 
 /* What makes a coupler of one kind. */
@@ -38,12 +41,11 @@ typedef struct fsdem__coupler_class {
     size_t record_size;                 /* bytes of its per-particle record, whose first field is the int id */
     const fsdem__field *fields;         /* the record's fields (>>core), CSV columns and restart */
     int field_count;
-    /* its step (>>impl_couple_step): prepare (may be NULL) does what must come before the step's length
-       is known, and undo (may be NULL) puts it back when the step is refused; limit (may be NULL)
-       cuts the fluid's stable dt by the coupler's own limits; check refuses a dt before anything
-       moves (chosen: the caller's dt, not a stable one); then the stages in order */
+    /* its step (>>impl_couple_step): prepare (may be NULL) does what must come before the step's
+       length is known; limit (may be NULL) cuts the fluid's stable dt by the coupler's own limits;
+       check refuses a dt before anything moves (chosen: the caller's dt, not a stable one); then the
+       stages in order. A refusal after the state was kept puts it back. */
     fsdem_result (*prepare)(fsdem_coupler *c);
-    void (*undo)(fsdem_coupler *c);
     fsdem_result (*limit)(const fsdem_coupler *c, fsdem_real *dt);
     fsdem_result (*check)(fsdem_coupler *c, fsdem_real dt, int chosen);
     const fsdem__stage *stages;
@@ -164,7 +166,7 @@ static const char *fsdem__fluid_pic_error(const void *f) { return fsdem_pic_last
 static fsdem_claims *fsdem__fluid_pic_claims(void *f) { return fsdem_pic_claims((fsdem_pic *)f); }
 static fsdem_result fsdem__fluid_pic_hold(void *f, int hold) { return fsdem_pic_gauges_hold((fsdem_pic *)f, hold); }
 static const fsdem__fluid fsdem__fluid_pic = {"PIC", "pic", fsdem__fluid_pic_time, fsdem__fluid_pic_stable, fsdem__fluid_pic_step,
-                                              fsdem__fluid_pic_error, fsdem__fluid_pic_claims, fsdem__fluid_pic_hold};
+                                              fsdem__fluid_pic_error, fsdem__fluid_pic_claims, fsdem__fluid_pic_hold, NULL};
 
 static double fsdem__fluid_mps_time(const void *f) { return fsdem_mps_time((const fsdem_mps *)f); }
 static fsdem_result fsdem__fluid_mps_stable(const void *f, fsdem_real *dt) { return fsdem_mps_stable_dt((const fsdem_mps *)f, dt); }
@@ -172,8 +174,10 @@ static fsdem_result fsdem__fluid_mps_step(void *f, fsdem_real dt) { return fsdem
 static const char *fsdem__fluid_mps_error(const void *f) { return fsdem_mps_last_error((const fsdem_mps *)f); }
 static fsdem_claims *fsdem__fluid_mps_claims(void *f) { return fsdem_mps_claims((fsdem_mps *)f); }
 static fsdem_result fsdem__fluid_mps_hold(void *f, int hold) { return fsdem_mps_gauges_hold((fsdem_mps *)f, hold); }
+static fsdem_result fsdem__fluid_mps_reserve(void *f) { return fsdem_mps_reserve((fsdem_mps *)f, 0); }
 static const fsdem__fluid fsdem__fluid_mps = {"MPS", "mps", fsdem__fluid_mps_time, fsdem__fluid_mps_stable, fsdem__fluid_mps_step,
-                                              fsdem__fluid_mps_error, fsdem__fluid_mps_claims, fsdem__fluid_mps_hold};
+                                              fsdem__fluid_mps_error, fsdem__fluid_mps_claims, fsdem__fluid_mps_hold,
+                                              fsdem__fluid_mps_reserve};
 
 static double fsdem__fluid_swe_time(const void *f) { return fsdem_swe_time((const fsdem_swe *)f); }
 static fsdem_result fsdem__fluid_swe_stable(const void *f, fsdem_real *dt) { return fsdem_swe_stable_dt((const fsdem_swe *)f, dt); }
@@ -182,4 +186,4 @@ static const char *fsdem__fluid_swe_error(const void *f) { return fsdem_swe_last
 static fsdem_claims *fsdem__fluid_swe_claims(void *f) { return fsdem_swe_claims((fsdem_swe *)f); }
 static fsdem_result fsdem__fluid_swe_hold(void *f, int hold) { return fsdem_swe_gauges_hold((fsdem_swe *)f, hold); }
 static const fsdem__fluid fsdem__fluid_swe = {"shallow-water", "swe", fsdem__fluid_swe_time, fsdem__fluid_swe_stable, fsdem__fluid_swe_step,
-                                              fsdem__fluid_swe_error, fsdem__fluid_swe_claims, fsdem__fluid_swe_hold};
+                                              fsdem__fluid_swe_error, fsdem__fluid_swe_claims, fsdem__fluid_swe_hold, NULL};

@@ -46,13 +46,6 @@ struct fsdem_mps_dem {
     fsdem_mps_dem_force *force;    /* per DEM particle of the last update (head.records of them) */
     int force_cap;
     fsdem__mps_dem_tally tally;
-    /* what the update of a step overwrote, put back when the step is refused (fsdem__mps_dem_keep) */
-    fsdem_real *kept_porosity;     /* per MPS particle */
-    fsdem_vec3 *kept_reaction;     /* per MPS particle */
-    fsdem_vec3 *kept_load;         /* per DEM particle: its external force */
-    fsdem_mps_dem_force *kept_force;
-    int kept_mps_cap, kept_dem_cap, kept_forces;
-    fsdem__mps_dem_tally kept_tally;
 };
 
 static const fsdem__coupler_class *fsdem__mps_dem_class(void);
@@ -158,10 +151,6 @@ void fsdem_mps_dem_destroy(fsdem_mps_dem *c) {
     fsdem__free(al, c->rate, sizeof(fsdem_real) * (size_t)c->solid_cap);
     fsdem__free(al, c->share, sizeof(fsdem_real) * (size_t)c->solid_cap);
     fsdem__free(al, c->force, sizeof(fsdem_mps_dem_force) * (size_t)c->force_cap);
-    fsdem__free(al, c->kept_porosity, sizeof(fsdem_real) * (size_t)c->kept_mps_cap);
-    fsdem__free(al, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)c->kept_mps_cap);
-    fsdem__free(al, c->kept_load, sizeof(fsdem_vec3) * (size_t)c->kept_dem_cap);
-    fsdem__free(al, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_dem_cap);
     fsdem__coupler_free(&c->head, sizeof *c);
 }
 
@@ -427,55 +416,8 @@ fsdem_result fsdem_mps_dem_write_csv(const fsdem_mps_dem *c, const char *path) {
 
 /* ---- >>couple_mps_step : coupled time stepping ---- */
 
-/* Keeps what the update of a step overwrites (the MPS's porosities and reactions, the DEM's loads,
-   the force records and the tally), so that a step refused after its update leaves coupler, MPS
-   and DEM as they were (fsdem__mps_dem_undo). */
-static fsdem_result fsdem__mps_dem_keep(fsdem_mps_dem *c) {
-    const fsdem_mps_coupling mc = fsdem_mps_get_coupling(c->desc.mps);
-    const fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
-    void **const fluid[2] = {(void **)&c->kept_porosity, (void **)&c->kept_reaction};
-    void **const grain[2] = {(void **)&c->kept_load, (void **)&c->kept_force};
-    const size_t fluid_size[2] = {sizeof(fsdem_real), sizeof(fsdem_vec3)};
-    const size_t grain_size[2] = {sizeof(fsdem_vec3), sizeof(fsdem_mps_dem_force)};
-    const int records = c->head.records;
-    if (fsdem__grow_set(&c->head.allocator, fluid, fluid_size, 2, &c->kept_mps_cap, 0, mc.count) != FSDEM_OK ||
-        fsdem__grow_set(&c->head.allocator, grain, grain_size, 2, &c->kept_dem_cap, 0, dc.count > records ? dc.count : records) != FSDEM_OK)
-        return fsdem__fail(&c->head.status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_dem: out of memory (%d DEM and %d MPS particles)", dc.count,
-                           mc.count);
-    if (mc.count) {
-        memcpy(c->kept_porosity, mc.porosity, sizeof(fsdem_real) * (size_t)mc.count);
-        memcpy(c->kept_reaction, mc.force, sizeof(fsdem_vec3) * (size_t)mc.count);
-    }
-    if (dc.count) memcpy(c->kept_load, dc.force, sizeof(fsdem_vec3) * (size_t)dc.count);
-    if (records) memcpy(c->kept_force, c->force, sizeof(fsdem_mps_dem_force) * (size_t)records);
-    c->kept_forces = records;
-    c->kept_tally = c->tally;
-    return FSDEM_OK;
-}
-
-/* Puts back what fsdem__mps_dem_keep kept (the class's undo). */
-static void fsdem__mps_dem_undo(fsdem_coupler *head) {
-    fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
-    const fsdem_mps_coupling mc = fsdem_mps_get_coupling(c->desc.mps);
-    const fsdem_dem_coupling dc = fsdem_dem_get_coupling(c->desc.dem);
-    if (mc.count) {
-        memcpy(mc.porosity, c->kept_porosity, sizeof(fsdem_real) * (size_t)mc.count);
-        memcpy(mc.force, c->kept_reaction, sizeof(fsdem_vec3) * (size_t)mc.count);
-    }
-    if (dc.count) memcpy(dc.force, c->kept_load, sizeof(fsdem_vec3) * (size_t)dc.count);
-    if (c->kept_forces) memcpy(c->force, c->kept_force, sizeof(fsdem_mps_dem_force) * (size_t)c->kept_forces);
-    c->head.record = c->force;
-    c->head.records = c->kept_forces;
-    c->tally = c->kept_tally;
-}
-
-/* The update of a step, kept to be undone if the step is refused (the class's prepare). */
-static fsdem_result fsdem__mps_dem_prepare(fsdem_coupler *head) {
-    fsdem_mps_dem *c = (fsdem_mps_dem *)(void *)head;
-    fsdem_result res = fsdem__mps_dem_keep(c);
-    if (res == FSDEM_OK && (res = fsdem_mps_dem_update(c)) != FSDEM_OK) fsdem__mps_dem_undo(head);
-    return res;
-}
+/* The update of a step (the class's prepare). */
+static fsdem_result fsdem__mps_dem_prepare(fsdem_coupler *head) { return fsdem_mps_dem_update((fsdem_mps_dem *)(void *)head); }
 
 /* The drag limit of the last update on the stable step (>>couple_mps; the class's limit). */
 static fsdem_result fsdem__mps_dem_limit(const fsdem_coupler *head, fsdem_real *dt) {
@@ -517,7 +459,7 @@ static const fsdem__field fsdem__mps_dem_fields[8] = {
 
 static const fsdem__coupler_class *fsdem__mps_dem_class(void) {
     static const fsdem__coupler_class cls = {"fsdem_mps_dem", &fsdem__fluid_mps, sizeof(fsdem_mps_dem_force),
-        fsdem__mps_dem_fields, 8, fsdem__mps_dem_prepare, fsdem__mps_dem_undo, fsdem__mps_dem_limit, fsdem__mps_dem_check,
+        fsdem__mps_dem_fields, 8, fsdem__mps_dem_prepare, fsdem__mps_dem_limit, fsdem__mps_dem_check,
         fsdem__mps_dem_stages, 2};
     return &cls;
 }

@@ -117,33 +117,27 @@ static void fsdem__pic_dem_free_bodies(fsdem_pic_dem *c) {
 }
 
 /* Per-body arrays for `n` bodies (zeroed). Allocates only when the DEM has more particles than any
-   step before. */
+   step before; all of them or, out of memory, none (nothing changes). */
 static fsdem_result fsdem__pic_dem_reserve_bodies(fsdem_pic_dem *c, int n) {
     const fsdem_allocator *al = &c->head.allocator;
     const size_t m = (size_t)(n > 0 ? n : 1), V = sizeof(fsdem_vec3) * m, R = sizeof(fsdem_real) * m;
+    void **const arrays[9] = {(void **)&c->load,  (void **)&c->vstar,  (void **)&c->wstar,      (void **)&c->inv_m,    (void **)&c->inv_i,
+                              (void **)&c->weight, (void **)&c->relax, (void **)&c->face_start, (void **)&c->jac_start};
+    const size_t bytes[9] = {sizeof(fsdem_pic_dem_force) * m, V, V, R, R, R, R, sizeof(int) * (m + 1), sizeof(int) * (m + 1)};
+    void *fresh[9];
+    int k;
     if (n <= c->body_cap && c->vstar) return FSDEM_OK;
+    for (k = 0; k < 9; ++k)
+        if (!(fresh[k] = fsdem__alloc(al, bytes[k]))) {
+            while (k-- > 0) fsdem__free(al, fresh[k], bytes[k]);
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        }
     fsdem__pic_dem_free_bodies(c);
-    c->load = (fsdem_pic_dem_force *)fsdem__alloc(al, sizeof(fsdem_pic_dem_force) * m);
-    c->vstar = (fsdem_vec3 *)fsdem__alloc(al, V);
-    c->wstar = (fsdem_vec3 *)fsdem__alloc(al, V);
-    c->inv_m = (fsdem_real *)fsdem__alloc(al, R);
-    c->inv_i = (fsdem_real *)fsdem__alloc(al, R);
-    c->weight = (fsdem_real *)fsdem__alloc(al, R);
-    c->relax = (fsdem_real *)fsdem__alloc(al, R);
-    c->face_start = (int *)fsdem__alloc(al, sizeof(int) * (m + 1));
-    c->jac_start = (int *)fsdem__alloc(al, sizeof(int) * (m + 1));
-    c->body_cap = (int)m;
-    if (!c->load || !c->vstar || !c->wstar || !c->inv_m || !c->inv_i || !c->weight || !c->relax || !c->face_start || !c->jac_start) {
-        fsdem__pic_dem_free_bodies(c);
-        return FSDEM_ERR_OUT_OF_MEMORY;
+    for (k = 0; k < 9; ++k) {
+        memset(fresh[k], 0, bytes[k]);
+        *arrays[k] = fresh[k];
     }
-    memset(c->load, 0, sizeof(fsdem_pic_dem_force) * m);
-    memset(c->vstar, 0, V);
-    memset(c->wstar, 0, V);
-    memset(c->weight, 0, R);
-    memset(c->relax, 0, R);
-    memset(c->face_start, 0, sizeof(int) * (m + 1));
-    memset(c->jac_start, 0, sizeof(int) * (m + 1));
+    c->body_cap = (int)m;
     c->loaded = 0;
     return FSDEM_OK;
 }
@@ -899,7 +893,7 @@ static const fsdem__field fsdem__pic_dem_fields[7] = {
 
 static const fsdem__coupler_class *fsdem__pic_dem_class(void) {
     static const fsdem__coupler_class cls = {"fsdem_pic_dem", &fsdem__fluid_pic, sizeof(fsdem_pic_dem_force),
-        fsdem__pic_dem_fields, 7, NULL, NULL, fsdem__pic_dem_limit, fsdem__pic_dem_check, fsdem__pic_dem_stages, 6};
+        fsdem__pic_dem_fields, 7, NULL, fsdem__pic_dem_limit, fsdem__pic_dem_check, fsdem__pic_dem_stages, 6};
     return &cls;
 }
 

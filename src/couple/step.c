@@ -20,18 +20,11 @@ static fsdem_result fsdem__coupled_fail(fsdem_coupler *const *list, int n, int f
     return res;
 }
 
-/* Puts back what the couplers' prepare did (a refused step); passes `res` on. */
-static fsdem_result fsdem__coupled_undo(fsdem_coupler *const *list, int n, fsdem_result res) {
-    int k;
-    for (k = 0; k < n; ++k)
-        if (list[k]->cls->undo) list[k]->cls->undo(list[k]);
-    return res;
-}
-
-/* A step of the list failed after something moved, with the message of couplers[from]: every
+/* A step of the list failed after its state was kept, with the message of couplers[from]: every
    coupler, fluid and DEM put back as kept before the prepare, the fluid's gauge rows of the step
-   dropped, the message (and a put-back that failed, out of memory) to every coupler; passes `res`
-   on. */
+   dropped, the message (and a put-back that failed) to every coupler; passes `res` on. The
+   restores write into the objects' own arrays, whose capacities the step did not change (the
+   fluid's reserve ran before the keep), so they allocate nothing. */
 static fsdem_result fsdem__coupled_put_back(fsdem_coupler *const *list, int n, int from, fsdem_result res) {
     char message[FSDEM__MESSAGE_SIZE];
     int k, lost = -1;
@@ -73,12 +66,15 @@ static fsdem_result fsdem__coupled_stable(fsdem_coupler *const *list, int n, fsd
     return FSDEM_OK;
 }
 
-/* Every coupler's state kept (>>restart_journal; a failure to keep it, out of memory, refuses the
-   step), then the couplers' prepare, in order, timed as coupling (a failure undoes those before),
-   then with `dt` the stable dt. */
+/* The fluid's reserve, then every coupler's state kept (>>restart_journal; a failure of either, out
+   of memory, refuses the step with nothing moved), then the couplers' prepare, in order, timed as
+   coupling, then with `dt` the stable dt; a failure after the keep puts the state back. */
 static fsdem_result fsdem__coupled_prepare(fsdem_coupler *const *list, int n, fsdem_real *dt) {
+    const fsdem__fluid *f = list[0]->cls->fluid;
     fsdem_result res = FSDEM_OK;
     int k;
+    if (f->reserve && (res = f->reserve(list[0]->fluid)) != FSDEM_OK)
+        return fsdem__coupled_fail(list, n, -1, res, "%s: %s: %s", list[0]->cls->name, f->name, f->last_error(list[0]->fluid));
     for (k = 0; k < n && res == FSDEM_OK; ++k) {
         const clock_t t0 = clock();
         if ((res = fsdem__restart_keep(list[k])) != FSDEM_OK) fsdem__coupled_fail(list, n, k, res, NULL);
@@ -87,10 +83,10 @@ static fsdem_result fsdem__coupled_prepare(fsdem_coupler *const *list, int n, fs
     for (k = 0; k < n && res == FSDEM_OK; ++k)
         if (list[k]->cls->prepare) {
             const clock_t t0 = clock();
-            if ((res = list[k]->cls->prepare(list[k])) != FSDEM_OK) fsdem__coupled_fail(list, n, k, fsdem__coupled_undo(list, k, res), NULL);
+            if ((res = list[k]->cls->prepare(list[k])) != FSDEM_OK) fsdem__coupled_put_back(list, n, k, res);
             list[k]->seconds[FSDEM__CLOCK_COUPLING] += (double)(clock() - t0) / CLOCKS_PER_SEC;
         }
-    if (res == FSDEM_OK && dt && (res = fsdem__coupled_stable(list, n, dt)) != FSDEM_OK) fsdem__coupled_undo(list, n, res);
+    if (res == FSDEM_OK && dt && (res = fsdem__coupled_stable(list, n, dt)) != FSDEM_OK) fsdem__coupled_put_back(list, n, 0, res);
     return res;
 }
 
@@ -118,10 +114,10 @@ static const char *fsdem__coupler_fluid_stage(const fsdem_coupler *c) {
     return c->cls->stages[s].name;
 }
 
-/* A coupled step of dt after the prepare (which kept the state): every coupler's checks (a refusal
-   undoes the prepare), the stages before the fluid's step, the fluid's step, the stages after it.
-   A failure once a stage ran puts the kept state back (fsdem__coupled_put_back), so a refused step
-   leaves couplers, fluid and DEMs as they were. `chosen`: dt is the caller's, not a stable one. */
+/* A coupled step of dt after the prepare (which kept the state): every coupler's checks, the stages
+   before the fluid's step, the fluid's step, the stages after it. A refusal or a failure puts the
+   kept state back (fsdem__coupled_put_back), so a refused step leaves couplers, fluid and DEMs as
+   they were. `chosen`: dt is the caller's, not a stable one. */
 static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_real dt, int chosen) {
     const fsdem__fluid *f = list[0]->cls->fluid;
     void *fluid = list[0]->fluid;
@@ -131,7 +127,7 @@ static fsdem_result fsdem__coupled_go(fsdem_coupler *const *list, int n, fsdem_r
     int k;
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupler_particles_valid(list[k])) != FSDEM_OK || (res = list[k]->cls->check(list[k], dt, chosen)) != FSDEM_OK)
-            return fsdem__coupled_undo(list, n, fsdem__coupled_fail(list, n, k, res, NULL));
+            return fsdem__coupled_put_back(list, n, k, res);
     f->gauges_hold(fluid, 1); /* the fluid's gauge rows of the step wait until it is taken */
     for (k = 0; k < n; ++k)
         if ((res = fsdem__coupled_stages(list[k], dt, 0)) != FSDEM_OK) return fsdem__coupled_put_back(list, n, k, res);

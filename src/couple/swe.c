@@ -307,7 +307,7 @@ static const fsdem__field fsdem__swe_dem_fields[9] = {
 
 static const fsdem__coupler_class *fsdem__swe_dem_class(void) {
     static const fsdem__coupler_class cls = {"fsdem_swe_dem", &fsdem__fluid_swe, sizeof(fsdem_swe_dem_force),
-        fsdem__swe_dem_fields, 9, NULL, NULL, NULL, fsdem__swe_dem_check, fsdem__swe_dem_stages, 3};
+        fsdem__swe_dem_fields, 9, NULL, NULL, fsdem__swe_dem_check, fsdem__swe_dem_stages, 3};
     return &cls;
 }
 

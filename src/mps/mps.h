@@ -236,6 +236,11 @@ FSDEM_API fsdem_mps_desc fsdem_mps_get_desc(const fsdem_mps *mps);
    domain), FSDEM_ERR_OUT_OF_MEMORY. Allocates (outside any step). */
 FSDEM_API fsdem_result fsdem_mps_add_particles(fsdem_mps *mps, fsdem_mps_kind kind, int count,
                                                const fsdem_vec3 *positions, const fsdem_vec3 *velocities);
+/* Makes room for `count` particles more than those present and those its inflows add in the next
+   step, so that the next step allocates no particle storage (a step grows it when it must; a
+   coupled step reserves first, so that a step it puts back allocates nothing). FSDEM_ERR_INVALID_ARG
+   (count < 0), FSDEM_ERR_OUT_OF_MEMORY; nothing changes on failure. */
+FSDEM_API fsdem_result fsdem_mps_reserve(fsdem_mps *mps, int count);
 /* Fills the box [lo, hi] with FLUID particles on the r0 lattice anchored at lo: centres at
    lo + (i + 1/2) r0 per axis, those inside the box and outside every box obstacle, all with
    `velocity`. The number added goes to *added (may be NULL). Errors as fsdem_mps_add_particles,

@@ -102,6 +102,15 @@ fsdem_result fsdem_mps_add_particles(fsdem_mps *s, fsdem_mps_kind kind, int coun
     return fsdem__ok(&s->status);
 }
 
+fsdem_result fsdem_mps_reserve(fsdem_mps *s, int count) {
+    if (!s) return FSDEM_ERR_INVALID_ARG;
+    if (count < 0) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps_reserve: count = %d < 0", count);
+    if (count > (1 << 29) - s->n - s->buffered || fsdem__mps_reserve(s, s->n + s->buffered + count) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps_reserve: no memory for %d particles",
+                           s->n + s->buffered + count);
+    return fsdem__ok(&s->status);
+}
+
 /* What a lattice walk does with a point: the kind to add, or -1 to skip it. */
 typedef int (*fsdem__mps_classify_fn)(const fsdem_mps *s, const void *user, fsdem_vec3 p);
 

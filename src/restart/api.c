@@ -72,7 +72,7 @@ static fsdem__restart_object fsdem__restart_of_swe(const fsdem_swe *s) {
 static fsdem__restart_object fsdem__restart_of_swe_dem(const fsdem_swe_dem *c) {
     if (!c) return fsdem__restart_object_of(NULL, 0, 0, NULL, NULL, NULL, NULL);
     {
-        const int sizes[4] = {c->desc.swe->nx, c->desc.swe->ny, c->desc.dem->n, c->force_capacity};
+        const int sizes[4] = {c->desc.swe->nx, c->desc.swe->ny, c->desc.dem->n, c->head.records};
         return fsdem__restart_object_of(c, FSDEM__RESTART_SWE_DEM, c->desc.swe->dim, sizes, fsdem__restart_swe_dem, &c->head.allocator, &c->head.status);
     }
 }

@@ -43,7 +43,8 @@ static void *fsdem__restart_here(const fsdem__restart *io, void *records) {
 }
 
 /* SWE-DEM: the counters, the last step, the impulse given to the water, and the force records and
-   reactions of every particle slot (the next step's impulse reads the reactions). */
+   reactions of its last update (files of older builds hold them for every slot of the arrays: `count`
+   slots, of which the first `records` are records). */
 static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
     static const fsdem__field same[7] = {
         FSDEM__SAME(fsdem_swe_dem, beta, REAL), FSDEM__SAME(fsdem_swe_dem, two_way, INT),
@@ -56,24 +57,26 @@ static void fsdem__restart_swe_dem(fsdem__restart *io, void *object) {
         FSDEM__SAVED(fsdem_swe_dem, wet), FSDEM__SAVED(fsdem_swe_dem, impulse)};
     fsdem_swe_dem *c = (fsdem_swe_dem *)object;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
-    int count = c->force_capacity, records = c->head.records;
-    fsdem_swe_dem_force *force;
-    fsdem_vec3 *reaction;
+    int count = c->head.records, records = c->head.records;
     fsdem__restart_coupler(io, &c->head, "SWD1", fsdem__restart_swe, "shallow water", "debris (DEM)", same, 7);
     fsdem__restart_fields(io, c, state, 6);
     fsdem__restart_count(io, &count, 1 << 29, fsdem__restart_record_bytes(&c->head) + sizeof(fsdem_vec3), "force record count");
     fsdem__restart_value(io, &records, sizeof records); /* checked before it is used */
     if (io->res == FSDEM_OK && (records < 0 || records > count)) fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "bad record count");
-    force = (fsdem_swe_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
-    reaction = (fsdem_vec3 *)fsdem__restart_block(io, &c->head.allocator, sizeof *reaction * (size_t)count);
+    if (count > c->force_capacity) { /* else into the object's arrays */
+        fsdem_swe_dem_force *force = (fsdem_swe_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
+        fsdem_vec3 *reaction = (fsdem_vec3 *)fsdem__restart_block(io, &c->head.allocator, sizeof *reaction * (size_t)count);
+        if (commit) {
+            fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_capacity);
+            fsdem__free(&c->head.allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
+            c->force = force;
+            c->reaction = reaction;
+            c->force_capacity = count;
+        }
+    }
     if (commit) {
-        fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_capacity);
-        fsdem__free(&c->head.allocator, c->reaction, sizeof *reaction * (size_t)c->force_capacity);
-        c->force = force;
-        c->reaction = reaction;
-        c->force_capacity = count;
-        if (force) memset(force, 0, sizeof *force * (size_t)count);
-        c->head.record = force;
+        if (c->force) memset(c->force, 0, sizeof *c->force * (size_t)count);
+        c->head.record = c->force;
         c->head.records = records;
     }
     fsdem__restart_records(io, &c->head, fsdem__restart_here(io, c->force), count);
@@ -101,11 +104,13 @@ static void fsdem__restart_mps_dem(fsdem__restart *io, void *object) {
     fsdem__restart_coupler(io, &c->head, "MPD1", fsdem__restart_mps, "water (MPS)", "sediment (DEM)", same, 5);
     fsdem__restart_fields(io, c, state, 10);
     fsdem__restart_count(io, &count, 1 << 29, fsdem__restart_record_bytes(&c->head), "force record count");
-    force = (fsdem_mps_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
+    force = count <= c->force_cap ? c->force : (fsdem_mps_dem_force *)fsdem__restart_block(io, &c->head.allocator, sizeof *force * (size_t)count);
     if (io->mode == FSDEM__RESTART_COMMIT) {
-        fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_cap);
-        c->force = force;
-        c->force_cap = count;
+        if (force != c->force) {
+            fsdem__free(&c->head.allocator, c->force, sizeof *force * (size_t)c->force_cap);
+            c->force = force;
+            c->force_cap = count;
+        }
         if (force) memset(force, 0, sizeof *force * (size_t)count);
         c->head.record = force;
         c->head.records = count;

@@ -26,8 +26,9 @@ static void fsdem__restart_mps_planes(fsdem__restart *io, int dim, int count, in
     }
 }
 
-/* The particles go into fresh arrays of the saved capacity (all FSDEM__MPS_ARRAYS of them and the
-   four row-offset arrays, as fsdem__mps_reserve makes them); of their contents the state that the
+/* The particles go into arrays of the saved capacity (all FSDEM__MPS_ARRAYS of them and the four
+   row-offset arrays, as fsdem__mps_reserve makes them; the object's own when it has that capacity,
+   so a coupled step's put-back allocates nothing); of their contents the state that the
    next step reads (positions, velocities, pressures: the pressure solve starts from them, kinds,
    porosities, a coupler's forces, obstacle membership) and the views of the last step (number
    density, surface flags, pressure gradients) are saved. The neighbour rows and the matrix are
@@ -61,31 +62,38 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
 
     fsdem__restart_fields(io, s, state, 8);
 
-    /* obstacles, into a fresh array */
+    /* obstacles and open boundaries, into the object's arrays when they hold them (else fresh ones) */
     fsdem__restart_count(io, &no, 1 << 24, sizeof(fsdem__mps_obst), "obstacle count");
-    obst = (fsdem__mps_obst *)fsdem__restart_block(io, al, sizeof *obst * (size_t)no);
-    if (commit) {
+    obst = no <= s->obst_cap ? s->obst : (fsdem__mps_obst *)fsdem__restart_block(io, al, sizeof *obst * (size_t)no);
+    if (commit && obst != s->obst) {
         fsdem__free(al, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
         s->bytes += sizeof *obst * (size_t)no - sizeof *s->obst * (size_t)s->obst_cap;
         s->obst = obst;
-        s->obst_n = s->obst_cap = no;
+        s->obst_cap = no;
     }
+    if (commit) s->obst_n = no;
     fsdem__restart_data(io, s->obst, sizeof *s->obst * (size_t)no);
 
-    /* open boundaries, into fresh arrays */
     fsdem__restart_count(io, &nin, 1 << 24, sizeof(fsdem_mps_inflow_desc), "inflow count");
-    inflows = (fsdem_mps_inflow_desc *)fsdem__restart_block(io, al, sizeof *inflows * (size_t)nin);
+    inflows = nin <= s->inflow_cap ? s->inflows : (fsdem_mps_inflow_desc *)fsdem__restart_block(io, al, sizeof *inflows * (size_t)nin);
     fsdem__restart_count(io, &nout, 1 << 24, sizeof(fsdem_mps_outflow_desc), "outflow count");
-    outflows = (fsdem_mps_outflow_desc *)fsdem__restart_block(io, al, sizeof *outflows * (size_t)nout);
-    if (commit) {
+    outflows = nout <= s->outflow_cap ? s->outflows
+                                      : (fsdem_mps_outflow_desc *)fsdem__restart_block(io, al, sizeof *outflows * (size_t)nout);
+    if (commit && inflows != s->inflows) {
         fsdem__free(al, s->inflows, sizeof *s->inflows * (size_t)s->inflow_cap);
-        fsdem__free(al, s->outflows, sizeof *s->outflows * (size_t)s->outflow_cap);
         s->bytes += sizeof *inflows * (size_t)nin - sizeof *s->inflows * (size_t)s->inflow_cap;
-        s->bytes += sizeof *outflows * (size_t)nout - sizeof *s->outflows * (size_t)s->outflow_cap;
         s->inflows = inflows;
-        s->inflow_n = s->inflow_cap = nin;
+        s->inflow_cap = nin;
+    }
+    if (commit && outflows != s->outflows) {
+        fsdem__free(al, s->outflows, sizeof *s->outflows * (size_t)s->outflow_cap);
+        s->bytes += sizeof *outflows * (size_t)nout - sizeof *s->outflows * (size_t)s->outflow_cap;
         s->outflows = outflows;
-        s->outflow_n = s->outflow_cap = nout;
+        s->outflow_cap = nout;
+    }
+    if (commit) {
+        s->inflow_n = nin;
+        s->outflow_n = nout;
     }
     fsdem__restart_mps_planes(io, s->dim, nin, 1);
     fsdem__restart_data(io, s->inflows, sizeof *s->inflows * (size_t)nin);
@@ -94,10 +102,10 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_data(io, &s->inflow_total, sizeof s->inflow_total);
     fsdem__restart_data(io, &s->outflow_total, sizeof s->outflow_total);
 
-    /* particles, into fresh arrays of the saved capacity */
+    /* particles, into arrays of the saved capacity: the object's own when it has that capacity */
     fsdem__restart_count(io, &cap, 1 << 29, 0, "particle capacity");
     fsdem__restart_count(io, &n, cap, 2 * sizeof(fsdem_vec3), "particle count");
-    if (io->res == FSDEM_OK && (io->mode == FSDEM__RESTART_RESERVE || commit)) {
+    if (io->res == FSDEM_OK && cap != s->cap && (io->mode == FSDEM__RESTART_RESERVE || commit)) {
         void **ptr[FSDEM__MPS_ARRAYS];
         size_t elem[FSDEM__MPS_ARRAYS];
         void *fresh[FSDEM__MPS_ARRAYS + 4];
@@ -114,13 +122,16 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
                 int **rows = fsdem__mps_rows(s, a);
                 fsdem__free(al, *rows, sizeof(int) * (size_t)(s->cap + 1));
                 *rows = (int *)fresh[k + a];
-                memset(*rows, 0, sizeof(int) * (size_t)(cap + 1));
             }
             s->bytes += 4 * sizeof(int) * (size_t)cap - 4 * sizeof(int) * (size_t)s->cap;
             s->cap = cap;
-            s->n = n;
-            s->rows = 0; /* the pressure matrix of the last step is not kept */
         }
+    }
+    if (commit) {
+        for (a = 0; a < 4; ++a)
+            if (*fsdem__mps_rows(s, a)) memset(*fsdem__mps_rows(s, a), 0, sizeof(int) * (size_t)(cap + 1));
+        s->n = n;
+        s->rows = 0; /* the pressure matrix of the last step is not kept */
     }
     fsdem__restart_data(io, s->x, sizeof *s->x * (size_t)n);
     fsdem__restart_data(io, s->v, sizeof *s->v * (size_t)n);

@@ -13,11 +13,12 @@
    linear solvers (set up at every use), CPU times, the allocator, log and message. SDF obstacles
    keep the object's callbacks; a pressure-extra operator stays as set. */
 /* The gauges of a PIC solver (positions, kinds, radii); their file is not part of the state. */
-/* Point gauges (fsdem__gauges) into fresh arrays; refused while their file is open (`close` names
-   the function that closes it), but for a coupled step's put-back (io->unchecked): its gauges are
-   the step's, and their series stays open, the rows the step held dropped. */
+/* Point gauges (fsdem__gauges), into the object's arrays when they hold them (else fresh ones);
+   refused while their file is open (`close` names the function that closes it), but for a coupled
+   step's put-back (io->unchecked): its gauges are the step's, and their series stays open, the rows
+   the step held dropped. */
 static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fsdem_allocator *al, const char *close) {
-    int ng = g->count;
+    int ng = g->count, in_place;
     fsdem_vec3 *at = g->at;
     int *kind = g->kind;
     fsdem_real *radius = g->radius;
@@ -25,39 +26,43 @@ static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fs
         fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                             "the object has a gauge file open: close it (%s) before restoring and open it again afterwards", close);
     fsdem__restart_count(io, &ng, 1 << 24, sizeof(fsdem_vec3) + sizeof(int) + sizeof(fsdem_real), "gauge count");
-    if (io->unchecked) {
-        if (io->res == FSDEM_OK && ng != g->count) fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "the gauges changed");
-        if (io->mode == FSDEM__RESTART_COMMIT) fsdem__series_drop(&g->series);
-    } else {
+    in_place = ng <= g->capacity;
+    if (!in_place) {
         at = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)ng);
         kind = (int *)fsdem__restart_block(io, al, sizeof(int) * (size_t)ng);
         radius = (fsdem_real *)fsdem__restart_block(io, al, sizeof(fsdem_real) * (size_t)ng);
     }
-    if (io->mode == FSDEM__RESTART_COMMIT && !io->unchecked) {
-        fsdem__gauges_free(g, al);
-        g->at = at;
-        g->kind = kind;
-        g->radius = radius;
-        g->count = g->capacity = ng;
+    if (io->mode == FSDEM__RESTART_COMMIT) {
+        if (io->unchecked) fsdem__series_drop(&g->series);
+        if (!in_place) {
+            fsdem__gauges_free(g, al);
+            g->at = at;
+            g->kind = kind;
+            g->radius = radius;
+            g->capacity = ng;
+        }
+        g->count = ng;
     }
     fsdem__restart_data(io, g->at, sizeof(fsdem_vec3) * (size_t)ng);
     fsdem__restart_ints(io, g->kind, ng, FSDEM__GAUGE_LEVEL, FSDEM__GAUGE_PRESSURE, "gauge kind");
     fsdem__restart_data(io, g->radius, sizeof(fsdem_real) * (size_t)ng);
 }
 
-/* The obstacles, into a fresh array (polygons own their vertices); SDF obstacles keep the object's
-   callbacks. */
+/* The obstacles (polygons own their vertices), written into the object's arrays where they hold
+   them, else into fresh ones; SDF obstacles keep the object's callbacks. */
 static void fsdem__restart_pic_obstacles(fsdem__restart *io, fsdem_pic *s) {
     const fsdem_allocator *al = &s->allocator;
     const int commit = io->mode == FSDEM__RESTART_COMMIT;
-    int no = s->obst_count, k;
+    int no = s->obst_count, k, in_place;
     fsdem__pic_obst *obst;
     fsdem__restart_count(io, &no, 1 << 20, 2 * sizeof(int) + 5 * sizeof(fsdem_vec3) + sizeof(fsdem_real), "obstacle count");
-    obst = (fsdem__pic_obst *)fsdem__restart_block(io, al, sizeof(fsdem__pic_obst) * (size_t)no);
+    in_place = no <= s->obst_capacity;
+    obst = in_place ? s->obst : (fsdem__pic_obst *)fsdem__restart_block(io, al, sizeof(fsdem__pic_obst) * (size_t)no);
     for (k = 0; k < no && io->res == FSDEM_OK; ++k) {
+        const fsdem__pic_obst *own = k < s->obst_count ? &s->obst[k] : NULL; /* the object's obstacle k */
         fsdem__pic_obst o;
         fsdem_vec3 *verts;
-        int type, nv;
+        int type, nv, own_verts;
         if (io->mode == FSDEM__RESTART_WRITE) o = s->obst[k];
         else memset(&o, 0, sizeof o);
         type = (int)o.d.type;
@@ -72,20 +77,23 @@ static void fsdem__restart_pic_obstacles(fsdem__restart *io, fsdem_pic *s) {
         fsdem__restart_count(io, &nv, 1 << 24, sizeof(fsdem_vec3), "polygon vertex count");
         if (io->mode == FSDEM__RESTART_CHECK && io->res == FSDEM_OK && (type == FSDEM_PIC_OBSTACLE_TYPE_POLYGON) != (nv >= 3))
             fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG, "obstacle %d has %d vertices (corrupted data)", k, nv);
-        verts = (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)nv);
+        own_verts = own && own->verts && own->d.vertex_count == nv;
+        verts = own_verts ? own->verts : (fsdem_vec3 *)fsdem__restart_block(io, al, sizeof(fsdem_vec3) * (size_t)nv);
         fsdem__restart_data(io, io->mode == FSDEM__RESTART_WRITE ? o.verts : verts, sizeof(fsdem_vec3) * (size_t)nv);
         if (io->mode != FSDEM__RESTART_WRITE && io->res == FSDEM_OK && type == FSDEM_PIC_OBSTACLE_TYPE_SDF) {
-            if (k >= s->obst_count || s->obst[k].d.type != FSDEM_PIC_OBSTACLE_TYPE_SDF)
+            if (!own || own->d.type != FSDEM_PIC_OBSTACLE_TYPE_SDF)
                 fsdem__restart_fail(io, FSDEM_ERR_INVALID_ARG,
                                     "obstacle %d is an SDF obstacle in the save: add the same SDF obstacles "
                                     "(fsdem_pic_obstacle_sdf), in the same order, to the object before restoring",
                                     k);
             else {
-                o.d.sdf = s->obst[k].d.sdf;
-                o.d.sdf_user = s->obst[k].d.sdf_user;
+                o.d.sdf = own->d.sdf;
+                o.d.sdf_user = own->d.sdf_user;
             }
         }
         if (commit) {
+            if (own && own->verts && !own_verts) fsdem__pic_release(s, own->verts, sizeof(fsdem_vec3) * (size_t)own->d.vertex_count);
+            if (!own_verts) s->bytes += sizeof(fsdem_vec3) * (size_t)nv;
             o.d.type = (fsdem_pic_obstacle_type)type;
             o.d.vertex_count = nv;
             o.d.vertices = o.verts = verts;
@@ -93,25 +101,27 @@ static void fsdem__restart_pic_obstacles(fsdem__restart *io, fsdem_pic *s) {
         }
     }
     if (commit) {
-        for (k = 0; k < s->obst_count; ++k)
+        for (k = no; k < s->obst_count; ++k)
             if (s->obst[k].verts) fsdem__pic_release(s, s->obst[k].verts, sizeof(fsdem_vec3) * (size_t)s->obst[k].d.vertex_count);
-        fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
-        s->obst = obst;
-        s->obst_count = s->obst_capacity = no;
-        s->bytes += sizeof(fsdem__pic_obst) * (size_t)no;
-        for (k = 0; k < no; ++k) s->bytes += sizeof(fsdem_vec3) * (size_t)obst[k].d.vertex_count;
+        if (!in_place) {
+            fsdem__pic_release(s, s->obst, sizeof(fsdem__pic_obst) * (size_t)s->obst_capacity);
+            s->obst = obst;
+            s->obst_capacity = no;
+            s->bytes += sizeof(fsdem__pic_obst) * (size_t)no;
+        }
+        s->obst_count = no;
     }
 }
 
-/* The particles, into fresh arrays of the saved capacity (a full capacity refuses inflow seeds),
-   with their APIC matrices. */
+/* The particles, with their APIC matrices, into arrays of the saved capacity (a full capacity
+   refuses inflow seeds): the object's own when it has that capacity, else fresh ones. */
 static void fsdem__restart_pic_particles(fsdem__restart *io, fsdem_pic *s) {
     const fsdem_allocator *al = &s->allocator;
     const int commit = io->mode == FSDEM__RESTART_COMMIT, apic = s->desc.transfer == FSDEM_PIC_TRANSFER_APIC;
     int np = s->np, pcap = s->pcap, a;
     fsdem__restart_count(io, &pcap, 1 << 29, 0, "particle capacity");
     fsdem__restart_count(io, &np, pcap, 2 * sizeof(fsdem_vec3), "particle count");
-    if (io->res == FSDEM_OK) {
+    if (io->res == FSDEM_OK && pcap != s->pcap) {
         const size_t vb = sizeof(fsdem_vec3) * (size_t)pcap, ib = sizeof(int) * (size_t)pcap;
         fsdem_vec3 *px = (fsdem_vec3 *)fsdem__restart_block(io, al, vb), *pv = (fsdem_vec3 *)fsdem__restart_block(io, al, vb);
         fsdem_vec3 *pt = (fsdem_vec3 *)fsdem__restart_block(io, al, vb), *pc[3] = {NULL, NULL, NULL};
@@ -130,11 +140,13 @@ static void fsdem__restart_pic_particles(fsdem__restart *io, fsdem_pic *s) {
             s->pcell = pcell;
             s->pidx = pidx;
             s->pflag = pflag;
-            if (pflag) memset(pflag, 0, (size_t)pcap);
             s->pcap = pcap;
-            s->np = np;
             s->bytes += (apic ? 6 : 3) * vb + 2 * ib + (size_t)pcap;
         }
+    }
+    if (commit) {
+        if (s->pflag) memset(s->pflag, 0, (size_t)pcap);
+        s->np = np;
     }
     fsdem__restart_data(io, s->px, sizeof(fsdem_vec3) * (size_t)np);
     fsdem__restart_data(io, s->pv, sizeof(fsdem_vec3) * (size_t)np);

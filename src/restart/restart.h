@@ -36,6 +36,10 @@
                     fsdem_dem, its fractions, counters and the drag limit of its last step (the
                     per-granule force records are not kept: fsdem_gic_get_force finds none until
                     the next step).
+   A restore writes into the object's own arrays wherever they hold what the save has (the PIC's
+   and the MPS's particle arrays when their capacity is the saved one), so restoring into an object
+   of the sizes saved allocates nothing: a coupled step that fails puts its state back so
+   (>>couple_step).
    What must match (else FSDEM_ERR_INVALID_ARG naming the field): the desc fields that steps read.
    DEM: dim, domain, gravity, law, integrator, dt_rule, dt_param, skin, contact_offset, linear_*,
    disc_length, rotation, the contact options (tangential_*, coulomb_limit), periodic. PIC: the grid (cells per axis), dim, domain_min, cell_size, density,

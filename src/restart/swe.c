@@ -1,37 +1,43 @@
 /* ---- >>restart_swe : shallow water ---- */
 
-/* The per-cell masks of the SWE: the blocked cells, when there are any (nx*ny flags); `masks`
-   counts them, so data with a mask this build does not know are refused. */
+/* The per-cell masks of the SWE: the blocked cells, when there are any (nx*ny flags; into the
+   object's array when it has one); `masks` counts them, so data with a mask this build does not know
+   are refused. */
 static void fsdem__restart_swe_masks(fsdem__restart *io, fsdem_swe *s) {
     int masks = s->blocked ? 1 : 0, k, count = 0;
     unsigned char *blocked;
     fsdem__restart_int_in(io, &masks, 0, 1, "the number of per-cell masks (data of a newer build)");
-    blocked = masks ? (unsigned char *)fsdem__restart_block(io, &s->allocator, (size_t)s->n) : NULL;
-    if (masks) fsdem__restart_flags(io, io->mode == FSDEM__RESTART_WRITE ? s->blocked : blocked, s->n, 1, "blocked flag of cell");
+    blocked = !masks || s->blocked ? s->blocked : (unsigned char *)fsdem__restart_block(io, &s->allocator, (size_t)s->n);
+    if (masks) fsdem__restart_flags(io, blocked, s->n, 1, "blocked flag of cell");
     if (io->mode != FSDEM__RESTART_COMMIT) return;
-    fsdem__free(&s->allocator, s->blocked, (size_t)s->n);
+    if (!masks) {
+        fsdem__free(&s->allocator, s->blocked, (size_t)s->n);
+        blocked = NULL;
+    }
     s->blocked = blocked;
     for (k = 0; blocked && k < s->n; ++k) count += blocked[k];
     s->blocked_count = count;
 }
 
-/* A series of n points (times and values): written, or read into fresh arrays that COMMIT hands to
-   *t and *v after freeing the old ones. */
+/* A series of n points (times and values): written, or read into *t and *v when they have that
+   length, else into fresh arrays that COMMIT hands to *t and *v after freeing the old ones. */
 static void fsdem__restart_swe_series(fsdem__restart *io, fsdem_swe *s, fsdem_real **t, fsdem_real **v, int *n,
                                       const char *what) {
     int count = *n;
-    fsdem_real *ft, *fv;
+    fsdem_real *ft = *t, *fv = *v;
     fsdem__restart_count(io, &count, 1 << 28, 2 * sizeof(fsdem_real), what);
-    ft = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
-    fv = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
-    if (io->mode == FSDEM__RESTART_COMMIT) {
-        fsdem__swe_free_series(s, t, v, n);
-        *t = ft;
-        *v = fv;
-        *n = count;
+    if (count != *n) {
+        ft = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
+        fv = (fsdem_real *)fsdem__restart_block(io, &s->allocator, sizeof(fsdem_real) * (size_t)count);
+        if (io->mode == FSDEM__RESTART_COMMIT) {
+            fsdem__swe_free_series(s, t, v, n);
+            *t = ft;
+            *v = fv;
+            *n = count;
+        }
     }
-    fsdem__restart_data(io, *t, sizeof(fsdem_real) * (size_t)count);
-    fsdem__restart_data(io, *v, sizeof(fsdem_real) * (size_t)count);
+    fsdem__restart_data(io, ft, sizeof(fsdem_real) * (size_t)count);
+    fsdem__restart_data(io, fv, sizeof(fsdem_real) * (size_t)count);
 }
 
 /* Everything of a shallow-water solver, in order. State: time, last dt, counters, the bound of the
@@ -115,10 +121,11 @@ static void fsdem__restart_swe(fsdem__restart *io, void *object) {
         }
     }
 
-    /* point sources, into a fresh array */
+    /* point sources and gauge positions (the gauge file is not part of the state), into the object's
+       arrays when they hold them, else into fresh ones */
     fsdem__restart_count(io, &ns, 1 << 24, sizeof(fsdem_real) + 4 * sizeof(int), "point source count");
     fsdem__restart_value(io, &next_id, sizeof next_id);
-    src = (fsdem__swe_src *)fsdem__restart_block(io, al, sizeof(fsdem__swe_src) * (size_t)ns);
+    src = ns <= s->src_capacity ? s->src : (fsdem__swe_src *)fsdem__restart_block(io, al, sizeof(fsdem__swe_src) * (size_t)ns);
     for (k = 0; k < ns && io->res == FSDEM_OK; ++k) {
         fsdem__swe_src q;
         if (io->mode == FSDEM__RESTART_WRITE) q = s->src[k];
@@ -127,24 +134,31 @@ static void fsdem__restart_swe(fsdem__restart *io, void *object) {
         fsdem__restart_int_in(io, &q.cell, 0, s->n - 1, "point source cell");
         fsdem__restart_value(io, &q.id, sizeof q.id);
         fsdem__restart_int_in(io, &q.active, 0, 1, "point source active flag");
+        if (io->mode != FSDEM__RESTART_WRITE && k < s->src_count) { /* its series into the object's source k's */
+            q.t = s->src[k].t;
+            q.v = s->src[k].v;
+            q.n = s->src[k].n;
+        }
         fsdem__restart_swe_series(io, s, &q.t, &q.v, &q.n, "point source series length");
         if (commit) src[k] = q;
     }
-    if (commit) {
-        for (k = 0; k < s->src_count; ++k) fsdem__swe_free_series(s, &s->src[k].t, &s->src[k].v, &s->src[k].n);
-        fsdem__free(al, s->src, sizeof(fsdem__swe_src) * (size_t)s->src_capacity);
-        s->src = src;
-        s->src_count = s->src_capacity = ns;
-        s->src_next_id = next_id;
-    }
-
-    /* gauge positions (the file is not part of the state) */
     fsdem__restart_count(io, &ng, 1 << 24, 2 * sizeof(fsdem_real), "gauge count");
-    xy = (fsdem_real *)fsdem__restart_block(io, al, 2 * sizeof(fsdem_real) * (size_t)ng);
+    xy = ng <= s->gauge_capacity ? s->gauge : (fsdem_real *)fsdem__restart_block(io, al, 2 * sizeof(fsdem_real) * (size_t)ng);
     if (commit) {
-        fsdem__free(al, s->gauge, 2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
-        s->gauge = xy;
-        s->gauge_count = s->gauge_capacity = ng;
+        for (k = ns; k < s->src_count; ++k) fsdem__swe_free_series(s, &s->src[k].t, &s->src[k].v, &s->src[k].n);
+        if (src != s->src) {
+            fsdem__free(al, s->src, sizeof(fsdem__swe_src) * (size_t)s->src_capacity);
+            s->src = src;
+            s->src_capacity = ns;
+        }
+        s->src_count = ns;
+        s->src_next_id = next_id;
+        if (xy != s->gauge) {
+            fsdem__free(al, s->gauge, 2 * sizeof(fsdem_real) * (size_t)s->gauge_capacity);
+            s->gauge = xy;
+            s->gauge_capacity = ng;
+        }
+        s->gauge_count = ng;
     }
     fsdem__restart_data(io, s->gauge, 2 * sizeof(fsdem_real) * (size_t)ng);
     fsdem__restart_tag(io, "SWE.");
