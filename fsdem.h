@@ -2188,6 +2188,38 @@ typedef enum fsdem_mps_wall_viscosity {
     FSDEM_MPS_WALL_VISCOSITY_AT_REST = 1
 } fsdem_mps_wall_viscosity;
 
+/* How the pressure is found (see >>mps_explicit in the implementation for the explicit scheme). */
+typedef enum fsdem_mps_scheme {
+    /* seed 002 §2.1: the pressure Poisson equation of steps 2-6 above (the seed's; incompressible
+       to the solver's tolerance; the default until the measurements of issue 35 choose) */
+    FSDEM_MPS_SCHEME_SEMI_IMPLICIT = 0,
+    /* weakly compressible, explicit (Oochi, Koshizuka and Sakai 2010; Shakibaeinia and Jin 2010):
+       every particle carries a density rho_i, evolved by the continuity equation with the MPS
+       divergence (Eq. 9) and a diffusion of the density like delta-SPH's (Molteni and Colagrossi
+       2009) of its departure from hydrostatic (so a liquid at rest stays so exactly); the pressure
+       follows by the linear equation of state p = c0^2 (rho_i - rho) with an artificial sound
+       speed c0 (desc.sound_speed); WALL and DUMMY particles take the pressure of the liquid around
+       them extrapolated hydrostatically (Adami, Hu and Adams 2012); the velocity is u += dt
+       (-grad p / rho + nu lap u + g + f/m) with the sum form of Eq. 8 (desc.gradient is not used),
+       then the density and the positions with the new velocity (symplectic Euler); the step is
+       limited by (c0 + u_max) dt / r0 <= cfl. The gradient and divergence weigh pairs by
+       q^2 (1 - q)^3, q = r / 2.8 r0 (so desc.re >= 2.8 r0): a pair then pushes as the Wendland
+       kernel's gradient does in SPH. With the seed's kernel (Eq. 6) the square lattice is unstable
+       to the shear of one column against the next (a column's stiffness against its neighbour,
+       summed over the lattice, is negative for a pair force decreasing as steeply as w/r; growth
+       about 30/s at 1 kPa, measured 35/s: the columns beside the walls slid from 0.15 s); with
+       this one it is slightly positive. A particle whose density is not set yet starts at the
+       hydrostatic density of its depth below the top of its column of liquid (the hydrostatic
+       start). No pressure equation, no surface detection (the surface's particles keep rho near
+       rho: p near 0). Still water (the tank of the notes above, 2D): largest displacement 0.157 r0
+       at 0.5 s and 0.145 r0 at 5 s, at the particles where the surface meets a wall (0.064 and
+       0.058 r0 three columns or more from the walls); mid-depth pressure +0.1 %; 3D (0.1 x 0.1 m,
+       0.2 m deep) 0.198 r0 at 0.5 s, 0.27 r0 at 1 s (0.11 and 0.13 r0 inside), pressure +0.4 %.
+       The porosity enters as in the corrector (Model B: the pressure term over eps_i); the
+       mixture's continuity is not in it yet. */
+    FSDEM_MPS_SCHEME_EXPLICIT = 1
+} fsdem_mps_scheme;
+
 /* Form of the pressure equation's source with a porosity field (seed 002 §2.1). */
 typedef enum fsdem_mps_model {
     FSDEM_MPS_MODEL_A = 0, /* Eq. 12: rho_f in both terms of the mixed source */
@@ -2196,6 +2228,7 @@ typedef enum fsdem_mps_model {
 
 typedef struct fsdem_mps_desc {
     int dim;                        /* 2 or 3 */
+    fsdem_mps_scheme scheme;        /* default FSDEM_MPS_SCHEME_SEMI_IMPLICIT (see the enum) */
     fsdem_real r0;                  /* m; initial particle spacing, > 0; default 0.01 */
     fsdem_real re;                  /* m; interaction radius, >= 2 r0; 0 = 4.1 r0 (seed 002 §2.1); */
                                     /*    default 0 */
@@ -2210,8 +2243,14 @@ typedef struct fsdem_mps_desc {
     fsdem_mps_model model;          /* source of the pressure equation: Eq. 12 or 13; default A */
     fsdem_real beta;                /* -; surface when n < beta n0 (Eq. 14), in (0, 1); default 0.8 */
     fsdem_real alpha;               /* -; surface when |F| > alpha |F0| (Eq. 16), > 0; default 0.9 */
-    fsdem_real cfl;                 /* -; Courant number C of Eq. 37, u_max dt / r0 <= C, in (0, 1]; */
-                                    /*    default 0.2 */
+    fsdem_real cfl;                 /* -; Courant number C of Eq. 37, u_max dt / r0 <= C (explicit: */
+                                    /*    (c0 + u_max) dt / r0 <= C), in (0, 1]; default 0.2 */
+    fsdem_real sound_speed;         /* m/s; c0 of FSDEM_MPS_SCHEME_EXPLICIT, >= 0; 0 = 10 sqrt(2 |g| H) */
+                                    /*    with H the height of the liquid at the first step (10 */
+                                    /*    times the speed of a fall from its top: density within */
+                                    /*    1 %); default 0 */
+    fsdem_real density_diffusion;   /* -; delta of the explicit scheme's density diffusion, in */
+                                    /*    [0, 1]; default 0.1 (delta-SPH's) */
     fsdem_real dt_max;              /* s; longest step (taken while nothing moves); default 1e-3 */
     fsdem_vec3 domain_min;          /* m; every particle must stay inside; default (0,0,0) */
     fsdem_vec3 domain_max;          /* m; default (1,1,1) (z unused in 2D) */
@@ -4544,7 +4583,8 @@ static fsdem_real fsdem__geom_face_fraction(int dim, int a, fsdem_vec3 c0, fsdem
 
    Contents: fsdem__kernel (per-axis node range, weights, derivatives and clamped node indices) and
    fsdem__kernel_weights, the tent (linear, 2 nodes) and quadratic B-spline (3 nodes) kernels at a
-   position given in grid units; fsdem__kernel_mps, the particle-interaction weight of MPS. */
+   position given in grid units; fsdem__kernel_mps, the particle-interaction weight of MPS, and fsdem__kernel_mps_explicit, that of
+   its explicit scheme. */
 
 /* Kernel weights of one point along each axis: nodes lo[b] .. lo[b] + count[b] - 1, weights w and
    their derivatives dw (per grid unit), and the node indices clamped into the grid (idx). */
@@ -4609,6 +4649,14 @@ static void fsdem__kernel_weights(fsdem__kernel *k, int dim, const fsdem_real s[
    coincident particles from producing infinite number densities and pressure spikes. */
 static inline fsdem_real fsdem__kernel_mps(fsdem_real r, fsdem_real re) {
     return r < re ? re / ((fsdem_real)0.85 * r + (fsdem_real)0.15 * re) - 1 : 0;
+}
+
+/* Weight of MPS's explicit scheme at distance r (m) for the support R (m): q^2 (1 - q)^3, q = r/R,
+   0 beyond. In MPS's sum-form gradient a pair pushes with w/r, which is then the gradient of the
+   Wendland C2 kernel of SPH (Wendland 1995) of support R: smooth, zero at contact and at R. */
+static inline fsdem_real fsdem__kernel_mps_explicit(fsdem_real r, fsdem_real R) {
+    const fsdem_real q = r / R;
+    return q < 1 ? q * q * (1 - q) * (1 - q) * (1 - q) : 0;
 }
 
 /* ===== >>impl_grid : cell grid ===================================================================== */
@@ -15005,7 +15053,7 @@ fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *normal) {
    >>mps_particles (storage, lattice fills, walls, obstacles), >>mps_open (inflow and outflow
    planes), >>mps_neighbours (cell-list search
    into sorted neighbour rows), >>mps_operators (number density, gradient, divergence, Laplacian,
-   surface), >>mps_step (predictor, pressure equation, corrector, collisions, time stepping),
+   surface, the solids' ghost velocities), >>mps_explicit (the weakly compressible scheme), >>mps_step (predictor, pressure equation, corrector, collisions, time stepping),
    >>mps_views (views, statistics), >>mps_probes (pressure, water level, obstacle force, gauges). */
 
 /* A box obstacle (fsdem_mps_add_box_obstacle) and the force of the fluid on it in the last step. */
@@ -15024,6 +15072,7 @@ struct fsdem_mps {
     fsdem_real r0, re, re_lap;    /* spacing, radius of Eq. 7-9 and of the Laplacian (Eq. 10-11) */
     fsdem_real n0, lambda, f0;    /* lattice constants (>>mps_desc): lambda with re_lap */
     fsdem_real n0_lap;            /* sum of the Laplacian's weights on the full lattice */
+    fsdem_real re_x, n0_x;        /* support and lattice sum of the explicit scheme's weight */
     int layers;                   /* WALL + DUMMY layers of a solid: ceil(re/r0) */
     fsdem__periods periods;       /* the periodic axes (desc.periodic) */
     /* particles, structure of arrays, `cap` allocated */
@@ -15031,6 +15080,8 @@ struct fsdem_mps {
     fsdem_vec3 *x, *v, *us;       /* position, velocity, predicted velocity u* */
     fsdem_vec3 *shift;            /* particle shift of the step (desc.shifting) */
     fsdem_real *p, *eps, *nd;     /* pressure, porosity, number density */
+    fsdem_real *rho;              /* density carried in the explicit scheme (kg/m^3; 0: not set yet) */
+    fsdem_real c0;                /* the explicit scheme's sound speed once set (m/s; 0: not yet) */
     fsdem_vec3 *fext;             /* external force of a coupler (N; N/m in 2D), FLUID particles */
     fsdem_vec3 *gradp;            /* pressure gradient of the last corrector (Pa/m), FLUID particles */
     fsdem_vec3 *uvisc;            /* velocity in the viscous term: u of FLUID, the ghost of solids */
@@ -15086,6 +15137,9 @@ static const char *const fsdem__mps_claimable[2] = {"forces", "porosity"};
 
 /* ---- >>mps_desc : defaults, validation, lattice constants, creation ---- */
 
+/* Support of the explicit scheme's gradient and divergence, in r0 (see >>mps_explicit). */
+#define FSDEM__MPS_EXPLICIT_SUPPORT 2.8f
+
 fsdem_mps_desc fsdem_mps_desc_default(int dim) {
     fsdem_mps_desc d;
     memset(&d, 0, sizeof d);
@@ -15099,6 +15153,7 @@ fsdem_mps_desc fsdem_mps_desc_default(int dim) {
     d.beta = (fsdem_real)0.8;
     d.alpha = (fsdem_real)0.9;
     d.cfl = (fsdem_real)0.2;
+    d.density_diffusion = (fsdem_real)0.1;
     d.dt_max = (fsdem_real)1e-3;
     d.domain_min = fsdem_v3(0, 0, 0);
     d.domain_max = fsdem_v3(1, 1, 1);
@@ -15123,11 +15178,21 @@ static fsdem_result fsdem__mps_check(const fsdem_mps_desc *d, char *msg, size_t 
     int a;
     if (msg && size) msg[0] = '\0';
     if (d->dim != 2 && d->dim != 3) return fsdem__reject(msg, size, "fsdem_mps_desc.dim = %d must be 2 or 3", d->dim);
+    if ((int)d->scheme < 0 || (int)d->scheme > 1)
+        return fsdem__reject(msg, size, "fsdem_mps_desc.scheme = %d is not a fsdem_mps_scheme", (int)d->scheme);
+    if (!(d->sound_speed >= 0) || !fsdem__finite(d->sound_speed))
+        return fsdem__reject(msg, size, "fsdem_mps_desc.sound_speed = %g m/s must be >= 0 and finite (0: from the liquid's height)",
+                             (double)d->sound_speed);
+    if (!(d->density_diffusion >= 0 && d->density_diffusion <= 1))
+        return fsdem__reject(msg, size, "fsdem_mps_desc.density_diffusion = %g must be in [0, 1]", (double)d->density_diffusion);
     if (!(d->r0 > 0) || !fsdem__finite(d->r0))
         return fsdem__reject(msg, size, "fsdem_mps_desc.r0 = %g m must be > 0 and finite", (double)d->r0);
     if (d->re != 0 && (!(d->re >= 2 * d->r0) || !fsdem__finite(d->re)))
         return fsdem__reject(msg, size, "fsdem_mps_desc.re = %g m must be 0 (4.1 r0) or >= 2 r0 = %g m", (double)d->re,
                              (double)(2 * d->r0));
+    if (d->scheme == FSDEM_MPS_SCHEME_EXPLICIT && d->re != 0 && d->re < FSDEM__MPS_EXPLICIT_SUPPORT * d->r0)
+        return fsdem__reject(msg, size, "fsdem_mps_desc.re = %g m must be >= %g r0 = %g m for the explicit scheme (the support of its "
+                             "gradient)", (double)d->re, (double)FSDEM__MPS_EXPLICIT_SUPPORT, (double)(FSDEM__MPS_EXPLICIT_SUPPORT * d->r0));
     if (d->re > 20 * d->r0)
         return fsdem__reject(msg, size, "fsdem_mps_desc.re = %g m must be <= 20 r0 = %g m", (double)d->re,
                              (double)(20 * d->r0));
@@ -15206,10 +15271,11 @@ fsdem_result fsdem_mps_desc_check(const fsdem_mps_desc *desc, char *message, siz
 
 /* n0 (Eq. 7), lambda (Eq. 11) of a particle inside the full r0 lattice, and |F| (Eq. 15) of a
    particle on its flat free surface (the lattice points at or below it along the last axis): the
-   reference values of the PPE source, the Laplacian and the surface test (Eq. 14-16). */
+   reference values of the PPE source, the Laplacian and the surface test (Eq. 14-16); and n0 of the
+   explicit scheme's weight. */
 static void fsdem__mps_lattice(fsdem_mps *s) {
     const int m = (int)ceil((double)(s->re / s->r0)), kz = s->dim == 3 ? m : 0;
-    double n0 = 0, nl = 0, l = 0, f = 0;
+    double n0 = 0, nl = 0, l = 0, f = 0, nx = 0;
     int i, j, k;
     for (k = -kz; k <= kz; ++k)
         for (j = -m; j <= m; ++j)
@@ -15220,11 +15286,13 @@ static void fsdem__mps_lattice(fsdem_mps *s) {
                 const int up = s->dim == 3 ? k : j;
                 if (i == 0 && j == 0 && k == 0) continue;
                 n0 += w;
+                nx += fsdem__kernel_mps_explicit(r, s->re_x);
                 nl += wl;
                 l += wl * r * r;
                 if (up <= 0) f += w * (double)up * s->r0 / r;
             }
     s->n0 = (fsdem_real)n0;
+    s->n0_x = (fsdem_real)nx;
     s->n0_lap = (fsdem_real)nl;
     s->lambda = (fsdem_real)(l / nl);
     s->f0 = (fsdem_real)(fabs(f) * s->dim / n0);
@@ -15252,6 +15320,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     s->desc.re = s->re;
     s->re_lap = desc->re_laplacian > 0 ? desc->re_laplacian : s->re;
     s->desc.re_laplacian = s->re_lap;
+    s->re_x = FSDEM__MPS_EXPLICIT_SUPPORT * desc->r0;
     s->layers = (int)ceil((double)(s->re / s->r0) - 1e-9);
     s->periods = fsdem__periods_of(desc->periodic, desc->dim, desc->domain_min, desc->domain_max);
     fsdem__mps_lattice(s);
@@ -15288,7 +15357,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
 
 /* The particle arrays of a capacity `cap`, with their element sizes (one list for allocation,
    copying and release). */
-#define FSDEM__MPS_ARRAYS 20
+#define FSDEM__MPS_ARRAYS 21
 #define FSDEM__MPS_ROW_ARRAYS 3
 static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     void **p[FSDEM__MPS_ARRAYS];
@@ -15306,6 +15375,7 @@ static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     FSDEM__MPS_ARRAY(p);
     FSDEM__MPS_ARRAY(eps);
     FSDEM__MPS_ARRAY(nd);
+    FSDEM__MPS_ARRAY(rho);
     FSDEM__MPS_ARRAY(fext);
     FSDEM__MPS_ARRAY(gradp);
     FSDEM__MPS_ARRAY(div);
@@ -15449,6 +15519,7 @@ static void fsdem__mps_push(fsdem_mps *s, fsdem_mps_kind kind, fsdem_vec3 x, fsd
     s->p[i] = 0;
     s->eps[i] = 1;
     s->nd[i] = 0;
+    s->rho[i] = 0; /* set by the explicit scheme's hydrostatic start */
     s->fext[i] = s->gradp[i] = fsdem__zero3();
     s->kind[i] = (unsigned char)kind;
     s->surf[i] = 0;
@@ -16223,6 +16294,34 @@ static fsdem_vec3 fsdem__mps_lap_at(const fsdem_mps *s, const fsdem_real *phi, c
     return fsdem__scale(l, 2 * (fsdem_real)s->dim / (s->n0_lap * s->lambda));
 }
 
+/* Mass of the fluid a particle stands for: rho r0^d (kg; kg per metre of depth in 2D). */
+static fsdem_real fsdem__mps_mass(const fsdem_mps *s) {
+    return s->desc.density * s->r0 * s->r0 * (s->dim == 3 ? s->r0 : 1);
+}
+
+/* The ghost velocities of FSDEM_MPS_WALL_VISCOSITY_NO_SLIP into s->uvisc (see the enum): FLUID particles
+   their own velocity, WALL and DUMMY particles -u~, the Shepard average of the FLUID velocities
+   around them, gathered by scattering from the FLUID rows (the rows of DUMMY particles are empty);
+   0 where no FLUID particle is within re. */
+static void fsdem__mps_wall_ghosts(fsdem_mps *s) {
+    int i, e;
+    for (i = 0; i < s->n; ++i) {
+        s->uvisc[i] = s->kind[i] == FSDEM_MPS_KIND_FLUID ? s->v[i] : fsdem__zero3();
+        s->ghost_weight[i] = 0;
+    }
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
+            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+                const int j = s->nb[e];
+                const fsdem_real w = s->nbw[e] / s->eps[i];
+                if (s->kind[j] == FSDEM_MPS_KIND_FLUID) continue;
+                s->uvisc[j] = fsdem__madd(s->uvisc[j], s->v[i], w);
+                s->ghost_weight[j] += w;
+            }
+    for (i = 0; i < s->n; ++i)
+        if (s->ghost_weight[i] > 0) s->uvisc[i] = fsdem__scale(s->uvisc[i], -1 / s->ghost_weight[i]);
+}
+
 /* Rebuilds the neighbours and the number density at the current positions for a public operator
    (`fn` names it), checking its arguments. */
 static fsdem_result fsdem__mps_operator_setup(fsdem_mps *s, const char *fn, const void *in, const void *out) {
@@ -16260,6 +16359,180 @@ fsdem_result fsdem_mps_laplacian(fsdem_mps *s, const fsdem_real *phi, fsdem_real
     return fsdem__ok(&s->status);
 }
 
+/* ---- >>mps_explicit : the weakly compressible scheme (FSDEM_MPS_SCHEME_EXPLICIT) ---- */
+
+/* Height of x against gravity, -g.x / |g| (m; 0 without gravity). */
+static fsdem_real fsdem__mps_height(const fsdem_mps *s, fsdem_vec3 x) {
+    const fsdem_real g = fsdem__norm(s->desc.gravity);
+    return g > 0 ? -fsdem__dot(s->desc.gravity, x) / g : 0;
+}
+
+/* The sound speed c0 of the explicit scheme (m/s): desc.sound_speed, or the one set at the first
+   step, or (before it) 10 sqrt(2 |g| H), H the height of the FLUID particles plus r0; 0 when
+   nothing gives one (no gravity, no desc.sound_speed). A Mach number of 0.1 for the speed of a fall
+   from the top keeps the density within about 1 % of rho (Monaghan 1994). */
+static fsdem_real fsdem__mps_c0(const fsdem_mps *s) {
+    fsdem_real lo = (fsdem_real)HUGE_VAL, hi = -(fsdem_real)HUGE_VAL;
+    int i;
+    if (s->desc.sound_speed > 0) return s->desc.sound_speed;
+    if (s->c0 > 0) return s->c0;
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID) {
+            const fsdem_real h = fsdem__mps_height(s, s->x[i]);
+            if (h < lo) lo = h;
+            if (h > hi) hi = h;
+        }
+    if (!(hi >= lo)) return 0;
+    return 10 * (fsdem_real)sqrt(2 * (double)fsdem__norm(s->desc.gravity) * (double)(hi - lo + s->r0));
+}
+
+/* The hydrostatic start: every FLUID particle whose density is not set yet (0) takes
+   rho + rho |g| depth / c0^2 (the equation of state of a liquid at rest), its depth measured from
+   r0/2 above the highest FLUID particle of its column (neighbours within r0/2 of its vertical line,
+   the top passed from neighbour to neighbour until no particle learns a higher one; s->div holds
+   the tops). */
+static void fsdem__mps_hydrostatic_start(fsdem_mps *s, fsdem_real c0) {
+    const fsdem_real g = fsdem__norm(s->desc.gravity), half = s->r0 / 2;
+    fsdem_real *top = s->div;
+    int i, e, unset = 0, changed = 1;
+    for (i = 0; i < s->n; ++i) {
+        unset += s->kind[i] == FSDEM_MPS_KIND_FLUID && s->rho[i] == 0;
+        top[i] = fsdem__mps_height(s, s->x[i]);
+    }
+    if (!unset) return;
+    while (changed) {
+        changed = 0;
+        for (i = 0; i < s->n; ++i)
+            if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
+                for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+                    const int j = s->nb[e];
+                    const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
+                    const fsdem_real up = g > 0 ? -fsdem__dot(s->desc.gravity, r) / g : 0;
+                    const fsdem_vec3 across = g > 0 ? fsdem__madd(r, s->desc.gravity, up / g) : r; /* r less its vertical part */
+                    if (s->kind[j] == FSDEM_MPS_KIND_FLUID && top[j] > top[i] && fsdem__norm(across) <= half) {
+                        top[i] = top[j];
+                        changed = 1;
+                    }
+                }
+    }
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID && s->rho[i] == 0)
+            s->rho[i] = s->desc.density * (1 + g * (top[i] + half - fsdem__mps_height(s, s->x[i])) / (c0 * c0));
+}
+
+/* Pressures: FLUID particles by the equation of state p = c0^2 (rho_i - rho); WALL and DUMMY
+   particles the Shepard average of the FLUID pressures within re of them extrapolated
+   hydrostatically to them, p_w = sum_f w (p_f + rho g.(r_w - r_f)) / sum_f w (Adami, Hu and Adams
+   2012, Eq. 27, fixed walls; gathered by scattering from the FLUID rows, as the rows of DUMMY
+   particles are empty), 0 with none; negative pressures set to 0 when
+   desc.clamp_negative_pressure. One pressure field on every particle: the DUMMY ghost of the
+   semi-implicit scheme, p_i + rho g.(r_j - r_i) seen from each i, let the columns beside the walls
+   slide (still water drifted 0.5 r0 by 0.5 s). */
+static void fsdem__mps_explicit_pressures(fsdem_mps *s, fsdem_real c0) {
+    const fsdem_real rho = s->desc.density;
+    const int clamp = s->desc.clamp_negative_pressure;
+    fsdem_real *weight = s->ghost_weight;
+    int i, e;
+    for (i = 0; i < s->n; ++i) {
+        const fsdem_real p = s->kind[i] == FSDEM_MPS_KIND_FLUID ? c0 * c0 * (s->rho[i] - rho) : 0;
+        s->p[i] = p < 0 && clamp ? 0 : p;
+        weight[i] = 0;
+    }
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
+            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+                const int j = s->nb[e];
+                if (s->kind[j] == FSDEM_MPS_KIND_FLUID) continue;
+                s->p[j] += s->nbw[e] * (s->p[i] + rho * fsdem__dot(s->desc.gravity, fsdem__mps_sep(s, i, j)));
+                weight[j] += s->nbw[e];
+            }
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID) {
+            s->p[i] = weight[i] > 0 ? s->p[i] / weight[i] : 0;
+            if (s->p[i] < 0 && clamp) s->p[i] = 0;
+        }
+}
+
+/* The weight of the pair (i, j) at separation r in the explicit scheme's gradient and divergence,
+   over |r|^2 eps_j (the factor of Eq. 8-9). */
+static fsdem_real fsdem__mps_explicit_pair(const fsdem_mps *s, int j, fsdem_vec3 r) {
+    const fsdem_real r2 = fsdem__dot(r, r);
+    return r2 > 0 ? fsdem__kernel_mps_explicit((fsdem_real)sqrt(r2), s->re_x) / (r2 * s->eps[j]) : 0;
+}
+
+/* The pressure gradient of the explicit scheme at FLUID particle i: the sum form of seed 002 Eq. 8
+   with the scheme's weight, d/n0x sum_j (p_i + p_j) (r_j - r_i) w_ij / (|r_j - r_i|^2 eps_j), over
+   every neighbour, solids with their extrapolated pressures: the form whose pair forces are equal
+   and opposite and whose adjoint is the divergence of the continuity equation (so pressure work
+   and compression balance); the min and corrected forms of desc.gradient blew still water up. */
+static fsdem_vec3 fsdem__mps_explicit_gradient(const fsdem_mps *s, int i) {
+    fsdem_vec3 g = fsdem__zero3();
+    int e;
+    for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+        const int j = s->nb[e];
+        const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
+        g = fsdem__madd(g, r, (s->p[i] + s->p[j]) * fsdem__mps_explicit_pair(s, j, r));
+    }
+    return fsdem__scale(g, (fsdem_real)s->dim / s->n0_x);
+}
+
+/* The rate of the density of FLUID particle i: -rho_i div u (Eq. 9 with the scheme's weight, every
+   neighbour, the solids at rest: the adjoint of fsdem__mps_explicit_gradient) plus the diffusion
+   delta c0 r0 lap(rho - rho_h) (Eq. 10's Laplacian over the FLUID neighbours). Molteni and
+   Colagrossi (2009) diffuse rho itself, which drives a liquid at rest away from hydrostatic; the
+   hydrostatic part rho_h, whose difference between j and i is rho g.(r_j - r_i) / c0^2 for the
+   linear equation of state, is taken out, after Fourtakas et al. (2019). */
+static fsdem_real fsdem__mps_density_rate(const fsdem_mps *s, int i, fsdem_real c0) {
+    const fsdem_real rho = s->desc.density, hydro = rho / (c0 * c0);
+    fsdem_real diffusion = 0, div = 0;
+    int e;
+    for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+        const int j = s->nb[e];
+        const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
+        div += fsdem__dot(fsdem__sub(s->v[j], s->v[i]), r) * fsdem__mps_explicit_pair(s, j, r);
+        if (s->kind[j] == FSDEM_MPS_KIND_FLUID)
+            diffusion += (s->rho[j] - s->rho[i] - hydro * fsdem__dot(s->desc.gravity, r)) * s->nbl[e] / s->eps[j];
+    }
+    diffusion *= s->desc.density_diffusion * c0 * s->r0 * 2 * (fsdem_real)s->dim / (s->n0_lap * s->lambda);
+    return -s->rho[i] * div * (fsdem_real)s->dim / s->n0_x + diffusion;
+}
+
+/* The explicit scheme's part of a step of dt (after the neighbours and the number density, before
+   the obstacle forces, collisions and the move): the hydrostatic start of new particles, the
+   pressures, the velocities u += dt (-grad p / rho + nu lap u + g + f/m) (FLUID particles outside
+   inflow buffers; with desc.model B the pressure term over eps_i as in the corrector), then the
+   densities with the new velocities. FSDEM_ERR_INVALID_ARG when no sound speed can be had. */
+static fsdem_result fsdem__mps_explicit(fsdem_mps *s, fsdem_real dt) {
+    const fsdem_real rho = s->desc.density, nu = s->desc.viscosity, mass = fsdem__mps_mass(s), c0 = fsdem__mps_c0(s);
+    const int no_slip = s->desc.wall_viscosity == FSDEM_MPS_WALL_VISCOSITY_NO_SLIP && nu > 0;
+    int i;
+    if (!(c0 > 0))
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG,
+                           "fsdem_mps: the explicit scheme has no sound speed: set desc.sound_speed (there is no gravity to take it from)");
+    s->c0 = c0;
+    fsdem__mps_hydrostatic_start(s, c0);
+    fsdem__mps_explicit_pressures(s, c0);
+    if (no_slip) fsdem__mps_wall_ghosts(s);
+    for (i = 0; i < s->n; ++i) {
+        fsdem_vec3 a;
+        if (s->kind[i] != FSDEM_MPS_KIND_FLUID || s->inlet[i] >= 0) continue;
+        s->gradp[i] = fsdem__mps_explicit_gradient(s, i);
+        a = fsdem__madd(s->desc.gravity, s->gradp[i], -1 / (rho * (s->desc.model == FSDEM_MPS_MODEL_B ? s->eps[i] : 1)));
+        if (nu > 0) a = fsdem__madd(a, fsdem__mps_lap_at(s, NULL, no_slip ? s->uvisc : s->v, i, no_slip), nu);
+        if (s->external) a = fsdem__madd(a, s->fext[i], 1 / mass); /* a coupler's force (Eq. 2, 4) */
+        s->us[i] = fsdem__madd(s->v[i], a, dt);
+        if (s->dim == 2) s->us[i].z = 0;
+    }
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID && s->inlet[i] < 0) s->v[i] = s->us[i];
+    for (i = 0; i < s->n; ++i) s->div[i] = s->kind[i] == FSDEM_MPS_KIND_FLUID ? fsdem__mps_density_rate(s, i, c0) : 0;
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID) s->rho[i] += dt * s->div[i];
+    s->iters = 0;
+    s->residual = 0;
+    return FSDEM_OK;
+}
+
 /* ---- >>mps_step : predictor, pressure equation, corrector, time stepping ---- */
 
 /* Largest FLUID speed (m/s) and its particle in *who (-1 when none; the particle with a non-finite
@@ -16284,11 +16557,6 @@ static fsdem_real fsdem__mps_umax(const fsdem_mps *s, int *who) {
     return (fsdem_real)sqrt(m2);
 }
 
-/* Mass of the fluid a particle stands for: rho r0^d (kg; kg per metre of depth in 2D). */
-static fsdem_real fsdem__mps_mass(const fsdem_mps *s) {
-    return s->desc.density * s->r0 * s->r0 * (s->dim == 3 ? s->r0 : 1);
-}
-
 /* The longest step the explicit viscous term of the predictor (step 2) allows, dt nu <= 0.8
    lambda eps_min / (2d) (s; infinite without viscosity). Eq. 10 on u at particle i, with
    S_i = sum_j w_ij / eps_j, has its row in the disc of centre -c S_i and radius c S_i
@@ -16305,36 +16573,18 @@ static fsdem_real fsdem__mps_dt_viscous(const fsdem_mps *s) {
     return (fsdem_real)0.8 * s->lambda * eps_min / (2 * (fsdem_real)s->dim * s->desc.viscosity);
 }
 
-/* The stable step: the CFL rule of seed 002 Eq. 37, u_max dt / r0 <= C, and the viscous limit,
-   at most dt_max. */
-static fsdem_real fsdem__mps_dt_from(const fsdem_mps *s, fsdem_real umax) {
-    const fsdem_real viscous = fsdem__mps_dt_viscous(s);
-    fsdem_real dt = s->desc.dt_max;
-    if (umax > 0 && s->desc.cfl * s->r0 / umax < dt) dt = s->desc.cfl * s->r0 / umax;
-    return viscous < dt ? viscous : dt;
+/* The speed of the CFL rule: u_max (seed 002 Eq. 37), c0 + u_max in the explicit scheme. */
+static fsdem_real fsdem__mps_signal_speed(const fsdem_mps *s, fsdem_real umax) {
+    return s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT ? fsdem__mps_c0(s) + umax : umax;
 }
 
-/* The ghost velocities of FSDEM_MPS_WALL_VISCOSITY_NO_SLIP into s->uvisc (see the enum): FLUID particles
-   their own velocity, WALL and DUMMY particles -u~, the Shepard average of the FLUID velocities
-   around them, gathered by scattering from the FLUID rows (the rows of DUMMY particles are empty);
-   0 where no FLUID particle is within re. */
-static void fsdem__mps_wall_ghosts(fsdem_mps *s) {
-    int i, e;
-    for (i = 0; i < s->n; ++i) {
-        s->uvisc[i] = s->kind[i] == FSDEM_MPS_KIND_FLUID ? s->v[i] : fsdem__zero3();
-        s->ghost_weight[i] = 0;
-    }
-    for (i = 0; i < s->n; ++i)
-        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
-            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
-                const int j = s->nb[e];
-                const fsdem_real w = s->nbw[e] / s->eps[i];
-                if (s->kind[j] == FSDEM_MPS_KIND_FLUID) continue;
-                s->uvisc[j] = fsdem__madd(s->uvisc[j], s->v[i], w);
-                s->ghost_weight[j] += w;
-            }
-    for (i = 0; i < s->n; ++i)
-        if (s->ghost_weight[i] > 0) s->uvisc[i] = fsdem__scale(s->uvisc[i], -1 / s->ghost_weight[i]);
+/* The stable step: the CFL rule, speed dt / r0 <= C (fsdem__mps_signal_speed), and the viscous
+   limit, at most dt_max. */
+static fsdem_real fsdem__mps_dt_from(const fsdem_mps *s, fsdem_real umax) {
+    const fsdem_real viscous = fsdem__mps_dt_viscous(s), speed = fsdem__mps_signal_speed(s, umax);
+    fsdem_real dt = s->desc.dt_max;
+    if (speed > 0 && s->desc.cfl * s->r0 / speed < dt) dt = s->desc.cfl * s->r0 / speed;
+    return viscous < dt ? viscous : dt;
 }
 
 /* Makes room for the pressure matrix of `nnz` entries (by doubling). */
@@ -16567,33 +16817,19 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
     return FSDEM_OK;
 }
 
-/* One step of dt (the section's steps 1-6). Failures before the pressure is known change nothing;
-   a completed step reports a non-finite or escaped particle. */
-static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
+/* Steps 2-4 and 6 of the section's step of dt (the seed's scheme, after the neighbours and the
+   number density, before the obstacle forces, collisions and the move): predictor, pressure
+   equation, corrector. A failure changes no particle. */
+static fsdem_result fsdem__mps_semi_implicit(fsdem_mps *s, fsdem_real dt) {
     const fsdem_real rho = s->desc.density, nu = s->desc.viscosity, mass = fsdem__mps_mass(s);
-    const double time0 = s->time;
+    const int no_slip = s->desc.wall_viscosity == FSDEM_MPS_WALL_VISCOSITY_NO_SLIP && nu > 0;
+    const fsdem_vec3 *visc_u = no_slip ? s->uvisc : s->v;
+    const clock_t tp = clock();
+    clock_t ta;
     fsdem_pcg_info info;
     fsdem_csr A;
     fsdem_result r;
-    clock_t t0 = clock(), t1, tp, ts, ta;
-    const int no_slip = s->desc.wall_viscosity == FSDEM_MPS_WALL_VISCOSITY_NO_SLIP && nu > 0;
-    const fsdem_vec3 *visc_u = no_slip ? s->uvisc : s->v;
-    int i, a, bad = -1;
-    if (s->counts[FSDEM_MPS_KIND_FLUID] == 0)
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: no FLUID particles to step");
-    for (i = 0; i < s->n; ++i)
-        if (!(s->eps[i] > 0 && s->eps[i] <= 1))
-            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: particle %d has porosity %g outside (0, 1]", i,
-                               (double)s->eps[i]);
-    if (fsdem__mps_reserve(s, s->n + s->buffered) != FSDEM_OK) /* the inflows' new particles of this step */
-        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory for the inflows' particles");
-    fsdem__series_begin(&s->gauges.series);
-    /* 1. neighbours, number density, free surface */
-    if (fsdem__mps_neighbours(s) != FSDEM_OK)
-        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory building the neighbour list");
-    s->surface_count = fsdem__mps_density(s);
-    ts = clock();
-    fsdem__mps_shift(s);
+    int i;
     /* 2. predictor: u* = u + dt (nu lap u + g) (seed 002 Eq. A.6 with eps = 1). WALL and DUMMY
        particles take u* = dt g, their velocity (0) plus the same body force: a uniform field has no
        divergence (Eq. 9), so gravity alone leaves no source at the walls in Eq. 12, and the walls
@@ -16617,7 +16853,6 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     }
     for (i = 0; i < s->n; ++i) s->div[i] = s->kind[i] == FSDEM_MPS_KIND_DUMMY ? 0 : fsdem__mps_div_at(s, s->us, i);
     /* 3. pressure equation */
-    tp = clock();
     if (fsdem__mps_assemble(s, dt) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory assembling the pressure matrix");
     ta = clock();
@@ -16631,7 +16866,6 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         A.val = s->a_val;
         r = fsdem__pcg_setup_csr_valid(s->pcg, &A);
         if (r == FSDEM_OK) r = fsdem_pcg_solve(s->pcg, s->b, s->sol, &info);
-        s->sec_pressure += (double)(clock() - tp) / CLOCKS_PER_SEC;
         s->iters = info.iterations;
         s->residual = info.residual;
         if (r != FSDEM_OK) {
@@ -16644,11 +16878,10 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
                                (double)s->desc.pressure_tolerance, fsdem_pcg_last_error(s->pcg));
         }
     }
-    t1 = clock();
-    s->sec_search += (double)(ts - t0) / CLOCKS_PER_SEC;
+    s->sec_pressure += (double)(clock() - tp) / CLOCKS_PER_SEC;
     s->sec_assembly += (double)(ta - tp) / CLOCKS_PER_SEC;
-    s->sec_solve += (double)(t1 - ta) / CLOCKS_PER_SEC;
-    /* 4. pressures (clamped where asked), then the corrector: u = u* - dt/rho grad p, r += dt u.
+    s->sec_solve += (double)(clock() - ta) / CLOCKS_PER_SEC;
+    /* 4. pressures (clamped where asked), then the corrector: u = u* - dt/rho grad p.
        A closed liquid's pressure is known up to a constant: the lowest is set to 0 */
     if (s->closed) {
         fsdem_real low = s->sol[0];
@@ -16671,6 +16904,36 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         s->v[i] = fsdem__madd(s->us[i], s->gradp[i], per_mass);
         if (s->dim == 2) s->v[i].z = 0;
     }
+    return FSDEM_OK;
+}
+
+/* One step of dt (the section's steps 1-7, or the explicit scheme's in place of 2-6). Failures
+   before the pressure is known change nothing; a completed step reports a non-finite or escaped
+   particle. */
+static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
+    const double time0 = s->time;
+    const clock_t t0 = clock();
+    clock_t ts;
+    fsdem_result r;
+    int i, a, bad = -1;
+    if (s->counts[FSDEM_MPS_KIND_FLUID] == 0)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: no FLUID particles to step");
+    for (i = 0; i < s->n; ++i)
+        if (!(s->eps[i] > 0 && s->eps[i] <= 1))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: particle %d has porosity %g outside (0, 1]", i,
+                               (double)s->eps[i]);
+    if (fsdem__mps_reserve(s, s->n + s->buffered) != FSDEM_OK) /* the inflows' new particles of this step */
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory for the inflows' particles");
+    fsdem__series_begin(&s->gauges.series);
+    /* 1. neighbours, number density, free surface */
+    if (fsdem__mps_neighbours(s) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory building the neighbour list");
+    s->surface_count = fsdem__mps_density(s);
+    ts = clock();
+    s->sec_search += (double)(ts - t0) / CLOCKS_PER_SEC;
+    fsdem__mps_shift(s);
+    r = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT ? fsdem__mps_explicit(s, dt) : fsdem__mps_semi_implicit(s, dt);
+    if (r != FSDEM_OK) return r;
     fsdem__mps_obstacle_forces(s);
     fsdem__mps_collide(s, dt);
     for (i = 0; i < s->n; ++i)
@@ -16678,6 +16941,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
             s->v[i] = fsdem__mps_inflow_velocity(s, s->inlet[i]);
             s->gradp[i] = fsdem__zero3();
         }
+    /* 6b-7. r += dt u, and the shift */
     for (i = 0; i < s->n; ++i)
         if (s->kind[i] == FSDEM_MPS_KIND_FLUID) {
             s->x[i] = fsdem__add(fsdem__madd(s->x[i], s->v[i], dt), s->shift[i]);
@@ -16688,7 +16952,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     s->dt_last = dt;
     s->steps++;
     s->iters_total += s->iters;
-    s->sec_total += (double)(clock() - t1) / CLOCKS_PER_SEC + (double)(t1 - t0) / CLOCKS_PER_SEC;
+    s->sec_total += (double)(clock() - t0) / CLOCKS_PER_SEC;
     for (i = 0; i < s->n && bad < 0; ++i)
         if (s->kind[i] == FSDEM_MPS_KIND_FLUID && (!fsdem__finite3(s->v[i]) || !fsdem__finite3(s->x[i]) || !fsdem__finite(s->p[i])))
             bad = i;
@@ -16730,7 +16994,7 @@ fsdem_result fsdem_mps_step(fsdem_mps *s) {
 fsdem_result fsdem_mps_check_dt(const fsdem_mps *s, fsdem_real dt) {
     fsdem__status *st;
     int who;
-    fsdem_real umax;
+    fsdem_real umax, speed;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     st = (fsdem__status *)&s->status; /* the message is the object's only mutable part here */
     if (!(dt > 0) || !fsdem__finite(dt))
@@ -16738,12 +17002,12 @@ fsdem_result fsdem_mps_check_dt(const fsdem_mps *s, fsdem_real dt) {
     umax = fsdem__mps_umax(s, &who);
     if (!fsdem__finite(umax))
         return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_mps_step_dt: particle %d has a non-finite velocity", who);
-    if (umax * dt > s->desc.cfl * s->r0 * (1 + (fsdem_real)1e-5))
+    speed = fsdem__mps_signal_speed(s, umax);
+    if (speed * dt > s->desc.cfl * s->r0 * (1 + (fsdem_real)1e-5))
         return fsdem__fail(st, FSDEM_ERR_CFL,
-                           "fsdem_mps_step_dt: dt = %g s gives u_max dt / r0 = %g > cfl = %g (seed 002 Eq. 37; particle %d at %g m/s; "
-                           "dt <= %g s)",
-                           (double)dt, (double)(umax * dt / s->r0), (double)s->desc.cfl, who, (double)umax,
-                           (double)(s->desc.cfl * s->r0 / umax));
+                           "fsdem_mps_step_dt: dt = %g s gives %s dt / r0 = %g > cfl = %g (particle %d at %g m/s; dt <= %g s)",
+                           (double)dt, s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT ? "(c0 + u_max)" : "u_max (seed 002 Eq. 37)",
+                           (double)(speed * dt / s->r0), (double)s->desc.cfl, who, (double)umax, (double)(s->desc.cfl * s->r0 / speed));
     if (dt > fsdem__mps_dt_viscous(s) * (1 + (fsdem_real)1e-5))
         return fsdem__fail(st, FSDEM_ERR_CFL,
                            "fsdem_mps_step_dt: dt = %g s exceeds the viscous limit %g s of the explicit viscous term (nu = %g m^2/s; "
@@ -19691,8 +19955,9 @@ fsdem_gic_stats fsdem_gic_get_stats(const fsdem_gic *c) {
 
 /* ---- >>restart_format : header, checksum, cursor ---- */
 
-#define FSDEM__RESTART_VERSION 4u /* 2: DEM contact options and material-pair tables; 3: the PIC's start
-                                      velocities of moving solids at any viscosity; 4: the PIC's porosity */
+#define FSDEM__RESTART_VERSION 5u /* 2: DEM contact options and material-pair tables; 3: the PIC's start
+                                      velocities of moving solids at any viscosity; 4: the PIC's porosity;
+                                      5: the MPS's explicit scheme (its desc fields, c0, densities) */
 #define FSDEM__RESTART_HEADER 64
 #define FSDEM__RESTART_BOM 0x01020304u
 #define FSDEM__RESTART_FNV_BASIS 0xcbf29ce484222325ull
@@ -20606,13 +20871,15 @@ static void fsdem__restart_mps_planes(fsdem__restart *io, int dim, int count, in
 /* The particles go into arrays of the saved capacity (all FSDEM__MPS_ARRAYS of them and the four
    row-offset arrays, as fsdem__mps_reserve makes them; the object's own when it has that capacity,
    so a coupled step's put-back allocates nothing); of their contents the state that the
-   next step reads (positions, velocities, pressures: the pressure solve starts from them, kinds,
-   porosities, a coupler's forces, obstacle membership) and the views of the last step (number
+   next step reads (positions, velocities, pressures: the pressure solve starts from them, the
+   explicit scheme's densities and its sound speed, kinds, porosities, a coupler's forces, obstacle
+   membership) and the views of the last step (number
    density, surface flags, pressure gradients) are saved. The neighbour rows and the matrix are
    rebuilt by every step; their memory stays. */
 static void fsdem__restart_mps(fsdem__restart *io, void *object) {
-    static const fsdem__field same[27] = {
-        FSDEM__SAME(fsdem_mps, dim, INT), FSDEM__SAME(fsdem_mps, r0, REAL), FSDEM__SAME(fsdem_mps, re, REAL),
+    static const fsdem__field same[30] = {
+        FSDEM__SAME(fsdem_mps, dim, INT), FSDEM__SAME(fsdem_mps, scheme, INT), FSDEM__SAME(fsdem_mps, sound_speed, REAL),
+        FSDEM__SAME(fsdem_mps, density_diffusion, REAL), FSDEM__SAME(fsdem_mps, r0, REAL), FSDEM__SAME(fsdem_mps, re, REAL),
         FSDEM__SAME(fsdem_mps, re_laplacian, REAL), FSDEM__SAME(fsdem_mps, density, REAL),
         FSDEM__SAME(fsdem_mps, viscosity, REAL), FSDEM__SAME(fsdem_mps, gravity, VEC3), FSDEM__SAME(fsdem_mps, gamma, REAL),
         FSDEM__SAME(fsdem_mps, model, INT), FSDEM__SAME(fsdem_mps, beta, REAL), FSDEM__SAME(fsdem_mps, alpha, REAL),
@@ -20623,8 +20890,8 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
         FSDEM__SAME(fsdem_mps, collision_distance, REAL), FSDEM__SAME(fsdem_mps, restitution, REAL),
         FSDEM__SAME(fsdem_mps, shifting, REAL), FSDEM__SAME(fsdem_mps, pressure_precond, INT),
         FSDEM__SAME(fsdem_mps, pressure_tolerance, REAL), FSDEM__SAME(fsdem_mps, pressure_max_iterations, INT)};
-    static const fsdem__field state[8] = {
-        FSDEM__SAVED(fsdem_mps, time), FSDEM__SAVED(fsdem_mps, dt_last), FSDEM__SAVED(fsdem_mps, steps),
+    static const fsdem__field state[9] = {
+        FSDEM__SAVED(fsdem_mps, c0), FSDEM__SAVED(fsdem_mps, time), FSDEM__SAVED(fsdem_mps, dt_last), FSDEM__SAVED(fsdem_mps, steps),
         FSDEM__SAVED(fsdem_mps, iters_total), FSDEM__SAVED(fsdem_mps, iters), FSDEM__SAVED(fsdem_mps, residual),
         FSDEM__SAVED(fsdem_mps, surface_count), FSDEM__SAVED(fsdem_mps, pair_count)};
     fsdem_mps *s = (fsdem_mps *)object;
@@ -20635,9 +20902,9 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem_mps_inflow_desc *inflows;
     fsdem_mps_outflow_desc *outflows;
     fsdem__restart_tag(io, "MPS5");
-    fsdem__restart_same_fields(io, s, same, 27);
+    fsdem__restart_same_fields(io, s, same, 30);
 
-    fsdem__restart_fields(io, s, state, 8);
+    fsdem__restart_fields(io, s, state, 9);
 
     /* obstacles and open boundaries, into the object's arrays when they hold them (else fresh ones) */
     fsdem__restart_count(io, &no, 1 << 24, sizeof(fsdem__mps_obst), "obstacle count");
@@ -20715,6 +20982,7 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_data(io, s->p, sizeof *s->p * (size_t)n);
     fsdem__restart_data(io, s->eps, sizeof *s->eps * (size_t)n);
     fsdem__restart_data(io, s->nd, sizeof *s->nd * (size_t)n);
+    fsdem__restart_data(io, s->rho, sizeof *s->rho * (size_t)n);
     fsdem__restart_data(io, &s->external, sizeof s->external);
     fsdem__restart_data(io, s->fext, sizeof *s->fext * (size_t)n);
     fsdem__restart_data(io, s->gradp, sizeof *s->gradp * (size_t)n);

@@ -32,7 +32,7 @@ IMPLEMENTATION="
     pic/extrapolate.c pic/viscosity.c pic/projection.c pic/advection.c pic/reseed.c pic/step.c
     pic/views.c pic/output.c
     swe/types.c swe/desc.c swe/object.c swe/sources.c swe/riemann.c swe/row.c swe/step.c swe/diag.c
-    mps/types.c mps/desc.c mps/particles.c mps/open.c mps/neighbours.c mps/operators.c mps/step.c
+    mps/types.c mps/desc.c mps/particles.c mps/open.c mps/neighbours.c mps/operators.c mps/explicit.c mps/step.c
     mps/views.c mps/probes.c
     drag/drag.c
     couple/head.c couple/dem.c couple/records.c couple/swe.c couple/mps.c couple/pic.c couple/gic.c

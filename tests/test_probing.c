@@ -354,6 +354,18 @@ START_TEST(implausible_mps_input_is_refused) {
     d.dt_max = 1; /* 9.81 m/s of free fall in a step is plausible, if not stable: the CFL limit takes over */
     ck_assert_int_eq(fsdem_mps_desc_check(&d, msg, sizeof msg), FSDEM_OK);
     d = fsdem_mps_desc_default(2);
+    d.scheme = (fsdem_mps_scheme)2;
+    REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "scheme");
+    d.scheme = FSDEM_MPS_SCHEME_EXPLICIT;
+    d.sound_speed = -1;
+    REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "sound_speed");
+    d.sound_speed = 0;
+    d.density_diffusion = 2;
+    REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "density_diffusion");
+    d.density_diffusion = (fsdem_real)0.1;
+    d.re = 2 * d.r0; /* inside the explicit gradient's support */
+    REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "re");
+    d = fsdem_mps_desc_default(2);
     ck_assert_int_eq(fsdem_mps_create(&d, &s), FSDEM_OK);
     REFUSED(fsdem_mps_add_particles(s, FSDEM_MPS_KIND_FLUID, 1, &x, &fast), fsdem_mps_last_error(s), "FSDEM_MAX_SPEED");
     REFUSED(fsdem_mps_fill_box(s, fsdem_v3(0.1f, 0.1f, 0), fsdem_v3(0.2f, 0.2f, 0), fast, NULL), fsdem_mps_last_error(s),

@@ -2,7 +2,8 @@
 
    Contents: fsdem__kernel (per-axis node range, weights, derivatives and clamped node indices) and
    fsdem__kernel_weights, the tent (linear, 2 nodes) and quadratic B-spline (3 nodes) kernels at a
-   position given in grid units; fsdem__kernel_mps, the particle-interaction weight of MPS. */
+   position given in grid units; fsdem__kernel_mps, the particle-interaction weight of MPS, and fsdem__kernel_mps_explicit, that of
+   its explicit scheme. */
 
 /* Kernel weights of one point along each axis: nodes lo[b] .. lo[b] + count[b] - 1, weights w and
    their derivatives dw (per grid unit), and the node indices clamped into the grid (idx). */
@@ -67,4 +68,12 @@ static void fsdem__kernel_weights(fsdem__kernel *k, int dim, const fsdem_real s[
    coincident particles from producing infinite number densities and pressure spikes. */
 static inline fsdem_real fsdem__kernel_mps(fsdem_real r, fsdem_real re) {
     return r < re ? re / ((fsdem_real)0.85 * r + (fsdem_real)0.15 * re) - 1 : 0;
+}
+
+/* Weight of MPS's explicit scheme at distance r (m) for the support R (m): q^2 (1 - q)^3, q = r/R,
+   0 beyond. In MPS's sum-form gradient a pair pushes with w/r, which is then the gradient of the
+   Wendland C2 kernel of SPH (Wendland 1995) of support R: smooth, zero at contact and at R. */
+static inline fsdem_real fsdem__kernel_mps_explicit(fsdem_real r, fsdem_real R) {
+    const fsdem_real q = r / R;
+    return q < 1 ? q * q * (1 - q) * (1 - q) * (1 - q) : 0;
 }

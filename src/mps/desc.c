@@ -1,5 +1,8 @@
 /* ---- >>mps_desc : defaults, validation, lattice constants, creation ---- */
 
+/* Support of the explicit scheme's gradient and divergence, in r0 (see >>mps_explicit). */
+#define FSDEM__MPS_EXPLICIT_SUPPORT 2.8f
+
 fsdem_mps_desc fsdem_mps_desc_default(int dim) {
     fsdem_mps_desc d;
     memset(&d, 0, sizeof d);
@@ -13,6 +16,7 @@ fsdem_mps_desc fsdem_mps_desc_default(int dim) {
     d.beta = (fsdem_real)0.8;
     d.alpha = (fsdem_real)0.9;
     d.cfl = (fsdem_real)0.2;
+    d.density_diffusion = (fsdem_real)0.1;
     d.dt_max = (fsdem_real)1e-3;
     d.domain_min = fsdem_v3(0, 0, 0);
     d.domain_max = fsdem_v3(1, 1, 1);
@@ -37,11 +41,21 @@ static fsdem_result fsdem__mps_check(const fsdem_mps_desc *d, char *msg, size_t 
     int a;
     if (msg && size) msg[0] = '\0';
     if (d->dim != 2 && d->dim != 3) return fsdem__reject(msg, size, "fsdem_mps_desc.dim = %d must be 2 or 3", d->dim);
+    if ((int)d->scheme < 0 || (int)d->scheme > 1)
+        return fsdem__reject(msg, size, "fsdem_mps_desc.scheme = %d is not a fsdem_mps_scheme", (int)d->scheme);
+    if (!(d->sound_speed >= 0) || !fsdem__finite(d->sound_speed))
+        return fsdem__reject(msg, size, "fsdem_mps_desc.sound_speed = %g m/s must be >= 0 and finite (0: from the liquid's height)",
+                             (double)d->sound_speed);
+    if (!(d->density_diffusion >= 0 && d->density_diffusion <= 1))
+        return fsdem__reject(msg, size, "fsdem_mps_desc.density_diffusion = %g must be in [0, 1]", (double)d->density_diffusion);
     if (!(d->r0 > 0) || !fsdem__finite(d->r0))
         return fsdem__reject(msg, size, "fsdem_mps_desc.r0 = %g m must be > 0 and finite", (double)d->r0);
     if (d->re != 0 && (!(d->re >= 2 * d->r0) || !fsdem__finite(d->re)))
         return fsdem__reject(msg, size, "fsdem_mps_desc.re = %g m must be 0 (4.1 r0) or >= 2 r0 = %g m", (double)d->re,
                              (double)(2 * d->r0));
+    if (d->scheme == FSDEM_MPS_SCHEME_EXPLICIT && d->re != 0 && d->re < FSDEM__MPS_EXPLICIT_SUPPORT * d->r0)
+        return fsdem__reject(msg, size, "fsdem_mps_desc.re = %g m must be >= %g r0 = %g m for the explicit scheme (the support of its "
+                             "gradient)", (double)d->re, (double)FSDEM__MPS_EXPLICIT_SUPPORT, (double)(FSDEM__MPS_EXPLICIT_SUPPORT * d->r0));
     if (d->re > 20 * d->r0)
         return fsdem__reject(msg, size, "fsdem_mps_desc.re = %g m must be <= 20 r0 = %g m", (double)d->re,
                              (double)(20 * d->r0));
@@ -120,10 +134,11 @@ fsdem_result fsdem_mps_desc_check(const fsdem_mps_desc *desc, char *message, siz
 
 /* n0 (Eq. 7), lambda (Eq. 11) of a particle inside the full r0 lattice, and |F| (Eq. 15) of a
    particle on its flat free surface (the lattice points at or below it along the last axis): the
-   reference values of the PPE source, the Laplacian and the surface test (Eq. 14-16). */
+   reference values of the PPE source, the Laplacian and the surface test (Eq. 14-16); and n0 of the
+   explicit scheme's weight. */
 static void fsdem__mps_lattice(fsdem_mps *s) {
     const int m = (int)ceil((double)(s->re / s->r0)), kz = s->dim == 3 ? m : 0;
-    double n0 = 0, nl = 0, l = 0, f = 0;
+    double n0 = 0, nl = 0, l = 0, f = 0, nx = 0;
     int i, j, k;
     for (k = -kz; k <= kz; ++k)
         for (j = -m; j <= m; ++j)
@@ -134,11 +149,13 @@ static void fsdem__mps_lattice(fsdem_mps *s) {
                 const int up = s->dim == 3 ? k : j;
                 if (i == 0 && j == 0 && k == 0) continue;
                 n0 += w;
+                nx += fsdem__kernel_mps_explicit(r, s->re_x);
                 nl += wl;
                 l += wl * r * r;
                 if (up <= 0) f += w * (double)up * s->r0 / r;
             }
     s->n0 = (fsdem_real)n0;
+    s->n0_x = (fsdem_real)nx;
     s->n0_lap = (fsdem_real)nl;
     s->lambda = (fsdem_real)(l / nl);
     s->f0 = (fsdem_real)(fabs(f) * s->dim / n0);
@@ -166,6 +183,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     s->desc.re = s->re;
     s->re_lap = desc->re_laplacian > 0 ? desc->re_laplacian : s->re;
     s->desc.re_laplacian = s->re_lap;
+    s->re_x = FSDEM__MPS_EXPLICIT_SUPPORT * desc->r0;
     s->layers = (int)ceil((double)(s->re / s->r0) - 1e-9);
     s->periods = fsdem__periods_of(desc->periodic, desc->dim, desc->domain_min, desc->domain_max);
     fsdem__mps_lattice(s);
@@ -202,7 +220,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
 
 /* The particle arrays of a capacity `cap`, with their element sizes (one list for allocation,
    copying and release). */
-#define FSDEM__MPS_ARRAYS 20
+#define FSDEM__MPS_ARRAYS 21
 #define FSDEM__MPS_ROW_ARRAYS 3
 static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     void **p[FSDEM__MPS_ARRAYS];
@@ -220,6 +238,7 @@ static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     FSDEM__MPS_ARRAY(p);
     FSDEM__MPS_ARRAY(eps);
     FSDEM__MPS_ARRAY(nd);
+    FSDEM__MPS_ARRAY(rho);
     FSDEM__MPS_ARRAY(fext);
     FSDEM__MPS_ARRAY(gradp);
     FSDEM__MPS_ARRAY(div);

@@ -163,6 +163,38 @@ typedef enum fsdem_mps_wall_viscosity {
     FSDEM_MPS_WALL_VISCOSITY_AT_REST = 1
 } fsdem_mps_wall_viscosity;
 
+/* How the pressure is found (see >>mps_explicit in the implementation for the explicit scheme). */
+typedef enum fsdem_mps_scheme {
+    /* seed 002 §2.1: the pressure Poisson equation of steps 2-6 above (the seed's; incompressible
+       to the solver's tolerance; the default until the measurements of issue 35 choose) */
+    FSDEM_MPS_SCHEME_SEMI_IMPLICIT = 0,
+    /* weakly compressible, explicit (Oochi, Koshizuka and Sakai 2010; Shakibaeinia and Jin 2010):
+       every particle carries a density rho_i, evolved by the continuity equation with the MPS
+       divergence (Eq. 9) and a diffusion of the density like delta-SPH's (Molteni and Colagrossi
+       2009) of its departure from hydrostatic (so a liquid at rest stays so exactly); the pressure
+       follows by the linear equation of state p = c0^2 (rho_i - rho) with an artificial sound
+       speed c0 (desc.sound_speed); WALL and DUMMY particles take the pressure of the liquid around
+       them extrapolated hydrostatically (Adami, Hu and Adams 2012); the velocity is u += dt
+       (-grad p / rho + nu lap u + g + f/m) with the sum form of Eq. 8 (desc.gradient is not used),
+       then the density and the positions with the new velocity (symplectic Euler); the step is
+       limited by (c0 + u_max) dt / r0 <= cfl. The gradient and divergence weigh pairs by
+       q^2 (1 - q)^3, q = r / 2.8 r0 (so desc.re >= 2.8 r0): a pair then pushes as the Wendland
+       kernel's gradient does in SPH. With the seed's kernel (Eq. 6) the square lattice is unstable
+       to the shear of one column against the next (a column's stiffness against its neighbour,
+       summed over the lattice, is negative for a pair force decreasing as steeply as w/r; growth
+       about 30/s at 1 kPa, measured 35/s: the columns beside the walls slid from 0.15 s); with
+       this one it is slightly positive. A particle whose density is not set yet starts at the
+       hydrostatic density of its depth below the top of its column of liquid (the hydrostatic
+       start). No pressure equation, no surface detection (the surface's particles keep rho near
+       rho: p near 0). Still water (the tank of the notes above, 2D): largest displacement 0.157 r0
+       at 0.5 s and 0.145 r0 at 5 s, at the particles where the surface meets a wall (0.064 and
+       0.058 r0 three columns or more from the walls); mid-depth pressure +0.1 %; 3D (0.1 x 0.1 m,
+       0.2 m deep) 0.198 r0 at 0.5 s, 0.27 r0 at 1 s (0.11 and 0.13 r0 inside), pressure +0.4 %.
+       The porosity enters as in the corrector (Model B: the pressure term over eps_i); the
+       mixture's continuity is not in it yet. */
+    FSDEM_MPS_SCHEME_EXPLICIT = 1
+} fsdem_mps_scheme;
+
 /* Form of the pressure equation's source with a porosity field (seed 002 §2.1). */
 typedef enum fsdem_mps_model {
     FSDEM_MPS_MODEL_A = 0, /* Eq. 12: rho_f in both terms of the mixed source */
@@ -171,6 +203,7 @@ typedef enum fsdem_mps_model {
 
 typedef struct fsdem_mps_desc {
     int dim;                        /* 2 or 3 */
+    fsdem_mps_scheme scheme;        /* default FSDEM_MPS_SCHEME_SEMI_IMPLICIT (see the enum) */
     fsdem_real r0;                  /* m; initial particle spacing, > 0; default 0.01 */
     fsdem_real re;                  /* m; interaction radius, >= 2 r0; 0 = 4.1 r0 (seed 002 §2.1); */
                                     /*    default 0 */
@@ -185,8 +218,14 @@ typedef struct fsdem_mps_desc {
     fsdem_mps_model model;          /* source of the pressure equation: Eq. 12 or 13; default A */
     fsdem_real beta;                /* -; surface when n < beta n0 (Eq. 14), in (0, 1); default 0.8 */
     fsdem_real alpha;               /* -; surface when |F| > alpha |F0| (Eq. 16), > 0; default 0.9 */
-    fsdem_real cfl;                 /* -; Courant number C of Eq. 37, u_max dt / r0 <= C, in (0, 1]; */
-                                    /*    default 0.2 */
+    fsdem_real cfl;                 /* -; Courant number C of Eq. 37, u_max dt / r0 <= C (explicit: */
+                                    /*    (c0 + u_max) dt / r0 <= C), in (0, 1]; default 0.2 */
+    fsdem_real sound_speed;         /* m/s; c0 of FSDEM_MPS_SCHEME_EXPLICIT, >= 0; 0 = 10 sqrt(2 |g| H) */
+                                    /*    with H the height of the liquid at the first step (10 */
+                                    /*    times the speed of a fall from its top: density within */
+                                    /*    1 %); default 0 */
+    fsdem_real density_diffusion;   /* -; delta of the explicit scheme's density diffusion, in */
+                                    /*    [0, 1]; default 0.1 (delta-SPH's) */
     fsdem_real dt_max;              /* s; longest step (taken while nothing moves); default 1e-3 */
     fsdem_vec3 domain_min;          /* m; every particle must stay inside; default (0,0,0) */
     fsdem_vec3 domain_max;          /* m; default (1,1,1) (z unused in 2D) */

@@ -138,6 +138,34 @@ static fsdem_vec3 fsdem__mps_lap_at(const fsdem_mps *s, const fsdem_real *phi, c
     return fsdem__scale(l, 2 * (fsdem_real)s->dim / (s->n0_lap * s->lambda));
 }
 
+/* Mass of the fluid a particle stands for: rho r0^d (kg; kg per metre of depth in 2D). */
+static fsdem_real fsdem__mps_mass(const fsdem_mps *s) {
+    return s->desc.density * s->r0 * s->r0 * (s->dim == 3 ? s->r0 : 1);
+}
+
+/* The ghost velocities of FSDEM_MPS_WALL_VISCOSITY_NO_SLIP into s->uvisc (see the enum): FLUID particles
+   their own velocity, WALL and DUMMY particles -u~, the Shepard average of the FLUID velocities
+   around them, gathered by scattering from the FLUID rows (the rows of DUMMY particles are empty);
+   0 where no FLUID particle is within re. */
+static void fsdem__mps_wall_ghosts(fsdem_mps *s) {
+    int i, e;
+    for (i = 0; i < s->n; ++i) {
+        s->uvisc[i] = s->kind[i] == FSDEM_MPS_KIND_FLUID ? s->v[i] : fsdem__zero3();
+        s->ghost_weight[i] = 0;
+    }
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
+            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+                const int j = s->nb[e];
+                const fsdem_real w = s->nbw[e] / s->eps[i];
+                if (s->kind[j] == FSDEM_MPS_KIND_FLUID) continue;
+                s->uvisc[j] = fsdem__madd(s->uvisc[j], s->v[i], w);
+                s->ghost_weight[j] += w;
+            }
+    for (i = 0; i < s->n; ++i)
+        if (s->ghost_weight[i] > 0) s->uvisc[i] = fsdem__scale(s->uvisc[i], -1 / s->ghost_weight[i]);
+}
+
 /* Rebuilds the neighbours and the number density at the current positions for a public operator
    (`fn` names it), checking its arguments. */
 static fsdem_result fsdem__mps_operator_setup(fsdem_mps *s, const char *fn, const void *in, const void *out) {

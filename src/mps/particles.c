@@ -73,6 +73,7 @@ static void fsdem__mps_push(fsdem_mps *s, fsdem_mps_kind kind, fsdem_vec3 x, fsd
     s->p[i] = 0;
     s->eps[i] = 1;
     s->nd[i] = 0;
+    s->rho[i] = 0; /* set by the explicit scheme's hydrostatic start */
     s->fext[i] = s->gradp[i] = fsdem__zero3();
     s->kind[i] = (unsigned char)kind;
     s->surf[i] = 0;

@@ -22,11 +22,6 @@ static fsdem_real fsdem__mps_umax(const fsdem_mps *s, int *who) {
     return (fsdem_real)sqrt(m2);
 }
 
-/* Mass of the fluid a particle stands for: rho r0^d (kg; kg per metre of depth in 2D). */
-static fsdem_real fsdem__mps_mass(const fsdem_mps *s) {
-    return s->desc.density * s->r0 * s->r0 * (s->dim == 3 ? s->r0 : 1);
-}
-
 /* The longest step the explicit viscous term of the predictor (step 2) allows, dt nu <= 0.8
    lambda eps_min / (2d) (s; infinite without viscosity). Eq. 10 on u at particle i, with
    S_i = sum_j w_ij / eps_j, has its row in the disc of centre -c S_i and radius c S_i
@@ -43,36 +38,18 @@ static fsdem_real fsdem__mps_dt_viscous(const fsdem_mps *s) {
     return (fsdem_real)0.8 * s->lambda * eps_min / (2 * (fsdem_real)s->dim * s->desc.viscosity);
 }
 
-/* The stable step: the CFL rule of seed 002 Eq. 37, u_max dt / r0 <= C, and the viscous limit,
-   at most dt_max. */
-static fsdem_real fsdem__mps_dt_from(const fsdem_mps *s, fsdem_real umax) {
-    const fsdem_real viscous = fsdem__mps_dt_viscous(s);
-    fsdem_real dt = s->desc.dt_max;
-    if (umax > 0 && s->desc.cfl * s->r0 / umax < dt) dt = s->desc.cfl * s->r0 / umax;
-    return viscous < dt ? viscous : dt;
+/* The speed of the CFL rule: u_max (seed 002 Eq. 37), c0 + u_max in the explicit scheme. */
+static fsdem_real fsdem__mps_signal_speed(const fsdem_mps *s, fsdem_real umax) {
+    return s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT ? fsdem__mps_c0(s) + umax : umax;
 }
 
-/* The ghost velocities of FSDEM_MPS_WALL_VISCOSITY_NO_SLIP into s->uvisc (see the enum): FLUID particles
-   their own velocity, WALL and DUMMY particles -u~, the Shepard average of the FLUID velocities
-   around them, gathered by scattering from the FLUID rows (the rows of DUMMY particles are empty);
-   0 where no FLUID particle is within re. */
-static void fsdem__mps_wall_ghosts(fsdem_mps *s) {
-    int i, e;
-    for (i = 0; i < s->n; ++i) {
-        s->uvisc[i] = s->kind[i] == FSDEM_MPS_KIND_FLUID ? s->v[i] : fsdem__zero3();
-        s->ghost_weight[i] = 0;
-    }
-    for (i = 0; i < s->n; ++i)
-        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
-            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
-                const int j = s->nb[e];
-                const fsdem_real w = s->nbw[e] / s->eps[i];
-                if (s->kind[j] == FSDEM_MPS_KIND_FLUID) continue;
-                s->uvisc[j] = fsdem__madd(s->uvisc[j], s->v[i], w);
-                s->ghost_weight[j] += w;
-            }
-    for (i = 0; i < s->n; ++i)
-        if (s->ghost_weight[i] > 0) s->uvisc[i] = fsdem__scale(s->uvisc[i], -1 / s->ghost_weight[i]);
+/* The stable step: the CFL rule, speed dt / r0 <= C (fsdem__mps_signal_speed), and the viscous
+   limit, at most dt_max. */
+static fsdem_real fsdem__mps_dt_from(const fsdem_mps *s, fsdem_real umax) {
+    const fsdem_real viscous = fsdem__mps_dt_viscous(s), speed = fsdem__mps_signal_speed(s, umax);
+    fsdem_real dt = s->desc.dt_max;
+    if (speed > 0 && s->desc.cfl * s->r0 / speed < dt) dt = s->desc.cfl * s->r0 / speed;
+    return viscous < dt ? viscous : dt;
 }
 
 /* Makes room for the pressure matrix of `nnz` entries (by doubling). */
@@ -305,33 +282,19 @@ static fsdem_result fsdem__mps_assemble(fsdem_mps *s, fsdem_real dt) {
     return FSDEM_OK;
 }
 
-/* One step of dt (the section's steps 1-6). Failures before the pressure is known change nothing;
-   a completed step reports a non-finite or escaped particle. */
-static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
+/* Steps 2-4 and 6 of the section's step of dt (the seed's scheme, after the neighbours and the
+   number density, before the obstacle forces, collisions and the move): predictor, pressure
+   equation, corrector. A failure changes no particle. */
+static fsdem_result fsdem__mps_semi_implicit(fsdem_mps *s, fsdem_real dt) {
     const fsdem_real rho = s->desc.density, nu = s->desc.viscosity, mass = fsdem__mps_mass(s);
-    const double time0 = s->time;
+    const int no_slip = s->desc.wall_viscosity == FSDEM_MPS_WALL_VISCOSITY_NO_SLIP && nu > 0;
+    const fsdem_vec3 *visc_u = no_slip ? s->uvisc : s->v;
+    const clock_t tp = clock();
+    clock_t ta;
     fsdem_pcg_info info;
     fsdem_csr A;
     fsdem_result r;
-    clock_t t0 = clock(), t1, tp, ts, ta;
-    const int no_slip = s->desc.wall_viscosity == FSDEM_MPS_WALL_VISCOSITY_NO_SLIP && nu > 0;
-    const fsdem_vec3 *visc_u = no_slip ? s->uvisc : s->v;
-    int i, a, bad = -1;
-    if (s->counts[FSDEM_MPS_KIND_FLUID] == 0)
-        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: no FLUID particles to step");
-    for (i = 0; i < s->n; ++i)
-        if (!(s->eps[i] > 0 && s->eps[i] <= 1))
-            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: particle %d has porosity %g outside (0, 1]", i,
-                               (double)s->eps[i]);
-    if (fsdem__mps_reserve(s, s->n + s->buffered) != FSDEM_OK) /* the inflows' new particles of this step */
-        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory for the inflows' particles");
-    fsdem__series_begin(&s->gauges.series);
-    /* 1. neighbours, number density, free surface */
-    if (fsdem__mps_neighbours(s) != FSDEM_OK)
-        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory building the neighbour list");
-    s->surface_count = fsdem__mps_density(s);
-    ts = clock();
-    fsdem__mps_shift(s);
+    int i;
     /* 2. predictor: u* = u + dt (nu lap u + g) (seed 002 Eq. A.6 with eps = 1). WALL and DUMMY
        particles take u* = dt g, their velocity (0) plus the same body force: a uniform field has no
        divergence (Eq. 9), so gravity alone leaves no source at the walls in Eq. 12, and the walls
@@ -355,7 +318,6 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     }
     for (i = 0; i < s->n; ++i) s->div[i] = s->kind[i] == FSDEM_MPS_KIND_DUMMY ? 0 : fsdem__mps_div_at(s, s->us, i);
     /* 3. pressure equation */
-    tp = clock();
     if (fsdem__mps_assemble(s, dt) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory assembling the pressure matrix");
     ta = clock();
@@ -369,7 +331,6 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         A.val = s->a_val;
         r = fsdem__pcg_setup_csr_valid(s->pcg, &A);
         if (r == FSDEM_OK) r = fsdem_pcg_solve(s->pcg, s->b, s->sol, &info);
-        s->sec_pressure += (double)(clock() - tp) / CLOCKS_PER_SEC;
         s->iters = info.iterations;
         s->residual = info.residual;
         if (r != FSDEM_OK) {
@@ -382,11 +343,10 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
                                (double)s->desc.pressure_tolerance, fsdem_pcg_last_error(s->pcg));
         }
     }
-    t1 = clock();
-    s->sec_search += (double)(ts - t0) / CLOCKS_PER_SEC;
+    s->sec_pressure += (double)(clock() - tp) / CLOCKS_PER_SEC;
     s->sec_assembly += (double)(ta - tp) / CLOCKS_PER_SEC;
-    s->sec_solve += (double)(t1 - ta) / CLOCKS_PER_SEC;
-    /* 4. pressures (clamped where asked), then the corrector: u = u* - dt/rho grad p, r += dt u.
+    s->sec_solve += (double)(clock() - ta) / CLOCKS_PER_SEC;
+    /* 4. pressures (clamped where asked), then the corrector: u = u* - dt/rho grad p.
        A closed liquid's pressure is known up to a constant: the lowest is set to 0 */
     if (s->closed) {
         fsdem_real low = s->sol[0];
@@ -409,6 +369,36 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
         s->v[i] = fsdem__madd(s->us[i], s->gradp[i], per_mass);
         if (s->dim == 2) s->v[i].z = 0;
     }
+    return FSDEM_OK;
+}
+
+/* One step of dt (the section's steps 1-7, or the explicit scheme's in place of 2-6). Failures
+   before the pressure is known change nothing; a completed step reports a non-finite or escaped
+   particle. */
+static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
+    const double time0 = s->time;
+    const clock_t t0 = clock();
+    clock_t ts;
+    fsdem_result r;
+    int i, a, bad = -1;
+    if (s->counts[FSDEM_MPS_KIND_FLUID] == 0)
+        return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: no FLUID particles to step");
+    for (i = 0; i < s->n; ++i)
+        if (!(s->eps[i] > 0 && s->eps[i] <= 1))
+            return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "fsdem_mps: particle %d has porosity %g outside (0, 1]", i,
+                               (double)s->eps[i]);
+    if (fsdem__mps_reserve(s, s->n + s->buffered) != FSDEM_OK) /* the inflows' new particles of this step */
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory for the inflows' particles");
+    fsdem__series_begin(&s->gauges.series);
+    /* 1. neighbours, number density, free surface */
+    if (fsdem__mps_neighbours(s) != FSDEM_OK)
+        return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory building the neighbour list");
+    s->surface_count = fsdem__mps_density(s);
+    ts = clock();
+    s->sec_search += (double)(ts - t0) / CLOCKS_PER_SEC;
+    fsdem__mps_shift(s);
+    r = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT ? fsdem__mps_explicit(s, dt) : fsdem__mps_semi_implicit(s, dt);
+    if (r != FSDEM_OK) return r;
     fsdem__mps_obstacle_forces(s);
     fsdem__mps_collide(s, dt);
     for (i = 0; i < s->n; ++i)
@@ -416,6 +406,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
             s->v[i] = fsdem__mps_inflow_velocity(s, s->inlet[i]);
             s->gradp[i] = fsdem__zero3();
         }
+    /* 6b-7. r += dt u, and the shift */
     for (i = 0; i < s->n; ++i)
         if (s->kind[i] == FSDEM_MPS_KIND_FLUID) {
             s->x[i] = fsdem__add(fsdem__madd(s->x[i], s->v[i], dt), s->shift[i]);
@@ -426,7 +417,7 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     s->dt_last = dt;
     s->steps++;
     s->iters_total += s->iters;
-    s->sec_total += (double)(clock() - t1) / CLOCKS_PER_SEC + (double)(t1 - t0) / CLOCKS_PER_SEC;
+    s->sec_total += (double)(clock() - t0) / CLOCKS_PER_SEC;
     for (i = 0; i < s->n && bad < 0; ++i)
         if (s->kind[i] == FSDEM_MPS_KIND_FLUID && (!fsdem__finite3(s->v[i]) || !fsdem__finite3(s->x[i]) || !fsdem__finite(s->p[i])))
             bad = i;
@@ -468,7 +459,7 @@ fsdem_result fsdem_mps_step(fsdem_mps *s) {
 fsdem_result fsdem_mps_check_dt(const fsdem_mps *s, fsdem_real dt) {
     fsdem__status *st;
     int who;
-    fsdem_real umax;
+    fsdem_real umax, speed;
     if (!s) return FSDEM_ERR_INVALID_ARG;
     st = (fsdem__status *)&s->status; /* the message is the object's only mutable part here */
     if (!(dt > 0) || !fsdem__finite(dt))
@@ -476,12 +467,12 @@ fsdem_result fsdem_mps_check_dt(const fsdem_mps *s, fsdem_real dt) {
     umax = fsdem__mps_umax(s, &who);
     if (!fsdem__finite(umax))
         return fsdem__fail(st, FSDEM_ERR_NAN, "fsdem_mps_step_dt: particle %d has a non-finite velocity", who);
-    if (umax * dt > s->desc.cfl * s->r0 * (1 + (fsdem_real)1e-5))
+    speed = fsdem__mps_signal_speed(s, umax);
+    if (speed * dt > s->desc.cfl * s->r0 * (1 + (fsdem_real)1e-5))
         return fsdem__fail(st, FSDEM_ERR_CFL,
-                           "fsdem_mps_step_dt: dt = %g s gives u_max dt / r0 = %g > cfl = %g (seed 002 Eq. 37; particle %d at %g m/s; "
-                           "dt <= %g s)",
-                           (double)dt, (double)(umax * dt / s->r0), (double)s->desc.cfl, who, (double)umax,
-                           (double)(s->desc.cfl * s->r0 / umax));
+                           "fsdem_mps_step_dt: dt = %g s gives %s dt / r0 = %g > cfl = %g (particle %d at %g m/s; dt <= %g s)",
+                           (double)dt, s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT ? "(c0 + u_max)" : "u_max (seed 002 Eq. 37)",
+                           (double)(speed * dt / s->r0), (double)s->desc.cfl, who, (double)umax, (double)(s->desc.cfl * s->r0 / speed));
     if (dt > fsdem__mps_dt_viscous(s) * (1 + (fsdem_real)1e-5))
         return fsdem__fail(st, FSDEM_ERR_CFL,
                            "fsdem_mps_step_dt: dt = %g s exceeds the viscous limit %g s of the explicit viscous term (nu = %g m^2/s; "

@@ -4,7 +4,7 @@
    >>mps_particles (storage, lattice fills, walls, obstacles), >>mps_open (inflow and outflow
    planes), >>mps_neighbours (cell-list search
    into sorted neighbour rows), >>mps_operators (number density, gradient, divergence, Laplacian,
-   surface), >>mps_step (predictor, pressure equation, corrector, collisions, time stepping),
+   surface, the solids' ghost velocities), >>mps_explicit (the weakly compressible scheme), >>mps_step (predictor, pressure equation, corrector, collisions, time stepping),
    >>mps_views (views, statistics), >>mps_probes (pressure, water level, obstacle force, gauges). */
 
 /* A box obstacle (fsdem_mps_add_box_obstacle) and the force of the fluid on it in the last step. */
@@ -23,6 +23,7 @@ struct fsdem_mps {
     fsdem_real r0, re, re_lap;    /* spacing, radius of Eq. 7-9 and of the Laplacian (Eq. 10-11) */
     fsdem_real n0, lambda, f0;    /* lattice constants (>>mps_desc): lambda with re_lap */
     fsdem_real n0_lap;            /* sum of the Laplacian's weights on the full lattice */
+    fsdem_real re_x, n0_x;        /* support and lattice sum of the explicit scheme's weight */
     int layers;                   /* WALL + DUMMY layers of a solid: ceil(re/r0) */
     fsdem__periods periods;       /* the periodic axes (desc.periodic) */
     /* particles, structure of arrays, `cap` allocated */
@@ -30,6 +31,8 @@ struct fsdem_mps {
     fsdem_vec3 *x, *v, *us;       /* position, velocity, predicted velocity u* */
     fsdem_vec3 *shift;            /* particle shift of the step (desc.shifting) */
     fsdem_real *p, *eps, *nd;     /* pressure, porosity, number density */
+    fsdem_real *rho;              /* density carried in the explicit scheme (kg/m^3; 0: not set yet) */
+    fsdem_real c0;                /* the explicit scheme's sound speed once set (m/s; 0: not yet) */
     fsdem_vec3 *fext;             /* external force of a coupler (N; N/m in 2D), FLUID particles */
     fsdem_vec3 *gradp;            /* pressure gradient of the last corrector (Pa/m), FLUID particles */
     fsdem_vec3 *uvisc;            /* velocity in the viscous term: u of FLUID, the ghost of solids */

@@ -10,8 +10,9 @@
 
 /* ---- >>restart_format : header, checksum, cursor ---- */
 
-#define FSDEM__RESTART_VERSION 4u /* 2: DEM contact options and material-pair tables; 3: the PIC's start
-                                      velocities of moving solids at any viscosity; 4: the PIC's porosity */
+#define FSDEM__RESTART_VERSION 5u /* 2: DEM contact options and material-pair tables; 3: the PIC's start
+                                      velocities of moving solids at any viscosity; 4: the PIC's porosity;
+                                      5: the MPS's explicit scheme (its desc fields, c0, densities) */
 #define FSDEM__RESTART_HEADER 64
 #define FSDEM__RESTART_BOM 0x01020304u
 #define FSDEM__RESTART_FNV_BASIS 0xcbf29ce484222325ull

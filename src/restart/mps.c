@@ -29,13 +29,15 @@ static void fsdem__restart_mps_planes(fsdem__restart *io, int dim, int count, in
 /* The particles go into arrays of the saved capacity (all FSDEM__MPS_ARRAYS of them and the four
    row-offset arrays, as fsdem__mps_reserve makes them; the object's own when it has that capacity,
    so a coupled step's put-back allocates nothing); of their contents the state that the
-   next step reads (positions, velocities, pressures: the pressure solve starts from them, kinds,
-   porosities, a coupler's forces, obstacle membership) and the views of the last step (number
+   next step reads (positions, velocities, pressures: the pressure solve starts from them, the
+   explicit scheme's densities and its sound speed, kinds, porosities, a coupler's forces, obstacle
+   membership) and the views of the last step (number
    density, surface flags, pressure gradients) are saved. The neighbour rows and the matrix are
    rebuilt by every step; their memory stays. */
 static void fsdem__restart_mps(fsdem__restart *io, void *object) {
-    static const fsdem__field same[27] = {
-        FSDEM__SAME(fsdem_mps, dim, INT), FSDEM__SAME(fsdem_mps, r0, REAL), FSDEM__SAME(fsdem_mps, re, REAL),
+    static const fsdem__field same[30] = {
+        FSDEM__SAME(fsdem_mps, dim, INT), FSDEM__SAME(fsdem_mps, scheme, INT), FSDEM__SAME(fsdem_mps, sound_speed, REAL),
+        FSDEM__SAME(fsdem_mps, density_diffusion, REAL), FSDEM__SAME(fsdem_mps, r0, REAL), FSDEM__SAME(fsdem_mps, re, REAL),
         FSDEM__SAME(fsdem_mps, re_laplacian, REAL), FSDEM__SAME(fsdem_mps, density, REAL),
         FSDEM__SAME(fsdem_mps, viscosity, REAL), FSDEM__SAME(fsdem_mps, gravity, VEC3), FSDEM__SAME(fsdem_mps, gamma, REAL),
         FSDEM__SAME(fsdem_mps, model, INT), FSDEM__SAME(fsdem_mps, beta, REAL), FSDEM__SAME(fsdem_mps, alpha, REAL),
@@ -46,8 +48,8 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
         FSDEM__SAME(fsdem_mps, collision_distance, REAL), FSDEM__SAME(fsdem_mps, restitution, REAL),
         FSDEM__SAME(fsdem_mps, shifting, REAL), FSDEM__SAME(fsdem_mps, pressure_precond, INT),
         FSDEM__SAME(fsdem_mps, pressure_tolerance, REAL), FSDEM__SAME(fsdem_mps, pressure_max_iterations, INT)};
-    static const fsdem__field state[8] = {
-        FSDEM__SAVED(fsdem_mps, time), FSDEM__SAVED(fsdem_mps, dt_last), FSDEM__SAVED(fsdem_mps, steps),
+    static const fsdem__field state[9] = {
+        FSDEM__SAVED(fsdem_mps, c0), FSDEM__SAVED(fsdem_mps, time), FSDEM__SAVED(fsdem_mps, dt_last), FSDEM__SAVED(fsdem_mps, steps),
         FSDEM__SAVED(fsdem_mps, iters_total), FSDEM__SAVED(fsdem_mps, iters), FSDEM__SAVED(fsdem_mps, residual),
         FSDEM__SAVED(fsdem_mps, surface_count), FSDEM__SAVED(fsdem_mps, pair_count)};
     fsdem_mps *s = (fsdem_mps *)object;
@@ -58,9 +60,9 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem_mps_inflow_desc *inflows;
     fsdem_mps_outflow_desc *outflows;
     fsdem__restart_tag(io, "MPS5");
-    fsdem__restart_same_fields(io, s, same, 27);
+    fsdem__restart_same_fields(io, s, same, 30);
 
-    fsdem__restart_fields(io, s, state, 8);
+    fsdem__restart_fields(io, s, state, 9);
 
     /* obstacles and open boundaries, into the object's arrays when they hold them (else fresh ones) */
     fsdem__restart_count(io, &no, 1 << 24, sizeof(fsdem__mps_obst), "obstacle count");
@@ -138,6 +140,7 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
     fsdem__restart_data(io, s->p, sizeof *s->p * (size_t)n);
     fsdem__restart_data(io, s->eps, sizeof *s->eps * (size_t)n);
     fsdem__restart_data(io, s->nd, sizeof *s->nd * (size_t)n);
+    fsdem__restart_data(io, s->rho, sizeof *s->rho * (size_t)n);
     fsdem__restart_data(io, &s->external, sizeof s->external);
     fsdem__restart_data(io, s->fext, sizeof *s->fext * (size_t)n);
     fsdem__restart_data(io, s->gradp, sizeof *s->gradp * (size_t)n);
