@@ -103,13 +103,19 @@ static fsdem_real fsdem__mps_explicit_pair(const fsdem_mps *s, int j, fsdem_vec3
    with the scheme's weight, d/n0x sum_j (p_i + p_j) (r_j - r_i) w_ij / (|r_j - r_i|^2 eps_j), over
    every neighbour, solids with their extrapolated pressures: the form whose pair forces are equal
    and opposite and whose adjoint is the divergence of the continuity equation (so pressure work
-   and compression balance); the min and corrected forms of desc.gradient blew still water up. */
+   and compression balance); the min and corrected forms of desc.gradient blew still water up.
+   Solid particles whose extrapolated pressure is not positive are in the air (the wall above a
+   free surface) and left out, as the missing liquid above the surface is: with their pressure 0
+   in the sum they pushed the particle where the surface meets a wall away with its own pressure
+   (0.16 r0 in still water; 0.05 r0 without them). A wall a jet presses on has a positive pressure
+   and pushes. */
 static fsdem_vec3 fsdem__mps_explicit_gradient(const fsdem_mps *s, int i) {
     fsdem_vec3 g = fsdem__zero3();
     int e;
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
         const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
+        if (s->kind[j] != FSDEM_MPS_KIND_FLUID && !(s->p[j] > 0)) continue; /* a solid in the air */
         g = fsdem__madd(g, r, (s->p[i] + s->p[j]) * fsdem__mps_explicit_pair(s, j, r));
     }
     return fsdem__scale(g, (fsdem_real)s->dim / s->n0_x);
