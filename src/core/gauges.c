@@ -71,11 +71,20 @@ static fsdem_result fsdem__gauges_close(fsdem__gauges *g, fsdem__status *st, con
     return fsdem__series_close(&g->series, al) == FSDEM_OK ? fsdem__ok(st) : fsdem__fail(st, FSDEM_ERR_IO, "%s: write error", fn);
 }
 
-/* Closes the series and frees the gauges. */
-static void fsdem__gauges_free(fsdem__gauges *g, const fsdem_allocator *al) {
-    fsdem__series_close(&g->series, al);
+/* Frees the gauges' arrays (count and capacity 0); the series is left as it is. */
+static void fsdem__gauges_free_arrays(fsdem__gauges *g, const fsdem_allocator *al) {
     fsdem__free(al, g->at, sizeof(fsdem_vec3) * (size_t)g->capacity);
     fsdem__free(al, g->kind, sizeof(int) * (size_t)g->capacity);
     fsdem__free(al, g->radius, sizeof(fsdem_real) * (size_t)g->capacity);
+    g->at = NULL;
+    g->kind = NULL;
+    g->radius = NULL;
+    g->count = g->capacity = 0;
+}
+
+/* Closes the series and frees the gauges. */
+static void fsdem__gauges_free(fsdem__gauges *g, const fsdem_allocator *al) {
+    fsdem__series_close(&g->series, al);
+    fsdem__gauges_free_arrays(g, al);
     memset(g, 0, sizeof *g);
 }

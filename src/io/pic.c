@@ -22,6 +22,7 @@ fsdem_result fsdem_mps_write_vtp(const fsdem_mps *s, const char *path, fsdem_vtk
     fsdem__vtk_write(&w, fsdem__vtk_vec3s("velocity", s->v, s->n));
     fsdem__vtk_write(&w, fsdem__vtk_reals("number_density", s->nd, s->n));
     fsdem__vtk_write(&w, fsdem__vtk_reals("porosity", s->eps, s->n));
+    if (s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT) fsdem__vtk_write(&w, fsdem__vtk_reals("density", s->rho, s->n));
     return fsdem__vtk_particles_end(&w, s->x, s->n);
 }
 

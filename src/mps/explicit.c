@@ -34,11 +34,9 @@ static void fsdem__mps_hydrostatic_start(fsdem_mps *s, fsdem_real c0) {
     const fsdem_real g = fsdem__norm(s->desc.gravity), half = s->r0 / 2;
     fsdem_real *top = s->div;
     int i, e, unset = 0, changed = 1;
-    for (i = 0; i < s->n; ++i) {
-        unset += s->kind[i] == FSDEM_MPS_KIND_FLUID && s->rho[i] == 0;
-        top[i] = fsdem__mps_height(s, s->x[i]);
-    }
+    for (i = 0; i < s->n; ++i) unset += s->kind[i] == FSDEM_MPS_KIND_FLUID && s->rho[i] == 0;
     if (!unset) return;
+    for (i = 0; i < s->n; ++i) top[i] = fsdem__mps_height(s, s->x[i]);
     while (changed) {
         changed = 0;
         for (i = 0; i < s->n; ++i)
@@ -92,15 +90,9 @@ static void fsdem__mps_explicit_pressures(fsdem_mps *s, fsdem_real c0) {
         }
 }
 
-/* The weight of the pair (i, j) at separation r in the explicit scheme's gradient and divergence,
-   over |r|^2 eps_j (the factor of Eq. 8-9). */
-static fsdem_real fsdem__mps_explicit_pair(const fsdem_mps *s, int j, fsdem_vec3 r) {
-    const fsdem_real r2 = fsdem__dot(r, r);
-    return r2 > 0 ? fsdem__kernel_mps_explicit((fsdem_real)sqrt(r2), s->re_x) / (r2 * s->eps[j]) : 0;
-}
-
 /* The pressure gradient of the explicit scheme at FLUID particle i: the sum form of seed 002 Eq. 8
-   with the scheme's weight, d/n0x sum_j (p_i + p_j) (r_j - r_i) w_ij / (|r_j - r_i|^2 eps_j), over
+   with the scheme's weight w_ij (s->nbx holds w_ij / |r_j - r_i|^2),
+   d/n0x sum_j (p_i + p_j) (r_j - r_i) w_ij / (|r_j - r_i|^2 eps_j), over
    every neighbour, solids with their extrapolated pressures: the form whose pair forces are equal
    and opposite and whose adjoint is the divergence of the continuity equation (so pressure work
    and compression balance); the min and corrected forms of desc.gradient blew still water up.
@@ -116,7 +108,7 @@ static fsdem_vec3 fsdem__mps_explicit_gradient(const fsdem_mps *s, int i) {
         const int j = s->nb[e];
         const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
         if (s->kind[j] != FSDEM_MPS_KIND_FLUID && !(s->p[j] > 0)) continue; /* a solid in the air */
-        g = fsdem__madd(g, r, (s->p[i] + s->p[j]) * fsdem__mps_explicit_pair(s, j, r));
+        g = fsdem__madd(g, r, (s->p[i] + s->p[j]) * s->nbx[e] / s->eps[j]);
     }
     return fsdem__scale(g, (fsdem_real)s->dim / s->n0_x);
 }
@@ -134,7 +126,7 @@ static fsdem_real fsdem__mps_density_rate(const fsdem_mps *s, int i, fsdem_real 
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
         const int j = s->nb[e];
         const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
-        div += fsdem__dot(fsdem__sub(s->v[j], s->v[i]), r) * fsdem__mps_explicit_pair(s, j, r);
+        div += fsdem__dot(fsdem__sub(s->v[j], s->v[i]), r) * s->nbx[e] / s->eps[j];
         if (s->kind[j] == FSDEM_MPS_KIND_FLUID)
             diffusion += (s->rho[j] - s->rho[i] - hydro * fsdem__dot(s->desc.gravity, r)) * s->nbl[e] / s->eps[j];
     }

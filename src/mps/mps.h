@@ -207,7 +207,8 @@ typedef struct fsdem_mps_desc {
     int dim;                        /* 2 or 3 */
     fsdem_mps_scheme scheme;        /* default FSDEM_MPS_SCHEME_SEMI_IMPLICIT (see the enum) */
     fsdem_real r0;                  /* m; initial particle spacing, > 0; default 0.01 */
-    fsdem_real re;                  /* m; interaction radius, >= 2 r0; 0 = 4.1 r0 (seed 002 §2.1); */
+    fsdem_real re;                  /* m; interaction radius, >= 2 r0; 0 = 4.1 r0 (seed 002 §2.1) */
+                                    /*    with the seed's scheme, 2.8 r0 with the explicit one; */
                                     /*    default 0 */
     fsdem_real re_laplacian;        /* m; radius of the Laplacian (Eq. 10-11: the pressure equation */
                                     /*    and viscosity), in [1.5 r0, re]; 0 = re (the seed's); */
@@ -221,7 +222,8 @@ typedef struct fsdem_mps_desc {
     fsdem_real beta;                /* -; surface when n < beta n0 (Eq. 14), in (0, 1); default 0.8 */
     fsdem_real alpha;               /* -; surface when |F| > alpha |F0| (Eq. 16), > 0; default 0.9 */
     fsdem_real cfl;                 /* -; Courant number C of Eq. 37, u_max dt / r0 <= C (explicit: */
-                                    /*    (c0 + u_max) dt / r0 <= C), in (0, 1]; default 0.2 */
+                                    /*    (c0 + u_max) dt / r0 <= C), in (0, 1]; 0 = the scheme's: */
+                                    /*    0.2 (the seed's), 0.35 (explicit); default 0 */
     fsdem_real sound_speed;         /* m/s; c0 of FSDEM_MPS_SCHEME_EXPLICIT, >= 0; 0 = 10 sqrt(2 |g| H) */
                                     /*    with H the height of the liquid at the first step (10 */
                                     /*    times the speed of a fall from its top: density within */
@@ -365,6 +367,9 @@ typedef struct fsdem_mps_particles {
     const unsigned char *kind;        /* fsdem_mps_kind */
     const unsigned char *surface;     /* 1: free-surface particle (p = 0) at the last step */
     const fsdem_real *number_density; /* -; n_i of Eq. 7 at the last step (0 for DUMMY) */
+    const fsdem_real *density;        /* kg/m^3; rho_i of FSDEM_MPS_SCHEME_EXPLICIT (its particle's */
+                                      /*    volume is mass / rho_i); 0 for WALL and DUMMY, and */
+                                      /*    with the seed's scheme */
     fsdem_real *porosity;             /* -; eps_f per particle */
     const fsdem_vec3 *pressure_gradient; /* Pa/m; grad p of the last corrector at FLUID particles */
                                       /*    (desc.gradient form; 0 elsewhere and before a step) */

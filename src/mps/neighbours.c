@@ -13,7 +13,8 @@ static int fsdem__mps_capacity(int have, long long need) {
 }
 
 /* The neighbours of every FLUID and WALL particle within re at the current positions, as rows of
-   ascending particle index with their weights w_ij (Eq. 6); DUMMY particles have empty rows (their
+   ascending particle index with their weights w_ij (Eq. 6; of the Laplacian; of the explicit
+   scheme's pair, over |r|^2); DUMMY particles have empty rows (their
    own sums are never needed) but appear in the others'. Pairs are found once each by the forward
    scan of the cell grid (as the DEM's pair search), put into unsorted rows, then copied column by
    column into the final rows, which leaves each sorted. Allocates only when the lists outgrow every
@@ -70,6 +71,7 @@ static fsdem_result fsdem__mps_scan(fsdem_mps *s, int solid, int **list, int *ca
 static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     const fsdem_cellgrid *g = &s->grid;
     const int solids = s->counts[FSDEM_MPS_KIND_WALL] + s->counts[FSDEM_MPS_KIND_DUMMY];
+    const int explicit_scheme = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT;
     long long examined = 0;
     int c, a, i, e, count = 0;
     if (fsdem_cellgrid_build(&s->grid, s->x, s->n) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
@@ -134,9 +136,9 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     }
     if (s->nb_start[s->n] > s->nb_cap) {
         const int cap = fsdem__mps_capacity(s->nb_cap, s->nb_start[s->n]);
-        void **arrays[6];
-        size_t elem[6];
-        void *fresh[6];
+        void **arrays[8];
+        size_t elem[8];
+        void *fresh[8];
         int k, ok = 1;
         arrays[0] = (void **)&s->nb;
         arrays[1] = (void **)&s->tmp_nb;
@@ -144,19 +146,21 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
         arrays[3] = (void **)&s->tmp_w;
         arrays[4] = (void **)&s->nbl;
         arrays[5] = (void **)&s->tmp_l;
+        arrays[6] = (void **)&s->nbx;
+        arrays[7] = (void **)&s->tmp_x;
         elem[0] = elem[1] = sizeof(int);
-        elem[2] = elem[3] = elem[4] = elem[5] = sizeof(fsdem_real);
+        for (k = 2; k < 8; ++k) elem[k] = sizeof(fsdem_real);
         if (!cap) return FSDEM_ERR_OUT_OF_MEMORY;
-        for (k = 0; k < 6; ++k) ok &= (fresh[k] = fsdem__alloc(&s->allocator, elem[k] * (size_t)cap)) != NULL;
+        for (k = 0; k < 8; ++k) ok &= (fresh[k] = fsdem__alloc(&s->allocator, elem[k] * (size_t)cap)) != NULL;
         if (!ok) {
-            for (k = 0; k < 6; ++k) fsdem__free(&s->allocator, fresh[k], elem[k] * (size_t)cap);
+            for (k = 0; k < 8; ++k) fsdem__free(&s->allocator, fresh[k], elem[k] * (size_t)cap);
             return FSDEM_ERR_OUT_OF_MEMORY;
         }
-        for (k = 0; k < 6; ++k) {
+        for (k = 0; k < 8; ++k) {
             fsdem__free(&s->allocator, *arrays[k], elem[k] * (size_t)s->nb_cap);
             *arrays[k] = fresh[k];
         }
-        s->bytes += 2 * (sizeof(int) + 2 * sizeof(fsdem_real)) * (size_t)(cap - s->nb_cap);
+        s->bytes += 2 * (sizeof(int) + 3 * sizeof(fsdem_real)) * (size_t)(cap - s->nb_cap);
         s->nb_cap = cap;
     }
     memcpy(s->cursor, s->tmp_start, sizeof(int) * (size_t)s->n);
@@ -165,14 +169,17 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
         const fsdem_real r = fsdem__norm(fsdem__mps_sep(s, pb, pa));
         const fsdem_real w = fsdem__kernel_mps(r, s->re);
         const fsdem_real wl = s->re_lap == s->re ? w : r < s->re_lap ? fsdem__kernel_mps(r, s->re_lap) : 0;
+        const fsdem_real wx = explicit_scheme && r > 0 ? fsdem__kernel_mps_explicit(r, s->re_x) / (r * r) : 0;
         if (s->kind[pa] != FSDEM_MPS_KIND_DUMMY) {
             s->tmp_nb[s->cursor[pb]] = pa;
             s->tmp_l[s->cursor[pb]] = wl;
+            s->tmp_x[s->cursor[pb]] = wx;
             s->tmp_w[s->cursor[pb]++] = w;
         }
         if (s->kind[pb] != FSDEM_MPS_KIND_DUMMY) {
             s->tmp_nb[s->cursor[pa]] = pb;
             s->tmp_l[s->cursor[pa]] = wl;
+            s->tmp_x[s->cursor[pa]] = wx;
             s->tmp_w[s->cursor[pa]++] = w;
         }
     }
@@ -182,6 +189,7 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
             const int r = s->tmp_nb[e];
             s->nb[s->cursor[r]] = c;
             s->nbl[s->cursor[r]] = s->tmp_l[e];
+            s->nbx[s->cursor[r]] = s->tmp_x[e];
             s->nbw[s->cursor[r]++] = s->tmp_w[e];
         }
     return FSDEM_OK;

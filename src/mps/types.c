@@ -55,6 +55,7 @@ struct fsdem_mps {
     int *nb, *tmp_nb, nb_cap;     /* neighbour indices */
     fsdem_real *nbw, *tmp_w;      /* w_ij (Eq. 6) */
     fsdem_real *nbl, *tmp_l;      /* w_ij of the Laplacian (Eq. 6 with re_laplacian; 0 beyond it) */
+    fsdem_real *nbx, *tmp_x;      /* the explicit scheme's pair weight over |r_ij|^2 (0 with the seed's) */
     long long pair_count;
     /* pressure matrix */
     int *a_start, *a_col, a_cap;

@@ -12,6 +12,7 @@ fsdem_mps_particles fsdem_mps_get_particles(fsdem_mps *s) {
     v.kind = s->kind;
     v.surface = s->surf;
     v.number_density = s->nd;
+    v.density = s->rho;
     v.porosity = s->eps;
     v.pressure_gradient = s->gradp;
     v.inflow = s->inlet;

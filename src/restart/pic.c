@@ -35,7 +35,7 @@ static void fsdem__restart_gauges(fsdem__restart *io, fsdem__gauges *g, const fs
     if (io->mode == FSDEM__RESTART_COMMIT) {
         if (io->unchecked) fsdem__series_drop(&g->series);
         if (!in_place) {
-            fsdem__gauges_free(g, al);
+            fsdem__gauges_free_arrays(g, al); /* the series stays as it is */
             g->at = at;
             g->kind = kind;
             g->radius = radius;
