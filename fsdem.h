@@ -15109,7 +15109,7 @@ struct fsdem_mps {
     int *unknown;                 /* row of each particle in the pressure equation, or -1 */
     int *row_particle;            /* particle of each row */
     int counts[3];                /* particles per kind */
-    /* neighbours: rows of every non-DUMMY particle (DUMMY rows are empty), columns ascending */
+    /* neighbours (>>mps_neighbours): rows of every non-DUMMY particle (DUMMY rows are empty), columns ascending */
     fsdem_cellgrid grid;
     int *cell_wall, *cell_dummy;  /* per cell: where its WALL and its DUMMY items start */
     int *pairs, pair_cap;         /* 2 per pair found by the cell scan */
@@ -15118,9 +15118,12 @@ struct fsdem_mps {
     int *nb_start;                /* n + 1 */
     int *tmp_start, *cursor;      /* n + 1 each: rows by column and fill cursors of the build */
     int *nb, *tmp_nb, nb_cap;     /* neighbour indices */
-    fsdem_real *nbw, *tmp_w;      /* w_ij (Eq. 6) */
-    fsdem_real *nbl, *tmp_l;      /* w_ij of the Laplacian (Eq. 6 with re_laplacian; 0 beyond it) */
-    fsdem_real *nbx, *tmp_x;      /* the explicit scheme's pair weight over |r_ij|^2 (0 with the seed's) */
+    fsdem_real *nbw;              /* w_ij (Eq. 6; 0 beyond re) */
+    fsdem_real *nbl;              /* w_ij of the Laplacian (Eq. 6 with re_laplacian; 0 beyond it) */
+    fsdem_real *nbx;              /* the explicit scheme's pair weight over |r_ij|^2 (0 with the seed's) */
+    fsdem_real skin;              /* the rows hold the pairs within re + skin (Verlet lists) */
+    fsdem_vec3 *x_built;          /* positions the rows were built at */
+    int rows_valid;               /* 0: particles were added, removed or restored since */
     long long pair_count;
     /* pressure matrix */
     int *a_start, *a_col, a_cap;
@@ -15328,6 +15331,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     fsdem_result r;
     fsdem_mps *s;
     fsdem_pcg_desc pd;
+    int a;
     if (out) *out = NULL;
     if (!desc || !out) return FSDEM_ERR_INVALID_ARG;
     r = fsdem__mps_check(desc, msg, sizeof msg);
@@ -15352,6 +15356,15 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     s->re_x = FSDEM__MPS_EXPLICIT_SUPPORT * desc->r0;
     s->layers = (int)ceil((double)(s->re / s->r0) - 1e-9);
     s->periods = fsdem__periods_of(desc->periodic, desc->dim, desc->domain_min, desc->domain_max);
+    /* the neighbour rows' skin (>>mps_neighbours): 0.3 r0, rebuilt when a particle has moved
+       0.15 r0 (every few steps of a dam break's front, rarely in a slow flow), less where a period
+       is short (a pair is seen through one image only while re + skin < L/2) */
+    s->skin = (fsdem_real)0.3 * desc->r0;
+    for (a = 0; a < desc->dim; ++a)
+        if (desc->periodic[a]) {
+            const fsdem_real room = (fsdem_real)0.99 * (s->periods.length[a] / 2 - s->re);
+            if (room < s->skin) s->skin = room > 0 ? room : 0;
+        }
     fsdem__mps_lattice(s);
     pd = fsdem_pcg_desc_default();
     /* AUTO: MIC(0) in 2D, Jacobi in 3D, where the incomplete factorisation of rows of ~280
@@ -15366,7 +15379,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     pd.allocator = desc->allocator;
     r = fsdem_pcg_create(&pd, &s->pcg);
     if (r == FSDEM_OK)
-        r = fsdem_cellgrid_setup_periodic(&s->grid, &s->allocator, s->dim, desc->domain_min, desc->domain_max, s->re, 0,
+        r = fsdem_cellgrid_setup_periodic(&s->grid, &s->allocator, s->dim, desc->domain_min, desc->domain_max, s->re + s->skin, 0,
                                           desc->periodic);
     if (r == FSDEM_OK) {
         s->cell_wall = (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)s->grid.cell_count);
@@ -15386,7 +15399,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
 
 /* The particle arrays of a capacity `cap`, with their element sizes (one list for allocation,
    copying and release). */
-#define FSDEM__MPS_ARRAYS 21
+#define FSDEM__MPS_ARRAYS 22
 #define FSDEM__MPS_ROW_ARRAYS 3
 static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     void **p[FSDEM__MPS_ARRAYS];
@@ -15415,6 +15428,7 @@ static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     FSDEM__MPS_ARRAY(uvisc);
     FSDEM__MPS_ARRAY(ghost_weight);
     FSDEM__MPS_ARRAY(inlet);
+    FSDEM__MPS_ARRAY(x_built);
     /* by pressure row, last (FSDEM__MPS_ROW_ARRAYS of them): not moved when particles are removed */
     FSDEM__MPS_ARRAY(b);
     FSDEM__MPS_ARRAY(sol);
@@ -15444,11 +15458,8 @@ void fsdem_mps_destroy(fsdem_mps *s) {
     fsdem__free(&s->allocator, s->nb, sizeof(int) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->tmp_nb, sizeof(int) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->nbw, sizeof(fsdem_real) * (size_t)s->nb_cap);
-    fsdem__free(&s->allocator, s->tmp_w, sizeof(fsdem_real) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->nbl, sizeof(fsdem_real) * (size_t)s->nb_cap);
-    fsdem__free(&s->allocator, s->tmp_l, sizeof(fsdem_real) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->nbx, sizeof(fsdem_real) * (size_t)s->nb_cap);
-    fsdem__free(&s->allocator, s->tmp_x, sizeof(fsdem_real) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->a_col, sizeof(int) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->a_val, sizeof(fsdem_real) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->obst, sizeof *s->obst * (size_t)s->obst_cap);
@@ -15558,6 +15569,7 @@ static void fsdem__mps_push(fsdem_mps *s, fsdem_mps_kind kind, fsdem_vec3 x, fsd
     s->inlet[i] = -1;
     s->unknown[i] = -1;
     s->counts[kind]++;
+    s->rows_valid = 0;
 }
 
 fsdem_result fsdem_mps_add_particles(fsdem_mps *s, fsdem_mps_kind kind, int count, const fsdem_vec3 *positions,
@@ -15992,11 +16004,12 @@ static void fsdem__mps_open_update(fsdem_mps *s) {
     }
     if (kept < s->n)
         for (k = 0; k < s->rows; ++k) s->row_particle[k] = s->cursor[s->row_particle[k]];
+    if (kept < s->n) s->rows_valid = 0; /* renumbered */
     s->n = kept;
     if (solids_after) s->solid_pairs_of = -1; /* solids renumbered: their pairs are found again */
 }
 
-/* ---- >>mps_neighbours : cell-list search into sorted neighbour rows ---- */
+/* ---- >>mps_neighbours : cell-list search into sorted neighbour rows, kept while they hold ---- */
 
 /* r_j - r_i, through the minimum image along periodic axes. */
 static fsdem_vec3 fsdem__mps_sep(const fsdem_mps *s, int i, int j) {
@@ -16010,14 +16023,13 @@ static int fsdem__mps_capacity(int have, long long need) {
     return cap > (1LL << 30) ? 0 : (int)cap;
 }
 
-/* The neighbours of every FLUID and WALL particle within re at the current positions, as rows of
-   ascending particle index with their weights w_ij (Eq. 6; of the Laplacian; of the explicit
-   scheme's pair, over |r|^2); DUMMY particles have empty rows (their
-   own sums are never needed) but appear in the others'. Pairs are found once each by the forward
-   scan of the cell grid (as the DEM's pair search), put into unsorted rows, then copied column by
-   column into the final rows, which leaves each sorted. Allocates only when the lists outgrow every
-   earlier one. */
-/* Pairs within re from the cell scan, appended to *list (2 ints each, from pair *count on, the
+/* The neighbour rows are Verlet lists: they hold every pair within re + s->skin at the positions
+   they were built at (s->x_built), so they still hold every pair within re until some particle has
+   moved skin/2; fsdem__mps_neighbours rebuilds them only then (or after particles were added,
+   removed or restored: s->rows_valid = 0) and weighs every entry at the current positions, those
+   beyond re with 0, which leaves every sum over a row as it would be over the pairs within re. */
+
+/* Pairs within re + skin from the cell scan, appended to *list (2 ints each, from pair *count on, the
    array grown as needed; *examined counts the candidates). Every cell holds its FLUID items, then
    its WALL items (from s->cell_wall[c]), then its DUMMY items (from s->cell_dummy[c]), so each kind
    of pair is one range of a neighbouring cell: with `solid` = 0 the pairs with a FLUID particle,
@@ -16025,7 +16037,7 @@ static int fsdem__mps_capacity(int have, long long need) {
    Returns FSDEM_ERR_OUT_OF_MEMORY when the list cannot grow. */
 static fsdem_result fsdem__mps_scan(fsdem_mps *s, int solid, int **list, int *cap, int *count, long long *examined) {
     const fsdem_cellgrid *g = &s->grid;
-    const fsdem_real re2 = s->re * s->re;
+    const fsdem_real reach2 = (s->re + s->skin) * (s->re + s->skin);
     int c, f, a, b;
     for (c = 0; c < g->cell_count; ++c) {
         int coord[3], cells[14], nf;
@@ -16059,19 +16071,24 @@ static fsdem_result fsdem__mps_scan(fsdem_mps *s, int solid, int **list, int *ca
                     const fsdem_vec3 d = fsdem__mps_sep(s, pb, pa);
                     (*list)[2 * *count] = pa;
                     (*list)[2 * *count + 1] = pb;
-                    *count += fsdem__dot(d, d) < re2;
+                    *count += fsdem__dot(d, d) < reach2;
                 }
             }
     }
     return FSDEM_OK;
 }
 
-static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
+/* Rebuilds the rows of every FLUID and WALL particle, ascending particle index: pairs found once
+   each by the forward scan of the cell grid (as the DEM's pair search), bucketed by column, then
+   copied column by column into the final rows, which leaves each sorted. DUMMY particles have
+   empty rows (their own sums are never needed) but appear in the others'. Allocates only when the
+   lists outgrow every earlier one. */
+static fsdem_result fsdem__mps_build_rows(fsdem_mps *s) {
     const fsdem_cellgrid *g = &s->grid;
     const int solids = s->counts[FSDEM_MPS_KIND_WALL] + s->counts[FSDEM_MPS_KIND_DUMMY];
-    const int explicit_scheme = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT;
     long long examined = 0;
     int c, a, i, e, count = 0;
+    s->rows_valid = 0;
     if (fsdem_cellgrid_build(&s->grid, s->x, s->n) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     /* each cell's items in the order FLUID, WALL, DUMMY (stable; s->cursor and s->tmp_start are
        free until the rows are built) */
@@ -16110,10 +16127,9 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     }
     if (s->solid_pair_n) memcpy(s->pairs + 2 * (size_t)count, s->solid_pairs, sizeof(int) * 2 * (size_t)s->solid_pair_n);
     count += s->solid_pair_n;
-    s->pair_count = count;
     s->candidates = examined;
     /* directed entries (r, c): c in the row of r, for every non-DUMMY r; first bucketed by column c
-       (counting sort into tmp_nb/tmp_w, rows r), then scattered by row in column order, which
+       (counting sort into tmp_nb, rows r), then scattered by row in column order, which
        leaves every row sorted */
     memset(s->tmp_start, 0, sizeof(int) * (size_t)(s->n + 1));
     memset(s->nb_start, 0, sizeof(int) * (size_t)(s->n + 1));
@@ -16134,62 +16150,90 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     }
     if (s->nb_start[s->n] > s->nb_cap) {
         const int cap = fsdem__mps_capacity(s->nb_cap, s->nb_start[s->n]);
-        void **arrays[8];
-        size_t elem[8];
-        void *fresh[8];
+        void **arrays[5];
+        size_t elem[5];
+        void *fresh[5];
         int k, ok = 1;
         arrays[0] = (void **)&s->nb;
         arrays[1] = (void **)&s->tmp_nb;
         arrays[2] = (void **)&s->nbw;
-        arrays[3] = (void **)&s->tmp_w;
-        arrays[4] = (void **)&s->nbl;
-        arrays[5] = (void **)&s->tmp_l;
-        arrays[6] = (void **)&s->nbx;
-        arrays[7] = (void **)&s->tmp_x;
+        arrays[3] = (void **)&s->nbl;
+        arrays[4] = (void **)&s->nbx;
         elem[0] = elem[1] = sizeof(int);
-        for (k = 2; k < 8; ++k) elem[k] = sizeof(fsdem_real);
+        elem[2] = elem[3] = elem[4] = sizeof(fsdem_real);
         if (!cap) return FSDEM_ERR_OUT_OF_MEMORY;
-        for (k = 0; k < 8; ++k) ok &= (fresh[k] = fsdem__alloc(&s->allocator, elem[k] * (size_t)cap)) != NULL;
+        for (k = 0; k < 5; ++k) ok &= (fresh[k] = fsdem__alloc(&s->allocator, elem[k] * (size_t)cap)) != NULL;
         if (!ok) {
-            for (k = 0; k < 8; ++k) fsdem__free(&s->allocator, fresh[k], elem[k] * (size_t)cap);
+            for (k = 0; k < 5; ++k) fsdem__free(&s->allocator, fresh[k], elem[k] * (size_t)cap);
             return FSDEM_ERR_OUT_OF_MEMORY;
         }
-        for (k = 0; k < 8; ++k) {
+        for (k = 0; k < 5; ++k) {
             fsdem__free(&s->allocator, *arrays[k], elem[k] * (size_t)s->nb_cap);
             *arrays[k] = fresh[k];
         }
-        s->bytes += 2 * (sizeof(int) + 3 * sizeof(fsdem_real)) * (size_t)(cap - s->nb_cap);
+        s->bytes += (2 * sizeof(int) + 3 * sizeof(fsdem_real)) * (size_t)(cap - s->nb_cap);
         s->nb_cap = cap;
     }
     memcpy(s->cursor, s->tmp_start, sizeof(int) * (size_t)s->n);
     for (e = 0; e < count; ++e) {
         const int pa = s->pairs[2 * e], pb = s->pairs[2 * e + 1];
-        const fsdem_real r = fsdem__norm(fsdem__mps_sep(s, pb, pa));
-        const fsdem_real w = fsdem__kernel_mps(r, s->re);
-        const fsdem_real wl = s->re_lap == s->re ? w : r < s->re_lap ? fsdem__kernel_mps(r, s->re_lap) : 0;
-        const fsdem_real wx = explicit_scheme && r > 0 ? fsdem__kernel_mps_explicit(r, s->re_x) / (r * r) : 0;
-        if (s->kind[pa] != FSDEM_MPS_KIND_DUMMY) {
-            s->tmp_nb[s->cursor[pb]] = pa;
-            s->tmp_l[s->cursor[pb]] = wl;
-            s->tmp_x[s->cursor[pb]] = wx;
-            s->tmp_w[s->cursor[pb]++] = w;
-        }
-        if (s->kind[pb] != FSDEM_MPS_KIND_DUMMY) {
-            s->tmp_nb[s->cursor[pa]] = pb;
-            s->tmp_l[s->cursor[pa]] = wl;
-            s->tmp_x[s->cursor[pa]] = wx;
-            s->tmp_w[s->cursor[pa]++] = w;
-        }
+        if (s->kind[pa] != FSDEM_MPS_KIND_DUMMY) s->tmp_nb[s->cursor[pb]++] = pa;
+        if (s->kind[pb] != FSDEM_MPS_KIND_DUMMY) s->tmp_nb[s->cursor[pa]++] = pb;
     }
     memcpy(s->cursor, s->nb_start, sizeof(int) * (size_t)s->n);
     for (c = 0; c < s->n; ++c)
-        for (e = s->tmp_start[c]; e < s->tmp_start[c + 1]; ++e) {
-            const int r = s->tmp_nb[e];
-            s->nb[s->cursor[r]] = c;
-            s->nbl[s->cursor[r]] = s->tmp_l[e];
-            s->nbx[s->cursor[r]] = s->tmp_x[e];
-            s->nbw[s->cursor[r]++] = s->tmp_w[e];
+        for (e = s->tmp_start[c]; e < s->tmp_start[c + 1]; ++e) s->nb[s->cursor[s->tmp_nb[e]]++] = c;
+    memcpy(s->x_built, s->x, sizeof(fsdem_vec3) * (size_t)s->n);
+    s->rows_valid = 1;
+    return FSDEM_OK;
+}
+
+/* Whether the rows still hold every pair within re: built for these particles, and no particle
+   more than skin/2 from where it was then (two of them then came at most skin closer). */
+static int fsdem__mps_rows_hold(const fsdem_mps *s) {
+    const fsdem_real half = s->skin / 2;
+    int i;
+    if (!s->rows_valid) return 0;
+    for (i = 0; i < s->n; ++i) {
+        const fsdem_vec3 d = fsdem__min_image(&s->periods, fsdem__sub(s->x[i], s->x_built[i]));
+        if (!(fsdem__dot(d, d) <= half * half)) return 0;
+    }
+    return 1;
+}
+
+/* The weights of every row entry at the current positions: w_ij (Eq. 6), the Laplacian's (with
+   re_laplacian), the explicit scheme's pair weight over |r_ij|^2; 0 beyond their radii. Counts the
+   pairs within re (a pair with a DUMMY particle has one entry, others two). */
+static void fsdem__mps_weigh(fsdem_mps *s) {
+    const int explicit_scheme = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT;
+    const fsdem_real re2 = s->re * s->re;
+    long long twice = 0;
+    int i, e;
+    for (i = 0; i < s->n; ++i)
+        for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+            const int j = s->nb[e];
+            const fsdem_vec3 d = fsdem__mps_sep(s, j, i);
+            const fsdem_real r2 = fsdem__dot(d, d);
+            fsdem_real r, w;
+            if (!(r2 < re2)) { /* in the skin: every radius is at most re */
+                s->nbw[e] = s->nbl[e] = s->nbx[e] = 0;
+                continue;
+            }
+            r = (fsdem_real)sqrt(r2);
+            w = fsdem__kernel_mps(r, s->re);
+            s->nbw[e] = w;
+            s->nbl[e] = s->re_lap == s->re ? w : r < s->re_lap ? fsdem__kernel_mps(r, s->re_lap) : 0;
+            s->nbx[e] = explicit_scheme && r > 0 ? fsdem__kernel_mps_explicit(r, s->re_x) / (r * r) : 0;
+            twice += s->kind[j] == FSDEM_MPS_KIND_DUMMY ? 2 : 1;
         }
+    s->pair_count = twice / 2;
+}
+
+/* The neighbour rows at the current positions with their weights (rebuilt when they no longer
+   hold). FSDEM_ERR_OUT_OF_MEMORY when a rebuild cannot grow the lists. */
+static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
+    if (!fsdem__mps_rows_hold(s) && fsdem__mps_build_rows(s) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    fsdem__mps_weigh(s);
     return FSDEM_OK;
 }
 
@@ -16286,7 +16330,7 @@ static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, 
     int e;
     if (s->desc.gradient == FSDEM_MPS_GRADIENT_MODEL_MIN)
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e)
-            if (s->kind[s->nb[e]] != FSDEM_MPS_KIND_DUMMY && phi[s->nb[e]] < base) base = phi[s->nb[e]];
+            if (s->kind[s->nb[e]] != FSDEM_MPS_KIND_DUMMY && s->nbw[e] > 0 && phi[s->nb[e]] < base) base = phi[s->nb[e]];
     if (s->desc.gradient == FSDEM_MPS_GRADIENT_MODEL_MIN) base = -base;
     fsdem__mps_gradient_transform(s, i, T);
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
@@ -16446,7 +16490,7 @@ static void fsdem__mps_hydrostatic_start(fsdem_mps *s, fsdem_real c0) {
                     const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
                     const fsdem_real up = g > 0 ? -fsdem__dot(s->desc.gravity, r) / g : 0;
                     const fsdem_vec3 across = g > 0 ? fsdem__madd(r, s->desc.gravity, up / g) : r; /* r less its vertical part */
-                    if (s->kind[j] == FSDEM_MPS_KIND_FLUID && top[j] > top[i] && fsdem__norm(across) <= half) {
+                    if (s->kind[j] == FSDEM_MPS_KIND_FLUID && s->nbw[e] > 0 && top[j] > top[i] && fsdem__norm(across) <= half) {
                         top[i] = top[j];
                         changed = 1;
                     }
@@ -16677,7 +16721,7 @@ static void fsdem__mps_shift(fsdem_mps *s) {
             const int j = s->nb[e];
             const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
             const fsdem_real r2 = fsdem__dot(r, r);
-            if (!(r2 > 0)) continue;
+            if (!(r2 > 0) || !(s->nbw[e] > 0)) continue; /* not within re */
             band |= s->surf[j];
             gc = fsdem__madd(gc, r, 2 * s->nbw[e] / (r2 * s->eps[j]));
             F = fsdem__madd(F, r, s->nbw[e] / ((fsdem_real)sqrt(r2) * s->eps[j]));
@@ -21039,6 +21083,7 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
             s->unknown[i] = -1;
         }
         s->solid_pairs_of = -1; /* the solids may be others: their pairs are found again */
+        s->rows_valid = 0;
     }
     fsdem__restart_tag(io, "MPS.");
 }

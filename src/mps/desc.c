@@ -174,6 +174,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     fsdem_result r;
     fsdem_mps *s;
     fsdem_pcg_desc pd;
+    int a;
     if (out) *out = NULL;
     if (!desc || !out) return FSDEM_ERR_INVALID_ARG;
     r = fsdem__mps_check(desc, msg, sizeof msg);
@@ -198,6 +199,15 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     s->re_x = FSDEM__MPS_EXPLICIT_SUPPORT * desc->r0;
     s->layers = (int)ceil((double)(s->re / s->r0) - 1e-9);
     s->periods = fsdem__periods_of(desc->periodic, desc->dim, desc->domain_min, desc->domain_max);
+    /* the neighbour rows' skin (>>mps_neighbours): 0.3 r0, rebuilt when a particle has moved
+       0.15 r0 (every few steps of a dam break's front, rarely in a slow flow), less where a period
+       is short (a pair is seen through one image only while re + skin < L/2) */
+    s->skin = (fsdem_real)0.3 * desc->r0;
+    for (a = 0; a < desc->dim; ++a)
+        if (desc->periodic[a]) {
+            const fsdem_real room = (fsdem_real)0.99 * (s->periods.length[a] / 2 - s->re);
+            if (room < s->skin) s->skin = room > 0 ? room : 0;
+        }
     fsdem__mps_lattice(s);
     pd = fsdem_pcg_desc_default();
     /* AUTO: MIC(0) in 2D, Jacobi in 3D, where the incomplete factorisation of rows of ~280
@@ -212,7 +222,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
     pd.allocator = desc->allocator;
     r = fsdem_pcg_create(&pd, &s->pcg);
     if (r == FSDEM_OK)
-        r = fsdem_cellgrid_setup_periodic(&s->grid, &s->allocator, s->dim, desc->domain_min, desc->domain_max, s->re, 0,
+        r = fsdem_cellgrid_setup_periodic(&s->grid, &s->allocator, s->dim, desc->domain_min, desc->domain_max, s->re + s->skin, 0,
                                           desc->periodic);
     if (r == FSDEM_OK) {
         s->cell_wall = (int *)fsdem__alloc(&s->allocator, sizeof(int) * (size_t)s->grid.cell_count);
@@ -232,7 +242,7 @@ fsdem_result fsdem_mps_create(const fsdem_mps_desc *desc, fsdem_mps **out) {
 
 /* The particle arrays of a capacity `cap`, with their element sizes (one list for allocation,
    copying and release). */
-#define FSDEM__MPS_ARRAYS 21
+#define FSDEM__MPS_ARRAYS 22
 #define FSDEM__MPS_ROW_ARRAYS 3
 static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     void **p[FSDEM__MPS_ARRAYS];
@@ -261,6 +271,7 @@ static int fsdem__mps_arrays(fsdem_mps *s, void ***ptr, size_t *elem) {
     FSDEM__MPS_ARRAY(uvisc);
     FSDEM__MPS_ARRAY(ghost_weight);
     FSDEM__MPS_ARRAY(inlet);
+    FSDEM__MPS_ARRAY(x_built);
     /* by pressure row, last (FSDEM__MPS_ROW_ARRAYS of them): not moved when particles are removed */
     FSDEM__MPS_ARRAY(b);
     FSDEM__MPS_ARRAY(sol);
@@ -290,11 +301,8 @@ void fsdem_mps_destroy(fsdem_mps *s) {
     fsdem__free(&s->allocator, s->nb, sizeof(int) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->tmp_nb, sizeof(int) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->nbw, sizeof(fsdem_real) * (size_t)s->nb_cap);
-    fsdem__free(&s->allocator, s->tmp_w, sizeof(fsdem_real) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->nbl, sizeof(fsdem_real) * (size_t)s->nb_cap);
-    fsdem__free(&s->allocator, s->tmp_l, sizeof(fsdem_real) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->nbx, sizeof(fsdem_real) * (size_t)s->nb_cap);
-    fsdem__free(&s->allocator, s->tmp_x, sizeof(fsdem_real) * (size_t)s->nb_cap);
     fsdem__free(&s->allocator, s->a_col, sizeof(int) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->a_val, sizeof(fsdem_real) * (size_t)s->a_cap);
     fsdem__free(&s->allocator, s->obst, sizeof *s->obst * (size_t)s->obst_cap);

@@ -46,7 +46,7 @@ static void fsdem__mps_hydrostatic_start(fsdem_mps *s, fsdem_real c0) {
                     const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
                     const fsdem_real up = g > 0 ? -fsdem__dot(s->desc.gravity, r) / g : 0;
                     const fsdem_vec3 across = g > 0 ? fsdem__madd(r, s->desc.gravity, up / g) : r; /* r less its vertical part */
-                    if (s->kind[j] == FSDEM_MPS_KIND_FLUID && top[j] > top[i] && fsdem__norm(across) <= half) {
+                    if (s->kind[j] == FSDEM_MPS_KIND_FLUID && s->nbw[e] > 0 && top[j] > top[i] && fsdem__norm(across) <= half) {
                         top[i] = top[j];
                         changed = 1;
                     }

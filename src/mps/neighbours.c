@@ -1,4 +1,4 @@
-/* ---- >>mps_neighbours : cell-list search into sorted neighbour rows ---- */
+/* ---- >>mps_neighbours : cell-list search into sorted neighbour rows, kept while they hold ---- */
 
 /* r_j - r_i, through the minimum image along periodic axes. */
 static fsdem_vec3 fsdem__mps_sep(const fsdem_mps *s, int i, int j) {
@@ -12,14 +12,13 @@ static int fsdem__mps_capacity(int have, long long need) {
     return cap > (1LL << 30) ? 0 : (int)cap;
 }
 
-/* The neighbours of every FLUID and WALL particle within re at the current positions, as rows of
-   ascending particle index with their weights w_ij (Eq. 6; of the Laplacian; of the explicit
-   scheme's pair, over |r|^2); DUMMY particles have empty rows (their
-   own sums are never needed) but appear in the others'. Pairs are found once each by the forward
-   scan of the cell grid (as the DEM's pair search), put into unsorted rows, then copied column by
-   column into the final rows, which leaves each sorted. Allocates only when the lists outgrow every
-   earlier one. */
-/* Pairs within re from the cell scan, appended to *list (2 ints each, from pair *count on, the
+/* The neighbour rows are Verlet lists: they hold every pair within re + s->skin at the positions
+   they were built at (s->x_built), so they still hold every pair within re until some particle has
+   moved skin/2; fsdem__mps_neighbours rebuilds them only then (or after particles were added,
+   removed or restored: s->rows_valid = 0) and weighs every entry at the current positions, those
+   beyond re with 0, which leaves every sum over a row as it would be over the pairs within re. */
+
+/* Pairs within re + skin from the cell scan, appended to *list (2 ints each, from pair *count on, the
    array grown as needed; *examined counts the candidates). Every cell holds its FLUID items, then
    its WALL items (from s->cell_wall[c]), then its DUMMY items (from s->cell_dummy[c]), so each kind
    of pair is one range of a neighbouring cell: with `solid` = 0 the pairs with a FLUID particle,
@@ -27,7 +26,7 @@ static int fsdem__mps_capacity(int have, long long need) {
    Returns FSDEM_ERR_OUT_OF_MEMORY when the list cannot grow. */
 static fsdem_result fsdem__mps_scan(fsdem_mps *s, int solid, int **list, int *cap, int *count, long long *examined) {
     const fsdem_cellgrid *g = &s->grid;
-    const fsdem_real re2 = s->re * s->re;
+    const fsdem_real reach2 = (s->re + s->skin) * (s->re + s->skin);
     int c, f, a, b;
     for (c = 0; c < g->cell_count; ++c) {
         int coord[3], cells[14], nf;
@@ -61,19 +60,24 @@ static fsdem_result fsdem__mps_scan(fsdem_mps *s, int solid, int **list, int *ca
                     const fsdem_vec3 d = fsdem__mps_sep(s, pb, pa);
                     (*list)[2 * *count] = pa;
                     (*list)[2 * *count + 1] = pb;
-                    *count += fsdem__dot(d, d) < re2;
+                    *count += fsdem__dot(d, d) < reach2;
                 }
             }
     }
     return FSDEM_OK;
 }
 
-static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
+/* Rebuilds the rows of every FLUID and WALL particle, ascending particle index: pairs found once
+   each by the forward scan of the cell grid (as the DEM's pair search), bucketed by column, then
+   copied column by column into the final rows, which leaves each sorted. DUMMY particles have
+   empty rows (their own sums are never needed) but appear in the others'. Allocates only when the
+   lists outgrow every earlier one. */
+static fsdem_result fsdem__mps_build_rows(fsdem_mps *s) {
     const fsdem_cellgrid *g = &s->grid;
     const int solids = s->counts[FSDEM_MPS_KIND_WALL] + s->counts[FSDEM_MPS_KIND_DUMMY];
-    const int explicit_scheme = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT;
     long long examined = 0;
     int c, a, i, e, count = 0;
+    s->rows_valid = 0;
     if (fsdem_cellgrid_build(&s->grid, s->x, s->n) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     /* each cell's items in the order FLUID, WALL, DUMMY (stable; s->cursor and s->tmp_start are
        free until the rows are built) */
@@ -112,10 +116,9 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     }
     if (s->solid_pair_n) memcpy(s->pairs + 2 * (size_t)count, s->solid_pairs, sizeof(int) * 2 * (size_t)s->solid_pair_n);
     count += s->solid_pair_n;
-    s->pair_count = count;
     s->candidates = examined;
     /* directed entries (r, c): c in the row of r, for every non-DUMMY r; first bucketed by column c
-       (counting sort into tmp_nb/tmp_w, rows r), then scattered by row in column order, which
+       (counting sort into tmp_nb, rows r), then scattered by row in column order, which
        leaves every row sorted */
     memset(s->tmp_start, 0, sizeof(int) * (size_t)(s->n + 1));
     memset(s->nb_start, 0, sizeof(int) * (size_t)(s->n + 1));
@@ -136,61 +139,89 @@ static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     }
     if (s->nb_start[s->n] > s->nb_cap) {
         const int cap = fsdem__mps_capacity(s->nb_cap, s->nb_start[s->n]);
-        void **arrays[8];
-        size_t elem[8];
-        void *fresh[8];
+        void **arrays[5];
+        size_t elem[5];
+        void *fresh[5];
         int k, ok = 1;
         arrays[0] = (void **)&s->nb;
         arrays[1] = (void **)&s->tmp_nb;
         arrays[2] = (void **)&s->nbw;
-        arrays[3] = (void **)&s->tmp_w;
-        arrays[4] = (void **)&s->nbl;
-        arrays[5] = (void **)&s->tmp_l;
-        arrays[6] = (void **)&s->nbx;
-        arrays[7] = (void **)&s->tmp_x;
+        arrays[3] = (void **)&s->nbl;
+        arrays[4] = (void **)&s->nbx;
         elem[0] = elem[1] = sizeof(int);
-        for (k = 2; k < 8; ++k) elem[k] = sizeof(fsdem_real);
+        elem[2] = elem[3] = elem[4] = sizeof(fsdem_real);
         if (!cap) return FSDEM_ERR_OUT_OF_MEMORY;
-        for (k = 0; k < 8; ++k) ok &= (fresh[k] = fsdem__alloc(&s->allocator, elem[k] * (size_t)cap)) != NULL;
+        for (k = 0; k < 5; ++k) ok &= (fresh[k] = fsdem__alloc(&s->allocator, elem[k] * (size_t)cap)) != NULL;
         if (!ok) {
-            for (k = 0; k < 8; ++k) fsdem__free(&s->allocator, fresh[k], elem[k] * (size_t)cap);
+            for (k = 0; k < 5; ++k) fsdem__free(&s->allocator, fresh[k], elem[k] * (size_t)cap);
             return FSDEM_ERR_OUT_OF_MEMORY;
         }
-        for (k = 0; k < 8; ++k) {
+        for (k = 0; k < 5; ++k) {
             fsdem__free(&s->allocator, *arrays[k], elem[k] * (size_t)s->nb_cap);
             *arrays[k] = fresh[k];
         }
-        s->bytes += 2 * (sizeof(int) + 3 * sizeof(fsdem_real)) * (size_t)(cap - s->nb_cap);
+        s->bytes += (2 * sizeof(int) + 3 * sizeof(fsdem_real)) * (size_t)(cap - s->nb_cap);
         s->nb_cap = cap;
     }
     memcpy(s->cursor, s->tmp_start, sizeof(int) * (size_t)s->n);
     for (e = 0; e < count; ++e) {
         const int pa = s->pairs[2 * e], pb = s->pairs[2 * e + 1];
-        const fsdem_real r = fsdem__norm(fsdem__mps_sep(s, pb, pa));
-        const fsdem_real w = fsdem__kernel_mps(r, s->re);
-        const fsdem_real wl = s->re_lap == s->re ? w : r < s->re_lap ? fsdem__kernel_mps(r, s->re_lap) : 0;
-        const fsdem_real wx = explicit_scheme && r > 0 ? fsdem__kernel_mps_explicit(r, s->re_x) / (r * r) : 0;
-        if (s->kind[pa] != FSDEM_MPS_KIND_DUMMY) {
-            s->tmp_nb[s->cursor[pb]] = pa;
-            s->tmp_l[s->cursor[pb]] = wl;
-            s->tmp_x[s->cursor[pb]] = wx;
-            s->tmp_w[s->cursor[pb]++] = w;
-        }
-        if (s->kind[pb] != FSDEM_MPS_KIND_DUMMY) {
-            s->tmp_nb[s->cursor[pa]] = pb;
-            s->tmp_l[s->cursor[pa]] = wl;
-            s->tmp_x[s->cursor[pa]] = wx;
-            s->tmp_w[s->cursor[pa]++] = w;
-        }
+        if (s->kind[pa] != FSDEM_MPS_KIND_DUMMY) s->tmp_nb[s->cursor[pb]++] = pa;
+        if (s->kind[pb] != FSDEM_MPS_KIND_DUMMY) s->tmp_nb[s->cursor[pa]++] = pb;
     }
     memcpy(s->cursor, s->nb_start, sizeof(int) * (size_t)s->n);
     for (c = 0; c < s->n; ++c)
-        for (e = s->tmp_start[c]; e < s->tmp_start[c + 1]; ++e) {
-            const int r = s->tmp_nb[e];
-            s->nb[s->cursor[r]] = c;
-            s->nbl[s->cursor[r]] = s->tmp_l[e];
-            s->nbx[s->cursor[r]] = s->tmp_x[e];
-            s->nbw[s->cursor[r]++] = s->tmp_w[e];
+        for (e = s->tmp_start[c]; e < s->tmp_start[c + 1]; ++e) s->nb[s->cursor[s->tmp_nb[e]]++] = c;
+    memcpy(s->x_built, s->x, sizeof(fsdem_vec3) * (size_t)s->n);
+    s->rows_valid = 1;
+    return FSDEM_OK;
+}
+
+/* Whether the rows still hold every pair within re: built for these particles, and no particle
+   more than skin/2 from where it was then (two of them then came at most skin closer). */
+static int fsdem__mps_rows_hold(const fsdem_mps *s) {
+    const fsdem_real half = s->skin / 2;
+    int i;
+    if (!s->rows_valid) return 0;
+    for (i = 0; i < s->n; ++i) {
+        const fsdem_vec3 d = fsdem__min_image(&s->periods, fsdem__sub(s->x[i], s->x_built[i]));
+        if (!(fsdem__dot(d, d) <= half * half)) return 0;
+    }
+    return 1;
+}
+
+/* The weights of every row entry at the current positions: w_ij (Eq. 6), the Laplacian's (with
+   re_laplacian), the explicit scheme's pair weight over |r_ij|^2; 0 beyond their radii. Counts the
+   pairs within re (a pair with a DUMMY particle has one entry, others two). */
+static void fsdem__mps_weigh(fsdem_mps *s) {
+    const int explicit_scheme = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT;
+    const fsdem_real re2 = s->re * s->re;
+    long long twice = 0;
+    int i, e;
+    for (i = 0; i < s->n; ++i)
+        for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
+            const int j = s->nb[e];
+            const fsdem_vec3 d = fsdem__mps_sep(s, j, i);
+            const fsdem_real r2 = fsdem__dot(d, d);
+            fsdem_real r, w;
+            if (!(r2 < re2)) { /* in the skin: every radius is at most re */
+                s->nbw[e] = s->nbl[e] = s->nbx[e] = 0;
+                continue;
+            }
+            r = (fsdem_real)sqrt(r2);
+            w = fsdem__kernel_mps(r, s->re);
+            s->nbw[e] = w;
+            s->nbl[e] = s->re_lap == s->re ? w : r < s->re_lap ? fsdem__kernel_mps(r, s->re_lap) : 0;
+            s->nbx[e] = explicit_scheme && r > 0 ? fsdem__kernel_mps_explicit(r, s->re_x) / (r * r) : 0;
+            twice += s->kind[j] == FSDEM_MPS_KIND_DUMMY ? 2 : 1;
         }
+    s->pair_count = twice / 2;
+}
+
+/* The neighbour rows at the current positions with their weights (rebuilt when they no longer
+   hold). FSDEM_ERR_OUT_OF_MEMORY when a rebuild cannot grow the lists. */
+static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
+    if (!fsdem__mps_rows_hold(s) && fsdem__mps_build_rows(s) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
+    fsdem__mps_weigh(s);
     return FSDEM_OK;
 }

@@ -216,6 +216,7 @@ static void fsdem__mps_open_update(fsdem_mps *s) {
     }
     if (kept < s->n)
         for (k = 0; k < s->rows; ++k) s->row_particle[k] = s->cursor[s->row_particle[k]];
+    if (kept < s->n) s->rows_valid = 0; /* renumbered */
     s->n = kept;
     if (solids_after) s->solid_pairs_of = -1; /* solids renumbered: their pairs are found again */
 }

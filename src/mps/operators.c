@@ -91,7 +91,7 @@ static fsdem_vec3 fsdem__mps_grad_at(const fsdem_mps *s, const fsdem_real *phi, 
     int e;
     if (s->desc.gradient == FSDEM_MPS_GRADIENT_MODEL_MIN)
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e)
-            if (s->kind[s->nb[e]] != FSDEM_MPS_KIND_DUMMY && phi[s->nb[e]] < base) base = phi[s->nb[e]];
+            if (s->kind[s->nb[e]] != FSDEM_MPS_KIND_DUMMY && s->nbw[e] > 0 && phi[s->nb[e]] < base) base = phi[s->nb[e]];
     if (s->desc.gradient == FSDEM_MPS_GRADIENT_MODEL_MIN) base = -base;
     fsdem__mps_gradient_transform(s, i, T);
     for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {

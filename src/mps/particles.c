@@ -81,6 +81,7 @@ static void fsdem__mps_push(fsdem_mps *s, fsdem_mps_kind kind, fsdem_vec3 x, fsd
     s->inlet[i] = -1;
     s->unknown[i] = -1;
     s->counts[kind]++;
+    s->rows_valid = 0;
 }
 
 fsdem_result fsdem_mps_add_particles(fsdem_mps *s, fsdem_mps_kind kind, int count, const fsdem_vec3 *positions,

@@ -105,7 +105,7 @@ static void fsdem__mps_shift(fsdem_mps *s) {
             const int j = s->nb[e];
             const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
             const fsdem_real r2 = fsdem__dot(r, r);
-            if (!(r2 > 0)) continue;
+            if (!(r2 > 0) || !(s->nbw[e] > 0)) continue; /* not within re */
             band |= s->surf[j];
             gc = fsdem__madd(gc, r, 2 * s->nbw[e] / (r2 * s->eps[j]));
             F = fsdem__madd(F, r, s->nbw[e] / ((fsdem_real)sqrt(r2) * s->eps[j]));

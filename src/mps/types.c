@@ -44,7 +44,7 @@ struct fsdem_mps {
     int *unknown;                 /* row of each particle in the pressure equation, or -1 */
     int *row_particle;            /* particle of each row */
     int counts[3];                /* particles per kind */
-    /* neighbours: rows of every non-DUMMY particle (DUMMY rows are empty), columns ascending */
+    /* neighbours (>>mps_neighbours): rows of every non-DUMMY particle (DUMMY rows are empty), columns ascending */
     fsdem_cellgrid grid;
     int *cell_wall, *cell_dummy;  /* per cell: where its WALL and its DUMMY items start */
     int *pairs, pair_cap;         /* 2 per pair found by the cell scan */
@@ -53,9 +53,12 @@ struct fsdem_mps {
     int *nb_start;                /* n + 1 */
     int *tmp_start, *cursor;      /* n + 1 each: rows by column and fill cursors of the build */
     int *nb, *tmp_nb, nb_cap;     /* neighbour indices */
-    fsdem_real *nbw, *tmp_w;      /* w_ij (Eq. 6) */
-    fsdem_real *nbl, *tmp_l;      /* w_ij of the Laplacian (Eq. 6 with re_laplacian; 0 beyond it) */
-    fsdem_real *nbx, *tmp_x;      /* the explicit scheme's pair weight over |r_ij|^2 (0 with the seed's) */
+    fsdem_real *nbw;              /* w_ij (Eq. 6; 0 beyond re) */
+    fsdem_real *nbl;              /* w_ij of the Laplacian (Eq. 6 with re_laplacian; 0 beyond it) */
+    fsdem_real *nbx;              /* the explicit scheme's pair weight over |r_ij|^2 (0 with the seed's) */
+    fsdem_real skin;              /* the rows hold the pairs within re + skin (Verlet lists) */
+    fsdem_vec3 *x_built;          /* positions the rows were built at */
+    int rows_valid;               /* 0: particles were added, removed or restored since */
     long long pair_count;
     /* pressure matrix */
     int *a_start, *a_col, a_cap;

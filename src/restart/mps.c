@@ -159,6 +159,7 @@ static void fsdem__restart_mps(fsdem__restart *io, void *object) {
             s->unknown[i] = -1;
         }
         s->solid_pairs_of = -1; /* the solids may be others: their pairs are found again */
+        s->rows_valid = 0;
     }
     fsdem__restart_tag(io, "MPS.");
 }
