@@ -2035,6 +2035,16 @@ FSDEM_API fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *nor
    at exact output times), particle snapshots (fsdem_mps_write_vtp in >>io) and save/restore
    (>>restart).
 
+   Two schemes find the pressure (desc.scheme). The default is weakly compressible and explicit
+   (FSDEM_MPS_SCHEME_EXPLICIT: a density per particle, an equation of state, no pressure equation),
+   chosen by measurement (issue 35; validation/mps_still_water, mps_dambreak_2d, mps_spheric2 run
+   both): it holds still water to 0.03 r0 where the seed's drifts 0.8 r0 (2D) and 3 r0 (3D), and
+   follows Martin & Moyce's front as well. Seed 002's semi-implicit scheme
+   (FSDEM_MPS_SCHEME_SEMI_IMPLICIT, the steps below) stays for reproducing the seed: it takes steps
+   about 7 times longer (its Courant number is on the flow's speed, not the sound speed's), each
+   with a pressure equation. MPS-DEM (>>couple_mps) was validated with the seed's scheme, and its
+   cases set it.
+
    Particles are of three kinds. FLUID particles move. WALL particles are the layer of a solid next
    to the fluid: fixed, their pressure is solved with the fluid's, so the fluid is pushed back.
    DUMMY particles are the deeper layers of a solid: fixed, they only complete the number density
@@ -2191,7 +2201,7 @@ typedef enum fsdem_mps_wall_viscosity {
 /* How the pressure is found (see >>mps_explicit in the implementation for the explicit scheme). */
 typedef enum fsdem_mps_scheme {
     /* seed 002 §2.1: the pressure Poisson equation of steps 2-6 above (the seed's; incompressible
-       to the solver's tolerance; the default until the measurements of issue 35 choose) */
+       to the solver's tolerance) */
     FSDEM_MPS_SCHEME_SEMI_IMPLICIT = 0,
     /* weakly compressible, explicit (Oochi, Koshizuka and Sakai 2010; Shakibaeinia and Jin 2010):
        every particle carries a density rho_i, evolved by the continuity equation with the MPS
@@ -2212,11 +2222,12 @@ typedef enum fsdem_mps_scheme {
        hydrostatic density of its depth below the top of its column of liquid (the hydrostatic
        start). No pressure equation, no surface detection (the surface's particles keep rho near
        rho: p near 0); the solid particles in the air (extrapolated pressure not positive) are left
-       out of the gradient. Still water (the tank of the notes above, 2D): largest displacement
-       0.053 r0 at 0.5 s and 0.083 r0 at 5 s, at the particles where the surface meets a wall
-       (0.012 and 0.03 r0 three columns or more from the walls); mid-depth pressure -0.04 %; 3D
-       (0.1 x 0.1 m, 0.2 m deep), measured before the solids in the air were left out, 0.198 r0 at
-       0.5 s, 0.27 r0 at 1 s (0.11 and 0.13 r0 inside), pressure +0.4 %.
+       out of the gradient. The default radius re is the weight's support, 2.8 r0, and the default
+       cfl 0.35 (SPH's usual 0.25 h / c0 for that support). Still water (the tank of the notes
+       above; validation/mps_still_water): 2D largest displacement 0.030 r0 at 0.5 s and 0.034 r0
+       at 5 s (0.008 and 0.02 r0 three columns or more from the walls), mid-depth pressure within
+       0.04 %; 3D (0.1 x 0.1 m, 0.2 m deep) 0.041 r0 at 0.5 s, 0.020 r0 at 1 s. With re = 4.1 r0 the
+       2D figure at 0.5 s was 0.053 r0.
        The porosity enters as in the corrector (Model B: the pressure term over eps_i); the
        mixture's continuity is not in it yet. */
     FSDEM_MPS_SCHEME_EXPLICIT = 1
@@ -2230,7 +2241,7 @@ typedef enum fsdem_mps_model {
 
 typedef struct fsdem_mps_desc {
     int dim;                        /* 2 or 3 */
-    fsdem_mps_scheme scheme;        /* default FSDEM_MPS_SCHEME_SEMI_IMPLICIT (see the enum) */
+    fsdem_mps_scheme scheme;        /* default FSDEM_MPS_SCHEME_EXPLICIT (see the enum) */
     fsdem_real r0;                  /* m; initial particle spacing, > 0; default 0.01 */
     fsdem_real re;                  /* m; interaction radius, >= 2 r0; 0 = 4.1 r0 (seed 002 §2.1) */
                                     /*    with the seed's scheme, 2.8 r0 with the explicit one; */
@@ -15172,6 +15183,7 @@ fsdem_mps_desc fsdem_mps_desc_default(int dim) {
     fsdem_mps_desc d;
     memset(&d, 0, sizeof d);
     d.dim = dim;
+    d.scheme = FSDEM_MPS_SCHEME_EXPLICIT;
     d.r0 = (fsdem_real)0.01;
     d.re = 0;
     d.density = 1000;
@@ -16206,7 +16218,7 @@ static int fsdem__mps_rows_hold(const fsdem_mps *s) {
    pairs within re (a pair with a DUMMY particle has one entry, others two). */
 static void fsdem__mps_weigh(fsdem_mps *s) {
     const int explicit_scheme = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT;
-    const fsdem_real re2 = s->re * s->re;
+    const fsdem_real re2 = s->re * s->re, inv_rx = 1 / s->re_x;
     long long twice = 0;
     int i, e;
     for (i = 0; i < s->n; ++i)
@@ -16223,7 +16235,11 @@ static void fsdem__mps_weigh(fsdem_mps *s) {
             w = fsdem__kernel_mps(r, s->re);
             s->nbw[e] = w;
             s->nbl[e] = s->re_lap == s->re ? w : r < s->re_lap ? fsdem__kernel_mps(r, s->re_lap) : 0;
-            s->nbx[e] = explicit_scheme && r > 0 ? fsdem__kernel_mps_explicit(r, s->re_x) / (r * r) : 0;
+            if (explicit_scheme && r < s->re_x) { /* w / r^2 = (1 - q)^3 / re_x^2 */
+                const fsdem_real c = 1 - r * inv_rx;
+                s->nbx[e] = c * c * c * inv_rx * inv_rx;
+            } else
+                s->nbx[e] = 0;
             twice += s->kind[j] == FSDEM_MPS_KIND_DUMMY ? 2 : 1;
         }
     s->pair_count = twice / 2;

@@ -74,6 +74,7 @@ int main(void) {
     fsdem_real dem_dt = 0;
     double bed_porosity;
     int material = 0, walls = 0, water = 0, above = 0, spheres = 0, frame = 0, status = 1, i, j, k;
+    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
 
     /* the water: MPS defaults (seed 002 §2.1: re = 4.1 r0, gamma 0.01, CFL 0.2) with Model B */
     md.r0 = (fsdem_real)R0;

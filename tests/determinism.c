@@ -162,6 +162,7 @@ static int mps_scene(void) {
     fsdem_mps_desc d = fsdem_mps_desc_default(2);
     fsdem_mps *mps;
     int bad;
+    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.domain_min = fsdem_v3(-0.05, -0.05, 0);
     d.domain_max = fsdem_v3(0.45, 0.4, 0);
     if (fsdem_mps_create(&d, &mps) != FSDEM_OK) return 1;
@@ -233,6 +234,7 @@ static int mps_dem_scene(void) {
     fsdem_dem *dem = NULL;
     fsdem_mps_dem *c = NULL;
     int bad, mat = 0;
+    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     md.model = FSDEM_MPS_MODEL_B;
     md.domain_min = fsdem_v3(-0.05, -0.05, 0);
     md.domain_max = fsdem_v3(0.2, 0.25, 0);

@@ -24,6 +24,7 @@ static test_pair test_pair_new(int dim, double r0, fsdem_mps_model model, double
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
     const double pad = 6 * r0;
+    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(&t, 0, sizeof t);
     md.r0 = (fsdem_real)r0;
     md.model = model;
@@ -403,6 +404,7 @@ static test_pair test_periodic_pair(int dim, double r0, fsdem_mps_model model, d
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
     const fsdem_vec3 hi = fsdem_v3((fsdem_real)size, (fsdem_real)size, dim == 3 ? (fsdem_real)size : 0);
+    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(&t, 0, sizeof t);
     md.r0 = (fsdem_real)r0;
     md.model = model;
@@ -724,6 +726,7 @@ START_TEST(test_mps_dem_failed_update_keeps_its_records) {
     fsdem_mps_dem_force before, after;
     fsdem_result res;
     int k;
+    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     md.domain_min = fsdem_v3(-0.06f, -0.06f, 0);
     md.domain_max = fsdem_v3(0.26f, 0.26f, 0);
     ck_assert_int_eq(fsdem_mps_create(&md, &mps), FSDEM_OK);

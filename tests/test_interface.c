@@ -1020,6 +1020,7 @@ START_TEST(null_objects_are_refused) {
         fsdem_mps_stats st;
         fsdem_csr a;
         const int *rows = (const int *)&p;
+        d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
         IF_REFUSED(&p, fsdem_mps_desc_check(NULL, msg, sizeof msg));
         IF_REFUSED(&p, fsdem_mps_create(NULL, &mps));
         IF_TRUE(&p, "fsdem_mps_create(NULL, &mps) sets mps to NULL", mps == NULL);

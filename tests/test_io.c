@@ -1103,6 +1103,7 @@ static void check_mps(int dim) {
     fsdem_mps *mps = NULL;
     const fsdem_vec3 hi = dim == 2 ? fsdem_v3(0.2, 0.2, 0) : fsdem_v3(0.1, 0.1, 0.1);
     int f;
+    desc.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     desc.r0 = dim == 2 ? 0.02 : 0.025;
     desc.domain_min = fsdem_v3(-0.2, -0.2, -0.2);
     ck_assert_int_eq(fsdem_mps_create(&desc, &mps), FSDEM_OK);
@@ -1362,6 +1363,7 @@ static void check_mps_csv(int dim) {
     fsdem_mps_particles p;
     double *e;
     int i;
+    desc.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     desc.r0 = dim == 2 ? 0.02 : 0.025;
     desc.domain_min = fsdem_v3(-0.2, -0.2, -0.2);
     ck_assert_int_eq(fsdem_mps_create(&desc, &mps), FSDEM_OK);

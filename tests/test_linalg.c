@@ -1243,6 +1243,7 @@ START_TEST(amg_iterations_are_size_independent_on_mps) {
         fsdem_csr A;
         fsdem_real *x_ref;
         int i;
+        d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
         d.r0 = r0;
         d.domain_min = fsdem_v3(-0.2f, -0.2f, 0);
         d.domain_max = fsdem_v3(W + 0.2f, W, 0);

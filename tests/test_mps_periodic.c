@@ -12,6 +12,7 @@ static fsdem_mps *test_channel(int dim, double r0, int rows, int cells, double g
     fsdem_mps_desc d = fsdem_mps_desc_default(dim);
     fsdem_mps *m = NULL;
     unsigned open = (1u << FSDEM_SIDE_XMIN) | (1u << FSDEM_SIDE_XMAX);
+    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.r0 = (fsdem_real)r0;
     d.viscosity = (fsdem_real)nu;
     d.wall_viscosity = walls;
@@ -100,6 +101,7 @@ static fsdem_mps *test_periodic_tank(int copies, double x0) {
     fsdem_mps *m = NULL;
     fsdem_mps_particles p;
     int i;
+    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.r0 = (fsdem_real)r0;
     d.domain_min = fsdem_v3((fsdem_real)x0, -0.125f, 0);
     d.domain_max = fsdem_v3((fsdem_real)(x0 + copies * P), 0.5f, 0);
@@ -200,6 +202,7 @@ static fsdem_mps *test_open_channel(void) {
     fsdem_mps_outflow_desc out;
     fsdem_mps *m = NULL;
     int added = 0;
+    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.gravity = fsdem_v3(0, 0, 0);
     d.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
     d.domain_max = fsdem_v3(0.4f, 0.2f, 0);
@@ -390,6 +393,7 @@ START_TEST(test_mps_open_bad_input) {
         fsdem_mps_dem *c = NULL;
         fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
         char msg[256];
+        md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
         dd.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
         dd.domain_max = fsdem_v3(0.4f, 0.2f, 0);
         dd.gravity = fsdem_v3(0, 0, 0);
@@ -431,6 +435,7 @@ END_TEST
 START_TEST(test_mps_periodic_bad_input) {
     fsdem_mps_desc d = fsdem_mps_desc_default(2);
     char msg[256];
+    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.domain_max = fsdem_v3(0.105f, 1, 0); /* 10.5 r0 */
     d.periodic[0] = 1;
     ck_assert_int_eq(fsdem_mps_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);

@@ -779,6 +779,7 @@ END_TEST
    column collapses, the surface and the neighbourhoods change every step. */
 static fsdem_mps_desc mps_desc(void) {
     fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.r0 = 0.01;
     d.domain_min = fsdem_v3(-0.1, -0.1, 0);
     d.domain_max = fsdem_v3(0.5, 0.4, 0);

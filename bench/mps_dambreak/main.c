@@ -2,12 +2,14 @@
 
    Case 1, "mps_dambreak" (issue 11): the PySPH example dam_break_2d (pysph.examples.dam_break_2d,
    Gomez-Gesteira et al. 2010) in 2D MPS. Tank inside [0, 4] x [0, 4] m, open at the top (walls by
-   fsdem_mps_add_box_walls: one WALL layer and 4 DUMMY layers outside the box); water column
-   [0, 1] x [0, 2] m at the left wall (fsdem_mps_fill_box: 67 x 133 = 8,911 FLUID particles at
-   r0 = 0.015 m). Everything else is fsdem_mps_desc_default(2): re = 4.1 r0, gamma = 0.01,
-   beta = 0.8, alpha = 0.9, CFL 0.2 with adaptive dt (dt_max 1e-3 s), min-form gradient,
-   collisions at 0.8 r0, negative pressures clamped, no shifting, MIC(0)-PCG to 1e-8. The domain is [-0.1, 4.1] x
-   [-0.1, 6] m. Simulated to t = 0.6 s in 0.1 s chunks by fsdem_mps_advance (each chunk ends exactly
+   fsdem_mps_add_box_walls: one WALL layer and the DUMMY layers of the scheme's re outside the
+   box); water column [0, 1] x [0, 2] m at the left wall (fsdem_mps_fill_box: 67 x 133 = 8,911
+   FLUID particles at r0 = 0.015 m). Everything else is fsdem_mps_desc_default(2): the explicit
+   scheme (re = 2.8 r0, c0 = 10 sqrt(2 g H), cfl 0.35 on c0 + u_max, density diffusion 0.1), then
+   the same with seed 002's scheme as "mps_dambreak_seed" (re = 4.1 r0, gamma = 0.01, beta = 0.8,
+   alpha = 0.9, CFL 0.2 with adaptive dt, min-form gradient, MIC(0)-PCG to 1e-8); both with
+   collisions at 0.8 r0, negative pressures clamped, no shifting, dt_max 1e-3 s. The domain is
+   [-0.1, 4.1] x [-0.1, 6] m. Simulated to t = 0.6 s in 0.1 s chunks by fsdem_mps_advance (each chunk ends exactly
    on its time, so the fronts at 0.4 and 0.6 s are at those times), single thread.
    Figures: wall_s = wall-clock seconds of the stepping (creation and filling excluded, as PySPH's
    "Run took"), steps = MPS steps to 0.6 s, particle_steps_per_s = FLUID particles x steps / wall_s,
@@ -23,8 +25,9 @@
    the container (0.2 m long, 0.1 m wide, 0.15 m high) but neither the water column nor a particle
    count; this bench ASSUMES a water column 0.05 m long x 0.1 m wide x 0.1 m high at the left
    wall (override: arguments 3 and 4) in that container (walls as in case 1, open top), 3D,
-   defaults otherwise, r0 = 0.0027 m. It is a 3D dam break: one untimed step (list growth and
-   first touch), then `steps_3d` timed steps from rest; time per step = wall time / steps.
+   the seed's scheme, defaults otherwise, r0 = 0.0027 m. It is a 3D dam break: one untimed step
+   (list growth and first touch), then `steps_3d` timed steps from rest; time per step = wall time
+   / steps.
    The particle counts of each kind are printed: compare with the count of the seed's case when
    it is known.
 
@@ -94,9 +97,8 @@ static void report_error(const char *name, fsdem_mps *mps, const char *what, fsd
     fflush(stdout);
 }
 
-/* Case 1: the PySPH dam_break_2d case to t_end. */
-static void bench_2d(double t_end) {
-    const char *name = "mps_dambreak";
+/* Case 1: the PySPH dam_break_2d case to t_end with `scheme`, its lines named `name`. */
+static void bench_2d(double t_end, fsdem_mps_scheme scheme, const char *name) {
     const fsdem_vec3 tank_lo = fsdem_v3(0, 0, 0), tank_hi = fsdem_v3(4, 4, 0);
     fsdem_mps_desc d = fsdem_mps_desc_default(2);
     fsdem_mps *mps = NULL;
@@ -107,6 +109,7 @@ static void bench_2d(double t_end) {
     long long steps = 0;
     int added_fluid = 0, added_walls = 0, nf = 0, k;
 
+    d.scheme = scheme;
     d.r0 = (fsdem_real)0.015;
     d.domain_min = fsdem_v3(-0.1, -0.1, 0);
     d.domain_max = fsdem_v3(4.1, 6, 0);
@@ -185,6 +188,7 @@ static void bench_3d(int steps, double column_length, double column_height) {
     double t0, wall;
     int added_fluid = 0, added_walls = 0, k;
 
+    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* Table 2 is the seed's scheme */
     d.r0 = (fsdem_real)0.0027;
     d.domain_min = fsdem_v3(-0.02, -0.02, -0.02);
     d.domain_max = fsdem_v3(0.22, 0.12, 0.3);
@@ -251,7 +255,10 @@ int main(int argc, char **argv) {
     double cl = argc > 3 ? atof(argv[3]) : 0.05, ch = argc > 4 ? atof(argv[4]) : 0.1;
     fsdem_set_threads(1); /* one thread, as the figures in README.md (the threaded benches print speedup_2t) */
     printf("BENCH mps_dambreak threads=%d ranks=1\n", fsdem_threads());
-    if (t_end > 0) bench_2d(t_end);
+    if (t_end > 0) {
+        bench_2d(t_end, fsdem_mps_desc_default(2).scheme, "mps_dambreak");    /* the default: the explicit scheme */
+        bench_2d(t_end, FSDEM_MPS_SCHEME_SEMI_IMPLICIT, "mps_dambreak_seed"); /* seed 002's, beside it */
+    }
     if (steps3 > 0) bench_3d(steps3, cl, ch);
     return 0;
 }

@@ -15,6 +15,7 @@ fsdem_mps_desc fsdem_mps_desc_default(int dim) {
     fsdem_mps_desc d;
     memset(&d, 0, sizeof d);
     d.dim = dim;
+    d.scheme = FSDEM_MPS_SCHEME_EXPLICIT;
     d.r0 = (fsdem_real)0.01;
     d.re = 0;
     d.density = 1000;

@@ -195,7 +195,7 @@ static int fsdem__mps_rows_hold(const fsdem_mps *s) {
    pairs within re (a pair with a DUMMY particle has one entry, others two). */
 static void fsdem__mps_weigh(fsdem_mps *s) {
     const int explicit_scheme = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT;
-    const fsdem_real re2 = s->re * s->re;
+    const fsdem_real re2 = s->re * s->re, inv_rx = 1 / s->re_x;
     long long twice = 0;
     int i, e;
     for (i = 0; i < s->n; ++i)
@@ -212,7 +212,11 @@ static void fsdem__mps_weigh(fsdem_mps *s) {
             w = fsdem__kernel_mps(r, s->re);
             s->nbw[e] = w;
             s->nbl[e] = s->re_lap == s->re ? w : r < s->re_lap ? fsdem__kernel_mps(r, s->re_lap) : 0;
-            s->nbx[e] = explicit_scheme && r > 0 ? fsdem__kernel_mps_explicit(r, s->re_x) / (r * r) : 0;
+            if (explicit_scheme && r < s->re_x) { /* w / r^2 = (1 - q)^3 / re_x^2 */
+                const fsdem_real c = 1 - r * inv_rx;
+                s->nbx[e] = c * c * c * inv_rx * inv_rx;
+            } else
+                s->nbx[e] = 0;
             twice += s->kind[j] == FSDEM_MPS_KIND_DUMMY ? 2 : 1;
         }
     s->pair_count = twice / 2;

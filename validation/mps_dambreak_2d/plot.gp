@@ -12,6 +12,7 @@ set xlabel 'T = t sqrt(2g/a)'
 set ylabel 'Z = x_{front} / a'
 set key top left
 plot [0:5.5][0:9] 'front.csv' using ($1*sqrt(2*g/a)):($2/a) with lines lw 2 title 'MPS a/40 (checked)', \
+     'front_other.csv' using ($1*sqrt(2*g/a)):($2/a) with lines dt 3 title 'MPS a/40, the other scheme', \
      'front_shifted.csv' using ($1*sqrt(2*g/a)):($2/a) with lines dt 4 title 'MPS a/40, best-fit delay', \
      'front_n20.csv' using ($1*sqrt(2*g/a)):($2/a) with lines dt 2 title 'MPS a/20', \
      'ref_front.csv' using ($1*sqrt(2*g/a)):($2/a) with points pt 7 ps 1.2 lc rgb 'black' title 'Martin and Moyce 1952', \
@@ -21,6 +22,7 @@ set xlabel 'tau = t sqrt(g/a)'
 set ylabel 'eta = h / (2a)'
 set key top right
 plot [0:8][0:1.1] 'front.csv' using ($1*sqrt(g/a)):($3/(2*a)) with lines lw 2 title 'MPS a/40', \
+     'front_other.csv' using ($1*sqrt(g/a)):($3/(2*a)) with lines dt 3 title 'MPS a/40, the other scheme', \
      'front_n20.csv' using ($1*sqrt(g/a)):($3/(2*a)) with lines dt 2 title 'MPS a/20', \
      'ref_height.csv' using ($1*sqrt(g/a)):($2/(2*a)) with points pt 7 ps 1.2 title 'Martin and Moyce 1952'
 set title 'Koshizuka and Oka column (L = 0.146 m, tank 4L)'

@@ -59,6 +59,7 @@ static int bed_run_go(bed_run *r, double relaxations, FILE *history) {
     int i, j, k, n = 0, samples = 0, material, ok = 1;
     double t_end;
     clock_t t0 = clock();
+    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     r->d = d;
     r->period = P;
     r->spheres = 2 * M * M * M;

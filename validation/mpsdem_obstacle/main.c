@@ -78,6 +78,7 @@ static void run_case(int k, int cells, double t_end, double radius, outcome *o) 
     fsdem_real dt_dem = 0;
     static double ts[MAX_SAMPLES], fx[MAX_SAMPLES];
     int ns = 0, a;
+    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(o, 0, sizeof *o);
     o->peak = o->raw_peak = o->solid_peak = o->p1_peak = -1;
     md.r0 = (fsdem_real)r0;

@@ -77,6 +77,7 @@ static outcome run(const setup *S, fsdem_mps_model model) {
     char name[64];
     int i, j, k, mat_id, n_out, n_avg = 0, n_end = 0;
     double prev_ke = -1, t0, sp = 0, sp2 = 0, sd = 0, sz = 0;
+    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(&o, 0, sizeof o);
     o.pres_z_min_end = 1e30;
     o.pres_z_max_end = -1e30;

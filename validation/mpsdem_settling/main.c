@@ -141,6 +141,7 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
     fsdem_csv csv;
     int i, j, k, nf = 0, layers, nx, nz, material;
     double z_susp, a, ax, az, next = 0, sv = 0, sv2 = 0, su = 0, se = 0, sn = 0;
+    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(&o, 0, sizeof o);
     memset(prof, 0, sizeof prof);
     memset(lat, 0, sizeof lat);
