@@ -19,8 +19,9 @@
    so the water volume with sediment is 0.05 x 0.1 x (0.07 + 0.03 eps_bed) m^3; the clear-water
    run fills the whole column with water (0.05 x 0.1 x 0.1 m^3).
 
-   Solvers: MPS defaults of fsdem_mps_desc_default(3) (seed 002 §2.1 values: re = 4.1 r0, gamma
-   0.01, beta 0.8, alpha 0.9, CFL 0.2, rho 1000, nu 1e-6) with model A or B; DEM Hertz-Mindlin with
+   Solvers: MPS with the seed's semi-implicit scheme, fsdem_mps_desc_default(3) otherwise (seed
+   002 §2.1 values: re = 4.1 r0, gamma 0.01, beta 0.8, alpha 0.9, CFL 0.2, rho 1000, nu 1e-6) with
+   model A or B; DEM Hertz-Mindlin with
    the sediment of Table 1 (E = 1e8 Pa, nu = 0.2, e = 0.9, mu = 0.2), velocity Verlet, dt = the
    Rayleigh rule of seed 002 Eq. 38 times 0.2 (the library default safety fraction); walls: a box
    [0, 0.2] x [0, 0.1] x [0, 0.29] m (the DEM needs a lid; it is far above the flow); coupler
@@ -77,6 +78,7 @@ static inline int sd_create(sd_case *c, double r0, fsdem_mps_model model, int se
     memset(c, 0, sizeof *c);
     c->r0 = r0;
     c->sediment = sediment;
+    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     md.r0 = (fsdem_real)r0;
     md.model = model;
     md.domain_min = fsdem_v3(-0.02, -0.02, -0.02);
