@@ -345,6 +345,7 @@
 #define fsdem_mps_dem_write_csv fsdem_mps_dem_write_csv_f
 #define fsdem_mps_desc_check fsdem_mps_desc_check_f
 #define fsdem_mps_desc_default fsdem_mps_desc_default_f
+#define fsdem_mps_desc_default_scheme fsdem_mps_desc_default_scheme_f
 #define fsdem_mps_destroy fsdem_mps_destroy_f
 #define fsdem_mps_divergence fsdem_mps_divergence_f
 #define fsdem_mps_fill_box fsdem_mps_fill_box_f
@@ -2070,7 +2071,7 @@ FSDEM_API fsdem_real fsdem_swe_bed_sdf(void *user, fsdem_vec3 p, fsdem_vec3 *nor
         non-DUMMY j) is symmetric and positive definite (a fsdem_csr, solved by fsdem_pcg; Eq. 13
         instead of Eq. 12 with desc.model = FSDEM_MPS_MODEL_B);
      5. negative pressures set to 0 when desc.clamp_negative_pressure (the seed says nothing; the
-        original MPS clamps, so the default does);
+        original MPS clamps, so this scheme's default does);
      6. corrector u = u* - dt/rho grad p (Eq. 8 or the stabilised form, desc.gradient);
      6b. collisions (desc.collision_distance, restitution; Koshizuka, Nobe and Oka 1998): pairs that
         would end the step closer than collision_distance r0 lose (1 + e) of their approach speed
@@ -2274,7 +2275,9 @@ typedef struct fsdem_mps_desc {
                                     /*    and more than 2 re; default 0 (see the section notes) */
     fsdem_mps_gradient_model gradient; /* default FSDEM_MPS_GRADIENT_MODEL_MIN (see the enum) */
     fsdem_mps_wall_viscosity wall_viscosity; /* default FSDEM_MPS_WALL_VISCOSITY_NO_SLIP (see the enum) */
-    int clamp_negative_pressure;    /* 1: p < 0 is set to 0 after the solve; default 1 */
+    int clamp_negative_pressure;    /* 1: p < 0 is set to 0 (after the solve, or from the equation */
+                                    /*    of state); default 1 for the seed's scheme, 0 for the */
+                                    /*    explicit one (fsdem_mps_desc_default_scheme) */
     fsdem_real collision_distance;  /* -; in units of r0: approaching FLUID particles that would */
                                     /*    come closer collide (step 6b), in [0, 1); 0 = off; */
                                     /*    default 0.8 (see fsdem__mps_collide) */
@@ -2292,8 +2295,13 @@ typedef struct fsdem_mps_desc {
     void *log_user;
 } fsdem_mps_desc;
 
-/* Defaults for dim = 2 (x-y plane, gravity -y) or 3 (gravity -z); see the field comments. */
+/* Defaults for dim = 2 (x-y plane, gravity -y) or 3 (gravity -z); see the field comments. The
+   explicit scheme's: fsdem_mps_desc_default_scheme(dim, FSDEM_MPS_SCHEME_EXPLICIT). */
 FSDEM_API fsdem_mps_desc fsdem_mps_desc_default(int dim);
+/* The defaults of a scheme: they differ in clamp_negative_pressure (1 for the seed's scheme, 0 for
+   the explicit one) and in what re = 0 and cfl = 0 stand for (their field comments). Use it, not
+   desc_default and a new desc.scheme, to run seed 002's scheme as the seed does. */
+FSDEM_API fsdem_mps_desc fsdem_mps_desc_default_scheme(int dim, fsdem_mps_scheme scheme);
 /* Checks a desc without creating anything; the reason, naming the field, goes to `message` (may be
    NULL). Returns FSDEM_OK or FSDEM_ERR_INVALID_ARG (r0 <= 0, re < 2 r0, an empty domain, ...). */
 FSDEM_API fsdem_result fsdem_mps_desc_check(const fsdem_mps_desc *desc, char *message, size_t message_size);
@@ -4879,7 +4887,7 @@ static fsdem__periods fsdem__periods_of(const int periodic[3], int dim, fsdem_ve
 }
 
 /* The minimum image of a separation e. */
-static fsdem_vec3 fsdem__min_image(const fsdem__periods *p, fsdem_vec3 e) {
+static inline fsdem_vec3 fsdem__min_image(const fsdem__periods *p, fsdem_vec3 e) {
     if (p->any) {
         e.x -= p->length[0] * (fsdem_real)floor(e.x * p->inv[0] + (fsdem_real)0.5);
         e.y -= p->length[1] * (fsdem_real)floor(e.y * p->inv[1] + (fsdem_real)0.5);
@@ -15132,6 +15140,8 @@ struct fsdem_mps {
     fsdem_real *nbw;              /* w_ij (Eq. 6; 0 beyond re) */
     fsdem_real *nbl;              /* w_ij of the Laplacian (Eq. 6 with re_laplacian; 0 beyond it) */
     fsdem_real *nbx;              /* the explicit scheme's pair weight over |r_ij|^2 (0 with the seed's) */
+    int *wall_entries, wall_entry_cap, wall_entry_n; /* (row, entry) of every WALL or DUMMY neighbour in a
+                                                        FLUID row, in row order (built with the rows) */
     fsdem_real skin;              /* the rows hold the pairs within re + skin (Verlet lists) */
     fsdem_vec3 *x_built;          /* positions the rows were built at */
     int rows_valid;               /* 0: particles were added, removed or restored since */
@@ -15179,11 +15189,13 @@ static fsdem_real fsdem__mps_default_re(const fsdem_mps_desc *d) {
     return (d->scheme == FSDEM_MPS_SCHEME_EXPLICIT ? FSDEM__MPS_EXPLICIT_SUPPORT : (fsdem_real)4.1) * d->r0;
 }
 
-fsdem_mps_desc fsdem_mps_desc_default(int dim) {
+fsdem_mps_desc fsdem_mps_desc_default(int dim) { return fsdem_mps_desc_default_scheme(dim, FSDEM_MPS_SCHEME_EXPLICIT); }
+
+fsdem_mps_desc fsdem_mps_desc_default_scheme(int dim, fsdem_mps_scheme scheme) {
     fsdem_mps_desc d;
     memset(&d, 0, sizeof d);
     d.dim = dim;
-    d.scheme = FSDEM_MPS_SCHEME_EXPLICIT;
+    d.scheme = scheme;
     d.r0 = (fsdem_real)0.01;
     d.re = 0;
     d.density = 1000;
@@ -15199,7 +15211,12 @@ fsdem_mps_desc fsdem_mps_desc_default(int dim) {
     d.domain_max = fsdem_v3(1, 1, 1);
     d.gradient = FSDEM_MPS_GRADIENT_MODEL_MIN;
     d.wall_viscosity = FSDEM_MPS_WALL_VISCOSITY_NO_SLIP;
-    d.clamp_negative_pressure = 1;
+    /* The explicit scheme's density is its particles' volume: clamped, the particles of a stretched
+       surface lost density with nothing to bring it back, and the Martin & Moyce column's volume
+       (sum m / rho_i) grew 5.7 % by 0.575 s (+0.22 % unclamped, the release of the hydrostatic
+       start's compression; still water the same either way). The seed's scheme needs the clamp:
+       without it its still water blew up (7.6 r0 at 0.5 s). */
+    d.clamp_negative_pressure = scheme != FSDEM_MPS_SCHEME_EXPLICIT;
     d.collision_distance = (fsdem_real)0.8;
     d.restitution = (fsdem_real)0.2;
     d.shifting = 0;
@@ -15481,6 +15498,7 @@ void fsdem_mps_destroy(fsdem_mps *s) {
     fsdem__free(&s->allocator, s->cell_wall, sizeof(int) * (size_t)s->grid.cell_count);
     fsdem__free(&s->allocator, s->cell_dummy, sizeof(int) * (size_t)s->grid.cell_count);
     fsdem__free(&s->allocator, s->solid_pairs, sizeof(int) * (size_t)s->solid_pair_cap);
+    fsdem__free(&s->allocator, s->wall_entries, sizeof(int) * (size_t)s->wall_entry_cap);
     fsdem_cellgrid_free(&s->grid);
     if (s->pcg) fsdem_pcg_destroy(s->pcg);
     al = s->allocator;
@@ -16024,7 +16042,7 @@ static void fsdem__mps_open_update(fsdem_mps *s) {
 /* ---- >>mps_neighbours : cell-list search into sorted neighbour rows, kept while they hold ---- */
 
 /* r_j - r_i, through the minimum image along periodic axes. */
-static fsdem_vec3 fsdem__mps_sep(const fsdem_mps *s, int i, int j) {
+static inline fsdem_vec3 fsdem__mps_sep(const fsdem_mps *s, int i, int j) {
     return fsdem__min_image(&s->periods, fsdem__sub(s->x[j], s->x[i]));
 }
 
@@ -16195,6 +16213,25 @@ static fsdem_result fsdem__mps_build_rows(fsdem_mps *s) {
     memcpy(s->cursor, s->nb_start, sizeof(int) * (size_t)s->n);
     for (c = 0; c < s->n; ++c)
         for (e = s->tmp_start[c]; e < s->tmp_start[c + 1]; ++e) s->nb[s->cursor[s->tmp_nb[e]]++] = c;
+    /* the FLUID rows' WALL and DUMMY entries, which the solids' Shepard averages scatter from */
+    count = 0;
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
+            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) count += s->kind[s->nb[e]] != FSDEM_MPS_KIND_FLUID;
+    if (2 * (long long)count > s->wall_entry_cap) {
+        const int before = s->wall_entry_cap;
+        if (fsdem__grow(&s->allocator, (void **)&s->wall_entries, &s->wall_entry_cap, 0, 2 * count, sizeof(int)) != FSDEM_OK)
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        s->bytes += sizeof(int) * (size_t)(s->wall_entry_cap - before);
+    }
+    s->wall_entry_n = 0;
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
+            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e)
+                if (s->kind[s->nb[e]] != FSDEM_MPS_KIND_FLUID) {
+                    s->wall_entries[2 * s->wall_entry_n] = i;
+                    s->wall_entries[2 * s->wall_entry_n++ + 1] = e;
+                }
     memcpy(s->x_built, s->x, sizeof(fsdem_vec3) * (size_t)s->n);
     s->rows_valid = 1;
     return FSDEM_OK;
@@ -16214,19 +16251,25 @@ static int fsdem__mps_rows_hold(const fsdem_mps *s) {
 }
 
 /* The weights of every row entry at the current positions: w_ij (Eq. 6), the Laplacian's (with
-   re_laplacian), the explicit scheme's pair weight over |r_ij|^2; 0 beyond their radii. Counts the
-   pairs within re (a pair with a DUMMY particle has one entry, others two). */
+   re_laplacian), the explicit scheme's pair weight over |r_ij|^2; 0 beyond their radii. In the same
+   pass, the sums over them that every step needs: the number density n_i (seed 002 Eq. 7, every
+   neighbour, DUMMY included) and the surface flag (Eq. 14-16) of every FLUID and WALL particle, on
+   the surface when n_i < beta n0, or else when the asymmetry |F_i| of Eq. 15 exceeds alpha |F0|
+   (|F0|: the flat surface of the lattice, >>mps_desc). Counts the pairs within re (a pair with a
+   DUMMY particle has one entry, others two) and the surface particles. */
 static void fsdem__mps_weigh(fsdem_mps *s) {
     const int explicit_scheme = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT;
-    const fsdem_real re2 = s->re * s->re, inv_rx = 1 / s->re_x;
+    const fsdem_real re2 = s->re * s->re, inv_rx = 1 / s->re_x, fscale = (fsdem_real)s->dim / s->n0;
     long long twice = 0;
-    int i, e;
-    for (i = 0; i < s->n; ++i)
+    int i, e, surface = 0;
+    for (i = 0; i < s->n; ++i) {
+        fsdem_real nd = 0;
+        fsdem_vec3 F = fsdem__zero3(); /* -F_i of Eq. 15: the entries' separations are r_i - r_j */
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
             const fsdem_vec3 d = fsdem__mps_sep(s, j, i);
             const fsdem_real r2 = fsdem__dot(d, d);
-            fsdem_real r, w;
+            fsdem_real r, w, we;
             if (!(r2 < re2)) { /* in the skin: every radius is at most re */
                 s->nbw[e] = s->nbl[e] = s->nbx[e] = 0;
                 continue;
@@ -16241,48 +16284,29 @@ static void fsdem__mps_weigh(fsdem_mps *s) {
             } else
                 s->nbx[e] = 0;
             twice += s->kind[j] == FSDEM_MPS_KIND_DUMMY ? 2 : 1;
+            we = w / s->eps[j];
+            nd += we;                                     /* seed 002 Eq. 7 */
+            if (r > 0) F = fsdem__madd(F, d, we / r);     /* seed 002 Eq. 15 */
         }
+        s->nd[i] = nd;
+        s->surf[i] = (unsigned char)(s->kind[i] != FSDEM_MPS_KIND_DUMMY &&
+                                     (nd < s->desc.beta * s->n0 ||                    /* seed 002 Eq. 14 */
+                                      fscale * fsdem__norm(F) > s->desc.alpha * s->f0)); /* Eq. 16 */
+        surface += s->surf[i];
+    }
     s->pair_count = twice / 2;
+    s->surface_count = surface;
 }
 
-/* The neighbour rows at the current positions with their weights (rebuilt when they no longer
-   hold). FSDEM_ERR_OUT_OF_MEMORY when a rebuild cannot grow the lists. */
+/* The neighbour rows at the current positions with their weights, the number density and the
+   surface (the rows rebuilt when they no longer hold). FSDEM_ERR_OUT_OF_MEMORY when a rebuild cannot grow the lists. */
 static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     if (!fsdem__mps_rows_hold(s) && fsdem__mps_build_rows(s) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     fsdem__mps_weigh(s);
     return FSDEM_OK;
 }
 
-/* ---- >>mps_operators : number density, gradient, divergence, Laplacian, surface ---- */
-
-/* Number density n_i (seed 002 Eq. 7, every neighbour, DUMMY included) and the surface flag
-   (Eq. 14-16) of every FLUID and WALL particle, from the neighbour rows; returns the number of
-   surface particles. A particle is on the surface when n_i < beta n0, or else when the asymmetry
-   |F_i| of Eq. 15 exceeds alpha |F0| (|F0|: the flat surface of the lattice, >>mps_desc). */
-static int fsdem__mps_density(fsdem_mps *s) {
-    const fsdem_real fscale = (fsdem_real)s->dim / s->n0;
-    int i, e, surface = 0;
-    for (i = 0; i < s->n; ++i) {
-        fsdem_real nd = 0;
-        fsdem_vec3 F = fsdem__zero3();
-        s->nd[i] = 0;
-        s->surf[i] = 0;
-        if (s->kind[i] == FSDEM_MPS_KIND_DUMMY) continue;
-        for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
-            const int j = s->nb[e];
-            const fsdem_real we = s->nbw[e] / s->eps[j];
-            const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
-            const fsdem_real len = fsdem__norm(r);
-            nd += we;                                           /* seed 002 Eq. 7 */
-            if (len > 0) F = fsdem__madd(F, r, we / len);       /* seed 002 Eq. 15 */
-        }
-        s->nd[i] = nd;
-        s->surf[i] = (unsigned char)(nd < s->desc.beta * s->n0 ||                 /* seed 002 Eq. 14 */
-                                     fscale * fsdem__norm(F) > s->desc.alpha * s->f0); /* Eq. 16 */
-        surface += s->surf[i];
-    }
-    return surface;
-}
+/* ---- >>mps_operators : gradient, divergence, Laplacian ---- */
 
 /* The 3 x 3 matrix (rows) that turns the kernel sum of the gradient at particle i into the
    gradient: d/n0 times the identity for the forms of Eq. 8, the inverse of the moment matrix
@@ -16400,23 +16424,20 @@ static fsdem_real fsdem__mps_mass(const fsdem_mps *s) {
 
 /* The ghost velocities of FSDEM_MPS_WALL_VISCOSITY_NO_SLIP into s->uvisc (see the enum): FLUID particles
    their own velocity, WALL and DUMMY particles -u~, the Shepard average of the FLUID velocities
-   around them, gathered by scattering from the FLUID rows (the rows of DUMMY particles are empty);
-   0 where no FLUID particle is within re. */
+   around them, gathered by scattering from the FLUID rows' solid entries (the rows of DUMMY
+   particles are empty); 0 where no FLUID particle is within re. */
 static void fsdem__mps_wall_ghosts(fsdem_mps *s) {
-    int i, e;
+    int i, k;
     for (i = 0; i < s->n; ++i) {
         s->uvisc[i] = s->kind[i] == FSDEM_MPS_KIND_FLUID ? s->v[i] : fsdem__zero3();
         s->ghost_weight[i] = 0;
     }
-    for (i = 0; i < s->n; ++i)
-        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
-            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
-                const int j = s->nb[e];
-                const fsdem_real w = s->nbw[e] / s->eps[i];
-                if (s->kind[j] == FSDEM_MPS_KIND_FLUID) continue;
-                s->uvisc[j] = fsdem__madd(s->uvisc[j], s->v[i], w);
-                s->ghost_weight[j] += w;
-            }
+    for (k = 0; k < s->wall_entry_n; ++k) {
+        const int f = s->wall_entries[2 * k], e = s->wall_entries[2 * k + 1], j = s->nb[e];
+        const fsdem_real w = s->nbw[e] / s->eps[f];
+        s->uvisc[j] = fsdem__madd(s->uvisc[j], s->v[f], w);
+        s->ghost_weight[j] += w;
+    }
     for (i = 0; i < s->n; ++i)
         if (s->ghost_weight[i] > 0) s->uvisc[i] = fsdem__scale(s->uvisc[i], -1 / s->ghost_weight[i]);
 }
@@ -16427,7 +16448,6 @@ static fsdem_result fsdem__mps_operator_setup(fsdem_mps *s, const char *fn, cons
     if (!in || !out) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: NULL field", fn);
     if (s->n > 0 && fsdem__mps_neighbours(s) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory building the neighbour list", fn);
-    if (s->n > 0) fsdem__mps_density(s);
     return FSDEM_OK;
 }
 
@@ -16520,8 +16540,8 @@ static void fsdem__mps_hydrostatic_start(fsdem_mps *s, fsdem_real c0) {
 /* Pressures: FLUID particles by the equation of state p = c0^2 (rho_i - rho); WALL and DUMMY
    particles the Shepard average of the FLUID pressures within re of them extrapolated
    hydrostatically to them, p_w = sum_f w (p_f + rho g.(r_w - r_f)) / sum_f w (Adami, Hu and Adams
-   2012, Eq. 27, fixed walls; gathered by scattering from the FLUID rows, as the rows of DUMMY
-   particles are empty), 0 with none; negative pressures set to 0 when
+   2012, Eq. 27, fixed walls; gathered by scattering from the FLUID rows' solid entries, as the
+   rows of DUMMY particles are empty), 0 with none; negative pressures set to 0 when
    desc.clamp_negative_pressure. One pressure field on every particle: the DUMMY ghost of the
    semi-implicit scheme, p_i + rho g.(r_j - r_i) seen from each i, let the columns beside the walls
    slide (still water drifted 0.5 r0 by 0.5 s). */
@@ -16529,20 +16549,17 @@ static void fsdem__mps_explicit_pressures(fsdem_mps *s, fsdem_real c0) {
     const fsdem_real rho = s->desc.density;
     const int clamp = s->desc.clamp_negative_pressure;
     fsdem_real *weight = s->ghost_weight;
-    int i, e;
+    int i, k;
     for (i = 0; i < s->n; ++i) {
         const fsdem_real p = s->kind[i] == FSDEM_MPS_KIND_FLUID ? c0 * c0 * (s->rho[i] - rho) : 0;
         s->p[i] = p < 0 && clamp ? 0 : p;
         weight[i] = 0;
     }
-    for (i = 0; i < s->n; ++i)
-        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
-            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
-                const int j = s->nb[e];
-                if (s->kind[j] == FSDEM_MPS_KIND_FLUID) continue;
-                s->p[j] += s->nbw[e] * (s->p[i] + rho * fsdem__dot(s->desc.gravity, fsdem__mps_sep(s, i, j)));
-                weight[j] += s->nbw[e];
-            }
+    for (k = 0; k < s->wall_entry_n; ++k) {
+        const int f = s->wall_entries[2 * k], e = s->wall_entries[2 * k + 1], j = s->nb[e];
+        s->p[j] += s->nbw[e] * (s->p[f] + rho * fsdem__dot(s->desc.gravity, fsdem__mps_sep(s, f, j)));
+        weight[j] += s->nbw[e];
+    }
     for (i = 0; i < s->n; ++i)
         if (s->kind[i] != FSDEM_MPS_KIND_FLUID) {
             s->p[i] = weight[i] > 0 ? s->p[i] / weight[i] : 0;
@@ -16774,15 +16791,16 @@ static void fsdem__mps_collide(fsdem_mps *s, fsdem_real dt) {
         if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         for (k = s->nb_start[i]; k < s->nb_start[i + 1]; ++k) {
             const int j = s->nb[k], fluid = s->kind[j] == FSDEM_MPS_KIND_FLUID;
-            const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
-            const fsdem_vec3 dv = fsdem__sub(s->v[j], s->v[i]);
-            const fsdem_vec3 ahead = fsdem__madd(r, dv, dt);
+            fsdem_vec3 r, dv, ahead, n;
             fsdem_real len, vn;
-            fsdem_vec3 n;
             if (fluid && j < i) continue; /* each FLUID pair once */
-            len = fsdem__norm(r);
+            r = fsdem__mps_sep(s, i, j);
+            dv = fsdem__sub(s->v[j], s->v[i]);
             vn = fsdem__dot(dv, r);
-            if (!(len > 0) || !(vn < 0) || !(fsdem__dot(ahead, ahead) < dc * dc)) continue;
+            if (!(vn < 0)) continue; /* not approaching (a pair at one point too: r = 0) */
+            ahead = fsdem__madd(r, dv, dt);
+            if (!(fsdem__dot(ahead, ahead) < dc * dc)) continue;
+            len = fsdem__norm(r);
             n = fsdem__scale(r, 1 / len);
             vn = (1 + e) * vn / len; /* (1 + e) times the approach speed along n, negative */
             if (fluid) {
@@ -17025,7 +17043,6 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     /* 1. neighbours, number density, free surface */
     if (fsdem__mps_neighbours(s) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory building the neighbour list");
-    s->surface_count = fsdem__mps_density(s);
     ts = clock();
     s->sec_search += (double)(ts - t0) / CLOCKS_PER_SEC;
     fsdem__mps_shift(s);

@@ -61,7 +61,7 @@ static double sediment_front(const fsdem_dem *dem) {
 
 int main(void) {
     const double t_end = 0.4, frame_every = 0.01, pi = 3.14159265358979323846;
-    fsdem_mps_desc md = fsdem_mps_desc_default(3);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(3, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     fsdem_dem_material glass = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
@@ -74,7 +74,6 @@ int main(void) {
     fsdem_real dem_dt = 0;
     double bed_porosity;
     int material = 0, walls = 0, water = 0, above = 0, spheres = 0, frame = 0, status = 1, i, j, k;
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
 
     /* the water: MPS defaults (seed 002 §2.1: re = 4.1 r0, gamma 0.01, CFL 0.2) with Model B */
     md.r0 = (fsdem_real)R0;

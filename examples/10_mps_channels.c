@@ -29,12 +29,12 @@ static int fail(fsdem_mps *mps) {
 static int poiseuille(void) {
     const double r0 = 0.01, H = 0.3, L = 0.16, nu = 0.01, g = 0.1;
     const double u_centre = g * H * H / (8 * nu); /* the parabola u = g/(2 nu) y (H - y) */
-    fsdem_mps_desc desc = fsdem_mps_desc_default(2);
+    /* the seed's scheme: an enclosed liquid, its pressure from the equation */
+    fsdem_mps_desc desc = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_mps *mps;
     fsdem_mps_particles p;
     fsdem_csv csv;
     int k, i;
-    desc.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's: an enclosed liquid, its pressure from the equation */
     desc.r0 = (fsdem_real)r0;
     desc.viscosity = (fsdem_real)nu;
     desc.gravity = fsdem_v3((fsdem_real)g, 0, 0); /* the body force drives the flow along x */
@@ -81,12 +81,12 @@ static int poiseuille(void) {
 
 static int open_channel(void) {
     const double r0 = 0.01, H = 0.1, L = 0.3, U = 0.1, buffer = 5 * r0; /* ceil(re/r0) = 5 layers */
-    fsdem_mps_desc desc = fsdem_mps_desc_default(2);
+    /* the seed's scheme: without gravity the explicit scheme would need desc.sound_speed */
+    fsdem_mps_desc desc = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_mps_inflow_desc in;
     fsdem_mps_outflow_desc out;
     fsdem_mps *mps;
     int k, i;
-    desc.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* without gravity the explicit scheme would need desc.sound_speed */
     desc.r0 = (fsdem_real)r0;
     desc.gravity = fsdem_v3(0, 0, 0);
     desc.domain_min = fsdem_v3(-0.1f, -0.1f, 0);

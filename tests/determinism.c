@@ -159,10 +159,9 @@ static int swe_scene(void) {
 /* A 2D MPS dam break (Model A): a column of 10 x 20 spacings in a walled tank of 40 x 30, 0.1 s:
    the pressure solve (MIC(0)-PCG), collisions, surface detection. */
 static int mps_scene(void) {
-    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_mps *mps;
     int bad;
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.domain_min = fsdem_v3(-0.05, -0.05, 0);
     d.domain_max = fsdem_v3(0.45, 0.4, 0);
     if (fsdem_mps_create(&d, &mps) != FSDEM_OK) return 1;
@@ -225,7 +224,7 @@ static int swe_dem_scene(void) {
 /* Twelve sand discs falling into a 2D MPS tank (Model B, Ergun/Wen-Yu drag), 0.04 s: porosity,
    drag, the reactions (Eq. 36), DEM substeps and wall contacts. */
 static int mps_dem_scene(void) {
-    fsdem_mps_desc md = fsdem_mps_desc_default(2);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(2);
     fsdem_dem_material m = fsdem_dem_material_default();
     fsdem_dem_wall_desc w;
@@ -234,7 +233,6 @@ static int mps_dem_scene(void) {
     fsdem_dem *dem = NULL;
     fsdem_mps_dem *c = NULL;
     int bad, mat = 0;
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     md.model = FSDEM_MPS_MODEL_B;
     md.domain_min = fsdem_v3(-0.05, -0.05, 0);
     md.domain_max = fsdem_v3(0.2, 0.25, 0);

@@ -19,12 +19,11 @@ typedef struct test_pair {
 static test_pair test_pair_new(int dim, double r0, fsdem_mps_model model, double nu, fsdem_vec3 lo, fsdem_vec3 hi,
                                double depth, double rho_s) {
     test_pair t;
-    fsdem_mps_desc md = fsdem_mps_desc_default(dim);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(dim, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(dim);
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
     const double pad = 6 * r0;
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(&t, 0, sizeof t);
     md.r0 = (fsdem_real)r0;
     md.model = model;
@@ -399,12 +398,11 @@ END_TEST
    rest; a DEM periodic alike; their coupler. */
 static test_pair test_periodic_pair(int dim, double r0, fsdem_mps_model model, double size) {
     test_pair t;
-    fsdem_mps_desc md = fsdem_mps_desc_default(dim);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(dim, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(dim);
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
     const fsdem_vec3 hi = fsdem_v3((fsdem_real)size, (fsdem_real)size, dim == 3 ? (fsdem_real)size : 0);
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(&t, 0, sizeof t);
     md.r0 = (fsdem_real)r0;
     md.model = model;
@@ -715,7 +713,7 @@ static void test_refusing_free(void *user, void *ptr, size_t size) {
    readable: get_force and write_csv give them as they were (the coupler's record array, grown for
    the new particles, carries them along; it once left the head pointing at the freed array). */
 START_TEST(test_mps_dem_failed_update_keeps_its_records) {
-    fsdem_mps_desc md = fsdem_mps_desc_default(2);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(2);
     fsdem_dem_material m = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
@@ -726,7 +724,6 @@ START_TEST(test_mps_dem_failed_update_keeps_its_records) {
     fsdem_mps_dem_force before, after;
     fsdem_result res;
     int k;
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     md.domain_min = fsdem_v3(-0.06f, -0.06f, 0);
     md.domain_max = fsdem_v3(0.26f, 0.26f, 0);
     ck_assert_int_eq(fsdem_mps_create(&md, &mps), FSDEM_OK);

@@ -1012,7 +1012,7 @@ START_TEST(null_objects_are_refused) {
     }
     /* ---- fsdem_mps ---- */
     {
-        fsdem_mps_desc d = fsdem_mps_desc_default(2);
+        fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
         fsdem_mps *mps = (fsdem_mps *)&p;
         fsdem_mps_particles pp;
         fsdem_mps_coupling cp;
@@ -1020,7 +1020,6 @@ START_TEST(null_objects_are_refused) {
         fsdem_mps_stats st;
         fsdem_csr a;
         const int *rows = (const int *)&p;
-        d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
         IF_REFUSED(&p, fsdem_mps_desc_check(NULL, msg, sizeof msg));
         IF_REFUSED(&p, fsdem_mps_create(NULL, &mps));
         IF_TRUE(&p, "fsdem_mps_create(NULL, &mps) sets mps to NULL", mps == NULL);

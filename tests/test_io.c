@@ -1099,11 +1099,10 @@ static double *from_bytes(const unsigned char *p, long n) {
 }
 
 static void check_mps(int dim) {
-    fsdem_mps_desc desc = fsdem_mps_desc_default(dim);
+    fsdem_mps_desc desc = fsdem_mps_desc_default_scheme(dim, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_mps *mps = NULL;
     const fsdem_vec3 hi = dim == 2 ? fsdem_v3(0.2, 0.2, 0) : fsdem_v3(0.1, 0.1, 0.1);
     int f;
-    desc.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     desc.r0 = dim == 2 ? 0.02 : 0.025;
     desc.domain_min = fsdem_v3(-0.2, -0.2, -0.2);
     ck_assert_int_eq(fsdem_mps_create(&desc, &mps), FSDEM_OK);
@@ -1357,13 +1356,12 @@ void test_csv_expect(const char *path, const char *header, int rows, const doubl
    (after a step, so pressures, number densities and surface flags are set); an unwritable path is
    FSDEM_ERR_IO with the path in the message. */
 static void check_mps_csv(int dim) {
-    fsdem_mps_desc desc = fsdem_mps_desc_default(dim);
+    fsdem_mps_desc desc = fsdem_mps_desc_default_scheme(dim, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_mps *mps = NULL;
     const fsdem_vec3 hi = dim == 2 ? fsdem_v3(0.2, 0.2, 0) : fsdem_v3(0.1, 0.1, 0.1);
     fsdem_mps_particles p;
     double *e;
     int i;
-    desc.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     desc.r0 = dim == 2 ? 0.02 : 0.025;
     desc.domain_min = fsdem_v3(-0.2, -0.2, -0.2);
     ck_assert_int_eq(fsdem_mps_create(&desc, &mps), FSDEM_OK);

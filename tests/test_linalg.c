@@ -1238,12 +1238,11 @@ START_TEST(amg_iterations_are_size_independent_on_mps) {
     int amg[3], k, lo, hi;
     for (k = 0; k < 3; ++k) {
         const fsdem_real r0 = (fsdem_real)(0.02 / (1 << k)), W = 1.6f;
-        fsdem_mps_desc d = fsdem_mps_desc_default(2);
+        fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
         fsdem_mps *m;
         fsdem_csr A;
         fsdem_real *x_ref;
         int i;
-        d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
         d.r0 = r0;
         d.domain_min = fsdem_v3(-0.2f, -0.2f, 0);
         d.domain_max = fsdem_v3(W + 0.2f, W, 0);

@@ -9,10 +9,9 @@
    and y = rows r0, full of liquid at rest, with the body force (gx, 0, 0) and viscosity nu. */
 static fsdem_mps *test_channel(int dim, double r0, int rows, int cells, double gx, double nu, fsdem_mps_wall_viscosity walls) {
     const double H = rows * r0, L = cells * r0;
-    fsdem_mps_desc d = fsdem_mps_desc_default(dim);
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(dim, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_mps *m = NULL;
     unsigned open = (1u << FSDEM_SIDE_XMIN) | (1u << FSDEM_SIDE_XMAX);
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.r0 = (fsdem_real)r0;
     d.viscosity = (fsdem_real)nu;
     d.wall_viscosity = walls;
@@ -97,11 +96,10 @@ END_TEST
    u_y = 0.05 sin(2 pi x / P) m/s, P one period, each copy alike; the domain starts at x0. */
 static fsdem_mps *test_periodic_tank(int copies, double x0) {
     const double r0 = 1.0 / 64, P = 16 * r0, depth = 0.25;
-    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_mps *m = NULL;
     fsdem_mps_particles p;
     int i;
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.r0 = (fsdem_real)r0;
     d.domain_min = fsdem_v3((fsdem_real)x0, -0.125f, 0);
     d.domain_max = fsdem_v3((fsdem_real)(x0 + copies * P), 0.5f, 0);
@@ -197,12 +195,11 @@ END_TEST
    0.1 m/s fed by an inflow at x = 0 and leaving through an outflow at x = 0.3 m. */
 static fsdem_mps *test_open_channel(void) {
     const fsdem_real L = 0.3f, H = 0.1f, U = 0.1f, depth = 0.05f;
-    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_mps_inflow_desc in;
     fsdem_mps_outflow_desc out;
     fsdem_mps *m = NULL;
     int added = 0;
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.gravity = fsdem_v3(0, 0, 0);
     d.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
     d.domain_max = fsdem_v3(0.4f, 0.2f, 0);
@@ -388,12 +385,11 @@ START_TEST(test_mps_open_bad_input) {
     ck_assert_int_eq(fsdem_mps_get_stats(m).outflow_planes, 1);
     {   /* a coupler cannot follow the particles open planes add and remove */
         fsdem_dem_desc dd = fsdem_dem_desc_default(2);
-        fsdem_mps_desc md = fsdem_mps_desc_default(2);
+        fsdem_mps_desc md = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
         fsdem_dem *dem = NULL;
         fsdem_mps_dem *c = NULL;
         fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
         char msg[256];
-        md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
         dd.domain_min = fsdem_v3(-0.1f, -0.1f, 0);
         dd.domain_max = fsdem_v3(0.4f, 0.2f, 0);
         dd.gravity = fsdem_v3(0, 0, 0);
@@ -433,9 +429,8 @@ END_TEST
    are periodic flags that are not 0/1 or name z in 2D, a wall option that does not exist, and a
    coupler over a periodic MPS (its averaging does not wrap). */
 START_TEST(test_mps_periodic_bad_input) {
-    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     char msg[256];
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.domain_max = fsdem_v3(0.105f, 1, 0); /* 10.5 r0 */
     d.periodic[0] = 1;
     ck_assert_int_eq(fsdem_mps_desc_check(&d, msg, sizeof msg), FSDEM_ERR_INVALID_ARG);

@@ -90,9 +90,8 @@ static int gauges_run(int pic, long n) {
         snprintf(message, sizeof message, "%s", fsdem_pic_last_error(s));
         fsdem_pic_destroy(s);
     } else {
-        fsdem_mps_desc d = fsdem_mps_desc_default(2);
+        fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
         fsdem_mps *s = NULL;
-        d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
         d.allocator = sized_allocator(&h);
         ck_assert_int_eq(fsdem_mps_create(&d, &s), FSDEM_OK);
         arm(&h, n);
@@ -214,8 +213,7 @@ static int coupled_oom_run(int mps, int lasting, long n) {
     int k;
     dd.allocator = sized_allocator(&h);
     if (mps) {
-        fsdem_mps_desc d = fsdem_mps_desc_default(2);
-        d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
+        fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
         d.domain_min = fsdem_v3(-0.06f, -0.06f, 0);
         d.domain_max = fsdem_v3(0.26f, 0.26f, 0);
         d.allocator = sized_allocator(&h);
@@ -338,15 +336,13 @@ END_TEST
     } while (0)
 
 START_TEST(implausible_mps_input_is_refused) {
-    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_mps *s = NULL;
     char msg[512];
     const fsdem_vec3 x = {0.5f, 0.5f, 0}, fast = {(fsdem_real)1e20, 0, 0};
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     d.gravity = fsdem_v3(0, (fsdem_real)-9.81, 1);
     REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "gravity.z");
-    d = fsdem_mps_desc_default(2);
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
+    d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     d.gravity = fsdem_v3(0, (fsdem_real)-1e20, 0);
     REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "FSDEM_MAX_ACCELERATION");
     d = fsdem_mps_desc_default(2);
@@ -369,8 +365,7 @@ START_TEST(implausible_mps_input_is_refused) {
     d.density_diffusion = (fsdem_real)0.1;
     d.re = 2 * d.r0; /* inside the explicit gradient's support */
     REFUSED(fsdem_mps_desc_check(&d, msg, sizeof msg), msg, "re");
-    d = fsdem_mps_desc_default(2);
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
+    d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     ck_assert_int_eq(fsdem_mps_create(&d, &s), FSDEM_OK);
     REFUSED(fsdem_mps_add_particles(s, FSDEM_MPS_KIND_FLUID, 1, &x, &fast), fsdem_mps_last_error(s), "FSDEM_MAX_SPEED");
     REFUSED(fsdem_mps_fill_box(s, fsdem_v3(0.1f, 0.1f, 0), fsdem_v3(0.2f, 0.2f, 0), fast, NULL), fsdem_mps_last_error(s),
@@ -473,7 +468,7 @@ END_TEST
 /* MPS-DEM's averaging radius and PIC-DEM's contact length of 1e30 m were accepted; so was a sphere
    wider than the fluid's domain (PIC-DEM: a body that leaves no open cell). */
 START_TEST(implausible_coupler_input_is_refused) {
-    fsdem_mps_desc md = fsdem_mps_desc_default(2);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_pic_desc pd = fsdem_pic_desc_default(2);
     fsdem_dem_desc dd = fsdem_dem_desc_default(2);
     fsdem_dem_material m = fsdem_dem_material_default();
@@ -486,7 +481,6 @@ START_TEST(implausible_coupler_input_is_refused) {
     fsdem_mps_dem *c = NULL;
     fsdem_pic_dem *cp = NULL;
     char msg[512];
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     pd.cell_size = (fsdem_real)0.05;
     ck_assert_int_eq(fsdem_mps_create(&md, &mps), FSDEM_OK);
     ck_assert_int_eq(fsdem_pic_create(&pd, &pic), FSDEM_OK);

@@ -778,8 +778,7 @@ END_TEST
 /* 2D dam break in a tank with a box obstacle on its floor (r0 = 1 cm, 300 fluid particles): the
    column collapses, the surface and the neighbourhoods change every step. */
 static fsdem_mps_desc mps_desc(void) {
-    fsdem_mps_desc d = fsdem_mps_desc_default(2);
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     d.r0 = 0.01;
     d.domain_min = fsdem_v3(-0.1, -0.1, 0);
     d.domain_max = fsdem_v3(0.5, 0.4, 0);

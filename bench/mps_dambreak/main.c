@@ -5,10 +5,11 @@
    fsdem_mps_add_box_walls: one WALL layer and the DUMMY layers of the scheme's re outside the
    box); water column [0, 1] x [0, 2] m at the left wall (fsdem_mps_fill_box: 67 x 133 = 8,911
    FLUID particles at r0 = 0.015 m). Everything else is fsdem_mps_desc_default(2): the explicit
-   scheme (re = 2.8 r0, c0 = 10 sqrt(2 g H), cfl 0.35 on c0 + u_max, density diffusion 0.1), then
-   the same with seed 002's scheme as "mps_dambreak_seed" (re = 4.1 r0, gamma = 0.01, beta = 0.8,
-   alpha = 0.9, CFL 0.2 with adaptive dt, min-form gradient, MIC(0)-PCG to 1e-8); both with
-   collisions at 0.8 r0, negative pressures clamped, no shifting, dt_max 1e-3 s. The domain is
+   scheme (re = 2.8 r0, c0 = 10 sqrt(2 g H), cfl 0.35 on c0 + u_max, density diffusion 0.1,
+   negative pressures kept), then seed 002's scheme with its defaults as "mps_dambreak_seed"
+   (fsdem_mps_desc_default_scheme: re = 4.1 r0, gamma = 0.01, beta = 0.8, alpha = 0.9, CFL 0.2 with
+   adaptive dt, min-form gradient, MIC(0)-PCG to 1e-8, negative pressures clamped); both with
+   collisions at 0.8 r0, no shifting, dt_max 1e-3 s. The domain is
    [-0.1, 4.1] x [-0.1, 6] m. Simulated to t = 0.6 s in 0.1 s chunks by fsdem_mps_advance (each chunk ends exactly
    on its time, so the fronts at 0.4 and 0.6 s are at those times), single thread.
    Figures: wall_s = wall-clock seconds of the stepping (creation and filling excluded, as PySPH's
@@ -100,7 +101,7 @@ static void report_error(const char *name, fsdem_mps *mps, const char *what, fsd
 /* Case 1: the PySPH dam_break_2d case to t_end with `scheme`, its lines named `name`. */
 static void bench_2d(double t_end, fsdem_mps_scheme scheme, const char *name) {
     const fsdem_vec3 tank_lo = fsdem_v3(0, 0, 0), tank_hi = fsdem_v3(4, 4, 0);
-    fsdem_mps_desc d = fsdem_mps_desc_default(2);
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(2, scheme);
     fsdem_mps *mps = NULL;
     fsdem_mps_stats st;
     fsdem_result r;
@@ -109,7 +110,6 @@ static void bench_2d(double t_end, fsdem_mps_scheme scheme, const char *name) {
     long long steps = 0;
     int added_fluid = 0, added_walls = 0, nf = 0, k;
 
-    d.scheme = scheme;
     d.r0 = (fsdem_real)0.015;
     d.domain_min = fsdem_v3(-0.1, -0.1, 0);
     d.domain_max = fsdem_v3(4.1, 6, 0);
@@ -180,7 +180,7 @@ static void bench_2d(double t_end, fsdem_mps_scheme scheme, const char *name) {
 static void bench_3d(int steps, double column_length, double column_height) {
     const char *name = "mps_sun2013_3d";
     const fsdem_vec3 tank_lo = fsdem_v3(0, 0, 0), tank_hi = fsdem_v3(0.2, 0.1, 0.15);
-    fsdem_mps_desc d = fsdem_mps_desc_default(3);
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(3, FSDEM_MPS_SCHEME_SEMI_IMPLICIT); /* Table 2 is the seed's */
     fsdem_mps *mps = NULL;
     fsdem_mps_stats st0, st;
     fsdem_result r;
@@ -188,7 +188,6 @@ static void bench_3d(int steps, double column_length, double column_height) {
     double t0, wall;
     int added_fluid = 0, added_walls = 0, k;
 
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* Table 2 is the seed's scheme */
     d.r0 = (fsdem_real)0.0027;
     d.domain_min = fsdem_v3(-0.02, -0.02, -0.02);
     d.domain_max = fsdem_v3(0.22, 0.12, 0.3);

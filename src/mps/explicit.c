@@ -60,8 +60,8 @@ static void fsdem__mps_hydrostatic_start(fsdem_mps *s, fsdem_real c0) {
 /* Pressures: FLUID particles by the equation of state p = c0^2 (rho_i - rho); WALL and DUMMY
    particles the Shepard average of the FLUID pressures within re of them extrapolated
    hydrostatically to them, p_w = sum_f w (p_f + rho g.(r_w - r_f)) / sum_f w (Adami, Hu and Adams
-   2012, Eq. 27, fixed walls; gathered by scattering from the FLUID rows, as the rows of DUMMY
-   particles are empty), 0 with none; negative pressures set to 0 when
+   2012, Eq. 27, fixed walls; gathered by scattering from the FLUID rows' solid entries, as the
+   rows of DUMMY particles are empty), 0 with none; negative pressures set to 0 when
    desc.clamp_negative_pressure. One pressure field on every particle: the DUMMY ghost of the
    semi-implicit scheme, p_i + rho g.(r_j - r_i) seen from each i, let the columns beside the walls
    slide (still water drifted 0.5 r0 by 0.5 s). */
@@ -69,20 +69,17 @@ static void fsdem__mps_explicit_pressures(fsdem_mps *s, fsdem_real c0) {
     const fsdem_real rho = s->desc.density;
     const int clamp = s->desc.clamp_negative_pressure;
     fsdem_real *weight = s->ghost_weight;
-    int i, e;
+    int i, k;
     for (i = 0; i < s->n; ++i) {
         const fsdem_real p = s->kind[i] == FSDEM_MPS_KIND_FLUID ? c0 * c0 * (s->rho[i] - rho) : 0;
         s->p[i] = p < 0 && clamp ? 0 : p;
         weight[i] = 0;
     }
-    for (i = 0; i < s->n; ++i)
-        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
-            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
-                const int j = s->nb[e];
-                if (s->kind[j] == FSDEM_MPS_KIND_FLUID) continue;
-                s->p[j] += s->nbw[e] * (s->p[i] + rho * fsdem__dot(s->desc.gravity, fsdem__mps_sep(s, i, j)));
-                weight[j] += s->nbw[e];
-            }
+    for (k = 0; k < s->wall_entry_n; ++k) {
+        const int f = s->wall_entries[2 * k], e = s->wall_entries[2 * k + 1], j = s->nb[e];
+        s->p[j] += s->nbw[e] * (s->p[f] + rho * fsdem__dot(s->desc.gravity, fsdem__mps_sep(s, f, j)));
+        weight[j] += s->nbw[e];
+    }
     for (i = 0; i < s->n; ++i)
         if (s->kind[i] != FSDEM_MPS_KIND_FLUID) {
             s->p[i] = weight[i] > 0 ? s->p[i] / weight[i] : 0;

@@ -45,7 +45,7 @@
         non-DUMMY j) is symmetric and positive definite (a fsdem_csr, solved by fsdem_pcg; Eq. 13
         instead of Eq. 12 with desc.model = FSDEM_MPS_MODEL_B);
      5. negative pressures set to 0 when desc.clamp_negative_pressure (the seed says nothing; the
-        original MPS clamps, so the default does);
+        original MPS clamps, so this scheme's default does);
      6. corrector u = u* - dt/rho grad p (Eq. 8 or the stabilised form, desc.gradient);
      6b. collisions (desc.collision_distance, restitution; Koshizuka, Nobe and Oka 1998): pairs that
         would end the step closer than collision_distance r0 lose (1 + e) of their approach speed
@@ -249,7 +249,9 @@ typedef struct fsdem_mps_desc {
                                     /*    and more than 2 re; default 0 (see the section notes) */
     fsdem_mps_gradient_model gradient; /* default FSDEM_MPS_GRADIENT_MODEL_MIN (see the enum) */
     fsdem_mps_wall_viscosity wall_viscosity; /* default FSDEM_MPS_WALL_VISCOSITY_NO_SLIP (see the enum) */
-    int clamp_negative_pressure;    /* 1: p < 0 is set to 0 after the solve; default 1 */
+    int clamp_negative_pressure;    /* 1: p < 0 is set to 0 (after the solve, or from the equation */
+                                    /*    of state); default 1 for the seed's scheme, 0 for the */
+                                    /*    explicit one (fsdem_mps_desc_default_scheme) */
     fsdem_real collision_distance;  /* -; in units of r0: approaching FLUID particles that would */
                                     /*    come closer collide (step 6b), in [0, 1); 0 = off; */
                                     /*    default 0.8 (see fsdem__mps_collide) */
@@ -267,8 +269,13 @@ typedef struct fsdem_mps_desc {
     void *log_user;
 } fsdem_mps_desc;
 
-/* Defaults for dim = 2 (x-y plane, gravity -y) or 3 (gravity -z); see the field comments. */
+/* Defaults for dim = 2 (x-y plane, gravity -y) or 3 (gravity -z); see the field comments. The
+   explicit scheme's: fsdem_mps_desc_default_scheme(dim, FSDEM_MPS_SCHEME_EXPLICIT). */
 FSDEM_API fsdem_mps_desc fsdem_mps_desc_default(int dim);
+/* The defaults of a scheme: they differ in clamp_negative_pressure (1 for the seed's scheme, 0 for
+   the explicit one) and in what re = 0 and cfl = 0 stand for (their field comments). Use it, not
+   desc_default and a new desc.scheme, to run seed 002's scheme as the seed does. */
+FSDEM_API fsdem_mps_desc fsdem_mps_desc_default_scheme(int dim, fsdem_mps_scheme scheme);
 /* Checks a desc without creating anything; the reason, naming the field, goes to `message` (may be
    NULL). Returns FSDEM_OK or FSDEM_ERR_INVALID_ARG (r0 <= 0, re < 2 r0, an empty domain, ...). */
 FSDEM_API fsdem_result fsdem_mps_desc_check(const fsdem_mps_desc *desc, char *message, size_t message_size);

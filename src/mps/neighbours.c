@@ -1,7 +1,7 @@
 /* ---- >>mps_neighbours : cell-list search into sorted neighbour rows, kept while they hold ---- */
 
 /* r_j - r_i, through the minimum image along periodic axes. */
-static fsdem_vec3 fsdem__mps_sep(const fsdem_mps *s, int i, int j) {
+static inline fsdem_vec3 fsdem__mps_sep(const fsdem_mps *s, int i, int j) {
     return fsdem__min_image(&s->periods, fsdem__sub(s->x[j], s->x[i]));
 }
 
@@ -172,6 +172,25 @@ static fsdem_result fsdem__mps_build_rows(fsdem_mps *s) {
     memcpy(s->cursor, s->nb_start, sizeof(int) * (size_t)s->n);
     for (c = 0; c < s->n; ++c)
         for (e = s->tmp_start[c]; e < s->tmp_start[c + 1]; ++e) s->nb[s->cursor[s->tmp_nb[e]]++] = c;
+    /* the FLUID rows' WALL and DUMMY entries, which the solids' Shepard averages scatter from */
+    count = 0;
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
+            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) count += s->kind[s->nb[e]] != FSDEM_MPS_KIND_FLUID;
+    if (2 * (long long)count > s->wall_entry_cap) {
+        const int before = s->wall_entry_cap;
+        if (fsdem__grow(&s->allocator, (void **)&s->wall_entries, &s->wall_entry_cap, 0, 2 * count, sizeof(int)) != FSDEM_OK)
+            return FSDEM_ERR_OUT_OF_MEMORY;
+        s->bytes += sizeof(int) * (size_t)(s->wall_entry_cap - before);
+    }
+    s->wall_entry_n = 0;
+    for (i = 0; i < s->n; ++i)
+        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
+            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e)
+                if (s->kind[s->nb[e]] != FSDEM_MPS_KIND_FLUID) {
+                    s->wall_entries[2 * s->wall_entry_n] = i;
+                    s->wall_entries[2 * s->wall_entry_n++ + 1] = e;
+                }
     memcpy(s->x_built, s->x, sizeof(fsdem_vec3) * (size_t)s->n);
     s->rows_valid = 1;
     return FSDEM_OK;
@@ -191,19 +210,25 @@ static int fsdem__mps_rows_hold(const fsdem_mps *s) {
 }
 
 /* The weights of every row entry at the current positions: w_ij (Eq. 6), the Laplacian's (with
-   re_laplacian), the explicit scheme's pair weight over |r_ij|^2; 0 beyond their radii. Counts the
-   pairs within re (a pair with a DUMMY particle has one entry, others two). */
+   re_laplacian), the explicit scheme's pair weight over |r_ij|^2; 0 beyond their radii. In the same
+   pass, the sums over them that every step needs: the number density n_i (seed 002 Eq. 7, every
+   neighbour, DUMMY included) and the surface flag (Eq. 14-16) of every FLUID and WALL particle, on
+   the surface when n_i < beta n0, or else when the asymmetry |F_i| of Eq. 15 exceeds alpha |F0|
+   (|F0|: the flat surface of the lattice, >>mps_desc). Counts the pairs within re (a pair with a
+   DUMMY particle has one entry, others two) and the surface particles. */
 static void fsdem__mps_weigh(fsdem_mps *s) {
     const int explicit_scheme = s->desc.scheme == FSDEM_MPS_SCHEME_EXPLICIT;
-    const fsdem_real re2 = s->re * s->re, inv_rx = 1 / s->re_x;
+    const fsdem_real re2 = s->re * s->re, inv_rx = 1 / s->re_x, fscale = (fsdem_real)s->dim / s->n0;
     long long twice = 0;
-    int i, e;
-    for (i = 0; i < s->n; ++i)
+    int i, e, surface = 0;
+    for (i = 0; i < s->n; ++i) {
+        fsdem_real nd = 0;
+        fsdem_vec3 F = fsdem__zero3(); /* -F_i of Eq. 15: the entries' separations are r_i - r_j */
         for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
             const int j = s->nb[e];
             const fsdem_vec3 d = fsdem__mps_sep(s, j, i);
             const fsdem_real r2 = fsdem__dot(d, d);
-            fsdem_real r, w;
+            fsdem_real r, w, we;
             if (!(r2 < re2)) { /* in the skin: every radius is at most re */
                 s->nbw[e] = s->nbl[e] = s->nbx[e] = 0;
                 continue;
@@ -218,12 +243,22 @@ static void fsdem__mps_weigh(fsdem_mps *s) {
             } else
                 s->nbx[e] = 0;
             twice += s->kind[j] == FSDEM_MPS_KIND_DUMMY ? 2 : 1;
+            we = w / s->eps[j];
+            nd += we;                                     /* seed 002 Eq. 7 */
+            if (r > 0) F = fsdem__madd(F, d, we / r);     /* seed 002 Eq. 15 */
         }
+        s->nd[i] = nd;
+        s->surf[i] = (unsigned char)(s->kind[i] != FSDEM_MPS_KIND_DUMMY &&
+                                     (nd < s->desc.beta * s->n0 ||                    /* seed 002 Eq. 14 */
+                                      fscale * fsdem__norm(F) > s->desc.alpha * s->f0)); /* Eq. 16 */
+        surface += s->surf[i];
+    }
     s->pair_count = twice / 2;
+    s->surface_count = surface;
 }
 
-/* The neighbour rows at the current positions with their weights (rebuilt when they no longer
-   hold). FSDEM_ERR_OUT_OF_MEMORY when a rebuild cannot grow the lists. */
+/* The neighbour rows at the current positions with their weights, the number density and the
+   surface (the rows rebuilt when they no longer hold). FSDEM_ERR_OUT_OF_MEMORY when a rebuild cannot grow the lists. */
 static fsdem_result fsdem__mps_neighbours(fsdem_mps *s) {
     if (!fsdem__mps_rows_hold(s) && fsdem__mps_build_rows(s) != FSDEM_OK) return FSDEM_ERR_OUT_OF_MEMORY;
     fsdem__mps_weigh(s);

@@ -1,33 +1,4 @@
-/* ---- >>mps_operators : number density, gradient, divergence, Laplacian, surface ---- */
-
-/* Number density n_i (seed 002 Eq. 7, every neighbour, DUMMY included) and the surface flag
-   (Eq. 14-16) of every FLUID and WALL particle, from the neighbour rows; returns the number of
-   surface particles. A particle is on the surface when n_i < beta n0, or else when the asymmetry
-   |F_i| of Eq. 15 exceeds alpha |F0| (|F0|: the flat surface of the lattice, >>mps_desc). */
-static int fsdem__mps_density(fsdem_mps *s) {
-    const fsdem_real fscale = (fsdem_real)s->dim / s->n0;
-    int i, e, surface = 0;
-    for (i = 0; i < s->n; ++i) {
-        fsdem_real nd = 0;
-        fsdem_vec3 F = fsdem__zero3();
-        s->nd[i] = 0;
-        s->surf[i] = 0;
-        if (s->kind[i] == FSDEM_MPS_KIND_DUMMY) continue;
-        for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
-            const int j = s->nb[e];
-            const fsdem_real we = s->nbw[e] / s->eps[j];
-            const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
-            const fsdem_real len = fsdem__norm(r);
-            nd += we;                                           /* seed 002 Eq. 7 */
-            if (len > 0) F = fsdem__madd(F, r, we / len);       /* seed 002 Eq. 15 */
-        }
-        s->nd[i] = nd;
-        s->surf[i] = (unsigned char)(nd < s->desc.beta * s->n0 ||                 /* seed 002 Eq. 14 */
-                                     fscale * fsdem__norm(F) > s->desc.alpha * s->f0); /* Eq. 16 */
-        surface += s->surf[i];
-    }
-    return surface;
-}
+/* ---- >>mps_operators : gradient, divergence, Laplacian ---- */
 
 /* The 3 x 3 matrix (rows) that turns the kernel sum of the gradient at particle i into the
    gradient: d/n0 times the identity for the forms of Eq. 8, the inverse of the moment matrix
@@ -145,23 +116,20 @@ static fsdem_real fsdem__mps_mass(const fsdem_mps *s) {
 
 /* The ghost velocities of FSDEM_MPS_WALL_VISCOSITY_NO_SLIP into s->uvisc (see the enum): FLUID particles
    their own velocity, WALL and DUMMY particles -u~, the Shepard average of the FLUID velocities
-   around them, gathered by scattering from the FLUID rows (the rows of DUMMY particles are empty);
-   0 where no FLUID particle is within re. */
+   around them, gathered by scattering from the FLUID rows' solid entries (the rows of DUMMY
+   particles are empty); 0 where no FLUID particle is within re. */
 static void fsdem__mps_wall_ghosts(fsdem_mps *s) {
-    int i, e;
+    int i, k;
     for (i = 0; i < s->n; ++i) {
         s->uvisc[i] = s->kind[i] == FSDEM_MPS_KIND_FLUID ? s->v[i] : fsdem__zero3();
         s->ghost_weight[i] = 0;
     }
-    for (i = 0; i < s->n; ++i)
-        if (s->kind[i] == FSDEM_MPS_KIND_FLUID)
-            for (e = s->nb_start[i]; e < s->nb_start[i + 1]; ++e) {
-                const int j = s->nb[e];
-                const fsdem_real w = s->nbw[e] / s->eps[i];
-                if (s->kind[j] == FSDEM_MPS_KIND_FLUID) continue;
-                s->uvisc[j] = fsdem__madd(s->uvisc[j], s->v[i], w);
-                s->ghost_weight[j] += w;
-            }
+    for (k = 0; k < s->wall_entry_n; ++k) {
+        const int f = s->wall_entries[2 * k], e = s->wall_entries[2 * k + 1], j = s->nb[e];
+        const fsdem_real w = s->nbw[e] / s->eps[f];
+        s->uvisc[j] = fsdem__madd(s->uvisc[j], s->v[f], w);
+        s->ghost_weight[j] += w;
+    }
     for (i = 0; i < s->n; ++i)
         if (s->ghost_weight[i] > 0) s->uvisc[i] = fsdem__scale(s->uvisc[i], -1 / s->ghost_weight[i]);
 }
@@ -172,7 +140,6 @@ static fsdem_result fsdem__mps_operator_setup(fsdem_mps *s, const char *fn, cons
     if (!in || !out) return fsdem__fail(&s->status, FSDEM_ERR_INVALID_ARG, "%s: NULL field", fn);
     if (s->n > 0 && fsdem__mps_neighbours(s) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "%s: out of memory building the neighbour list", fn);
-    if (s->n > 0) fsdem__mps_density(s);
     return FSDEM_OK;
 }
 

@@ -142,15 +142,16 @@ static void fsdem__mps_collide(fsdem_mps *s, fsdem_real dt) {
         if (s->kind[i] != FSDEM_MPS_KIND_FLUID) continue;
         for (k = s->nb_start[i]; k < s->nb_start[i + 1]; ++k) {
             const int j = s->nb[k], fluid = s->kind[j] == FSDEM_MPS_KIND_FLUID;
-            const fsdem_vec3 r = fsdem__mps_sep(s, i, j);
-            const fsdem_vec3 dv = fsdem__sub(s->v[j], s->v[i]);
-            const fsdem_vec3 ahead = fsdem__madd(r, dv, dt);
+            fsdem_vec3 r, dv, ahead, n;
             fsdem_real len, vn;
-            fsdem_vec3 n;
             if (fluid && j < i) continue; /* each FLUID pair once */
-            len = fsdem__norm(r);
+            r = fsdem__mps_sep(s, i, j);
+            dv = fsdem__sub(s->v[j], s->v[i]);
             vn = fsdem__dot(dv, r);
-            if (!(len > 0) || !(vn < 0) || !(fsdem__dot(ahead, ahead) < dc * dc)) continue;
+            if (!(vn < 0)) continue; /* not approaching (a pair at one point too: r = 0) */
+            ahead = fsdem__madd(r, dv, dt);
+            if (!(fsdem__dot(ahead, ahead) < dc * dc)) continue;
+            len = fsdem__norm(r);
             n = fsdem__scale(r, 1 / len);
             vn = (1 + e) * vn / len; /* (1 + e) times the approach speed along n, negative */
             if (fluid) {
@@ -393,7 +394,6 @@ static fsdem_result fsdem__mps_do_step(fsdem_mps *s, fsdem_real dt) {
     /* 1. neighbours, number density, free surface */
     if (fsdem__mps_neighbours(s) != FSDEM_OK)
         return fsdem__fail(&s->status, FSDEM_ERR_OUT_OF_MEMORY, "fsdem_mps: out of memory building the neighbour list");
-    s->surface_count = fsdem__mps_density(s);
     ts = clock();
     s->sec_search += (double)(ts - t0) / CLOCKS_PER_SEC;
     fsdem__mps_shift(s);

@@ -56,6 +56,8 @@ struct fsdem_mps {
     fsdem_real *nbw;              /* w_ij (Eq. 6; 0 beyond re) */
     fsdem_real *nbl;              /* w_ij of the Laplacian (Eq. 6 with re_laplacian; 0 beyond it) */
     fsdem_real *nbx;              /* the explicit scheme's pair weight over |r_ij|^2 (0 with the seed's) */
+    int *wall_entries, wall_entry_cap, wall_entry_n; /* (row, entry) of every WALL or DUMMY neighbour in a
+                                                        FLUID row, in row order (built with the rows) */
     fsdem_real skin;              /* the rows hold the pairs within re + skin (Verlet lists) */
     fsdem_vec3 *x_built;          /* positions the rows were built at */
     int rows_valid;               /* 0: particles were added, removed or restored since */

@@ -68,7 +68,7 @@ static void profile(const fsdem_mps *s, int dim, double width, double depth, dou
 /* Fluid h deep in a tank w wide (w x w in 3D), open at the top; the tank's walls rise 0.5 h above
    the water. Samples the sensors after every step. */
 static outcome run(int dim, double r0, double width, double depth, double gamma, const char *suffix) {
-    fsdem_mps_desc d = fsdem_mps_desc_default(dim);
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(dim, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_mps *s = NULL;
     fsdem_mps_particles p;
     fsdem_mps_stats st;
@@ -80,7 +80,6 @@ static outcome run(int dim, double r0, double width, double depth, double gamma,
     char csv_name[64];
     fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi, fill_hi, sensor, *start = NULL;
     int i, top_n = 0;
-    d.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(&o, 0, sizeof o);
     o.depth = depth;
     o.r0 = r0;

@@ -45,7 +45,7 @@ static void still_sense(const fsdem_mps *s, int dim, double width, double *p_mid
 }
 
 static void still_run(fsdem_mps_scheme scheme, int dim, double t_end, const char *csv_name, still_outcome *o) {
-    fsdem_mps_desc d = fsdem_mps_desc_default(dim);
+    fsdem_mps_desc d = fsdem_mps_desc_default_scheme(dim, scheme);
     const double width = dim == 3 ? 0.1 : 0.2;
     const fsdem_vec3 hi = dim == 3 ? fsdem_v3((fsdem_real)width, (fsdem_real)width, (fsdem_real)h) : fsdem_v3((fsdem_real)width, (fsdem_real)h, 0);
     const fsdem_vec3 wall_hi = dim == 3 ? fsdem_v3((fsdem_real)width, (fsdem_real)width, (fsdem_real)(2 * h)) : fsdem_v3((fsdem_real)width, (fsdem_real)(2 * h), 0);
@@ -54,7 +54,6 @@ static void still_run(fsdem_mps_scheme scheme, int dim, double t_end, const char
     fsdem_csv csv;
     int i, k, samples = (int)floor(t_end / sample + 0.5);
     memset(o, 0, sizeof *o);
-    d.scheme = scheme;
     d.r0 = (fsdem_real)r0;
     d.domain_min = fsdem_v3(-0.1f, -0.1f, dim == 3 ? -0.1f : 0);
     d.domain_max = fsdem_v3((fsdem_real)(width + 0.1), dim == 3 ? (fsdem_real)(width + 0.1) : 0.6f, dim == 3 ? 0.6f : 0);

@@ -68,7 +68,7 @@ static inline void sd_destroy(sd_case *c) {
 /* Builds the case at MPS spacing r0 (m), model A or B, with (sediment = 1) or without the bed.
    Returns 0, or -1 with the reason in c->error. */
 static inline int sd_create(sd_case *c, double r0, fsdem_mps_model model, int sediment) {
-    fsdem_mps_desc md = fsdem_mps_desc_default(3);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(3, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
@@ -78,7 +78,6 @@ static inline int sd_create(sd_case *c, double r0, fsdem_mps_model model, int se
     memset(c, 0, sizeof *c);
     c->r0 = r0;
     c->sediment = sediment;
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     md.r0 = (fsdem_real)r0;
     md.model = model;
     md.domain_min = fsdem_v3(-0.02, -0.02, -0.02);

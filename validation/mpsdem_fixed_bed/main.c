@@ -47,7 +47,7 @@ static int bed_run_go(bed_run *r, double relaxations, FILE *history) {
     const double P = r->n * r0, a_f = P / r->n_f, phi = 1 - r->eps;
     const int M = (int)floor(P / (d_target / cbrt(3 * phi / PI)) + 0.5); /* BCC: phi = 2 (pi/6) d^3 / b^3 */
     const double b = P / M, d = b * cbrt(3 * phi / PI);
-    fsdem_mps_desc md = fsdem_mps_desc_default(3);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(3, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
@@ -59,7 +59,6 @@ static int bed_run_go(bed_run *r, double relaxations, FILE *history) {
     int i, j, k, n = 0, samples = 0, material, ok = 1;
     double t_end;
     clock_t t0 = clock();
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     r->d = d;
     r->period = P;
     r->spheres = 2 * M * M * M;

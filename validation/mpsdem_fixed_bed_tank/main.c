@@ -63,7 +63,7 @@ int main(int argc, char **argv) {
     const double eps_pack = 1 - PI / 6, V = PI / 6 * d * d * d;
     double t_end, t_start, z_bed0;
     int below;
-    fsdem_mps_desc md = fsdem_mps_desc_default(3);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(3, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
@@ -76,7 +76,6 @@ int main(int argc, char **argv) {
     double z, top, sum = 0, sum2 = 0, T = 0, next = 0, next_prof = 0, eps_core = 0;
     double s_drag = 0, s_drag_eps = 0, s_us_core = 0, s_us_wall = 0, s_eps_bed = 0;
     double prof_axis[NPROF] = {0}, prof_wall[NPROF] = {0};
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     vc_begin(CASE, argc, argv, NULL);
     t_end = vc_option_num("--t-end", vc_full() ? T_END : T_END_DEFAULT);
     t_start = vc_option_num("--t-start", T_START);

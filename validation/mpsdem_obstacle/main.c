@@ -63,7 +63,7 @@ static void run_case(int k, int cells, double t_end, double radius, outcome *o) 
     const int ny = (int)floor(tank_w / r0 + 0.5), nx_col = (int)floor(col_len / r0 + 0.5), nz = (int)floor(col_h / r0 + 0.5);
     const double W = ny * r0, Lcol = nx_col * r0, Hcol = nz * r0, x0 = tank_len - Lcol;
     const double Hbed = layers[k] * 2 * R, eps_bed = 1 - 3.14159265358979323846 / 6; /* simple cubic packing */
-    fsdem_mps_desc md = fsdem_mps_desc_default(3);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(3, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
@@ -78,7 +78,6 @@ static void run_case(int k, int cells, double t_end, double radius, outcome *o) 
     fsdem_real dt_dem = 0;
     static double ts[MAX_SAMPLES], fx[MAX_SAMPLES];
     int ns = 0, a;
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(o, 0, sizeof *o);
     o->peak = o->raw_peak = o->solid_peak = o->p1_peak = -1;
     md.r0 = (fsdem_real)r0;

@@ -62,7 +62,7 @@ static double vlen(fsdem_vec3 v) { return sqrt((double)v.x * v.x + (double)v.y *
 static outcome run(const setup *S, fsdem_mps_model model) {
     const char tag = model == FSDEM_MPS_MODEL_A ? 'A' : 'B';
     const double r0 = S->r0, R = S->R, pad = 6 * r0;
-    fsdem_mps_desc md = fsdem_mps_desc_default(3);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(3, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
@@ -77,7 +77,6 @@ static outcome run(const setup *S, fsdem_mps_model model) {
     char name[64];
     int i, j, k, mat_id, n_out, n_avg = 0, n_end = 0;
     double prev_ke = -1, t0, sp = 0, sp2 = 0, sd = 0, sz = 0;
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(&o, 0, sizeof o);
     o.pres_z_min_end = 1e30;
     o.pres_z_max_end = -1e30;

@@ -128,7 +128,7 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
     const double W = WIDTH * r0, pad = 6 * r0, V = PI / 6 * d * d * d;
     double eps0 = 1 - phi;
     const double re = 4.1 * r0, x_lo = re, x_hi = W - re;
-    fsdem_mps_desc md = fsdem_mps_desc_default(3);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(3, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
     fsdem_dem_desc dd = fsdem_dem_desc_default(3);
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
@@ -141,7 +141,6 @@ static outcome run(double phi, fsdem_drag_law law, double ut, const char *csv_na
     fsdem_csv csv;
     int i, j, k, nf = 0, layers, nx, nz, material;
     double z_susp, a, ax, az, next = 0, sv = 0, sv2 = 0, su = 0, se = 0, sn = 0;
-    md.scheme = FSDEM_MPS_SCHEME_SEMI_IMPLICIT; /* the seed's scheme */
     memset(&o, 0, sizeof o);
     memset(prof, 0, sizeof prof);
     memset(lat, 0, sizeof lat);
