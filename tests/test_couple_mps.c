@@ -13,13 +13,13 @@ typedef struct test_pair {
     int material;
 } test_pair;
 
-/* An MPS of spacing r0 (model A or B, kinematic viscosity nu) over [lo, hi] filled with water to
-   `depth` inside box walls (open top) when depth > 0, a DEM of the same dim and gravity with one
-   material of density rho_s, and their coupler. */
-static test_pair test_pair_new(int dim, double r0, fsdem_mps_model model, double nu, fsdem_vec3 lo, fsdem_vec3 hi,
-                               double depth, double rho_s) {
+/* An MPS of `scheme` and spacing r0 (model A or B, kinematic viscosity nu) over [lo, hi] filled
+   with water to `depth` inside box walls (open top) when depth > 0, a DEM of the same dim and
+   gravity with one material of density rho_s, and their coupler. */
+static test_pair test_pair_of(fsdem_mps_scheme scheme, int dim, double r0, fsdem_mps_model model, double nu, fsdem_vec3 lo,
+                              fsdem_vec3 hi, double depth, double rho_s) {
     test_pair t;
-    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(dim, FSDEM_MPS_SCHEME_SEMI_IMPLICIT);
+    fsdem_mps_desc md = fsdem_mps_desc_default_scheme(dim, scheme);
     fsdem_dem_desc dd = fsdem_dem_desc_default(dim);
     fsdem_dem_material mat = fsdem_dem_material_default();
     fsdem_mps_dem_desc cd = fsdem_mps_dem_desc_default();
@@ -50,6 +50,12 @@ static test_pair test_pair_new(int dim, double r0, fsdem_mps_model model, double
     cd.dem = t.dem;
     ck_assert_int_eq(fsdem_mps_dem_create(&cd, &t.cpl), FSDEM_OK);
     return t;
+}
+
+/* The same with the seed's scheme, with which the coupler was validated (validation/mpsdem_*). */
+static test_pair test_pair_new(int dim, double r0, fsdem_mps_model model, double nu, fsdem_vec3 lo, fsdem_vec3 hi,
+                               double depth, double rho_s) {
+    return test_pair_of(FSDEM_MPS_SCHEME_SEMI_IMPLICIT, dim, r0, model, nu, lo, hi, depth, rho_s);
 }
 
 static void test_pair_free(test_pair *t) {
@@ -208,42 +214,45 @@ static void test_audit_agrees(test_pair *t, fsdem_vec3 fluid, fsdem_vec3 solid, 
 
 /* Eq. 36: every exchanged force is split into shares that sum to one, so the fluid gets exactly
    minus what the solids get, to rounding (a few eps of the sum of magnitudes), at every step, in
-   both models and both dims, with moving water and particles of several sizes. */
+   both models, both dims and both MPS schemes, with moving water and particles of several sizes. */
 START_TEST(test_mps_dem_momentum_exchange) {
     const double r0 = 0.01;
-    int dim, model;
-    for (dim = 2; dim <= 3; ++dim)
-        for (model = 0; model <= 1; ++model) {
-            const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3(0.1f, 0.1f, dim == 3 ? 0.1f : 0);
-            test_pair t = test_pair_new(dim, r0, (fsdem_mps_model)model, 1e-6, lo, hi, 0.06, 2500);
-            fsdem_mps_particles mv = fsdem_mps_get_particles(t.mps);
-            int i, step;
-            for (i = 0; i < mv.count; ++i)
-                if (mv.kind[i] == FSDEM_MPS_KIND_FLUID) mv.velocity[i] = fsdem_v3((fsdem_real)(0.05 * sin(40 * mv.position[i].y)), 0, 0);
-            for (i = 0; i < 40; ++i) {
-                const double s = i * 0.618034;
-                const fsdem_vec3 x = fsdem_v3((fsdem_real)(0.02 + 0.06 * (s - floor(s))), (fsdem_real)(0.01 + 0.0011 * i),
-                                              dim == 3 ? (fsdem_real)(0.02 + 0.06 * fmod(s * 1.7, 1.0)) : 0);
-                fsdem_vec3 y = x;
-                if (dim == 3) y.y = (fsdem_real)(0.02 + 0.06 * fmod(s * 2.3, 1.0)), y.z = x.y;
-                test_add_sphere(&t, y, fsdem_v3((fsdem_real)(0.01 * (i % 3)), 0, 0), (0.0008 + 0.00005 * (i % 5)));
+    int dim, model, scheme;
+    for (scheme = 0; scheme < 2; ++scheme)
+        for (dim = 2; dim <= 3; ++dim)
+            for (model = 0; model <= 1; ++model) {
+                const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3(0.1f, 0.1f, dim == 3 ? 0.1f : 0);
+                test_pair t = test_pair_of(scheme ? FSDEM_MPS_SCHEME_EXPLICIT : FSDEM_MPS_SCHEME_SEMI_IMPLICIT, dim, r0,
+                                           (fsdem_mps_model)model, 1e-6, lo, hi, 0.06, 2500);
+                fsdem_mps_particles mv = fsdem_mps_get_particles(t.mps);
+                int i, step;
+                for (i = 0; i < mv.count; ++i)
+                    if (mv.kind[i] == FSDEM_MPS_KIND_FLUID) mv.velocity[i] = fsdem_v3((fsdem_real)(0.05 * sin(40 * mv.position[i].y)), 0, 0);
+                for (i = 0; i < 40; ++i) {
+                    const double s = i * 0.618034;
+                    const fsdem_vec3 x = fsdem_v3((fsdem_real)(0.02 + 0.06 * (s - floor(s))), (fsdem_real)(0.01 + 0.0011 * i),
+                                                  dim == 3 ? (fsdem_real)(0.02 + 0.06 * fmod(s * 1.7, 1.0)) : 0);
+                    fsdem_vec3 y = x;
+                    if (dim == 3) y.y = (fsdem_real)(0.02 + 0.06 * fmod(s * 2.3, 1.0)), y.z = x.y;
+                    test_add_sphere(&t, y, fsdem_v3((fsdem_real)(0.01 * (i % 3)), 0, 0), (0.0008 + 0.00005 * (i % 5)));
+                }
+                for (step = 0; step < 5; ++step) {
+                    fsdem_vec3 fluid, solid;
+                    double scale;
+                    ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
+                    test_exchange_sums(&t, (fsdem_mps_model)model, &fluid, &solid, &scale);
+                    TEST_REPORT("%s, dim %d model %c step %d: |sum fluid + sum solid| = %.2e N of %.2e", scheme ? "explicit" : "seed's",
+                                dim, "AB"[model], step,
+                                fabs(fluid.x + solid.x) + fabs(fluid.y + solid.y) + fabs(fluid.z + solid.z), scale);
+                    ck_assert_msg(scale > 0, "no exchange");
+                    test_audit_agrees(&t, fluid, solid, scale);
+                    ck_assert_msg(fabs(fluid.x + solid.x) + fabs(fluid.y + solid.y) + fabs(fluid.z + solid.z) < 64 * TEST_EPS * scale,
+                                  "dim %d model %d: fluid (%g, %g, %g) solid (%g, %g, %g)", dim, model, (double)fluid.x, (double)fluid.y,
+                                  (double)fluid.z, (double)solid.x, (double)solid.y, (double)solid.z);
+                    ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK);
+                }
+                test_pair_free(&t);
             }
-            for (step = 0; step < 5; ++step) {
-                fsdem_vec3 fluid, solid;
-                double scale;
-                ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
-                test_exchange_sums(&t, (fsdem_mps_model)model, &fluid, &solid, &scale);
-                TEST_REPORT("dim %d model %c step %d: |sum fluid + sum solid| = %.2e N of %.2e", dim, "AB"[model], step,
-                            fabs(fluid.x + solid.x) + fabs(fluid.y + solid.y) + fabs(fluid.z + solid.z), scale);
-                ck_assert_msg(scale > 0, "no exchange");
-                test_audit_agrees(&t, fluid, solid, scale);
-                ck_assert_msg(fabs(fluid.x + solid.x) + fabs(fluid.y + solid.y) + fabs(fluid.z + solid.z) < 64 * TEST_EPS * scale,
-                              "dim %d model %d: fluid (%g, %g, %g) solid (%g, %g, %g)", dim, model, (double)fluid.x, (double)fluid.y,
-                              (double)fluid.z, (double)solid.x, (double)solid.y, (double)solid.z);
-                ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK);
-            }
-            test_pair_free(&t);
-        }
 }
 END_TEST
 
@@ -259,10 +268,12 @@ END_TEST
    rounds the velocity once (K + 16 eps of g dt). */
 START_TEST(test_mps_dem_rest_in_still_water) {
     const double r0 = 0.01, R = 0.002, rho = 1000, g = 9.81;
-    int model;
-    for (model = 0; model <= 1; ++model) {
+    int k;
+    for (k = 0; k < 4; ++k) { /* models A and B with the seed's scheme, then with the explicit one */
+        const int model = k % 2;
+        const fsdem_mps_scheme scheme = k < 2 ? FSDEM_MPS_SCHEME_SEMI_IMPLICIT : FSDEM_MPS_SCHEME_EXPLICIT;
         const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3(0.12f, 0.12f, 0.2f);
-        test_pair t = test_pair_new(3, r0, (fsdem_mps_model)model, 1e-6, lo, hi, 0.16, 2500);
+        test_pair t = test_pair_of(scheme, 3, r0, (fsdem_mps_model)model, 1e-6, lo, hi, 0.16, 2500);
         const double V = 4.0 / 3.0 * TEST_PI * R * R * R;
         fsdem_mps_dem_force f;
         int step;
@@ -289,7 +300,8 @@ START_TEST(test_mps_dem_rest_in_still_water) {
             dt = fsdem_mps_dem_get_stats(t.cpl).coupling.dt;
             k = (double)fsdem_mps_dem_get_stats(t.cpl).coupling.substeps + 16;
             dv = fsdem_dem_get_particles(t.dem);
-            TEST_REPORT("model B, one step of %.3e s in %lld substeps: v = %.9e m/s (Archimedes %.9e), neutral %.2e m/s", dt,
+            TEST_REPORT("%s, model B, one step of %.3e s in %lld substeps: v = %.9e m/s (Archimedes %.9e), neutral %.2e m/s",
+                        k < 2 ? "seed's" : "explicit", dt,
                         fsdem_mps_dem_get_stats(t.cpl).coupling.substeps, (double)dv.velocity[0].z, -g * (1 - rho / 2500) * dt,
                         (double)dv.velocity[1].z);
             ck_assert_msg(fabs(dv.velocity[0].z + 0.6 * g * dt) <= k * TEST_EPS * g * dt, "sphere of 2500 kg/m^3: %.9e m/s",
@@ -303,7 +315,8 @@ START_TEST(test_mps_dem_rest_in_still_water) {
             ck_assert_int_eq(fsdem_mps_dem_step(t.cpl), FSDEM_OK); /* Model A needs a pressure field */
             ck_assert_int_eq(fsdem_mps_dem_update(t.cpl), FSDEM_OK);
             ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, 0, &f), FSDEM_OK);
-            TEST_REPORT("model A step %d: drag %.3e N, pressure part %.6e N vs rho g V %.6e N (%.2f%%)", step, (double)f.drag.z,
+            TEST_REPORT("%s, model A step %d: drag %.3e N, pressure part %.6e N vs rho g V %.6e N (%.2f%%)",
+                        k < 2 ? "seed's" : "explicit", step, (double)f.drag.z,
                         (double)f.pressure.z, rho * g * V, 100 * (f.pressure.z / (rho * g * V) - 1));
             ck_assert_msg(fabs(f.pressure.z / (rho * g * V) - 1) < 0.05, "Model A buoyancy %g vs %g", (double)f.pressure.z, rho * g * V);
             ck_assert_msg(fabs(f.pressure.x) + fabs(f.pressure.y) < 0.05 * rho * g * V, "sideways pressure force");
@@ -343,7 +356,7 @@ static double test_terminal(double eps, double d, double rho_s, double rho, doub
    radius about r_e / 2, not to have set that blob moving: in Stokes flow it would reach about
    d / r_e of the sphere's speed (6%) after the viscous time (r_e / 2)^2 / nu = 0.6 s, far longer
    than the runs here (about 0.01-0.15 s after release; the fluid at the sphere is reported).
-   Model B (the seed's choice); 3D.
+   Model B (the seed's choice); 3D; each case with both MPS schemes.
    (light: Re 0.1 alone, its sphere released at once into the water at rest: the 0.1 s of settling
    are nine tenths of the run's steps, and the still-water noise, which starts in the surface band,
    does not reach the sphere 10 r0 below it in the 0.01 s to its terminal velocity (measured
@@ -354,11 +367,13 @@ START_TEST(test_mps_dem_terminal_velocity) {
     } cases[] = {{1e-4, 0.00107, 0.004, 0.05, 0.2, 0.1}, {1e-6, 0.0003, 0.004, 5, 20, 0.1}, {1e-6, 0.0009, 0.004, 50, 200, 0.1}};
     const double rho = 1000, rho_s = 2500, g = 9.81;
     const int light = test_light();
-    int c;
-    for (c = 0; c < (light ? 1 : 3); ++c) {
+    int k;
+    for (k = 0; k < (light ? 2 : 6); ++k) { /* each case with the seed's scheme, then with the explicit one */
+        const int c = k / 2;
+        const fsdem_mps_scheme scheme = k % 2 ? FSDEM_MPS_SCHEME_EXPLICIT : FSDEM_MPS_SCHEME_SEMI_IMPLICIT;
         const double r0 = cases[c].r0, d = cases[c].d, mu = rho * cases[c].nu;
         const fsdem_vec3 lo = fsdem_v3(0, 0, 0), hi = fsdem_v3((fsdem_real)(8 * r0), (fsdem_real)(8 * r0), (fsdem_real)(30 * r0));
-        test_pair t = test_pair_new(3, r0, FSDEM_MPS_MODEL_B, cases[c].nu, lo, hi, 28 * r0, rho_s);
+        test_pair t = test_pair_of(scheme, 3, r0, FSDEM_MPS_MODEL_B, cases[c].nu, lo, hi, 28 * r0, rho_s);
         fsdem_mps_dem_force f;
         double ut, w, Re, tau, t_end, sim = 0;
         fsdem_dem_particles dv;
@@ -385,8 +400,9 @@ START_TEST(test_mps_dem_terminal_velocity) {
         w = -dv.velocity[0].z;
         ck_assert_int_eq(fsdem_mps_dem_get_force(t.cpl, 0, &f), FSDEM_OK);
         TEST_REPORT("water settled %.1f s, fastest particle then %.2e m/s", settle, umax);
-        TEST_REPORT("Re %.3g: terminal %.5f m/s (force balance), measured %.5f m/s (%+.2f%%), fluid at the sphere %.2e m/s, eps %.6f, %.2f s",
-                    Re, ut, w, 100 * (w / ut - 1), (double)f.fluid_velocity.z, (double)f.porosity, sim);
+        TEST_REPORT("%s, Re %.3g: terminal %.5f m/s (force balance), measured %.5f m/s (%+.2f%%), fluid at the sphere %.2e m/s, eps "
+                    "%.6f, %.2f s",
+                    k % 2 ? "explicit" : "seed's", Re, ut, w, 100 * (w / ut - 1), (double)f.fluid_velocity.z, (double)f.porosity, sim);
         ck_assert_msg(Re > cases[c].Re_lo && Re < cases[c].Re_hi, "case %d: Re %g", c, Re);
         ck_assert_msg(fabs(w / ut - 1) < 0.03, "case %d (Re %g): %g m/s vs %g m/s", c, Re, w, ut);
         test_pair_free(&t);
