@@ -191,7 +191,7 @@ static fsdem__periods fsdem__periods_of(const int periodic[3], int dim, fsdem_ve
 }
 
 /* The minimum image of a separation e. */
-static inline fsdem_vec3 fsdem__min_image(const fsdem__periods *p, fsdem_vec3 e) {
+static fsdem_vec3 fsdem__min_image(const fsdem__periods *p, fsdem_vec3 e) {
     if (p->any) {
         e.x -= p->length[0] * (fsdem_real)floor(e.x * p->inv[0] + (fsdem_real)0.5);
         e.y -= p->length[1] * (fsdem_real)floor(e.y * p->inv[1] + (fsdem_real)0.5);
