@@ -282,6 +282,39 @@ START_TEST(test_gic_virtual_mass_inertia) {
 }
 END_TEST
 
+/* The drag limit from the first step (>>couple_gic): a granule of diameter d released at rest in
+   still water falls towards the terminal slip s_t of Eq. 5b, (rho_s - rho) g = 18 mu rho s_t^2 / d
+   (mu = 0.44), with the relaxation time tau_t = m / (c(s_t) V) = rho_s d / (18 mu rho s_t). The
+   drag of Eq. 5b is 0 at zero slip, so the slip against the water at the step's start gives no
+   limit: the first stable step was the PIC's 5 ms, 1.5 tau_t for d = 0.2 mm. It must be at most
+   drag_dt_fraction tau_t (the slip the step reaches, g x 5 ms = 0.05 m/s, exceeds s_t = 0.019 m/s,
+   so the relaxation time at it is below tau_t), and once the granule falls at its terminal slip (no
+   acceleration) the limit is drag_dt_fraction tau(slip) again, at least 0.9 of drag_dt_fraction
+   tau_t (the water it drags along only lowers its slip). */
+START_TEST(test_gic_first_step_resolves_the_drag_relaxation) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        const double rho_s = 2500, d = 2e-4, mu = 0.44;
+        const double st = sqrt((rho_s - RHO) * G * d / (18 * mu * RHO)), tau = rho_s * d / (18 * mu * RHO * st);
+        gic_tank t = make_gic(dim, 0.1, 0.01, 0.08, rho_s);
+        const double f = (double)fsdem_gic_get_desc(t.gic).drag_dt_fraction;
+        fsdem_real first = 0, late = 0;
+        add_granule(&t, dim == 2 ? fsdem_v3((fsdem_real)0.051, (fsdem_real)0.053, 0) : fsdem_v3((fsdem_real)0.051, (fsdem_real)0.047, (fsdem_real)0.053),
+                    d / 2, 0, fsdem_v3(0, 0, 0));
+        ck_assert_int_eq(fsdem_gic_update(t.gic), FSDEM_OK);
+        ck_assert_int_eq(fsdem_gic_stable_dt(t.gic, &first), FSDEM_OK);
+        ck_assert_int_eq(fsdem_gic_advance(t.gic, (fsdem_real)(10 * tau), NULL), FSDEM_OK);
+        ck_assert_int_eq(fsdem_gic_stable_dt(t.gic, &late), FSDEM_OK);
+        TEST_REPORT("%dD: s_t %.4g m/s, tau_t %.4g s: first stable step %.4g s (%.3f tau_t), after 10 tau_t %.4g s (%.3f tau_t), fall speed %.4g m/s",
+                    dim, st, tau, (double)first, (double)first / tau, (double)late, (double)late / tau,
+                    -test_up(fsdem_dem_get_particles(t.dem).velocity[0], dim));
+        ck_assert_msg((double)first <= f * tau, "%dD: first step %g s, above %g tau_t = %g s", dim, (double)first, f, f * tau);
+        ck_assert_msg((double)late >= 0.9 * f * tau, "%dD: step %g s at the terminal slip, below 0.9 x %g tau_t", dim, (double)late, f);
+        free_gic(&t);
+    }
+}
+END_TEST
+
 /* A saved coupler goes on bit for bit: the granules' and the water's states after three more steps
    from the restored state equal those of the uninterrupted run. */
 START_TEST(test_gic_restart_bit_for_bit) {
@@ -574,6 +607,7 @@ Suite *couple_gic_suite(void) {
     tcase_add_test(tc, test_gic_still_water_over_a_fixed_bed);
     tcase_add_test(tc, test_gic_momentum_exchange_exact);
     tcase_add_test(tc, test_gic_virtual_mass_inertia);
+    tcase_add_test(tc, test_gic_first_step_resolves_the_drag_relaxation);
     tcase_add_test(tc, test_gic_restart_bit_for_bit);
     tcase_add_test(tc, test_gic_bad_input);
     tcase_add_test(tc, test_gic_refused_step_changes_nothing);

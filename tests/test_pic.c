@@ -110,6 +110,47 @@ START_TEST(still_water_apic_quadratic_stays_still) {
 }
 END_TEST
 
+/* Still water with the library's defaults (issue 38: a user's tank with the seeding of the day,
+   jitter 0.5, reached 3.7 cm/s at 0.07 s and 0.9 mm/s at 1 s, faster than fine sand settles): the
+   default seeds lie on the sub-cell lattice, so the surface is flat and the tank stays at rest, at
+   most 1 mm/s at every step to 1 s (the issue's line; the bound of check_still is far below it).
+   The jittered seeding is reported beside it, not checked. */
+static double still_default_peak(int dim, double jitter) {
+    fsdem_pic_desc d = fsdem_pic_desc_default(dim);
+    fsdem_pic *s = NULL;
+    double peak = 0;
+    d.cell_size = (fsdem_real)0.02;
+    d.domain_max = dim == 2 ? fsdem_v3((fsdem_real)0.4, (fsdem_real)0.3, 0) : fsdem_v3((fsdem_real)0.2, (fsdem_real)0.2, (fsdem_real)0.3);
+    if (jitter >= 0) d.jitter = (fsdem_real)jitter;
+    ck_assert_int_eq(fsdem_pic_create(&d, &s), FSDEM_OK);
+    ck_assert_int_eq(fsdem_pic_fill_box(s, fsdem_v3(0, 0, 0), dim == 2 ? fsdem_v3((fsdem_real)0.4, (fsdem_real)0.2, 0) : fsdem_v3((fsdem_real)0.2, (fsdem_real)0.2, (fsdem_real)0.2),
+                                        fsdem_v3(0, 0, 0), NULL),
+                     FSDEM_OK);
+    while (fsdem_pic_time(s) < 1) {
+        fsdem_pic_particles p;
+        int i;
+        ck_assert_int_eq(fsdem_pic_step(s), FSDEM_OK);
+        p = fsdem_pic_get_particles(s);
+        for (i = 0; i < p.count; ++i) {
+            const double v = sqrt((double)(p.velocity[i].x * p.velocity[i].x + p.velocity[i].y * p.velocity[i].y + p.velocity[i].z * p.velocity[i].z));
+            if (v > peak) peak = v;
+        }
+    }
+    fsdem_pic_destroy(s);
+    return peak;
+}
+
+START_TEST(still_water_with_the_default_seeding_stays_still) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        const double peak = still_default_peak(dim, -1), jittered = still_default_peak(dim, 0.5);
+        TEST_REPORT("%dD, defaults (jitter %g): peak particle speed %.3g m/s to 1 s; seeds jittered by 0.5: %.3g m/s", dim,
+                    (double)fsdem_pic_desc_default(dim).jitter, peak, jittered);
+        ck_assert_msg(peak <= 1e-3, "%dD: still water with the defaults reached %g m/s", dim, peak);
+    }
+}
+END_TEST
+
 /* Still water around submerged obstacles (2D: a disc and a wedge polygon; 3D: a sphere and a
    horizontal cylinder) stays still: the cut-cell fractions E, the solid fluxes and the fluid
    fraction next to solids are consistent with the hydrostatic state. */
@@ -874,6 +915,7 @@ Suite *pic_suite(void) {
     tcase_set_timeout(tc, 60);
     tcase_add_test(tc, still_water_2d_stays_still);
     tcase_add_test(tc, still_water_3d_stays_still);
+    tcase_add_test(tc, still_water_with_the_default_seeding_stays_still);
     tcase_add_test(tc, still_water_apic_quadratic_stays_still);
     tcase_add_test(tc, still_water_around_obstacles_stays_still);
     tcase_add_test(tc, projection_is_discretely_divergence_free);

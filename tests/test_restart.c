@@ -208,6 +208,7 @@ static fsdem_pic_desc pic_desc(int dim, int apic, double cell) {
     d.domain_max = fsdem_v3(1.0, dim == 3 ? 0.4 : 0.5, dim == 3 ? 0.5 : 0);
     d.cell_size = (fsdem_real)cell;
     d.min_particles_per_cell = d.particles_per_cell;
+    d.jitter = (fsdem_real)0.5; /* seeds off the lattice: the reseeding (and its random stream) then works */
     if (apic) {
         d.transfer = FSDEM_PIC_TRANSFER_APIC;
         d.kernel = FSDEM_PIC_KERNEL_QUADRATIC;

@@ -35,6 +35,7 @@ struct fsdem_gic {
     fsdem_real h, dt_now;
     long long substeps_now, calls;
     int failed;                    /* an evaluation failed (its message is in status) */
+    int water_at_rest;             /* the PIC has not stepped: no pressure solved yet */
     fsdem__gic_tally tally, last;  /* of the step under way, of the last step */
     fsdem_real max_solid, solid_volume;
 };
@@ -270,7 +271,7 @@ static void fsdem__gic_fluid_accelerations(fsdem_gic *c) {
     const fsdem_vec3 g = fsdem_pic_get_desc(c->desc.pic).gravity;
     int i;
     if (!c->desc.virtual_mass) return;
-    if (fsdem_pic_get_stats(c->desc.pic).steps == 0) {
+    if (c->water_at_rest) {
         for (i = 0; i < P.count; ++i) c->fluid_accel[i] = fsdem__zero3();
         return;
     }
@@ -297,7 +298,7 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
     for (i = 0; i < P.count; ++i) c->point[i] = P.position[i];
     res = fsdem_pic_sample(c->desc.pic, P.count, c->point, c->sample);
     if (res != FSDEM_OK) return fsdem__fail(&c->head.status, res, "fsdem_gic: %s", fsdem_pic_last_error(c->desc.pic));
-    if (fsdem_pic_get_stats(c->desc.pic).steps == 0) /* no pressure solved yet: the water's at rest */
+    if (c->water_at_rest) /* no pressure solved yet */
         for (i = 0; i < P.count; ++i) c->sample[i].pressure_gradient = fsdem__scale(fsdem_pic_get_desc(c->desc.pic).gravity, c->rho);
     for (i = 0; i < P.count; ++i) {
         char why[FSDEM__MESSAGE_SIZE];
@@ -361,25 +362,32 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
    water at rest), from the water of the last step: a granule's own, m_i / (s c V_i), and the
    water's in each cell, rho alpha_f' dx^dim / sum_i s c_i V_i N_i over the granules' kernel
    weights there (the rate at which their drag relaxes it: the cell's share of the exchange over
-   its water's mass, with the capped porosity and overlapping granules as they are). */
+   its water's mass, with the capped porosity and overlapping granules as they are). c is taken at
+   the slip the granule reaches within the horizon at its present acceleration,
+   |u - v_i| + horizon |(F_c + F_ext) / m_i + g| (the drag's growth only slows it): a law whose
+   drag vanishes at zero slip (Eq. 5b) gave a granule released from rest no limit, and the first
+   step ran two relaxation times; a granule resting on a bed or falling at its terminal speed has
+   no acceleration and keeps its slip. */
 static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
+    const fsdem_vec3 g = fsdem_dem_get_desc(c->desc.dem).gravity;
     fsdem_real shortest = 0;
     int i, k, q0, q1, q2;
     memset(c->rate, 0, sizeof(fsdem_real) * (size_t)c->grid.ncell);
     for (i = 0; i < P.count; ++i) {
         fsdem_fluid_sample here, ahead;
         const fsdem_vec3 x = P.position[i], y = fsdem__madd(x, P.velocity[i], horizon);
-        const fsdem_real volume = fsdem__gic_volume(c, P.radius[i]);
-        fsdem_real cv = 0, t;
+        const fsdem_vec3 load = P.external_force ? fsdem__add(P.force[i], P.external_force[i]) : P.force[i];
+        const fsdem_real volume = fsdem__gic_volume(c, P.radius[i]), gain = horizon * fsdem__norm(fsdem__madd(g, load, 1 / P.mass[i]));
+        fsdem_real cv = 0, t, slip;
         fsdem__kernel kw;
         if (P.fixed[i] || fsdem_pic_sample(c->desc.pic, 1, &x, &here) != FSDEM_OK || fsdem_pic_sample(c->desc.pic, 1, &y, &ahead) != FSDEM_OK)
             continue;
         if (!(here.volume_fraction > 0) && !(ahead.volume_fraction > 0)) continue;
         if (!(here.volume_fraction > 0)) here.velocity = fsdem__zero3();
+        slip = fsdem__norm(fsdem__sub(here.velocity, P.velocity[i])) + gain;
         if (fsdem_drag_coefficient(c->desc.drag, fsdem__gic_porosity_at(c, here.volume_fraction > 0 ? x : y), 2 * P.radius[i],
-                                   fsdem__norm(fsdem__sub(here.velocity, P.velocity[i])), c->rho, c->mu > 0 ? c->mu : 1,
-                                   &cv, NULL, NULL, 0) != FSDEM_OK ||
+                                   slip < FSDEM_MAX_SPEED ? slip : FSDEM_MAX_SPEED, c->rho, c->mu > 0 ? c->mu : 1, &cv, NULL, NULL, 0) != FSDEM_OK ||
             !(cv > 0))
             continue;
         cv *= c->desc.drag_scale;
@@ -455,6 +463,7 @@ static fsdem_result fsdem__gic_sand(fsdem_coupler *head, fsdem_real dt) {
     c->dt_now = dt;
     c->calls = 0;
     c->failed = 0;
+    c->water_at_rest = fsdem_pic_get_stats(c->desc.pic).steps == 0; /* once a step: the stats sum over the PIC */
     memset(&c->tally, 0, sizeof c->tally);
     c->tally.drag_dt = fsdem__gic_drag_time(c, dt);
     fsdem__gic_fluid_accelerations(c);

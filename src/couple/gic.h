@@ -49,8 +49,11 @@
    (Eq. 33) is the PIC's, at most desc.cfl dx / max |v_i| and desc.max_dt_ratio times the DEM's dt
    (1000 in the seed), and at most desc.drag_dt_fraction of the shortest drag relaxation time of a
    granule, m_i / (s c V_i), or of the water round it, alpha_f rho / (alpha_s s c), since the
-   exchange is explicit for the water: c at the granule's slip against the water of the last step,
-   for the granules in the water and those that reach it within the step (against water at rest).
+   exchange is explicit for the water: c at the granule's slip against the water of the last step
+   plus what its present acceleration (contacts, loads and gravity) adds within the step, for the
+   granules in the water and those that reach it within the step (against water at rest); a
+   granule released from rest, whose drag of Eq. 5b is 0 at zero slip, is so limited from the first
+   step on.
    Ownership: the coupler claims the PIC's porosity and its accelerations (it zeroes them at the start
    of every step, fsdem_pic_clear_forces) and the DEM's external forces (>>couple); a resolved
    PIC-DEM on the same PIC, with its own DEM, steps with it (fsdem_coupled_step).

@@ -20,7 +20,7 @@ fsdem_pic_desc fsdem_pic_desc_default(int dim) {
     d.flip_ratio = (fsdem_real)0.97;
     d.kernel = FSDEM_PIC_KERNEL_LINEAR;
     d.particles_per_cell = dim == 3 ? 8 : 4;
-    d.jitter = (fsdem_real)0.5;
+    d.jitter = 0;
     d.seed = 1;
     d.min_particles_per_cell = d.particles_per_cell / 2;
     d.max_particles_per_cell = 3 * d.particles_per_cell;

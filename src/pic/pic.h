@@ -76,7 +76,10 @@ typedef struct fsdem_pic_desc {
     fsdem_pic_kernel kernel;          /* default FSDEM_PIC_KERNEL_LINEAR */
     int particles_per_cell;           /* seeding density; default 4 (2D) / 8 (3D) */
     fsdem_real jitter;                /* -; random displacement of seeds as a fraction of their */
-                                      /*    spacing, in [0, 1]; default 0.5 */
+                                      /*    spacing, in [0, 1]; default 0: seeds on the sub-cell */
+                                      /*    lattice, a flat surface, still water at rest (jittered, */
+                                      /*    the surface is rough at the scale of a cell and relaxes */
+                                      /*    in waves of cm/s: validation/pic_hydrostatic) */
     unsigned seed;                    /* random seed of jitter and reseeding; default 1 */
     int min_particles_per_cell;       /* reseeding moves particles from crowded neighbour cells into */
                                       /*    interior fluid cells with fewer (volume-neutral); */

@@ -111,8 +111,8 @@ int main(int argc, char **argv) {
         vc_check(CASE, metric, o.u_max, 0, 1e-3);
         snprintf(metric, sizeof metric, "%s_volume_drift", tag);
         vc_check(CASE, metric, o.drift, 0, 1e-3);
-        /* the default seeding jitters the particles: the reconstructed surface is then rough at the
-           scale of a cell and relaxes as small waves; reported, not checked */
+        /* seeds jittered by half their spacing (the default until issue 38; now 0): the reconstructed
+           surface is then rough at the scale of a cell and relaxes as small waves; reported, not checked */
         oj = run(dim, dim == 2 ? 0.02 : 0.04, 0.5, dim == 2 ? "2d_jitter" : "3d_jitter");
         vc_info(CASE, "%s with jittered seeding (jitter 0.5): pressure error %.4f of rho g h, speed %.3g m/s, volume drift %.2e",
                 tag, oj.p_err, oj.u_max, oj.drift);
