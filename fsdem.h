@@ -3189,8 +3189,13 @@ FSDEM_API fsdem_coupler *fsdem_pic_dem_coupler(fsdem_pic_dem *coupler);
         outside the grid folded into the boundary cell (so sum alpha_s dx^dim = sum V_i exactly),
         capped at desc.max_solid_fraction (§5.1: 0.740 in 3D, 0.907 in 2D); alpha_f' = 1 - alpha_s
         becomes the PIC's porosity (fsdem_pic_coupling.porosity);
-     4. one PIC step of dt: the variable-coefficient velocity projection div(alpha_f' u) = 0
-        (Eq. 11/12a) after the exchanged accelerations, and after advection the density projection
+     4. one PIC step of dt: the variable-coefficient velocity projection (Eq. 11/12a) after the
+        exchanged accelerations, div(alpha_f' u) = 0 as the seed prints it or, with
+        desc.displacement_flow (the default), the mixture's continuity
+        div(alpha_f' u) = -(alpha_f'(new) - alpha_f'(old)) / dt (the porosities of step 3 and of
+        the step before), so that the water's velocity carries the volume the granules leave and
+        take (a settling grain's return flow: the momentum of grain and water is then
+        (rho_s - rho_f) V w, not rho_s V w); and after advection the density projection
         towards alpha_f' (Eq. 12b-13, the ratio clamped to [0.5, 1.5], moves within a cell), which
         pushes water out of the space the sand took and lets it into the space the sand left.
    The granule forces of a substep use the fluid of the last step (§5.2); before the PIC's first
@@ -3206,8 +3211,7 @@ FSDEM_API fsdem_coupler *fsdem_pic_dem_coupler(fsdem_pic_dem *coupler);
    Ownership: the coupler claims the PIC's porosity and its accelerations (it zeroes them at the start
    of every step, fsdem_pic_clear_forces) and the DEM's external forces (>>couple); a resolved
    PIC-DEM on the same PIC, with its own DEM, steps with it (fsdem_coupled_step).
-   Not built yet: the concentration-gradient and capillary forces (Eq. 21-31), wetting (Eq. 19-20),
-   the granules' flux in the velocity projection. The
+   Not built yet: the concentration-gradient and capillary forces (Eq. 21-31), wetting (Eq. 19-20). The
    viscous stress of Eq. 3 is the PIC's nu lap(u), not div(alpha_f T). */
 
 typedef struct fsdem_gic fsdem_gic;
@@ -3236,6 +3240,10 @@ typedef struct fsdem_gic_desc {
                                   /*    [0.01, 1]; default 0.5 */
     long long max_substeps;       /* DEM substeps one coupled step may take; a longer step is */
                                   /*    refused before anything moves; default 100000 */
+    int displacement_flow;        /* 1: the velocity projection carries the granules' change of */
+                                  /*    alpha_f' (step 4; written into the PIC's pressure_rhs for */
+                                  /*    its step); 0: Eq. 12a as printed, div(alpha_f' u) = 0; */
+                                  /*    default 1 */
     fsdem_log_fn log;             /* optional; default NULL */
     void *log_user;
 } fsdem_gic_desc;
@@ -19577,7 +19585,10 @@ struct fsdem_gic {
     fsdem_real depth;              /* m; the DEM's disc_length in 2D (the PIC's forces are per metre), 1 in 3D */
     fsdem_real cell_volume;        /* m^dim */
     fsdem_real *solid, *porosity;  /* per cell: alpha_s (Eq. 7a), alpha_f' */
-    fsdem_real *rate;              /* per cell: the water's drag rate (1/s), scratch of the step limit */
+    fsdem_real *rate;              /* per cell scratch: the water's drag rate (1/s) of the step limit, */
+                                   /*    the porosity before the step's update */
+    fsdem_real *held;              /* per cell: the PIC's pressure_rhs before the displacement flow's */
+                                   /*    source, put back after the PIC step */
     /* per granule: sample points, the samples, the force records of the last evaluation */
     fsdem_vec3 *point;
     fsdem_fluid_sample *sample;
@@ -19604,6 +19615,7 @@ fsdem_gic_desc fsdem_gic_desc_default(void) {
     d.max_dt_ratio = 1000;
     d.drag_dt_fraction = (fsdem_real)0.5;
     d.max_substeps = 100000;
+    d.displacement_flow = 1;
     return d;
 }
 
@@ -19616,6 +19628,8 @@ fsdem_result fsdem_gic_desc_check(const fsdem_gic_desc *d, char *msg, size_t siz
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag = %d is not a fsdem_drag_law", (int)d->drag);
     if (d->virtual_mass != 0 && d->virtual_mass != 1)
         return fsdem__reject(msg, size, "fsdem_gic_desc.virtual_mass must be 0 or 1 (got %d)", d->virtual_mass);
+    if (d->displacement_flow != 0 && d->displacement_flow != 1)
+        return fsdem__reject(msg, size, "fsdem_gic_desc.displacement_flow must be 0 or 1 (got %d)", d->displacement_flow);
     if (!(d->drag_scale >= 1e-3 && d->drag_scale <= 1e3))
         return fsdem__reject(msg, size, "fsdem_gic_desc.drag_scale must be in [1e-3, 1e3] (got %g)", (double)d->drag_scale);
     if (!(d->viscosity >= 0) || !fsdem__finite(d->viscosity))
@@ -19668,8 +19682,9 @@ fsdem_result fsdem_gic_create(const fsdem_gic_desc *desc, fsdem_gic **out) {
     c->solid = (fsdem_real *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_real) * cells);
     c->porosity = (fsdem_real *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_real) * cells);
     c->rate = (fsdem_real *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_real) * cells);
-    if (!c->solid || !c->porosity || !c->rate) {
-        fsdem__log_oom(desc->log, desc->log_user, "fsdem_gic_create", 3 * sizeof(fsdem_real) * cells);
+    c->held = (fsdem_real *)fsdem__alloc(&c->head.allocator, sizeof(fsdem_real) * cells);
+    if (!c->solid || !c->porosity || !c->rate || !c->held) {
+        fsdem__log_oom(desc->log, desc->log_user, "fsdem_gic_create", 4 * sizeof(fsdem_real) * cells);
         fsdem_gic_destroy(c);
         return FSDEM_ERR_OUT_OF_MEMORY;
     }
@@ -19690,6 +19705,7 @@ void fsdem_gic_destroy(fsdem_gic *c) {
     fsdem__free(al, c->solid, sizeof(fsdem_real) * cells);
     fsdem__free(al, c->porosity, sizeof(fsdem_real) * cells);
     fsdem__free(al, c->rate, sizeof(fsdem_real) * cells);
+    fsdem__free(al, c->held, sizeof(fsdem_real) * cells);
     fsdem__free(al, c->point, sizeof(fsdem_vec3) * (size_t)c->granule_cap);
     fsdem__free(al, c->sample, sizeof(fsdem_fluid_sample) * (size_t)c->granule_cap);
     fsdem__free(al, c->force, sizeof(fsdem_gic_force) * (size_t)c->granule_cap);
@@ -20026,15 +20042,45 @@ static fsdem_result fsdem__gic_sand(fsdem_coupler *head, fsdem_real dt) {
     return res;
 }
 
-/* Step 3 of >>couple_gic at the sand's new positions. */
+/* Step 3 of >>couple_gic at the sand's new positions; with desc.displacement_flow, the volume the
+   granules moved over the step becomes the source of the water's velocity projection: the
+   mixture's continuity, d alpha_f'/dt + div(alpha_f' u) = 0, asks div(alpha_f' u) =
+   -(alpha_f'(new) - alpha_f'(old)) / dt, which the PIC's pressure_rhs gives as
+   -rho dx^2 (alpha_f'(new) - alpha_f'(old)) / dt^2 (>>pic: after the projection
+   div = dt pressure_rhs / (rho dx^2)). The source sums to 0 over the cells, as the granules' volume
+   is kept; a step in which it changed (granules added or removed, or the first step without
+   fsdem_gic_update) has no earlier fractions to difference and takes none. The PIC's values are
+   held and put back after its step (fsdem__gic_release). */
 static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
-    (void)dt;
-    return fsdem_gic_update((fsdem_gic *)(void *)head);
+    fsdem_gic *c = (fsdem_gic *)(void *)head;
+    const fsdem_real before = c->solid_volume;
+    const size_t cells = sizeof(fsdem_real) * (size_t)c->grid.ncell;
+    fsdem_pic_coupling pc;
+    fsdem_result res;
+    int k;
+    memcpy(c->rate, c->porosity, cells);
+    if ((res = fsdem_gic_update(c)) != FSDEM_OK) return res;
+    pc = fsdem_pic_get_coupling(c->desc.pic);
+    memcpy(c->held, pc.pressure_rhs, cells);
+    if (c->desc.displacement_flow && before > 0 && (fsdem_real)fabs(c->solid_volume - before) <= (fsdem_real)1e-9 * before) {
+        const fsdem_real scale = -c->rho * c->grid.dx * c->grid.dx / (dt * dt);
+        for (k = 0; k < c->grid.ncell; ++k) pc.pressure_rhs[k] += scale * (c->porosity[k] - c->rate[k]);
+    }
+    return FSDEM_OK;
 }
 
-static const fsdem__stage fsdem__gic_stages[3] = {{"sand substeps", FSDEM__CLOCK_DEM, fsdem__gic_sand},
+/* After the PIC step: the PIC's pressure_rhs as it was before the displacement flow's source. */
+static fsdem_result fsdem__gic_release(fsdem_coupler *head, fsdem_real dt) {
+    fsdem_gic *c = (fsdem_gic *)(void *)head;
+    (void)dt;
+    memcpy(fsdem_pic_get_coupling(c->desc.pic).pressure_rhs, c->held, sizeof(fsdem_real) * (size_t)c->grid.ncell);
+    return FSDEM_OK;
+}
+
+static const fsdem__stage fsdem__gic_stages[4] = {{"sand substeps", FSDEM__CLOCK_DEM, fsdem__gic_sand},
                                                   {"fractions", FSDEM__CLOCK_COUPLING, fsdem__gic_fractions},
-                                                  {"PIC step", FSDEM__CLOCK_FLUID, NULL}};
+                                                  {"PIC step", FSDEM__CLOCK_FLUID, NULL},
+                                                  {"release", FSDEM__CLOCK_COUPLING, fsdem__gic_release}};
 
 #define FSDEM__GIC_FIELD(name, kind) FSDEM__FIELD(fsdem_gic_force, name, #name, kind, 0)
 static const fsdem__field fsdem__gic_fields[8] = {
@@ -20045,7 +20091,7 @@ static const fsdem__field fsdem__gic_fields[8] = {
 
 static const fsdem__coupler_class *fsdem__gic_class(void) {
     static const fsdem__coupler_class cls = {"fsdem_gic", &fsdem__fluid_pic, sizeof(fsdem_gic_force), fsdem__gic_fields, 8, NULL,
-        fsdem__gic_limit, fsdem__gic_check, fsdem__gic_stages, 3};
+        fsdem__gic_limit, fsdem__gic_check, fsdem__gic_stages, 4};
     return &cls;
 }
 

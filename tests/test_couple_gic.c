@@ -315,6 +315,49 @@ START_TEST(test_gic_first_step_resolves_the_drag_relaxation) {
 }
 END_TEST
 
+/* The mixture's continuity (desc.displacement_flow): a grain settling in a closed tank swaps its
+   volume with the water's, so the water's momentum is -rho V w exactly (its centre of mass rises as
+   the grain's volume goes down; the tank and the level do not move) and the momentum of grain and
+   water is (rho_s - rho) V w. Measured on the PIC's particles (their FLIP velocities interpolated
+   from the faces, on which the projection makes it exact) after 0.1 s, ten relaxation times of the
+   grain: within 10 % (measured 2D +4.5 %, where the disc covers 3 % of a cell, 3D +0.3 %).
+   With Eq. 12a as printed the water does not carry it (its momentum under 10 % of -rho V w,
+   measured 3 %; the total is then about rho_s V w, 1.64 times the above). */
+START_TEST(test_gic_settling_grain_carries_its_return_flow) {
+    int dim, flow;
+    for (dim = 2; dim <= 3; ++dim)
+        for (flow = 0; flow <= 1; ++flow) {
+            const double rho_s = 2500, r = 1e-3;
+            gic_tank t = make_gic(dim, 0.1, 0.01, 0.08, rho_s);
+            fsdem_gic_desc gd = fsdem_gic_get_desc(t.gic);
+            fsdem_dem_particles P;
+            fsdem_pic_particles W;
+            double V, w, water = 0, ratio;
+            int i;
+            fsdem_gic_destroy(t.gic);
+            gd.displacement_flow = flow;
+            ck_assert_int_eq(fsdem_gic_create(&gd, &t.gic), FSDEM_OK);
+            add_granule(&t, dim == 2 ? fsdem_v3((fsdem_real)0.051, (fsdem_real)0.07, 0) : fsdem_v3((fsdem_real)0.051, (fsdem_real)0.047, (fsdem_real)0.07),
+                        r, 0, fsdem_v3(0, 0, 0));
+            ck_assert_int_eq(fsdem_gic_update(t.gic), FSDEM_OK);
+            ck_assert_int_eq(fsdem_gic_advance(t.gic, (fsdem_real)0.1, NULL), FSDEM_OK);
+            P = fsdem_dem_get_particles(t.dem);
+            W = fsdem_pic_get_particles(t.pic);
+            V = dim == 3 ? 4 * PI / 3 * r * r * r : PI * r * r * (double)fsdem_dem_get_desc(t.dem).disc_length;
+            w = test_up(P.velocity[0], dim);
+            for (i = 0; i < W.count; ++i) water += RHO * (double)W.volume * test_up(W.velocity[i], dim);
+            if (dim == 2) water *= (double)fsdem_dem_get_desc(t.dem).disc_length;
+            ratio = water / (-RHO * V * w);
+            TEST_REPORT("%dD, displacement_flow %d: grain at %.5f m/s; water's momentum %.4g of -rho V w, grain and water %.4f of (rho_s - rho) V w",
+                        dim, flow, w, ratio, ((double)P.mass[0] * w + water) / ((rho_s - RHO) * V * w));
+            ck_assert_msg(w < 0, "%dD: the grain did not settle", dim);
+            if (flow) ck_assert_msg(fabs(ratio - 1) <= 0.1, "%dD: water's momentum %g of -rho V w", dim, ratio);
+            else ck_assert_msg(fabs(ratio) <= 0.1, "%dD: without the displacement flow the water carried %g of -rho V w", dim, ratio);
+            free_gic(&t);
+        }
+}
+END_TEST
+
 /* A saved coupler goes on bit for bit: the granules' and the water's states after three more steps
    from the restored state equal those of the uninterrupted run. */
 START_TEST(test_gic_restart_bit_for_bit) {
@@ -502,7 +545,7 @@ START_TEST(test_gic_bad_input) {
         double value;
     } bad[] = {{"drag_scale", 0, 0}, {"drag_scale", 0, NAN}, {"viscosity", 1, -1}, {"max_solid_fraction", 2, 1},
                {"cfl", 3, 0}, {"max_dt_ratio", 4, 0.5}, {"drag_dt_fraction", 5, 1.5}, {"max_substeps", 6, 0},
-               {"virtual_mass", 7, 2},
+               {"virtual_mass", 7, 2}, {"displacement_flow", 8, -1},
                /* issue 34: accepted at create, the first step then failed with another message (1e-300 is
                   0 in float, which means the default for max_solid_fraction: 1e-30 there) */
                {"drag_scale", 0, 1e300}, {"max_solid_fraction", 2, TEST_FLOAT ? 1e-30 : 1e-300}, {"cfl", 3, 1e-300},
@@ -525,6 +568,7 @@ START_TEST(test_gic_bad_input) {
         case 4: e.max_dt_ratio = (fsdem_real)bad[k].value; break;
         case 5: e.drag_dt_fraction = (fsdem_real)bad[k].value; break;
         case 7: e.virtual_mass = (int)bad[k].value; break;
+        case 8: e.displacement_flow = (int)bad[k].value; break;
         default: e.max_substeps = (long long)bad[k].value; break;
         }
         ck_assert_int_eq(fsdem_gic_create(&e, &g), FSDEM_ERR_INVALID_ARG);
@@ -608,6 +652,7 @@ Suite *couple_gic_suite(void) {
     tcase_add_test(tc, test_gic_momentum_exchange_exact);
     tcase_add_test(tc, test_gic_virtual_mass_inertia);
     tcase_add_test(tc, test_gic_first_step_resolves_the_drag_relaxation);
+    tcase_add_test(tc, test_gic_settling_grain_carries_its_return_flow);
     tcase_add_test(tc, test_gic_restart_bit_for_bit);
     tcase_add_test(tc, test_gic_bad_input);
     tcase_add_test(tc, test_gic_refused_step_changes_nothing);

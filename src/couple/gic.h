@@ -40,8 +40,13 @@
         outside the grid folded into the boundary cell (so sum alpha_s dx^dim = sum V_i exactly),
         capped at desc.max_solid_fraction (§5.1: 0.740 in 3D, 0.907 in 2D); alpha_f' = 1 - alpha_s
         becomes the PIC's porosity (fsdem_pic_coupling.porosity);
-     4. one PIC step of dt: the variable-coefficient velocity projection div(alpha_f' u) = 0
-        (Eq. 11/12a) after the exchanged accelerations, and after advection the density projection
+     4. one PIC step of dt: the variable-coefficient velocity projection (Eq. 11/12a) after the
+        exchanged accelerations, div(alpha_f' u) = 0 as the seed prints it or, with
+        desc.displacement_flow (the default), the mixture's continuity
+        div(alpha_f' u) = -(alpha_f'(new) - alpha_f'(old)) / dt (the porosities of step 3 and of
+        the step before), so that the water's velocity carries the volume the granules leave and
+        take (a settling grain's return flow: the momentum of grain and water is then
+        (rho_s - rho_f) V w, not rho_s V w); and after advection the density projection
         towards alpha_f' (Eq. 12b-13, the ratio clamped to [0.5, 1.5], moves within a cell), which
         pushes water out of the space the sand took and lets it into the space the sand left.
    The granule forces of a substep use the fluid of the last step (§5.2); before the PIC's first
@@ -57,8 +62,7 @@
    Ownership: the coupler claims the PIC's porosity and its accelerations (it zeroes them at the start
    of every step, fsdem_pic_clear_forces) and the DEM's external forces (>>couple); a resolved
    PIC-DEM on the same PIC, with its own DEM, steps with it (fsdem_coupled_step).
-   Not built yet: the concentration-gradient and capillary forces (Eq. 21-31), wetting (Eq. 19-20),
-   the granules' flux in the velocity projection. The
+   Not built yet: the concentration-gradient and capillary forces (Eq. 21-31), wetting (Eq. 19-20). The
    viscous stress of Eq. 3 is the PIC's nu lap(u), not div(alpha_f T). */
 
 typedef struct fsdem_gic fsdem_gic;
@@ -87,6 +91,10 @@ typedef struct fsdem_gic_desc {
                                   /*    [0.01, 1]; default 0.5 */
     long long max_substeps;       /* DEM substeps one coupled step may take; a longer step is */
                                   /*    refused before anything moves; default 100000 */
+    int displacement_flow;        /* 1: the velocity projection carries the granules' change of */
+                                  /*    alpha_f' (step 4; written into the PIC's pressure_rhs for */
+                                  /*    its step); 0: Eq. 12a as printed, div(alpha_f' u) = 0; */
+                                  /*    default 1 */
     fsdem_log_fn log;             /* optional; default NULL */
     void *log_user;
 } fsdem_gic_desc;
