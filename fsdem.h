@@ -3191,11 +3191,12 @@ FSDEM_API fsdem_coupler *fsdem_pic_dem_coupler(fsdem_pic_dem *coupler);
         becomes the PIC's porosity (fsdem_pic_coupling.porosity);
      4. one PIC step of dt: the variable-coefficient velocity projection (Eq. 11/12a) after the
         exchanged accelerations, div(alpha_f' u) = 0 as the seed prints it or, with
-        desc.displacement_flow (the default), the mixture's continuity
-        div(alpha_f' u) = -(alpha_f'(new) - alpha_f'(old)) / dt (the porosities of step 3 and of
-        the step before), so that the water's velocity carries the volume the granules leave and
-        take (a settling grain's return flow: the momentum of grain and water is then
-        (rho_s - rho_f) V w, not rho_s V w); and after advection the density projection
+        desc.displacement_flow, the mixture's continuity
+        div(alpha_f' u) = -l (alpha_f'(new) - alpha_f'(old)) / dt (the porosities of step 3 and
+        of the step before, l the cell's liquid fraction), so that the water's velocity carries
+        the volume the granules leave and take (a settling grain's return flow: the momentum of
+        grain and water is then (rho_s - rho_f) V w, not rho_s V w); and after advection the
+        density projection
         towards alpha_f' (Eq. 12b-13, the ratio clamped to [0.5, 1.5], moves within a cell), which
         pushes water out of the space the sand took and lets it into the space the sand left.
    The granule forces of a substep use the fluid of the last step (§5.2); before the PIC's first
@@ -3204,7 +3205,8 @@ FSDEM_API fsdem_coupler *fsdem_pic_dem_coupler(fsdem_pic_dem *coupler);
    (1000 in the seed), and at most desc.drag_dt_fraction of the shortest drag relaxation time of a
    granule, m_i / (s c V_i), or of the water round it, alpha_f rho / (alpha_s s c), since the
    exchange is explicit for the water: c at the granule's slip against the water of the last step
-   plus what its present acceleration (contacts, loads and gravity) adds within the step, for the
+   plus what its present acceleration (loads and gravity, for a granule without contacts) adds
+   within the step, for the
    granules in the water and those that reach it within the step (against water at rest); a
    granule released from rest, whose drag of Eq. 5b is 0 at zero slip, is so limited from the first
    step on.
@@ -3242,8 +3244,10 @@ typedef struct fsdem_gic_desc {
                                   /*    refused before anything moves; default 100000 */
     int displacement_flow;        /* 1: the velocity projection carries the granules' change of */
                                   /*    alpha_f' (step 4; written into the PIC's pressure_rhs for */
-                                  /*    its step); 0: Eq. 12a as printed, div(alpha_f' u) = 0; */
-                                  /*    default 1 */
+                                  /*    its step); default 0: Eq. 12a as printed, */
+                                  /*    div(alpha_f' u) = 0 (with 1, the dense ball of */
+                                  /*    validation/gic_volume diverges as it enters the water; a */
+                                  /*    settling grain takes it: tests/test_couple_gic.c) */
     fsdem_log_fn log;             /* optional; default NULL */
     void *log_user;
 } fsdem_gic_desc;
@@ -19615,7 +19619,6 @@ fsdem_gic_desc fsdem_gic_desc_default(void) {
     d.max_dt_ratio = 1000;
     d.drag_dt_fraction = (fsdem_real)0.5;
     d.max_substeps = 100000;
-    d.displacement_flow = 1;
     return d;
 }
 
@@ -19932,11 +19935,13 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
    water's in each cell, rho alpha_f' dx^dim / sum_i s c_i V_i N_i over the granules' kernel
    weights there (the rate at which their drag relaxes it: the cell's share of the exchange over
    its water's mass, with the capped porosity and overlapping granules as they are). c is taken at
-   the slip the granule reaches within the horizon at its present acceleration,
-   |u - v_i| + horizon |(F_c + F_ext) / m_i + g| (the drag's growth only slows it): a law whose
-   drag vanishes at zero slip (Eq. 5b) gave a granule released from rest no limit, and the first
-   step ran two relaxation times; a granule resting on a bed or falling at its terminal speed has
-   no acceleration and keeps its slip. */
+   the slip a granule without contacts reaches within the horizon at its present acceleration,
+   |u - v_i| + horizon |F_ext / m_i + g| (the drag's growth only slows it): a law whose drag
+   vanishes at zero slip (Eq. 5b) gave a granule released from rest no limit, and the first step
+   ran two relaxation times; one falling at its terminal speed has no acceleration and keeps its
+   slip. A granule in contact keeps its slip too: the contacts carry its weight in a bed, and their
+   forces swing from substep to substep without building up a slip (with them in the acceleration,
+   gic_volume's resting ball took 8 times the steps). */
 static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     const fsdem_vec3 g = fsdem_dem_get_desc(c->desc.dem).gravity;
@@ -19946,8 +19951,9 @@ static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
     for (i = 0; i < P.count; ++i) {
         fsdem_fluid_sample here, ahead;
         const fsdem_vec3 x = P.position[i], y = fsdem__madd(x, P.velocity[i], horizon);
-        const fsdem_vec3 load = P.external_force ? fsdem__add(P.force[i], P.external_force[i]) : P.force[i];
-        const fsdem_real volume = fsdem__gic_volume(c, P.radius[i]), gain = horizon * fsdem__norm(fsdem__madd(g, load, 1 / P.mass[i]));
+        const int alone = P.force[i].x == 0 && P.force[i].y == 0 && P.force[i].z == 0; /* no contact */
+        const fsdem_vec3 load = P.external_force ? P.external_force[i] : fsdem__zero3();
+        const fsdem_real volume = fsdem__gic_volume(c, P.radius[i]), gain = alone ? horizon * fsdem__norm(fsdem__madd(g, load, 1 / P.mass[i])) : 0;
         fsdem_real cv = 0, t, slip;
         fsdem__kernel kw;
         if (P.fixed[i] || fsdem_pic_sample(c->desc.pic, 1, &x, &here) != FSDEM_OK || fsdem_pic_sample(c->desc.pic, 1, &y, &ahead) != FSDEM_OK)
@@ -20047,10 +20053,11 @@ static fsdem_result fsdem__gic_sand(fsdem_coupler *head, fsdem_real dt) {
    mixture's continuity, d alpha_f'/dt + div(alpha_f' u) = 0, asks div(alpha_f' u) =
    -(alpha_f'(new) - alpha_f'(old)) / dt, which the PIC's pressure_rhs gives as
    -rho dx^2 (alpha_f'(new) - alpha_f'(old)) / dt^2 (>>pic: after the projection
-   div = dt pressure_rhs / (rho dx^2)). The source sums to 0 over the cells, as the granules' volume
-   is kept; a step in which it changed (granules added or removed, or the first step without
-   fsdem_gic_update) has no earlier fractions to difference and takes none. The PIC's values are
-   held and put back after its step (fsdem__gic_release). */
+   div = dt pressure_rhs / (rho dx^2)), times the cell's liquid fraction (in a cell the surface
+   cuts, the granules displace air too). In the liquid the source sums to 0 over the cells, as the
+   granules' volume is kept; a step in which that volume changed (granules added or removed, or the
+   first step without fsdem_gic_update) has no earlier fractions to difference and takes none. The
+   PIC's values are held and put back after its step (fsdem__gic_release). */
 static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
     fsdem_gic *c = (fsdem_gic *)(void *)head;
     const fsdem_real before = c->solid_volume;
@@ -20064,7 +20071,8 @@ static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
     memcpy(c->held, pc.pressure_rhs, cells);
     if (c->desc.displacement_flow && before > 0 && (fsdem_real)fabs(c->solid_volume - before) <= (fsdem_real)1e-9 * before) {
         const fsdem_real scale = -c->rho * c->grid.dx * c->grid.dx / (dt * dt);
-        for (k = 0; k < c->grid.ncell; ++k) pc.pressure_rhs[k] += scale * (c->porosity[k] - c->rate[k]);
+        const fsdem_real *wet = fsdem_pic_get_fields(c->desc.pic).fraction;
+        for (k = 0; k < c->grid.ncell; ++k) pc.pressure_rhs[k] += scale * (wet[k] < 1 ? wet[k] : 1) * (c->porosity[k] - c->rate[k]);
     }
     return FSDEM_OK;
 }

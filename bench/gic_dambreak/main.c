@@ -12,7 +12,7 @@
    x = 0.28 m, granules of radius 4 mm on a cubic lattice of spacing 2.1 r (3,990 granules, 1/55 of
    Table 1's), seed 004's contact law and material (E = 1e6 Pa, 2500 kg/m^3, friction 0.5) at the
    DEM's stable step, and the library's defaults otherwise (quadratic drag Eq. 5b, density
-   projection, displacement flow). The fluid steps are the coupler's stable ones to t_end.
+   projection). The fluid steps are the coupler's stable ones to t_end.
    Figures (CPU seconds from the solvers' statistics, clock(); wall_s elapsed):
      s_per_step        wall seconds per coupled (fluid) step
      water_particles   PIC particles at the end

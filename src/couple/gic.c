@@ -54,7 +54,6 @@ fsdem_gic_desc fsdem_gic_desc_default(void) {
     d.max_dt_ratio = 1000;
     d.drag_dt_fraction = (fsdem_real)0.5;
     d.max_substeps = 100000;
-    d.displacement_flow = 1;
     return d;
 }
 
@@ -371,11 +370,13 @@ static fsdem_result fsdem__gic_evaluate(void *user, fsdem_dem *dem, double time)
    water's in each cell, rho alpha_f' dx^dim / sum_i s c_i V_i N_i over the granules' kernel
    weights there (the rate at which their drag relaxes it: the cell's share of the exchange over
    its water's mass, with the capped porosity and overlapping granules as they are). c is taken at
-   the slip the granule reaches within the horizon at its present acceleration,
-   |u - v_i| + horizon |(F_c + F_ext) / m_i + g| (the drag's growth only slows it): a law whose
-   drag vanishes at zero slip (Eq. 5b) gave a granule released from rest no limit, and the first
-   step ran two relaxation times; a granule resting on a bed or falling at its terminal speed has
-   no acceleration and keeps its slip. */
+   the slip a granule without contacts reaches within the horizon at its present acceleration,
+   |u - v_i| + horizon |F_ext / m_i + g| (the drag's growth only slows it): a law whose drag
+   vanishes at zero slip (Eq. 5b) gave a granule released from rest no limit, and the first step
+   ran two relaxation times; one falling at its terminal speed has no acceleration and keeps its
+   slip. A granule in contact keeps its slip too: the contacts carry its weight in a bed, and their
+   forces swing from substep to substep without building up a slip (with them in the acceleration,
+   gic_volume's resting ball took 8 times the steps). */
 static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
     const fsdem_dem_particles P = fsdem_dem_get_particles(c->desc.dem);
     const fsdem_vec3 g = fsdem_dem_get_desc(c->desc.dem).gravity;
@@ -385,8 +386,9 @@ static fsdem_real fsdem__gic_drag_time(const fsdem_gic *c, fsdem_real horizon) {
     for (i = 0; i < P.count; ++i) {
         fsdem_fluid_sample here, ahead;
         const fsdem_vec3 x = P.position[i], y = fsdem__madd(x, P.velocity[i], horizon);
-        const fsdem_vec3 load = P.external_force ? fsdem__add(P.force[i], P.external_force[i]) : P.force[i];
-        const fsdem_real volume = fsdem__gic_volume(c, P.radius[i]), gain = horizon * fsdem__norm(fsdem__madd(g, load, 1 / P.mass[i]));
+        const int alone = P.force[i].x == 0 && P.force[i].y == 0 && P.force[i].z == 0; /* no contact */
+        const fsdem_vec3 load = P.external_force ? P.external_force[i] : fsdem__zero3();
+        const fsdem_real volume = fsdem__gic_volume(c, P.radius[i]), gain = alone ? horizon * fsdem__norm(fsdem__madd(g, load, 1 / P.mass[i])) : 0;
         fsdem_real cv = 0, t, slip;
         fsdem__kernel kw;
         if (P.fixed[i] || fsdem_pic_sample(c->desc.pic, 1, &x, &here) != FSDEM_OK || fsdem_pic_sample(c->desc.pic, 1, &y, &ahead) != FSDEM_OK)
@@ -486,10 +488,11 @@ static fsdem_result fsdem__gic_sand(fsdem_coupler *head, fsdem_real dt) {
    mixture's continuity, d alpha_f'/dt + div(alpha_f' u) = 0, asks div(alpha_f' u) =
    -(alpha_f'(new) - alpha_f'(old)) / dt, which the PIC's pressure_rhs gives as
    -rho dx^2 (alpha_f'(new) - alpha_f'(old)) / dt^2 (>>pic: after the projection
-   div = dt pressure_rhs / (rho dx^2)). The source sums to 0 over the cells, as the granules' volume
-   is kept; a step in which it changed (granules added or removed, or the first step without
-   fsdem_gic_update) has no earlier fractions to difference and takes none. The PIC's values are
-   held and put back after its step (fsdem__gic_release). */
+   div = dt pressure_rhs / (rho dx^2)), times the cell's liquid fraction (in a cell the surface
+   cuts, the granules displace air too). In the liquid the source sums to 0 over the cells, as the
+   granules' volume is kept; a step in which that volume changed (granules added or removed, or the
+   first step without fsdem_gic_update) has no earlier fractions to difference and takes none. The
+   PIC's values are held and put back after its step (fsdem__gic_release). */
 static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
     fsdem_gic *c = (fsdem_gic *)(void *)head;
     const fsdem_real before = c->solid_volume;
@@ -503,7 +506,8 @@ static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
     memcpy(c->held, pc.pressure_rhs, cells);
     if (c->desc.displacement_flow && before > 0 && (fsdem_real)fabs(c->solid_volume - before) <= (fsdem_real)1e-9 * before) {
         const fsdem_real scale = -c->rho * c->grid.dx * c->grid.dx / (dt * dt);
-        for (k = 0; k < c->grid.ncell; ++k) pc.pressure_rhs[k] += scale * (c->porosity[k] - c->rate[k]);
+        const fsdem_real *wet = fsdem_pic_get_fields(c->desc.pic).fraction;
+        for (k = 0; k < c->grid.ncell; ++k) pc.pressure_rhs[k] += scale * (wet[k] < 1 ? wet[k] : 1) * (c->porosity[k] - c->rate[k]);
     }
     return FSDEM_OK;
 }

@@ -42,11 +42,12 @@
         becomes the PIC's porosity (fsdem_pic_coupling.porosity);
      4. one PIC step of dt: the variable-coefficient velocity projection (Eq. 11/12a) after the
         exchanged accelerations, div(alpha_f' u) = 0 as the seed prints it or, with
-        desc.displacement_flow (the default), the mixture's continuity
-        div(alpha_f' u) = -(alpha_f'(new) - alpha_f'(old)) / dt (the porosities of step 3 and of
-        the step before), so that the water's velocity carries the volume the granules leave and
-        take (a settling grain's return flow: the momentum of grain and water is then
-        (rho_s - rho_f) V w, not rho_s V w); and after advection the density projection
+        desc.displacement_flow, the mixture's continuity
+        div(alpha_f' u) = -l (alpha_f'(new) - alpha_f'(old)) / dt (the porosities of step 3 and
+        of the step before, l the cell's liquid fraction), so that the water's velocity carries
+        the volume the granules leave and take (a settling grain's return flow: the momentum of
+        grain and water is then (rho_s - rho_f) V w, not rho_s V w); and after advection the
+        density projection
         towards alpha_f' (Eq. 12b-13, the ratio clamped to [0.5, 1.5], moves within a cell), which
         pushes water out of the space the sand took and lets it into the space the sand left.
    The granule forces of a substep use the fluid of the last step (§5.2); before the PIC's first
@@ -55,7 +56,8 @@
    (1000 in the seed), and at most desc.drag_dt_fraction of the shortest drag relaxation time of a
    granule, m_i / (s c V_i), or of the water round it, alpha_f rho / (alpha_s s c), since the
    exchange is explicit for the water: c at the granule's slip against the water of the last step
-   plus what its present acceleration (contacts, loads and gravity) adds within the step, for the
+   plus what its present acceleration (loads and gravity, for a granule without contacts) adds
+   within the step, for the
    granules in the water and those that reach it within the step (against water at rest); a
    granule released from rest, whose drag of Eq. 5b is 0 at zero slip, is so limited from the first
    step on.
@@ -93,8 +95,10 @@ typedef struct fsdem_gic_desc {
                                   /*    refused before anything moves; default 100000 */
     int displacement_flow;        /* 1: the velocity projection carries the granules' change of */
                                   /*    alpha_f' (step 4; written into the PIC's pressure_rhs for */
-                                  /*    its step); 0: Eq. 12a as printed, div(alpha_f' u) = 0; */
-                                  /*    default 1 */
+                                  /*    its step); default 0: Eq. 12a as printed, */
+                                  /*    div(alpha_f' u) = 0 (with 1, the dense ball of */
+                                  /*    validation/gic_volume diverges as it enters the water; a */
+                                  /*    settling grain takes it: tests/test_couple_gic.c) */
     fsdem_log_fn log;             /* optional; default NULL */
     void *log_user;
 } fsdem_gic_desc;
