@@ -19593,6 +19593,8 @@ struct fsdem_gic {
                                    /*    the porosity before the step's update */
     fsdem_real *held;              /* per cell: the PIC's pressure_rhs before the displacement flow's */
                                    /*    source, put back after the PIC step */
+    fsdem_real *pressure_rhs;      /* the PIC's (fsdem_pic_coupling): kept, as asking for the */
+                                   /*    coupling arrays again makes the PIC recount its cells */
     /* per granule: sample points, the samples, the force records of the last evaluation */
     fsdem_vec3 *point;
     fsdem_fluid_sample *sample;
@@ -20068,6 +20070,7 @@ static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
     memcpy(c->rate, c->porosity, cells);
     if ((res = fsdem_gic_update(c)) != FSDEM_OK) return res;
     pc = fsdem_pic_get_coupling(c->desc.pic);
+    c->pressure_rhs = pc.pressure_rhs;
     memcpy(c->held, pc.pressure_rhs, cells);
     if (c->desc.displacement_flow && before > 0 && (fsdem_real)fabs(c->solid_volume - before) <= (fsdem_real)1e-9 * before) {
         const fsdem_real scale = -c->rho * c->grid.dx * c->grid.dx / (dt * dt);
@@ -20081,7 +20084,7 @@ static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
 static fsdem_result fsdem__gic_release(fsdem_coupler *head, fsdem_real dt) {
     fsdem_gic *c = (fsdem_gic *)(void *)head;
     (void)dt;
-    memcpy(fsdem_pic_get_coupling(c->desc.pic).pressure_rhs, c->held, sizeof(fsdem_real) * (size_t)c->grid.ncell);
+    memcpy(c->pressure_rhs, c->held, sizeof(fsdem_real) * (size_t)c->grid.ncell);
     return FSDEM_OK;
 }
 
