@@ -47,9 +47,9 @@
         of the step before, l the cell's liquid fraction), so that the water's velocity carries
         the volume the granules leave and take (a settling grain's return flow: the momentum of
         grain and water is then (rho_s - rho_f) V w, not rho_s V w); and after advection the
-        density projection
-        towards alpha_f' (Eq. 12b-13, the ratio clamped to [0.5, 1.5], moves within a cell), which
-        pushes water out of the space the sand took and lets it into the space the sand left.
+        density projection towards alpha_f' (Eq. 12b-13, the ratio clamped to [0.5, 1.5], moves
+        within a cell), which pushes water out of the space the sand took and lets it into the
+        space the sand left.
    The granule forces of a substep use the fluid of the last step (§5.2); before the PIC's first
    step, which has solved no pressure yet, grad p is that of water at rest, rho_f g. The stable coupled step
    (Eq. 33) is the PIC's, at most desc.cfl dx / max |v_i| and desc.max_dt_ratio times the DEM's dt
@@ -57,15 +57,14 @@
    granule, m_i / (s c V_i), or of the water round it, alpha_f rho / (alpha_s s c), since the
    exchange is explicit for the water: c at the granule's slip against the water of the last step
    plus what its present acceleration (loads and gravity, for a granule without contacts) adds
-   within the step, for the
-   granules in the water and those that reach it within the step (against water at rest); a
-   granule released from rest, whose drag of Eq. 5b is 0 at zero slip, is so limited from the first
-   step on.
+   within the step, for the granules in the water and those that reach it within the step
+   (against water at rest); a granule released from rest, whose drag of Eq. 5b is 0 at zero slip,
+   is so limited from the first step on.
    Ownership: the coupler claims the PIC's porosity and its accelerations (it zeroes them at the start
    of every step, fsdem_pic_clear_forces) and the DEM's external forces (>>couple); a resolved
    PIC-DEM on the same PIC, with its own DEM, steps with it (fsdem_coupled_step).
-   Not built yet: the concentration-gradient and capillary forces (Eq. 21-31), wetting (Eq. 19-20). The
-   viscous stress of Eq. 3 is the PIC's nu lap(u), not div(alpha_f T). */
+   Not built yet: the concentration-gradient and capillary forces (Eq. 21-31), wetting
+   (Eq. 19-20). The viscous stress of Eq. 3 is the PIC's nu lap(u), not div(alpha_f T). */
 
 typedef struct fsdem_gic fsdem_gic;
 
