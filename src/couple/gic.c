@@ -43,6 +43,7 @@ struct fsdem_gic {
     int water_at_rest;             /* the PIC has not stepped: no pressure solved yet */
     fsdem__gic_tally tally, last;  /* of the step under way, of the last step */
     fsdem_real max_solid, solid_volume;
+    double granule_volume;         /* m^3 (m^2 in 2D); sum of V_i at the last update (0: none yet) */
 };
 
 static const fsdem__coupler_class *fsdem__gic_class(void);
@@ -256,6 +257,8 @@ fsdem_result fsdem_gic_update(fsdem_gic *c) {
     }
     c->max_solid = most;
     c->solid_volume = (fsdem_real)(volume * (double)c->cell_volume);
+    for (volume = 0, i = 0; i < P.count; ++i) volume += (double)fsdem__gic_volume(c, P.radius[i]);
+    c->granule_volume = volume;
     return fsdem__ok(&c->head.status);
 }
 
@@ -492,12 +495,13 @@ static fsdem_result fsdem__gic_sand(fsdem_coupler *head, fsdem_real dt) {
    -rho dx^2 (alpha_f'(new) - alpha_f'(old)) / dt^2 (>>pic: after the projection
    div = dt pressure_rhs / (rho dx^2)), times the cell's liquid fraction (in a cell the surface
    cuts, the granules displace air too). In the liquid the source sums to 0 over the cells, as the
-   granules' volume is kept; a step in which that volume changed (granules added or removed, or the
-   first step without fsdem_gic_update) has no earlier fractions to difference and takes none. The
-   PIC's values are held and put back after its step (fsdem__gic_release). */
+   granules' volume is kept; a step in which their volume changed (granules added or removed, or the
+   first step without fsdem_gic_update; the sum of their volumes, not of the cells', which rounds
+   differently as they move) has no earlier fractions to difference and takes none. The PIC's
+   values are held and put back after its step (fsdem__gic_release). */
 static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
     fsdem_gic *c = (fsdem_gic *)(void *)head;
-    const fsdem_real before = c->solid_volume;
+    const double before = c->granule_volume;
     const size_t cells = sizeof(fsdem_real) * (size_t)c->grid.ncell;
     fsdem_pic_coupling pc;
     fsdem_result res;
@@ -507,7 +511,7 @@ static fsdem_result fsdem__gic_fractions(fsdem_coupler *head, fsdem_real dt) {
     pc = fsdem_pic_get_coupling(c->desc.pic);
     c->pressure_rhs = pc.pressure_rhs;
     memcpy(c->held, pc.pressure_rhs, cells);
-    if (c->desc.displacement_flow && before > 0 && (fsdem_real)fabs(c->solid_volume - before) <= (fsdem_real)1e-9 * before) {
+    if (c->desc.displacement_flow && before > 0 && fabs(c->granule_volume - before) <= 1e-9 * before) {
         const fsdem_real scale = -c->rho * c->grid.dx * c->grid.dx / (dt * dt);
         const fsdem_real *wet = fsdem_pic_get_fields(c->desc.pic).fraction;
         for (k = 0; k < c->grid.ncell; ++k) pc.pressure_rhs[k] += scale * (wet[k] < 1 ? wet[k] : 1) * (c->porosity[k] - c->rate[k]);
